@@ -1,0 +1,10 @@
+# Third-party dependencies, all from Debian packages (scripts/setup.sh installs them).
+# Each one is exposed as a namespaced imported target so the rest of the build never sees paths.
+
+find_package(Eigen3 3.3 REQUIRED NO_MODULE)
+include(TorsionBullet)  # Bullet::Bullet, double precision
+
+if(TORSION_BUILD_DEMOS)
+  find_package(CLI11 REQUIRED)
+  find_package(nlohmann_json 3.10 REQUIRED)
+endif()

@@ -1,0 +1,102 @@
+#include "mesh_command.h"
+
+#include <cstdio>
+#include <iostream>
+#include <memory>
+
+#include "../meshgen/mesh_generate_command.h"
+#include "torsion/mesh/mesh_io.h"
+#include "torsion/mesh/mesh_quality.h"
+
+namespace torsion::cli {
+
+namespace {
+
+int g_exit_code = 0;
+
+struct InfoOptions {
+  std::string file;
+  bool refuse_inverted = false;
+};
+
+struct ConvertOptions {
+  std::string input;
+  std::string output;
+  bool refuse_inverted = false;
+};
+
+void printWarnings(const LoadedMesh& loaded) {
+  for (const std::string& w : loaded.warnings) std::cerr << "warning: " << w << "\n";
+}
+
+int runInfo(const InfoOptions& options) {
+  Result<LoadedMesh> loaded = readMesh(options.file, {options.refuse_inverted});
+  if (!loaded) {
+    std::cerr << "error: " << loaded.error().message << "\n";
+    return 1;
+  }
+  printWarnings(loaded.value());
+  const TetMesh& mesh = loaded.value().mesh;
+  const MeshQuality q = measureQuality(mesh, mesh.restPositions());
+  const Eigen::Vector3d lo = mesh.boundsMin(), hi = mesh.boundsMax();
+  std::printf("file              %s\n", options.file.c_str());
+  std::printf("nodes             %d\n", mesh.nodeCount());
+  std::printf("tets              %d\n", mesh.tetCount());
+  std::printf("surface triangles %d\n", mesh.surfaceTriangleCount());
+  std::printf("surface nodes     %zu\n", mesh.surfaceNodes().size());
+  std::printf("volume            %.6g\n", mesh.totalRestVolume());
+  std::printf("bounds min        %.6g %.6g %.6g\n", lo.x(), lo.y(), lo.z());
+  std::printf("bounds max        %.6g %.6g %.6g\n", hi.x(), hi.y(), hi.z());
+  std::printf("dihedral min/max  %.3f / %.3f deg\n", q.min_dihedral_deg, q.max_dihedral_deg);
+  std::printf("aspect max/mean   %.3f / %.3f\n", q.max_aspect_ratio, q.mean_aspect_ratio);
+  std::printf("inverted in file  %d (reoriented)\n", loaded.value().reoriented_tets);
+  return 0;
+}
+
+int runConvert(const ConvertOptions& options) {
+  Result<LoadedMesh> loaded = readMesh(options.input, {options.refuse_inverted});
+  if (!loaded) {
+    std::cerr << "error: " << loaded.error().message << "\n";
+    return 1;
+  }
+  printWarnings(loaded.value());
+  Status written = writeMesh(options.output, loaded.value().mesh);
+  if (!written) {
+    std::cerr << "error: " << written.error().message << "\n";
+    return 1;
+  }
+  std::printf("wrote %s (%d nodes, %d tets)\n", options.output.c_str(),
+              loaded.value().mesh.nodeCount(), loaded.value().mesh.tetCount());
+  return 0;
+}
+
+}  // namespace
+
+int exitCode() { return g_exit_code; }
+void setExitCode(int code) { g_exit_code = code; }
+
+void addMeshCommand(CLI::App& app) {
+  CLI::App* mesh = app.add_subcommand("mesh", "Inspect, convert and generate tetrahedral meshes");
+  mesh->require_subcommand(1);
+
+  auto info = std::make_shared<InfoOptions>();
+  CLI::App* info_cmd =
+      mesh->add_subcommand("info", "Counts, volume, bounds and element quality of a mesh");
+  info_cmd->add_option("file", info->file, "Mesh file (.node/.ele, .msh, .vtk)")->required();
+  info_cmd->add_flag("--refuse-inverted", info->refuse_inverted,
+                     "Fail on inverted tets instead of reorienting them");
+  info_cmd->callback([info] { setExitCode(runInfo(*info)); });
+
+  auto convert = std::make_shared<ConvertOptions>();
+  CLI::App* convert_cmd = mesh->add_subcommand(
+      "convert", "Convert between mesh formats (by extension: .node/.ele, .msh, .vtk)");
+  convert_cmd->add_option("input", convert->input, "Mesh to read")->required();
+  convert_cmd->add_option("output", convert->output, "Mesh to write")->required();
+  convert_cmd->add_flag("--refuse-inverted", convert->refuse_inverted,
+                        "Fail on inverted tets instead of reorienting them");
+  convert_cmd->callback([convert] { setExitCode(runConvert(*convert)); });
+
+  addMeshGenerateCommands(*mesh);
+}
+
+}  // namespace torsion::cli

@@ -1,0 +1,37 @@
+#pragma once
+// Mesh files by name: the format follows the extension.
+//   .node / .ele (or a base name with both beside it)  TetGen
+//   .msh                                                Gmsh 2.2 / 4.1 ASCII
+//   .vtk                                                legacy VTK unstructured grid
+
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "torsion/mesh/mesh_fields.h"
+#include "torsion/mesh/tet_mesh.h"
+#include "torsion/mesh/tet_mesh_builder.h"
+#include "torsion/result.h"
+
+namespace torsion {
+
+enum class MeshFormat { kTetGen, kGmsh, kVtk };
+
+/// The format a path names by its extension, or an Error listing the known extensions.
+Result<MeshFormat> meshFormatOf(const std::filesystem::path& path);
+
+/// Reads, parses and validates. Errors name the file (and line or element) and the fault:
+/// missing or unreadable file, empty file, syntax, geometry.
+Result<LoadedMesh> readMesh(const std::filesystem::path& path, const MeshLoadOptions& options = {});
+
+/// Writes the mesh in the format of the path's extension (for TetGen, both .node and .ele beside
+/// each other). Fields are written only to VTK; other formats ignore them.
+Status writeMesh(const std::filesystem::path& path, const TetMesh& mesh,
+                 const MeshFields& fields = {});
+
+/// Whole file as text, or an Error: "<path>: cannot open: <reason>" / "<path>: file is empty".
+Result<std::string> readTextFile(const std::filesystem::path& path);
+/// Writes text atomically enough for our use (temp + rename), or an Error naming the path.
+Status writeTextFile(const std::filesystem::path& path, const std::string& text);
+
+}  // namespace torsion

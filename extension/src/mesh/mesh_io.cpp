@@ -1,0 +1,134 @@
+#include "torsion/mesh/mesh_io.h"
+
+#include <cerrno>
+#include <cstring>
+#include <fstream>
+#include <sstream>
+
+#include "torsion/mesh/gmsh_format.h"
+#include "torsion/mesh/tetgen_format.h"
+#include "torsion/mesh/vtk_format.h"
+
+namespace torsion {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+std::string lowerExtension(const fs::path& path) {
+  std::string ext = path.extension().string();
+  for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return ext;
+}
+
+// TetGen meshes are two files; any of "name", "name.node", "name.ele" names the pair.
+fs::path tetgenBase(const fs::path& path) {
+  const std::string ext = lowerExtension(path);
+  if (ext == ".node" || ext == ".ele") {
+    fs::path base = path;
+    return base.replace_extension();
+  }
+  return path;
+}
+
+}  // namespace
+
+Result<MeshFormat> meshFormatOf(const fs::path& path) {
+  const std::string ext = lowerExtension(path);
+  if (ext == ".node" || ext == ".ele") return MeshFormat::kTetGen;
+  if (ext == ".msh") return MeshFormat::kGmsh;
+  if (ext == ".vtk") return MeshFormat::kVtk;
+  if (ext.empty()) {
+    fs::path node = path;
+    node += ".node";
+    if (fs::exists(node)) return MeshFormat::kTetGen;
+  }
+  return Error{path.string() + ": unknown mesh format '" + ext +
+               "' (known: .node/.ele for TetGen, .msh for Gmsh 2.2/4.1, .vtk for legacy VTK)"};
+}
+
+Result<std::string> readTextFile(const fs::path& path) {
+  std::error_code ec;
+  if (fs::is_directory(path, ec)) return Error{path.string() + ": cannot open: is a directory"};
+  std::ifstream in(path, std::ios::binary);
+  if (!in) return Error{path.string() + ": cannot open: " + std::strerror(errno)};
+  std::ostringstream text;
+  text << in.rdbuf();
+  if (in.bad()) return Error{path.string() + ": read error: " + std::strerror(errno)};
+  std::string content = std::move(text).str();
+  if (content.find_first_not_of(" \t\r\n") == std::string::npos) {
+    return Error{path.string() + ": file is empty"};
+  }
+  return content;
+}
+
+Status writeTextFile(const fs::path& path, const std::string& text) {
+  fs::path temp = path;
+  temp += ".partial";
+  {
+    std::ofstream out(temp, std::ios::binary | std::ios::trunc);
+    if (!out) return Error{path.string() + ": cannot write: " + std::strerror(errno)};
+    out << text;
+    out.flush();
+    if (!out) return Error{path.string() + ": write failed: " + std::strerror(errno)};
+  }
+  std::error_code ec;
+  fs::rename(temp, path, ec);
+  if (ec) return Error{path.string() + ": cannot write: " + ec.message()};
+  return Ok{};
+}
+
+Result<LoadedMesh> readMesh(const fs::path& path, const MeshLoadOptions& options) {
+  Result<MeshFormat> format = meshFormatOf(path);
+  if (!format) return format.error();
+
+  Result<RawTetMesh> raw = Error{};
+  switch (format.value()) {
+    case MeshFormat::kTetGen: {
+      const fs::path base = tetgenBase(path);
+      fs::path node_path = base, ele_path = base;
+      node_path += ".node";
+      ele_path += ".ele";
+      Result<std::string> node_text = readTextFile(node_path);
+      if (!node_text) return node_text.error();
+      Result<std::string> ele_text = readTextFile(ele_path);
+      if (!ele_text) return ele_text.error();
+      raw = parseTetGen(node_text.value(), node_path.string(), ele_text.value(), ele_path.string());
+      break;
+    }
+    case MeshFormat::kGmsh:
+    case MeshFormat::kVtk: {
+      Result<std::string> text = readTextFile(path);
+      if (!text) return text.error();
+      raw = format.value() == MeshFormat::kGmsh ? parseGmsh(text.value(), path.string())
+                                                : parseVtk(text.value(), path.string());
+      break;
+    }
+  }
+  if (!raw) return raw.error();
+  return buildTetMesh(std::move(raw).value(), options);
+}
+
+Status writeMesh(const fs::path& path, const TetMesh& mesh, const MeshFields& fields) {
+  Result<MeshFormat> format = meshFormatOf(path);
+  if (!format) return format.error();
+  switch (format.value()) {
+    case MeshFormat::kTetGen: {
+      const fs::path base = tetgenBase(path);
+      fs::path node_path = base, ele_path = base;
+      node_path += ".node";
+      ele_path += ".ele";
+      const TetGenText text = formatTetGen(mesh);
+      Status node_written = writeTextFile(node_path, text.node);
+      if (!node_written) return node_written;
+      return writeTextFile(ele_path, text.ele);
+    }
+    case MeshFormat::kGmsh:
+      return writeTextFile(path, formatGmsh41(mesh));
+    case MeshFormat::kVtk:
+      return writeTextFile(path, formatVtk(mesh, mesh.restPositions(), fields));
+  }
+  return Error{path.string() + ": unsupported format"};
+}
+
+}  // namespace torsion
