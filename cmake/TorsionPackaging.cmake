@@ -20,4 +20,5 @@ install(FILES
   "${PROJECT_BINARY_DIR}/TorsionConfig.cmake"
   "${PROJECT_BINARY_DIR}/TorsionConfigVersion.cmake"
   "${PROJECT_SOURCE_DIR}/cmake/TorsionBullet.cmake"
+  "${PROJECT_SOURCE_DIR}/cmake/TorsionCholmod.cmake"
   DESTINATION "${TORSION_CMAKE_INSTALL_DIR}")

@@ -1,9 +1,14 @@
 #pragma once
 // Gmsh .msh ASCII, versions 2.2 and 4.1 (https://gmsh.info/doc/texinfo/gmsh.html#MSH-file-format).
-// Tets are element type 4; other element types are skipped (and counted in RawTetMesh::notes).
+// Tets are element type 4; other element types (points, lines, triangles, quadrangles, prisms,
+// ...) are skipped and counted in RawTetMesh::notes; higher-order tets (types 11, 29-31) are
+// skipped with a note that they are not supported. A file with no type-4 tet is an error.
 // Node tags may be non-sequential and sparse; they are renumbered densely in order of appearance.
-// Binary files, other versions and unknown sections before $Nodes are errors or skipped as
-// documented in the implementation.
+// Sections other than $MeshFormat, $Nodes and $Elements ($PhysicalNames, $Entities, $NodeData,
+// ...) are skipped up to their $End line. Refused: versions other than 2.2 and 4.1, binary files
+// (file-type 1), data-size other than 8, MSH 1 files ($NOD/$ELM), and any malformed content
+// (counts that do not match, truncated or non-numeric fields, unknown or duplicate node tags).
+// Errors read "file:line: fault".
 
 #include <string>
 #include <string_view>

@@ -1,0 +1,27 @@
+#pragma once
+// The rotation of a deformation gradient F = R S (polar decomposition), robust to inversion.
+//
+// Fast path: Mueller, Bender, Chentanez, Macklin, "A Robust Method to Extract the Rotational Part
+// of Deformations", MIG 2016. It maximises tr(R^T F) over rotations by a few quaternion updates,
+// warm-started from the previous step's rotation, so it usually converges in 1-3 iterations and
+// always returns a proper rotation.
+// Inverted or flat tets (det F <= 0) take the SVD path of Irving, Teran, Fedkiw, "Invertible
+// Finite Elements for Robust Simulation of Large Deformation", SCA 2004: F = U Sigma V^T with the
+// signs fixed so U and V are rotations (the smallest singular value takes the negative sign).
+// R = U V^T then makes the corotated strain compressive along the inverted direction, and the
+// elastic force pushes the tet back to positive volume.
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+
+namespace torsion {
+
+/// Rotation of F, warm-started and updated in place through `q` (unit quaternion).
+/// Returns the rotation matrix. max_iterations bounds the fast path.
+Eigen::Matrix3d extractRotation(const Eigen::Matrix3d& F, Eigen::Quaterniond& q,
+                                int max_iterations = 20);
+
+/// The SVD path alone (Irving et al. 2004), for tests and inverted tets.
+Eigen::Matrix3d rotationBySvd(const Eigen::Matrix3d& F);
+
+}  // namespace torsion

@@ -1,0 +1,92 @@
+#pragma once
+// One linearised backward-Euler step of one FEM body (Baraff & Witkin 1998; the report's
+// integrator), as named stages:
+//
+//   1. kRotations      F = Ds Bm and its rotation R per tet (warm-started polar decomposition)
+//   2. kElasticForces  f(x) = -Re Ke (Re^T x - X) gathered per node; elastic energy
+//   3. kRightHandSide  b = M v + dt (f(x) + f_ext)
+//   4. kSolve          (M (1 + dt alpha) + (dt^2 + dt beta) K) v' = b, prescribed components of v'
+//                      imposed (projection), free ones solved by CG or CHOLMOD
+//   5. kIntegrate      x' = x + dt v'   (constrained nodes land exactly on their targets)
+//   6. kHealth         non-finite values, speeds beyond SolverSettings::max_speed, solver trouble
+//
+// Internal forces at the end of the step (what the body exerts on whatever holds its nodes) are
+// available afterwards, linearised: f_int = f(x) - (dt + beta) K v'.
+
+#include <Eigen/Core>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "torsion/fem/fem_model.h"
+#include "torsion/solve/fem_state.h"
+#include "torsion/solve/node_constraints.h"
+#include "torsion/solve/parallel.h"
+#include "torsion/solve/projected_cg.h"
+#include "torsion/solve/solver_settings.h"
+#include "torsion/solve/system_operator.h"
+
+namespace torsion {
+
+class CholmodSolver;
+
+enum class StepHealth {
+  kOk,
+  kSolverNotConverged,  ///< CG hit its cap above tolerance: the step is usable but inaccurate
+  kNonFinite,           ///< NaN or inf in positions or velocities: the state is unusable
+  kBlowUp,              ///< a node moves faster than max_speed: unstable
+};
+const char* toString(StepHealth health);
+inline bool isFatal(StepHealth h) { return h == StepHealth::kNonFinite || h == StepHealth::kBlowUp; }
+
+struct StepReport {
+  LinearSolveReport solve;
+  double elastic_energy = 0;  ///< J, at the start of the step
+  double kinetic_energy = 0;  ///< J, at the end of the step
+  double max_speed = 0;       ///< m/s, at the end of the step
+  StepHealth health = StepHealth::kOk;
+  std::string message;        ///< what went wrong, for the user
+};
+
+class ImplicitStepper {
+ public:
+  ImplicitStepper(std::shared_ptr<const FemModel> model, const SolverSettings& settings,
+                  const Parallel& parallel);
+  ~ImplicitStepper();
+  ImplicitStepper(const ImplicitStepper&) = delete;
+  ImplicitStepper& operator=(const ImplicitStepper&) = delete;
+
+  /// Advances `state` by one step. external_forces: 3n, N (e.g. m g per node).
+  /// Non-finite forces are caught before the state is touched; on any fatal report callers stop
+  /// and report instead of writing the state out.
+  StepReport step(FemState& state, const NodeConstraints& constraints,
+                  const Eigen::VectorXd& external_forces);
+
+  /// Elastic + stiffness-damping forces on each node at the end of the last step, 3n, N.
+  const Eigen::VectorXd& internalForces();
+  /// Elastic forces f(x) at the start of the last step, 3n, N.
+  const Eigen::VectorXd& elasticForces() const { return elastic_forces_; }
+
+  const SolverSettings& settings() const { return settings_; }
+  void setSettings(const SolverSettings& settings) { settings_ = settings; }
+  const FemModel& model() const { return *model_; }
+  const SystemOperator& system() const { return system_; }
+
+  /// Stage 1 and 2 alone: rotations and elastic forces at `state` (also used by tests).
+  double computeElasticForces(FemState& state);
+
+ private:
+  std::shared_ptr<const FemModel> model_;
+  SolverSettings settings_;
+  const Parallel& parallel_;
+  SystemOperator system_;
+  ProjectedCg cg_;
+  std::unique_ptr<CholmodSolver> cholmod_;
+
+  Eigen::VectorXd elastic_forces_, rhs_, velocity_next_, internal_forces_, scratch_;
+  std::vector<std::array<Eigen::Vector3d, 4>> tet_forces_;
+  std::vector<double> tet_energy_;
+  bool internal_forces_valid_ = false;
+};
+
+}  // namespace torsion

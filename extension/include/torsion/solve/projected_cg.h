@@ -1,0 +1,36 @@
+#pragma once
+// Preconditioned conjugate gradients on the constrained system S A S y = S r (Baraff & Witkin
+// 1998, "modified PCG"): prescribed velocity components never change, free ones are solved.
+
+#include <Eigen/Core>
+#include <vector>
+
+#include "torsion/solve/node_constraints.h"
+#include "torsion/solve/solver_settings.h"
+#include "torsion/solve/system_operator.h"
+
+namespace torsion {
+
+struct LinearSolveReport {
+  int iterations = 0;
+  double relative_residual = 0;  ///< |S(b - A v)| / |S(b - A v_prescribed)|
+  bool converged = false;
+};
+
+/// Solves A v = b for the free components of v. On entry v holds the warm start; prescribed
+/// components are imposed from `constraints` first. Workspace vectors are reused across calls.
+class ProjectedCg {
+ public:
+  LinearSolveReport solve(const SystemOperator& op, const NodeConstraints& constraints,
+                          const Eigen::VectorXd& b, const SolverSettings& settings,
+                          Eigen::VectorXd& v);
+
+ private:
+  void precondition(const NodeConstraints& constraints, PreconditionerKind kind,
+                    const Eigen::VectorXd& r, Eigen::VectorXd& z) const;
+
+  std::vector<Eigen::Matrix3d> block_inverse_;
+  Eigen::VectorXd r_, z_, p_, q_, prescribed_only_;
+};
+
+}  // namespace torsion

@@ -1,0 +1,38 @@
+#pragma once
+// Settings of the implicit step, with defaults, units and validation.
+
+#include <string>
+
+#include "torsion/result.h"
+
+namespace torsion {
+
+enum class LinearSolverKind {
+  kConjugateGradient,  ///< matrix-free preconditioned CG, warm-started from the last velocity
+  kCholmod,            ///< sparse direct Cholesky (SuiteSparse CHOLMOD), assembled every step
+};
+
+enum class PreconditionerKind {
+  kJacobi,       ///< inverse diagonal of the system matrix
+  kBlockJacobi,  ///< inverse 3x3 node blocks: captures each node's anisotropic stiffness
+};
+
+struct SolverSettings {
+  double time_step = 0.01;  ///< dt, s
+  LinearSolverKind linear_solver = LinearSolverKind::kConjugateGradient;
+  PreconditionerKind preconditioner = PreconditionerKind::kBlockJacobi;
+  /// CG stops when |S(b - A v)| <= tolerance |S(b - A v_prescribed)|, the residual of the
+  /// constrained system relative to its right-hand side.
+  double tolerance = 1e-4;
+  int max_iterations = 300;  ///< CG iteration cap
+  int threads = 0;           ///< worker threads; 0: all cores
+  /// A node faster than this (m/s) means the simulation blew up; the run stops.
+  double max_speed = 1e3;
+
+  Status validate() const;
+};
+
+const char* toString(LinearSolverKind kind);
+const char* toString(PreconditionerKind kind);
+
+}  // namespace torsion

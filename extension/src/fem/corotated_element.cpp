@@ -1,0 +1,72 @@
+#include "torsion/fem/corotated_element.h"
+
+namespace torsion {
+
+namespace {
+
+// Columns of the 3x3 "force matrix" H = -V P Bm^T are the forces on nodes 1..3; node 0 takes
+// minus their sum (the shape gradients sum to zero).
+std::array<Eigen::Vector3d, 4> nodeForces(const Eigen::Matrix3d& P, const TetRestData& rest) {
+  const Eigen::Matrix3d H = -rest.volume * P * rest.rest_shape_inverse.transpose();
+  return {-(H.col(0) + H.col(1) + H.col(2)), H.col(0), H.col(1), H.col(2)};
+}
+
+Eigen::Matrix3d linearStress(const Eigen::Matrix3d& strain, double mu, double lambda) {
+  return 2 * mu * strain + lambda * strain.trace() * Eigen::Matrix3d::Identity();
+}
+
+}  // namespace
+
+Eigen::Matrix3d deformationGradient(const std::array<Eigen::Vector3d, 4>& x,
+                                    const Eigen::Matrix3d& rest_shape_inverse) {
+  Eigen::Matrix3d Ds;
+  Ds.col(0) = x[1] - x[0];
+  Ds.col(1) = x[2] - x[0];
+  Ds.col(2) = x[3] - x[0];
+  return Ds * rest_shape_inverse;
+}
+
+std::array<Eigen::Vector3d, 4> corotatedForces(const Eigen::Matrix3d& F, const Eigen::Matrix3d& R,
+                                               const TetRestData& rest, double mu, double lambda) {
+  const Eigen::Matrix3d RtF = R.transpose() * F;
+  const Eigen::Matrix3d strain = 0.5 * (RtF + RtF.transpose()) - Eigen::Matrix3d::Identity();
+  return nodeForces(R * linearStress(strain, mu, lambda), rest);
+}
+
+std::array<Eigen::Vector3d, 4> corotatedForceDifferential(const std::array<Eigen::Vector3d, 4>& dx,
+                                                          const Eigen::Matrix3d& R,
+                                                          const TetRestData& rest, double mu,
+                                                          double lambda) {
+  const Eigen::Matrix3d dF = deformationGradient(dx, rest.rest_shape_inverse);
+  const Eigen::Matrix3d RtdF = R.transpose() * dF;
+  const Eigen::Matrix3d dstrain = 0.5 * (RtdF + RtdF.transpose());
+  return nodeForces(R * linearStress(dstrain, mu, lambda), rest);
+}
+
+double corotatedEnergy(const Eigen::Matrix3d& F, const Eigen::Matrix3d& R, const TetRestData& rest,
+                       double mu, double lambda) {
+  const Eigen::Matrix3d RtF = R.transpose() * F;
+  const Eigen::Matrix3d strain = 0.5 * (RtF + RtF.transpose()) - Eigen::Matrix3d::Identity();
+  const double trace = strain.trace();
+  return rest.volume * (mu * strain.squaredNorm() + 0.5 * lambda * trace * trace);
+}
+
+std::array<Eigen::Matrix3d, 4> corotatedDiagonalBlocks(const Eigen::Matrix3d& R,
+                                                       const TetRestData& rest, double mu,
+                                                       double lambda) {
+  // Displacing node a alone by dx gives, in the rotated frame y = R^T dx, a force
+  // -V (mu |g|^2 y + (mu + lambda) g (g . y)) with g = grad N_a.
+  const Eigen::Matrix3d& B = rest.rest_shape_inverse;
+  const std::array<Eigen::Vector3d, 4> g = {-(B.row(0) + B.row(1) + B.row(2)).transpose(),
+                                            B.row(0).transpose(), B.row(1).transpose(),
+                                            B.row(2).transpose()};
+  std::array<Eigen::Matrix3d, 4> blocks;
+  for (size_t a = 0; a < 4; ++a) {
+    const Eigen::Matrix3d local = rest.volume * (mu * g[a].squaredNorm() * Eigen::Matrix3d::Identity() +
+                                                 (mu + lambda) * g[a] * g[a].transpose());
+    blocks[a] = R * local * R.transpose();
+  }
+  return blocks;
+}
+
+}  // namespace torsion

@@ -1,0 +1,43 @@
+#include "torsion/fem/polar_rotation.h"
+
+#include <Eigen/SVD>
+#include <cmath>
+
+namespace torsion {
+
+Eigen::Matrix3d rotationBySvd(const Eigen::Matrix3d& F) {
+  Eigen::JacobiSVD<Eigen::Matrix3d> svd(F, Eigen::ComputeFullU | Eigen::ComputeFullV);
+  Eigen::Matrix3d U = svd.matrixU();
+  Eigen::Matrix3d V = svd.matrixV();
+  // Singular values come sorted descending, so column 2 carries the smallest: flipping it moves
+  // the reflection onto the least-stretched direction (Irving et al. 2004, section 5).
+  if (U.determinant() < 0) U.col(2) *= -1;
+  if (V.determinant() < 0) V.col(2) *= -1;
+  return U * V.transpose();
+}
+
+Eigen::Matrix3d extractRotation(const Eigen::Matrix3d& F, Eigen::Quaterniond& q,
+                                int max_iterations) {
+  if (!(F.determinant() > 0)) {
+    const Eigen::Matrix3d R = rotationBySvd(F);
+    q = Eigen::Quaterniond(R);
+    return R;
+  }
+  Eigen::Matrix3d R = q.toRotationMatrix();
+  for (int iteration = 0; iteration < max_iterations; ++iteration) {
+    // Torque-like vector that rotates R's columns toward F's columns (Mueller et al. 2016, eq. 6).
+    const Eigen::Vector3d omega_num =
+        R.col(0).cross(F.col(0)) + R.col(1).cross(F.col(1)) + R.col(2).cross(F.col(2));
+    const double omega_den =
+        std::abs(R.col(0).dot(F.col(0)) + R.col(1).dot(F.col(1)) + R.col(2).dot(F.col(2))) + 1e-9;
+    const Eigen::Vector3d omega = omega_num / omega_den;
+    const double angle = omega.norm();
+    if (angle < 1e-9) break;  // rotation accurate to 1e-9 rad
+    q = Eigen::Quaterniond(Eigen::AngleAxisd(angle, omega / angle)) * q;
+    q.normalize();
+    R = q.toRotationMatrix();
+  }
+  return R;
+}
+
+}  // namespace torsion

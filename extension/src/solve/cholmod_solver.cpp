@@ -1,0 +1,208 @@
+#include "torsion/solve/cholmod_solver.h"
+
+#include <Eigen/CholmodSupport>
+#include <cmath>
+
+namespace torsion {
+
+struct CholmodSolver::Impl {
+  Eigen::SparseMatrix<double> matrix;  // lower triangle, column-major, fixed pattern
+  // Node-pair blocks (i >= j) of the pattern, and for each the value index of its 9 entries
+  // (row-major within the block; -1 for the upper triangle of a diagonal block).
+  std::vector<std::pair<int, int>> blocks;
+  std::vector<std::array<int, 9>> block_values;
+  std::vector<std::array<int, 16>> tet_block;  // per tet, per (a, b): block id, -1 if i < j
+  std::vector<int> diagonal_block;             // per node
+  bool analysed = false;
+  Eigen::CholmodDecomposition<Eigen::SparseMatrix<double>, Eigen::Lower> factor;
+  Eigen::VectorXd rhs, prescribed, q, solution;
+};
+
+CholmodSolver::CholmodSolver() : impl_(std::make_unique<Impl>()) {}
+CholmodSolver::~CholmodSolver() = default;
+
+void CholmodSolver::buildPattern(const SystemOperator& op) {
+  const TetMesh& mesh = op.model().mesh();
+  const int n = mesh.nodeCount();
+  // Node-pair blocks (i >= j) present in some tet. Lower triangle of the scalar matrix: in a
+  // diagonal block keep entries r >= c only; off-diagonal blocks (i > j) are dense.
+  std::vector<std::pair<int, int>> pairs;
+  pairs.reserve(static_cast<size_t>(mesh.tetCount()) * 10 + static_cast<size_t>(n));
+  for (int i = 0; i < n; ++i) pairs.emplace_back(i, i);
+  for (const Tet& tet : mesh.tets()) {
+    for (int a = 0; a < 4; ++a) {
+      for (int b = 0; b < 4; ++b) {
+        if (tet[static_cast<size_t>(a)] > tet[static_cast<size_t>(b)]) {
+          pairs.emplace_back(tet[static_cast<size_t>(a)], tet[static_cast<size_t>(b)]);
+        }
+      }
+    }
+  }
+  std::sort(pairs.begin(), pairs.end());
+  pairs.erase(std::unique(pairs.begin(), pairs.end()), pairs.end());
+
+  std::vector<Eigen::Triplet<double>> triplets;
+  triplets.reserve(pairs.size() * 9);
+  for (const auto& [i, j] : pairs) {
+    for (int r = 0; r < 3; ++r) {
+      for (int c = 0; c < 3; ++c) {
+        if (i == j && r < c) continue;
+        triplets.emplace_back(3 * i + r, 3 * j + c, 0.0);
+      }
+    }
+  }
+  Impl& m = *impl_;
+  m.matrix.resize(3 * n, 3 * n);
+  m.matrix.setFromTriplets(triplets.begin(), triplets.end());
+  m.matrix.makeCompressed();
+
+  // Value index of every stored entry, found once.
+  auto value_index = [&](int row, int col) -> int {
+    const int* outer = m.matrix.outerIndexPtr();
+    const int* inner = m.matrix.innerIndexPtr();
+    const int* first = inner + outer[col];
+    const int* last = inner + outer[col + 1];
+    const int* it = std::lower_bound(first, last, row);
+    return (it != last && *it == row) ? static_cast<int>(it - inner) : -1;
+  };
+  m.blocks = pairs;
+  m.block_values.resize(pairs.size());
+  for (size_t k = 0; k < pairs.size(); ++k) {
+    const auto [i, j] = pairs[k];
+    for (int r = 0; r < 3; ++r) {
+      for (int c = 0; c < 3; ++c) m.block_values[k][static_cast<size_t>(3 * r + c)] = value_index(3 * i + r, 3 * j + c);
+    }
+  }
+  auto block_of = [&](int i, int j) {
+    return static_cast<int>(std::lower_bound(pairs.begin(), pairs.end(), std::make_pair(i, j)) - pairs.begin());
+  };
+  m.diagonal_block.resize(static_cast<size_t>(n));
+  for (int i = 0; i < n; ++i) m.diagonal_block[static_cast<size_t>(i)] = block_of(i, i);
+  m.tet_block.resize(static_cast<size_t>(mesh.tetCount()));
+  for (int t = 0; t < mesh.tetCount(); ++t) {
+    const Tet& tet = mesh.tets()[static_cast<size_t>(t)];
+    for (int a = 0; a < 4; ++a) {
+      for (int b = 0; b < 4; ++b) {
+        const int i = tet[static_cast<size_t>(a)], j = tet[static_cast<size_t>(b)];
+        m.tet_block[static_cast<size_t>(t)][static_cast<size_t>(4 * a + b)] = i >= j ? block_of(i, j) : -1;
+      }
+    }
+  }
+}
+
+const Eigen::SparseMatrix<double>& CholmodSolver::assemble(const SystemOperator& op,
+                                                           const NodeConstraints& constraints) {
+  Impl& m = *impl_;
+  if (m.matrix.rows() != 3 * op.model().nodeCount()) buildPattern(op);
+  const TetMesh& mesh = op.model().mesh();
+  const double mu = op.model().material().mu();
+  const double lambda = op.model().material().lambda();
+  const double c = op.stiffnessCoefficient();
+  double* values = m.matrix.valuePtr();
+  std::fill(values, values + m.matrix.nonZeros(), 0.0);
+
+  auto add_block = [&](int block, const Eigen::Matrix3d& value) {
+    const std::array<int, 9>& idx = m.block_values[static_cast<size_t>(block)];
+    for (int r = 0; r < 3; ++r) {
+      for (int col = 0; col < 3; ++col) {
+        const int k = idx[static_cast<size_t>(3 * r + col)];
+        if (k >= 0) values[k] += value(r, col);
+      }
+    }
+  };
+
+  // K_ab = V R (mu (g_a . g_b) I + mu g_b g_a^T + lambda g_a g_b^T) R^T.
+  for (int t = 0; t < mesh.tetCount(); ++t) {
+    const TetRestData& rest = op.model().tetRestData()[static_cast<size_t>(t)];
+    const Eigen::Matrix3d& R = op.rotations()[static_cast<size_t>(t)];
+    const Eigen::Matrix3d& B = rest.rest_shape_inverse;
+    const std::array<Eigen::Vector3d, 4> g = {-(B.row(0) + B.row(1) + B.row(2)).transpose(),
+                                              B.row(0).transpose(), B.row(1).transpose(),
+                                              B.row(2).transpose()};
+    for (size_t a = 0; a < 4; ++a) {
+      for (size_t b = 0; b < 4; ++b) {
+        const int block = m.tet_block[static_cast<size_t>(t)][4 * a + b];
+        if (block < 0) continue;
+        const Eigen::Matrix3d local =
+            rest.volume * (mu * g[a].dot(g[b]) * Eigen::Matrix3d::Identity() +
+                           mu * g[b] * g[a].transpose() + lambda * g[a] * g[b].transpose());
+        add_block(block, c * (R * local * R.transpose()));
+      }
+    }
+  }
+  const std::vector<double>& mass = op.model().nodeMasses();
+  for (int i = 0; i < mesh.nodeCount(); ++i) {
+    add_block(m.diagonal_block[static_cast<size_t>(i)],
+              op.massCoefficient() * mass[static_cast<size_t>(i)] * Eigen::Matrix3d::Identity());
+  }
+
+  // Constraints: A' = S A S + (I - S), block by block. S_i = I (free), 0 (full), I - n n^T.
+  if (constraints.constrainedCount() > 0) {
+    auto filter_matrix = [&](int node) {
+      Eigen::Matrix3d S;
+      for (int col = 0; col < 3; ++col) S.col(col) = constraints.filterNode(node, Eigen::Vector3d::Unit(col));
+      return S;
+    };
+    for (size_t k = 0; k < m.blocks.size(); ++k) {
+      const auto [i, j] = m.blocks[k];
+      if (!constraints.isConstrained(i) && !constraints.isConstrained(j)) continue;
+      const std::array<int, 9>& idx = m.block_values[k];
+      Eigen::Matrix3d block;
+      for (int r = 0; r < 3; ++r) {
+        for (int col = 0; col < 3; ++col) {
+          // The upper triangle of a diagonal block is not stored: mirror it.
+          const int at = idx[static_cast<size_t>(3 * r + col)] >= 0 ? idx[static_cast<size_t>(3 * r + col)]
+                                                                    : idx[static_cast<size_t>(3 * col + r)];
+          block(r, col) = values[at];
+        }
+      }
+      Eigen::Matrix3d filtered = filter_matrix(i) * block * filter_matrix(j);
+      if (i == j) filtered += Eigen::Matrix3d::Identity() - filter_matrix(i);
+      for (int r = 0; r < 3; ++r) {
+        for (int col = 0; col < 3; ++col) {
+          const int at = idx[static_cast<size_t>(3 * r + col)];
+          if (at >= 0) values[at] = filtered(r, col);
+        }
+      }
+    }
+  }
+  return m.matrix;
+}
+
+LinearSolveReport CholmodSolver::solve(const SystemOperator& op, const NodeConstraints& constraints,
+                                       const Eigen::VectorXd& b, Eigen::VectorXd& v) {
+  Impl& m = *impl_;
+  LinearSolveReport report;
+  // Right-hand side of the reduced system: S (b - A v_c).
+  m.prescribed.setZero(b.size());
+  constraints.impose(m.prescribed);
+  op.multiply(m.prescribed, m.q);
+  m.rhs = b - m.q;
+  constraints.filter(m.rhs);
+  const double reference = m.rhs.norm();
+
+  const Eigen::SparseMatrix<double>& A = assemble(op, constraints);
+  if (!m.analysed) {
+    m.factor.analyzePattern(A);
+    m.analysed = true;
+  }
+  m.factor.factorize(A);
+  if (m.factor.info() != Eigen::Success) {
+    report.converged = false;
+    report.relative_residual = std::numeric_limits<double>::infinity();
+    return report;
+  }
+  m.solution = m.factor.solve(m.rhs);
+  constraints.filter(m.solution);
+  v = m.prescribed + m.solution;
+
+  // Honest residual of the result, measured with the matrix-free operator.
+  op.multiply(v, m.q);
+  m.rhs = b - m.q;
+  constraints.filter(m.rhs);
+  report.relative_residual = reference > 0 ? m.rhs.norm() / reference : 0.0;
+  report.converged = std::isfinite(report.relative_residual) && report.relative_residual < 1e-6;
+  return report;
+}
+
+}  // namespace torsion

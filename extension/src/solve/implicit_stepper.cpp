@@ -1,0 +1,142 @@
+#include "torsion/solve/implicit_stepper.h"
+
+#include <cmath>
+#include <sstream>
+
+#include "torsion/fem/corotated_element.h"
+#include "torsion/fem/polar_rotation.h"
+#include "torsion/solve/cholmod_solver.h"
+
+namespace torsion {
+
+namespace {
+constexpr int kTetGrain = 256;
+constexpr int kNodeGrain = 512;
+}  // namespace
+
+const char* toString(StepHealth health) {
+  switch (health) {
+    case StepHealth::kOk: return "ok";
+    case StepHealth::kSolverNotConverged: return "solver not converged";
+    case StepHealth::kNonFinite: return "non-finite state";
+    case StepHealth::kBlowUp: return "blow-up";
+  }
+  return "?";
+}
+
+ImplicitStepper::ImplicitStepper(std::shared_ptr<const FemModel> model,
+                                 const SolverSettings& settings, const Parallel& parallel)
+    : model_(std::move(model)), settings_(settings), parallel_(parallel), system_(model_, parallel) {
+  tet_forces_.resize(static_cast<size_t>(model_->tetCount()));
+  tet_energy_.resize(static_cast<size_t>(model_->tetCount()));
+}
+
+ImplicitStepper::~ImplicitStepper() = default;
+
+double ImplicitStepper::computeElasticForces(FemState& state) {
+  const TetMesh& mesh = model_->mesh();
+  const double mu = model_->material().mu();
+  const double lambda = model_->material().lambda();
+  std::vector<Eigen::Matrix3d>& rotations = system_.mutableRotations();
+  parallel_.forRange(mesh.tetCount(), kTetGrain, [&](int begin, int end) {
+    for (int t = begin; t < end; ++t) {
+      const size_t ti = static_cast<size_t>(t);
+      const Tet& tet = mesh.tets()[ti];
+      const TetRestData& rest = model_->tetRestData()[ti];
+      std::array<Eigen::Vector3d, 4> x;
+      for (size_t a = 0; a < 4; ++a) x[a] = state.positions.segment<3>(3 * tet[a]);
+      const Eigen::Matrix3d F = deformationGradient(x, rest.rest_shape_inverse);
+      rotations[ti] = extractRotation(F, state.tet_rotations[ti]);
+      tet_forces_[ti] = corotatedForces(F, rotations[ti], rest, mu, lambda);
+      tet_energy_[ti] = corotatedEnergy(F, rotations[ti], rest, mu, lambda);
+    }
+  });
+  system_.gather(tet_forces_, 1.0, elastic_forces_);
+  double energy = 0;
+  for (double e : tet_energy_) energy += e;
+  return energy;
+}
+
+StepReport ImplicitStepper::step(FemState& state, const NodeConstraints& constraints,
+                                 const Eigen::VectorXd& external_forces) {
+  StepReport report;
+  internal_forces_valid_ = false;
+  const double dt = settings_.time_step;
+  const Material& material = model_->material();
+  const std::vector<double>& mass = model_->nodeMasses();
+  const int n = model_->nodeCount();
+
+  // 1-2. Rotations and elastic forces.
+  report.elastic_energy = computeElasticForces(state);
+
+  // 3. Right-hand side b = M v + dt (f + f_ext).
+  rhs_.resize(3 * n);
+  for (int i = 0; i < n; ++i) {
+    rhs_.segment<3>(3 * i) = mass[static_cast<size_t>(i)] * state.velocities.segment<3>(3 * i) +
+                             dt * (elastic_forces_.segment<3>(3 * i) + external_forces.segment<3>(3 * i));
+  }
+
+  if (!rhs_.allFinite()) {
+    // Bad forces in, or a state already broken: stop before anything is written.
+    report.health = StepHealth::kNonFinite;
+    report.message = elastic_forces_.allFinite() && external_forces.allFinite()
+                         ? "non-finite velocities at the start of the step"
+                         : (elastic_forces_.allFinite() ? "non-finite external forces"
+                                                        : "non-finite elastic forces (a degenerate tet?)");
+    return report;
+  }
+
+  // 4. Solve for v', warm-started from v.
+  system_.setCoefficients(1.0 + dt * material.mass_damping,
+                          dt * dt + dt * material.stiffness_damping);
+  velocity_next_ = state.velocities;
+  if (settings_.linear_solver == LinearSolverKind::kCholmod) {
+    if (!cholmod_) cholmod_ = std::make_unique<CholmodSolver>();
+    report.solve = cholmod_->solve(system_, constraints, rhs_, velocity_next_);
+  } else {
+    report.solve = cg_.solve(system_, constraints, rhs_, settings_, velocity_next_);
+  }
+
+  // 5. Integrate positions.
+  state.velocities = velocity_next_;
+  state.positions += dt * state.velocities;
+
+  // 6. Health.
+  double kinetic = 0, max_speed_sq = 0;
+  for (int i = 0; i < n; ++i) {
+    const double speed_sq = state.velocities.segment<3>(3 * i).squaredNorm();
+    kinetic += 0.5 * mass[static_cast<size_t>(i)] * speed_sq;
+    max_speed_sq = std::max(max_speed_sq, speed_sq);
+  }
+  report.kinetic_energy = kinetic;
+  report.max_speed = std::sqrt(max_speed_sq);
+  if (!std::isfinite(kinetic) || !state.positions.allFinite() || !std::isfinite(report.elastic_energy)) {
+    report.health = StepHealth::kNonFinite;
+    report.message = "non-finite positions or velocities (NaN or inf)";
+  } else if (report.max_speed > settings_.max_speed) {
+    report.health = StepHealth::kBlowUp;
+    std::ostringstream s;
+    s << "a node moves at " << report.max_speed << " m/s, beyond max_speed " << settings_.max_speed
+      << " m/s: the simulation is unstable (reduce dt or stiffness, or raise damping)";
+    report.message = s.str();
+  } else if (!report.solve.converged) {
+    report.health = StepHealth::kSolverNotConverged;
+    std::ostringstream s;
+    s << "linear solver stopped after " << report.solve.iterations << " iterations at relative residual "
+      << report.solve.relative_residual << " > tolerance " << settings_.tolerance;
+    report.message = s.str();
+  }
+  return report;
+}
+
+const Eigen::VectorXd& ImplicitStepper::internalForces() {
+  if (!internal_forces_valid_) {
+    system_.multiplyStiffness(velocity_next_, scratch_);
+    internal_forces_ =
+        elastic_forces_ - (settings_.time_step + model_->material().stiffness_damping) * scratch_;
+    internal_forces_valid_ = true;
+  }
+  return internal_forces_;
+}
+
+}  // namespace torsion

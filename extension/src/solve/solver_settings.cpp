@@ -1,0 +1,35 @@
+#include "torsion/solve/solver_settings.h"
+
+#include <cmath>
+
+namespace torsion {
+
+Status SolverSettings::validate() const {
+  if (!(std::isfinite(time_step) && time_step > 0 && time_step <= 1))
+    return Error{"solver: time_step = " + std::to_string(time_step) + ": must be in (0, 1] s"};
+  if (!(std::isfinite(tolerance) && tolerance > 0 && tolerance < 1))
+    return Error{"solver: tolerance = " + std::to_string(tolerance) + ": must be in (0, 1)"};
+  if (max_iterations < 1)
+    return Error{"solver: max_iterations = " + std::to_string(max_iterations) + ": must be >= 1"};
+  if (threads < 0) return Error{"solver: threads = " + std::to_string(threads) + ": must be >= 0"};
+  if (!(max_speed > 0)) return Error{"solver: max_speed must be > 0 m/s"};
+  return Ok{};
+}
+
+const char* toString(LinearSolverKind kind) {
+  switch (kind) {
+    case LinearSolverKind::kConjugateGradient: return "cg";
+    case LinearSolverKind::kCholmod: return "cholmod";
+  }
+  return "?";
+}
+
+const char* toString(PreconditionerKind kind) {
+  switch (kind) {
+    case PreconditionerKind::kJacobi: return "jacobi";
+    case PreconditionerKind::kBlockJacobi: return "block_jacobi";
+  }
+  return "?";
+}
+
+}  // namespace torsion

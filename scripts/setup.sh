@@ -1,0 +1,47 @@
+#!/usr/bin/env bash
+# Installs the Debian packages Torsion needs, only those that are missing.
+#
+# As root it runs apt-get itself. As another user it uses `sudo -n` when that works without a
+# password; otherwise it prints the exact apt-get command to run and exits with status 1, changing
+# nothing. Nothing is downloaded from anywhere but Debian's archive.
+set -euo pipefail
+
+packages=(
+  # build
+  cmake ninja-build g++ pkg-config
+  # libraries
+  libbullet-dev libeigen3-dev libsuitesparse-dev libccd-dev libtbb-dev
+  libcli11-dev nlohmann-json3-dev libpng-dev
+  libosmesa6-dev libglfw3-dev
+  # tests and benchmarks; clang + its runtime for the libFuzzer targets
+  libgtest-dev libbenchmark-dev clang libclang-rt-14-dev
+  # mesh generation (`torsion mesh cylinder` runs the tetgen command)
+  tetgen
+)
+
+missing=()
+for p in "${packages[@]}"; do
+  if ! dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed"; then
+    missing+=("$p")
+  fi
+done
+
+if [ ${#missing[@]} -eq 0 ]; then
+  echo "setup: all ${#packages[@]} Debian packages present"
+  exit 0
+fi
+
+echo "setup: installing ${#missing[@]} missing Debian package(s): ${missing[*]}"
+if [ "$(id -u)" -eq 0 ]; then
+  as_root=()
+elif command -v sudo >/dev/null 2>&1 && sudo -n true 2>/dev/null; then
+  as_root=(sudo -n)
+else
+  echo "setup: not root and no password-less sudo; run this, then try again:" >&2
+  echo "  sudo apt-get update && sudo apt-get install -y --no-install-recommends ${missing[*]}" >&2
+  exit 1
+fi
+export DEBIAN_FRONTEND=noninteractive
+"${as_root[@]}" apt-get update -qq
+"${as_root[@]}" apt-get install -y -qq --no-install-recommends "${missing[@]}"
+echo "setup: done"

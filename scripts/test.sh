@@ -1,0 +1,22 @@
+#!/usr/bin/env bash
+# The whole test suite, from a fresh machine: set-up, Release build, every CTest test, then a
+# clang build with ASan+UBSan that runs the unit tests again and fuzzes each mesh reader for a
+# bounded time. `.ci/run` calls exactly this.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+jobs=$(nproc 2>/dev/null || echo 2)
+
+bash scripts/setup.sh
+
+echo "== Release build (build/)"
+cmake -S . -B build -G Ninja -DCMAKE_BUILD_TYPE=Release -DTORSION_WARNINGS_AS_ERRORS=ON
+cmake --build build -j"$jobs"
+echo "== Test suite"
+ctest --test-dir build -j"$jobs" --output-on-failure --timeout 900
+
+echo "== Sanitizer + fuzz build (build-asan/, clang, ASan+UBSan)"
+cmake -S . -B build-asan -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_CXX_COMPILER=clang++ \
+  -DTORSION_SANITIZE=ON -DTORSION_FUZZ=ON -DTORSION_BUILD_BENCHMARKS=OFF
+cmake --build build-asan -j"$jobs"
+ASAN_OPTIONS=detect_leaks=1 UBSAN_OPTIONS=print_stacktrace=1 \
+  ctest --test-dir build-asan -j"$jobs" --output-on-failure -L "unit|cli|fuzz" --timeout 900

@@ -1,0 +1,28 @@
+// Links the installed Torsion package: reads a mesh, uses a device type, and checks that Bullet
+// arrives in double precision through the exported target.
+#include <LinearMath/btScalar.h>
+
+#include <cmath>
+#include <cstdio>
+
+#include "torsion/device/wrench_safety.h"
+#include "torsion/mesh/tet_mesh_builder.h"
+#include "torsion/mesh/tetgen_format.h"
+
+static_assert(sizeof(btScalar) == sizeof(double), "Torsion::extension must forward BT_USE_DOUBLE_PRECISION");
+
+int main() {
+  const char* node = "4 3 0 0\n0 0 0 0\n1 1 0 0\n2 0 1 0\n3 0 0 1\n";
+  const char* ele = "1 4 0\n0 0 1 2 3\n";
+  torsion::Result<torsion::RawTetMesh> raw = torsion::parseTetGen(node, "t.node", ele, "t.ele");
+  if (!raw) return std::printf("%s\n", raw.error().message.c_str()), 1;
+  torsion::Result<torsion::LoadedMesh> mesh = torsion::buildTetMesh(std::move(raw).value());
+  if (!mesh || mesh.value().mesh.surfaceTriangleCount() != 4) return std::printf("bad mesh\n"), 1;
+  torsion::device::DeviceLimits limits;
+  limits.max_force = 1;
+  const torsion::device::Wrench w = torsion::device::saturate({{3, 4, 0}, {}}, limits);
+  if (std::abs(w.force.x - 0.6) > 1e-12) return std::printf("bad saturation\n"), 1;
+  std::printf("consumer OK: %d tets, btScalar is %zu bytes\n", mesh.value().mesh.tetCount(),
+              sizeof(btScalar));
+  return 0;
+}

@@ -1,0 +1,44 @@
+# Runs one libFuzzer target for a bounded time (ctest label "fuzz"), on a fresh scratch copy of its
+# seed corpus so the seeds in the source tree are never written:
+#   cmake -D FUZZER=<exe> -D SEEDS=<seed dir> -D WORK_DIR=<scratch dir> -D SECONDS=<n>
+#         [-D DICT=<dictionary>] -P run_fuzzer.cmake
+# The environment variable TORSION_FUZZ_SECONDS, when set, overrides SECONDS. Crashing inputs are
+# kept in WORK_DIR/artifacts/ (not cleared between runs); the corpus grown by the run in
+# WORK_DIR/corpus/ is replaced by the next run.
+
+foreach(var FUZZER SEEDS WORK_DIR SECONDS)
+  if(NOT DEFINED ${var})
+    message(FATAL_ERROR "run_fuzzer.cmake: -D ${var}=... is required")
+  endif()
+endforeach()
+if(NOT "$ENV{TORSION_FUZZ_SECONDS}" STREQUAL "")
+  set(SECONDS "$ENV{TORSION_FUZZ_SECONDS}")
+endif()
+if(NOT SECONDS MATCHES "^[0-9]+$")
+  message(FATAL_ERROR "run_fuzzer.cmake: fuzzing time '${SECONDS}' is not a whole number of seconds")
+endif()
+
+set(corpus "${WORK_DIR}/corpus")
+set(artifacts "${WORK_DIR}/artifacts")
+file(REMOVE_RECURSE "${corpus}")
+file(MAKE_DIRECTORY "${corpus}" "${artifacts}")
+file(GLOB seeds LIST_DIRECTORIES false "${SEEDS}/*")
+if(NOT seeds)
+  message(FATAL_ERROR "run_fuzzer.cmake: no seeds in ${SEEDS}")
+endif()
+file(COPY ${seeds} DESTINATION "${corpus}")
+
+set(args "${corpus}" -max_total_time=${SECONDS} -rss_limit_mb=2048 -timeout=10
+         "-artifact_prefix=${artifacts}/" -print_final_stats=1)
+if(DEFINED DICT AND EXISTS "${DICT}")
+  list(APPEND args "-dict=${DICT}")
+endif()
+string(REPLACE ";" " " shown "${FUZZER};${args}")
+message(STATUS "${shown}")
+execute_process(COMMAND "${FUZZER}" ${args} RESULT_VARIABLE result)
+if(NOT result EQUAL 0)
+  file(GLOB found LIST_DIRECTORIES false "${artifacts}/*")
+  string(REPLACE ";" "\n  " found "${found}")
+  message(FATAL_ERROR "${FUZZER} failed (${result}). Inputs it saved:\n  ${found}\n"
+                      "Reproduce one with: ${FUZZER} <input>")
+endif()
