@@ -458,6 +458,8 @@ TEST(GmshFaults, DuplicateOrInvalidTag) {
                         {"m.msh:14:", "node tag 30 appears twice (first at line 12)"}));
   EXPECT_TRUE(failsWith(parse(withLine(kMsh41, 21, "7")),
                         {"m.msh:21:", "node tag 7 appears twice (first at line 12)"}));
+  EXPECT_TRUE(failsWith(parse(withLine(kMsh22, 24, "8 4 2 2 1 30 20 7 99")),
+                        {"m.msh:24:", "tet tag 8 appears twice (first at line 23)"}));
   EXPECT_TRUE(failsWith(parse(withLine(kMsh22, 12, "0 1 0 0")),
                         {"m.msh:12:", "node tag must be positive, found 0"}));
   EXPECT_TRUE(failsWith(parse(withLine(kMsh41, 33, "-11 10 30 20 7")),

@@ -517,6 +517,33 @@ class GmshReader {
     return known != nullptr && known->higher_order_tet;
   }
 
+  // (tag, position) pairs sorted by tag; fails at the later line of a repeated tag.
+  std::vector<std::pair<long, int>> sortedUniqueTags(const std::vector<long>& tags,
+                                                     const std::vector<int>& lines,
+                                                     const char* noun) const {
+    std::vector<std::pair<long, int>> sorted(tags.size());
+    for (size_t i = 0; i < tags.size(); ++i)
+      sorted[i] = {tags[i], static_cast<int>(i)};
+    std::sort(sorted.begin(), sorted.end());
+    int repeat_line = 0, first_line = 0;
+    long repeated = 0;
+    for (size_t i = 0; i + 1 < sorted.size(); ++i) {
+      if (sorted[i].first != sorted[i + 1].first) continue;
+      const int line = lines[static_cast<size_t>(sorted[i + 1].second)];
+      if (repeat_line == 0 || line < repeat_line) {
+        repeat_line = line;
+        first_line = lines[static_cast<size_t>(sorted[i].second)];
+        repeated = sorted[i].first;
+      }
+    }
+    if (repeat_line > 0) {
+      in_.failAt(repeat_line, std::string(noun) + " tag " + std::to_string(repeated) +
+                                  " appears twice (first at line " + std::to_string(first_line) +
+                                  ")");
+    }
+    return sorted;
+  }
+
   RawTetMesh finish() {
     const std::string higher_order = skippedList(isHigherOrderTet);
     const std::string others = skippedList([](long type) { return !isHigherOrderTet(type); });
@@ -532,25 +559,16 @@ class GmshReader {
     }
 
     // Node tags -> dense indices (order of appearance), by binary search in the sorted tags.
-    std::vector<std::pair<long, int>> sorted(node_tags_.size());
-    for (size_t i = 0; i < node_tags_.size(); ++i)
-      sorted[i] = {node_tags_[i], static_cast<int>(i)};
-    std::sort(sorted.begin(), sorted.end());
-    int duplicate_line = 0, first_line = 0;
-    long duplicate_tag = 0;
-    for (size_t i = 0; i + 1 < sorted.size(); ++i) {
-      if (sorted[i].first != sorted[i + 1].first) continue;
-      const int line = node_lines_[static_cast<size_t>(sorted[i + 1].second)];
-      if (duplicate_line == 0 || line < duplicate_line) {
-        duplicate_line = line;
-        first_line = node_lines_[static_cast<size_t>(sorted[i].second)];
-        duplicate_tag = sorted[i].first;
+    const std::vector<std::pair<long, int>> sorted =
+        sortedUniqueTags(node_tags_, node_lines_, "node");
+    {
+      std::vector<long> tet_tags(tets_.size());
+      std::vector<int> tet_lines(tets_.size());
+      for (size_t t = 0; t < tets_.size(); ++t) {
+        tet_tags[t] = tets_[t].origin.id;
+        tet_lines[t] = tets_[t].origin.line;
       }
-    }
-    if (duplicate_line > 0) {
-      in_.failAt(duplicate_line, "node tag " + std::to_string(duplicate_tag) +
-                                     " appears twice (first at line " + std::to_string(first_line) +
-                                     ")");
+      sortedUniqueTags(tet_tags, tet_lines, "tet");
     }
 
     RawTetMesh raw;

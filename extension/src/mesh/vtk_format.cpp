@@ -64,74 +64,40 @@ bool looksNumeric(std::string_view token) {
 }
 
 const char* cellTypeName(long type) {
-  switch (type) {
-    case 0:
-      return "empty cell";
-    case 1:
-      return "vertex";
-    case 2:
-      return "poly-vertex";
-    case 3:
-      return "line";
-    case 4:
-      return "poly-line";
-    case 5:
-      return "triangle";
-    case 6:
-      return "triangle strip";
-    case 7:
-      return "polygon";
-    case 8:
-      return "pixel";
-    case 9:
-      return "quad";
-    case 10:
-      return "tetrahedron";
-    case 11:
-      return "voxel";
-    case 12:
-      return "hexahedron";
-    case 13:
-      return "wedge";
-    case 14:
-      return "pyramid";
-    case 15:
-      return "pentagonal prism";
-    case 16:
-      return "hexagonal prism";
-    case 21:
-      return "quadratic edge";
-    case 22:
-      return "quadratic triangle";
-    case 23:
-      return "quadratic quad";
-    case 24:
-      return "quadratic tetrahedron";
-    case 25:
-      return "quadratic hexahedron";
-    case 26:
-      return "quadratic wedge";
-    case 27:
-      return "quadratic pyramid";
-    case 28:
-      return "biquadratic quad";
-    case 29:
-      return "triquadratic hexahedron";
-    case 34:
-      return "biquadratic triangle";
-    case 35:
-      return "cubic line";
-    case 42:
-      return "polyhedron";
-    case 68:
-      return "Lagrange triangle";
-    case 71:
-      return "Lagrange tetrahedron";
-    case 72:
-      return "Lagrange hexahedron";
-    default:
-      return "unknown cell type";
-  }
+  static const std::map<long, const char*> kNames = {{0, "empty cell"},
+                                                     {1, "vertex"},
+                                                     {2, "poly-vertex"},
+                                                     {3, "line"},
+                                                     {4, "poly-line"},
+                                                     {5, "triangle"},
+                                                     {6, "triangle strip"},
+                                                     {7, "polygon"},
+                                                     {8, "pixel"},
+                                                     {9, "quad"},
+                                                     {10, "tetrahedron"},
+                                                     {11, "voxel"},
+                                                     {12, "hexahedron"},
+                                                     {13, "wedge"},
+                                                     {14, "pyramid"},
+                                                     {15, "pentagonal prism"},
+                                                     {16, "hexagonal prism"},
+                                                     {21, "quadratic edge"},
+                                                     {22, "quadratic triangle"},
+                                                     {23, "quadratic quad"},
+                                                     {24, "quadratic tetrahedron"},
+                                                     {25, "quadratic hexahedron"},
+                                                     {26, "quadratic wedge"},
+                                                     {27, "quadratic pyramid"},
+                                                     {28, "biquadratic quad"},
+                                                     {29, "triquadratic hexahedron"},
+                                                     {34, "biquadratic triangle"},
+                                                     {35, "cubic line"},
+                                                     {42, "polyhedron"},
+                                                     {68, "Lagrange triangle"},
+                                                     {71, "Lagrange tetrahedron"},
+                                                     {72, "Lagrange hexahedron"}};
+  const auto found = kNames.find(type);
+  return found == kNames.end() ? "unknown cell type" : found->second;
 }
 
 std::string plural(long n, const char* one, const char* many) {

@@ -1,0 +1,69 @@
+#pragma once
+// One corotational FEM body living in a Bullet world. It owns its FEM state, its implicit
+// stepper and its node groups, and mirrors its nodes into a btSoftBody so Bullet's broadphase and
+// soft-rigid collision detection see it. Touched only by the simulation thread.
+
+#include <btBulletDynamicsCommon.h>
+#include <BulletSoftBody/btSoftBody.h>
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "torsion/constraints/carried_nodes.h"
+#include "torsion/fem/fem_model.h"
+#include "torsion/solve/implicit_stepper.h"
+
+namespace torsion {
+
+class FemBody {
+ public:
+  FemBody(std::string name, std::shared_ptr<const FemModel> model, const SolverSettings& settings,
+          const Parallel& parallel, btSoftBodyWorldInfo& world_info);
+  ~FemBody();
+  FemBody(const FemBody&) = delete;
+  FemBody& operator=(const FemBody&) = delete;
+
+  const std::string& name() const { return name_; }
+  const FemModel& model() const { return *model_; }
+  const FemState& state() const { return state_; }
+  btSoftBody* softBody() { return soft_body_.get(); }
+
+  /// Adds a group of nodes carried rigidly by `motion` (a constant frame fixes them). Returns its
+  /// index. p_hat is captured from the nodes' current positions and motion(now).
+  int carryNodes(std::string group_name, std::vector<int> nodes, FrameMotion motion, double now);
+  /// Frees the group's nodes (its index stays reserved and reports zero wrench).
+  void releaseGroup(int group);
+  const std::vector<std::unique_ptr<CarriedNodes>>& groups() const { return groups_; }
+
+  /// The wrench the body exerts on group `group` at the end of the last step, about `point`.
+  Wrench groupWrench(int group, const Eigen::Vector3d& point);
+
+  /// Sets gravity (m/s^2) as the external force m_i g on every node.
+  void setGravity(const Eigen::Vector3d& gravity);
+
+  // ---- called by FemSoftBodySolver, in this order, each step ----
+  /// Bullet's predictor: m_q = x_n, m_x = x_n + dt v_n, bounds and node tree refreshed, contacts
+  /// cleared, so Bullet's collision detection runs on this step's motion.
+  void predict(double dt);
+  /// The FEM step from time `now` to now + dt; writes the result back into the btSoftBody.
+  const StepReport& advance(double now, double dt);
+
+  const StepReport& lastReport() const { return last_report_; }
+  ImplicitStepper& stepper() { return stepper_; }
+
+ private:
+  void writeBack();
+
+  std::string name_;
+  std::shared_ptr<const FemModel> model_;
+  FemState state_;
+  ImplicitStepper stepper_;
+  NodeConstraints constraints_;
+  Eigen::VectorXd external_forces_;
+  std::vector<std::unique_ptr<CarriedNodes>> groups_;
+  std::unique_ptr<btSoftBody> soft_body_;
+  StepReport last_report_;
+};
+
+}  // namespace torsion

@@ -1,0 +1,50 @@
+#pragma once
+// A group of nodes carried rigidly by a moving frame: fixed nodes (a frame that never moves),
+// a scripted rigid motion of an end of the body, and the hand plane's grabbed patch all are one.
+// Each step, node l is prescribed to R(t+dt) p_hat_l + O(t+dt) in position and velocity through the
+// solver's projection; the implicit solve sees it (positions are never snapped afterwards).
+
+#include <Eigen/Core>
+#include <string>
+#include <vector>
+
+#include "torsion/constraints/frame.h"
+#include "torsion/solve/fem_state.h"
+#include "torsion/solve/node_constraints.h"
+
+namespace torsion {
+
+/// Force and torque (N, N m).
+struct Wrench {
+  Eigen::Vector3d force = Eigen::Vector3d::Zero();
+  Eigen::Vector3d torque = Eigen::Vector3d::Zero();
+};
+
+class CarriedNodes {
+ public:
+  /// Captures p_hat = R^T (x - O) for each node at its current position, with `motion` evaluated
+  /// at `time`.
+  CarriedNodes(std::string name, std::vector<int> nodes, FrameMotion motion, const FemState& state,
+               double time);
+
+  const std::string& name() const { return name_; }
+  const std::vector<int>& nodes() const { return nodes_; }
+  const std::vector<Eigen::Vector3d>& localCoordinates() const { return local_; }
+  Frame frameAt(double time) const { return motion_(time); }
+
+  /// Prescribes each node's velocity so it reaches R(t_next) p_hat + O(t_next) after dt.
+  void prescribe(double time_next, double dt, const FemState& state, NodeConstraints& constraints) const;
+
+  /// The wrench the body exerts on the group: F = sum f_l, tau = sum (x_l - point) x f_l, for
+  /// per-node forces `forces` (3n, e.g. ImplicitStepper::internalForces()).
+  Wrench wrenchOn(const Eigen::VectorXd& forces, const FemState& state,
+                  const Eigen::Vector3d& point) const;
+
+ private:
+  std::string name_;
+  std::vector<int> nodes_;
+  std::vector<Eigen::Vector3d> local_;
+  FrameMotion motion_;
+};
+
+}  // namespace torsion

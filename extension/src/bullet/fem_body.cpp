@@ -1,0 +1,101 @@
+#include "torsion/bullet/fem_body.h"
+
+namespace torsion {
+
+namespace {
+btVector3 toBt(const Eigen::Vector3d& v) { return btVector3(v.x(), v.y(), v.z()); }
+}  // namespace
+
+FemBody::FemBody(std::string name, std::shared_ptr<const FemModel> model,
+                 const SolverSettings& settings, const Parallel& parallel,
+                 btSoftBodyWorldInfo& world_info)
+    : name_(std::move(name)),
+      model_(std::move(model)),
+      state_(FemState::atRest(*model_)),
+      stepper_(model_, settings, parallel),
+      constraints_(model_->nodeCount()),
+      external_forces_(Eigen::VectorXd::Zero(3 * model_->nodeCount())) {
+  const int n = model_->nodeCount();
+  std::vector<btVector3> x(static_cast<size_t>(n));
+  std::vector<btScalar> m(static_cast<size_t>(n));
+  for (int i = 0; i < n; ++i) {
+    x[static_cast<size_t>(i)] = toBt(state_.position(i));
+    m[static_cast<size_t>(i)] = model_->nodeMasses()[static_cast<size_t>(i)];
+  }
+  // Nodes and surface faces only: our solver never uses Bullet's links, and soft-rigid contact
+  // (SDF_RS) is node-based. No VF_SS/SDF_RD flags: without links their tree build would hang.
+  soft_body_ = std::make_unique<btSoftBody>(&world_info, n, x.data(), m.data());
+  for (const Triangle& tri : model_->mesh().surfaceTriangles()) {
+    soft_body_->appendFace(tri[0], tri[1], tri[2]);
+  }
+  soft_body_->m_cfg.collisions = btSoftBody::fCollision::SDF_RS;
+  const Eigen::Vector3d extent = model_->mesh().boundsMax() - model_->mesh().boundsMin();
+  soft_body_->getCollisionShape()->setMargin(1e-3 * extent.norm());
+  soft_body_->setActivationState(DISABLE_DEACTIVATION);
+  soft_body_->updateNodeTree(false, false);
+  soft_body_->updateBounds();
+  soft_body_->updateNormals();
+}
+
+FemBody::~FemBody() = default;
+
+int FemBody::carryNodes(std::string group_name, std::vector<int> nodes, FrameMotion motion,
+                        double now) {
+  groups_.push_back(std::make_unique<CarriedNodes>(std::move(group_name), std::move(nodes),
+                                                   std::move(motion), state_, now));
+  return static_cast<int>(groups_.size()) - 1;
+}
+
+void FemBody::releaseGroup(int group) {
+  auto& g = groups_[static_cast<size_t>(group)];
+  g = std::make_unique<CarriedNodes>(g->name(), std::vector<int>{}, [](double) { return Frame{}; },
+                                     state_, 0.0);
+}
+
+Wrench FemBody::groupWrench(int group, const Eigen::Vector3d& point) {
+  return groups_[static_cast<size_t>(group)]->wrenchOn(stepper_.internalForces(), state_, point);
+}
+
+void FemBody::setGravity(const Eigen::Vector3d& gravity) {
+  for (int i = 0; i < model_->nodeCount(); ++i) {
+    external_forces_.segment<3>(3 * i) = model_->nodeMasses()[static_cast<size_t>(i)] * gravity;
+  }
+}
+
+void FemBody::predict(double dt) {
+  btSoftBody& sb = *soft_body_;
+  sb.m_sst.sdt = dt;
+  sb.m_sst.isdt = 1 / dt;
+  sb.m_sst.velmrg = 3 * dt;
+  sb.m_sst.radmrg = sb.getCollisionShape()->getMargin();
+  sb.m_sst.updmrg = sb.m_sst.radmrg / 4;
+  for (int i = 0; i < model_->nodeCount(); ++i) {
+    btSoftBody::Node& node = sb.m_nodes[i];
+    node.m_q = toBt(state_.position(i));
+    node.m_v = toBt(state_.velocity(i));
+    node.m_x = node.m_q + node.m_v * dt;
+  }
+  sb.updateNodeTree(true, true);
+  sb.updateBounds();
+  sb.m_rcontacts.resizeNoInitialize(0);
+  sb.m_scontacts.resizeNoInitialize(0);
+}
+
+const StepReport& FemBody::advance(double now, double dt) {
+  constraints_.reset(model_->nodeCount());
+  for (const auto& group : groups_) group->prescribe(now + dt, dt, state_, constraints_);
+  // Contacts with rigid bodies (btSoftBody::m_rcontacts) will prescribe normal velocities here.
+  last_report_ = stepper_.step(state_, constraints_, external_forces_);
+  if (!isFatal(last_report_.health)) writeBack();
+  return last_report_;
+}
+
+void FemBody::writeBack() {
+  btSoftBody& sb = *soft_body_;
+  for (int i = 0; i < model_->nodeCount(); ++i) {
+    sb.m_nodes[i].m_x = toBt(state_.position(i));
+    sb.m_nodes[i].m_v = toBt(state_.velocity(i));
+  }
+}
+
+}  // namespace torsion
