@@ -154,6 +154,7 @@ int main(int argc, char** argv) {
   j["setup_s"] = result.setup_seconds;
   j["run_s"] = total_ms / 1000;
   j["steps_per_s"] = total_ms > 0 ? result.steps_done / (total_ms / 1000) : 0.0;
+  j["cpu_ms_per_step"] = 1000 * result.loop_cpu_seconds / steps_done;
   j["ms_median"] = number(torsion::bench::quantile(result.step_ms, 0.5));
   j["ms_p95"] = number(torsion::bench::quantile(result.step_ms, 0.95));
   j["ms_mean"] = total_ms / steps_done;

@@ -160,8 +160,14 @@ TwistResult runBulletTwist(const TwistProtocol& protocol, const TetMesh& mesh,
   for (const auto& [a, b] : edges) body->appendLink(a, b, nullptr, false);
   for (const Triangle& f : mesh.surfaceTriangles()) body->appendFace(f[0], f[1], f[2]);
   body->initializeDmInverse();
-  body->m_tetraScratches.resize(body->m_tetras.size());
-  body->m_tetraScratchesTn.resize(body->m_tetras.size());
+  btSoftBody::TetraScratch rest_scratch;  // what updateDeformation writes for an undeformed tet
+  rest_scratch.m_F.setIdentity();
+  rest_scratch.m_trace = 3;
+  rest_scratch.m_J = 1;
+  rest_scratch.m_cofF.setIdentity();
+  rest_scratch.m_corotation.setIdentity();
+  body->m_tetraScratches.resize(body->m_tetras.size(), rest_scratch);
+  body->m_tetraScratchesTn.resize(body->m_tetras.size(), rest_scratch);
   body->m_cfg.collisions = 0;
   body->getCollisionShape()->setMargin(0.01);
   body->updateNodeTree(false, false);
@@ -212,6 +218,7 @@ TwistResult runBulletTwist(const TwistProtocol& protocol, const TetMesh& mesh,
   btAlignedObjectArray<btSoftBody::Node>& nodes = body->m_nodes;
   result.step_ms.reserve(static_cast<size_t>(protocol.total_steps));
   result.step_iterations.reserve(static_cast<size_t>(protocol.total_steps));
+  const double cpu_start = processCpuSeconds();
   bool preconditioner_ready = !options.mass_preconditioner;
   for (int k = 0; k < protocol.total_steps; ++k) {
     const long multiplies0 = g_multiplies, solves0 = g_solves;
@@ -265,6 +272,7 @@ TwistResult runBulletTwist(const TwistProtocol& protocol, const TetMesh& mesh,
       break;
     }
   }
+  result.loop_cpu_seconds = processCpuSeconds() - cpu_start;
   result.peak_rss_kb = peakRssKb();
 
   Eigen::VectorXd positions(3 * n);

@@ -77,6 +77,7 @@ TwistResult runTorsionTwist(const TwistProtocol& protocol, std::shared_ptr<const
 
   result.step_ms.reserve(static_cast<size_t>(protocol.total_steps));
   result.step_iterations.reserve(static_cast<size_t>(protocol.total_steps));
+  const double cpu_start = processCpuSeconds();
   for (int k = 0; k < protocol.total_steps; ++k) {
     const Clock::time_point t0 = Clock::now();
     const double angle = protocol.angle((k + 1) * dt);
@@ -97,6 +98,7 @@ TwistResult runTorsionTwist(const TwistProtocol& protocol, std::shared_ptr<const
       break;
     }
   }
+  result.loop_cpu_seconds = processCpuSeconds() - cpu_start;
   result.peak_rss_kb = peakRssKb();
   result.final_positions = state.positions;
   measureTwist(protocol, *mesh, scene, state.positions, result);

@@ -62,7 +62,8 @@ struct TwistResult {
   std::string message;
   int steps_done = 0;
   double setup_seconds = 0;
-  std::vector<double> step_ms;         ///< per benchmark step (all substeps of one dt)
+  std::vector<double> step_ms;         ///< wall clock per benchmark step (all substeps of one dt)
+  double loop_cpu_seconds = 0;         ///< process CPU time (all threads) of the stepping loop
   std::vector<int> step_iterations;    ///< linear-solver iterations per step (sum over substeps)
   int not_converged_steps = 0;         ///< steps whose solver stopped above tolerance (ours)
   double max_speed = 0;                ///< largest node speed seen at the end of any step, m/s
@@ -83,6 +84,9 @@ void measureTwist(const TwistProtocol& protocol, const TetMesh& mesh, const Twis
 
 /// Peak resident set size of this process so far, kB (getrusage ru_maxrss).
 long peakRssKb();
+/// CPU time of this process (all threads) so far, s. Less sensitive than wall clock to other
+/// processes competing for the cores (it still sees their cache and memory-bandwidth pressure).
+double processCpuSeconds();
 
 /// q-quantile (0..1) of `values`, linear interpolation between order statistics; NaN if empty.
 double quantile(std::vector<double> values, double q);

@@ -223,6 +223,112 @@ $EndElements
                         {"m.msh:9:", "entity dimension must be 0 to 3, found 4"}));
 }
 
+// Written by Gmsh 4.8.4 itself (one tet, "gmsh -3 tet.geo -format msh41 / msh22"), trailing
+// spaces and empty node blocks (entities whose nodes live on their boundary) included.
+const std::string kGmshWrote41 = R"($MeshFormat
+4.1 0 8
+$EndMeshFormat
+$PhysicalNames
+2
+2 2 "skin"
+3 1 "body"
+$EndPhysicalNames
+$Entities
+4 6 4 1
+1 0 0 0 0 
+2 1 0 0 0 
+3 0 1 0 0 
+4 0 0 1 0 
+1 0 0 0 1 0 0 0 2 1 -2 
+2 0 0 0 1 1 0 0 2 2 -3 
+3 0 0 0 0 1 0 0 2 3 -1 
+4 0 0 0 0 0 1 0 2 1 -4 
+5 0 0 0 1 0 1 0 2 2 -4 
+6 0 0 0 0 1 1 0 2 3 -4 
+1 0 0 0 1 1 0 1 2 3 1 2 3 
+2 0 0 0 1 0 1 1 2 3 1 5 -4 
+3 0 0 0 1 1 1 1 2 3 2 6 -5 
+4 0 0 0 0 1 1 1 2 3 3 4 -6 
+1 0 0 0 1 1 1 1 1 4 1 2 3 4 
+$EndEntities
+$Nodes
+9 4 1 4
+0 1 0 1
+1
+0 0 0
+0 2 0 1
+2
+1 0 0
+0 3 0 1
+3
+0 1 0
+0 4 0 1
+4
+0 0 1
+2 1 0 0
+2 2 0 0
+2 3 0 0
+2 4 0 0
+3 1 0 0
+$EndNodes
+$Elements
+5 5 1 5
+2 1 2 1
+1 1 2 3 
+2 2 2 1
+2 1 2 4 
+2 3 2 1
+3 2 3 4 
+2 4 2 1
+4 1 4 3 
+3 1 4 1
+5 1 3 4 2 
+$EndElements
+)";
+const std::string kGmshWrote22 = R"($MeshFormat
+2.2 0 8
+$EndMeshFormat
+$PhysicalNames
+2
+2 2 "skin"
+3 1 "body"
+$EndPhysicalNames
+$Nodes
+4
+1 0 0 0
+2 1 0 0
+3 0 1 0
+4 0 0 1
+$EndNodes
+$Elements
+5
+1 2 2 2 1 1 2 3
+2 2 2 2 2 1 2 4
+3 2 2 2 3 2 3 4
+4 2 2 2 4 1 4 3
+5 4 2 1 1 1 3 4 2
+$EndElements
+)";
+
+TEST(Gmsh, ReadsFilesWrittenByGmsh) {
+  for (const std::string* text : {&kGmshWrote41, &kGmshWrote22}) {
+    Result<RawTetMesh> raw = parse(*text);
+    ASSERT_TRUE(raw.ok()) << raw.error().message;
+    EXPECT_EQ(raw.value().positions,
+              (std::vector<Eigen::Vector3d>{{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0, 0, 1}}));
+    ASSERT_EQ(raw.value().tets.size(), 1u);
+    EXPECT_EQ(raw.value().tets[0], (Tet{0, 2, 3, 1}));
+    EXPECT_EQ(raw.value().origins[0].id, 5);
+    EXPECT_EQ(raw.value().notes,
+              std::vector<std::string>{"m.msh: skipped 4 elements of type 2 (3-node triangle)"});
+    Result<LoadedMesh> built = buildTetMesh(raw.value());
+    ASSERT_TRUE(built.ok()) << built.error().message;
+    EXPECT_EQ(built.value().reoriented_tets, 0);
+  }
+  EXPECT_EQ(parse(kGmshWrote41).value().origins[0].line, 58);
+  EXPECT_EQ(parse(kGmshWrote22).value().origins[0].line, 22);
+}
+
 TEST(Gmsh, AcceptsCrLfBlankLinesAndUnknownSections) {
   std::string text = "$Comments\nwritten by hand\n$EndComments\n" + kMsh41 +
                      "$Periodic\n0\n$EndPeriodic\n\n$SomethingNew\n1 2 3\n$EndSomethingNew\n";

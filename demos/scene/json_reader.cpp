@@ -1,0 +1,150 @@
+#include "json_reader.h"
+
+#include <cmath>
+
+namespace torsion::scene {
+
+namespace {
+std::string typeName(const nlohmann::json& j) {
+  if (j.is_number()) return "a number";
+  if (j.is_string()) return "a string";
+  if (j.is_boolean()) return "a boolean";
+  if (j.is_array()) return "an array";
+  if (j.is_object()) return "an object";
+  return "null";
+}
+}  // namespace
+
+JsonObject::JsonObject(const nlohmann::json& json, std::string path, const std::string& file)
+    : json_(json), path_(std::move(path)), file_(file) {
+  if (!json_.is_object()) {
+    throw JsonFault(file_ + ": " + (path_.empty() ? "the scene" : path_) + ": expected an object, found " +
+                    typeName(json_));
+  }
+}
+
+std::string JsonObject::keyPath(const std::string& key) const {
+  if (key.empty()) return path_;
+  return path_.empty() ? key : path_ + "." + key;
+}
+
+void JsonObject::fail(const std::string& key, const std::string& fault) const {
+  throw JsonFault(file_ + ": " + keyPath(key) + ": " + fault);
+}
+
+bool JsonObject::has(const std::string& key) const {
+  read_.insert(key);
+  return json_.contains(key);
+}
+
+const nlohmann::json& JsonObject::at(const std::string& key) const {
+  read_.insert(key);
+  if (!json_.contains(key)) {
+    // A misspelt key shows up here first: name the keys this object has that nobody asked for.
+    std::string unread;
+    for (auto it = json_.begin(); it != json_.end(); ++it) {
+      if (read_.count(it.key()) == 0) unread += (unread.empty() ? "" : ", ") + ("'" + it.key() + "'");
+    }
+    fail(key, "missing (required)" + (unread.empty() ? std::string() : "; also found unknown key(s) " + unread));
+  }
+  return json_.at(key);
+}
+
+double JsonObject::number(const std::string& key) const {
+  const nlohmann::json& j = at(key);
+  if (!j.is_number()) fail(key, "expected a number, found " + typeName(j));
+  const double value = j.get<double>();
+  if (!std::isfinite(value)) fail(key, "must be finite");
+  return value;
+}
+
+double JsonObject::number(const std::string& key, double fallback) const {
+  return has(key) ? number(key) : fallback;
+}
+
+int JsonObject::integer(const std::string& key, int fallback) const {
+  if (!has(key)) return fallback;
+  const nlohmann::json& j = at(key);
+  if (!j.is_number_integer()) fail(key, "expected an integer, found " + typeName(j));
+  const auto value = j.get<long long>();
+  if (value < -2147483647LL || value > 2147483647LL) fail(key, "integer out of range");
+  return static_cast<int>(value);
+}
+
+std::string JsonObject::string(const std::string& key) const {
+  const nlohmann::json& j = at(key);
+  if (!j.is_string()) fail(key, "expected a string, found " + typeName(j));
+  return j.get<std::string>();
+}
+
+std::string JsonObject::string(const std::string& key, const std::string& fallback) const {
+  return has(key) ? string(key) : fallback;
+}
+
+bool JsonObject::boolean(const std::string& key, bool fallback) const {
+  if (!has(key)) return fallback;
+  const nlohmann::json& j = at(key);
+  if (!j.is_boolean()) fail(key, "expected true or false, found " + typeName(j));
+  return j.get<bool>();
+}
+
+Eigen::Vector3d JsonObject::vector3(const std::string& key) const {
+  const nlohmann::json& j = at(key);
+  if (!j.is_array() || j.size() != 3) fail(key, "expected an array of 3 numbers");
+  Eigen::Vector3d v;
+  for (size_t i = 0; i < 3; ++i) {
+    if (!j[i].is_number()) fail(key, "element " + std::to_string(i) + ": expected a number, found " + typeName(j[i]));
+    v[static_cast<Eigen::Index>(i)] = j[i].get<double>();
+  }
+  if (!v.allFinite()) fail(key, "must be finite");
+  return v;
+}
+
+Eigen::Vector3d JsonObject::vector3(const std::string& key, const Eigen::Vector3d& fallback) const {
+  return has(key) ? vector3(key) : fallback;
+}
+
+JsonObject JsonObject::object(const std::string& key) const {
+  const nlohmann::json& j = at(key);
+  if (!j.is_object()) fail(key, "expected an object, found " + typeName(j));
+  return JsonObject(j, keyPath(key), file_);
+}
+
+std::vector<JsonObject> JsonObject::objects(const std::string& key) const {
+  std::vector<JsonObject> out;
+  if (!has(key)) return out;
+  const nlohmann::json& j = at(key);
+  if (!j.is_array()) fail(key, "expected an array, found " + typeName(j));
+  for (size_t i = 0; i < j.size(); ++i) {
+    const std::string item = keyPath(key) + "[" + std::to_string(i) + "]";
+    if (!j[i].is_object()) throw JsonFault(file_ + ": " + item + ": expected an object, found " + typeName(j[i]));
+    out.emplace_back(j[i], item, file_);
+  }
+  return out;
+}
+
+std::string JsonObject::oneOf(const std::vector<std::string>& choices) const {
+  std::string found;
+  std::string list;
+  for (const std::string& c : choices) {
+    list += (list.empty() ? "" : ", ") + c;
+    if (has(c)) {
+      if (!found.empty()) throw JsonFault(file_ + ": " + path_ + ": give only one of " + list + "...");
+      found = c;
+    }
+  }
+  if (found.empty()) throw JsonFault(file_ + ": " + path_ + ": needs one of: " + list);
+  return found;
+}
+
+void JsonObject::finish() const {
+  for (auto it = json_.begin(); it != json_.end(); ++it) {
+    if (read_.count(it.key()) == 0) {
+      std::string known;
+      for (const std::string& k : read_) known += (known.empty() ? "" : ", ") + k;
+      fail(it.key(), "unknown key (known here: " + known + ")");
+    }
+  }
+}
+
+}  // namespace torsion::scene

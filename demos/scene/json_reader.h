@@ -1,0 +1,53 @@
+#pragma once
+// Typed, path-tracking access to a JSON object for scene files. Each accessor fails with
+// "<file>: <path>: <fault>" (thrown as JsonFault, caught by parseScene), and finish() rejects any
+// key that was never asked for, so a misspelt key never passes silently.
+
+#include <Eigen/Core>
+#include <nlohmann/json.hpp>
+#include <set>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+namespace torsion::scene {
+
+struct JsonFault : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
+class JsonObject {
+ public:
+  JsonObject(const nlohmann::json& json, std::string path, const std::string& file);
+
+  bool has(const std::string& key) const;
+  double number(const std::string& key) const;
+  double number(const std::string& key, double fallback) const;
+  int integer(const std::string& key, int fallback) const;
+  std::string string(const std::string& key) const;
+  std::string string(const std::string& key, const std::string& fallback) const;
+  bool boolean(const std::string& key, bool fallback) const;
+  Eigen::Vector3d vector3(const std::string& key) const;
+  Eigen::Vector3d vector3(const std::string& key, const Eigen::Vector3d& fallback) const;
+  JsonObject object(const std::string& key) const;
+  std::vector<JsonObject> objects(const std::string& key) const;  ///< an array of objects; [] if absent
+  /// The single key present among `choices` (exactly one must be).
+  std::string oneOf(const std::vector<std::string>& choices) const;
+
+  /// Fails on keys never read through this object.
+  void finish() const;
+
+  [[noreturn]] void fail(const std::string& key, const std::string& fault) const;
+  const std::string& path() const { return path_; }
+
+ private:
+  const nlohmann::json& at(const std::string& key) const;
+  std::string keyPath(const std::string& key) const;
+
+  const nlohmann::json& json_;
+  std::string path_;
+  const std::string& file_;
+  mutable std::set<std::string> read_;
+};
+
+}  // namespace torsion::scene

@@ -1,0 +1,88 @@
+#include "scene_builder.h"
+
+#include "torsion/mesh/mesh_io.h"
+
+namespace torsion::scene {
+
+std::vector<int> selectNodes(const TetMesh& mesh, const NodeSelection& selection) {
+  std::vector<int> nodes;
+  for (int i = 0; i < mesh.nodeCount(); ++i) {
+    const Eigen::Vector3d& p = mesh.restPositions()[static_cast<size_t>(i)];
+    bool inside = false;
+    switch (selection.kind) {
+      case NodeSelection::Kind::kPlane:
+        inside = std::abs(selection.normal.dot(p - selection.point)) <= selection.tolerance;
+        break;
+      case NodeSelection::Kind::kBox:
+        inside = (p.array() >= selection.min.array()).all() && (p.array() <= selection.max.array()).all();
+        break;
+      case NodeSelection::Kind::kSphere:
+        inside = (p - selection.point).norm() <= selection.radius;
+        break;
+    }
+    if (inside) nodes.push_back(i);
+  }
+  return nodes;
+}
+
+Result<std::unique_ptr<BuiltScene>> buildScene(SceneSpec spec, int threads_override) {
+  auto built = std::make_unique<BuiltScene>();
+  if (threads_override >= 0) spec.world.solver.threads = threads_override;
+  built->world = std::make_unique<FemWorld>(spec.world);
+  FemWorld& world = *built->world;
+
+  for (size_t b = 0; b < spec.bodies.size(); ++b) {
+    const BodySpec& body = spec.bodies[b];
+    const std::string entry = spec.file + ": bodies[" + std::to_string(b) + "] '" + body.name + "'";
+    Result<LoadedMesh> mesh = readMesh(body.mesh_path);
+    if (!mesh) return Error{entry + ": " + mesh.error().message};
+    for (const std::string& w : mesh.value().warnings) built->warnings.push_back(w);
+    Result<FemBody*> added = world.addBody(body.name, mesh.value().mesh, body.material, body.pose);
+    if (!added) return Error{entry + ": " + added.error().message};
+  }
+
+  for (size_t s = 0; s < spec.node_sets.size(); ++s) {
+    const NodeSetSpec& set = spec.node_sets[s];
+    const std::string entry = spec.file + ": node_sets[" + std::to_string(s) + "] '" + set.name + "'";
+    FemBody* body = world.body(set.body);
+    std::vector<int> nodes = selectNodes(body->model().mesh(), set.selection);
+    if (nodes.empty()) {
+      return Error{entry + ": the selection matches no node of body '" + set.body +
+                   "' (check the plane, box or sphere against the mesh bounds)"};
+    }
+    NodeSetHandle handle;
+    handle.name = set.name;
+    handle.body = body;
+    handle.wrench_about = set.wrench_about;
+    handle.node_count = static_cast<int>(nodes.size());
+    FrameMotion motion = set.fixed ? FrameMotion([](double) { return Frame{}; })
+                                   : FrameMotion([m = set.motion](double t) { return m.frameAt(t); });
+    handle.group = body->carryNodes(set.name, std::move(nodes), std::move(motion), world.time());
+    built->node_sets.push_back(handle);
+  }
+
+  for (const RigidBodySpec& r : spec.rigid_bodies) {
+    std::unique_ptr<btCollisionShape> shape;
+    btTransform transform;
+    transform.setIdentity();
+    switch (r.shape) {
+      case RigidBodySpec::Shape::kBox:
+        shape = std::make_unique<btBoxShape>(btVector3(r.half_extents.x(), r.half_extents.y(), r.half_extents.z()));
+        break;
+      case RigidBodySpec::Shape::kSphere:
+        shape = std::make_unique<btSphereShape>(r.radius);
+        break;
+      case RigidBodySpec::Shape::kPlane:
+        shape = std::make_unique<btStaticPlaneShape>(
+            btVector3(r.plane_normal.x(), r.plane_normal.y(), r.plane_normal.z()), r.plane_offset);
+        break;
+    }
+    transform.setOrigin(btVector3(r.pose.origin.x(), r.pose.origin.y(), r.pose.origin.z()));
+    transform.setRotation(btQuaternion(r.pose.rotation.x(), r.pose.rotation.y(), r.pose.rotation.z(), r.pose.rotation.w()));
+    world.addRigidBody(std::move(shape), r.mass, transform);
+  }
+  built->spec = std::move(spec);
+  return built;
+}
+
+}  // namespace torsion::scene

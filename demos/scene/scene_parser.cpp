@@ -1,0 +1,241 @@
+#include "scene_parser.h"
+
+#include <filesystem>
+
+#include "json_reader.h"
+#include "torsion/mesh/mesh_io.h"
+
+namespace torsion::scene {
+
+namespace {
+
+Frame readPose(const JsonObject& parent, const std::string& key) {
+  Frame pose;
+  if (!parent.has(key)) return pose;
+  const JsonObject p = parent.object(key);
+  pose.origin = p.vector3("position", Eigen::Vector3d::Zero());
+  if (p.has("axis_angle")) {
+    const JsonObject aa = p.object("axis_angle");
+    const Eigen::Vector3d axis = aa.vector3("axis");
+    if (axis.norm() < 1e-12) aa.fail("axis", "must not be zero");
+    pose.rotation = Eigen::AngleAxisd(aa.number("angle"), axis.normalized());
+    aa.finish();
+  }
+  p.finish();
+  return pose;
+}
+
+Material readMaterial(const JsonObject& m) {
+  Material material;
+  material.youngs_modulus = m.number("youngs_modulus");
+  material.poisson_ratio = m.number("poisson_ratio");
+  material.density = m.number("density");
+  material.mass_damping = m.number("mass_damping", material.mass_damping);
+  material.stiffness_damping = m.number("stiffness_damping", material.stiffness_damping);
+  m.finish();
+  Status valid = material.validate();
+  if (!valid) m.fail("", valid.error().message.substr(valid.error().message.find(':') + 2));
+  return material;
+}
+
+SolverSettings readSolver(const JsonObject& s) {
+  SolverSettings settings;
+  settings.time_step = s.number("dt", settings.time_step);
+  const std::string solver = s.string("linear_solver", "cg");
+  if (solver == "cg") {
+    settings.linear_solver = LinearSolverKind::kConjugateGradient;
+  } else if (solver == "cholmod") {
+    settings.linear_solver = LinearSolverKind::kCholmod;
+  } else {
+    s.fail("linear_solver", "'" + solver + "' is not one of: cg, cholmod");
+  }
+  const std::string preconditioner = s.string("preconditioner", "block_jacobi");
+  if (preconditioner == "jacobi") {
+    settings.preconditioner = PreconditionerKind::kJacobi;
+  } else if (preconditioner == "block_jacobi") {
+    settings.preconditioner = PreconditionerKind::kBlockJacobi;
+  } else {
+    s.fail("preconditioner", "'" + preconditioner + "' is not one of: jacobi, block_jacobi");
+  }
+  settings.tolerance = s.number("tolerance", settings.tolerance);
+  settings.max_iterations = s.integer("max_iterations", settings.max_iterations);
+  settings.threads = s.integer("threads", settings.threads);
+  settings.max_speed = s.number("max_speed", settings.max_speed);
+  s.finish();
+  Status valid = settings.validate();
+  if (!valid) s.fail("", valid.error().message.substr(valid.error().message.find(':') + 2));
+  return settings;
+}
+
+NodeSelection readSelection(const JsonObject& s) {
+  NodeSelection sel;
+  const std::string kind = s.oneOf({"plane", "box", "sphere"});
+  const JsonObject o = s.object(kind);
+  if (kind == "plane") {
+    sel.kind = NodeSelection::Kind::kPlane;
+    sel.point = o.vector3("point");
+    const Eigen::Vector3d n = o.vector3("normal");
+    if (n.norm() < 1e-12) o.fail("normal", "must not be zero");
+    sel.normal = n.normalized();
+    sel.tolerance = o.number("tolerance", 1e-6);
+    if (!(sel.tolerance >= 0)) o.fail("tolerance", "must be >= 0");
+  } else if (kind == "box") {
+    sel.kind = NodeSelection::Kind::kBox;
+    sel.min = o.vector3("min");
+    sel.max = o.vector3("max");
+    if (!(sel.max.array() >= sel.min.array()).all()) o.fail("max", "must be >= min on every axis");
+  } else {
+    sel.kind = NodeSelection::Kind::kSphere;
+    sel.point = o.vector3("center");
+    sel.radius = o.number("radius");
+    if (!(sel.radius > 0)) o.fail("radius", "must be > 0");
+  }
+  o.finish();
+  s.finish();
+  return sel;
+}
+
+MotionSpec readMotion(const JsonObject& m) {
+  MotionSpec motion;
+  motion.angular_velocity = m.vector3("angular_velocity", Eigen::Vector3d::Zero());
+  motion.linear_velocity = m.vector3("linear_velocity", Eigen::Vector3d::Zero());
+  motion.pivot = m.vector3("pivot", Eigen::Vector3d::Zero());
+  motion.start = m.number("start", 0.0);
+  if (m.has("duration")) {
+    motion.duration = m.number("duration");
+    if (!(motion.duration >= 0)) m.fail("duration", "must be >= 0 s");
+  }
+  if (!(motion.start >= 0)) m.fail("start", "must be >= 0 s");
+  m.finish();
+  return motion;
+}
+
+RigidBodySpec readRigidBody(const JsonObject& r) {
+  RigidBodySpec spec;
+  spec.name = r.string("name");
+  const JsonObject shape = r.object("shape");
+  const std::string kind = shape.oneOf({"box", "sphere", "plane"});
+  const JsonObject s = shape.object(kind);
+  if (kind == "box") {
+    spec.shape = RigidBodySpec::Shape::kBox;
+    spec.half_extents = s.vector3("half_extents");
+    if (!(spec.half_extents.minCoeff() > 0)) s.fail("half_extents", "must be > 0");
+  } else if (kind == "sphere") {
+    spec.shape = RigidBodySpec::Shape::kSphere;
+    spec.radius = s.number("radius");
+    if (!(spec.radius > 0)) s.fail("radius", "must be > 0");
+  } else {
+    spec.shape = RigidBodySpec::Shape::kPlane;
+    const Eigen::Vector3d n = s.vector3("normal");
+    if (n.norm() < 1e-12) s.fail("normal", "must not be zero");
+    spec.plane_normal = n.normalized();
+    spec.plane_offset = s.number("offset", 0.0);
+  }
+  s.finish();
+  shape.finish();
+  spec.mass = r.number("mass", spec.shape == RigidBodySpec::Shape::kPlane ? 0.0 : 1.0);
+  if (!(spec.mass >= 0)) r.fail("mass", "must be >= 0 kg (0: static)");
+  if (spec.shape == RigidBodySpec::Shape::kPlane && spec.mass != 0) r.fail("mass", "a plane must be static (mass 0)");
+  spec.pose = readPose(r, "pose");
+  r.finish();
+  return spec;
+}
+
+std::string lineAndColumn(std::string_view text, size_t byte) {
+  int line = 1, column = 1;
+  for (size_t i = 0; i < byte && i < text.size(); ++i) {
+    if (text[i] == '\n') {
+      ++line;
+      column = 1;
+    } else {
+      ++column;
+    }
+  }
+  return std::to_string(line) + ":" + std::to_string(column);
+}
+
+}  // namespace
+
+Frame MotionSpec::frameAt(double t) const {
+  const double tau = std::clamp(t - start, 0.0, duration);
+  Frame frame;
+  const double angle = angular_velocity.norm() * tau;
+  if (angle > 0) frame.rotation = Eigen::AngleAxisd(angle, angular_velocity.normalized());
+  // Rotation about the pivot, then translation: p -> R (p - c) + c + v tau.
+  frame.origin = pivot - (frame.rotation * pivot) + linear_velocity * tau;
+  return frame;
+}
+
+Result<SceneSpec> parseScene(std::string_view text, const std::string& file_name,
+                             const std::string& base_directory) {
+  nlohmann::json json;
+  try {
+    json = nlohmann::json::parse(text.begin(), text.end());
+  } catch (const nlohmann::json::parse_error& e) {
+    // nlohmann's text repeats the position; keep only what went wrong.
+    std::string what = e.what();
+    const size_t column = what.find("column ");
+    const size_t colon = column == std::string::npos ? std::string::npos : what.find(": ", column);
+    return Error{file_name + ":" + lineAndColumn(text, e.byte == 0 ? 0 : e.byte - 1) +
+                 ": invalid JSON: " + (colon != std::string::npos ? what.substr(colon + 2) : what)};
+  }
+  try {
+    SceneSpec scene;
+    scene.file = file_name;
+    const JsonObject root(json, "", file_name);
+    scene.name = root.string("name", std::filesystem::path(file_name).stem().string());
+    scene.world.gravity = root.vector3("gravity", Eigen::Vector3d(0, 0, -9.81));
+    if (root.has("solver")) scene.world.solver = readSolver(root.object("solver"));
+    scene.steps = root.integer("steps", scene.steps);
+    if (scene.steps < 1) root.fail("steps", "must be >= 1");
+
+    for (const JsonObject& b : root.objects("bodies")) {
+      BodySpec body;
+      body.name = b.string("name");
+      for (const BodySpec& other : scene.bodies) {
+        if (other.name == body.name) b.fail("name", "duplicate body name '" + body.name + "'");
+      }
+      const std::string mesh = b.string("mesh");
+      const std::filesystem::path mesh_path(mesh);
+      body.mesh_path = mesh_path.is_absolute() ? mesh : (std::filesystem::path(base_directory) / mesh_path).string();
+      body.material = readMaterial(b.object("material"));
+      body.pose = readPose(b, "pose");
+      b.finish();
+      scene.bodies.push_back(std::move(body));
+    }
+    if (scene.bodies.empty()) root.fail("bodies", "a scene needs at least one FEM body");
+
+    for (const JsonObject& s : root.objects("node_sets")) {
+      NodeSetSpec set;
+      set.name = s.string("name");
+      for (const NodeSetSpec& other : scene.node_sets) {
+        if (other.name == set.name) s.fail("name", "duplicate node set name '" + set.name + "'");
+      }
+      set.body = s.string("body");
+      bool known = false;
+      for (const BodySpec& body : scene.bodies) known = known || body.name == set.body;
+      if (!known) s.fail("body", "no body named '" + set.body + "'");
+      set.selection = readSelection(s.object("select"));
+      set.fixed = !s.has("motion");
+      if (!set.fixed) set.motion = readMotion(s.object("motion"));
+      set.wrench_about = s.vector3("wrench_about", set.motion.pivot);
+      s.finish();
+      scene.node_sets.push_back(std::move(set));
+    }
+    for (const JsonObject& r : root.objects("rigid_bodies")) scene.rigid_bodies.push_back(readRigidBody(r));
+    root.finish();
+    Status world_ok = scene.world.validate();
+    if (!world_ok) return Error{file_name + ": " + world_ok.error().message};
+    return scene;
+  } catch (const JsonFault& fault) {
+    return Error{fault.what()};
+  }
+}
+
+Result<SceneSpec> loadScene(const std::string& path) {
+  Result<std::string> text = readTextFile(path);
+  if (!text) return text.error();
+  return parseScene(text.value(), path, std::filesystem::path(path).parent_path().string());
+}
+
+}  // namespace torsion::scene

@@ -1,0 +1,76 @@
+#pragma once
+// A scene as parsed from its JSON file (docs/scene-format.md): plain data, validated, with every
+// path already resolved relative to the scene file. Building a world from it is scene_builder's job.
+
+#include <Eigen/Core>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "torsion/bullet/fem_world.h"
+#include "torsion/constraints/frame.h"
+#include "torsion/fem/material.h"
+
+namespace torsion::scene {
+
+struct BodySpec {
+  std::string name;
+  std::string mesh_path;  ///< resolved
+  Material material;
+  Frame pose;
+};
+
+/// Which nodes of a body a set takes (rest positions, after the body's pose).
+struct NodeSelection {
+  enum class Kind { kPlane, kBox, kSphere } kind = Kind::kPlane;
+  Eigen::Vector3d point = Eigen::Vector3d::Zero();   ///< plane point / sphere centre
+  Eigen::Vector3d normal = Eigen::Vector3d::UnitZ(); ///< plane normal (unit)
+  double tolerance = 1e-6;                           ///< plane half-thickness, m
+  Eigen::Vector3d min = Eigen::Vector3d::Zero(), max = Eigen::Vector3d::Zero();  ///< box
+  double radius = 0;                                 ///< sphere
+};
+
+/// Constant rigid motion of a node set: rotation at angular_velocity about pivot plus translation
+/// at linear_velocity, active for t in [start, start + duration], held before and after.
+struct MotionSpec {
+  Eigen::Vector3d angular_velocity = Eigen::Vector3d::Zero();  ///< rad/s (axis * rate)
+  Eigen::Vector3d linear_velocity = Eigen::Vector3d::Zero();   ///< m/s
+  Eigen::Vector3d pivot = Eigen::Vector3d::Zero();             ///< m
+  double start = 0;                                            ///< s
+  double duration = std::numeric_limits<double>::infinity();   ///< s
+
+  /// The frame at time t: identity at and before `start` (the set's capture time is 0).
+  Frame frameAt(double t) const;
+};
+
+struct NodeSetSpec {
+  std::string name;
+  std::string body;
+  NodeSelection selection;
+  bool fixed = true;             ///< true: held in place; false: follows `motion`
+  MotionSpec motion;
+  Eigen::Vector3d wrench_about = Eigen::Vector3d::Zero();  ///< point for the reported torque
+};
+
+struct RigidBodySpec {
+  std::string name;
+  enum class Shape { kBox, kSphere, kPlane } shape = Shape::kBox;
+  Eigen::Vector3d half_extents = Eigen::Vector3d::Constant(0.5);  ///< box
+  double radius = 0.5;                                             ///< sphere
+  Eigen::Vector3d plane_normal = Eigen::Vector3d::UnitZ();         ///< static plane
+  double plane_offset = 0;                                         ///< n . x = offset
+  double mass = 1;                                                 ///< kg; 0 = static
+  Frame pose;
+};
+
+struct SceneSpec {
+  std::string file;  ///< the scene file, for messages
+  std::string name;
+  WorldSettings world;
+  int steps = 100;
+  std::vector<BodySpec> bodies;
+  std::vector<NodeSetSpec> node_sets;
+  std::vector<RigidBodySpec> rigid_bodies;
+};
+
+}  // namespace torsion::scene

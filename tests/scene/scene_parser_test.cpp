@@ -1,0 +1,139 @@
+// Scene files: a complete valid scene, and one test per kind of bad input, each checking that the
+// error names the file and the key path (or line:column for JSON syntax).
+#include "scene_parser.h"
+
+#include <gtest/gtest.h>
+
+#include "../unit/error_matchers.h"
+
+namespace torsion::scene {
+namespace {
+
+using test::failsWith;
+
+const std::string kValid = R"({
+  "name": "twist",
+  "gravity": [0, 0, 0],
+  "steps": 50,
+  "solver": {"dt": 0.005, "linear_solver": "cholmod", "tolerance": 1e-6, "threads": 1},
+  "bodies": [{"name": "cyl", "mesh": "meshes/cyl.node",
+              "material": {"youngs_modulus": 1e5, "poisson_ratio": 0.3, "density": 1000},
+              "pose": {"position": [1, 0, 0], "axis_angle": {"axis": [0, 0, 1], "angle": 0.5}}}],
+  "node_sets": [
+    {"name": "base", "body": "cyl", "select": {"plane": {"point": [0, 0, 0], "normal": [0, 0, 1]}}},
+    {"name": "end", "body": "cyl", "select": {"box": {"min": [-2, -2, 9.9], "max": [2, 2, 10.1]}},
+     "motion": {"angular_velocity": [0, 0, 0.1], "pivot": [0, 0, 10], "duration": 5},
+     "wrench_about": [0, 0, 10]}
+  ],
+  "rigid_bodies": [{"name": "ground", "shape": {"plane": {"normal": [0, 0, 1], "offset": -1}}},
+                   {"name": "ball", "shape": {"sphere": {"radius": 0.2}}, "mass": 2,
+                    "pose": {"position": [0, 0, 12]}}]
+})";
+
+Result<SceneSpec> parse(const std::string& text) { return parseScene(text, "s.json", "/base"); }
+
+std::string replaced(std::string text, const std::string& from, const std::string& to) {
+  const size_t at = text.find(from);
+  EXPECT_NE(at, std::string::npos) << from;
+  return at == std::string::npos ? text : text.replace(at, from.size(), to);
+}
+
+TEST(SceneParser, ReadsACompleteScene) {
+  Result<SceneSpec> r = parse(kValid);
+  ASSERT_TRUE(r.ok()) << r.error().message;
+  const SceneSpec& s = r.value();
+  EXPECT_EQ(s.name, "twist");
+  EXPECT_EQ(s.steps, 50);
+  EXPECT_EQ(s.world.solver.linear_solver, LinearSolverKind::kCholmod);
+  EXPECT_DOUBLE_EQ(s.world.solver.time_step, 0.005);
+  ASSERT_EQ(s.bodies.size(), 1u);
+  EXPECT_EQ(s.bodies[0].mesh_path, "/base/meshes/cyl.node");
+  EXPECT_NEAR(s.bodies[0].pose.rotation.angularDistance(Eigen::Quaterniond(Eigen::AngleAxisd(0.5, Eigen::Vector3d::UnitZ()))), 0, 1e-12);
+  ASSERT_EQ(s.node_sets.size(), 2u);
+  EXPECT_TRUE(s.node_sets[0].fixed);
+  EXPECT_FALSE(s.node_sets[1].fixed);
+  EXPECT_EQ(s.rigid_bodies.size(), 2u);
+  EXPECT_EQ(s.rigid_bodies[0].mass, 0.0);
+}
+
+TEST(SceneParser, MotionRotatesAboutPivotThenHolds) {
+  MotionSpec m;
+  m.angular_velocity = Eigen::Vector3d(0, 0, 0.5);
+  m.pivot = Eigen::Vector3d(1, 0, 0);
+  m.duration = 2;
+  const Eigen::Vector3d p(2, 0, 0);
+  EXPECT_LT((m.frameAt(0).toWorld(p) - p).norm(), 1e-15);
+  const Eigen::Vector3d quarter(1, 1, 0);  // 0.5 rad/s for pi s would be a quarter turn; hold at 1 rad
+  EXPECT_LT((m.frameAt(M_PI).toWorld(p) - Eigen::Vector3d(1 + std::cos(1.0), std::sin(1.0), 0)).norm(), 1e-12);
+  (void)quarter;
+}
+
+TEST(SceneParserFaults, JsonSyntaxNamesLineAndColumn) {
+  EXPECT_TRUE(failsWith(parse("{\n  \"steps\": 10,\n  \"bodies\": [\n}"), {"s.json:4:", "invalid JSON"}));
+}
+
+TEST(SceneParserFaults, UnknownKeyIsNamedWithItsPath) {
+  // A misspelt optional key is an unknown key; a misspelt required one is named as both.
+  EXPECT_TRUE(failsWith(parse(replaced(kValid, "\"linear_solver\"", "\"linearsolver\"")),
+                        {"s.json: solver.linearsolver: unknown key", "linear_solver"}));
+  EXPECT_TRUE(failsWith(parse(replaced(kValid, "\"density\"", "\"densty\"")),
+                        {"s.json: bodies[0].material.density: missing", "unknown key(s) 'densty'"}));
+}
+
+TEST(SceneParserFaults, WrongTypeIsNamed) {
+  std::string text = kValid;
+  text.replace(text.find("\"steps\": 50"), 11, "\"steps\": \"50\"");
+  EXPECT_TRUE(failsWith(parse(text), {"s.json: steps: expected an integer, found a string"}));
+  text = kValid;
+  text.replace(text.find("[1, 0, 0]"), 9, "[1, 0]");
+  EXPECT_TRUE(failsWith(parse(text), {"bodies[0].pose.position: expected an array of 3 numbers"}));
+}
+
+TEST(SceneParserFaults, MissingRequiredKey) {
+  std::string text = kValid;
+  text.replace(text.find("\"poisson_ratio\": 0.3, "), 22, "");
+  EXPECT_TRUE(failsWith(parse(text), {"bodies[0].material.poisson_ratio: missing (required)"}));
+}
+
+TEST(SceneParserFaults, OutOfRangeValues) {
+  std::string text = kValid;
+  text.replace(text.find("\"poisson_ratio\": 0.3"), 20, "\"poisson_ratio\": 0.5");
+  EXPECT_TRUE(failsWith(parse(text), {"bodies[0].material", "poisson_ratio", "[0, 0.5)"}));
+  text = kValid;
+  text.replace(text.find("\"dt\": 0.005"), 11, "\"dt\": -1");
+  EXPECT_TRUE(failsWith(parse(text), {"s.json: solver", "time_step"}));
+}
+
+TEST(SceneParserFaults, UnknownBodyInNodeSet) {
+  std::string text = kValid;
+  text.replace(text.find("\"body\": \"cyl\""), 13, "\"body\": \"cyl2\"");
+  EXPECT_TRUE(failsWith(parse(text), {"node_sets[0].body: no body named 'cyl2'"}));
+}
+
+TEST(SceneParserFaults, SelectionNeedsExactlyOneShape) {
+  const std::string text = replaced(kValid, "{\"plane\": {\"point\": [0, 0, 0], \"normal\": [0, 0, 1]}}", "{}");
+  EXPECT_TRUE(failsWith(parse(text), {"node_sets[0].select: needs one of: plane, box, sphere"}));
+}
+
+TEST(SceneParserFaults, UnknownSolverName) {
+  std::string text = kValid;
+  text.replace(text.find("\"cholmod\""), 9, "\"lu\"");
+  EXPECT_TRUE(failsWith(parse(text), {"solver.linear_solver: 'lu' is not one of: cg, cholmod"}));
+}
+
+TEST(SceneParserFaults, NonFiniteNumbersAndZeroAxis) {
+  std::string text = kValid;
+  text.replace(text.find("\"axis\": [0, 0, 1]"), 17, "\"axis\": [0, 0, 0]");
+  EXPECT_TRUE(failsWith(parse(text), {"bodies[0].pose.axis_angle.axis: must not be zero"}));
+}
+
+TEST(SceneParserFaults, NoBodies) {
+  EXPECT_TRUE(failsWith(parse("{\"steps\": 3}"), {"s.json: bodies: a scene needs at least one FEM body"}));
+}
+
+TEST(SceneParserFaults, TopLevelMustBeAnObject) {
+  EXPECT_TRUE(failsWith(parse("[1, 2]"), {"s.json: the scene: expected an object, found an array"}));
+}
+
+}  // namespace
+}  // namespace torsion::scene
