@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
-# The main job, from a fresh machine: set-up, Release build, then the headless job.
-# Until the FEM solver lands, the job inspects every shipped mesh asset and writes a report.
+# The main job, from a fresh machine: set-up, Release build, then the headless twist of the small
+# cylinder (the report's section 6.1.2: r = 1, L = 10, one end fixed, the other turned by 2 pi at
+# 0.1 rad/s, dt = 0.01). Prints its progress; writes its results to results/twist_cylinder_2430/.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 jobs=$(nproc 2>/dev/null || echo 2)
@@ -9,12 +10,11 @@ bash scripts/setup.sh
 cmake -S . -B build -G Ninja -DCMAKE_BUILD_TYPE=Release
 cmake --build build -j"$jobs" --target torsion
 
-out=results/assets
-mkdir -p "$out"
-for node in assets/meshes/*.node; do
-  name=$(basename "$node" .node)
-  echo "== $name"
-  build/demos/torsion mesh info "$node" | tee "$out/$name.txt"
-  build/demos/torsion mesh convert "$node" "$out/$name.vtk"
-done
-echo "Results: $out/ (one .txt report and one ParaView .vtk per mesh)"
+scene=demos/scenes/twist_cylinder_2430.json
+out=results/twist_cylinder_2430
+build/demos/torsion run "$scene" --out "$out"
+echo
+echo "Summary ($out/summary.json):"
+cat "$out/summary.json"
+echo
+echo "Results in $out/: summary.json, wrench.csv (torque on the turned end), energy.csv, cylinder.vtk (open in ParaView)"

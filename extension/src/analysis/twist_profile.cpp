@@ -1,5 +1,6 @@
 #include "torsion/analysis/twist_profile.h"
 
+#include <Eigen/LU>
 #include <cmath>
 #include <limits>
 
@@ -81,6 +82,31 @@ double twistNonlinearity(const std::vector<SliceRotation>& profile, double z_min
   }
   const double span = std::abs(line.slope) * (z_max - z_min);
   return span > 0 ? worst / span : std::numeric_limits<double>::infinity();
+}
+
+double polarMomentOfSection(const std::vector<Eigen::Vector3d>& rest,
+                            const std::vector<std::array<int, 4>>& tets, double length,
+                            double axis_x, double axis_y) {
+  // Exact integral of a quadratic over a tet: int x_i x_j dV = V/20 (sum_a x_ai x_aj + s_i s_j),
+  // with s the sum of the four vertex coordinates.
+  double total = 0;
+  for (const auto& tet : tets) {
+    Eigen::Vector2d p[4];
+    Eigen::Vector2d sum = Eigen::Vector2d::Zero();
+    for (int a = 0; a < 4; ++a) {
+      const Eigen::Vector3d& x = rest[static_cast<size_t>(tet[static_cast<size_t>(a)])];
+      p[a] = Eigen::Vector2d(x.x() - axis_x, x.y() - axis_y);
+      sum += p[a];
+    }
+    const Eigen::Vector3d& x0 = rest[static_cast<size_t>(tet[0])];
+    Eigen::Matrix3d D;
+    for (int k = 0; k < 3; ++k) D.col(k) = rest[static_cast<size_t>(tet[static_cast<size_t>(k + 1)])] - x0;
+    const double volume = std::abs(D.determinant()) / 6.0;
+    double squares = sum.squaredNorm();
+    for (int a = 0; a < 4; ++a) squares += p[a].squaredNorm();
+    total += volume / 20.0 * squares;
+  }
+  return total / length;
 }
 
 }  // namespace torsion

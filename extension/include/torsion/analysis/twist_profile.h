@@ -3,6 +3,7 @@
 // slices and the twist rate, for validation against St-Venant (T = G J theta').
 
 #include <Eigen/Core>
+#include <array>
 #include <vector>
 
 namespace torsion {
@@ -29,5 +30,12 @@ double twistRate(const std::vector<SliceRotation>& profile, double z_min, double
 /// Largest deviation of the angles in [z_min, z_max] from their least-squares line, relative to
 /// the angle change across that range (0 for a perfectly linear profile).
 double twistNonlinearity(const std::vector<SliceRotation>& profile, double z_min, double z_max);
+
+/// Polar moment of the body's cross-section about the z axis through (axis_x, axis_y), averaged
+/// over its length: (1 / length) * integral of ((x - ax)^2 + (y - ay)^2) dV, exact for the meshed
+/// (polygonal) section. For a prismatic body this is the section's J; St-Venant's J = pi r^4 / 2
+/// is the smooth circle's, a few % more than a 20-gon's.
+double polarMomentOfSection(const std::vector<Eigen::Vector3d>& rest, const std::vector<std::array<int, 4>>& tets,
+                            double length, double axis_x = 0, double axis_y = 0);
 
 }  // namespace torsion
