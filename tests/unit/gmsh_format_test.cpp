@@ -488,12 +488,13 @@ TEST(GmshFaults, CountsDoNotMatch41) {
   EXPECT_TRUE(failsWith(parse(withLine(kMsh41, 10, "2 5 7 99")),
                         {"m.msh:10:", "declares 5 nodes, its 2 entity blocks hold 3"}));
   // numNodesInBlock smaller than the tags present: a tag line is read as a coordinate line.
-  EXPECT_TRUE(
-      failsWith(parse(withLine(withLine(kMsh41, 10, "3 4 7 99"), 14, "2 4 1 1")),
-                {"m.msh:16:", "'x y z' and 2 parametric coordinates of node 30", "found 1 field"}));
+  EXPECT_TRUE(failsWith(parse(withLine(withLine(kMsh41, 10, "3 4 7 99"), 14, "2 4 1 1")),
+                        {"m.msh:16:", "'x y z' and 2 parametric coordinates of node 30",
+                         "found 1 field", "(the block header, line 14, declares 1 node)"}));
   // numNodesInBlock larger than the tags present: a coordinate line is read as a tag line.
   EXPECT_TRUE(failsWith(parse(withLine(withLine(kMsh41, 10, "3 6 7 99"), 19, "3 1 0 3")),
-                        {"m.msh:22:", "one node tag per line", "found 3 fields"}));
+                        {"m.msh:22:", "one node tag per line", "found 3 fields",
+                         "(the block header, line 19, declares 3 nodes)"}));
   // numElementsInBlock larger than the lines present.
   EXPECT_TRUE(failsWith(parse(withLine(withLine(kMsh41, 26, "3 6 1 12"), 32, "3 1 4 3")),
                         {"m.msh:35:", "unexpected '$EndElements'",

@@ -98,6 +98,26 @@ Result<LoadedMesh> buildTetMesh(RawTetMesh raw, const MeshLoadOptions& options) 
     loaded.warnings.push_back(s.str());
   }
 
+  // The same four nodes twice would pass the face test below (each face shared by two tets).
+  {
+    std::vector<std::pair<Tet, size_t>> sorted;
+    sorted.reserve(raw.tets.size());
+    for (size_t t = 0; t < raw.tets.size(); ++t) {
+      Tet key = raw.tets[t];
+      std::sort(key.begin(), key.end());
+      sorted.emplace_back(key, t);
+    }
+    std::sort(sorted.begin(), sorted.end());
+    for (size_t i = 1; i < sorted.size(); ++i) {
+      if (sorted[i].first == sorted[i - 1].first) {
+        const size_t later = std::max(sorted[i].second, sorted[i - 1].second);
+        const size_t earlier = std::min(sorted[i].second, sorted[i - 1].second);
+        return Error{where(raw, later) + ": duplicates tet " + std::to_string(raw.origins[earlier].id) +
+                     " (the same four vertices)"};
+      }
+    }
+  }
+
   // A face inside a tet mesh is shared by two tets; three or more means overlapping tets.
   const std::vector<detail::FaceRecord> faces = detail::sortedFaces(raw.tets);
   for (size_t i = 0; i + 2 < faces.size(); ++i) {
