@@ -10,6 +10,7 @@
 #include <string>
 #include <string_view>
 #include <utility>
+#include <vector>
 
 #include "torsion/mesh/raw_tet_mesh.h"
 #include "torsion/mesh/tet_mesh.h"

@@ -22,7 +22,7 @@ Result<LoadedMesh> build(const std::string& ele, MeshLoadOptions options = {}) {
 }
 
 TEST(BuildTetMesh, RepeatedVertex) {
-  EXPECT_TRUE(failsWith(build("1 4 0\n7 0 1 1 3\n"), {"m.ele:2: tet 7:", "vertex 1 appears twice"}));
+  EXPECT_TRUE(failsWith(build("1 4 0\n1 0 1 1 3\n"), {"m.ele:2: tet 1:", "vertex 1 appears twice"}));
 }
 
 TEST(BuildTetMesh, ZeroVolume) {

@@ -114,3 +114,28 @@ TEST(TetGenFaults, IndicesOutOfSequence) {
 
 }  // namespace
 }  // namespace torsion
+
+namespace torsion {
+namespace {
+
+// Inputs the fuzzer found: each must fail cleanly (no huge allocation, no overflow).
+TEST(TetGenFaults, HostileHeadersAndIndices) {
+  EXPECT_FALSE(parseTetGen("21474836481 3 0 0\n0 0 0 0\n", "m.node", "1 4 0\n0 0 1 2 3\n", "m.ele").ok());
+  EXPECT_TRUE(test::failsWith(parseTetGen("4 3 9223372036854775800 1\n", "m.node", "", "m.ele"),
+                              {"m.node:1:", "attributes"}));
+  const std::string node = "4 3 0 0\n1 0 0 0\n2 1 0 0\n3 0 1 0\n4 0 0 1\n";
+  EXPECT_TRUE(test::failsWith(parseTetGen(node, "m.node", "1 4 0\n9223372036854775807 1 2 3 4\n", "m.ele"),
+                              {"m.ele:2:", "first tet index must be 0 or 1"}));
+  EXPECT_TRUE(test::failsWith(parseTetGen(node, "m.node", "1 4 0\n1 -9223372036854775808 2 3 4\n", "m.ele"),
+                              {"m.ele:2:", "< first point index 1"}));
+}
+
+TEST(TetGenFaults, HugeCoordinatesOverflowingTheVolume) {
+  Result<RawTetMesh> raw = parseTetGen("4 3 0 0\n0 0 0 0\n1 1e200 0 0\n2 0 1e200 0\n3 0 0 1e200\n", "m.node",
+                                       "1 4 0\n0 0 1 2 3\n", "m.ele");
+  ASSERT_TRUE(raw.ok());
+  EXPECT_TRUE(test::failsWith(buildTetMesh(std::move(raw).value()), {"m.ele:2: tet 0:", "overflows"}));
+}
+
+}  // namespace
+}  // namespace torsion

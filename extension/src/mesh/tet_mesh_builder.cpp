@@ -69,6 +69,9 @@ Result<LoadedMesh> buildTetMesh(RawTetMesh raw, const MeshLoadOptions& options) 
     for (size_t i = 0; i < 4; ++i) x[i] = raw.positions[static_cast<size_t>(tet[i])];
     const double six_volume = sixSignedVolume(x[0], x[1], x[2], x[3]);
     const double edge = longestEdge(x);
+    if (!std::isfinite(six_volume) || !std::isfinite(edge)) {
+      return Error{where(raw, t) + ": coordinates too large: its volume overflows a double"};
+    }
     if (std::abs(six_volume) <= options.degenerate_tolerance * edge * edge * edge) {
       std::ostringstream s;
       s << where(raw, t) << ": zero volume (6V = " << six_volume << ", longest edge " << edge

@@ -1,5 +1,6 @@
 #include "torsion/mesh/tetgen_format.h"
 
+#include <algorithm>
 #include <cstdio>
 #include <string>
 
@@ -10,6 +11,15 @@ namespace torsion {
 namespace {
 
 using detail::TextScanner;
+
+// More per-point attributes than this is no mesh we can use; it also keeps field counts small.
+constexpr long kMaxAttributes = 1000;
+
+// A header count is only trusted as far as the text could hold it (each entry is at least one
+// short line), so a hostile header cannot make us reserve gigabytes.
+size_t plausibleCount(long count, const TextScanner& in) {
+  return static_cast<size_t>(std::min<long>(count, static_cast<long>(in.textSize() / 2 + 1)));
+}
 
 struct NodeTable {
   std::vector<Eigen::Vector3d> positions;
@@ -26,12 +36,15 @@ NodeTable parseNodes(TextScanner& in) {
   const long markers = header.size() > 3 ? in.parseInteger(header[3], "the number of boundary markers") : 0;
   if (count <= 0) in.fail("the header declares " + std::to_string(count) + " points; a mesh needs some");
   if (dimension != 3) in.fail("dimension is " + std::to_string(dimension) + "; only 3 is supported");
-  if (attributes < 0) in.fail("negative number of attributes");
+  if (attributes < 0 || attributes > kMaxAttributes) {
+    in.fail("number of attributes " + std::to_string(attributes) + " is out of range [0, " +
+            std::to_string(kMaxAttributes) + "]");
+  }
   if (markers != 0 && markers != 1) in.fail("boundary markers must be 0 or 1, found " + std::to_string(markers));
   const int header_line = in.lineNumber();
 
   NodeTable table;
-  table.positions.reserve(static_cast<size_t>(count));
+  table.positions.reserve(plausibleCount(count, in));
   const size_t fields = static_cast<size_t>(4 + attributes + markers);
   for (long i = 0; i < count; ++i) {
     if (!in.nextLine()) {
@@ -75,13 +88,16 @@ void parseElements(TextScanner& in, const NodeTable& nodes, RawTetMesh& raw) {
   if (count <= 0) in.fail("the header declares " + std::to_string(count) + " tetrahedra; a mesh needs some");
   if (per_tet == 10) in.fail("quadratic (10-node) tetrahedra are not supported; mesh with 4-node tets");
   if (per_tet != 4) in.fail("nodes per tetrahedron is " + std::to_string(per_tet) + "; must be 4");
-  if (attributes < 0) in.fail("negative number of attributes");
+  if (attributes < 0 || attributes > kMaxAttributes) {
+    in.fail("number of attributes " + std::to_string(attributes) + " is out of range [0, " +
+            std::to_string(kMaxAttributes) + "]");
+  }
   const int header_line = in.lineNumber();
 
   const long node_count = static_cast<long>(nodes.positions.size());
   const size_t fields = static_cast<size_t>(5 + attributes);
-  raw.tets.reserve(static_cast<size_t>(count));
-  raw.origins.reserve(static_cast<size_t>(count));
+  raw.tets.reserve(plausibleCount(count, in));
+  raw.origins.reserve(plausibleCount(count, in));
   long first_index = 0;
   for (long i = 0; i < count; ++i) {
     if (!in.nextLine()) {
@@ -95,6 +111,7 @@ void parseElements(TextScanner& in, const NodeTable& nodes, RawTetMesh& raw) {
     }
     const long index = in.parseInteger(in.tokens()[0], "the tetrahedron index");
     if (i == 0) {
+      if (index != 0 && index != 1) in.fail("the first tet index must be 0 or 1, found " + std::to_string(index));
       first_index = index;
     } else if (index != first_index + i) {
       in.fail("tet index " + std::to_string(index) + " out of sequence, expected " +
@@ -103,10 +120,12 @@ void parseElements(TextScanner& in, const NodeTable& nodes, RawTetMesh& raw) {
     Tet tet;
     for (size_t k = 0; k < 4; ++k) {
       const long v = in.parseInteger(in.tokens()[1 + k], "a vertex of tet " + std::to_string(index));
-      const long zero_based = v - nodes.first_index;
-      if (zero_based < 0 || zero_based >= node_count) {
+      // Compare before subtracting: v may be any long.
+      const bool in_range = v >= nodes.first_index && v - nodes.first_index < node_count;
+      const long zero_based = in_range ? v - nodes.first_index : -1;
+      if (!in_range) {
         in.fail("tet " + std::to_string(index) + ": vertex " + std::to_string(v) +
-                (zero_based < 0 ? " < first point index " + std::to_string(nodes.first_index)
+                (v < nodes.first_index ? " < first point index " + std::to_string(nodes.first_index)
                  : nodes.first_index == 0
                      ? " >= vertex count " + std::to_string(node_count)
                      : " > vertex count " + std::to_string(node_count) + " (indices are 1-based)"));

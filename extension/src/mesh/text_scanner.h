@@ -24,6 +24,7 @@ class TextScanner {
   TextScanner(std::string_view text, std::string file_name, char comment = '\0');
 
   const std::string& fileName() const { return file_name_; }
+  size_t textSize() const { return text_.size(); }
 
   // ---- Line by line ----
   /// Moves to the next line that has a token; false at end of text. Splits it into tokens().
