@@ -20,11 +20,11 @@ struct CylinderSpec {
 
 struct CylinderMesh {
   LoadedMesh mesh;
-  int segments = 0;         ///< points per ring (around the axis)
-  int layers = 0;           ///< rings - 1 (along the axis)
-  double max_volume = 0;    ///< tetgen -a
-  std::string switches;     ///< the tetgen switches of the run that made it
-  int runs = 0;             ///< tetgen runs the search took
+  int segments = 0;       ///< points per ring (around the axis)
+  int layers = 0;         ///< rings - 1 (along the axis)
+  double max_volume = 0;  ///< tetgen -a
+  std::string switches;   ///< the tetgen switches of the run that made it
+  int runs = 0;           ///< tetgen runs the search took
 };
 
 /// The tetgen switches for the cylinder: quality (radius-edge ratio 1.4, min dihedral 12 deg) and

@@ -16,7 +16,8 @@ namespace {
 
 std::string lowerExtension(const fs::path& path) {
   std::string ext = path.extension().string();
-  for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  for (char& c : ext)
+    c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
   return ext;
 }
 
@@ -76,7 +77,10 @@ Status prepareClosedSurface(SurfaceMesh& surface, const std::string& file) {
   const std::pair<const std::pair<int, int>, std::pair<int, size_t>>* example = nullptr;
   for (const auto& entry : edges) {
     if (entry.second.first == 2) continue;
-    if (entry.second.first == 1) ++open; else ++crowded;
+    if (entry.second.first == 1)
+      ++open;
+    else
+      ++crowded;
     if (example == nullptr) example = &entry;
   }
   if (example != nullptr) {
@@ -84,15 +88,17 @@ Status prepareClosedSurface(SurfaceMesh& surface, const std::string& file) {
     const auto [uses, t] = example->second;
     return Error{where(file, surface, t) + "the surface is not closed: " + std::to_string(open) +
                  " edge(s) used by one triangle, " + std::to_string(crowded) +
-                 " by more than two; e.g. edge " + pointText(surface.vertices[static_cast<size_t>(a)]) +
-                 " - " + pointText(surface.vertices[static_cast<size_t>(b)]) + " is used by " +
+                 " by more than two; e.g. edge " +
+                 pointText(surface.vertices[static_cast<size_t>(a)]) + " - " +
+                 pointText(surface.vertices[static_cast<size_t>(b)]) + " is used by " +
                  std::to_string(uses) + " triangle(s)"};
   }
 
   // Drop vertices no triangle uses (tetgen would keep them as loose points).
   std::vector<int> remap(surface.vertices.size(), -1);
   for (const auto& tri : surface.triangles) {
-    for (int v : tri) remap[static_cast<size_t>(v)] = 0;
+    for (int v : tri)
+      remap[static_cast<size_t>(v)] = 0;
   }
   std::vector<Eigen::Vector3d> kept;
   for (size_t v = 0; v < remap.size(); ++v) {
@@ -101,7 +107,8 @@ Status prepareClosedSurface(SurfaceMesh& surface, const std::string& file) {
     kept.push_back(surface.vertices[v]);
   }
   for (auto& tri : surface.triangles) {
-    for (int& v : tri) v = remap[static_cast<size_t>(v)];
+    for (int& v : tri)
+      v = remap[static_cast<size_t>(v)];
   }
   surface.vertices = std::move(kept);
   return Ok{};

@@ -32,7 +32,8 @@ SurfaceMesh parseOffOrThrow(std::string_view text, const std::string& file) {
   if (counts.size() < 2) in.fail("expected '<#vertices> <#faces> <#edges>'");
   const long vertex_count = in.integer(counts[0], "the vertex count");
   const long face_count = in.integer(counts[1], "the face count");
-  if (vertex_count < 3) in.fail("needs at least 3 vertices, the header says " + std::string(counts[0]));
+  if (vertex_count < 3)
+    in.fail("needs at least 3 vertices, the header says " + std::string(counts[0]));
   if (face_count < 1) in.fail("needs at least 1 face, the header says " + std::string(counts[1]));
   if (vertex_count > 100'000'000 || face_count > 100'000'000) {
     in.fail("implausibly large counts in the header");

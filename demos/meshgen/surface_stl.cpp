@@ -32,8 +32,8 @@ class VertexMerger {
 
 bool startsWithSolid(std::string_view bytes) {
   size_t i = 0;
-  while (i < bytes.size() && (bytes[i] == ' ' || bytes[i] == '\t' || bytes[i] == '\r' ||
-                              bytes[i] == '\n')) {
+  while (i < bytes.size() &&
+         (bytes[i] == ' ' || bytes[i] == '\t' || bytes[i] == '\r' || bytes[i] == '\n')) {
     ++i;
   }
   return bytes.substr(i, 5) == "solid";
@@ -64,10 +64,11 @@ Result<SurfaceMesh> parseBinaryStl(std::string_view bytes, const std::string& fi
     for (int c = 0; c < 3; ++c) {
       Eigen::Vector3d p;
       for (int k = 0; k < 3; ++k) {
-        const float v = readF32(bytes, base + 12 + 12 * static_cast<size_t>(c) + 4 * static_cast<size_t>(k));
+        const float v =
+            readF32(bytes, base + 12 + 12 * static_cast<size_t>(c) + 4 * static_cast<size_t>(k));
         if (!std::isfinite(v)) {
-          return Error{file + ": binary STL triangle " + std::to_string(t) +
-                       " (byte " + std::to_string(base) + "): non-finite coordinate"};
+          return Error{file + ": binary STL triangle " + std::to_string(t) + " (byte " +
+                       std::to_string(base) + "): non-finite coordinate"};
         }
         p[k] = static_cast<double>(v);
       }
@@ -120,8 +121,8 @@ SurfaceMesh parseAsciiStlOrThrow(std::string_view text, const std::string& file)
       if (v.size() < 4) {
         in.fail("vertex: expected 3 coordinates, got " + std::to_string(v.size() - 1));
       }
-      tri[c] = merger.add(
-          Eigen::Vector3d(in.real(v[1], "x"), in.real(v[2], "y"), in.real(v[3], "z")));
+      tri[c] =
+          merger.add(Eigen::Vector3d(in.real(v[1], "x"), in.real(v[2], "y"), in.real(v[3], "z")));
     }
     expectWords(in, {"endloop"}, "'endloop' (STL facets are triangles)");
     expectWords(in, {"endfacet"}, "'endfacet'");

@@ -93,9 +93,11 @@ class LineCursor {
     tokens_.clear();
     size_t i = 0;
     while (i < line.size()) {
-      while (i < line.size() && isSpace(line[i])) ++i;
+      while (i < line.size() && isSpace(line[i]))
+        ++i;
       const size_t start = i;
-      while (i < line.size() && !isSpace(line[i])) ++i;
+      while (i < line.size() && !isSpace(line[i]))
+        ++i;
       if (i > start) tokens_.push_back(line.substr(start, i - start));
     }
   }

@@ -36,7 +36,9 @@ Result<TempDir> TempDir::create(std::string_view prefix) {
   return TempDir(fs::path(buffer.data()));
 }
 
-TempDir::TempDir(TempDir&& other) noexcept : path_(std::move(other.path_)) { other.path_.clear(); }
+TempDir::TempDir(TempDir&& other) noexcept : path_(std::move(other.path_)) {
+  other.path_.clear();
+}
 
 TempDir& TempDir::operator=(TempDir&& other) noexcept {
   if (this != &other) {
@@ -112,7 +114,8 @@ Result<ProcessResult> runProcess(const std::vector<std::string>& argv, const fs:
   posix_spawn_file_actions_addopen(&actions, 2, err_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC,
                                    0644);
   std::vector<char*> args;
-  for (const std::string& a : argv) args.push_back(const_cast<char*>(a.c_str()));  // NOLINT
+  for (const std::string& a : argv)
+    args.push_back(const_cast<char*>(a.c_str()));  // NOLINT
   args.push_back(nullptr);
   pid_t pid = 0;
   const int spawned = ::posix_spawn(&pid, argv[0].c_str(), &actions, nullptr, args.data(), environ);
@@ -154,6 +157,7 @@ std::string outputTail(const ProcessResult& run) {
       if (!line.empty() && line.back() == '\r') line.pop_back();
       if (line.find_first_not_of(" \t") == std::string::npos) continue;
       if (line.find("terminate called after throwing") != std::string::npos) continue;
+      if (line.rfind("Opening ", 0) == 0) continue;  // names our temporary file
       lines.push_back(line);
     }
   }
@@ -212,11 +216,11 @@ Result<TetgenRun> runTetgen(const fs::path& tetgen, const std::string& switches,
   const bool ended_well = r.exited && r.exit_code == 0;
   const bool have_files = fs::exists(out.node) && fs::exists(out.ele);
   if (!ended_well || !have_files) {
-    std::string message = "tetgen " + switches + " failed on " + input.filename().string() + " (" +
-                          howItEnded(r) +
+    std::string message = "tetgen " + switches + " failed (" + howItEnded(r) +
                           (ended_well ? ", but it wrote no tetrahedra" : "") + ")";
     const std::string tail = outputTail(r);
-    message += tail.empty() ? "; it printed nothing" : "; its last output:\n" + tail;
+    message += tail.empty() ? "; it printed no message (TetGen 1.5 aborts silently on many faults)"
+                            : "; its last output:\n" + tail;
     if (!message.empty() && message.back() == '\n') message.pop_back();
     return Error{message};
   }
@@ -233,8 +237,8 @@ Result<std::vector<std::pair<int, int>>> findSelfIntersections(const fs::path& t
   static const std::regex pair_re(R"(Facet #(\d+) intersects facet #(\d+))");
   std::vector<std::pair<int, int>> pairs;
   const std::string& out = run.value().out;
-  for (auto it = std::sregex_iterator(out.begin(), out.end(), pair_re); it != std::sregex_iterator();
-       ++it) {
+  for (auto it = std::sregex_iterator(out.begin(), out.end(), pair_re);
+       it != std::sregex_iterator(); ++it) {
     pairs.emplace_back(std::stoi((*it)[1].str()) - 1, std::stoi((*it)[2].str()) - 1);
   }
   return pairs;

@@ -51,7 +51,7 @@ Result<TetgenRun> runTetgen(const std::filesystem::path& tetgen, const std::stri
 
 /// Runs `tetgen -d` (self-intersection check) on a PLC. Returns the pairs of facets (0-based, in
 /// input order) that tetgen reports intersecting; an empty list when it found none.
-Result<std::vector<std::pair<int, int>>> findSelfIntersections(
-    const std::filesystem::path& tetgen, const std::filesystem::path& input);
+Result<std::vector<std::pair<int, int>>> findSelfIntersections(const std::filesystem::path& tetgen,
+                                                               const std::filesystem::path& input);
 
 }  // namespace torsion::meshgen

@@ -1,0 +1,363 @@
+#!/usr/bin/env bash
+# The torsion tool as a user runs it: one check per call, named by its first argument.
+#   cli_checks.sh CASE TORSION ASSETS_DIR
+# Exit 0: pass; 77: skipped (e.g. no tetgen on PATH; CTest SKIP_RETURN_CODE); anything else: fail.
+# Each case works in a fresh temporary directory, removed afterwards.
+set -uo pipefail
+
+case_name=$1
+torsion=$2
+assets=$3
+
+work=$(mktemp -d "${TMPDIR:-/tmp}/torsion-cli-test-XXXXXX")
+trap 'rm -rf "$work"' EXIT
+cd "$work" || exit 1
+
+fail() {
+  echo "FAIL: $*" >&2
+  exit 1
+}
+
+# run CMD...: runs it, keeping its exit code in $rc and its stdout+stderr in $out.
+run() {
+  out=$("$@" 2>&1)
+  rc=$?
+  printf '%s\n' "$out"
+}
+
+expect_rc() {  # expect_rc 0|nonzero
+  if [[ $1 == 0 && $rc -ne 0 ]]; then fail "exit code $rc, expected 0"; fi
+  if [[ $1 == nonzero && $rc -eq 0 ]]; then fail "exit code 0, expected non-zero"; fi
+}
+
+expect_out() {  # expect_out REGEX (extended, matched against the whole output)
+  grep -Eq -- "$1" <<<"$out" || fail "output does not match: $1"
+}
+
+# Value of one `torsion mesh info` field, e.g. info_field tets FILE.
+info_field() {
+  "$torsion" mesh info "$2" | sed -n "s/^$1 \{1,\}\([^ ]*\).*/\1/p"
+}
+
+need_tetgen() {
+  if ! command -v tetgen >/dev/null 2>&1; then
+    echo "SKIP: the 'tetgen' command is not on PATH (Debian package 'tetgen')"
+    exit 77
+  fi
+}
+
+# A closed cube [0,2]^3 in each surface format (outward triangles).
+write_cube_off() {
+  cat >"$1" <<'EOF'
+OFF
+# a cube of side 2
+8 6 0
+0 0 0
+2 0 0
+2 2 0
+0 2 0
+0 0 2
+2 0 2
+2 2 2
+0 2 2
+4 0 3 2 1
+4 4 5 6 7
+4 0 1 5 4
+4 1 2 6 5
+4 2 3 7 6
+4 3 0 4 7
+EOF
+}
+
+# An octahedron with quads-free faces, OBJ with texture/normal indices, a negative (relative)
+# index, and lines to ignore.
+write_octahedron_obj() {
+  cat >"$1" <<'EOF'
+# octahedron
+mtllib none.mtl
+o octahedron
+v 1 0 0
+v -1 0 0
+v 0 1 0
+v 0 -1 0
+v 0 0 1
+v 0 0 -1
+vt 0 0
+vn 0 0 1
+s off
+usemtl default
+f 1/1/1 3/1/1 5/1/1
+f 3//1 2//1 5//1
+f 2/1 4/1 5/1
+f 4 1 5
+f 3 1 6
+f 2 3 6
+f 4 2 6
+f 1 4 -1
+EOF
+}
+
+# Cube triangles as (v0 v1 v2) corner lists over the corners of write_cube_off.
+cube_triangles=("0 3 2" "0 2 1" "4 5 6" "4 6 7" "0 1 5" "0 5 4" "1 2 6" "1 6 5" "2 3 7" "2 7 6"
+  "3 0 4" "3 4 7")
+cube_corner() {  # cube_corner I -> "x y z"
+  local c=("0 0 0" "2 0 0" "2 2 0" "0 2 0" "0 0 2" "2 0 2" "2 2 2" "0 2 2")
+  echo "${c[$1]}"
+}
+
+write_cube_stl_ascii() {
+  {
+    echo "solid cube"
+    for t in "${cube_triangles[@]}"; do
+      echo "  facet normal 0 0 0"
+      echo "    outer loop"
+      for i in $t; do echo "      vertex $(cube_corner "$i")"; done
+      echo "    endloop"
+      echo "  endfacet"
+    done
+    echo "endsolid cube"
+  } >"$1"
+}
+
+# shellcheck disable=SC2059  # the byte escapes live in the format strings on purpose
+write_cube_stl_binary() {
+  # Little-endian float32: 0 -> 00 00 00 00, 2 -> 00 00 00 40.
+  local f0='\x00\x00\x00\x00' f2='\x00\x00\x00\x40'
+  {
+    printf 'binary cube%69s' ''                 # 80-byte header
+    printf '\x0c\x00\x00\x00'                   # 12 triangles
+    for t in "${cube_triangles[@]}"; do
+      printf "$f0$f0$f0"                        # normal (unused)
+      for i in $t; do
+        for x in $(cube_corner "$i"); do
+          if [[ $x == 0 ]]; then printf "$f0"; else printf "$f2"; fi
+        done
+      done
+      printf '\x00\x00'                         # attribute byte count
+    done
+  } >"$1"
+}
+
+check_cube_mesh() {  # check_cube_mesh MESH: a valid mesh of volume exactly 8
+  local tets volume
+  tets=$(info_field tets "$1")
+  volume=$(info_field volume "$1")
+  [[ -n $tets && $tets -ge 6 ]] || fail "expected at least 6 tets in $1, got '$tets'"
+  [[ $volume == 8 ]] || fail "expected volume 8 for the cube in $1, got '$volume'"
+  echo "ok: $1: $tets tets, volume $volume"
+}
+
+case $case_name in
+  info_missing_file)
+    run "$torsion" mesh info does_not_exist.node
+    expect_rc nonzero
+    expect_out "^error: does_not_exist.node: cannot open: No such file or directory"
+    ;;
+
+  info_malformed_file)
+    printf '4 3 0 0\n0 0 0 0\n1 1 0 0\n2 0 x 0\n3 0 0 1\n' >bad.node
+    printf '1 4 0\n0 0 1 2 3\n' >bad.ele
+    run "$torsion" mesh info bad.node
+    expect_rc nonzero
+    expect_out "^error: bad.node:4: .*'x'"
+    ;;
+
+  convert_round_trip)
+    cp "$assets/cylinder_2430.node" "$assets/cylinder_2430.ele" .
+    for step in "cylinder_2430.node a.msh" "a.msh b.vtk" "b.vtk c.node"; do
+      # shellcheck disable=SC2086
+      run "$torsion" mesh convert $step
+      expect_rc 0
+    done
+    for f in a.msh b.vtk c.node; do
+      [[ $(info_field tets "$f") == 2408 && $(info_field nodes "$f") == 661 ]] ||
+        fail "$f: counts changed in the round trip"
+    done
+    cmp c.node cylinder_2430.node || fail "node file differs after .node -> .msh -> .vtk -> .node"
+    cmp c.ele cylinder_2430.ele || fail "ele file differs after .node -> .msh -> .vtk -> .node"
+    ;;
+
+  cylinder_small)
+    need_tetgen
+    run "$torsion" mesh cylinder --radius 0.5 --length 2 --tets 500 -o small.vtk
+    expect_rc 0
+    expect_out "^wrote small.vtk: cylinder radius 0.5 length 2, [0-9]+ tets \(target 500"
+    tets=$(info_field tets small.vtk)
+    ((tets >= 485 && tets <= 515)) || fail "$tets tets, not within 3% of 500"
+    run "$torsion" mesh info small.vtk
+    expect_out "bounds min +-0.[0-9]+ -0.[0-9]+ 0$"
+    expect_out "bounds max +0.5 0.[0-9]+ 2$"
+    # Deterministic: the same arguments give the same file.
+    "$torsion" mesh cylinder --radius 0.5 --length 2 --tets 500 -o again.vtk >/dev/null ||
+      fail "second run failed"
+    cmp small.vtk again.vtk || fail "two runs with the same arguments differ"
+    ;;
+
+  cylinder_unreachable)
+    need_tetgen
+    run "$torsion" mesh cylinder --radius 1 --length 10 --tets 6 -o c.node
+    expect_rc nonzero
+    expect_out "^error: torsion mesh cylinder: could not get within 3% of 6 tets: the closest count found was [0-9]+"
+    [[ ! -e c.node ]] || fail "wrote a mesh anyway"
+    ;;
+
+  cylinder_without_tetgen)
+    run env PATH="$work/empty" "$torsion" mesh cylinder --radius 1 --length 10 --tets 500 -o c.node
+    expect_rc nonzero
+    expect_out "^error: torsion mesh cylinder: needs the 'tetgen' command \(Debian package 'tetgen'\); it is not on PATH$"
+    [[ ! -e c.node ]] || fail "wrote a mesh anyway"
+    ;;
+
+  cylinder_bad_arguments)
+    run "$torsion" mesh cylinder --radius -1 --length 10 --tets 500 -o c.node
+    expect_rc nonzero
+    expect_out "^error: torsion mesh cylinder: --radius must be a positive number, got -1"
+    run "$torsion" mesh cylinder --radius 1 --length 0 --tets 500 -o c.node
+    expect_rc nonzero
+    expect_out "^error: torsion mesh cylinder: --length must be a positive number, got 0"
+    run "$torsion" mesh cylinder --radius 1 --length 10 --tets 5 -o c.node
+    expect_rc nonzero
+    expect_out "^error: torsion mesh cylinder: --tets must be between 6 and"
+    run "$torsion" mesh cylinder --radius 1 --length 10 --tets 500 -o c.stl
+    expect_rc nonzero
+    expect_out "^error: c.stl: unknown mesh format '.stl'"
+    run "$torsion" mesh cylinder --radius 1 --length 10 --tets 500 -o c.node --mesher gmsh
+    expect_rc nonzero
+    expect_out "unknown --mesher 'gmsh' \(known: tetgen\)"
+    ;;
+
+  tetrahedralize_off)
+    need_tetgen
+    write_cube_off cube.off
+    run "$torsion" mesh tetrahedralize cube.off -o cube.msh
+    expect_rc 0
+    expect_out "^wrote cube.msh: [0-9]+ tets"
+    check_cube_mesh cube.msh
+    ;;
+
+  tetrahedralize_obj)
+    need_tetgen
+    write_octahedron_obj octa.obj
+    run "$torsion" mesh tetrahedralize octa.obj -o octa.node --max-volume 0.05 --quality 1.5
+    expect_rc 0
+    volume=$(info_field volume octa.node)
+    [[ $volume == 1.33333 ]] || fail "octahedron volume $volume, expected 1.33333"
+    tets=$(info_field tets octa.node)
+    ((tets >= 27)) || fail "--max-volume 0.05 should give at least 27 tets, got $tets"
+    ;;
+
+  tetrahedralize_stl_ascii)
+    need_tetgen
+    write_cube_stl_ascii cube.stl
+    run "$torsion" mesh tetrahedralize cube.stl -o cube.vtk
+    expect_rc 0
+    expect_out "from cube.stl: 8 vertices, 12 triangles"
+    check_cube_mesh cube.vtk
+    ;;
+
+  tetrahedralize_stl_binary)
+    need_tetgen
+    write_cube_stl_binary cube.stl
+    [[ $(stat -c %s cube.stl) == 684 ]] || fail "test bug: binary STL of $(stat -c %s cube.stl) bytes"
+    run "$torsion" mesh tetrahedralize cube.stl -o cube.node
+    expect_rc 0
+    expect_out "from cube.stl: 8 vertices, 12 triangles"
+    check_cube_mesh cube.node
+    ;;
+
+  tetrahedralize_self_intersecting)
+    need_tetgen
+    # Two closed tetrahedra that overlap.
+    cat >two.off <<'EOF'
+OFF
+8 8 0
+0 0 0
+2 0 0
+0 2 0
+0 0 2
+0.5 0.5 0.5
+2.5 0.5 0.5
+0.5 2.5 0.5
+0.5 0.5 2.5
+3 0 2 1
+3 0 1 3
+3 0 3 2
+3 1 2 3
+3 4 6 5
+3 4 5 7
+3 4 7 6
+3 5 6 7
+EOF
+    run "$torsion" mesh tetrahedralize two.off -o two.node
+    expect_rc nonzero
+    expect_out "^error: torsion mesh tetrahedralize: two.off: tetgen .* failed"
+    expect_out "two.off: the surface intersects itself"
+    expect_out "two.off:14 and two.off:1[5-7]"
+    ;;
+
+  tetrahedralize_open_surface)
+    write_cube_off cube.off
+    sed -i 's/^8 6 0$/8 5 0/; $d' cube.off  # drop the last face
+    run "$torsion" mesh tetrahedralize cube.off -o cube.node
+    expect_rc nonzero
+    expect_out "^error: cube.off:[0-9]+: the surface is not closed: 4 edge\(s\) used by one triangle"
+    ;;
+
+  tetrahedralize_malformed)
+    printf 'OFF\n4 4 0\n0 0 0\n1 0\n0 1 0\n0 0 1\n3 0 1 2\n3 0 1 3\n3 0 2 3\n3 1 2 3\n' >a.off
+    run "$torsion" mesh tetrahedralize a.off -o a.node
+    expect_rc nonzero
+    expect_out "^error: a.off:4: vertex 1: expected 3 coordinates, got 2$"
+
+    printf 'OFF\n4 4 0\n0 0 0\n1 0 0\n0 1 0\n0 0 1\n3 0 1 2\n3 0 1 4\n' >b.off
+    run "$torsion" mesh tetrahedralize b.off -o b.node
+    expect_rc nonzero
+    expect_out "^error: b.off:8: face 1: vertex index 4 out of range \(4 vertices, 0-based\)$"
+
+    printf 'OFF\n4 2 0\n0 0 0\n1 0 0\n0 1 0\n0 0 1\n3 0 1 2\n' >c.off
+    run "$torsion" mesh tetrahedralize c.off -o c.node
+    expect_rc nonzero
+    expect_out "^error: c.off:7: unexpected end of file, expected face 1 of 2$"
+
+    printf 'v 0 0 0\nv 1 0 0\nv 0 1 0\n# comment\nf 1 2 9\n' >d.obj
+    run "$torsion" mesh tetrahedralize d.obj -o d.node
+    expect_rc nonzero
+    expect_out "^error: d.obj:5: face corner '9': vertex index 9 out of range \(3 vertices read so far\)$"
+
+    printf 'v 0 0 0\nv 1 zero 0\n' >e.obj
+    run "$torsion" mesh tetrahedralize e.obj -o e.node
+    expect_rc nonzero
+    expect_out "^error: e.obj:2: expected a number for y, got 'zero'$"
+
+    printf 'solid s\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 1 0 0\nvertex 0 1 0\nendfacet\nendsolid s\n' >f.stl
+    run "$torsion" mesh tetrahedralize f.stl -o f.node
+    expect_rc nonzero
+    expect_out "^error: f.stl:7: expected 'endloop' \(STL facets are triangles\), got 'endfacet'$"
+
+    printf 'binary junk header that is not a solid' >g.stl
+    run "$torsion" mesh tetrahedralize g.stl -o g.node
+    expect_rc nonzero
+    expect_out "^error: g.stl: not an STL file"
+
+    printf 'ply\n' >h.ply
+    run "$torsion" mesh tetrahedralize h.ply -o h.node
+    expect_rc nonzero
+    expect_out "^error: h.ply: unknown surface format '.ply' \(known: .off, .obj, .stl\)$"
+
+    run "$torsion" mesh tetrahedralize missing.off -o m.node
+    expect_rc nonzero
+    expect_out "^error: missing.off: cannot open: No such file or directory$"
+    ;;
+
+  tetrahedralize_without_tetgen)
+    write_cube_off cube.off
+    run env PATH="$work/empty" "$torsion" mesh tetrahedralize cube.off -o cube.node
+    expect_rc nonzero
+    expect_out "^error: torsion mesh tetrahedralize: needs the 'tetgen' command \(Debian package 'tetgen'\); it is not on PATH$"
+    ;;
+
+  *)
+    fail "unknown case '$case_name'"
+    ;;
+esac
+echo "PASS: $case_name"
