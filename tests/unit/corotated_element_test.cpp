@@ -29,11 +29,11 @@ struct TetFixture {
   std::array<Eigen::Vector3d, 4> forces(const std::array<Eigen::Vector3d, 4>& x) const {
     const Eigen::Matrix3d F = deformationGradient(x, data.rest_shape_inverse);
     Eigen::Quaterniond q = Eigen::Quaterniond::Identity();
-    return corotatedForces(F, extractRotation(F, q), data, kMu, kLambda);
+    return corotatedForces(F, extractRotation(F, q, 100, 1e-13), data, kMu, kLambda);
   }
   Eigen::Matrix3d rotation(const std::array<Eigen::Vector3d, 4>& x) const {
     Eigen::Quaterniond q = Eigen::Quaterniond::Identity();
-    return extractRotation(deformationGradient(x, data.rest_shape_inverse), q);
+    return extractRotation(deformationGradient(x, data.rest_shape_inverse), q, 100, 1e-13);
   }
   // 12x12 stiffness K (df = -K dx) built column by column from the force differential.
   Eigen::Matrix<double, 12, 12> stiffness(const Eigen::Matrix3d& R) const {

@@ -17,7 +17,7 @@ Eigen::Matrix3d rotationBySvd(const Eigen::Matrix3d& F) {
 }
 
 Eigen::Matrix3d extractRotation(const Eigen::Matrix3d& F, Eigen::Quaterniond& q,
-                                int max_iterations) {
+                                int max_iterations, double tolerance) {
   if (!(F.determinant() > 0)) {
     const Eigen::Matrix3d R = rotationBySvd(F);
     q = Eigen::Quaterniond(R);
@@ -31,10 +31,13 @@ Eigen::Matrix3d extractRotation(const Eigen::Matrix3d& F, Eigen::Quaterniond& q,
     const double omega_den =
         std::abs(R.col(0).dot(F.col(0)) + R.col(1).dot(F.col(1)) + R.col(2).dot(F.col(2))) + 1e-9;
     const Eigen::Vector3d omega = omega_num / omega_den;
-    const double angle = omega.norm();
-    if (angle < 1e-9) break;  // rotation accurate to 1e-9 rad
-    q = Eigen::Quaterniond(Eigen::AngleAxisd(angle, omega / angle)) * q;
-    q.normalize();
+    const double angle_sq = omega.squaredNorm();
+    if (angle_sq < tolerance * tolerance) break;
+    // Rotate q by omega. The paper uses the exact exponential; a normalised first-order
+    // quaternion (1, omega / 2) has the same fixed point and needs no sin/cos. Large first
+    // steps (cold starts) still move toward the fixed point, just less than the full angle.
+    const Eigen::Quaterniond delta(1.0, 0.5 * omega.x(), 0.5 * omega.y(), 0.5 * omega.z());
+    q = (delta * q).normalized();
     R = q.toRotationMatrix();
   }
   return R;
