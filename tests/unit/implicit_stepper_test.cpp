@@ -184,11 +184,13 @@ TEST(ImplicitStepper, DirectionConstraintFixesOnlyTheNormalComponent) {
   }
 }
 
-FemState twistedRun(int threads, LinearSolverKind kind, int steps = 15) {
+FemState twistedRun(int threads, LinearSolverKind kind, int steps = 15,
+                    PreconditionerKind preconditioner = PreconditionerKind::kBlockJacobi) {
   auto model = beamModel();
   Parallel parallel(threads);
   SolverSettings settings;
   settings.linear_solver = kind;
+  settings.preconditioner = preconditioner;
   settings.tolerance = 1e-8;
   ImplicitStepper stepper(model, settings, parallel);
   FemState state = FemState::atRest(*model);
@@ -206,7 +208,9 @@ FemState twistedRun(int threads, LinearSolverKind kind, int steps = 15) {
         constraints.prescribeVelocity(i, (turn * r - r) / settings.time_step);
       }
     }
-    EXPECT_FALSE(isFatal(stepper.step(state, constraints, f).health));
+    const StepReport r = stepper.step(state, constraints, f);
+    EXPECT_EQ(r.health, StepHealth::kOk) << r.message;
+    if (kind == LinearSolverKind::kConjugateGradient) EXPECT_GT(r.solve.iterations, 0);
   }
   return state;
 }
@@ -215,6 +219,31 @@ TEST(ImplicitStepper, SameResultForAnyThreadCount) {
   const FemState one = twistedRun(1, LinearSolverKind::kConjugateGradient);
   const FemState two = twistedRun(2, LinearSolverKind::kConjugateGradient);
   EXPECT_TRUE(one.positions == two.positions) << "max diff " << (one.positions - two.positions).cwiseAbs().maxCoeff();
+}
+
+TEST(ImplicitStepper, JacobiAndBlockJacobiReachTheSameSolution) {
+  const FemState block = twistedRun(1, LinearSolverKind::kConjugateGradient);
+  const FemState diagonal = twistedRun(1, LinearSolverKind::kConjugateGradient, 15, PreconditionerKind::kJacobi);
+  const FemState start = FemState::atRest(*beamModel());
+  EXPECT_LT((block.positions - diagonal.positions).norm(), 1e-6 * (block.positions - start.positions).norm());
+}
+
+TEST(ImplicitStepper, ConjugateGradientStuckFarAboveToleranceIsFatal) {
+  auto model = beamModel();
+  Parallel parallel(1);
+  SolverSettings settings = tight();
+  settings.max_iterations = 1;  // cannot reach 1e-10 in one iteration
+  ImplicitStepper stepper(model, settings, parallel);
+  FemState state = FemState::atRest(*model);
+  NodeConstraints constraints(model->nodeCount());
+  for (int i = 0; i < model->nodeCount(); ++i) {
+    if (model->mesh().restPositions()[static_cast<size_t>(i)].x() < 1e-9) constraints.prescribeVelocity(i, Eigen::Vector3d::Zero());
+  }
+  Eigen::VectorXd f(3 * model->nodeCount());
+  for (int i = 0; i < model->nodeCount(); ++i) f.segment<3>(3 * i) = Eigen::Vector3d(0, 0, -9.81 * model->nodeMasses()[static_cast<size_t>(i)]);
+  const StepReport r = stepper.step(state, constraints, f);
+  EXPECT_EQ(r.health, StepHealth::kSolverFailed);
+  EXPECT_NE(r.message.find("did not converge"), std::string::npos) << r.message;
 }
 
 TEST(ImplicitStepper, CholmodAgreesWithConjugateGradient) {

@@ -189,6 +189,7 @@ LinearSolveReport CholmodSolver::solve(const SystemOperator& op, const NodeConst
   m.factor.factorize(A);
   if (m.factor.info() != Eigen::Success) {
     report.converged = false;
+    report.breakdown = true;
     report.relative_residual = std::numeric_limits<double>::infinity();
     return report;
   }

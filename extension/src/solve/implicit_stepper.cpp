@@ -18,6 +18,7 @@ const char* toString(StepHealth health) {
   switch (health) {
     case StepHealth::kOk: return "ok";
     case StepHealth::kSolverNotConverged: return "solver not converged";
+    case StepHealth::kSolverFailed: return "solver failed";
     case StepHealth::kNonFinite: return "non-finite state";
     case StepHealth::kBlowUp: return "blow-up";
   }
@@ -118,6 +119,14 @@ StepReport ImplicitStepper::step(FemState& state, const NodeConstraints& constra
     std::ostringstream s;
     s << "a node moves at " << report.max_speed << " m/s, beyond max_speed " << settings_.max_speed
       << " m/s: the simulation is unstable (reduce dt or stiffness, or raise damping)";
+    report.message = s.str();
+  } else if (report.solve.breakdown || report.solve.relative_residual > 10 * settings_.tolerance) {
+    report.health = StepHealth::kSolverFailed;
+    std::ostringstream s;
+    s << "linear solver " << (report.solve.breakdown ? "broke down" : "did not converge") << " after "
+      << report.solve.iterations << " iterations at relative residual " << report.solve.relative_residual
+      << " (tolerance " << settings_.tolerance << ", max_iterations " << settings_.max_iterations
+      << "): the system is indefinite or badly conditioned; raise max_iterations, reduce dt, or use cholmod";
     report.message = s.str();
   } else if (!report.solve.converged) {
     report.health = StepHealth::kSolverNotConverged;

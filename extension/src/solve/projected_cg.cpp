@@ -31,7 +31,9 @@ LinearSolveReport ProjectedCg::solve(const SystemOperator& op, const NodeConstra
     if (settings.preconditioner == PreconditionerKind::kBlockJacobi) {
       block = block.inverse().eval();
     } else {
-      block = block.diagonal().cwiseInverse().asDiagonal();
+      // Through a temporary: assigning a diagonal wrapper zeroes the target before reading it.
+      const Eigen::Vector3d inverse_diagonal = block.diagonal().cwiseInverse();
+      block = inverse_diagonal.asDiagonal();
     }
   }
 
@@ -62,7 +64,10 @@ LinearSolveReport ProjectedCg::solve(const SystemOperator& op, const NodeConstra
     op.multiply(p_, q_);
     constraints.filter(q_);
     const double pq = p_.dot(q_);
-    if (!(pq > 0)) break;  // A is SPD on the free subspace; anything else is breakdown
+    if (!(pq > 0)) {  // A is SPD on the free subspace: anything else means a broken system
+      report.breakdown = true;
+      break;
+    }
     const double alpha = rz / pq;
     v += alpha * p_;
     r_ -= alpha * q_;
@@ -78,6 +83,7 @@ LinearSolveReport ProjectedCg::solve(const SystemOperator& op, const NodeConstra
     rz = rz_next;
   }
   report.relative_residual = residual / reference;
+  if (!std::isfinite(report.relative_residual)) report.breakdown = true;
   return report;
 }
 

@@ -8,7 +8,9 @@
 //   4. kSolve          (M (1 + dt alpha) + (dt^2 + dt beta) K) v' = b, prescribed components of v'
 //                      imposed (projection), free ones solved by CG or CHOLMOD
 //   5. kIntegrate      x' = x + dt v'   (constrained nodes land exactly on their targets)
-//   6. kHealth         non-finite values, speeds beyond SolverSettings::max_speed, solver trouble
+//   6. kHealth         non-finite values, speeds beyond SolverSettings::max_speed, a linear solve
+//                      that broke down or stopped above 10x its tolerance (fatal), or one that
+//                      stopped at its cap within 10x (a warning)
 //
 // Internal forces at the end of the step (what the body exerts on whatever holds its nodes) are
 // available afterwards, linearised: f_int = f(x) - (dt + beta) K v'.
@@ -32,12 +34,15 @@ class CholmodSolver;
 
 enum class StepHealth {
   kOk,
-  kSolverNotConverged,  ///< CG hit its cap above tolerance: the step is usable but inaccurate
+  kSolverNotConverged,  ///< CG hit its cap within 10x tolerance: usable but inaccurate (warning)
+  kSolverFailed,        ///< breakdown, or CG stuck far above tolerance: the step is meaningless
   kNonFinite,           ///< NaN or inf in positions or velocities: the state is unusable
   kBlowUp,              ///< a node moves faster than max_speed: unstable
 };
 const char* toString(StepHealth health);
-inline bool isFatal(StepHealth h) { return h == StepHealth::kNonFinite || h == StepHealth::kBlowUp; }
+inline bool isFatal(StepHealth h) {
+  return h == StepHealth::kNonFinite || h == StepHealth::kBlowUp || h == StepHealth::kSolverFailed;
+}
 
 struct StepReport {
   LinearSolveReport solve;

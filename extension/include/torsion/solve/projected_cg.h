@@ -15,6 +15,9 @@ struct LinearSolveReport {
   int iterations = 0;
   double relative_residual = 0;  ///< |S(b - A v)| / |S(b - A v_prescribed)|
   bool converged = false;
+  /// The solver could not proceed (non-positive curvature, non-finite numbers, failed
+  /// factorisation): the result is meaningless, unlike a merely unconverged one.
+  bool breakdown = false;
 };
 
 /// Solves A v = b for the free components of v. On entry v holds the warm start; prescribed
