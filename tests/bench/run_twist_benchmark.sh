@@ -17,9 +17,13 @@
 #   E_SWEEP_SIZE  mesh also run at the E_SWEEP moduli [8332]
 #   E_SWEEP       ["1e6 1e7"]
 #   REPS          repetitions [3]
-#   REPS_LARGE    repetitions for the 31558 mesh [1]
-#   LARGE_SIZE    which size REPS_LARGE applies to [31558]
-#   BULLET_RELAXED_TOL  relaxed btConjugateGradient tolerance [1e-8]
+#   REPS_LARGE    repetitions for the LARGE_SIZE mesh [1]
+#   LARGE_SIZE    [31558]; CHOLMOD and the CG tolerance sweep are not run on it
+#   REPS_SWEEP    repetitions for the E_SWEEP cases [REPS]
+#   BULLET_RELAXED_TOL  relaxed btConjugateGradient tolerance, identity preconditioner [1e-4]
+#   BULLET_PC_TOL       tolerance of the mass-preconditioned row [1e-5]
+#                 (both chosen so Bullet's deviation from its own exactly solved trajectory is at
+#                 most ours at tolerance 1e-4; see tests/bench/README_twist.md)
 #   TOLERANCE_SWEEP_SIZES  sizes that also run our CG at 1e-3 and 1e-6 [8332]
 #   CHOLMOD_MAX_TETS  skip CHOLMOD above this many tets [10000]
 #   STEPS         override the step count (quick tests only; the protocol is 600) []
@@ -40,7 +44,9 @@ E_SWEEP=${E_SWEEP:-"1e6 1e7"}
 REPS=${REPS:-3}
 REPS_LARGE=${REPS_LARGE:-1}
 LARGE_SIZE=${LARGE_SIZE:-31558}
-BULLET_RELAXED_TOL=${BULLET_RELAXED_TOL:-1e-8}
+REPS_SWEEP=${REPS_SWEEP:-$REPS}
+BULLET_RELAXED_TOL=${BULLET_RELAXED_TOL:-1e-4}
+BULLET_PC_TOL=${BULLET_PC_TOL:-1e-5}
 TOLERANCE_SWEEP_SIZES=${TOLERANCE_SWEEP_SIZES:-8332}
 CHOLMOD_MAX_TETS=${CHOLMOD_MAX_TETS:-10000}
 STEPS=${STEPS:-}
@@ -65,8 +71,8 @@ STEP_ARGS=()
   echo "load at start: $(cut -d' ' -f1-3 /proc/loadavg)"
   echo "git: $(git -C "$ROOT" rev-parse --short HEAD 2>/dev/null) $(git -C "$ROOT" status --porcelain 2>/dev/null | wc -l) changed files"
   echo "binary: $BENCH_TWIST"
-  echo "settings: SIZES='$SIZES' E_SWEEP_SIZE=$E_SWEEP_SIZE E_SWEEP='$E_SWEEP' REPS=$REPS REPS_LARGE=$REPS_LARGE"
-  echo "          BULLET_RELAXED_TOL=$BULLET_RELAXED_TOL TOLERANCE_SWEEP_SIZES='$TOLERANCE_SWEEP_SIZES' CHOLMOD_MAX_TETS=$CHOLMOD_MAX_TETS STEPS='$STEPS'"
+  echo "settings: SIZES='$SIZES' E_SWEEP_SIZE=$E_SWEEP_SIZE E_SWEEP='$E_SWEEP' REPS=$REPS REPS_LARGE=$REPS_LARGE REPS_SWEEP=$REPS_SWEEP"
+  echo "          BULLET_RELAXED_TOL=$BULLET_RELAXED_TOL BULLET_PC_TOL=$BULLET_PC_TOL TOLERANCE_SWEEP_SIZES='$TOLERANCE_SWEEP_SIZES' CHOLMOD_MAX_TETS=$CHOLMOD_MAX_TETS STEPS='$STEPS'"
 } >"$RESULTS_DIR/machine.txt"
 
 # Cases: "size E".
@@ -85,7 +91,7 @@ for c in "${CASES[@]}"; do
   [[ -f $mesh ]] || { echo "missing mesh $mesh" >&2; exit 2; }
   found=""
   for s in $SUBSTEP_LIST; do
-    line=$("$BENCH_TWIST" --solver bullet-explicit --mesh "$mesh" --E "$E" --substeps "$s" "${STEP_ARGS[@]}" \
+    line=$(OMP_NUM_THREADS=1 "$BENCH_TWIST" --solver bullet-explicit --mesh "$mesh" --E "$E" --substeps "$s" "${STEP_ARGS[@]}" \
              --label "search $size $E")
     echo "$line" >>"$SEARCH"
     ok=$(python3 -c 'import json,sys,math; j=json.loads(sys.argv[1]); print(int(j["stable"] and all(x["error"] is not None for x in j["slices"])))' "$line")
@@ -100,32 +106,36 @@ configs_of() {
   local size=$1 E=$2 tets
   echo "torsion-cg tol=1e-4 t1|--solver torsion-cg --tolerance 1e-4 --threads 1"
   echo "torsion-cg tol=1e-4 t2|--solver torsion-cg --tolerance 1e-4 --threads 2"
-  if [[ " $TOLERANCE_SWEEP_SIZES " == *" $size "* ]]; then
+  if [[ " $TOLERANCE_SWEEP_SIZES " == *" $size "* && $E == 1e5 ]]; then
     echo "torsion-cg tol=1e-3 t1|--solver torsion-cg --tolerance 1e-3 --threads 1"
     echo "torsion-cg tol=1e-6 t1|--solver torsion-cg --tolerance 1e-6 --threads 1"
   fi
   tets=$size
-  if (( tets <= CHOLMOD_MAX_TETS )); then
+  if (( tets <= CHOLMOD_MAX_TETS )) && [[ $size != "$LARGE_SIZE" ]]; then
     echo "torsion-cholmod t1|--solver torsion-cholmod --threads 1"
   fi
   echo "bullet-implicit default|--solver bullet-implicit"
   echo "bullet-implicit tol=$BULLET_RELAXED_TOL|--solver bullet-implicit --tolerance $BULLET_RELAXED_TOL"
-  echo "bullet-implicit mass-pc tol=$BULLET_RELAXED_TOL|--solver bullet-implicit --tolerance $BULLET_RELAXED_TOL --mass-preconditioner"
+  echo "bullet-implicit mass-pc tol=$BULLET_PC_TOL|--solver bullet-implicit --tolerance $BULLET_PC_TOL --mass-preconditioner"
   local s=${SUBSTEPS["$size $E"]}
   if [[ $s != none ]]; then
     echo "bullet-explicit substeps=$s|--solver bullet-explicit --substeps $s"
   fi
 }
 
+reps_of() {  # size E
+  if [[ $1 == "$LARGE_SIZE" ]]; then echo "$REPS_LARGE"; elif [[ $2 != 1e5 ]]; then echo "$REPS_SWEEP"; else echo "$REPS"; fi
+}
 max_reps=$REPS
 (( REPS_LARGE > max_reps )) && max_reps=$REPS_LARGE
+(( REPS_SWEEP > max_reps )) && max_reps=$REPS_SWEEP
 for ((rep = 1; rep <= max_reps; rep++)); do
   # Every configuration of every case in one pass; the order rotates from one repetition to the
   # next so that no configuration always runs first or right after the same neighbour.
   JOBS=()
   for c in "${CASES[@]}"; do
     read -r size E <<<"$c"
-    if [[ $size == "$LARGE_SIZE" ]]; then (( rep <= REPS_LARGE )) || continue; else (( rep <= REPS )) || continue; fi
+    (( rep <= $(reps_of "$size" "$E") )) || continue
     while IFS= read -r cfg; do JOBS+=("$size|$E|$cfg"); done < <(configs_of "$size" "$E")
   done
   n=${#JOBS[@]}
@@ -133,8 +143,11 @@ for ((rep = 1; rep <= max_reps; rep++)); do
     job=${JOBS[$(((k + (rep - 1) * (n / max_reps + 1)) % n))]}
     IFS='|' read -r size E name args <<<"$job"
     mesh=$(mesh_of "$size")
+    threads=1
+    [[ $args == *"--threads 2"* ]] && threads=2
+    # OMP_NUM_THREADS: CHOLMOD runs its supernodal factorisation on OpenMP; match our thread count.
     # shellcheck disable=SC2086
-    line=$("$BENCH_TWIST" $args --mesh "$mesh" --E "$E" "${STEP_ARGS[@]}" --label "$name") || line='{"status":"crashed"}'
+    line=$(OMP_NUM_THREADS=$threads "$BENCH_TWIST" $args --mesh "$mesh" --E "$E" "${STEP_ARGS[@]}" --label "$name") || line='{"status":"crashed"}'
     python3 -c 'import json,sys; j=json.loads(sys.argv[1]); j.update(case_size=int(sys.argv[2]), case_E=float(sys.argv[3]), config=sys.argv[4], rep=int(sys.argv[5])); print(json.dumps(j))' \
       "$line" "$size" "$E" "$name" "$rep" >>"$RAW"
     echo "rep $rep [$((k + 1))/$n] cylinder_$size E=$E $name: $(python3 -c 'import json,sys; j=json.loads(sys.argv[1]); print(j.get("status"), "%.1f steps/s" % (j.get("steps_per_s") or 0))' "$line")" >&2

@@ -210,7 +210,9 @@ FemState twistedRun(int threads, LinearSolverKind kind, int steps = 15,
     }
     const StepReport r = stepper.step(state, constraints, f);
     EXPECT_EQ(r.health, StepHealth::kOk) << r.message;
-    if (kind == LinearSolverKind::kConjugateGradient) EXPECT_GT(r.solve.iterations, 0);
+    if (kind == LinearSolverKind::kConjugateGradient) {
+      EXPECT_GT(r.solve.iterations, 0);
+    }
   }
   return state;
 }
