@@ -8,6 +8,7 @@
 
 #include "torsion/mesh/box_mesh.h"
 #include "torsion/solve/implicit_stepper.h"
+#include "validation_output.h"
 
 namespace torsion {
 namespace {
@@ -71,11 +72,13 @@ TEST(Cantilever, TipDeflectionConvergesToBeamTheory) {
   std::printf("| cells across | tets | tip deflection (m) | error vs Timoshenko |\n|---|---|---|---|\n");
   double previous_error = std::numeric_limits<double>::infinity();
   std::vector<std::pair<int, double>> tips;
+  auto csv = test::validationCsv("cantilever.csv", "cells_across,tets,tip_deflection,timoshenko,euler_bernoulli");
   for (int n : {1, 2, 4, 6, 8}) {
     const double tip = simulatedTip(n);
     tips.emplace_back(n, tip);
     const double error = std::abs(tip - reference) / reference;
     std::printf("| %d | %d | %.5f | %.1f %% |\n", n, 60 * n * n * n, tip, 100 * error);
+    if (csv) *csv << n << "," << 60 * n * n * n << "," << tip << "," << reference << "," << eulerBernoulliTip() << "\n";
     EXPECT_LT(error, previous_error) << "no convergence at " << n << " cells across";
     EXPECT_LT(tip, reference * 1.01) << "linear tets should not be softer than beam theory";
     previous_error = error;

@@ -11,6 +11,7 @@
 #include "torsion/analysis/twist_profile.h"
 #include "torsion/bullet/fem_world.h"
 #include "torsion/mesh/mesh_io.h"
+#include "validation_output.h"
 
 namespace torsion {
 namespace {
@@ -110,11 +111,13 @@ TEST_F(StVenant, SmallTwistIsUniformAlongTheMediumCylinder) {
 TEST_F(StVenant, TorqueConvergesToGJThetaPrimeWithRefinement) {
   std::printf("| tets | T (N m) | G J theta' (N m) | T / (G J theta') |\n|---|---|---|---|\n");
   std::vector<std::pair<double, double>> ratios;  // (h^2 ~ N^(-2/3), T / (G J theta'))
+  auto csv = test::validationCsv("st_venant_small_twist.csv", "tets,torque,gj_theta_prime,ratio");
   double previous = std::numeric_limits<double>::infinity();
   for (int tets : {2430, 4323, 8332, 31558}) {
     const TorsionResult& r = at(tets);
     const double ratio = r.torque / r.expected;
     std::printf("| %d | %.4f | %.4f | %.4f |\n", r.tets, r.torque, r.expected, ratio);
+    if (csv) *csv << r.tets << "," << r.torque << "," << r.expected << "," << ratio << "\n";
     EXPECT_GT(ratio, 1.0) << "linear tets cannot be softer than the continuum";
     EXPECT_LT(ratio, previous) << tets << " tets: refinement must reduce the error";
     previous = ratio;
@@ -153,6 +156,9 @@ TEST(StVenantLargeTwist, TwoPiTwistStaysStableAndLinear) {
   const double nonlinearity = twistNonlinearity(profile, 2, 8);
   std::printf("2 pi twist: theta' = %.5f rad/m (uniform %.5f), nonlinearity %.2f %%\n", rate, total / kLength,
               100 * nonlinearity);
+  if (auto csv = test::validationCsv("st_venant_two_pi_profile.csv", "z,angle,st_venant")) {
+    for (const SliceRotation& slice : profile) *csv << slice.z << "," << slice.angle << "," << total * slice.z / kLength << "\n";
+  }
   EXPECT_LT(nonlinearity, 0.03);
   EXPECT_NEAR(rate, total / kLength, 0.05 * total / kLength);
 }
