@@ -7,6 +7,7 @@
 #include <random>
 
 #include "torsion/mesh/box_mesh.h"
+#include "torsion/solve/cholmod_solver.h"
 
 namespace torsion {
 namespace {
@@ -281,6 +282,43 @@ TEST(ImplicitStepper, BlowUpIsDetected) {
   const StepReport r = stepper.step(state, constraints, Eigen::VectorXd::Zero(3 * model->nodeCount()));
   EXPECT_EQ(r.health, StepHealth::kBlowUp);
   EXPECT_NE(r.message.find("max_speed"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace torsion
+
+namespace torsion {
+namespace {
+
+// Two independent constructions of the system matrix must agree: the matrix-free operator's
+// products and diagonal blocks, and CHOLMOD's assembled matrix.
+TEST(SystemOperator, ProductsAndDiagonalBlocksMatchTheAssembledMatrix) {
+  auto model = beamModel();
+  Parallel parallel(2);
+  SystemOperator op(model, parallel);
+  std::mt19937 rng(9);
+  std::normal_distribution<double> n(0, 1);
+  for (auto& R : op.mutableRotations()) {
+    R = Eigen::Quaterniond(n(rng), n(rng), n(rng), n(rng)).normalized().toRotationMatrix();
+  }
+  op.setCoefficients(1.01, 1e-4);
+  CholmodSolver cholmod;
+  const NodeConstraints none(model->nodeCount());
+  const Eigen::SparseMatrix<double> lower = cholmod.assemble(op, none);
+  const Eigen::MatrixXd L = Eigen::MatrixXd(lower);
+  const Eigen::MatrixXd A = L + L.transpose() - Eigen::MatrixXd(L.diagonal().asDiagonal());
+
+  Eigen::VectorXd y(3 * model->nodeCount());
+  for (int i = 0; i < y.size(); ++i) y[i] = n(rng);
+  Eigen::VectorXd Ay;
+  op.multiply(y, Ay);
+  EXPECT_LT((Ay - A * y).norm(), 1e-10 * Ay.norm());
+
+  std::vector<Eigen::Matrix3d> blocks;
+  op.diagonalBlocks(blocks);
+  for (int i = 0; i < model->nodeCount(); ++i) {
+    EXPECT_LT((blocks[static_cast<size_t>(i)] - A.block<3, 3>(3 * i, 3 * i)).norm(), 1e-10 * A.norm()) << "node " << i;
+  }
 }
 
 }  // namespace

@@ -90,7 +90,13 @@ StepReport ImplicitStepper::step(FemState& state, const NodeConstraints& constra
   // 4. Solve for v', warm-started from v.
   system_.setCoefficients(1.0 + dt * material.mass_damping,
                           dt * dt + dt * material.stiffness_damping);
-  velocity_next_ = state.velocities;
+  // Warm start: extrapolate the velocity linearly from the last two steps (constant acceleration).
+  if (previous_velocities_.size() == state.velocities.size()) {
+    velocity_next_ = 2.0 * state.velocities - previous_velocities_;
+  } else {
+    velocity_next_ = state.velocities;
+  }
+  previous_velocities_ = state.velocities;
   if (settings_.linear_solver == LinearSolverKind::kCholmod) {
     if (!cholmod_) cholmod_ = std::make_unique<CholmodSolver>();
     report.solve = cholmod_->solve(system_, constraints, rhs_, velocity_next_);

@@ -83,28 +83,30 @@ void SystemOperator::multiplyStiffness(const Eigen::VectorXd& y, Eigen::VectorXd
 }
 
 void SystemOperator::diagonalBlocks(std::vector<Eigen::Matrix3d>& blocks) const {
+  // K_aa of one tet is R V (mu |g|^2 I + (mu + lambda) g g^T) R^T with g = grad N_a, which is
+  // V (mu |g|^2 I + (mu + lambda) (R g)(R g)^T): built per node straight from the tet's rotation,
+  // with no per-tet buffer (see corotatedDiagonalBlocks for the same formula per tet).
   const TetMesh& mesh = model_->mesh();
   const double mu = model_->material().mu();
-  const double lambda = model_->material().lambda();
-  std::vector<std::array<Eigen::Matrix3d, 4>>& tet_blocks = tet_blocks_;
-  tet_blocks.resize(static_cast<size_t>(mesh.tetCount()));
-  parallel_.forRange(mesh.tetCount(), kTetGrain, [&](int begin, int end) {
-    for (int t = begin; t < end; ++t) {
-      tet_blocks[static_cast<size_t>(t)] = corotatedDiagonalBlocks(
-          rotations_[static_cast<size_t>(t)], model_->tetRestData()[static_cast<size_t>(t)], mu, lambda);
-    }
-  });
-  blocks.resize(static_cast<size_t>(mesh.nodeCount()));
+  const double mu_plus_lambda = mu + model_->material().lambda();
   const std::vector<double>& mass = model_->nodeMasses();
+  blocks.resize(static_cast<size_t>(mesh.nodeCount()));
   parallel_.forRange(mesh.nodeCount(), kNodeGrain, [&](int begin, int end) {
     for (int n = begin; n < end; ++n) {
       Eigen::Matrix3d k = Eigen::Matrix3d::Zero();
       for (int e = node_offsets_[static_cast<size_t>(n)]; e < node_offsets_[static_cast<size_t>(n) + 1]; ++e) {
         const int entry = node_entries_[static_cast<size_t>(e)];
-        k += tet_blocks[static_cast<size_t>(entry / 4)][static_cast<size_t>(entry % 4)];
+        const int t = entry / 4, a = entry % 4;
+        const TetRestData& rest = model_->tetRestData()[static_cast<size_t>(t)];
+        const Eigen::Matrix3d& B = rest.rest_shape_inverse;
+        const Eigen::Vector3d g = a == 0 ? Eigen::Vector3d(-(B.row(0) + B.row(1) + B.row(2)).transpose())
+                                         : Eigen::Vector3d(B.row(a - 1).transpose());
+        const Eigen::Vector3d rg = rotations_[static_cast<size_t>(t)] * g;
+        k.diagonal().array() += rest.volume * mu * g.squaredNorm();
+        k.noalias() += (rest.volume * mu_plus_lambda) * rg * rg.transpose();
       }
-      blocks[static_cast<size_t>(n)] = mass_coefficient_ * mass[static_cast<size_t>(n)] * Eigen::Matrix3d::Identity() +
-                                       stiffness_coefficient_ * k;
+      blocks[static_cast<size_t>(n)] =
+          mass_coefficient_ * mass[static_cast<size_t>(n)] * Eigen::Matrix3d::Identity() + stiffness_coefficient_ * k;
     }
   });
 }

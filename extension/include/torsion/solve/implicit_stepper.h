@@ -89,6 +89,7 @@ class ImplicitStepper {
   std::unique_ptr<CholmodSolver> cholmod_;
 
   Eigen::VectorXd elastic_forces_, rhs_, velocity_next_, internal_forces_, scratch_;
+  Eigen::VectorXd previous_velocities_;  // v of the step before, for the CG warm start
   std::vector<std::array<Eigen::Vector3d, 4>> tet_forces_;
   std::vector<double> tet_energy_;
   bool internal_forces_valid_ = false;

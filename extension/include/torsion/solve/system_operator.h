@@ -51,7 +51,6 @@ class SystemOperator {
   double mass_coefficient_ = 1;
   double stiffness_coefficient_ = 0;
   mutable std::vector<std::array<Eigen::Vector3d, 4>> tet_scratch_;
-  mutable std::vector<std::array<Eigen::Matrix3d, 4>> tet_blocks_;
   std::vector<int> node_entries_;  // per node: 4 * tet + local index, node-major
   std::vector<int> node_offsets_;
 };
