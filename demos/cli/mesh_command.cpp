@@ -26,7 +26,8 @@ struct ConvertOptions {
 };
 
 void printWarnings(const LoadedMesh& loaded) {
-  for (const std::string& w : loaded.warnings) std::cerr << "warning: " << w << "\n";
+  for (const std::string& w : loaded.warnings)
+    std::cerr << "warning: " << w << "\n";
 }
 
 int runInfo(const InfoOptions& options) {
@@ -72,8 +73,12 @@ int runConvert(const ConvertOptions& options) {
 
 }  // namespace
 
-int exitCode() { return g_exit_code; }
-void setExitCode(int code) { g_exit_code = code; }
+int exitCode() {
+  return g_exit_code;
+}
+void setExitCode(int code) {
+  g_exit_code = code;
+}
 
 void addMeshCommand(CLI::App& app) {
   CLI::App* mesh = app.add_subcommand("mesh", "Inspect, convert and generate tetrahedral meshes");

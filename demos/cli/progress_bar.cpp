@@ -6,7 +6,8 @@
 
 namespace torsion::cli {
 
-ProgressBar::ProgressBar(std::string label) : label_(std::move(label)), terminal_(isatty(STDERR_FILENO) != 0) {}
+ProgressBar::ProgressBar(std::string label)
+    : label_(std::move(label)), terminal_(isatty(STDERR_FILENO) != 0) {}
 
 void ProgressBar::update(int done, int total, double rate) {
   const double fraction = total > 0 ? double(done) / total : 1.0;
@@ -17,15 +18,16 @@ void ProgressBar::update(int done, int total, double rate) {
     std::string bar(static_cast<size_t>(filled), '=');
     if (filled < kWidth) bar += '>';
     bar.resize(kWidth, ' ');
-    std::fprintf(stderr, "\r%s [%s] %d/%d steps  %.1f steps/s  %.0f s left ", label_.c_str(), bar.c_str(), done,
-                 total, rate, eta);
+    std::fprintf(stderr, "\r%s [%s] %d/%d steps  %.1f steps/s  %.0f s left ", label_.c_str(),
+                 bar.c_str(), done, total, rate, eta);
     std::fflush(stderr);
     drawn_ = true;
   } else {
     const int decile = static_cast<int>(fraction * 10);
     if (decile != last_decile_) {
       last_decile_ = decile;
-      std::fprintf(stderr, "%s: step %d/%d (%d%%), %.1f steps/s\n", label_.c_str(), done, total, decile * 10, rate);
+      std::fprintf(stderr, "%s: step %d/%d (%d%%), %.1f steps/s\n", label_.c_str(), done, total,
+                   decile * 10, rate);
     }
   }
 }

@@ -26,13 +26,15 @@ int run(const RunArguments& args) {
     std::cerr << "error: " << spec.error().message << "\n";
     return 1;
   }
-  Result<std::unique_ptr<scene::BuiltScene>> built = scene::buildScene(std::move(spec).value(), args.threads);
+  Result<std::unique_ptr<scene::BuiltScene>> built =
+      scene::buildScene(std::move(spec).value(), args.threads);
   if (!built) {
     std::cerr << "error: " << built.error().message << "\n";
     return 1;
   }
   scene::BuiltScene& s = *built.value();
-  for (const std::string& w : s.warnings) std::cerr << "warning: " << w << "\n";
+  for (const std::string& w : s.warnings)
+    std::cerr << "warning: " << w << "\n";
   for (const auto& body : s.world->bodies()) {
     std::cerr << "body '" << body->name() << "': " << body->model().nodeCount() << " nodes, "
               << body->model().tetCount() << " tets\n";
@@ -66,8 +68,10 @@ void addRunCommand(CLI::App& app) {
   CLI::App* cmd = app.add_subcommand("run", "Run a scene headless and write its results");
   cmd->add_option("scene", args->scene, "Scene file (JSON, see docs/scene-format.md)")->required();
   cmd->add_option("--out", args->out, "Output directory")->capture_default_str();
-  cmd->add_option("--steps", args->steps, "Number of steps (default: the scene's)")->check(CLI::PositiveNumber);
-  cmd->add_option("--threads", args->threads, "Worker threads (default: the scene's; 0 = all cores)")
+  cmd->add_option("--steps", args->steps, "Number of steps (default: the scene's)")
+      ->check(CLI::PositiveNumber);
+  cmd->add_option("--threads", args->threads,
+                  "Worker threads (default: the scene's; 0 = all cores)")
       ->check(CLI::NonNegativeNumber);
   cmd->callback([args] { setExitCode(run(*args)); });
 }

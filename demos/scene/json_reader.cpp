@@ -18,8 +18,8 @@ std::string typeName(const nlohmann::json& j) {
 JsonObject::JsonObject(const nlohmann::json& json, std::string path, const std::string& file)
     : json_(json), path_(std::move(path)), file_(file) {
   if (!json_.is_object()) {
-    throw JsonFault(file_ + ": " + (path_.empty() ? "the scene" : path_) + ": expected an object, found " +
-                    typeName(json_));
+    throw JsonFault(file_ + ": " + (path_.empty() ? "the scene" : path_) +
+                    ": expected an object, found " + typeName(json_));
   }
 }
 
@@ -43,9 +43,11 @@ const nlohmann::json& JsonObject::at(const std::string& key) const {
     // A misspelt key shows up here first: name the keys this object has that nobody asked for.
     std::string unread;
     for (auto it = json_.begin(); it != json_.end(); ++it) {
-      if (read_.count(it.key()) == 0) unread += (unread.empty() ? "" : ", ") + ("'" + it.key() + "'");
+      if (read_.count(it.key()) == 0)
+        unread += (unread.empty() ? "" : ", ") + ("'" + it.key() + "'");
     }
-    fail(key, "missing (required)" + (unread.empty() ? std::string() : "; also found unknown key(s) " + unread));
+    fail(key, "missing (required)" +
+                  (unread.empty() ? std::string() : "; also found unknown key(s) " + unread));
   }
   return json_.at(key);
 }
@@ -93,7 +95,8 @@ Eigen::Vector3d JsonObject::vector3(const std::string& key) const {
   if (!j.is_array() || j.size() != 3) fail(key, "expected an array of 3 numbers");
   Eigen::Vector3d v;
   for (size_t i = 0; i < 3; ++i) {
-    if (!j[i].is_number()) fail(key, "element " + std::to_string(i) + ": expected a number, found " + typeName(j[i]));
+    if (!j[i].is_number())
+      fail(key, "element " + std::to_string(i) + ": expected a number, found " + typeName(j[i]));
     v[static_cast<Eigen::Index>(i)] = j[i].get<double>();
   }
   if (!v.allFinite()) fail(key, "must be finite");
@@ -117,7 +120,8 @@ std::vector<JsonObject> JsonObject::objects(const std::string& key) const {
   if (!j.is_array()) fail(key, "expected an array, found " + typeName(j));
   for (size_t i = 0; i < j.size(); ++i) {
     const std::string item = keyPath(key) + "[" + std::to_string(i) + "]";
-    if (!j[i].is_object()) throw JsonFault(file_ + ": " + item + ": expected an object, found " + typeName(j[i]));
+    if (!j[i].is_object())
+      throw JsonFault(file_ + ": " + item + ": expected an object, found " + typeName(j[i]));
     out.emplace_back(j[i], item, file_);
   }
   return out;
@@ -129,7 +133,8 @@ std::string JsonObject::oneOf(const std::vector<std::string>& choices) const {
   for (const std::string& c : choices) {
     list += (list.empty() ? "" : ", ") + c;
     if (has(c)) {
-      if (!found.empty()) throw JsonFault(file_ + ": " + path_ + ": give only one of " + list + "...");
+      if (!found.empty())
+        throw JsonFault(file_ + ": " + path_ + ": give only one of " + list + "...");
       found = c;
     }
   }
@@ -141,7 +146,8 @@ void JsonObject::finish() const {
   for (auto it = json_.begin(); it != json_.end(); ++it) {
     if (read_.count(it.key()) == 0) {
       std::string known;
-      for (const std::string& k : read_) known += (known.empty() ? "" : ", ") + k;
+      for (const std::string& k : read_)
+        known += (known.empty() ? "" : ", ") + k;
       fail(it.key(), "unknown key (known here: " + known + ")");
     }
   }

@@ -30,7 +30,8 @@ class JsonObject {
   Eigen::Vector3d vector3(const std::string& key) const;
   Eigen::Vector3d vector3(const std::string& key, const Eigen::Vector3d& fallback) const;
   JsonObject object(const std::string& key) const;
-  std::vector<JsonObject> objects(const std::string& key) const;  ///< an array of objects; [] if absent
+  std::vector<JsonObject> objects(
+      const std::string& key) const;  ///< an array of objects; [] if absent
   /// The single key present among `choices` (exactly one must be).
   std::string oneOf(const std::vector<std::string>& choices) const;
 

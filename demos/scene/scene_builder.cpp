@@ -14,7 +14,8 @@ std::vector<int> selectNodes(const TetMesh& mesh, const NodeSelection& selection
         inside = std::abs(selection.normal.dot(p - selection.point)) <= selection.tolerance;
         break;
       case NodeSelection::Kind::kBox:
-        inside = (p.array() >= selection.min.array()).all() && (p.array() <= selection.max.array()).all();
+        inside = (p.array() >= selection.min.array()).all() &&
+                 (p.array() <= selection.max.array()).all();
         break;
       case NodeSelection::Kind::kSphere:
         inside = (p - selection.point).norm() <= selection.radius;
@@ -36,14 +37,16 @@ Result<std::unique_ptr<BuiltScene>> buildScene(SceneSpec spec, int threads_overr
     const std::string entry = spec.file + ": bodies[" + std::to_string(b) + "] '" + body.name + "'";
     Result<LoadedMesh> mesh = readMesh(body.mesh_path);
     if (!mesh) return Error{entry + ": " + mesh.error().message};
-    for (const std::string& w : mesh.value().warnings) built->warnings.push_back(w);
+    for (const std::string& w : mesh.value().warnings)
+      built->warnings.push_back(w);
     Result<FemBody*> added = world.addBody(body.name, mesh.value().mesh, body.material, body.pose);
     if (!added) return Error{entry + ": " + added.error().message};
   }
 
   for (size_t s = 0; s < spec.node_sets.size(); ++s) {
     const NodeSetSpec& set = spec.node_sets[s];
-    const std::string entry = spec.file + ": node_sets[" + std::to_string(s) + "] '" + set.name + "'";
+    const std::string entry =
+        spec.file + ": node_sets[" + std::to_string(s) + "] '" + set.name + "'";
     FemBody* body = world.body(set.body);
     std::vector<int> nodes = selectNodes(body->model().mesh(), set.selection);
     if (nodes.empty()) {
@@ -55,8 +58,9 @@ Result<std::unique_ptr<BuiltScene>> buildScene(SceneSpec spec, int threads_overr
     handle.body = body;
     handle.wrench_about = set.wrench_about;
     handle.node_count = static_cast<int>(nodes.size());
-    FrameMotion motion = set.fixed ? FrameMotion([](double) { return Frame{}; })
-                                   : FrameMotion([m = set.motion](double t) { return m.frameAt(t); });
+    FrameMotion motion = set.fixed
+                             ? FrameMotion([](double) { return Frame{}; })
+                             : FrameMotion([m = set.motion](double t) { return m.frameAt(t); });
     handle.group = body->carryNodes(set.name, std::move(nodes), std::move(motion), world.time());
     built->node_sets.push_back(handle);
   }
@@ -67,7 +71,8 @@ Result<std::unique_ptr<BuiltScene>> buildScene(SceneSpec spec, int threads_overr
     transform.setIdentity();
     switch (r.shape) {
       case RigidBodySpec::Shape::kBox:
-        shape = std::make_unique<btBoxShape>(btVector3(r.half_extents.x(), r.half_extents.y(), r.half_extents.z()));
+        shape = std::make_unique<btBoxShape>(
+            btVector3(r.half_extents.x(), r.half_extents.y(), r.half_extents.z()));
         break;
       case RigidBodySpec::Shape::kSphere:
         shape = std::make_unique<btSphereShape>(r.radius);
@@ -78,7 +83,8 @@ Result<std::unique_ptr<BuiltScene>> buildScene(SceneSpec spec, int threads_overr
         break;
     }
     transform.setOrigin(btVector3(r.pose.origin.x(), r.pose.origin.y(), r.pose.origin.z()));
-    transform.setRotation(btQuaternion(r.pose.rotation.x(), r.pose.rotation.y(), r.pose.rotation.z(), r.pose.rotation.w()));
+    transform.setRotation(btQuaternion(r.pose.rotation.x(), r.pose.rotation.y(),
+                                       r.pose.rotation.z(), r.pose.rotation.w()));
     world.addRigidBody(std::move(shape), r.mass, transform);
   }
   built->spec = std::move(spec);

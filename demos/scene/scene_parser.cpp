@@ -135,7 +135,8 @@ RigidBodySpec readRigidBody(const JsonObject& r) {
   shape.finish();
   spec.mass = r.number("mass", spec.shape == RigidBodySpec::Shape::kPlane ? 0.0 : 1.0);
   if (!(spec.mass >= 0)) r.fail("mass", "must be >= 0 kg (0: static)");
-  if (spec.shape == RigidBodySpec::Shape::kPlane && spec.mass != 0) r.fail("mass", "a plane must be static (mass 0)");
+  if (spec.shape == RigidBodySpec::Shape::kPlane && spec.mass != 0)
+    r.fail("mass", "a plane must be static (mass 0)");
   spec.pose = readPose(r, "pose");
   r.finish();
   return spec;
@@ -197,7 +198,9 @@ Result<SceneSpec> parseScene(std::string_view text, const std::string& file_name
       }
       const std::string mesh = b.string("mesh");
       const std::filesystem::path mesh_path(mesh);
-      body.mesh_path = mesh_path.is_absolute() ? mesh : (std::filesystem::path(base_directory) / mesh_path).string();
+      body.mesh_path = mesh_path.is_absolute()
+                           ? mesh
+                           : (std::filesystem::path(base_directory) / mesh_path).string();
       body.material = readMaterial(b.object("material"));
       body.pose = readPose(b, "pose");
       b.finish();
@@ -213,7 +216,8 @@ Result<SceneSpec> parseScene(std::string_view text, const std::string& file_name
       }
       set.body = s.string("body");
       bool known = false;
-      for (const BodySpec& body : scene.bodies) known = known || body.name == set.body;
+      for (const BodySpec& body : scene.bodies)
+        known = known || body.name == set.body;
       if (!known) s.fail("body", "no body named '" + set.body + "'");
       set.selection = readSelection(s.object("select"));
       set.fixed = !s.has("motion");
@@ -222,7 +226,8 @@ Result<SceneSpec> parseScene(std::string_view text, const std::string& file_name
       s.finish();
       scene.node_sets.push_back(std::move(set));
     }
-    for (const JsonObject& r : root.objects("rigid_bodies")) scene.rigid_bodies.push_back(readRigidBody(r));
+    for (const JsonObject& r : root.objects("rigid_bodies"))
+      scene.rigid_bodies.push_back(readRigidBody(r));
     root.finish();
     Status world_ok = scene.world.validate();
     if (!world_ok) return Error{file_name + ": " + world_ok.error().message};

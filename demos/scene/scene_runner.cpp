@@ -31,7 +31,8 @@ Status writeFinalMesh(const FemBody& body, const Eigen::VectorXd& positions, con
   displacement.values.reserve(static_cast<size_t>(3 * mesh.nodeCount()));
   for (int i = 0; i < mesh.nodeCount(); ++i) {
     x[static_cast<size_t>(i)] = positions.segment<3>(3 * i);
-    const Eigen::Vector3d u = x[static_cast<size_t>(i)] - mesh.restPositions()[static_cast<size_t>(i)];
+    const Eigen::Vector3d u =
+        x[static_cast<size_t>(i)] - mesh.restPositions()[static_cast<size_t>(i)];
     displacement.values.insert(displacement.values.end(), {u.x(), u.y(), u.z()});
   }
   MeshFields fields;
@@ -54,17 +55,20 @@ Result<RunOutcome> runScene(BuiltScene& scene, const RunOptions& options) {
   if (!wrench_csv || !energy_csv) return Error{out.string() + ": cannot write the CSV files"};
   wrench_csv << "step,time";
   for (const NodeSetHandle& s : scene.node_sets) {
-    for (const char* c : {"fx", "fy", "fz", "tx", "ty", "tz"}) wrench_csv << "," << s.name << "." << c;
+    for (const char* c : {"fx", "fy", "fz", "tx", "ty", "tz"})
+      wrench_csv << "," << s.name << "." << c;
   }
   wrench_csv << "\n";
   energy_csv << "step,time";
-  for (const auto& body : world.bodies()) energy_csv << "," << body->name() << ".kinetic," << body->name() << ".elastic";
+  for (const auto& body : world.bodies())
+    energy_csv << "," << body->name() << ".kinetic," << body->name() << ".elastic";
   energy_csv << ",iterations,relative_residual\n";
   wrench_csv.precision(10);
   energy_csv.precision(10);
 
   std::vector<Eigen::VectorXd> last_good;
-  for (const auto& body : world.bodies()) last_good.push_back(body->state().positions);
+  for (const auto& body : world.bodies())
+    last_good.push_back(body->state().positions);
 
   RunOutcome outcome;
   std::vector<double> step_ms;
@@ -75,7 +79,8 @@ Result<RunOutcome> runScene(BuiltScene& scene, const RunOptions& options) {
   for (int k = 0; k < steps; ++k) {
     const auto t0 = std::chrono::steady_clock::now();
     const WorldStepReport report = world.step();
-    step_ms.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
+    step_ms.push_back(
+        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
     if (!report.ok) {
       outcome.stable = false;
       outcome.failure = report.message;
@@ -96,18 +101,20 @@ Result<RunOutcome> runScene(BuiltScene& scene, const RunOptions& options) {
     wrench_csv << report.step << "," << world.time();
     for (const NodeSetHandle& s : scene.node_sets) {
       const Wrench w = s.body->groupWrench(s.group, s.wrench_about);
-      wrench_csv << "," << w.force.x() << "," << w.force.y() << "," << w.force.z() << "," << w.torque.x()
-                 << "," << w.torque.y() << "," << w.torque.z();
+      wrench_csv << "," << w.force.x() << "," << w.force.y() << "," << w.force.z() << ","
+                 << w.torque.x() << "," << w.torque.y() << "," << w.torque.z();
     }
     wrench_csv << "\n";
     energy_csv << report.step << "," << world.time();
     for (const auto& body : world.bodies()) {
       // kinetic at the end of the step; elastic at its start (the stepper's by-product)
-      energy_csv << "," << body->lastReport().kinetic_energy << "," << body->lastReport().elastic_energy;
+      energy_csv << "," << body->lastReport().kinetic_energy << ","
+                 << body->lastReport().elastic_energy;
     }
     energy_csv << "," << iterations << "," << residual << "\n";
     if (options.progress) {
-      const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - run_start).count();
+      const double elapsed =
+          std::chrono::duration<double>(std::chrono::steady_clock::now() - run_start).count();
       options.progress(k + 1, steps, elapsed > 0 ? (k + 1) / elapsed : 0.0);
     }
   }
@@ -129,7 +136,8 @@ Result<RunOutcome> runScene(BuiltScene& scene, const RunOptions& options) {
   summary["preconditioner"] = toString(world.settings().solver.preconditioner);
   summary["tolerance"] = world.settings().solver.tolerance;
   summary["threads"] = world.settings().solver.threads;
-  summary["ms_per_step"] = {{"median", percentile(step_ms, 0.5)}, {"p95", percentile(step_ms, 0.95)}};
+  summary["ms_per_step"] = {{"median", percentile(step_ms, 0.5)},
+                            {"p95", percentile(step_ms, 0.95)}};
   summary["solver_iterations"] = {
       {"mean", outcome.steps_done > 0 ? double(iteration_sum) / outcome.steps_done : 0.0},
       {"max", iteration_max}};
@@ -142,7 +150,8 @@ Result<RunOutcome> runScene(BuiltScene& scene, const RunOptions& options) {
   }
   summary["node_sets"] = nlohmann::json::array();
   for (const NodeSetHandle& s : scene.node_sets) {
-    summary["node_sets"].push_back({{"name", s.name}, {"body", s.body->name()}, {"nodes", s.node_count}});
+    summary["node_sets"].push_back(
+        {{"name", s.name}, {"body", s.body->name()}, {"nodes", s.node_count}});
   }
   summary["stable"] = outcome.stable;
   if (!outcome.stable) summary["failure"] = outcome.failure;

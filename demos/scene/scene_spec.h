@@ -1,6 +1,7 @@
 #pragma once
 // A scene as parsed from its JSON file (docs/scene-format.md): plain data, validated, with every
-// path already resolved relative to the scene file. Building a world from it is scene_builder's job.
+// path already resolved relative to the scene file. Building a world from it is scene_builder's
+// job.
 
 #include <Eigen/Core>
 #include <optional>
@@ -23,11 +24,11 @@ struct BodySpec {
 /// Which nodes of a body a set takes (rest positions, after the body's pose).
 struct NodeSelection {
   enum class Kind { kPlane, kBox, kSphere } kind = Kind::kPlane;
-  Eigen::Vector3d point = Eigen::Vector3d::Zero();   ///< plane point / sphere centre
-  Eigen::Vector3d normal = Eigen::Vector3d::UnitZ(); ///< plane normal (unit)
-  double tolerance = 1e-6;                           ///< plane half-thickness, m
+  Eigen::Vector3d point = Eigen::Vector3d::Zero();    ///< plane point / sphere centre
+  Eigen::Vector3d normal = Eigen::Vector3d::UnitZ();  ///< plane normal (unit)
+  double tolerance = 1e-6;                            ///< plane half-thickness, m
   Eigen::Vector3d min = Eigen::Vector3d::Zero(), max = Eigen::Vector3d::Zero();  ///< box
-  double radius = 0;                                 ///< sphere
+  double radius = 0;                                                             ///< sphere
 };
 
 /// Constant rigid motion of a node set: rotation at angular_velocity about pivot plus translation
@@ -47,7 +48,7 @@ struct NodeSetSpec {
   std::string name;
   std::string body;
   NodeSelection selection;
-  bool fixed = true;             ///< true: held in place; false: follows `motion`
+  bool fixed = true;  ///< true: held in place; false: follows `motion`
   MotionSpec motion;
   Eigen::Vector3d wrench_about = Eigen::Vector3d::Zero();  ///< point for the reported torque
 };
@@ -56,10 +57,10 @@ struct RigidBodySpec {
   std::string name;
   enum class Shape { kBox, kSphere, kPlane } shape = Shape::kBox;
   Eigen::Vector3d half_extents = Eigen::Vector3d::Constant(0.5);  ///< box
-  double radius = 0.5;                                             ///< sphere
-  Eigen::Vector3d plane_normal = Eigen::Vector3d::UnitZ();         ///< static plane
-  double plane_offset = 0;                                         ///< n . x = offset
-  double mass = 1;                                                 ///< kg; 0 = static
+  double radius = 0.5;                                            ///< sphere
+  Eigen::Vector3d plane_normal = Eigen::Vector3d::UnitZ();        ///< static plane
+  double plane_offset = 0;                                        ///< n . x = offset
+  double mass = 1;                                                ///< kg; 0 = static
   Frame pose;
 };
 

@@ -6,7 +6,9 @@ namespace torsion::device {
 
 namespace {
 
-double norm(const Vec3& v) { return std::sqrt(v.x * v.x + v.y * v.y + v.z * v.z); }
+double norm(const Vec3& v) {
+  return std::sqrt(v.x * v.x + v.y * v.y + v.z * v.z);
+}
 
 Vec3 clampNorm(const Vec3& v, double max_norm) {
   const double n = norm(v);
@@ -15,11 +17,15 @@ Vec3 clampNorm(const Vec3& v, double max_norm) {
   return {v.x * scale, v.y * scale, v.z * scale};
 }
 
-bool isFinite(const Vec3& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
+bool isFinite(const Vec3& v) {
+  return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z);
+}
 
 }  // namespace
 
-bool isFinite(const Wrench& wrench) { return isFinite(wrench.force) && isFinite(wrench.torque); }
+bool isFinite(const Wrench& wrench) {
+  return isFinite(wrench.force) && isFinite(wrench.torque);
+}
 
 Wrench saturate(const Wrench& wrench, const DeviceLimits& limits) {
   if (!isFinite(wrench)) return Wrench{};

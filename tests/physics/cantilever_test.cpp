@@ -30,10 +30,10 @@ double timoshenkoTip() {
 // Static tip deflection: backward Euler with a 1 s step is a damped Newton iteration on the
 // static equilibrium (M / dt^2 is 1e-9 of K here); a few steps converge.
 double simulatedTip(int cells_across) {
-  auto mesh = std::make_shared<TetMesh>(makeBoxTetMesh(Eigen::Vector3d(0, 0, 0),
-                                                       Eigen::Vector3d(kLength, kSide, kSide),
-                                                       10 * cells_across, cells_across, cells_across)
-                                            .value());
+  auto mesh = std::make_shared<TetMesh>(
+      makeBoxTetMesh(Eigen::Vector3d(0, 0, 0), Eigen::Vector3d(kLength, kSide, kSide),
+                     10 * cells_across, cells_across, cells_across)
+          .value());
   Material material;
   material.youngs_modulus = kE;
   material.poisson_ratio = kNu;
@@ -49,19 +49,22 @@ double simulatedTip(int cells_across) {
   Eigen::VectorXd gravity(3 * model->nodeCount());
   std::vector<int> tip;
   for (int i = 0; i < model->nodeCount(); ++i) {
-    gravity.segment<3>(3 * i) = model->nodeMasses()[static_cast<size_t>(i)] * Eigen::Vector3d(0, 0, -kG);
+    gravity.segment<3>(3 * i) =
+        model->nodeMasses()[static_cast<size_t>(i)] * Eigen::Vector3d(0, 0, -kG);
     const double x = mesh->restPositions()[static_cast<size_t>(i)].x();
     if (x < 1e-9) constraints.prescribeVelocity(i, Eigen::Vector3d::Zero());
     if (x > kLength - 1e-9) tip.push_back(i);
   }
   double deflection = 0, previous = -1;
-  for (int step = 0; step < 30 && std::abs(deflection - previous) > 1e-9 * std::abs(deflection); ++step) {
+  for (int step = 0; step < 30 && std::abs(deflection - previous) > 1e-9 * std::abs(deflection);
+       ++step) {
     previous = deflection;
     const StepReport r = stepper.step(state, constraints, gravity);
     EXPECT_FALSE(isFatal(r.health)) << r.message;
     state.velocities.setZero();  // quasi-static: keep only the configuration
     deflection = 0;
-    for (int i : tip) deflection += mesh->restPositions()[static_cast<size_t>(i)].z() - state.position(i).z();
+    for (int i : tip)
+      deflection += mesh->restPositions()[static_cast<size_t>(i)].z() - state.position(i).z();
     deflection /= static_cast<double>(tip.size());
   }
   return deflection;
@@ -69,16 +72,20 @@ double simulatedTip(int cells_across) {
 
 TEST(Cantilever, TipDeflectionConvergesToBeamTheory) {
   const double reference = timoshenkoTip();
-  std::printf("| cells across | tets | tip deflection (m) | error vs Timoshenko |\n|---|---|---|---|\n");
+  std::printf(
+      "| cells across | tets | tip deflection (m) | error vs Timoshenko |\n|---|---|---|---|\n");
   double previous_error = std::numeric_limits<double>::infinity();
   std::vector<std::pair<int, double>> tips;
-  auto csv = test::validationCsv("cantilever.csv", "cells_across,tets,tip_deflection,timoshenko,euler_bernoulli");
+  auto csv = test::validationCsv("cantilever.csv",
+                                 "cells_across,tets,tip_deflection,timoshenko,euler_bernoulli");
   for (int n : {1, 2, 4, 6, 8}) {
     const double tip = simulatedTip(n);
     tips.emplace_back(n, tip);
     const double error = std::abs(tip - reference) / reference;
     std::printf("| %d | %d | %.5f | %.1f %% |\n", n, 60 * n * n * n, tip, 100 * error);
-    if (csv) *csv << n << "," << 60 * n * n * n << "," << tip << "," << reference << "," << eulerBernoulliTip() << "\n";
+    if (csv)
+      *csv << n << "," << 60 * n * n * n << "," << tip << "," << reference << ","
+           << eulerBernoulliTip() << "\n";
     EXPECT_LT(error, previous_error) << "no convergence at " << n << " cells across";
     EXPECT_LT(tip, reference * 1.01) << "linear tets should not be softer than beam theory";
     previous_error = error;
@@ -90,7 +97,8 @@ TEST(Cantilever, TipDeflectionConvergesToBeamTheory) {
   const auto [n2, d2] = tips.back();
   const double extrapolated = (d2 * n2 * n2 - d1 * n1 * n1) / double(n2 * n2 - n1 * n1);
   std::printf("Euler-Bernoulli %.5f m, Timoshenko %.5f m, extrapolated FEM %.5f m (%.1f %%)\n",
-              eulerBernoulliTip(), reference, extrapolated, 100 * (extrapolated - reference) / reference);
+              eulerBernoulliTip(), reference, extrapolated,
+              100 * (extrapolated - reference) / reference);
   EXPECT_LT(previous_error, 0.08);  // 8 cells across, 30720 tets
   EXPECT_NEAR(extrapolated, reference, 0.05 * reference);
 }

@@ -19,7 +19,8 @@ namespace {
 constexpr double kLength = 10;
 
 TetMesh cylinder(int tets) {
-  const std::string path = std::string(TORSION_ASSETS_DIR) + "/cylinder_" + std::to_string(tets) + ".node";
+  const std::string path =
+      std::string(TORSION_ASSETS_DIR) + "/cylinder_" + std::to_string(tets) + ".node";
   Result<LoadedMesh> loaded = readMesh(path);
   EXPECT_TRUE(loaded.ok()) << loaded.error().message;
   return loaded.ok() ? std::move(loaded).value().mesh : TetMesh();
@@ -35,7 +36,8 @@ std::vector<int> nodesAtZ(const TetMesh& mesh, double z) {
 
 std::vector<double> sliceCentres(double spacing) {
   std::vector<double> z;
-  for (double c = 0; c <= kLength + 1e-9; c += spacing) z.push_back(c);
+  for (double c = 0; c <= kLength + 1e-9; c += spacing)
+    z.push_back(c);
   return z;
 }
 
@@ -48,10 +50,10 @@ FrameMotion turnAboutZ(std::function<double(double)> angle) {
 }
 
 struct TorsionResult {
-  double torque = 0;          // measured axial torque on the turned end, N m (magnitude)
-  double expected = 0;        // G J theta'
-  double twist_rate = 0;      // theta', rad/m
-  double nonlinearity = 0;    // of theta(z) over the middle 60 %
+  double torque = 0;        // measured axial torque on the turned end, N m (magnitude)
+  double expected = 0;      // G J theta'
+  double twist_rate = 0;    // theta', rad/m
+  double nonlinearity = 0;  // of theta(z) over the middle 60 %
   int tets = 0;
 };
 
@@ -65,16 +67,19 @@ TorsionResult smallTwist(int tets, double angle) {
   FemWorld world(settings);
   Material material;  // E = 1e5, nu = 0.3, rho = 1000
   FemBody* body = world.addBody("cylinder", mesh, material).value();
-  body->carryNodes("base", nodesAtZ(mesh, 0), [](double) { return Frame{}; }, 0);
-  const int end = body->carryNodes("end", nodesAtZ(mesh, kLength),
-                                   turnAboutZ([angle](double t) { return angle * std::min(t / 3.0, 1.0); }), 0);
+  body->carryNodes(
+      "base", nodesAtZ(mesh, 0), [](double) { return Frame{}; }, 0);
+  const int end =
+      body->carryNodes("end", nodesAtZ(mesh, kLength),
+                       turnAboutZ([angle](double t) { return angle * std::min(t / 3.0, 1.0); }), 0);
   for (int k = 0; k < 12; ++k) {
     const WorldStepReport r = world.step();
     EXPECT_TRUE(r.ok) << r.message;
   }
   TorsionResult result;
   result.tets = mesh.tetCount();
-  const auto profile = twistProfile(mesh.restPositions(), body->state().positions, sliceCentres(0.5), 0.26);
+  const auto profile =
+      twistProfile(mesh.restPositions(), body->state().positions, sliceCentres(0.5), 0.26);
   result.twist_rate = twistRate(profile, 2, 8);
   result.nonlinearity = twistNonlinearity(profile, 2, 8);
   const double J = polarMomentOfSection(mesh.restPositions(), mesh.tets(), kLength);
@@ -143,21 +148,25 @@ TEST(StVenantLargeTwist, TwoPiTwistStaysStableAndLinear) {
   settings.gravity.setZero();
   FemWorld world(settings);
   FemBody* body = world.addBody("cylinder", mesh, Material{}).value();
-  body->carryNodes("base", nodesAtZ(mesh, 0), [](double) { return Frame{}; }, 0);
+  body->carryNodes(
+      "base", nodesAtZ(mesh, 0), [](double) { return Frame{}; }, 0);
   const double omega = 0.1, total = 2 * M_PI;
-  body->carryNodes("end", nodesAtZ(mesh, kLength), turnAboutZ([=](double t) { return std::min(omega * t, total); }), 0);
+  body->carryNodes("end", nodesAtZ(mesh, kLength),
+                   turnAboutZ([=](double t) { return std::min(omega * t, total); }), 0);
   const int steps = static_cast<int>(std::ceil(total / omega / settings.solver.time_step)) + 200;
   for (int k = 0; k < steps; ++k) {
     const WorldStepReport r = world.step();
     ASSERT_TRUE(r.ok) << r.message;
   }
-  const auto profile = twistProfile(mesh.restPositions(), body->state().positions, sliceCentres(0.5), 0.26);
+  const auto profile =
+      twistProfile(mesh.restPositions(), body->state().positions, sliceCentres(0.5), 0.26);
   const double rate = twistRate(profile, 2, 8);
   const double nonlinearity = twistNonlinearity(profile, 2, 8);
-  std::printf("2 pi twist: theta' = %.5f rad/m (uniform %.5f), nonlinearity %.2f %%\n", rate, total / kLength,
-              100 * nonlinearity);
+  std::printf("2 pi twist: theta' = %.5f rad/m (uniform %.5f), nonlinearity %.2f %%\n", rate,
+              total / kLength, 100 * nonlinearity);
   if (auto csv = test::validationCsv("st_venant_two_pi_profile.csv", "z,angle,st_venant")) {
-    for (const SliceRotation& slice : profile) *csv << slice.z << "," << slice.angle << "," << total * slice.z / kLength << "\n";
+    for (const SliceRotation& slice : profile)
+      *csv << slice.z << "," << slice.angle << "," << total * slice.z / kLength << "\n";
   }
   EXPECT_LT(nonlinearity, 0.03);
   EXPECT_NEAR(rate, total / kLength, 0.05 * total / kLength);

@@ -10,7 +10,8 @@
 namespace torsion::test {
 
 /// An open CSV file in $TORSION_VALIDATION_OUT, or null when the variable is unset.
-inline std::unique_ptr<std::ofstream> validationCsv(const std::string& name, const std::string& header) {
+inline std::unique_ptr<std::ofstream> validationCsv(const std::string& name,
+                                                    const std::string& header) {
   const char* dir = std::getenv("TORSION_VALIDATION_OUT");
   if (dir == nullptr || *dir == '\0') return nullptr;
   auto out = std::make_unique<std::ofstream>(std::string(dir) + "/" + name);

@@ -30,7 +30,9 @@ const std::string kValid = R"({
                     "pose": {"position": [0, 0, 12]}}]
 })";
 
-Result<SceneSpec> parse(const std::string& text) { return parseScene(text, "s.json", "/base"); }
+Result<SceneSpec> parse(const std::string& text) {
+  return parseScene(text, "s.json", "/base");
+}
 
 std::string replaced(std::string text, const std::string& from, const std::string& to) {
   const size_t at = text.find(from);
@@ -48,7 +50,9 @@ TEST(SceneParser, ReadsACompleteScene) {
   EXPECT_DOUBLE_EQ(s.world.solver.time_step, 0.005);
   ASSERT_EQ(s.bodies.size(), 1u);
   EXPECT_EQ(s.bodies[0].mesh_path, "/base/meshes/cyl.node");
-  EXPECT_NEAR(s.bodies[0].pose.rotation.angularDistance(Eigen::Quaterniond(Eigen::AngleAxisd(0.5, Eigen::Vector3d::UnitZ()))), 0, 1e-12);
+  EXPECT_NEAR(s.bodies[0].pose.rotation.angularDistance(
+                  Eigen::Quaterniond(Eigen::AngleAxisd(0.5, Eigen::Vector3d::UnitZ()))),
+              0, 1e-12);
   ASSERT_EQ(s.node_sets.size(), 2u);
   EXPECT_TRUE(s.node_sets[0].fixed);
   EXPECT_FALSE(s.node_sets[1].fixed);
@@ -63,21 +67,26 @@ TEST(SceneParser, MotionRotatesAboutPivotThenHolds) {
   m.duration = 2;
   const Eigen::Vector3d p(2, 0, 0);
   EXPECT_LT((m.frameAt(0).toWorld(p) - p).norm(), 1e-15);
-  const Eigen::Vector3d quarter(1, 1, 0);  // 0.5 rad/s for pi s would be a quarter turn; hold at 1 rad
-  EXPECT_LT((m.frameAt(M_PI).toWorld(p) - Eigen::Vector3d(1 + std::cos(1.0), std::sin(1.0), 0)).norm(), 1e-12);
+  const Eigen::Vector3d quarter(1, 1,
+                                0);  // 0.5 rad/s for pi s would be a quarter turn; hold at 1 rad
+  EXPECT_LT(
+      (m.frameAt(M_PI).toWorld(p) - Eigen::Vector3d(1 + std::cos(1.0), std::sin(1.0), 0)).norm(),
+      1e-12);
   (void)quarter;
 }
 
 TEST(SceneParserFaults, JsonSyntaxNamesLineAndColumn) {
-  EXPECT_TRUE(failsWith(parse("{\n  \"steps\": 10,\n  \"bodies\": [\n}"), {"s.json:4:", "invalid JSON"}));
+  EXPECT_TRUE(
+      failsWith(parse("{\n  \"steps\": 10,\n  \"bodies\": [\n}"), {"s.json:4:", "invalid JSON"}));
 }
 
 TEST(SceneParserFaults, UnknownKeyIsNamedWithItsPath) {
   // A misspelt optional key is an unknown key; a misspelt required one is named as both.
   EXPECT_TRUE(failsWith(parse(replaced(kValid, "\"linear_solver\"", "\"linearsolver\"")),
                         {"s.json: solver.linearsolver: unknown key", "linear_solver"}));
-  EXPECT_TRUE(failsWith(parse(replaced(kValid, "\"density\"", "\"densty\"")),
-                        {"s.json: bodies[0].material.density: missing", "unknown key(s) 'densty'"}));
+  EXPECT_TRUE(
+      failsWith(parse(replaced(kValid, "\"density\"", "\"densty\"")),
+                {"s.json: bodies[0].material.density: missing", "unknown key(s) 'densty'"}));
 }
 
 TEST(SceneParserFaults, WrongTypeIsNamed) {
@@ -111,7 +120,8 @@ TEST(SceneParserFaults, UnknownBodyInNodeSet) {
 }
 
 TEST(SceneParserFaults, SelectionNeedsExactlyOneShape) {
-  const std::string text = replaced(kValid, "{\"plane\": {\"point\": [0, 0, 0], \"normal\": [0, 0, 1]}}", "{}");
+  const std::string text =
+      replaced(kValid, "{\"plane\": {\"point\": [0, 0, 0], \"normal\": [0, 0, 1]}}", "{}");
   EXPECT_TRUE(failsWith(parse(text), {"node_sets[0].select: needs one of: plane, box, sphere"}));
 }
 
@@ -128,11 +138,13 @@ TEST(SceneParserFaults, NonFiniteNumbersAndZeroAxis) {
 }
 
 TEST(SceneParserFaults, NoBodies) {
-  EXPECT_TRUE(failsWith(parse("{\"steps\": 3}"), {"s.json: bodies: a scene needs at least one FEM body"}));
+  EXPECT_TRUE(
+      failsWith(parse("{\"steps\": 3}"), {"s.json: bodies: a scene needs at least one FEM body"}));
 }
 
 TEST(SceneParserFaults, TopLevelMustBeAnObject) {
-  EXPECT_TRUE(failsWith(parse("[1, 2]"), {"s.json: the scene: expected an object, found an array"}));
+  EXPECT_TRUE(
+      failsWith(parse("[1, 2]"), {"s.json: the scene: expected an object, found an array"}));
 }
 
 }  // namespace

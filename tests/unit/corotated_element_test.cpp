@@ -18,11 +18,13 @@ constexpr double kLambda = 5.769e4;
 
 struct TetFixture {
   std::array<Eigen::Vector3d, 4> rest = {Eigen::Vector3d(0, 0, 0), Eigen::Vector3d(1, 0.1, 0),
-                                         Eigen::Vector3d(0.2, 0.9, 0.1), Eigen::Vector3d(0.1, 0.2, 1.1)};
+                                         Eigen::Vector3d(0.2, 0.9, 0.1),
+                                         Eigen::Vector3d(0.1, 0.2, 1.1)};
   TetRestData data;
   TetFixture() {
     Eigen::Matrix3d Dm;
-    for (int k = 0; k < 3; ++k) Dm.col(k) = rest[static_cast<size_t>(k + 1)] - rest[0];
+    for (int k = 0; k < 3; ++k)
+      Dm.col(k) = rest[static_cast<size_t>(k + 1)] - rest[0];
     data.rest_shape_inverse = Dm.inverse();
     data.volume = Dm.determinant() / 6;
   }
@@ -40,10 +42,12 @@ struct TetFixture {
     Eigen::Matrix<double, 12, 12> K;
     for (int c = 0; c < 12; ++c) {
       std::array<Eigen::Vector3d, 4> dx;
-      for (auto& v : dx) v.setZero();
+      for (auto& v : dx)
+        v.setZero();
       dx[static_cast<size_t>(c / 3)][c % 3] = 1;
       const auto df = corotatedForceDifferential(dx, R, data, kMu, kLambda);
-      for (int a = 0; a < 4; ++a) K.block<3, 1>(3 * a, c) = -df[static_cast<size_t>(a)];
+      for (int a = 0; a < 4; ++a)
+        K.block<3, 1>(3 * a, c) = -df[static_cast<size_t>(a)];
     }
     return K;
   }
@@ -52,7 +56,8 @@ struct TetFixture {
 std::array<Eigen::Vector3d, 4> rigidlyMoved(const std::array<Eigen::Vector3d, 4>& x,
                                             const Eigen::Matrix3d& R, const Eigen::Vector3d& t) {
   std::array<Eigen::Vector3d, 4> y;
-  for (size_t a = 0; a < 4; ++a) y[a] = R * x[a] + t;
+  for (size_t a = 0; a < 4; ++a)
+    y[a] = R * x[a] + t;
   return y;
 }
 
@@ -63,7 +68,8 @@ Eigen::Matrix3d randomRotation(std::mt19937& rng) {
 
 TEST(CorotatedElement, ZeroForceAtRest) {
   TetFixture tet;
-  for (const auto& f : tet.forces(tet.rest)) EXPECT_LT(f.norm(), 1e-9);
+  for (const auto& f : tet.forces(tet.rest))
+    EXPECT_LT(f.norm(), 1e-9);
 }
 
 TEST(CorotatedElement, ZeroForceUnderRigidMotions) {
@@ -72,7 +78,8 @@ TEST(CorotatedElement, ZeroForceUnderRigidMotions) {
   for (int trial = 0; trial < 50; ++trial) {
     const auto moved = rigidlyMoved(tet.rest, randomRotation(rng), Eigen::Vector3d(3, -2, 5));
     // Forces scale with E * area ~ 1e5; rigid motion must leave round-off only.
-    for (const auto& f : tet.forces(moved)) EXPECT_LT(f.norm(), 1e-6) << "trial " << trial;
+    for (const auto& f : tet.forces(moved))
+      EXPECT_LT(f.norm(), 1e-6) << "trial " << trial;
   }
 }
 
@@ -96,14 +103,17 @@ TEST(CorotatedElement, ForcesSumToZeroAndCarryNoTorque) {
 TEST(CorotatedElement, StiffnessSymmetricPsdWithSixZeroModes) {
   TetFixture tet;
   std::mt19937 rng(3);
-  for (const Eigen::Matrix3d& R : {Eigen::Matrix3d(Eigen::Matrix3d::Identity()), randomRotation(rng)}) {
+  for (const Eigen::Matrix3d& R :
+       {Eigen::Matrix3d(Eigen::Matrix3d::Identity()), randomRotation(rng)}) {
     const Eigen::Matrix<double, 12, 12> K = tet.stiffness(R);
     EXPECT_LT((K - K.transpose()).norm(), 1e-9 * K.norm());
     Eigen::SelfAdjointEigenSolver<Eigen::Matrix<double, 12, 12>> eig(0.5 * (K + K.transpose()));
     const auto values = eig.eigenvalues();  // ascending
     const double largest = values(11);
-    for (int i = 0; i < 6; ++i) EXPECT_LT(std::abs(values(i)), 1e-10 * largest) << "mode " << i;
-    for (int i = 6; i < 12; ++i) EXPECT_GT(values(i), 1e-4 * largest) << "mode " << i;
+    for (int i = 0; i < 6; ++i)
+      EXPECT_LT(std::abs(values(i)), 1e-10 * largest) << "mode " << i;
+    for (int i = 6; i < 12; ++i)
+      EXPECT_GT(values(i), 1e-4 * largest) << "mode " << i;
   }
 }
 
@@ -116,7 +126,8 @@ TEST(CorotatedElement, DifferentialMatchesFiniteDifferenceAtRigidConfigurations)
   const auto x = rigidlyMoved(tet.rest, R, Eigen::Vector3d(1, 2, 3));
   std::normal_distribution<double> n(0, 1);
   std::array<Eigen::Vector3d, 4> dx;
-  for (auto& v : dx) v = Eigen::Vector3d(n(rng), n(rng), n(rng));
+  for (auto& v : dx)
+    v = Eigen::Vector3d(n(rng), n(rng), n(rng));
   const double h = 1e-6;
   std::array<Eigen::Vector3d, 4> plus = x, minus = x;
   for (size_t a = 0; a < 4; ++a) {
@@ -162,7 +173,8 @@ TEST(CorotatedElement, DiagonalBlocksMatchStiffness) {
   const auto K = tet.stiffness(R);
   const auto blocks = corotatedDiagonalBlocks(R, tet.data, kMu, kLambda);
   for (int a = 0; a < 4; ++a) {
-    EXPECT_LT((blocks[static_cast<size_t>(a)] - K.block<3, 3>(3 * a, 3 * a)).norm(), 1e-9 * K.norm());
+    EXPECT_LT((blocks[static_cast<size_t>(a)] - K.block<3, 3>(3 * a, 3 * a)).norm(),
+              1e-9 * K.norm());
   }
 }
 

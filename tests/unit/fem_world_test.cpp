@@ -8,9 +8,12 @@
 namespace torsion {
 namespace {
 
-TetMesh beam() { return makeBoxTetMesh({0, 0, 0}, {4, 1, 1}, 8, 2, 2).value(); }
+TetMesh beam() {
+  return makeBoxTetMesh({0, 0, 0}, {4, 1, 1}, 8, 2, 2).value();
+}
 
-std::vector<int> nodesWhere(const FemBody& body, const std::function<bool(const Eigen::Vector3d&)>& pick) {
+std::vector<int> nodesWhere(const FemBody& body,
+                            const std::function<bool(const Eigen::Vector3d&)>& pick) {
   std::vector<int> nodes;
   for (int i = 0; i < body.model().nodeCount(); ++i) {
     if (pick(body.model().mesh().restPositions()[static_cast<size_t>(i)])) nodes.push_back(i);
@@ -22,12 +25,14 @@ TEST(FemWorld, CantileverSagsAndRigidBoxFallsBesideIt) {
   WorldSettings settings;
   FemWorld world(settings);
   FemBody* body = world.addBody("beam", beam(), Material{}).value();
-  body->carryNodes("clamp", nodesWhere(*body, [](const Eigen::Vector3d& p) { return p.x() < 1e-9; }),
-                   [](double) { return Frame{}; }, world.time());
+  body->carryNodes(
+      "clamp", nodesWhere(*body, [](const Eigen::Vector3d& p) { return p.x() < 1e-9; }),
+      [](double) { return Frame{}; }, world.time());
   btTransform start;
   start.setIdentity();
   start.setOrigin(btVector3(20, 0, 10));  // far from the beam: no contact
-  btRigidBody* box = world.addRigidBody(std::make_unique<btBoxShape>(btVector3(0.5, 0.5, 0.5)), 1.0, start);
+  btRigidBody* box =
+      world.addRigidBody(std::make_unique<btBoxShape>(btVector3(0.5, 0.5, 0.5)), 1.0, start);
 
   const int steps = 50;
   for (int k = 0; k < steps; ++k) {
@@ -39,7 +44,8 @@ TEST(FemWorld, CantileverSagsAndRigidBoxFallsBesideIt) {
   // The free end sags; the clamped end stays.
   const FemState& s = body->state();
   double tip_z = 0;
-  for (int i : nodesWhere(*body, [](const Eigen::Vector3d& p) { return p.x() > 4 - 1e-9; })) tip_z += s.position(i).z();
+  for (int i : nodesWhere(*body, [](const Eigen::Vector3d& p) { return p.x() > 4 - 1e-9; }))
+    tip_z += s.position(i).z();
   EXPECT_LT(tip_z, 0);
   for (int i : nodesWhere(*body, [](const Eigen::Vector3d& p) { return p.x() < 1e-9; })) {
     EXPECT_EQ(s.position(i), body->model().mesh().restPositions()[static_cast<size_t>(i)]);
@@ -51,7 +57,8 @@ TEST(FemWorld, CantileverSagsAndRigidBoxFallsBesideIt) {
   }
   // The rigid box fell freely: z = 10 - g t^2 / 2 within Bullet's semi-implicit Euler error.
   const double t = world.time();
-  EXPECT_NEAR(box->getWorldTransform().getOrigin().z(), 10 - 0.5 * 9.81 * t * t, 0.5 * 9.81 * t * settings.solver.time_step + 1e-9);
+  EXPECT_NEAR(box->getWorldTransform().getOrigin().z(), 10 - 0.5 * 9.81 * t * t,
+              0.5 * 9.81 * t * settings.solver.time_step + 1e-9);
 }
 
 TEST(FemWorld, PoseMovesTheRestShape) {
@@ -60,9 +67,10 @@ TEST(FemWorld, PoseMovesTheRestShape) {
   pose.origin = Eigen::Vector3d(1, 2, 3);
   pose.rotation = Eigen::AngleAxisd(M_PI / 2, Eigen::Vector3d::UnitZ());
   FemBody* body = world.addBody("b", beam(), Material{}, pose).value();
-  const Eigen::Vector3d lo = body->model().mesh().boundsMin(), hi = body->model().mesh().boundsMax();
-  EXPECT_NEAR(lo.x(), 0, 1e-12);   // x in [1 - 1, 1]
-  EXPECT_NEAR(hi.y(), 6, 1e-12);   // y in [2, 2 + 4]
+  const Eigen::Vector3d lo = body->model().mesh().boundsMin(),
+                        hi = body->model().mesh().boundsMax();
+  EXPECT_NEAR(lo.x(), 0, 1e-12);  // x in [1 - 1, 1]
+  EXPECT_NEAR(hi.y(), 6, 1e-12);  // y in [2, 2 + 4]
   EXPECT_NEAR(lo.z(), 3, 1e-12);
 }
 
@@ -83,7 +91,8 @@ TEST(FemWorld, InstabilityStopsWithBodyAndStep) {
   FemWorld world(settings);
   world.addBody("faller", beam(), Material{}).value();
   WorldStepReport r;
-  for (int k = 0; k < 200 && r.ok; ++k) r = world.step();
+  for (int k = 0; k < 200 && r.ok; ++k)
+    r = world.step();
   ASSERT_FALSE(r.ok);
   EXPECT_NE(r.message.find("body 'faller', step "), std::string::npos) << r.message;
   EXPECT_NE(r.message.find("blow-up"), std::string::npos) << r.message;
@@ -105,13 +114,18 @@ TEST(FemWorld, ScriptedRotationCarriesNodesExactly) {
         return f;
       },
       world.time());
-  body->carryNodes("clamp", nodesWhere(*body, [](const Eigen::Vector3d& p) { return p.x() < 1e-9; }),
-                   [](double) { return Frame{}; }, world.time());
-  for (int k = 0; k < 20; ++k) ASSERT_TRUE(world.step().ok);
+  body->carryNodes(
+      "clamp", nodesWhere(*body, [](const Eigen::Vector3d& p) { return p.x() < 1e-9; }),
+      [](double) { return Frame{}; }, world.time());
+  for (int k = 0; k < 20; ++k)
+    ASSERT_TRUE(world.step().ok);
   const CarriedNodes& group = *body->groups()[static_cast<size_t>(end)];
   const Frame frame = group.frameAt(world.time());
   for (size_t k = 0; k < group.nodes().size(); ++k) {
-    EXPECT_LT((body->state().position(group.nodes()[k]) - frame.toWorld(group.localCoordinates()[k])).norm(), 1e-12);
+    EXPECT_LT(
+        (body->state().position(group.nodes()[k]) - frame.toWorld(group.localCoordinates()[k]))
+            .norm(),
+        1e-12);
   }
   // Twisting the end by +omega t about +x: the body resists with a negative torque about x.
   const Wrench w = body->groupWrench(end, axis_point);

@@ -20,7 +20,8 @@ std::shared_ptr<const FemModel> beamModel(Material material = {}) {
 
 Eigen::VectorXd gravityForces(const FemModel& model, const Eigen::Vector3d& g) {
   Eigen::VectorXd f(3 * model.nodeCount());
-  for (int i = 0; i < model.nodeCount(); ++i) f.segment<3>(3 * i) = model.nodeMasses()[static_cast<size_t>(i)] * g;
+  for (int i = 0; i < model.nodeCount(); ++i)
+    f.segment<3>(3 * i) = model.nodeMasses()[static_cast<size_t>(i)] * g;
   return f;
 }
 
@@ -57,7 +58,8 @@ TEST(ImplicitStepper, FreeFallIsExactBackwardEuler) {
   const Eigen::Vector3d g(0, 0, -9.81);
   const Eigen::VectorXd f = gravityForces(*model, g);
   const int steps = 20;
-  for (int k = 0; k < steps; ++k) ASSERT_FALSE(isFatal(stepper.step(state, constraints, f).health));
+  for (int k = 0; k < steps; ++k)
+    ASSERT_FALSE(isFatal(stepper.step(state, constraints, f).health));
   const double dt = settings.time_step;
   for (int i = 0; i < model->nodeCount(); ++i) {
     // CG stops at a relative residual of 1e-10 of |M v + dt f| per step: ~1e-9 of v after 20.
@@ -76,16 +78,19 @@ TEST(ImplicitStepper, InternalForcesConserveMomentum) {
   FemState state = FemState::atRest(*model);
   std::mt19937 rng(2);
   std::normal_distribution<double> n(0, 0.5);
-  for (int i = 0; i < state.velocities.size(); ++i) state.velocities[i] = n(rng);
+  for (int i = 0; i < state.velocities.size(); ++i)
+    state.velocities[i] = n(rng);
   auto momentum = [&] {
     Eigen::Vector3d p = Eigen::Vector3d::Zero();
-    for (int i = 0; i < model->nodeCount(); ++i) p += model->nodeMasses()[static_cast<size_t>(i)] * state.velocity(i);
+    for (int i = 0; i < model->nodeCount(); ++i)
+      p += model->nodeMasses()[static_cast<size_t>(i)] * state.velocity(i);
     return p;
   };
   const Eigen::Vector3d p0 = momentum();
   NodeConstraints constraints(model->nodeCount());
   const Eigen::VectorXd zero = Eigen::VectorXd::Zero(3 * model->nodeCount());
-  for (int k = 0; k < 30; ++k) ASSERT_FALSE(isFatal(stepper.step(state, constraints, zero).health));
+  for (int k = 0; k < 30; ++k)
+    ASSERT_FALSE(isFatal(stepper.step(state, constraints, zero).health));
   EXPECT_LT((momentum() - p0).norm(), 1e-6 * (p0.norm() + model->totalMass() * 0.5));
 }
 
@@ -115,17 +120,22 @@ TEST(ImplicitStepper, TotalEnergyNeverRisesWithDamping) {
 TEST(ImplicitStepper, InvertedTetRecovers) {
   // One tet with its apex pushed through the opposite face.
   auto mesh = std::make_shared<TetMesh>(
-      std::vector<Eigen::Vector3d>{{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0, 0, 1}}, std::vector<Tet>{{0, 1, 2, 3}});
+      std::vector<Eigen::Vector3d>{{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0, 0, 1}},
+      std::vector<Tet>{{0, 1, 2, 3}});
   auto model = FemModel::create(mesh, Material{}).value();
   Parallel parallel(1);
   ImplicitStepper stepper(model, tight(), parallel);
   FemState state = FemState::atRest(*model);
   state.positions.segment<3>(9) = Eigen::Vector3d(0.2, 0.2, -0.3);
-  EXPECT_LT(sixSignedVolume(state.position(0), state.position(1), state.position(2), state.position(3)), 0);
+  EXPECT_LT(
+      sixSignedVolume(state.position(0), state.position(1), state.position(2), state.position(3)),
+      0);
   NodeConstraints constraints(model->nodeCount());
   const Eigen::VectorXd zero = Eigen::VectorXd::Zero(12);
-  for (int k = 0; k < 300; ++k) ASSERT_FALSE(isFatal(stepper.step(state, constraints, zero).health));
-  const double six_volume = sixSignedVolume(state.position(0), state.position(1), state.position(2), state.position(3));
+  for (int k = 0; k < 300; ++k)
+    ASSERT_FALSE(isFatal(stepper.step(state, constraints, zero).health));
+  const double six_volume =
+      sixSignedVolume(state.position(0), state.position(1), state.position(2), state.position(3));
   EXPECT_NEAR(six_volume, 1.0, 0.02);  // back to its rest volume (6V = 1)
 }
 
@@ -152,7 +162,8 @@ TEST(ImplicitStepper, ProjectionHoldsFixedAndDrivesPrescribedNodes) {
       if (x < 1e-9) {
         EXPECT_EQ(state.position(i), before.position(i));
       } else if (x > 4 - 1e-9) {
-        EXPECT_LT((state.position(i) - before.position(i) - settings.time_step * drive).norm(), 1e-14);
+        EXPECT_LT((state.position(i) - before.position(i) - settings.time_step * drive).norm(),
+                  1e-14);
       }
     }
   }
@@ -176,7 +187,8 @@ TEST(ImplicitStepper, DirectionConstraintFixesOnlyTheNormalComponent) {
   }
   const Eigen::VectorXd f = gravityForces(*model, Eigen::Vector3d(1.0, 0, 0));
   const int steps = 10;
-  for (int k = 0; k < steps; ++k) ASSERT_FALSE(isFatal(stepper.step(state, constraints, f).health));
+  for (int k = 0; k < steps; ++k)
+    ASSERT_FALSE(isFatal(stepper.step(state, constraints, f).health));
   for (int i = 0; i < model->nodeCount(); ++i) {
     if (model->mesh().restPositions()[static_cast<size_t>(i)].z() < 1e-9) {
       EXPECT_NEAR(state.position(i).z(), 0.0, 1e-12);
@@ -202,7 +214,8 @@ FemState twistedRun(int threads, LinearSolverKind kind, int steps = 15,
     constraints.reset(model->nodeCount());
     for (int i = 0; i < model->nodeCount(); ++i) {
       const Eigen::Vector3d p = state.position(i);
-      if (model->mesh().restPositions()[static_cast<size_t>(i)].x() < 1e-9) constraints.prescribeVelocity(i, Eigen::Vector3d::Zero());
+      if (model->mesh().restPositions()[static_cast<size_t>(i)].x() < 1e-9)
+        constraints.prescribeVelocity(i, Eigen::Vector3d::Zero());
       if (model->mesh().restPositions()[static_cast<size_t>(i)].x() > 4 - 1e-9) {
         const Eigen::Vector3d r = p - Eigen::Vector3d(p.x(), 0.5, 0.5);
         const Eigen::AngleAxisd turn(omega * settings.time_step, Eigen::Vector3d::UnitX());
@@ -221,14 +234,17 @@ FemState twistedRun(int threads, LinearSolverKind kind, int steps = 15,
 TEST(ImplicitStepper, SameResultForAnyThreadCount) {
   const FemState one = twistedRun(1, LinearSolverKind::kConjugateGradient);
   const FemState two = twistedRun(2, LinearSolverKind::kConjugateGradient);
-  EXPECT_TRUE(one.positions == two.positions) << "max diff " << (one.positions - two.positions).cwiseAbs().maxCoeff();
+  EXPECT_TRUE(one.positions == two.positions)
+      << "max diff " << (one.positions - two.positions).cwiseAbs().maxCoeff();
 }
 
 TEST(ImplicitStepper, JacobiAndBlockJacobiReachTheSameSolution) {
   const FemState block = twistedRun(1, LinearSolverKind::kConjugateGradient);
-  const FemState diagonal = twistedRun(1, LinearSolverKind::kConjugateGradient, 15, PreconditionerKind::kJacobi);
+  const FemState diagonal =
+      twistedRun(1, LinearSolverKind::kConjugateGradient, 15, PreconditionerKind::kJacobi);
   const FemState start = FemState::atRest(*beamModel());
-  EXPECT_LT((block.positions - diagonal.positions).norm(), 1e-6 * (block.positions - start.positions).norm());
+  EXPECT_LT((block.positions - diagonal.positions).norm(),
+            1e-6 * (block.positions - start.positions).norm());
 }
 
 TEST(ImplicitStepper, ConjugateGradientStuckFarAboveToleranceIsFatal) {
@@ -240,10 +256,13 @@ TEST(ImplicitStepper, ConjugateGradientStuckFarAboveToleranceIsFatal) {
   FemState state = FemState::atRest(*model);
   NodeConstraints constraints(model->nodeCount());
   for (int i = 0; i < model->nodeCount(); ++i) {
-    if (model->mesh().restPositions()[static_cast<size_t>(i)].x() < 1e-9) constraints.prescribeVelocity(i, Eigen::Vector3d::Zero());
+    if (model->mesh().restPositions()[static_cast<size_t>(i)].x() < 1e-9)
+      constraints.prescribeVelocity(i, Eigen::Vector3d::Zero());
   }
   Eigen::VectorXd f(3 * model->nodeCount());
-  for (int i = 0; i < model->nodeCount(); ++i) f.segment<3>(3 * i) = Eigen::Vector3d(0, 0, -9.81 * model->nodeMasses()[static_cast<size_t>(i)]);
+  for (int i = 0; i < model->nodeCount(); ++i)
+    f.segment<3>(3 * i) =
+        Eigen::Vector3d(0, 0, -9.81 * model->nodeMasses()[static_cast<size_t>(i)]);
   const StepReport r = stepper.step(state, constraints, f);
   EXPECT_EQ(r.health, StepHealth::kSolverFailed);
   EXPECT_NE(r.message.find("did not converge"), std::string::npos) << r.message;
@@ -279,7 +298,8 @@ TEST(ImplicitStepper, BlowUpIsDetected) {
   FemState state = FemState::atRest(*model);
   state.velocities.setConstant(50.0);
   NodeConstraints constraints(model->nodeCount());
-  const StepReport r = stepper.step(state, constraints, Eigen::VectorXd::Zero(3 * model->nodeCount()));
+  const StepReport r =
+      stepper.step(state, constraints, Eigen::VectorXd::Zero(3 * model->nodeCount()));
   EXPECT_EQ(r.health, StepHealth::kBlowUp);
   EXPECT_NE(r.message.find("max_speed"), std::string::npos);
 }
@@ -309,7 +329,8 @@ TEST(SystemOperator, ProductsAndDiagonalBlocksMatchTheAssembledMatrix) {
   const Eigen::MatrixXd A = L + L.transpose() - Eigen::MatrixXd(L.diagonal().asDiagonal());
 
   Eigen::VectorXd y(3 * model->nodeCount());
-  for (int i = 0; i < y.size(); ++i) y[i] = n(rng);
+  for (int i = 0; i < y.size(); ++i)
+    y[i] = n(rng);
   Eigen::VectorXd Ay;
   op.multiply(y, Ay);
   EXPECT_LT((Ay - A * y).norm(), 1e-10 * Ay.norm());
@@ -317,7 +338,9 @@ TEST(SystemOperator, ProductsAndDiagonalBlocksMatchTheAssembledMatrix) {
   std::vector<Eigen::Matrix3d> blocks;
   op.diagonalBlocks(blocks);
   for (int i = 0; i < model->nodeCount(); ++i) {
-    EXPECT_LT((blocks[static_cast<size_t>(i)] - A.block<3, 3>(3 * i, 3 * i)).norm(), 1e-10 * A.norm()) << "node " << i;
+    EXPECT_LT((blocks[static_cast<size_t>(i)] - A.block<3, 3>(3 * i, 3 * i)).norm(),
+              1e-10 * A.norm())
+        << "node " << i;
   }
 }
 

@@ -18,7 +18,8 @@ class MeshIo : public ::testing::Test {
  protected:
   void SetUp() override {
     dir_ = fs::temp_directory_path() /
-           ("torsion_mesh_io_" + std::string(::testing::UnitTest::GetInstance()->current_test_info()->name()));
+           ("torsion_mesh_io_" +
+            std::string(::testing::UnitTest::GetInstance()->current_test_info()->name()));
     fs::remove_all(dir_);
     fs::create_directories(dir_);
   }
@@ -83,7 +84,8 @@ TEST_F(MeshIo, WriteToMissingDirectoryFails) {
   write("cube.node", test::kCubeNode);
   write("cube.ele", test::kCubeEle);
   const TetMesh mesh = readMesh(dir_ / "cube").value().mesh;
-  EXPECT_TRUE(failsWith(writeMesh(dir_ / "no" / "such" / "dir.vtk", mesh), {"dir.vtk: cannot write"}));
+  EXPECT_TRUE(
+      failsWith(writeMesh(dir_ / "no" / "such" / "dir.vtk", mesh), {"dir.vtk: cannot write"}));
 }
 
 }  // namespace

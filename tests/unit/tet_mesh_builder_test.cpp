@@ -22,7 +22,8 @@ Result<LoadedMesh> build(const std::string& ele, MeshLoadOptions options = {}) {
 }
 
 TEST(BuildTetMesh, RepeatedVertex) {
-  EXPECT_TRUE(failsWith(build("1 4 0\n1 0 1 1 3\n"), {"m.ele:2: tet 1:", "vertex 1 appears twice"}));
+  EXPECT_TRUE(
+      failsWith(build("1 4 0\n1 0 1 1 3\n"), {"m.ele:2: tet 1:", "vertex 1 appears twice"}));
 }
 
 TEST(BuildTetMesh, ZeroVolume) {
@@ -58,13 +59,16 @@ TEST(BuildTetMesh, UnusedNodesAreDroppedWithWarning) {
 TEST(BuildTetMesh, FaceSharedByThreeTetsIsRefused) {
   // Three different apexes on the face (0, 1, 2): two above it, one below; the two above overlap.
   const std::string nodes = "6 3 0 0\n0 0 0 0\n1 1 0 0\n2 0 1 0\n3 0 0 1\n4 0 0 -1\n5 0.1 0.1 2\n";
-  Result<RawTetMesh> raw = parseTetGen(nodes, "m.node", "3 4 0\n0 0 1 2 3\n1 0 2 1 4\n2 0 1 2 5\n", "m.ele");
+  Result<RawTetMesh> raw =
+      parseTetGen(nodes, "m.node", "3 4 0\n0 0 1 2 3\n1 0 2 1 4\n2 0 1 2 5\n", "m.ele");
   ASSERT_TRUE(raw.ok()) << raw.error().message;
-  EXPECT_TRUE(failsWith(buildTetMesh(std::move(raw).value()), {"m.ele:4: tet 2:", "already shared by tets", "overlap"}));
+  EXPECT_TRUE(failsWith(buildTetMesh(std::move(raw).value()),
+                        {"m.ele:4: tet 2:", "already shared by tets", "overlap"}));
 }
 
 TEST(BuildTetMesh, DuplicateTetIsRefused) {
-  EXPECT_TRUE(failsWith(build("2 4 0\n0 0 1 2 3\n1 3 1 2 0\n"), {"m.ele:3: tet 1:", "duplicates tet 0"}));
+  EXPECT_TRUE(
+      failsWith(build("2 4 0\n0 0 1 2 3\n1 3 1 2 0\n"), {"m.ele:3: tet 1:", "duplicates tet 0"}));
 }
 
 TEST(BuildTetMesh, EmptyMeshes) {

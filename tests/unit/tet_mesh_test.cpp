@@ -3,12 +3,11 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/Geometry>
-
 #include <set>
 
 #include "test_meshes.h"
-#include "torsion/mesh/tetgen_format.h"
 #include "torsion/mesh/tet_mesh_builder.h"
+#include "torsion/mesh/tetgen_format.h"
 
 namespace torsion {
 namespace {
@@ -26,7 +25,8 @@ TEST(TetMesh, CubeVolumeIsOne) {
   EXPECT_EQ(mesh.nodeCount(), 8);
   EXPECT_EQ(mesh.tetCount(), 5);
   EXPECT_NEAR(mesh.totalRestVolume(), 1.0, 1e-14);
-  for (int t = 0; t < mesh.tetCount(); ++t) EXPECT_GT(mesh.restVolume(t), 0);
+  for (int t = 0; t < mesh.tetCount(); ++t)
+    EXPECT_GT(mesh.restVolume(t), 0);
 }
 
 TEST(TetMesh, CubeSurfaceIsTwelveOutwardTriangles) {
@@ -58,7 +58,8 @@ TEST(TetMesh, ClosedSurfaceHasThreeNeighboursPerTriangle) {
       const Triangle& b = mesh.surfaceTriangles()[static_cast<size_t>(other)];
       int shared = 0;
       for (int u : a)
-        for (int v : b) shared += (u == v);
+        for (int v : b)
+          shared += (u == v);
       EXPECT_EQ(shared, 2);
     }
   }

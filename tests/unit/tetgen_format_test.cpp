@@ -67,8 +67,8 @@ TEST(TetGenFaults, EmptyEleFile) {
 
 TEST(TetGenFaults, UnsupportedHeader) {
   EXPECT_TRUE(failsWith(parse("4 2 0 0\n", kTetEle), {"m.node:1:", "dimension is 2"}));
-  EXPECT_TRUE(failsWith(parse(kTetNode, "1 10 0\n0 0 1 2 3 4 5 6 7 8 9\n"),
-                        {"m.ele:1:", "10-node"}));
+  EXPECT_TRUE(
+      failsWith(parse(kTetNode, "1 10 0\n0 0 1 2 3 4 5 6 7 8 9\n"), {"m.ele:1:", "10-node"}));
   EXPECT_TRUE(failsWith(parse("4 3 0 2\n", kTetEle), {"m.node:1:", "boundary markers"}));
 }
 
@@ -76,7 +76,8 @@ TEST(TetGenFaults, CountsDoNotMatch) {
   EXPECT_TRUE(failsWith(parse("5 3 0 0\n0 0 0 0\n1 1 0 0\n2 0 1 0\n3 0 0 1\n", kTetEle),
                         {"m.node:5:", "declares 5 points, found 4"}));
   EXPECT_TRUE(failsWith(parse(kTetNode + "4 1 1 1\n", kTetEle), {"m.node:6:", "more point lines"}));
-  EXPECT_TRUE(failsWith(parse(kTetNode, "2 4 0\n0 0 1 2 3\n"), {"m.ele:2:", "declares 2 tetrahedra, found 1"}));
+  EXPECT_TRUE(failsWith(parse(kTetNode, "2 4 0\n0 0 1 2 3\n"),
+                        {"m.ele:2:", "declares 2 tetrahedra, found 1"}));
 }
 
 TEST(TetGenFaults, TruncatedLine) {
@@ -120,21 +121,25 @@ namespace {
 
 // Inputs the fuzzer found: each must fail cleanly (no huge allocation, no overflow).
 TEST(TetGenFaults, HostileHeadersAndIndices) {
-  EXPECT_FALSE(parseTetGen("21474836481 3 0 0\n0 0 0 0\n", "m.node", "1 4 0\n0 0 1 2 3\n", "m.ele").ok());
+  EXPECT_FALSE(
+      parseTetGen("21474836481 3 0 0\n0 0 0 0\n", "m.node", "1 4 0\n0 0 1 2 3\n", "m.ele").ok());
   EXPECT_TRUE(test::failsWith(parseTetGen("4 3 9223372036854775800 1\n", "m.node", "", "m.ele"),
                               {"m.node:1:", "attributes"}));
   const std::string node = "4 3 0 0\n1 0 0 0\n2 1 0 0\n3 0 1 0\n4 0 0 1\n";
-  EXPECT_TRUE(test::failsWith(parseTetGen(node, "m.node", "1 4 0\n9223372036854775807 1 2 3 4\n", "m.ele"),
-                              {"m.ele:2:", "first tet index must be 0 or 1"}));
-  EXPECT_TRUE(test::failsWith(parseTetGen(node, "m.node", "1 4 0\n1 -9223372036854775808 2 3 4\n", "m.ele"),
-                              {"m.ele:2:", "< first point index 1"}));
+  EXPECT_TRUE(
+      test::failsWith(parseTetGen(node, "m.node", "1 4 0\n9223372036854775807 1 2 3 4\n", "m.ele"),
+                      {"m.ele:2:", "first tet index must be 0 or 1"}));
+  EXPECT_TRUE(
+      test::failsWith(parseTetGen(node, "m.node", "1 4 0\n1 -9223372036854775808 2 3 4\n", "m.ele"),
+                      {"m.ele:2:", "< first point index 1"}));
 }
 
 TEST(TetGenFaults, HugeCoordinatesOverflowingTheVolume) {
-  Result<RawTetMesh> raw = parseTetGen("4 3 0 0\n0 0 0 0\n1 1e200 0 0\n2 0 1e200 0\n3 0 0 1e200\n", "m.node",
-                                       "1 4 0\n0 0 1 2 3\n", "m.ele");
+  Result<RawTetMesh> raw = parseTetGen("4 3 0 0\n0 0 0 0\n1 1e200 0 0\n2 0 1e200 0\n3 0 0 1e200\n",
+                                       "m.node", "1 4 0\n0 0 1 2 3\n", "m.ele");
   ASSERT_TRUE(raw.ok());
-  EXPECT_TRUE(test::failsWith(buildTetMesh(std::move(raw).value()), {"m.ele:2: tet 0:", "overflows"}));
+  EXPECT_TRUE(
+      test::failsWith(buildTetMesh(std::move(raw).value()), {"m.ele:2: tet 0:", "overflows"}));
 }
 
 }  // namespace

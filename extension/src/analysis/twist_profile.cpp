@@ -100,10 +100,12 @@ double polarMomentOfSection(const std::vector<Eigen::Vector3d>& rest,
     }
     const Eigen::Vector3d& x0 = rest[static_cast<size_t>(tet[0])];
     Eigen::Matrix3d D;
-    for (int k = 0; k < 3; ++k) D.col(k) = rest[static_cast<size_t>(tet[static_cast<size_t>(k + 1)])] - x0;
+    for (int k = 0; k < 3; ++k)
+      D.col(k) = rest[static_cast<size_t>(tet[static_cast<size_t>(k + 1)])] - x0;
     const double volume = std::abs(D.determinant()) / 6.0;
     double squares = sum.squaredNorm();
-    for (int a = 0; a < 4; ++a) squares += p[a].squaredNorm();
+    for (int a = 0; a < 4; ++a)
+      squares += p[a].squaredNorm();
     total += volume / 20.0 * squares;
   }
   return total / length;

@@ -3,7 +3,9 @@
 namespace torsion {
 
 namespace {
-btVector3 toBt(const Eigen::Vector3d& v) { return btVector3(v.x(), v.y(), v.z()); }
+btVector3 toBt(const Eigen::Vector3d& v) {
+  return btVector3(v.x(), v.y(), v.z());
+}
 }  // namespace
 
 FemBody::FemBody(std::string name, std::shared_ptr<const FemModel> model,
@@ -48,8 +50,8 @@ int FemBody::carryNodes(std::string group_name, std::vector<int> nodes, FrameMot
 
 void FemBody::releaseGroup(int group) {
   auto& g = groups_[static_cast<size_t>(group)];
-  g = std::make_unique<CarriedNodes>(g->name(), std::vector<int>{}, [](double) { return Frame{}; },
-                                     state_, 0.0);
+  g = std::make_unique<CarriedNodes>(
+      g->name(), std::vector<int>{}, [](double) { return Frame{}; }, state_, 0.0);
 }
 
 Wrench FemBody::groupWrench(int group, const Eigen::Vector3d& point) {
@@ -83,7 +85,8 @@ void FemBody::predict(double dt) {
 
 const StepReport& FemBody::advance(double now, double dt) {
   constraints_.reset(model_->nodeCount());
-  for (const auto& group : groups_) group->prescribe(now + dt, dt, state_, constraints_);
+  for (const auto& group : groups_)
+    group->prescribe(now + dt, dt, state_, constraints_);
   // Contacts with rigid bodies (btSoftBody::m_rcontacts) will prescribe normal velocities here.
   last_report_ = stepper_.step(state_, constraints_, external_forces_);
   if (!isFatal(last_report_.health)) writeBack();

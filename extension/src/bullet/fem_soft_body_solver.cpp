@@ -14,12 +14,14 @@ void FemSoftBodySolver::optimize(btAlignedObjectArray<btSoftBody*>& /*soft_bodie
 }
 
 void FemSoftBodySolver::predictMotion(btScalar /*solver_dt*/) {
-  for (FemBody* body : bodies_) body->predict(time_step_);
+  for (FemBody* body : bodies_)
+    body->predict(time_step_);
 }
 
 void FemSoftBodySolver::solveConstraints(btScalar /*solver_dt*/) {
   reports_.clear();
-  for (FemBody* body : bodies_) reports_.push_back(&body->advance(time_, time_step_));
+  for (FemBody* body : bodies_)
+    reports_.push_back(&body->advance(time_, time_step_));
 }
 
 void FemSoftBodySolver::updateSoftBodies() {

@@ -19,10 +19,9 @@ FemWorld::FemWorld(const WorldSettings& settings)
       broadphase_(std::make_unique<btDbvtBroadphase>()),
       constraint_solver_(std::make_unique<btSequentialImpulseConstraintSolver>()),
       soft_solver_(std::make_unique<FemSoftBodySolver>(settings.solver.time_step)) {
-  world_ = std::make_unique<btSoftRigidDynamicsWorld>(dispatcher_.get(), broadphase_.get(),
-                                                      constraint_solver_.get(),
-                                                      collision_configuration_.get(),
-                                                      soft_solver_.get());
+  world_ = std::make_unique<btSoftRigidDynamicsWorld>(
+      dispatcher_.get(), broadphase_.get(), constraint_solver_.get(),
+      collision_configuration_.get(), soft_solver_.get());
   const btVector3 g(settings.gravity.x(), settings.gravity.y(), settings.gravity.z());
   world_->setGravity(g);
   btSoftBodyWorldInfo& info = world_->getWorldInfo();
@@ -31,7 +30,8 @@ FemWorld::FemWorld(const WorldSettings& settings)
 }
 
 FemWorld::~FemWorld() {
-  for (auto& body : bodies_) world_->removeSoftBody(body->softBody());
+  for (auto& body : bodies_)
+    world_->removeSoftBody(body->softBody());
   for (btRigidBody* rigid : rigid_bodies_) {
     world_->removeRigidBody(rigid);
     delete rigid;
@@ -43,7 +43,8 @@ Result<FemBody*> FemWorld::addBody(const std::string& name, const TetMesh& mesh,
                                    const Material& material, const Frame& pose) {
   if (body(name) != nullptr) return Error{"body '" + name + "' already exists"};
   std::vector<Eigen::Vector3d> placed = mesh.restPositions();
-  for (Eigen::Vector3d& p : placed) p = pose.toWorld(p);
+  for (Eigen::Vector3d& p : placed)
+    p = pose.toWorld(p);
   auto placed_mesh = std::make_shared<const TetMesh>(std::move(placed), mesh.tets());
   Result<std::shared_ptr<const FemModel>> model = FemModel::create(placed_mesh, material);
   if (!model) return Error{"body '" + name + "': " + model.error().message};

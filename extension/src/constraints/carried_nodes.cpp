@@ -7,7 +7,8 @@ CarriedNodes::CarriedNodes(std::string name, std::vector<int> nodes, FrameMotion
     : name_(std::move(name)), nodes_(std::move(nodes)), motion_(std::move(motion)) {
   const Frame frame = motion_(time);
   local_.reserve(nodes_.size());
-  for (int node : nodes_) local_.push_back(frame.toLocal(state.position(node)));
+  for (int node : nodes_)
+    local_.push_back(frame.toLocal(state.position(node)));
 }
 
 void CarriedNodes::prescribe(double time_next, double dt, const FemState& state,

@@ -62,8 +62,9 @@ std::array<Eigen::Matrix3d, 4> corotatedDiagonalBlocks(const Eigen::Matrix3d& R,
                                             B.row(2).transpose()};
   std::array<Eigen::Matrix3d, 4> blocks;
   for (size_t a = 0; a < 4; ++a) {
-    const Eigen::Matrix3d local = rest.volume * (mu * g[a].squaredNorm() * Eigen::Matrix3d::Identity() +
-                                                 (mu + lambda) * g[a] * g[a].transpose());
+    const Eigen::Matrix3d local =
+        rest.volume * (mu * g[a].squaredNorm() * Eigen::Matrix3d::Identity() +
+                       (mu + lambda) * g[a] * g[a].transpose());
     blocks[a] = R * local * R.transpose();
   }
   return blocks;

@@ -13,7 +13,8 @@ Status Material::validate() const {
     return bad("youngs_modulus", youngs_modulus, "must be > 0 Pa");
   if (!(std::isfinite(poisson_ratio) && poisson_ratio >= 0 && poisson_ratio < 0.5))
     return bad("poisson_ratio", poisson_ratio, "must be in [0, 0.5)");
-  if (!(std::isfinite(density) && density > 0)) return bad("density", density, "must be > 0 kg/m^3");
+  if (!(std::isfinite(density) && density > 0))
+    return bad("density", density, "must be > 0 kg/m^3");
   if (!(std::isfinite(mass_damping) && mass_damping >= 0))
     return bad("mass_damping", mass_damping, "must be >= 0 1/s");
   if (!(std::isfinite(stiffness_damping) && stiffness_damping >= 0))

@@ -16,8 +16,8 @@ Eigen::Matrix3d rotationBySvd(const Eigen::Matrix3d& F) {
   return U * V.transpose();
 }
 
-Eigen::Matrix3d extractRotation(const Eigen::Matrix3d& F, Eigen::Quaterniond& q,
-                                int max_iterations, double tolerance) {
+Eigen::Matrix3d extractRotation(const Eigen::Matrix3d& F, Eigen::Quaterniond& q, int max_iterations,
+                                double tolerance) {
   if (!(F.determinant() > 0)) {
     const Eigen::Matrix3d R = rotationBySvd(F);
     q = Eigen::Quaterniond(R);

@@ -8,7 +8,8 @@ namespace torsion {
 Result<TetMesh> makeBoxTetMesh(const Eigen::Vector3d& min_corner, const Eigen::Vector3d& max_corner,
                                int nx, int ny, int nz) {
   if (nx < 1 || ny < 1 || nz < 1) return Error{"box mesh: every cell count must be >= 1"};
-  if (!((max_corner - min_corner).minCoeff() > 0)) return Error{"box mesh: max corner must exceed min corner"};
+  if (!((max_corner - min_corner).minCoeff() > 0))
+    return Error{"box mesh: max corner must exceed min corner"};
   auto node = [&](int i, int j, int k) { return (k * (ny + 1) + j) * (nx + 1) + i; };
 
   std::vector<Eigen::Vector3d> positions;

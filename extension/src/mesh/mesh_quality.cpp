@@ -56,8 +56,8 @@ MeshQuality measureQuality(const TetMesh& mesh, const std::vector<Eigen::Vector3
       q.max_dihedral_deg = std::max(q.max_dihedral_deg, angle * 180.0 / M_PI);
     }
 
-    const double longest = std::max({(a - b).norm(), (a - c).norm(), (a - d).norm(),
-                                     (b - c).norm(), (b - d).norm(), (c - d).norm()});
+    const double longest = std::max({(a - b).norm(), (a - c).norm(), (a - d).norm(), (b - c).norm(),
+                                     (b - d).norm(), (c - d).norm()});
     const double area = 0.5 * ((b - a).cross(c - a).norm() + (b - a).cross(d - a).norm() +
                                (c - a).cross(d - a).norm() + (c - b).cross(d - b).norm());
     const double inradius = 0.5 * std::abs(six_volume) / area;  // 3 V / A

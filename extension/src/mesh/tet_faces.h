@@ -15,7 +15,7 @@ inline constexpr int kOutwardFaces[4][3] = {{1, 2, 3}, {0, 3, 2}, {0, 1, 3}, {0,
 struct FaceRecord {
   std::array<int, 3> key;  ///< sorted node indices
   int tet;
-  int local_face;          ///< row of kOutwardFaces
+  int local_face;  ///< row of kOutwardFaces
 };
 
 /// All 4 * tets.size() faces, sorted by key (then tet), so equal faces are consecutive.

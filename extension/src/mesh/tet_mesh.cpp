@@ -69,7 +69,8 @@ TetMesh::TetMesh(std::vector<Eigen::Vector3d> rest_positions, std::vector<Tet> t
   const std::vector<detail::FaceRecord> faces = detail::sortedFaces(tets_);
   for (size_t i = 0; i < faces.size();) {
     size_t j = i + 1;
-    while (j < faces.size() && faces[j].key == faces[i].key) ++j;
+    while (j < faces.size() && faces[j].key == faces[i].key)
+      ++j;
     if (j - i == 1) {
       const Tet& tet = tets_[static_cast<size_t>(faces[i].tet)];
       const int* local = detail::kOutwardFaces[faces[i].local_face];
@@ -97,7 +98,8 @@ TetMesh::TetMesh(std::vector<Eigen::Vector3d> rest_positions, std::vector<Tet> t
   std::vector<std::pair<int, int>> neighbour_pairs;
   for (size_t i = 0; i < edges.size();) {
     size_t j = i + 1;
-    while (j < edges.size() && edges[j].a == edges[i].a && edges[j].b == edges[i].b) ++j;
+    while (j < edges.size() && edges[j].a == edges[i].a && edges[j].b == edges[i].b)
+      ++j;
     for (size_t p = i; p < j; ++p) {
       for (size_t q = i; q < j; ++q) {
         if (p != q) neighbour_pairs.emplace_back(edges[p].triangle, edges[q].triangle);
@@ -135,19 +137,22 @@ double TetMesh::restVolume(int t) const {
 
 double TetMesh::totalRestVolume() const {
   double sum = 0;
-  for (int t = 0; t < tetCount(); ++t) sum += restVolume(t);
+  for (int t = 0; t < tetCount(); ++t)
+    sum += restVolume(t);
   return sum;
 }
 
 Eigen::Vector3d TetMesh::boundsMin() const {
   Eigen::Vector3d lo = Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity());
-  for (const auto& p : rest_positions_) lo = lo.cwiseMin(p);
+  for (const auto& p : rest_positions_)
+    lo = lo.cwiseMin(p);
   return lo;
 }
 
 Eigen::Vector3d TetMesh::boundsMax() const {
   Eigen::Vector3d hi = Eigen::Vector3d::Constant(-std::numeric_limits<double>::infinity());
-  for (const auto& p : rest_positions_) hi = hi.cwiseMax(p);
+  for (const auto& p : rest_positions_)
+    hi = hi.cwiseMax(p);
   return hi;
 }
 

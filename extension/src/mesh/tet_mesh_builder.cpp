@@ -35,7 +35,8 @@ Result<LoadedMesh> buildTetMesh(RawTetMesh raw, const MeshLoadOptions& options) 
   const std::string& file = raw.element_file;
   if (raw.origins.size() != raw.tets.size()) {
     raw.origins.resize(raw.tets.size());
-    for (size_t t = 0; t < raw.tets.size(); ++t) raw.origins[t].id = static_cast<long>(t);
+    for (size_t t = 0; t < raw.tets.size(); ++t)
+      raw.origins[t].id = static_cast<long>(t);
   }
   if (raw.positions.empty()) return Error{file + ": the mesh has no nodes"};
   if (raw.tets.empty()) return Error{file + ": the mesh has no tetrahedra"};
@@ -66,7 +67,8 @@ Result<LoadedMesh> buildTetMesh(RawTetMesh raw, const MeshLoadOptions& options) 
       }
     }
     std::array<Eigen::Vector3d, 4> x;
-    for (size_t i = 0; i < 4; ++i) x[i] = raw.positions[static_cast<size_t>(tet[i])];
+    for (size_t i = 0; i < 4; ++i)
+      x[i] = raw.positions[static_cast<size_t>(tet[i])];
     const double six_volume = sixSignedVolume(x[0], x[1], x[2], x[3]);
     const double edge = longestEdge(x);
     if (!std::isfinite(six_volume) || !std::isfinite(edge)) {
@@ -92,8 +94,8 @@ Result<LoadedMesh> buildTetMesh(RawTetMesh raw, const MeshLoadOptions& options) 
     const bool by_line = raw.origins.front().line > 0;
     std::ostringstream s;
     s << file << ": " << loaded.reoriented_tets << " inverted tet"
-      << (loaded.reoriented_tets == 1 ? " was" : "s were") << " reoriented (" << (by_line ? "line" : "tet")
-      << (inverted_lines.size() == 1 ? " " : "s ");
+      << (loaded.reoriented_tets == 1 ? " was" : "s were") << " reoriented ("
+      << (by_line ? "line" : "tet") << (inverted_lines.size() == 1 ? " " : "s ");
     for (size_t i = 0; i < std::min<size_t>(inverted_lines.size(), 5); ++i) {
       s << (i ? ", " : "") << inverted_lines[i];
     }
@@ -115,8 +117,8 @@ Result<LoadedMesh> buildTetMesh(RawTetMesh raw, const MeshLoadOptions& options) 
       if (sorted[i].first == sorted[i - 1].first) {
         const size_t later = std::max(sorted[i].second, sorted[i - 1].second);
         const size_t earlier = std::min(sorted[i].second, sorted[i - 1].second);
-        return Error{where(raw, later) + ": duplicates tet " + std::to_string(raw.origins[earlier].id) +
-                     " (the same four vertices)"};
+        return Error{where(raw, later) + ": duplicates tet " +
+                     std::to_string(raw.origins[earlier].id) + " (the same four vertices)"};
       }
     }
   }
@@ -138,7 +140,8 @@ Result<LoadedMesh> buildTetMesh(RawTetMesh raw, const MeshLoadOptions& options) 
   // Nodes no tet uses would have no mass and make the system singular: drop them.
   std::vector<int> new_index(raw.positions.size(), -1);
   for (const Tet& tet : raw.tets) {
-    for (int v : tet) new_index[static_cast<size_t>(v)] = 0;
+    for (int v : tet)
+      new_index[static_cast<size_t>(v)] = 0;
   }
   std::vector<Eigen::Vector3d> positions;
   positions.reserve(raw.positions.size());
@@ -151,13 +154,15 @@ Result<LoadedMesh> buildTetMesh(RawTetMesh raw, const MeshLoadOptions& options) 
   const size_t unused = raw.positions.size() - positions.size();
   if (unused > 0) {
     loaded.warnings.push_back(file + ": " + std::to_string(unused) + " node" +
-                              (unused == 1 ? " is" : "s are") +
-                              " used by no tet and " + (unused == 1 ? "was" : "were") + " dropped");
+                              (unused == 1 ? " is" : "s are") + " used by no tet and " +
+                              (unused == 1 ? "was" : "were") + " dropped");
     for (Tet& tet : raw.tets) {
-      for (int& v : tet) v = new_index[static_cast<size_t>(v)];
+      for (int& v : tet)
+        v = new_index[static_cast<size_t>(v)];
     }
   }
-  for (const std::string& note : raw.notes) loaded.warnings.push_back(note);
+  for (const std::string& note : raw.notes)
+    loaded.warnings.push_back(note);
 
   loaded.mesh = TetMesh(std::move(positions), std::move(raw.tets));
   return loaded;

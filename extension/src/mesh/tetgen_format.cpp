@@ -32,15 +32,20 @@ NodeTable parseNodes(TextScanner& in) {
   const auto& header = in.tokens();
   const long count = in.parseInteger(header[0], "the number of points");
   const long dimension = header.size() > 1 ? in.parseInteger(header[1], "the dimension") : 3;
-  const long attributes = header.size() > 2 ? in.parseInteger(header[2], "the number of attributes") : 0;
-  const long markers = header.size() > 3 ? in.parseInteger(header[3], "the number of boundary markers") : 0;
-  if (count <= 0) in.fail("the header declares " + std::to_string(count) + " points; a mesh needs some");
-  if (dimension != 3) in.fail("dimension is " + std::to_string(dimension) + "; only 3 is supported");
+  const long attributes =
+      header.size() > 2 ? in.parseInteger(header[2], "the number of attributes") : 0;
+  const long markers =
+      header.size() > 3 ? in.parseInteger(header[3], "the number of boundary markers") : 0;
+  if (count <= 0)
+    in.fail("the header declares " + std::to_string(count) + " points; a mesh needs some");
+  if (dimension != 3)
+    in.fail("dimension is " + std::to_string(dimension) + "; only 3 is supported");
   if (attributes < 0 || attributes > kMaxAttributes) {
     in.fail("number of attributes " + std::to_string(attributes) + " is out of range [0, " +
             std::to_string(kMaxAttributes) + "]");
   }
-  if (markers != 0 && markers != 1) in.fail("boundary markers must be 0 or 1, found " + std::to_string(markers));
+  if (markers != 0 && markers != 1)
+    in.fail("boundary markers must be 0 or 1, found " + std::to_string(markers));
   const int header_line = in.lineNumber();
 
   NodeTable table;
@@ -53,12 +58,13 @@ NodeTable parseNodes(TextScanner& in) {
     }
     in.requireTokens(4, "'<index> <x> <y> <z>' for point " + std::to_string(i));
     if (in.tokens().size() > fields) {
-      in.fail("point line has " + std::to_string(in.tokens().size()) + " fields, the header allows " +
-              std::to_string(fields));
+      in.fail("point line has " + std::to_string(in.tokens().size()) +
+              " fields, the header allows " + std::to_string(fields));
     }
     const long index = in.parseInteger(in.tokens()[0], "the point index");
     if (i == 0) {
-      if (index != 0 && index != 1) in.fail("the first point index must be 0 or 1, found " + std::to_string(index));
+      if (index != 0 && index != 1)
+        in.fail("the first point index must be 0 or 1, found " + std::to_string(index));
       table.first_index = index;
     } else if (index != table.first_index + i) {
       in.fail("point index " + std::to_string(index) + " out of sequence, expected " +
@@ -66,10 +72,12 @@ NodeTable parseNodes(TextScanner& in) {
     }
     Eigen::Vector3d p;
     for (int d = 0; d < 3; ++d) {
-      p[d] = in.parseReal(in.tokens()[static_cast<size_t>(1 + d)],
-                          std::string("coordinate ") + "xyz"[d] + " of point " + std::to_string(index));
+      p[d] = in.parseReal(
+          in.tokens()[static_cast<size_t>(1 + d)],
+          std::string("coordinate ") + "xyz"[d] + " of point " + std::to_string(index));
     }
-    for (size_t a = 4; a < in.tokens().size(); ++a) in.parseReal(in.tokens()[a], "a point attribute");
+    for (size_t a = 4; a < in.tokens().size(); ++a)
+      in.parseReal(in.tokens()[a], "a point attribute");
     table.positions.push_back(p);
   }
   if (in.nextLine()) {
@@ -83,10 +91,14 @@ void parseElements(TextScanner& in, const NodeTable& nodes, RawTetMesh& raw) {
   in.requireLine("the .ele header '<#tetrahedra> <nodes per tet> <#attributes>'");
   const auto& header = in.tokens();
   const long count = in.parseInteger(header[0], "the number of tetrahedra");
-  const long per_tet = header.size() > 1 ? in.parseInteger(header[1], "the nodes per tetrahedron") : 4;
-  const long attributes = header.size() > 2 ? in.parseInteger(header[2], "the number of attributes") : 0;
-  if (count <= 0) in.fail("the header declares " + std::to_string(count) + " tetrahedra; a mesh needs some");
-  if (per_tet == 10) in.fail("quadratic (10-node) tetrahedra are not supported; mesh with 4-node tets");
+  const long per_tet =
+      header.size() > 1 ? in.parseInteger(header[1], "the nodes per tetrahedron") : 4;
+  const long attributes =
+      header.size() > 2 ? in.parseInteger(header[2], "the number of attributes") : 0;
+  if (count <= 0)
+    in.fail("the header declares " + std::to_string(count) + " tetrahedra; a mesh needs some");
+  if (per_tet == 10)
+    in.fail("quadratic (10-node) tetrahedra are not supported; mesh with 4-node tets");
   if (per_tet != 4) in.fail("nodes per tetrahedron is " + std::to_string(per_tet) + "; must be 4");
   if (attributes < 0 || attributes > kMaxAttributes) {
     in.fail("number of attributes " + std::to_string(attributes) + " is out of range [0, " +
@@ -111,7 +123,8 @@ void parseElements(TextScanner& in, const NodeTable& nodes, RawTetMesh& raw) {
     }
     const long index = in.parseInteger(in.tokens()[0], "the tetrahedron index");
     if (i == 0) {
-      if (index != 0 && index != 1) in.fail("the first tet index must be 0 or 1, found " + std::to_string(index));
+      if (index != 0 && index != 1)
+        in.fail("the first tet index must be 0 or 1, found " + std::to_string(index));
       first_index = index;
     } else if (index != first_index + i) {
       in.fail("tet index " + std::to_string(index) + " out of sequence, expected " +
@@ -119,7 +132,8 @@ void parseElements(TextScanner& in, const NodeTable& nodes, RawTetMesh& raw) {
     }
     Tet tet;
     for (size_t k = 0; k < 4; ++k) {
-      const long v = in.parseInteger(in.tokens()[1 + k], "a vertex of tet " + std::to_string(index));
+      const long v =
+          in.parseInteger(in.tokens()[1 + k], "a vertex of tet " + std::to_string(index));
       // Compare before subtracting: v may be any long.
       const bool in_range = v >= nodes.first_index && v - nodes.first_index < node_count;
       const long zero_based = in_range ? v - nodes.first_index : -1;
@@ -132,7 +146,8 @@ void parseElements(TextScanner& in, const NodeTable& nodes, RawTetMesh& raw) {
       }
       tet[k] = static_cast<int>(zero_based);
     }
-    for (size_t a = 5; a < in.tokens().size(); ++a) in.parseReal(in.tokens()[a], "a tet attribute");
+    for (size_t a = 5; a < in.tokens().size(); ++a)
+      in.parseReal(in.tokens()[a], "a tet attribute");
     raw.tets.push_back(tet);
     raw.origins.push_back({in.lineNumber(), index});
   }

@@ -7,7 +7,9 @@
 namespace torsion::detail {
 
 namespace {
-bool isSpace(char c) { return c == ' ' || c == '\t' || c == '\r' || c == '\v' || c == '\f'; }
+bool isSpace(char c) {
+  return c == ' ' || c == '\t' || c == '\r' || c == '\v' || c == '\f';
+}
 }  // namespace
 
 TextScanner::TextScanner(std::string_view text, std::string file_name, char comment)
@@ -25,18 +27,22 @@ bool TextScanner::readRawLine() {
     if (c != std::string_view::npos) line = line.substr(0, c);
   }
   size_t b = 0;
-  while (b < line.size() && isSpace(line[b])) ++b;
+  while (b < line.size() && isSpace(line[b]))
+    ++b;
   size_t e = line.size();
-  while (e > b && isSpace(line[e - 1])) --e;
+  while (e > b && isSpace(line[e - 1]))
+    --e;
   line_text_ = line.substr(b, e - b);
 
   tokens_.clear();
   token_cursor_ = 0;
   size_t i = 0;
   while (i < line_text_.size()) {
-    while (i < line_text_.size() && isSpace(line_text_[i])) ++i;
+    while (i < line_text_.size() && isSpace(line_text_[i]))
+      ++i;
     size_t start = i;
-    while (i < line_text_.size() && !isSpace(line_text_[i])) ++i;
+    while (i < line_text_.size() && !isSpace(line_text_[i]))
+      ++i;
     if (i > start) tokens_.push_back(line_text_.substr(start, i - start));
   }
   return true;
@@ -109,7 +115,9 @@ double TextScanner::parseReal(std::string_view token, std::string_view what) con
   return value;
 }
 
-void TextScanner::fail(const std::string& message) const { failAt(line_number_, message); }
+void TextScanner::fail(const std::string& message) const {
+  failAt(line_number_, message);
+}
 
 void TextScanner::failAt(int line, const std::string& message) const {
   throw ParseFailure(file_name_ + ":" + std::to_string(line) + ": " + message);

@@ -28,7 +28,8 @@ void CholmodSolver::buildPattern(const SystemOperator& op) {
   // diagonal block keep entries r >= c only; off-diagonal blocks (i > j) are dense.
   std::vector<std::pair<int, int>> pairs;
   pairs.reserve(static_cast<size_t>(mesh.tetCount()) * 10 + static_cast<size_t>(n));
-  for (int i = 0; i < n; ++i) pairs.emplace_back(i, i);
+  for (int i = 0; i < n; ++i)
+    pairs.emplace_back(i, i);
   for (const Tet& tet : mesh.tets()) {
     for (int a = 0; a < 4; ++a) {
       for (int b = 0; b < 4; ++b) {
@@ -70,21 +71,25 @@ void CholmodSolver::buildPattern(const SystemOperator& op) {
   for (size_t k = 0; k < pairs.size(); ++k) {
     const auto [i, j] = pairs[k];
     for (int r = 0; r < 3; ++r) {
-      for (int c = 0; c < 3; ++c) m.block_values[k][static_cast<size_t>(3 * r + c)] = value_index(3 * i + r, 3 * j + c);
+      for (int c = 0; c < 3; ++c)
+        m.block_values[k][static_cast<size_t>(3 * r + c)] = value_index(3 * i + r, 3 * j + c);
     }
   }
   auto block_of = [&](int i, int j) {
-    return static_cast<int>(std::lower_bound(pairs.begin(), pairs.end(), std::make_pair(i, j)) - pairs.begin());
+    return static_cast<int>(std::lower_bound(pairs.begin(), pairs.end(), std::make_pair(i, j)) -
+                            pairs.begin());
   };
   m.diagonal_block.resize(static_cast<size_t>(n));
-  for (int i = 0; i < n; ++i) m.diagonal_block[static_cast<size_t>(i)] = block_of(i, i);
+  for (int i = 0; i < n; ++i)
+    m.diagonal_block[static_cast<size_t>(i)] = block_of(i, i);
   m.tet_block.resize(static_cast<size_t>(mesh.tetCount()));
   for (int t = 0; t < mesh.tetCount(); ++t) {
     const Tet& tet = mesh.tets()[static_cast<size_t>(t)];
     for (int a = 0; a < 4; ++a) {
       for (int b = 0; b < 4; ++b) {
         const int i = tet[static_cast<size_t>(a)], j = tet[static_cast<size_t>(b)];
-        m.tet_block[static_cast<size_t>(t)][static_cast<size_t>(4 * a + b)] = i >= j ? block_of(i, j) : -1;
+        m.tet_block[static_cast<size_t>(t)][static_cast<size_t>(4 * a + b)] =
+            i >= j ? block_of(i, j) : -1;
       }
     }
   }
@@ -140,7 +145,8 @@ const Eigen::SparseMatrix<double>& CholmodSolver::assemble(const SystemOperator&
   if (constraints.constrainedCount() > 0) {
     auto filter_matrix = [&](int node) {
       Eigen::Matrix3d S;
-      for (int col = 0; col < 3; ++col) S.col(col) = constraints.filterNode(node, Eigen::Vector3d::Unit(col));
+      for (int col = 0; col < 3; ++col)
+        S.col(col) = constraints.filterNode(node, Eigen::Vector3d::Unit(col));
       return S;
     };
     for (size_t k = 0; k < m.blocks.size(); ++k) {
@@ -151,8 +157,9 @@ const Eigen::SparseMatrix<double>& CholmodSolver::assemble(const SystemOperator&
       for (int r = 0; r < 3; ++r) {
         for (int col = 0; col < 3; ++col) {
           // The upper triangle of a diagonal block is not stored: mirror it.
-          const int at = idx[static_cast<size_t>(3 * r + col)] >= 0 ? idx[static_cast<size_t>(3 * r + col)]
-                                                                    : idx[static_cast<size_t>(3 * col + r)];
+          const int at = idx[static_cast<size_t>(3 * r + col)] >= 0
+                             ? idx[static_cast<size_t>(3 * r + col)]
+                             : idx[static_cast<size_t>(3 * col + r)];
           block(r, col) = values[at];
         }
       }

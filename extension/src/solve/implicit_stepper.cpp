@@ -16,18 +16,26 @@ constexpr int kNodeGrain = 512;
 
 const char* toString(StepHealth health) {
   switch (health) {
-    case StepHealth::kOk: return "ok";
-    case StepHealth::kSolverNotConverged: return "solver not converged";
-    case StepHealth::kSolverFailed: return "solver failed";
-    case StepHealth::kNonFinite: return "non-finite state";
-    case StepHealth::kBlowUp: return "blow-up";
+    case StepHealth::kOk:
+      return "ok";
+    case StepHealth::kSolverNotConverged:
+      return "solver not converged";
+    case StepHealth::kSolverFailed:
+      return "solver failed";
+    case StepHealth::kNonFinite:
+      return "non-finite state";
+    case StepHealth::kBlowUp:
+      return "blow-up";
   }
   return "?";
 }
 
 ImplicitStepper::ImplicitStepper(std::shared_ptr<const FemModel> model,
                                  const SolverSettings& settings, const Parallel& parallel)
-    : model_(std::move(model)), settings_(settings), parallel_(parallel), system_(model_, parallel) {
+    : model_(std::move(model)),
+      settings_(settings),
+      parallel_(parallel),
+      system_(model_, parallel) {
   tet_forces_.resize(static_cast<size_t>(model_->tetCount()));
   tet_energy_.resize(static_cast<size_t>(model_->tetCount()));
 }
@@ -45,7 +53,8 @@ double ImplicitStepper::computeElasticForces(FemState& state) {
       const Tet& tet = mesh.tets()[ti];
       const TetRestData& rest = model_->tetRestData()[ti];
       std::array<Eigen::Vector3d, 4> x;
-      for (size_t a = 0; a < 4; ++a) x[a] = state.positions.segment<3>(3 * tet[a]);
+      for (size_t a = 0; a < 4; ++a)
+        x[a] = state.positions.segment<3>(3 * tet[a]);
       const Eigen::Matrix3d F = deformationGradient(x, rest.rest_shape_inverse);
       rotations[ti] = extractRotation(F, state.tet_rotations[ti]);
       tet_forces_[ti] = corotatedForces(F, rotations[ti], rest, mu, lambda);
@@ -54,7 +63,8 @@ double ImplicitStepper::computeElasticForces(FemState& state) {
   });
   system_.gather(tet_forces_, 1.0, elastic_forces_);
   double energy = 0;
-  for (double e : tet_energy_) energy += e;
+  for (double e : tet_energy_)
+    energy += e;
   return energy;
 }
 
@@ -73,17 +83,19 @@ StepReport ImplicitStepper::step(FemState& state, const NodeConstraints& constra
   // 3. Right-hand side b = M v + dt (f + f_ext).
   rhs_.resize(3 * n);
   for (int i = 0; i < n; ++i) {
-    rhs_.segment<3>(3 * i) = mass[static_cast<size_t>(i)] * state.velocities.segment<3>(3 * i) +
-                             dt * (elastic_forces_.segment<3>(3 * i) + external_forces.segment<3>(3 * i));
+    rhs_.segment<3>(3 * i) =
+        mass[static_cast<size_t>(i)] * state.velocities.segment<3>(3 * i) +
+        dt * (elastic_forces_.segment<3>(3 * i) + external_forces.segment<3>(3 * i));
   }
 
   if (!rhs_.allFinite()) {
     // Bad forces in, or a state already broken: stop before anything is written.
     report.health = StepHealth::kNonFinite;
-    report.message = elastic_forces_.allFinite() && external_forces.allFinite()
-                         ? "non-finite velocities at the start of the step"
-                         : (elastic_forces_.allFinite() ? "non-finite external forces"
-                                                        : "non-finite elastic forces (a degenerate tet?)");
+    report.message =
+        elastic_forces_.allFinite() && external_forces.allFinite()
+            ? "non-finite velocities at the start of the step"
+            : (elastic_forces_.allFinite() ? "non-finite external forces"
+                                           : "non-finite elastic forces (a degenerate tet?)");
     return report;
   }
 
@@ -117,7 +129,8 @@ StepReport ImplicitStepper::step(FemState& state, const NodeConstraints& constra
   }
   report.kinetic_energy = kinetic;
   report.max_speed = std::sqrt(max_speed_sq);
-  if (!std::isfinite(kinetic) || !state.positions.allFinite() || !std::isfinite(report.elastic_energy)) {
+  if (!std::isfinite(kinetic) || !state.positions.allFinite() ||
+      !std::isfinite(report.elastic_energy)) {
     report.health = StepHealth::kNonFinite;
     report.message = "non-finite positions or velocities (NaN or inf)";
   } else if (report.max_speed > settings_.max_speed) {
@@ -129,16 +142,19 @@ StepReport ImplicitStepper::step(FemState& state, const NodeConstraints& constra
   } else if (report.solve.breakdown || report.solve.relative_residual > 10 * settings_.tolerance) {
     report.health = StepHealth::kSolverFailed;
     std::ostringstream s;
-    s << "linear solver " << (report.solve.breakdown ? "broke down" : "did not converge") << " after "
-      << report.solve.iterations << " iterations at relative residual " << report.solve.relative_residual
-      << " (tolerance " << settings_.tolerance << ", max_iterations " << settings_.max_iterations
-      << "): the system is indefinite or badly conditioned; raise max_iterations, reduce dt, or use cholmod";
+    s << "linear solver " << (report.solve.breakdown ? "broke down" : "did not converge")
+      << " after " << report.solve.iterations << " iterations at relative residual "
+      << report.solve.relative_residual << " (tolerance " << settings_.tolerance
+      << ", max_iterations " << settings_.max_iterations
+      << "): the system is indefinite or badly conditioned; raise max_iterations, reduce dt, or "
+         "use cholmod";
     report.message = s.str();
   } else if (!report.solve.converged) {
     report.health = StepHealth::kSolverNotConverged;
     std::ostringstream s;
-    s << "linear solver stopped after " << report.solve.iterations << " iterations at relative residual "
-      << report.solve.relative_residual << " > tolerance " << settings_.tolerance;
+    s << "linear solver stopped after " << report.solve.iterations
+      << " iterations at relative residual " << report.solve.relative_residual << " > tolerance "
+      << settings_.tolerance;
     report.message = s.str();
   }
   return report;

@@ -25,7 +25,8 @@ void NodeConstraints::prescribeDirection(int node, const Eigen::Vector3d& direct
 
 int NodeConstraints::constrainedCount() const {
   int count = 0;
-  for (Kind k : kind_) count += (k != Kind::kFree);
+  for (Kind k : kind_)
+    count += (k != Kind::kFree);
   return count;
 }
 

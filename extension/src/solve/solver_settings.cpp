@@ -18,16 +18,20 @@ Status SolverSettings::validate() const {
 
 const char* toString(LinearSolverKind kind) {
   switch (kind) {
-    case LinearSolverKind::kConjugateGradient: return "cg";
-    case LinearSolverKind::kCholmod: return "cholmod";
+    case LinearSolverKind::kConjugateGradient:
+      return "cg";
+    case LinearSolverKind::kCholmod:
+      return "cholmod";
   }
   return "?";
 }
 
 const char* toString(PreconditionerKind kind) {
   switch (kind) {
-    case PreconditionerKind::kJacobi: return "jacobi";
-    case PreconditionerKind::kBlockJacobi: return "block_jacobi";
+    case PreconditionerKind::kJacobi:
+      return "jacobi";
+    case PreconditionerKind::kBlockJacobi:
+      return "block_jacobi";
   }
   return "?";
 }

@@ -22,7 +22,8 @@ SystemOperator::SystemOperator(std::shared_ptr<const FemModel> model, const Para
       const int t = node_tets.items[static_cast<size_t>(k)];
       const Tet& tet = mesh.tets()[static_cast<size_t>(t)];
       int local = 0;
-      while (tet[static_cast<size_t>(local)] != n) ++local;
+      while (tet[static_cast<size_t>(local)] != n)
+        ++local;
       node_entries_[static_cast<size_t>(k)] = 4 * t + local;
     }
   }
@@ -42,10 +43,11 @@ void SystemOperator::apply(const Eigen::VectorXd& y, Eigen::VectorXd& out, doubl
     for (int t = begin; t < end; ++t) {
       const Tet& tet = mesh.tets()[static_cast<size_t>(t)];
       std::array<Eigen::Vector3d, 4> dx;
-      for (size_t a = 0; a < 4; ++a) dx[a] = y.segment<3>(3 * tet[a]);
-      tet_scratch_[static_cast<size_t>(t)] = corotatedForceDifferential(
-          dx, rotations_[static_cast<size_t>(t)], model_->tetRestData()[static_cast<size_t>(t)], mu,
-          lambda);
+      for (size_t a = 0; a < 4; ++a)
+        dx[a] = y.segment<3>(3 * tet[a]);
+      tet_scratch_[static_cast<size_t>(t)] =
+          corotatedForceDifferential(dx, rotations_[static_cast<size_t>(t)],
+                                     model_->tetRestData()[static_cast<size_t>(t)], mu, lambda);
     }
   });
   out.resize(y.size());
@@ -65,7 +67,8 @@ void SystemOperator::gather(const std::vector<std::array<Eigen::Vector3d, 4>>& t
   parallel_.forRange(node_count, kNodeGrain, [&](int begin, int end) {
     for (int n = begin; n < end; ++n) {
       Eigen::Vector3d sum = Eigen::Vector3d::Zero();
-      for (int k = node_offsets_[static_cast<size_t>(n)]; k < node_offsets_[static_cast<size_t>(n) + 1]; ++k) {
+      for (int k = node_offsets_[static_cast<size_t>(n)];
+           k < node_offsets_[static_cast<size_t>(n) + 1]; ++k) {
         const int entry = node_entries_[static_cast<size_t>(k)];
         sum += tet_values[static_cast<size_t>(entry / 4)][static_cast<size_t>(entry % 4)];
       }
@@ -94,19 +97,22 @@ void SystemOperator::diagonalBlocks(std::vector<Eigen::Matrix3d>& blocks) const 
   parallel_.forRange(mesh.nodeCount(), kNodeGrain, [&](int begin, int end) {
     for (int n = begin; n < end; ++n) {
       Eigen::Matrix3d k = Eigen::Matrix3d::Zero();
-      for (int e = node_offsets_[static_cast<size_t>(n)]; e < node_offsets_[static_cast<size_t>(n) + 1]; ++e) {
+      for (int e = node_offsets_[static_cast<size_t>(n)];
+           e < node_offsets_[static_cast<size_t>(n) + 1]; ++e) {
         const int entry = node_entries_[static_cast<size_t>(e)];
         const int t = entry / 4, a = entry % 4;
         const TetRestData& rest = model_->tetRestData()[static_cast<size_t>(t)];
         const Eigen::Matrix3d& B = rest.rest_shape_inverse;
-        const Eigen::Vector3d g = a == 0 ? Eigen::Vector3d(-(B.row(0) + B.row(1) + B.row(2)).transpose())
-                                         : Eigen::Vector3d(B.row(a - 1).transpose());
+        const Eigen::Vector3d g =
+            a == 0 ? Eigen::Vector3d(-(B.row(0) + B.row(1) + B.row(2)).transpose())
+                   : Eigen::Vector3d(B.row(a - 1).transpose());
         const Eigen::Vector3d rg = rotations_[static_cast<size_t>(t)] * g;
         k.diagonal().array() += rest.volume * mu * g.squaredNorm();
         k.noalias() += (rest.volume * mu_plus_lambda) * rg * rg.transpose();
       }
       blocks[static_cast<size_t>(n)] =
-          mass_coefficient_ * mass[static_cast<size_t>(n)] * Eigen::Matrix3d::Identity() + stiffness_coefficient_ * k;
+          mass_coefficient_ * mass[static_cast<size_t>(n)] * Eigen::Matrix3d::Identity() +
+          stiffness_coefficient_ * k;
     }
   });
 }

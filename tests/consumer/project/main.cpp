@@ -9,7 +9,8 @@
 #include "torsion/mesh/tet_mesh_builder.h"
 #include "torsion/mesh/tetgen_format.h"
 
-static_assert(sizeof(btScalar) == sizeof(double), "Torsion::extension must forward BT_USE_DOUBLE_PRECISION");
+static_assert(sizeof(btScalar) == sizeof(double),
+              "Torsion::extension must forward BT_USE_DOUBLE_PRECISION");
 
 int main() {
   const char* node = "4 3 0 0\n0 0 0 0\n1 1 0 0\n2 0 1 0\n3 0 0 1\n";

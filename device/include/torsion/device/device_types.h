@@ -38,10 +38,10 @@ struct DeviceLimits {
 
 /// One reading of the device.
 struct DeviceSample {
-  double time = 0;         ///< s, monotonic clock of the reader
+  double time = 0;  ///< s, monotonic clock of the reader
   Pose pose;
   std::uint32_t buttons = 0;  ///< bit k set: button k+1 held (bit 0 is the report's button 1)
-  bool alive = false;      ///< false when the device stopped answering
+  bool alive = false;         ///< false when the device stopped answering
 };
 
 }  // namespace torsion::device

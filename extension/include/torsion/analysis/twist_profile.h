@@ -35,7 +35,8 @@ double twistNonlinearity(const std::vector<SliceRotation>& profile, double z_min
 /// over its length: (1 / length) * integral of ((x - ax)^2 + (y - ay)^2) dV, exact for the meshed
 /// (polygonal) section. For a prismatic body this is the section's J; St-Venant's J = pi r^4 / 2
 /// is the smooth circle's, a few % more than a 20-gon's.
-double polarMomentOfSection(const std::vector<Eigen::Vector3d>& rest, const std::vector<std::array<int, 4>>& tets,
-                            double length, double axis_x = 0, double axis_y = 0);
+double polarMomentOfSection(const std::vector<Eigen::Vector3d>& rest,
+                            const std::vector<std::array<int, 4>>& tets, double length,
+                            double axis_x = 0, double axis_y = 0);
 
 }  // namespace torsion

@@ -3,8 +3,8 @@
 // stepper and its node groups, and mirrors its nodes into a btSoftBody so Bullet's broadphase and
 // soft-rigid collision detection see it. Touched only by the simulation thread.
 
-#include <btBulletDynamicsCommon.h>
 #include <BulletSoftBody/btSoftBody.h>
+#include <btBulletDynamicsCommon.h>
 
 #include <memory>
 #include <string>

@@ -10,8 +10,8 @@
 // its lifetime. Single-threaded API: call it from the simulation thread only (the solver's own
 // worker threads are internal).
 
-#include <btBulletDynamicsCommon.h>
 #include <BulletSoftBody/btSoftRigidDynamicsWorld.h>
+#include <btBulletDynamicsCommon.h>
 
 #include <memory>
 #include <string>

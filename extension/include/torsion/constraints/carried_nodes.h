@@ -33,7 +33,8 @@ class CarriedNodes {
   Frame frameAt(double time) const { return motion_(time); }
 
   /// Prescribes each node's velocity so it reaches R(t_next) p_hat + O(t_next) after dt.
-  void prescribe(double time_next, double dt, const FemState& state, NodeConstraints& constraints) const;
+  void prescribe(double time_next, double dt, const FemState& state,
+                 NodeConstraints& constraints) const;
 
   /// The wrench the body exerts on the group: F = sum f_l, tau = sum (x_l - point) x f_l, for
   /// per-node forces `forces` (3n, e.g. ImplicitStepper::internalForces()).

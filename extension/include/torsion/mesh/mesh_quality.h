@@ -14,7 +14,7 @@ struct MeshQuality {
   /// Aspect ratio: longest edge / (2 sqrt(6) inradius); 1 for a regular tet, large for slivers.
   double max_aspect_ratio = 0;
   double mean_aspect_ratio = 0;
-  int inverted_tets = 0;        ///< tets with non-positive volume at the given positions
+  int inverted_tets = 0;  ///< tets with non-positive volume at the given positions
 };
 
 /// Quality at the given positions (rest or deformed; one per node).

@@ -22,8 +22,8 @@ struct MeshLoadOptions {
 
 struct LoadedMesh {
   TetMesh mesh;
-  int reoriented_tets = 0;             ///< inverted rest tets that were flipped
-  std::vector<std::string> warnings;   ///< for the user, one line each, with file:line
+  int reoriented_tets = 0;            ///< inverted rest tets that were flipped
+  std::vector<std::string> warnings;  ///< for the user, one line each, with file:line
 };
 
 /// Validates a raw mesh and builds the TetMesh. Errors: no nodes, no tets, a tet with a repeated

@@ -50,7 +50,7 @@ struct StepReport {
   double kinetic_energy = 0;  ///< J, at the end of the step
   double max_speed = 0;       ///< m/s, at the end of the step
   StepHealth health = StepHealth::kOk;
-  std::string message;        ///< what went wrong, for the user
+  std::string message;  ///< what went wrong, for the user
 };
 
 class ImplicitStepper {

@@ -38,7 +38,8 @@ class Parallel {
     if (threads_ == 1 || n <= grain) {
       // Same chunking as the parallel path, so the rounding is identical.
       double total = 0;
-      for (int begin = 0; begin < n; begin += grain) total += fn(begin, std::min(n, begin + grain));
+      for (int begin = 0; begin < n; begin += grain)
+        total += fn(begin, std::min(n, begin + grain));
       return total;
     }
     const int chunks = (n + grain - 1) / grain;
@@ -49,7 +50,8 @@ class Parallel {
       }
     });
     double total = 0;
-    for (double p : partial_) total += p;
+    for (double p : partial_)
+      total += p;
     return total;
   }
 
