@@ -8,6 +8,7 @@ set -uo pipefail
 case_name=$1
 torsion=$2
 assets=$3
+scenes=$(cd "$(dirname "$0")/../../demos/scenes" && pwd)
 
 work=$(mktemp -d "${TMPDIR:-/tmp}/torsion-cli-test-XXXXXX")
 trap 'rm -rf "$work"' EXIT
@@ -354,6 +355,50 @@ EOF
     run env PATH="$work/empty" "$torsion" mesh tetrahedralize cube.off -o cube.node
     expect_rc nonzero
     expect_out "^error: torsion mesh tetrahedralize: needs the 'tetgen' command \(Debian package 'tetgen'\); it is not on PATH$"
+    ;;
+
+  run_twist)
+    # A short twist of the small cylinder: runs, reports, writes every output.
+    sed "s|../../assets/meshes|$assets|" "$scenes/twist_cylinder_2430.json" > twist.json
+    run "$torsion" run twist.json --out out --steps 40 --threads 1
+    expect_rc 0
+    expect_out "body 'cylinder': 661 nodes, 2408 tets"
+    expect_out "done: 40 steps; results in out/"
+    for f in summary.json wrench.csv energy.csv cylinder.vtk; do [[ -s out/$f ]] || fail "missing out/$f"; done
+    grep -q '"stable": true' out/summary.json || fail "summary does not say stable"
+    grep -q '"steps": 40' out/summary.json || fail "summary does not count 40 steps"
+    [[ $(wc -l < out/wrench.csv) -eq 41 ]] || fail "wrench.csv should have a header and 40 rows"
+    head -1 out/wrench.csv | grep -q "end.tz" || fail "wrench.csv lacks the end set's torque"
+    # The turned end feels a restoring torque: negative about +z once it has turned.
+    awk -F, 'NR == 41 { for (i = 1; i <= NF; i++) if (col[i] == "end.tz") exit !($i < 0) }
+             NR == 1 { for (i = 1; i <= NF; i++) col[i] = $i }' out/wrench.csv || fail "end torque not restoring"
+    "$torsion" mesh info out/cylinder.vtk > /dev/null || fail "the final mesh does not read back"
+    ;;
+
+  run_bad_scene)
+    printf '{\n  "steps": 10,\n  "bodies": [{"name": "b", "mesh": "x.node", "material": {"youngs_modulus": 1e5, "poisson_ratio": 0.3, "densty": 1000}}]\n}\n' > bad.json
+    run "$torsion" run bad.json --out out
+    expect_rc nonzero
+    expect_out "^error: bad.json: bodies\\[0\\].material.density: missing \\(required\\); also found unknown key\\(s\\) 'densty'$"
+    [[ ! -e out/summary.json ]] || fail "no output may be written for a bad scene"
+    ;;
+
+  run_missing_mesh)
+    printf '{"bodies": [{"name": "b", "mesh": "nowhere.node", "material": {"youngs_modulus": 1e5, "poisson_ratio": 0.3, "density": 1000}}]}' > s.json
+    run "$torsion" run s.json --out out
+    expect_rc nonzero
+    expect_out "^error: s.json: bodies\\[0\\] 'b': .*nowhere.node: cannot open"
+    ;;
+
+  run_unstable)
+    # A speed limit that gravity alone exceeds: the run must stop, say where, and exit 3.
+    sed "s|../../assets/meshes|$assets|; s|\"gravity\": \\[0, 0, 0\\]|\"gravity\": [0, 0, -9.81]|; s|\"tolerance\": 1e-4|\"tolerance\": 1e-4, \"max_speed\": 0.05|" \
+      "$scenes/twist_cylinder_2430.json" > unstable.json
+    run "$torsion" run unstable.json --out out --steps 200 --threads 1
+    [[ $rc -eq 3 ]] || fail "exit code $rc, expected 3"
+    expect_out "^error: simulation unstable: body 'cylinder', step [0-9]+: blow-up: a node moves at"
+    grep -q '"stable": false' out/summary.json || fail "summary does not say unstable"
+    ! grep -qi nan out/cylinder.vtk || fail "NaN written to the final mesh"
     ;;
 
   *)
