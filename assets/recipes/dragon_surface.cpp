@@ -11,7 +11,8 @@
 // its base on z = 0, up along +z, its face towards -y, its bounding box centred on x = y = 0.
 // That is the source rotated about x by `tilt` degrees (90 would take the source's +y to +z; the
 // base plane of the source is tilted 17.5 degrees from that, hence 72.5), scaled by `scale`, and
-// moved. (17.5 is the tilt that puts the most source vertices within 0.5 units of one support plane.)
+// moved. (17.5 is the tilt that puts the most source vertices within 0.5 units of one support
+// plane.)
 //
 // usage: dragon_surface IN.off OUT.off [alpha_div offset_div edge_div scale tilt iterations]
 //   alpha = diag / alpha_div, offset = diag / offset_div, edge length = diag / edge_div, where diag
@@ -62,10 +63,11 @@ int main(int argc, char** argv) {
     p = Point(scale * p.x(), scale * (c * p.y() - s * p.z()), scale * (s * p.y() + c * p.z()));
   }
   CGAL::Bbox_3 box;
-  for (const Point& p : points) box += p.bbox();
-  const double diag = std::sqrt(CGAL::square(box.xmax() - box.xmin()) +
-                                CGAL::square(box.ymax() - box.ymin()) +
-                                CGAL::square(box.zmax() - box.zmin()));
+  for (const Point& p : points)
+    box += p.bbox();
+  const double diag =
+      std::sqrt(CGAL::square(box.xmax() - box.xmin()) + CGAL::square(box.ymax() - box.ymin()) +
+                CGAL::square(box.zmax() - box.zmin()));
 
   Mesh mesh;
   CGAL::alpha_wrap_3(points, polygons, diag / alpha_div, diag / offset_div, mesh);
@@ -79,7 +81,8 @@ int main(int argc, char** argv) {
 
   // Stand it on z = 0, centred on the z axis.
   CGAL::Bbox_3 out_box;
-  for (const auto v : vertices(mesh)) out_box += mesh.point(v).bbox();
+  for (const auto v : vertices(mesh))
+    out_box += mesh.point(v).bbox();
   const double cx = 0.5 * (out_box.xmin() + out_box.xmax());
   const double cy = 0.5 * (out_box.ymin() + out_box.ymax());
   const double z0 = out_box.zmin();

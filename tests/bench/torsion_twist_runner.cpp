@@ -93,7 +93,9 @@ TwistResult runTorsionTwist(const TwistProtocol& protocol, std::shared_ptr<const
     result.max_speed = std::max(result.max_speed, report.max_speed);
     if (report.health == StepHealth::kSolverNotConverged) ++result.not_converged_steps;
     if (isFatal(report.health)) {
-      result.status = report.health == StepHealth::kNonFinite ? RunStatus::kNonFinite : RunStatus::kBlowUp;
+      result.status = report.health == StepHealth::kNonFinite ? RunStatus::kNonFinite
+                      : report.health == StepHealth::kBlowUp  ? RunStatus::kBlowUp
+                                                              : RunStatus::kSolverFailed;
       result.message = "step " + std::to_string(k) + ": " + report.message;
       break;
     }

@@ -46,6 +46,7 @@ const char* toString(RunStatus status) {
     case RunStatus::kOk: return "ok";
     case RunStatus::kNonFinite: return "nan";
     case RunStatus::kBlowUp: return "blowup";
+    case RunStatus::kSolverFailed: return "solver-failed";
     case RunStatus::kSetupFailed: return "setup-failed";
   }
   return "?";

@@ -52,7 +52,7 @@ TwistScene classifyNodes(const TetMesh& mesh);
 /// Rest position turned about the z axis (through x = y = 0) by `angle`.
 Eigen::Vector3d turnedAboutZ(const Eigen::Vector3d& rest, double angle);
 
-enum class RunStatus { kOk, kNonFinite, kBlowUp, kSetupFailed };
+enum class RunStatus { kOk, kNonFinite, kBlowUp, kSolverFailed, kSetupFailed };
 const char* toString(RunStatus status);
 
 /// Everything one configuration reports. Times are wall clock of the stepping loop only (setup,
