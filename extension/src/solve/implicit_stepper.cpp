@@ -161,6 +161,11 @@ StepReport ImplicitStepper::step(FemState& state, const NodeConstraints& constra
 }
 
 const Eigen::VectorXd& ImplicitStepper::internalForces() {
+  if (velocity_next_.size() != 3 * model_->nodeCount()) {
+    // No step taken yet: the body is at rest in its initial state and exerts nothing.
+    internal_forces_.setZero(3 * model_->nodeCount());
+    return internal_forces_;
+  }
   if (!internal_forces_valid_) {
     system_.multiplyStiffness(velocity_next_, scratch_);
     internal_forces_ =
