@@ -26,6 +26,29 @@ std::vector<int> selectNodes(const TetMesh& mesh, const NodeSelection& selection
   return nodes;
 }
 
+Status driveHands(BuiltScene& scene) {
+  const double now = scene.world->time();
+  const double dt = scene.world->settings().solver.time_step;
+  // Half a step of slack so that a time written in the scene is reached despite round-off.
+  const double reached = now + 0.5 * dt;
+  for (size_t h = 0; h < scene.hands.size(); ++h) {
+    SceneHand& s = scene.hands[h];
+    if (s.hand->grabbed() && reached >= s.spec.release_at) {
+      s.hand->release();
+      s.released = true;
+    }
+    if (!s.hand->grabbed() && !s.released && reached >= s.spec.grab_at) {
+      Result<int> grabbed = s.hand->grab(s.spec.frameAt(now), now);
+      if (!grabbed) {
+        return Error{"hands[" + std::to_string(h) + "] '" + s.spec.name + "': grab at t = " + std::to_string(now) +
+                     " s: " + grabbed.error().message};
+      }
+    }
+    if (s.hand->grabbed()) s.hand->moveTo(s.spec.frameAt(now + dt));
+  }
+  return Ok{};
+}
+
 Result<std::unique_ptr<BuiltScene>> buildScene(SceneSpec spec, int threads_override) {
   auto built = std::make_unique<BuiltScene>();
   if (threads_override >= 0) spec.world.solver.threads = threads_override;
@@ -63,6 +86,20 @@ Result<std::unique_ptr<BuiltScene>> buildScene(SceneSpec spec, int threads_overr
                              : FrameMotion([m = set.motion](double t) { return m.frameAt(t); });
     handle.group = body->carryNodes(set.name, std::move(nodes), std::move(motion), world.time());
     built->node_sets.push_back(handle);
+  }
+
+  for (size_t h = 0; h < spec.hands.size(); ++h) {
+    SceneHand scene_hand;
+    scene_hand.spec = spec.hands[h];
+    scene_hand.hand = std::make_unique<Hand>(*world.body(scene_hand.spec.body), scene_hand.spec.name);
+    built->hands.push_back(std::move(scene_hand));
+  }
+  // Hands that grab at t = 0 grab now, so a plane that misses is reported before any step.
+  for (size_t h = 0; h < built->hands.size(); ++h) {
+    if (built->hands[h].spec.grab_at > 0) continue;
+    Status grabbed = driveHands(*built);
+    if (!grabbed) return Error{spec.file + ": " + grabbed.error().message};
+    break;
   }
 
   for (const RigidBodySpec& r : spec.rigid_bodies) {

@@ -8,6 +8,7 @@
 
 #include "scene_spec.h"
 #include "torsion/bullet/fem_world.h"
+#include "torsion/constraints/hand.h"
 #include "torsion/result.h"
 
 namespace torsion::scene {
@@ -20,15 +21,28 @@ struct NodeSetHandle {
   int node_count = 0;
 };
 
+/// A scene hand: its script (spec) and the live Hand. Hands whose grab_at is 0 have already
+/// grabbed when buildScene returns, so a plane that misses is an error before any step.
+struct SceneHand {
+  HandSpec spec;
+  std::unique_ptr<Hand> hand;
+  bool released = false;
+};
+
 struct BuiltScene {
   SceneSpec spec;
   std::unique_ptr<FemWorld> world;
   std::vector<NodeSetHandle> node_sets;
+  std::vector<SceneHand> hands;
   std::vector<std::string> warnings;  ///< from mesh loading
 };
 
 /// Nodes of `mesh` whose rest positions fall in `selection`.
 std::vector<int> selectNodes(const TetMesh& mesh, const NodeSelection& selection);
+
+/// Grabs, releases and moves every scene hand for the step from world time t to t + dt: call
+/// before each FemWorld::step(). Errors: a scripted grab whose plane misses the body.
+Status driveHands(BuiltScene& scene);
 
 /// threads >= 0 overrides the scene's solver.threads.
 Result<std::unique_ptr<BuiltScene>> buildScene(SceneSpec spec, int threads_override = -1);

@@ -95,6 +95,33 @@ NodeSelection readSelection(const JsonObject& s) {
   return sel;
 }
 
+// A hand frame: origin plus either axis_angle or the in-plane axes i and j (k = i x j). i and j
+// must be orthonormal: a degenerate rotation is refused rather than silently repaired.
+Frame readHandFrame(const JsonObject& f) {
+  Frame frame;
+  frame.origin = f.vector3("origin");
+  const bool has_axes = f.has("i") || f.has("j");
+  if (f.has("axis_angle") && has_axes) f.fail("axis_angle", "give either axis_angle or i and j, not both");
+  if (f.has("axis_angle")) {
+    const JsonObject aa = f.object("axis_angle");
+    const Eigen::Vector3d axis = aa.vector3("axis");
+    if (axis.norm() < 1e-12) aa.fail("axis", "must not be zero");
+    frame.rotation = Eigen::AngleAxisd(aa.number("angle"), axis.normalized());
+    aa.finish();
+  } else if (has_axes) {
+    const Eigen::Vector3d i = f.vector3("i"), j = f.vector3("j");
+    if (std::abs(i.norm() - 1) > 1e-6 || std::abs(j.norm() - 1) > 1e-6 || std::abs(i.dot(j)) > 1e-6) {
+      f.fail("i", "degenerate rotation: i and j must be orthonormal (|i| = " + std::to_string(i.norm()) +
+                      ", |j| = " + std::to_string(j.norm()) + ", i.j = " + std::to_string(i.dot(j)) + ")");
+    }
+    Eigen::Matrix3d R;
+    R << i, j, i.cross(j);
+    frame.rotation = Eigen::Quaterniond(R).normalized();
+  }
+  f.finish();
+  return frame;
+}
+
 MotionSpec readMotion(const JsonObject& m) {
   MotionSpec motion;
   motion.angular_velocity = m.vector3("angular_velocity", Eigen::Vector3d::Zero());
@@ -108,6 +135,36 @@ MotionSpec readMotion(const JsonObject& m) {
   if (!(motion.start >= 0)) m.fail("start", "must be >= 0 s");
   m.finish();
   return motion;
+}
+
+HandSpec readHand(const JsonObject& h) {
+  HandSpec hand;
+  hand.name = h.string("name");
+  hand.body = h.string("body");
+  if (h.has("keyframes")) {
+    if (h.has("frame") || h.has("motion")) h.fail("keyframes", "give either keyframes or frame (+ motion), not both");
+    const std::vector<JsonObject> keys = h.objects("keyframes");
+    if (keys.empty()) h.fail("keyframes", "needs at least one keyframe");
+    for (size_t k = 0; k < keys.size(); ++k) {
+      const double time = keys[k].number("time");
+      if (k > 0 && !(time > hand.keyframes.back().first)) {
+        keys[k].fail("time", std::to_string(time) + " is not after the previous keyframe's " +
+                                 std::to_string(hand.keyframes.back().first) + ": keyframes must be in time order");
+      }
+      hand.keyframes.emplace_back(time, readHandFrame(keys[k]));
+    }
+  } else {
+    hand.initial = readHandFrame(h.object("frame"));
+    if (h.has("motion")) hand.motion = readMotion(h.object("motion"));
+  }
+  hand.grab_at = h.number("grab_at", 0.0);
+  if (!(hand.grab_at >= 0)) h.fail("grab_at", "must be >= 0 s");
+  if (h.has("release_at")) {
+    hand.release_at = h.number("release_at");
+    if (!(hand.release_at > hand.grab_at)) h.fail("release_at", "must be after grab_at");
+  }
+  h.finish();
+  return hand;
 }
 
 RigidBodySpec readRigidBody(const JsonObject& r) {
@@ -165,6 +222,27 @@ Frame MotionSpec::frameAt(double t) const {
   // Rotation about the pivot, then translation: p -> R (p - c) + c + v tau.
   frame.origin = pivot - (frame.rotation * pivot) + linear_velocity * tau;
   return frame;
+}
+
+Frame HandSpec::frameAt(double t) const {
+  if (keyframes.empty()) {
+    const Frame m = motion.frameAt(t);
+    Frame f;
+    f.origin = m.toWorld(initial.origin);
+    f.rotation = m.rotation * initial.rotation;
+    return f;
+  }
+  if (t <= keyframes.front().first) return keyframes.front().second;
+  if (t >= keyframes.back().first) return keyframes.back().second;
+  size_t k = 1;
+  while (keyframes[k].first < t) ++k;
+  const auto& [t0, f0] = keyframes[k - 1];
+  const auto& [t1, f1] = keyframes[k];
+  const double s = (t - t0) / (t1 - t0);
+  Frame f;
+  f.origin = (1 - s) * f0.origin + s * f1.origin;
+  f.rotation = f0.rotation.slerp(s, f1.rotation);
+  return f;
 }
 
 Result<SceneSpec> parseScene(std::string_view text, const std::string& file_name,
@@ -225,6 +303,16 @@ Result<SceneSpec> parseScene(std::string_view text, const std::string& file_name
       set.wrench_about = s.vector3("wrench_about", set.motion.pivot);
       s.finish();
       scene.node_sets.push_back(std::move(set));
+    }
+    for (const JsonObject& h : root.objects("hands")) {
+      HandSpec hand = readHand(h);
+      bool known = false;
+      for (const BodySpec& body : scene.bodies) known = known || body.name == hand.body;
+      if (!known) h.fail("body", "no body named '" + hand.body + "'");
+      for (const HandSpec& other : scene.hands) {
+        if (other.name == hand.name) h.fail("name", "duplicate hand name '" + hand.name + "'");
+      }
+      scene.hands.push_back(std::move(hand));
     }
     for (const JsonObject& r : root.objects("rigid_bodies"))
       scene.rigid_bodies.push_back(readRigidBody(r));

@@ -58,6 +58,10 @@ Result<RunOutcome> runScene(BuiltScene& scene, const RunOptions& options) {
     for (const char* c : {"fx", "fy", "fz", "tx", "ty", "tz"})
       wrench_csv << "," << s.name << "." << c;
   }
+  for (const SceneHand& h : scene.hands) {
+    for (const char* c : {"fx", "fy", "fz", "tx", "ty", "tz"})
+      wrench_csv << "," << h.spec.name << "." << c;
+  }
   wrench_csv << "\n";
   energy_csv << "step,time";
   for (const auto& body : world.bodies())
@@ -77,6 +81,8 @@ Result<RunOutcome> runScene(BuiltScene& scene, const RunOptions& options) {
   int iteration_max = 0;
   const auto run_start = std::chrono::steady_clock::now();
   for (int k = 0; k < steps; ++k) {
+    Status hands_driven = driveHands(scene);
+    if (!hands_driven) return Error{scene.spec.file + ": " + hands_driven.error().message};
     const auto t0 = std::chrono::steady_clock::now();
     const WorldStepReport report = world.step();
     step_ms.push_back(
@@ -101,6 +107,11 @@ Result<RunOutcome> runScene(BuiltScene& scene, const RunOptions& options) {
     wrench_csv << report.step << "," << world.time();
     for (const NodeSetHandle& s : scene.node_sets) {
       const Wrench w = s.body->groupWrench(s.group, s.wrench_about);
+      wrench_csv << "," << w.force.x() << "," << w.force.y() << "," << w.force.z() << ","
+                 << w.torque.x() << "," << w.torque.y() << "," << w.torque.z();
+    }
+    for (const SceneHand& h : scene.hands) {  // about the hand's origin O; zero when not holding
+      const Wrench w = h.hand->wrench();
       wrench_csv << "," << w.force.x() << "," << w.force.y() << "," << w.force.z() << ","
                  << w.torque.x() << "," << w.torque.y() << "," << w.torque.z();
     }
@@ -152,6 +163,13 @@ Result<RunOutcome> runScene(BuiltScene& scene, const RunOptions& options) {
   for (const NodeSetHandle& s : scene.node_sets) {
     summary["node_sets"].push_back(
         {{"name", s.name}, {"body", s.body->name()}, {"nodes", s.node_count}});
+  }
+  summary["hands"] = nlohmann::json::array();
+  for (const SceneHand& h : scene.hands) {
+    summary["hands"].push_back({{"name", h.spec.name},
+                                {"body", h.spec.body},
+                                {"grabbed_nodes", static_cast<int>(h.hand->selection().nodes.size())},
+                                {"holding_at_end", h.hand->grabbed()}});
   }
   summary["stable"] = outcome.stable;
   if (!outcome.stable) summary["failure"] = outcome.failure;

@@ -53,6 +53,23 @@ struct NodeSetSpec {
   Eigen::Vector3d wrench_about = Eigen::Vector3d::Zero();  ///< point for the reported torque
 };
 
+/// A hand-plane on one body (DESIGN.md section 3): it grabs at `grab_at` the surface patch its
+/// plane cuts where the ray from O along i hits, carries it along its trajectory and lets go at
+/// `release_at`. The trajectory is either `initial` moved by `motion`, or keyframes (origin
+/// interpolated linearly, rotation by slerp, held before the first and after the last).
+struct HandSpec {
+  std::string name;
+  std::string body;
+  Frame initial;
+  MotionSpec motion;
+  std::vector<std::pair<double, Frame>> keyframes;  ///< (time, frame), times strictly increasing
+  double grab_at = 0;
+  double release_at = std::numeric_limits<double>::infinity();
+
+  /// The hand's frame at time t.
+  Frame frameAt(double t) const;
+};
+
 struct RigidBodySpec {
   std::string name;
   enum class Shape { kBox, kSphere, kPlane } shape = Shape::kBox;
@@ -71,6 +88,7 @@ struct SceneSpec {
   int steps = 100;
   std::vector<BodySpec> bodies;
   std::vector<NodeSetSpec> node_sets;
+  std::vector<HandSpec> hands;
   std::vector<RigidBodySpec> rigid_bodies;
 };
 

@@ -368,10 +368,10 @@ EOF
     grep -q '"stable": true' out/summary.json || fail "summary does not say stable"
     grep -q '"steps": 40' out/summary.json || fail "summary does not count 40 steps"
     [[ $(wc -l < out/wrench.csv) -eq 41 ]] || fail "wrench.csv should have a header and 40 rows"
-    head -1 out/wrench.csv | grep -q "end.tz" || fail "wrench.csv lacks the end set's torque"
+    head -1 out/wrench.csv | grep -q "hand.tz" || fail "wrench.csv lacks the hand's torque"
     # The turned end feels a restoring torque: negative about +z once it has turned.
-    awk -F, 'NR == 41 { for (i = 1; i <= NF; i++) if (col[i] == "end.tz") exit !($i < 0) }
-             NR == 1 { for (i = 1; i <= NF; i++) col[i] = $i }' out/wrench.csv || fail "end torque not restoring"
+    awk -F, 'NR == 41 { for (i = 1; i <= NF; i++) if (col[i] == "hand.tz") exit !($i < 0) }
+             NR == 1 { for (i = 1; i <= NF; i++) col[i] = $i }' out/wrench.csv || fail "hand torque not restoring"
     "$torsion" mesh info out/cylinder.vtk > /dev/null || fail "the final mesh does not read back"
     ;;
 
@@ -388,6 +388,16 @@ EOF
     run "$torsion" run s.json --out out
     expect_rc nonzero
     expect_out "^error: s.json: bodies\\[0\\] 'b': .*nowhere.node: cannot open"
+    ;;
+
+  run_hand_misses)
+    # A hand whose plane misses the body: a clear error before any step, nothing written.
+    sed "s|../../assets/meshes|$assets|; s|\"origin\": \\[0, 0, 9.9\\]|\"origin\": [0, 0, 20]|" \
+      "$scenes/twist_cylinder_2430.json" > miss.json
+    run "$torsion" run miss.json --out out --steps 5
+    expect_rc nonzero
+    expect_out "^error: miss.json: hands\\[0\\] 'hand': grab at t = 0.000000 s: .*"
+    [[ ! -e out/summary.json ]] || fail "no output may be written when a hand misses"
     ;;
 
   run_unstable)
