@@ -70,7 +70,7 @@ STEP_ARGS=()
   echo "kernel: $(uname -sr)"
   echo "load at start: $(cut -d' ' -f1-3 /proc/loadavg)"
   echo "git: $(git -C "$ROOT" rev-parse --short HEAD 2>/dev/null) $(git -C "$ROOT" status --porcelain 2>/dev/null | wc -l) changed files"
-  echo "binary: $BENCH_TWIST"
+  echo "binary: $BENCH_TWIST (built $(date -Is -r "$BENCH_TWIST"))"
   echo "settings: SIZES='$SIZES' E_SWEEP_SIZE=$E_SWEEP_SIZE E_SWEEP='$E_SWEEP' REPS=$REPS REPS_LARGE=$REPS_LARGE REPS_SWEEP=$REPS_SWEEP"
   echo "          BULLET_RELAXED_TOL=$BULLET_RELAXED_TOL BULLET_PC_TOL=$BULLET_PC_TOL TOLERANCE_SWEEP_SIZES='$TOLERANCE_SWEEP_SIZES' CHOLMOD_MAX_TETS=$CHOLMOD_MAX_TETS STEPS='$STEPS'"
 } >"$RESULTS_DIR/machine.txt"
