@@ -40,8 +40,8 @@ Status driveHands(BuiltScene& scene) {
     if (!s.hand->grabbed() && !s.released && reached >= s.spec.grab_at) {
       Result<int> grabbed = s.hand->grab(s.spec.frameAt(now), now);
       if (!grabbed) {
-        return Error{"hands[" + std::to_string(h) + "] '" + s.spec.name + "': grab at t = " + std::to_string(now) +
-                     " s: " + grabbed.error().message};
+        return Error{"hands[" + std::to_string(h) + "] '" + s.spec.name +
+                     "': grab at t = " + std::to_string(now) + " s: " + grabbed.error().message};
       }
     }
     if (s.hand->grabbed()) s.hand->moveTo(s.spec.frameAt(now + dt));
@@ -91,7 +91,8 @@ Result<std::unique_ptr<BuiltScene>> buildScene(SceneSpec spec, int threads_overr
   for (size_t h = 0; h < spec.hands.size(); ++h) {
     SceneHand scene_hand;
     scene_hand.spec = spec.hands[h];
-    scene_hand.hand = std::make_unique<Hand>(*world.body(scene_hand.spec.body), scene_hand.spec.name);
+    scene_hand.hand =
+        std::make_unique<Hand>(*world.body(scene_hand.spec.body), scene_hand.spec.name);
     built->hands.push_back(std::move(scene_hand));
   }
   // Hands that grab at t = 0 grab now, so a plane that misses is reported before any step.

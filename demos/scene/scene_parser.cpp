@@ -9,18 +9,21 @@ namespace torsion::scene {
 
 namespace {
 
+// {"axis": [3], "angle": rad} -> a rotation; the axis need not be unit, but not zero.
+Eigen::Quaterniond readAxisAngle(const JsonObject& aa) {
+  const Eigen::Vector3d axis = aa.vector3("axis");
+  if (axis.norm() < 1e-12) aa.fail("axis", "must not be zero");
+  const Eigen::Quaterniond rotation(Eigen::AngleAxisd(aa.number("angle"), axis.normalized()));
+  aa.finish();
+  return rotation;
+}
+
 Frame readPose(const JsonObject& parent, const std::string& key) {
   Frame pose;
   if (!parent.has(key)) return pose;
   const JsonObject p = parent.object(key);
   pose.origin = p.vector3("position", Eigen::Vector3d::Zero());
-  if (p.has("axis_angle")) {
-    const JsonObject aa = p.object("axis_angle");
-    const Eigen::Vector3d axis = aa.vector3("axis");
-    if (axis.norm() < 1e-12) aa.fail("axis", "must not be zero");
-    pose.rotation = Eigen::AngleAxisd(aa.number("angle"), axis.normalized());
-    aa.finish();
-  }
+  if (p.has("axis_angle")) pose.rotation = readAxisAngle(p.object("axis_angle"));
   p.finish();
   return pose;
 }
@@ -101,18 +104,17 @@ Frame readHandFrame(const JsonObject& f) {
   Frame frame;
   frame.origin = f.vector3("origin");
   const bool has_axes = f.has("i") || f.has("j");
-  if (f.has("axis_angle") && has_axes) f.fail("axis_angle", "give either axis_angle or i and j, not both");
+  if (f.has("axis_angle") && has_axes)
+    f.fail("axis_angle", "give either axis_angle or i and j, not both");
   if (f.has("axis_angle")) {
-    const JsonObject aa = f.object("axis_angle");
-    const Eigen::Vector3d axis = aa.vector3("axis");
-    if (axis.norm() < 1e-12) aa.fail("axis", "must not be zero");
-    frame.rotation = Eigen::AngleAxisd(aa.number("angle"), axis.normalized());
-    aa.finish();
+    frame.rotation = readAxisAngle(f.object("axis_angle"));
   } else if (has_axes) {
     const Eigen::Vector3d i = f.vector3("i"), j = f.vector3("j");
-    if (std::abs(i.norm() - 1) > 1e-6 || std::abs(j.norm() - 1) > 1e-6 || std::abs(i.dot(j)) > 1e-6) {
-      f.fail("i", "degenerate rotation: i and j must be orthonormal (|i| = " + std::to_string(i.norm()) +
-                      ", |j| = " + std::to_string(j.norm()) + ", i.j = " + std::to_string(i.dot(j)) + ")");
+    if (std::abs(i.norm() - 1) > 1e-6 || std::abs(j.norm() - 1) > 1e-6 ||
+        std::abs(i.dot(j)) > 1e-6) {
+      f.fail("i", "degenerate rotation: i and j must be orthonormal (|i| = " +
+                      std::to_string(i.norm()) + ", |j| = " + std::to_string(j.norm()) +
+                      ", i.j = " + std::to_string(i.dot(j)) + ")");
     }
     Eigen::Matrix3d R;
     R << i, j, i.cross(j);
@@ -142,14 +144,16 @@ HandSpec readHand(const JsonObject& h) {
   hand.name = h.string("name");
   hand.body = h.string("body");
   if (h.has("keyframes")) {
-    if (h.has("frame") || h.has("motion")) h.fail("keyframes", "give either keyframes or frame (+ motion), not both");
+    if (h.has("frame") || h.has("motion"))
+      h.fail("keyframes", "give either keyframes or frame (+ motion), not both");
     const std::vector<JsonObject> keys = h.objects("keyframes");
     if (keys.empty()) h.fail("keyframes", "needs at least one keyframe");
     for (size_t k = 0; k < keys.size(); ++k) {
       const double time = keys[k].number("time");
       if (k > 0 && !(time > hand.keyframes.back().first)) {
         keys[k].fail("time", std::to_string(time) + " is not after the previous keyframe's " +
-                                 std::to_string(hand.keyframes.back().first) + ": keyframes must be in time order");
+                                 std::to_string(hand.keyframes.back().first) +
+                                 ": keyframes must be in time order");
       }
       hand.keyframes.emplace_back(time, readHandFrame(keys[k]));
     }
@@ -235,7 +239,8 @@ Frame HandSpec::frameAt(double t) const {
   if (t <= keyframes.front().first) return keyframes.front().second;
   if (t >= keyframes.back().first) return keyframes.back().second;
   size_t k = 1;
-  while (keyframes[k].first < t) ++k;
+  while (keyframes[k].first < t)
+    ++k;
   const auto& [t0, f0] = keyframes[k - 1];
   const auto& [t1, f1] = keyframes[k];
   const double s = (t - t0) / (t1 - t0);
@@ -307,7 +312,8 @@ Result<SceneSpec> parseScene(std::string_view text, const std::string& file_name
     for (const JsonObject& h : root.objects("hands")) {
       HandSpec hand = readHand(h);
       bool known = false;
-      for (const BodySpec& body : scene.bodies) known = known || body.name == hand.body;
+      for (const BodySpec& body : scene.bodies)
+        known = known || body.name == hand.body;
       if (!known) h.fail("body", "no body named '" + hand.body + "'");
       for (const HandSpec& other : scene.hands) {
         if (other.name == hand.name) h.fail("name", "duplicate hand name '" + hand.name + "'");

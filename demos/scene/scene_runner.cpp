@@ -166,10 +166,11 @@ Result<RunOutcome> runScene(BuiltScene& scene, const RunOptions& options) {
   }
   summary["hands"] = nlohmann::json::array();
   for (const SceneHand& h : scene.hands) {
-    summary["hands"].push_back({{"name", h.spec.name},
-                                {"body", h.spec.body},
-                                {"grabbed_nodes", static_cast<int>(h.hand->selection().nodes.size())},
-                                {"holding_at_end", h.hand->grabbed()}});
+    summary["hands"].push_back(
+        {{"name", h.spec.name},
+         {"body", h.spec.body},
+         {"grabbed_nodes", static_cast<int>(h.hand->selection().nodes.size())},
+         {"holding_at_end", h.hand->grabbed()}});
   }
   summary["stable"] = outcome.stable;
   if (!outcome.stable) summary["failure"] = outcome.failure;

@@ -4,8 +4,8 @@
 // the whole matrix, interleaved and repeated.
 //
 //   bench_twist --solver torsion-cg --mesh cylinder_8332 --E 1e5 --threads 2 --tolerance 1e-4
-//   bench_twist --solver bullet-implicit --mesh cylinder_8332 --tolerance 1e-8 --mass-preconditioner
-//   bench_twist --solver bullet-explicit --mesh cylinder_8332 --substeps 4
+//   bench_twist --solver bullet-implicit --mesh cylinder_8332 --tolerance 1e-8
+//   --mass-preconditioner bench_twist --solver bullet-explicit --mesh cylinder_8332 --substeps 4
 
 #include <CLI/CLI.hpp>
 #include <cmath>
@@ -37,7 +37,8 @@ nlohmann::json number(double value) {
 std::filesystem::path resolveMesh(const std::string& name) {
   std::filesystem::path path(name);
   auto exists = [](const std::filesystem::path& p) {
-    return std::filesystem::exists(p) || std::filesystem::exists(std::filesystem::path(p).concat(".node"));
+    return std::filesystem::exists(p) ||
+           std::filesystem::exists(std::filesystem::path(p).concat(".node"));
   };
   if (exists(path)) return path;
   const std::filesystem::path in_assets = std::filesystem::path(TORSION_ASSETS_DIR) / name;
@@ -59,8 +60,10 @@ int main(int argc, char** argv) {
   int substeps = 1;
   int max_iterations = 300;
   bool mass_preconditioner = false;
-  app.add_option("--solver", solver, "torsion-cg | torsion-cholmod | bullet-implicit | bullet-explicit")
-      ->check(CLI::IsMember({"torsion-cg", "torsion-cholmod", "bullet-implicit", "bullet-explicit"}));
+  app.add_option("--solver", solver,
+                 "torsion-cg | torsion-cholmod | bullet-implicit | bullet-explicit")
+      ->check(
+          CLI::IsMember({"torsion-cg", "torsion-cholmod", "bullet-implicit", "bullet-explicit"}));
   app.add_option("--mesh", mesh_name,
                  "mesh file (.node/.ele base name, .msh, .vtk) or a name in assets/meshes")
       ->required();
@@ -68,21 +71,24 @@ int main(int argc, char** argv) {
   app.add_option("--nu", protocol.poisson_ratio, "Poisson ratio")->capture_default_str();
   app.add_option("--rho", protocol.density, "density, kg/m^3")->capture_default_str();
   app.add_option("--dt", protocol.time_step, "time step, s")->capture_default_str();
-  app.add_option("--steps", protocol.total_steps, "total steps (ramp + hold)")->capture_default_str();
+  app.add_option("--steps", protocol.total_steps, "total steps (ramp + hold)")
+      ->capture_default_str();
   app.add_option("--ramp-steps", protocol.ramp_steps, "steps to reach pi/2")->capture_default_str();
   app.add_option("--beta", protocol.stiffness_damping,
                  "stiffness damping, s (ours and Bullet implicit; explicit corotated has none)")
       ->capture_default_str();
   app.add_option("--max-speed", protocol.max_speed, "m/s; a faster node ends the run as unstable")
       ->capture_default_str();
-  app.add_option("--slice-half", protocol.slice_half_thickness, "half thickness of measuring slices, m")
+  app.add_option("--slice-half", protocol.slice_half_thickness,
+                 "half thickness of measuring slices, m")
       ->capture_default_str();
   app.add_option("--threads", threads, "worker threads (ours; Bullet is single-threaded)")
       ->capture_default_str();
   app.add_option("--tolerance", tolerance,
                  "ours: CG relative residual (default 1e-4); bullet-implicit: btConjugateGradient "
                  "tolerance, r.z < tol * min(1, z0.b0) (default SIMD_EPSILON)");
-  app.add_option("--max-iterations", max_iterations, "Bullet CG iteration cap")->capture_default_str();
+  app.add_option("--max-iterations", max_iterations, "Bullet CG iteration cap")
+      ->capture_default_str();
   app.add_flag("--mass-preconditioner", mass_preconditioner,
                "bullet-implicit: initialise Bullet's mass preconditioner after the first step");
   app.add_option("--substeps", substeps, "bullet-explicit: stepSimulation calls per dt")
@@ -106,7 +112,8 @@ int main(int argc, char** argv) {
     options.cholmod = solver == "torsion-cholmod";
     if (!std::isnan(tolerance)) options.tolerance = tolerance;
     options.threads = threads;
-    reported_tolerance = options.cholmod ? std::numeric_limits<double>::quiet_NaN() : options.tolerance;
+    reported_tolerance =
+        options.cholmod ? std::numeric_limits<double>::quiet_NaN() : options.tolerance;
     result = torsion::bench::runTorsionTwist(protocol, mesh, options);
   } else {
     torsion::bench::BulletOptions options;
@@ -148,8 +155,8 @@ int main(int argc, char** argv) {
   j["substeps"] = solver == "bullet-explicit" ? substeps : 1;
   j["status"] = torsion::bench::toString(result.status);
   j["message"] = result.message;
-  j["stable"] = result.status == torsion::bench::RunStatus::kOk &&
-                result.steps_done == protocol.total_steps;
+  j["stable"] =
+      result.status == torsion::bench::RunStatus::kOk && result.steps_done == protocol.total_steps;
   j["steps_done"] = result.steps_done;
   j["setup_s"] = result.setup_seconds;
   j["run_s"] = total_ms / 1000;

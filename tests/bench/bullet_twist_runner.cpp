@@ -11,7 +11,8 @@
 //   keeps the contact and face-tree machinery out of the timing), DISABLE_DEACTIVATION.
 // - A zero btDeformableGravityForce is always added (implicit mode reads an uninitialised gravity
 //   otherwise, memo section 4.8).
-// - Driven nodes: both m_v and m_vn set to (target(t + h) - x) / h before every stepSimulation(h, 0)
+// - Driven nodes: both m_v and m_vn set to (target(t + h) - x) / h before every stepSimulation(h,
+// 0)
 //   (implicit mode keeps m_vn as the velocity backup; memo section 3, run t4).
 //
 // Implicit: btDeformableLinearElasticityForce(mu, lambda, alpha = 0, beta), setImplicit(true),
@@ -96,7 +97,9 @@ class BenchDeformableSolver : public btDeformableBodySolver {
   int cgMaxIterations() const { return m_cg.m_maxIterations; }
 };
 
-btVector3 toBt(const Eigen::Vector3d& v) { return {v.x(), v.y(), v.z()}; }
+btVector3 toBt(const Eigen::Vector3d& v) {
+  return {v.x(), v.y(), v.z()};
+}
 
 }  // namespace
 
@@ -139,7 +142,8 @@ TwistResult runBulletTwist(const TwistProtocol& protocol, const TetMesh& mesh,
   // Body.
   std::vector<btVector3> x(static_cast<size_t>(n));
   std::vector<btScalar> mass(static_cast<size_t>(n), 0);
-  for (int i = 0; i < n; ++i) x[static_cast<size_t>(i)] = toBt(rest[static_cast<size_t>(i)]);
+  for (int i = 0; i < n; ++i)
+    x[static_cast<size_t>(i)] = toBt(rest[static_cast<size_t>(i)]);
   std::set<std::pair<int, int>> edges;
   for (int t = 0; t < mesh.tetCount(); ++t) {
     const Tet& tet = mesh.tets()[static_cast<size_t>(t)];
@@ -156,9 +160,12 @@ TwistResult runBulletTwist(const TwistProtocol& protocol, const TetMesh& mesh,
     }
   }
   auto body = std::make_unique<btSoftBody>(&world->getWorldInfo(), n, x.data(), mass.data());
-  for (const Tet& tet : mesh.tets()) body->appendTetra(tet[0], tet[1], tet[2], tet[3]);
-  for (const auto& [a, b] : edges) body->appendLink(a, b, nullptr, false);
-  for (const Triangle& f : mesh.surfaceTriangles()) body->appendFace(f[0], f[1], f[2]);
+  for (const Tet& tet : mesh.tets())
+    body->appendTetra(tet[0], tet[1], tet[2], tet[3]);
+  for (const auto& [a, b] : edges)
+    body->appendLink(a, b, nullptr, false);
+  for (const Triangle& f : mesh.surfaceTriangles())
+    body->appendFace(f[0], f[1], f[2]);
   body->initializeDmInverse();
   btSoftBody::TetraScratch rest_scratch;  // what updateDeformation writes for an undeformed tet
   rest_scratch.m_F.setIdentity();

@@ -43,11 +43,16 @@ Eigen::Vector3d turnedAboutZ(const Eigen::Vector3d& rest, double angle) {
 
 const char* toString(RunStatus status) {
   switch (status) {
-    case RunStatus::kOk: return "ok";
-    case RunStatus::kNonFinite: return "nan";
-    case RunStatus::kBlowUp: return "blowup";
-    case RunStatus::kSolverFailed: return "solver-failed";
-    case RunStatus::kSetupFailed: return "setup-failed";
+    case RunStatus::kOk:
+      return "ok";
+    case RunStatus::kNonFinite:
+      return "nan";
+    case RunStatus::kBlowUp:
+      return "blowup";
+    case RunStatus::kSolverFailed:
+      return "solver-failed";
+    case RunStatus::kSetupFailed:
+      return "setup-failed";
   }
   return "?";
 }
@@ -56,7 +61,8 @@ void measureTwist(const TwistProtocol& protocol, const TetMesh& mesh, const Twis
                   const Eigen::VectorXd& positions, TwistResult& result) {
   const double length = scene.length();
   result.slice_z.clear();
-  for (double f : protocol.slice_fractions) result.slice_z.push_back(f * length);
+  for (double f : protocol.slice_fractions)
+    result.slice_z.push_back(f * length);
   const double final_angle = protocol.angle(protocol.total_steps * protocol.time_step);
   const std::vector<SliceRotation> profile =
       twistProfile(mesh.restPositions(), positions, result.slice_z, protocol.slice_half_thickness);
@@ -75,7 +81,8 @@ void measureTwist(const TwistProtocol& protocol, const TetMesh& mesh, const Twis
   double max_error = 0;
   for (int i = 0; i < mesh.nodeCount(); ++i) {
     if (scene.roles[static_cast<size_t>(i)] != NodeRole::kDriven) continue;
-    const Eigen::Vector3d target = turnedAboutZ(mesh.restPositions()[static_cast<size_t>(i)], final_angle);
+    const Eigen::Vector3d target =
+        turnedAboutZ(mesh.restPositions()[static_cast<size_t>(i)], final_angle);
     max_error = std::max(max_error, (positions.segment<3>(3 * i) - target).norm());
   }
   result.driven_error = max_error;

@@ -30,8 +30,8 @@ struct TwistProtocol {
   /// Rayleigh stiffness damping beta, s (C = beta K). Ours: Material::stiffness_damping; Bullet's
   /// btDeformableLinearElasticityForce: damping_beta (same meaning, see bullet_twist_runner.cpp).
   double stiffness_damping = 0.01;
-  double max_speed = 100;              ///< m/s: a faster node means the run is unstable
-  double slice_half_thickness = 0.3;   ///< m, half thickness of the measuring slices
+  double max_speed = 100;             ///< m/s: a faster node means the run is unstable
+  double slice_half_thickness = 0.3;  ///< m, half thickness of the measuring slices
   std::vector<double> slice_fractions{0.25, 0.5, 0.75};  ///< slice z / L
 
   /// Prescribed angle of the driven end at time t, rad.
@@ -62,20 +62,20 @@ struct TwistResult {
   std::string message;
   int steps_done = 0;
   double setup_seconds = 0;
-  std::vector<double> step_ms;         ///< wall clock per benchmark step (all substeps of one dt)
-  double loop_cpu_seconds = 0;         ///< process CPU time (all threads) of the stepping loop
-  std::vector<int> step_iterations;    ///< linear-solver iterations per step (sum over substeps)
-  int not_converged_steps = 0;         ///< steps whose solver stopped above tolerance (ours)
-  double max_speed = 0;                ///< largest node speed seen at the end of any step, m/s
-  double driven_error = 0;             ///< max |x - target| of driven nodes at the end, m
-  long setup_rss_kb = 0;               ///< peak RSS before the first step
-  long peak_rss_kb = 0;                ///< peak RSS at the end
+  std::vector<double> step_ms;       ///< wall clock per benchmark step (all substeps of one dt)
+  double loop_cpu_seconds = 0;       ///< process CPU time (all threads) of the stepping loop
+  std::vector<int> step_iterations;  ///< linear-solver iterations per step (sum over substeps)
+  int not_converged_steps = 0;       ///< steps whose solver stopped above tolerance (ours)
+  double max_speed = 0;              ///< largest node speed seen at the end of any step, m/s
+  double driven_error = 0;           ///< max |x - target| of driven nodes at the end, m
+  long setup_rss_kb = 0;             ///< peak RSS before the first step
+  long peak_rss_kb = 0;              ///< peak RSS at the end
   // Final twist profile
   std::vector<double> slice_z, slice_angle, slice_expected, slice_error;
   std::vector<int> slice_nodes;
-  double tip_angle = 0;                ///< angle of the driven end, rad
-  Eigen::VectorXd final_positions;     ///< 3n
-  std::string solver_detail;           ///< e.g. "cg block-jacobi tol 1e-4"
+  double tip_angle = 0;             ///< angle of the driven end, rad
+  Eigen::VectorXd final_positions;  ///< 3n
+  std::string solver_detail;        ///< e.g. "cg block-jacobi tol 1e-4"
 };
 
 /// Fills slice_* of `result` from final positions (3n) against the rest mesh.

@@ -162,7 +162,9 @@ const std::string kWithHand = R"({
              "grab_at": 0.5, "release_at": 3}]
 })";
 
-Result<SceneSpec> parseHand(const std::string& text) { return parseScene(text, "h.json", "/"); }
+Result<SceneSpec> parseHand(const std::string& text) {
+  return parseScene(text, "h.json", "/");
+}
 
 std::string with(const std::string& from, const std::string& to) {
   std::string text = kWithHand;
@@ -181,26 +183,35 @@ TEST(SceneHands, ReadsAHandAndFollowsItsMotion) {
   // After 1 s at 0.5 rad/s about z through the origin's axis: O fixed, i turned by 0.5 rad.
   const Frame f = h.frameAt(1.0);
   EXPECT_LT((f.origin - Eigen::Vector3d(0, 0, 9.9)).norm(), 1e-12);
-  EXPECT_LT((f.rotation * Eigen::Vector3d::UnitX() - Eigen::Vector3d(std::cos(0.5), std::sin(0.5), 0)).norm(), 1e-12);
-  EXPECT_LT((h.frameAt(10).rotation * Eigen::Vector3d::UnitX() - Eigen::Vector3d(std::cos(1.0), std::sin(1.0), 0)).norm(), 1e-12);
+  EXPECT_LT(
+      (f.rotation * Eigen::Vector3d::UnitX() - Eigen::Vector3d(std::cos(0.5), std::sin(0.5), 0))
+          .norm(),
+      1e-12);
+  EXPECT_LT((h.frameAt(10).rotation * Eigen::Vector3d::UnitX() -
+             Eigen::Vector3d(std::cos(1.0), std::sin(1.0), 0))
+                .norm(),
+            1e-12);
 }
 
 TEST(SceneHands, KeyframesInterpolateOriginLinearlyAndRotationBySlerp) {
-  const std::string keyed = with(R"("frame": {"origin": [0, 0, 9.9], "i": [1, 0, 0], "j": [0, 1, 0]},
+  const std::string keyed =
+      with(R"("frame": {"origin": [0, 0, 9.9], "i": [1, 0, 0], "j": [0, 1, 0]},
              "motion": {"angular_velocity": [0, 0, 0.5], "pivot": [0, 0, 9.9], "duration": 2},)",
-                                 R"("keyframes": [{"time": 0, "origin": [0, 0, 0]},
+           R"("keyframes": [{"time": 0, "origin": [0, 0, 0]},
                            {"time": 2, "origin": [2, 0, 0], "axis_angle": {"axis": [0, 0, 1], "angle": 1.0}}],)");
   Result<SceneSpec> r = parseHand(keyed);
   ASSERT_TRUE(r.ok()) << r.error().message;
   const Frame mid = r.value().hands[0].frameAt(1.0);
   EXPECT_LT((mid.origin - Eigen::Vector3d(1, 0, 0)).norm(), 1e-12);
   EXPECT_NEAR(mid.rotation.angularDistance(Eigen::Quaterniond::Identity()), 0.5, 1e-12);
-  EXPECT_LT((r.value().hands[0].frameAt(5.0).origin - Eigen::Vector3d(2, 0, 0)).norm(), 1e-12);  // held
+  EXPECT_LT((r.value().hands[0].frameAt(5.0).origin - Eigen::Vector3d(2, 0, 0)).norm(),
+            1e-12);  // held
 }
 
 TEST(SceneHandsFaults, UnknownBody) {
   EXPECT_TRUE(test::failsWith(parseHand(with(R"("body": "cyl",
-             "frame")", R"("body": "arm",
+             "frame")",
+                                             R"("body": "arm",
              "frame")")),
                               {"h.json: hands[0].body: no body named 'arm'"}));
 }
@@ -211,17 +222,20 @@ TEST(SceneHandsFaults, DegenerateRotation) {
 }
 
 TEST(SceneHandsFaults, KeyframesOutOfOrder) {
-  const std::string keyed = with(R"("frame": {"origin": [0, 0, 9.9], "i": [1, 0, 0], "j": [0, 1, 0]},
+  const std::string keyed = with(
+      R"("frame": {"origin": [0, 0, 9.9], "i": [1, 0, 0], "j": [0, 1, 0]},
              "motion": {"angular_velocity": [0, 0, 0.5], "pivot": [0, 0, 9.9], "duration": 2},)",
-                                 R"("keyframes": [{"time": 1, "origin": [0, 0, 0]}, {"time": 0.5, "origin": [1, 0, 0]}],)");
-  EXPECT_TRUE(test::failsWith(parseHand(keyed), {"h.json: hands[0].keyframes[1].time", "time order"}));
+      R"("keyframes": [{"time": 1, "origin": [0, 0, 0]}, {"time": 0.5, "origin": [1, 0, 0]}],)");
+  EXPECT_TRUE(
+      test::failsWith(parseHand(keyed), {"h.json: hands[0].keyframes[1].time", "time order"}));
 }
 
 TEST(SceneHandsFaults, ReleaseBeforeGrabAndNonNumbers) {
   EXPECT_TRUE(test::failsWith(parseHand(with(R"("release_at": 3)", R"("release_at": 0.2)")),
                               {"hands[0].release_at: must be after grab_at"}));
-  EXPECT_TRUE(test::failsWith(parseHand(with(R"("origin": [0, 0, 9.9])", R"("origin": [0, "x", 9.9])")),
-                              {"hands[0].frame.origin: element 1: expected a number"}));
+  EXPECT_TRUE(
+      test::failsWith(parseHand(with(R"("origin": [0, 0, 9.9])", R"("origin": [0, "x", 9.9])")),
+                      {"hands[0].frame.origin: element 1: expected a number"}));
 }
 
 }  // namespace
