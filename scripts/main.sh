@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # The main job, from a fresh machine: set-up, Release build, then the headless twist of the small
-# cylinder (the report's section 6.1.2: r = 1, L = 10, one end fixed, the other turned by 2 pi at
+# cylinder (the report's section 6.1.2: r = 1, L = 10, one end fixed, a hand near the other end turning 2 pi at
 # 0.1 rad/s, dt = 0.01). Prints its progress; writes its results to results/twist_cylinder_2430/.
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -17,4 +17,4 @@ echo
 echo "Summary ($out/summary.json):"
 cat "$out/summary.json"
 echo
-echo "Results in $out/: summary.json, wrench.csv (torque on the turned end), energy.csv, cylinder.vtk (open in ParaView)"
+echo "Results in $out/: summary.json, wrench.csv (force and torque on the hand and the fixed base), energy.csv, cylinder.vtk (open in ParaView)"
