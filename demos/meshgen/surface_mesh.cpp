@@ -14,13 +14,6 @@ namespace fs = std::filesystem;
 
 namespace {
 
-std::string lowerExtension(const fs::path& path) {
-  std::string ext = path.extension().string();
-  for (char& c : ext)
-    c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-  return ext;
-}
-
 std::string where(const std::string& file, const SurfaceMesh& surface, size_t triangle) {
   const int line = triangle < surface.triangle_lines.size() ? surface.triangle_lines[triangle] : 0;
   if (line > 0) return file + ":" + std::to_string(line) + ": ";

@@ -13,14 +13,14 @@ namespace torsion {
 
 namespace fs = std::filesystem;
 
-namespace {
-
 std::string lowerExtension(const fs::path& path) {
   std::string ext = path.extension().string();
   for (char& c : ext)
     c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
   return ext;
 }
+
+namespace {
 
 // TetGen meshes are two files; any of "name", "name.node", "name.ele" names the pair.
 fs::path tetgenBase(const fs::path& path) {

@@ -17,6 +17,9 @@ namespace torsion {
 
 enum class MeshFormat { kTetGen, kGmsh, kVtk };
 
+/// The path's extension, lower-cased, with its dot (".msh"); empty when there is none.
+std::string lowerExtension(const std::filesystem::path& path);
+
 /// The format a path names by its extension, or an Error listing the known extensions.
 Result<MeshFormat> meshFormatOf(const std::filesystem::path& path);
 
