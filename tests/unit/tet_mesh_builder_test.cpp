@@ -66,6 +66,27 @@ TEST(BuildTetMesh, FaceSharedByThreeTetsIsRefused) {
                         {"m.ele:4: tet 2:", "already shared by tets", "overlap"}));
 }
 
+TEST(BuildTetMesh, TwoTetsOnOneSideOfTheirSharedFaceAreRefused) {
+  // Both apexes above the face (0, 1, 2): each face is shared at most twice, yet the tets overlap.
+  const std::string nodes = "5 3 0 0\n0 0 0 0\n1 1 0 0\n2 0 1 0\n3 0 0 1\n4 0.1 0.1 2\n";
+  Result<RawTetMesh> raw = parseTetGen(nodes, "m.node", "2 4 0\n0 0 1 2 3\n1 0 1 2 4\n", "m.ele");
+  ASSERT_TRUE(raw.ok()) << raw.error().message;
+  EXPECT_TRUE(failsWith(buildTetMesh(std::move(raw).value()),
+                        {"m.ele:3: tet 1:", "same side of face (0, 1, 2) as tet 0", "overlap"}));
+}
+
+TEST(BuildTetMesh, FoldedMeshWithoutBoundaryIsRefused) {
+  // Found by fuzz_tetgen: tet 0 plus four tets fanning from an apex outside it, every face shared
+  // twice, so no boundary surface at all.
+  const std::string nodes =
+      "8 3\n0 0 0 0\n1 1 0 0\n2 0 1 0\n3 1 1 0\n4 0 4 1\n5 1 0 1\n6 0 1 5\n7 1 1 9\n";
+  const std::string tets =
+      "5 4 0\n0 0 1 2 4\n1 0 2 1 7\n2 0 1 4 7\n3 1 4 2 7\n4 0 2 4 7\n";
+  Result<RawTetMesh> raw = parseTetGen(nodes, "m.node", tets, "m.ele");
+  ASSERT_TRUE(raw.ok()) << raw.error().message;
+  EXPECT_TRUE(failsWith(buildTetMesh(std::move(raw).value()), {"m.ele:", "overlap"}));
+}
+
 TEST(BuildTetMesh, DuplicateTetIsRefused) {
   EXPECT_TRUE(
       failsWith(build("2 4 0\n0 0 1 2 3\n1 3 1 2 0\n"), {"m.ele:3: tet 1:", "duplicates tet 0"}));

@@ -1,6 +1,7 @@
 #include "torsion/mesh/tet_mesh_builder.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <sstream>
 
@@ -134,6 +135,35 @@ Result<LoadedMesh> buildTetMesh(RawTetMesh raw, const MeshLoadOptions& options) 
                    std::to_string(raw.origins[static_cast<size_t>(faces[i].tet)].id) + " and " +
                    std::to_string(raw.origins[static_cast<size_t>(faces[i + 1].tet)].id) +
                    ": tets overlap or are duplicated"};
+    }
+  }
+
+  // Two positively oriented tets sharing a face lie on opposite sides of it exactly when they see
+  // it with opposite orientations. The same orientation puts both on one side: they overlap, even
+  // though every face is shared only twice (a fuzzer found five tets folded over each other that
+  // way, leaving no boundary surface at all).
+  for (size_t i = 0; i + 1 < faces.size(); ++i) {
+    if (faces[i].key != faces[i + 1].key) continue;
+    const auto oriented = [&](const detail::FaceRecord& face) {
+      const Tet& tet = raw.tets[static_cast<size_t>(face.tet)];
+      const int* local = detail::kOutwardFaces[face.local_face];
+      return std::array<int, 3>{tet[static_cast<size_t>(local[0])],
+                                tet[static_cast<size_t>(local[1])],
+                                tet[static_cast<size_t>(local[2])]};
+    };
+    const std::array<int, 3> a = oriented(faces[i]);
+    const std::array<int, 3> b = oriented(faces[i + 1]);
+    // b is a reversed a when it equals one of the three rotations of (a0, a2, a1).
+    const bool opposite = (b == std::array<int, 3>{a[0], a[2], a[1]}) ||
+                          (b == std::array<int, 3>{a[2], a[1], a[0]}) ||
+                          (b == std::array<int, 3>{a[1], a[0], a[2]});
+    if (!opposite) {
+      const auto& k = faces[i].key;
+      const size_t later = static_cast<size_t>(std::max(faces[i].tet, faces[i + 1].tet));
+      const size_t earlier = static_cast<size_t>(std::min(faces[i].tet, faces[i + 1].tet));
+      return Error{where(raw, later) + ": lies on the same side of face (" + std::to_string(k[0]) +
+                   ", " + std::to_string(k[1]) + ", " + std::to_string(k[2]) + ") as tet " +
+                   std::to_string(raw.origins[earlier].id) + ": tets overlap"};
     }
   }
 
