@@ -44,4 +44,29 @@ struct DeviceSample {
   bool alive = false;         ///< false when the device stopped answering
 };
 
+/// What the haptic loop hands the simulation every tick (device frame). Grab and release requests
+/// are counters, not flags, so that a press between two simulation steps is never lost: the
+/// simulation acts when a counter moved since it last looked.
+struct HandCommand {
+  std::uint64_t tick = 0;  ///< the loop's tick that wrote it
+  double time = 0;         ///< s, loop clock
+  Pose pose;
+  bool alive = false;                  ///< the device answered this tick
+  std::uint32_t grab_requests = 0;     ///< button 1 presses so far (report section 5.4)
+  std::uint32_t release_requests = 0;  ///< button 2 presses so far
+};
+
+/// What the simulation hands the haptic loop after each step (device frame and units). The loop
+/// renders W = wrench + stiffness * (pose now - pose) between steps (DESIGN.md section 4).
+struct SimulationWrench {
+  std::uint64_t step = 0;          ///< simulation step that produced it; 0: nothing published yet
+  std::uint64_t command_tick = 0;  ///< HandCommand::tick of the pose the step used
+  bool grabbed = false;            ///< the hand holds a patch and force output is enabled
+  Pose pose;                       ///< device pose the wrench belongs to
+  Wrench wrench;                   ///< what the body pushes the hand with, N and N m
+  /// 6x6 row-major dW/dpose at `pose`: rows (force, torque), columns (translation in m, rotation
+  /// vector in rad). Units N/m, N/rad, N m/m, N m/rad. Zero when unknown.
+  double stiffness[36] = {};
+};
+
 }  // namespace torsion::device

@@ -1,0 +1,123 @@
+#pragma once
+// The haptic loop: one thread at 1 kHz (absolute deadlines on the monotonic clock, so periods do
+// not drift), each tick:
+//   1. read the device (pose, buttons, alive);
+//   2. buttons, as the report's section 5.4: button 1 pressed -> a grab request and force
+//      enabled; button 2 pressed -> a release request and force disabled;
+//   3. hand the simulation a HandCommand (lock-free, commands());
+//   4. take the newest SimulationWrench (lock-free, wrenches()) and render the local model
+//      W_sim + K_h dpose - B twist (local_wrench_model.h);
+//   5. pass it through the SafetyFilter and write it to the device;
+//   6. append a row to the in-memory log (no I/O on this thread; writeLog after stop()).
+//
+// Threads: tick() runs on the loop thread (or on a test's thread with a fake clock, never both);
+// commands() is read and wrenches() written by exactly one simulation thread; stats() from any.
+
+#include <atomic>
+#include <cstdint>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "torsion/device/haptic_device.h"
+#include "torsion/device/local_wrench_model.h"
+#include "torsion/device/triple_buffer.h"
+#include "torsion/device/wrench_safety.h"
+
+namespace torsion::device {
+
+struct HapticLoopSettings {
+  double rate_hz = 1000;  ///< ticks per second
+  SafetySettings safety;
+  CouplingDamper damper;
+  double twist_cutoff_hz = 50;   ///< low-pass of the velocity the damper sees
+  std::size_t log_capacity = 0;  ///< rows kept in memory (one per tick); 0: no log
+
+  /// Empty when valid, else the message naming the field.
+  std::string validate() const;
+};
+
+/// One tick as logged (docs/haptics.md lists the CSV columns).
+struct LoopLogRow {
+  std::uint64_t tick = 0;
+  double time = 0;      ///< s, loop clock
+  double period = 0;    ///< s since the previous tick
+  double lateness = 0;  ///< s the tick started after its deadline
+  Pose pose;
+  std::uint32_t buttons = 0;
+  bool alive = false;
+  Wrench output;     ///< what was written to the device
+  Wrench simulated;  ///< the simulation's wrench the local model started from
+  std::uint64_t sim_step = 0;
+  double wrench_age = 0;             ///< s since that simulation wrench arrived
+  std::int64_t pose_lag_ticks = -1;  ///< ticks since the pose the simulation used (-1: none)
+  bool grabbed = false;
+  bool fresh = false;
+};
+
+struct LoopStats {
+  std::atomic<std::uint64_t> ticks{0};
+  std::atomic<std::uint64_t> overruns{0};     ///< ticks that started a full period late
+  std::atomic<std::uint64_t> log_dropped{0};  ///< rows not logged: capacity reached
+  std::atomic<std::uint64_t> nonfinite{0};    ///< rendered wrenches with NaN/inf (zeroed)
+};
+
+class HapticLoop {
+ public:
+  HapticLoop(HapticDevice& device, const HapticLoopSettings& settings);
+  ~HapticLoop();
+  HapticLoop(const HapticLoop&) = delete;
+  HapticLoop& operator=(const HapticLoop&) = delete;
+
+  /// The simulation reads device commands here...
+  TripleBuffer<HandCommand>& commands() { return commands_; }
+  /// ...and publishes its wrenches here.
+  TripleBuffer<SimulationWrench>& wrenches() { return wrenches_; }
+
+  /// One tick at loop time `now` (s). `deadline` is when it was due (for the log).
+  void tick(double now, double deadline);
+  void tick(double now) { tick(now, now); }
+
+  /// Runs tick() on its own thread at rate_hz until stop(). The loop clock is seconds of the
+  /// monotonic clock since start().
+  void start();
+  /// Stops the thread and writes a zero wrench to the device.
+  void stop();
+  bool running() const { return thread_.joinable(); }
+
+  const LoopStats& stats() const { return stats_; }
+  /// The log so far; only while the loop is not running (or from the ticking thread).
+  const std::vector<LoopLogRow>& log() const { return log_; }
+  /// Writes the log as CSV; false when the file cannot be written.
+  bool writeLog(const std::string& path) const;
+  const Wrench& lastOutput() const { return safety_.output(); }
+  bool forceEnabled() const { return force_enabled_; }
+
+ private:
+  void run();
+
+  HapticDevice& device_;
+  HapticLoopSettings settings_;
+  DeviceLimits limits_;
+  SafetyFilter safety_;
+  TwistEstimator twist_;
+  TripleBuffer<HandCommand> commands_;
+  TripleBuffer<SimulationWrench> wrenches_;
+  LoopStats stats_;
+  std::vector<LoopLogRow> log_;
+
+  std::uint64_t tick_ = 0;
+  double previous_time_ = 0;
+  bool have_previous_ = false;
+  std::uint32_t previous_buttons_ = 0;
+  bool force_enabled_ = false;
+  std::uint32_t grab_requests_ = 0;
+  std::uint32_t release_requests_ = 0;
+  SimulationWrench simulated_;
+  double last_fresh_time_ = -1e300;
+
+  std::thread thread_;
+  std::atomic<bool> stop_requested_{false};
+};
+
+}  // namespace torsion::device

@@ -1,0 +1,51 @@
+#pragma once
+// A device in another process, over UDP (loopback by default): pose packets in, wrench packets
+// out, in the format of udp_packet.h. A vendor's force-feedback driver (their SDKs are
+// proprietary) runs as its own process and speaks this format; network_peer.h is the reference
+// peer. The device answers to whoever sent the newest accepted pose. It is alive while accepted
+// packets flagged alive keep arriving within `timeout`.
+
+#include <memory>
+#include <string>
+
+#include "torsion/device/haptic_device.h"
+#include "torsion/device/packet_stats.h"
+#include "torsion/device/udp_socket.h"
+
+namespace torsion::device {
+
+struct NetworkDeviceSettings {
+  UdpEndpoint local{0x7f000001, 5750};  ///< where poses arrive; port 0: any free port
+  double timeout = 0.05;                ///< s without an accepted pose before the device is dead
+  DeviceLimits limits;                  ///< of the device behind the peer
+};
+
+class NetworkDevice : public HapticDevice {
+ public:
+  static Loaded<std::unique_ptr<NetworkDevice>> open(const NetworkDeviceSettings& settings);
+
+  std::string name() const override;
+  DeviceLimits limits() const override { return settings_.limits; }
+  /// Drains every queued datagram, keeps the newest valid pose.
+  DeviceSample read(double time) override;
+  /// Sends the wrench to the peer of the newest accepted pose (nothing before one arrived).
+  void write(const Wrench& wrench) override;
+
+  UdpEndpoint local() const { return socket_->local(); }
+  const PacketStats& stats() const { return stats_; }
+
+ private:
+  NetworkDevice(const NetworkDeviceSettings& settings, std::shared_ptr<UdpSocket> socket);
+
+  NetworkDeviceSettings settings_;
+  std::shared_ptr<UdpSocket> socket_;
+  PacketFilter filter_{PacketKind::kPose};
+  PacketStats stats_;
+  Packet newest_;
+  bool have_peer_ = false;
+  UdpEndpoint peer_;
+  double last_accepted_time_ = -1e300;  // loop clock, s
+  std::uint32_t sent_sequence_ = 0;
+};
+
+}  // namespace torsion::device

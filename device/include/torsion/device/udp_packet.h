@@ -1,0 +1,62 @@
+#pragma once
+// The network device's wire format (docs/haptics.md, "Packet format"). One UDP datagram is one
+// packet of exactly kPacketSize bytes, little-endian:
+//
+//   offset size  field
+//   0      4     magic 0x54525348 ("HSRT" in memory; reads "TRSH" as a big-endian word)
+//   4      2     version = 1
+//   6      2     kind: 1 = pose (peer -> simulation), 2 = wrench (simulation -> peer)
+//   8      4     sequence number, +1 per packet sent by that side (wraps modulo 2^32)
+//   12     4     flags: bit 0 alive (pose) / force enabled (wrench)
+//   16     8     timestamp, ns, sender's monotonic clock
+//   24     56    pose:   7 float64 px py pz (m) qw qx qy qz (unit quaternion)
+//                wrench: 6 float64 fx fy fz (N) tx ty tz (N m), then 8 bytes zero
+//   80     4     pose: buttons (bit k = button k+1); wrench: sequence of the newest pose received
+//   84     4     reserved, zero
+//   88     4     checksum: FNV-1a 32 of bytes 0..87
+//
+// decodePacket classifies what arrives; NetworkDevice counts every kind of rejection.
+
+#include <array>
+#include <cstddef>
+#include <cstdint>
+
+#include "torsion/device/device_types.h"
+
+namespace torsion::device {
+
+inline constexpr std::size_t kPacketSize = 92;
+inline constexpr std::uint32_t kPacketMagic = 0x54525348;
+inline constexpr std::uint16_t kPacketVersion = 1;
+
+enum class PacketKind : std::uint16_t { kPose = 1, kWrench = 2 };
+
+struct Packet {
+  PacketKind kind = PacketKind::kPose;
+  std::uint32_t sequence = 0;
+  bool flag = false;  ///< pose: device alive; wrench: force enabled
+  std::uint64_t timestamp_ns = 0;
+  Pose pose;                        ///< kind pose
+  Wrench wrench;                    ///< kind wrench
+  std::uint32_t buttons = 0;        ///< kind pose
+  std::uint32_t echo_sequence = 0;  ///< kind wrench
+};
+
+enum class PacketError {
+  kNone,
+  kTruncated,  ///< not exactly kPacketSize bytes
+  kMalformed,  ///< bad magic, version, kind or checksum; non-finite numbers; not a unit quaternion
+};
+
+using PacketBytes = std::array<unsigned char, kPacketSize>;
+
+PacketBytes encodePacket(const Packet& packet);
+/// Decodes `size` bytes; `out` is only meaningful when the result is kNone.
+PacketError decodePacket(const unsigned char* bytes, std::size_t size, Packet& out);
+
+/// Serial-number order of sequence numbers (RFC 1982): true when b comes after a.
+inline bool sequenceAfter(std::uint32_t b, std::uint32_t a) {
+  return static_cast<std::int32_t>(b - a) > 0;
+}
+
+}  // namespace torsion::device

@@ -1,0 +1,190 @@
+#include "torsion/device/haptic_loop.h"
+
+#include <time.h>
+
+#include <cmath>
+#include <fstream>
+
+#include "torsion/device/pose_math.h"
+
+namespace torsion::device {
+
+namespace {
+
+constexpr std::uint32_t kButton1 = 1u << 0;  // grab, force on (report section 5.4)
+constexpr std::uint32_t kButton2 = 1u << 1;  // release, force off
+
+double monotonicSeconds() {
+  timespec ts{};
+  clock_gettime(CLOCK_MONOTONIC, &ts);
+  return static_cast<double>(ts.tv_sec) + 1e-9 * static_cast<double>(ts.tv_nsec);
+}
+
+// Sleeps until the absolute monotonic time `seconds` (no drift from relative sleeps).
+void sleepUntil(double seconds) {
+  timespec ts{};
+  ts.tv_sec = static_cast<time_t>(std::floor(seconds));
+  ts.tv_nsec = static_cast<long>((seconds - std::floor(seconds)) * 1e9);
+  if (ts.tv_nsec >= 1000000000L) {
+    ts.tv_sec += 1;
+    ts.tv_nsec -= 1000000000L;
+  }
+  while (clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &ts, nullptr) == EINTR) {
+  }
+}
+
+}  // namespace
+
+std::string HapticLoopSettings::validate() const {
+  if (!(rate_hz > 0 && rate_hz <= 20000)) return "rate_hz must be in (0, 20000]";
+  if (!(damper.linear >= 0) || !(damper.angular >= 0)) return "damper must be non-negative";
+  if (!(twist_cutoff_hz > 0)) return "twist_cutoff_hz must be positive";
+  return safety.validate();
+}
+
+HapticLoop::HapticLoop(HapticDevice& device, const HapticLoopSettings& settings)
+    : device_(device),
+      settings_(settings),
+      limits_(device.limits()),
+      safety_(settings.safety, limits_),
+      twist_(settings.twist_cutoff_hz) {
+  log_.reserve(settings.log_capacity);
+}
+
+HapticLoop::~HapticLoop() {
+  stop();
+}
+
+void HapticLoop::tick(double now, double deadline) {
+  ++tick_;
+  const double dt = have_previous_ ? now - previous_time_ : 1.0 / settings_.rate_hz;
+
+  // 1-2. device and buttons (rising edges only)
+  const DeviceSample sample = device_.read(now);
+  const std::uint32_t pressed = sample.alive ? sample.buttons & ~previous_buttons_ : 0;
+  if (sample.alive) previous_buttons_ = sample.buttons;
+  if (pressed & kButton1) {
+    ++grab_requests_;
+    force_enabled_ = true;
+  }
+  if (pressed & kButton2) {
+    ++release_requests_;
+    force_enabled_ = false;
+  }
+  const double* twist = twist_.update(sample.pose, now);
+
+  // 3. command for the simulation
+  HandCommand command;
+  command.tick = tick_;
+  command.time = now;
+  command.pose = sample.pose;
+  command.alive = sample.alive;
+  command.grab_requests = grab_requests_;
+  command.release_requests = release_requests_;
+  commands_.write(command);
+
+  // 4. newest simulation wrench and the local model around it
+  const bool fresh = wrenches_.read(simulated_);
+  if (fresh) last_fresh_time_ = now;
+  const bool published = simulated_.step > 0;
+  Wrench desired;
+  if (published && simulated_.grabbed) {
+    desired = renderLocalModel(simulated_, sample.pose, twist, settings_.damper);
+  }
+  if (!isFinite(desired)) {
+    ++stats_.nonfinite;
+    desired = Wrench{};
+  }
+
+  // 5. safety, then the device
+  SafetyInputs inputs;
+  inputs.device_alive = sample.alive;
+  inputs.simulation_fresh = published && now - last_fresh_time_ <= settings_.safety.stale_after;
+  inputs.grabbed = force_enabled_ && simulated_.grabbed;
+  const Wrench output = safety_.apply(desired, inputs, dt);
+  device_.write(output);
+
+  // 6. log
+  if (settings_.log_capacity > 0) {
+    if (log_.size() < settings_.log_capacity) {
+      LoopLogRow row;
+      row.tick = tick_;
+      row.time = now;
+      row.period = dt;
+      row.lateness = now - deadline;
+      row.pose = sample.pose;
+      row.buttons = sample.buttons;
+      row.alive = sample.alive;
+      row.output = output;
+      row.simulated = simulated_.wrench;
+      row.sim_step = simulated_.step;
+      row.wrench_age = published ? now - last_fresh_time_ : 0;
+      row.pose_lag_ticks =
+          published ? static_cast<std::int64_t>(tick_ - simulated_.command_tick) : -1;
+      row.grabbed = inputs.grabbed;
+      row.fresh = fresh;
+      log_.push_back(row);
+    } else {
+      ++stats_.log_dropped;
+    }
+  }
+  have_previous_ = true;
+  previous_time_ = now;
+  ++stats_.ticks;
+}
+
+void HapticLoop::start() {
+  if (thread_.joinable()) return;
+  stop_requested_ = false;
+  thread_ = std::thread([this] { run(); });
+}
+
+void HapticLoop::stop() {
+  if (!thread_.joinable()) return;
+  stop_requested_ = true;
+  thread_.join();
+  device_.write(Wrench{});
+}
+
+void HapticLoop::run() {
+  const double period = 1.0 / settings_.rate_hz;
+  const double origin = monotonicSeconds();
+  double deadline = 0;
+  while (!stop_requested_.load(std::memory_order_relaxed)) {
+    deadline += period;
+    sleepUntil(origin + deadline);
+    const double now = monotonicSeconds() - origin;
+    if (now - deadline >= period) {
+      // A whole period lost (the machine was busy): count it and skip the missed deadlines
+      // rather than firing a burst of ticks to catch up.
+      ++stats_.overruns;
+      deadline = std::floor(now / period) * period;
+    }
+    tick(now, deadline);
+  }
+}
+
+bool HapticLoop::writeLog(const std::string& path) const {
+  std::ofstream out(path);
+  if (!out) return false;
+  out.precision(10);
+  out << "tick,time,period_ms,lateness_ms,px,py,pz,qw,qx,qy,qz,buttons,alive,"
+         "fx,fy,fz,tx,ty,tz,sim_fx,sim_fy,sim_fz,sim_tx,sim_ty,sim_tz,"
+         "sim_step,wrench_age_ms,pose_lag_ticks,grabbed,fresh\n";
+  for (const LoopLogRow& r : log_) {
+    const Pose& p = r.pose;
+    const Wrench& w = r.output;
+    const Wrench& s = r.simulated;
+    out << r.tick << ',' << r.time << ',' << 1e3 * r.period << ',' << 1e3 * r.lateness << ','
+        << p.position.x << ',' << p.position.y << ',' << p.position.z << ',' << p.orientation.w
+        << ',' << p.orientation.x << ',' << p.orientation.y << ',' << p.orientation.z << ','
+        << r.buttons << ',' << r.alive << ',' << w.force.x << ',' << w.force.y << ',' << w.force.z
+        << ',' << w.torque.x << ',' << w.torque.y << ',' << w.torque.z << ',' << s.force.x << ','
+        << s.force.y << ',' << s.force.z << ',' << s.torque.x << ',' << s.torque.y << ','
+        << s.torque.z << ',' << r.sim_step << ',' << 1e3 * r.wrench_age << ',' << r.pose_lag_ticks
+        << ',' << r.grabbed << ',' << r.fresh << '\n';
+  }
+  return static_cast<bool>(out);
+}
+
+}  // namespace torsion::device

@@ -1,0 +1,75 @@
+#include "torsion/device/network_device.h"
+
+#include <chrono>
+
+namespace torsion::device {
+
+namespace {
+
+std::uint64_t monotonicNanoseconds() {
+  return static_cast<std::uint64_t>(std::chrono::duration_cast<std::chrono::nanoseconds>(
+                                        std::chrono::steady_clock::now().time_since_epoch())
+                                        .count());
+}
+
+}  // namespace
+
+Loaded<std::unique_ptr<NetworkDevice>> NetworkDevice::open(const NetworkDeviceSettings& settings) {
+  using Out = Loaded<std::unique_ptr<NetworkDevice>>;
+  if (!(settings.timeout > 0)) return Out::fail("network device: timeout must be positive");
+  auto socket = UdpSocket::open(settings.local);
+  if (!socket) return Out::fail("network device: " + socket.error);
+  return Out{std::unique_ptr<NetworkDevice>(new NetworkDevice(settings, *socket.value)), {}};
+}
+
+NetworkDevice::NetworkDevice(const NetworkDeviceSettings& settings,
+                             std::shared_ptr<UdpSocket> socket)
+    : settings_(settings), socket_(std::move(socket)) {}
+
+std::string NetworkDevice::name() const {
+  return "network(udp port " + std::to_string(socket_->local().port) + ")";
+}
+
+DeviceSample NetworkDevice::read(double time) {
+  unsigned char buffer[kPacketSize + 1];  // one spare byte: longer datagrams are seen as such
+  UdpEndpoint from;
+  long size;
+  while ((size = socket_->receive(buffer, sizeof buffer, from)) >= 0) {
+    Packet packet;
+    const std::size_t kept = std::min(static_cast<std::size_t>(size), sizeof buffer);
+    if (static_cast<std::size_t>(size) != kept) {
+      ++stats_.truncated;  // longer than any packet
+      continue;
+    }
+    if (!filter_.accept(buffer, kept, packet, stats_)) continue;
+    newest_ = packet;
+    peer_ = from;
+    have_peer_ = true;
+    last_accepted_time_ = time;
+  }
+  DeviceSample sample;
+  sample.time = time;
+  sample.pose = newest_.pose;
+  sample.buttons = newest_.buttons;
+  sample.alive = have_peer_ && newest_.flag && time - last_accepted_time_ <= settings_.timeout;
+  return sample;
+}
+
+void NetworkDevice::write(const Wrench& wrench) {
+  if (!have_peer_) return;
+  Packet packet;
+  packet.kind = PacketKind::kWrench;
+  packet.sequence = ++sent_sequence_;
+  packet.timestamp_ns = monotonicNanoseconds();
+  packet.wrench = wrench;
+  packet.flag = true;  // the loop only writes wrenches that passed its safety filter
+  packet.echo_sequence = newest_.sequence;
+  const PacketBytes bytes = encodePacket(packet);
+  if (socket_->send(peer_, bytes.data(), bytes.size())) {
+    ++stats_.sent;
+  } else {
+    ++stats_.send_failed;
+  }
+}
+
+}  // namespace torsion::device

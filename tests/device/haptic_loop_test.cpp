@@ -1,0 +1,189 @@
+#include "torsion/device/haptic_loop.h"
+
+#include <gtest/gtest.h>
+
+#include <chrono>
+#include <cstdio>
+#include <thread>
+
+#include "torsion/device/pose_math.h"
+#include "torsion/device/scripted_device.h"
+
+// The loop driven by a fake 1 kHz clock (tick(now)), with a stand-in simulation that answers
+// every `sim_every` ticks with a spring about the grab pose.
+namespace torsion::device {
+namespace {
+
+constexpr double kDt = 0.001;
+
+struct SpringSimulation {
+  double stiffness = 200;  // N/m
+  std::uint64_t step = 0;
+  void answer(HapticLoop& loop) {
+    HandCommand c;
+    loop.commands().read(c);
+    SimulationWrench w;
+    w.step = ++step;
+    w.command_tick = c.tick;
+    w.grabbed = c.grab_requests > c.release_requests;
+    w.pose = c.pose;
+    w.wrench.force = -stiffness * c.pose.position;
+    for (int k = 0; k < 3; ++k)
+      w.stiffness[7 * k] = -stiffness;
+    loop.wrenches().write(w);
+  }
+};
+
+Trajectory pushAlongX(double speed) {
+  // Button 1 at once, then a push along x at `speed` m/s for 1 s, then held.
+  return Trajectory({{0, Pose{}}, {1, Pose{{speed, 0, 0}, {}}}}, {{0, 1u}, {0.01, 0u}});
+}
+
+TEST(HapticLoop, ButtonsGrabAndReleaseAsInTheReport) {
+  ScriptedDevice device(Trajectory({{0, Pose{}}}, {{0, 0u}, {0.1, 1u}, {0.2, 0u}, {0.3, 2u}}),
+                        defaultDeviceLimits(), "buttons");
+  HapticLoop loop(device, HapticLoopSettings{});
+  HandCommand c;
+  loop.tick(0.0);
+  EXPECT_FALSE(loop.forceEnabled());
+  for (int k = 1; k <= 150; ++k)
+    loop.tick(k * kDt);
+  loop.commands().read(c);
+  EXPECT_EQ(c.grab_requests, 1u);  // held for 100 ticks: one press
+  EXPECT_EQ(c.release_requests, 0u);
+  EXPECT_TRUE(loop.forceEnabled());
+  for (int k = 151; k <= 400; ++k)
+    loop.tick(k * kDt);
+  loop.commands().read(c);
+  EXPECT_EQ(c.release_requests, 1u);
+  EXPECT_FALSE(loop.forceEnabled());
+}
+
+TEST(HapticLoop, LocalModelAndDamperBetweenSteps) {
+  SimulationWrench sim;
+  sim.pose = Pose{{0.01, 0, 0}, {}};
+  sim.wrench.force = {-2, 0, 0};
+  sim.stiffness[0] = -200;        // dFx/dx
+  sim.stiffness[6 * 5 + 5] = -4;  // dTz/dthetaz
+  const double still[6] = {};
+  const Pose moved{{0.02, 0, 0}, fromRotationVector({0, 0, 0.1})};
+  const Wrench w = renderLocalModel(sim, moved, still, CouplingDamper{});
+  EXPECT_NEAR(w.force.x, -4, 1e-12);  // -2 N - 200 N/m * 0.01 m
+  EXPECT_NEAR(w.torque.z, -0.4, 1e-12);
+  const double moving[6] = {0.5, 0, 0, 0, 0, 0};
+  const Wrench d = renderLocalModel(sim, sim.pose, moving, CouplingDamper{3, 0});
+  EXPECT_NEAR(d.force.x, -2 - 1.5, 1e-12);  // the damper opposes the velocity
+}
+
+TEST(HapticLoop, ForceOpposesThePushAndTracksTheSimulation) {
+  ScriptedDevice device(pushAlongX(0.05), defaultDeviceLimits(), "push");
+  HapticLoop loop(device, HapticLoopSettings{});
+  SpringSimulation sim;
+  for (int k = 0; k <= 1500; ++k) {
+    loop.tick(k * kDt);
+    if (k % 10 == 0) sim.answer(loop);  // a 100 Hz simulation
+  }
+  EXPECT_NEAR(device.lastWritten().force.x, -200 * 0.05, 1e-6);
+  EXPECT_EQ(loop.stats().nonfinite, 0u);
+}
+
+TEST(HapticLoop, StalledSimulationFadesWithinTheSetTime) {
+  ScriptedDevice device(pushAlongX(0.05), defaultDeviceLimits(), "stall");
+  HapticLoopSettings settings;
+  HapticLoop loop(device, settings);
+  SpringSimulation sim;
+  int k = 0;
+  for (; k <= 1500; ++k) {
+    loop.tick(k * kDt);
+    if (k % 10 == 0) sim.answer(loop);
+  }
+  ASSERT_GT(norm(device.lastWritten().force), 5.0);
+  const double stall_time = (k - 1) * kDt;  // the last answer came at or before this
+  const double deadline = stall_time + settings.safety.stale_after + settings.safety.fade_time;
+  for (; k * kDt <= deadline + 1e-9; ++k)
+    loop.tick(k * kDt);
+  EXPECT_EQ(norm(device.lastWritten().force), 0.0);
+  EXPECT_EQ(norm(device.lastWritten().torque), 0.0);
+}
+
+TEST(HapticLoop, DeadDeviceGetsZero) {
+  ScriptedDevice device(pushAlongX(0.05), defaultDeviceLimits(), "dies");
+  device.dieAt(1.2);
+  HapticLoopSettings settings;
+  HapticLoop loop(device, settings);
+  SpringSimulation sim;
+  for (int k = 0; k * kDt <= 1.2 + settings.safety.fade_time + 1e-9; ++k) {
+    loop.tick(k * kDt);
+    sim.answer(loop);  // the simulation keeps going; the device is what died
+  }
+  EXPECT_EQ(norm(device.lastWritten().force), 0.0);
+}
+
+TEST(HapticLoop, NothingPublishedOrReleasedGivesZero) {
+  ScriptedDevice device(pushAlongX(0.05), defaultDeviceLimits(), "quiet");
+  HapticLoop loop(device, HapticLoopSettings{});
+  for (int k = 0; k <= 500; ++k)
+    loop.tick(k * kDt);
+  EXPECT_EQ(norm(device.lastWritten().force), 0.0);
+}
+
+TEST(HapticLoop, ViolentMotionStaysSaturatedAndFinite) {
+  // 2 m in 10 ms against a stiff spring: the raw request is kilonewtons.
+  ScriptedDevice device(
+      Trajectory({{0, Pose{}}, {0.01, Pose{{2, 0, 0}, {}}}, {0.02, Pose{}}}, {{0, 1u}}),
+      defaultDeviceLimits(), "violent");
+  HapticLoopSettings settings;
+  settings.damper = {50, 1};
+  HapticLoop loop(device, settings);
+  SpringSimulation sim;
+  sim.stiffness = 1e5;
+  for (int k = 0; k <= 1000; ++k) {
+    loop.tick(k * kDt);
+    sim.answer(loop);
+    EXPECT_LE(norm(device.lastWritten().force), defaultDeviceLimits().max_force + 1e-9);
+    EXPECT_TRUE(isFinite(device.lastWritten()));
+  }
+}
+
+TEST(HapticLoop, LogReplaysAsTheSameMotion) {
+  const Trajectory script({{0, Pose{}},
+                           {0.2, Pose{{0.01, 0.02, 0}, fromRotationVector({0, 0.3, 0})}},
+                           {0.4, Pose{{0, 0.03, 0.01}, {}}}},
+                          {{0, 1u}, {0.1, 0u}});
+  ScriptedDevice device(script, defaultDeviceLimits(), "record");
+  HapticLoopSettings settings;
+  settings.log_capacity = 1000;
+  HapticLoop loop(device, settings);
+  for (int k = 0; k <= 400; ++k)
+    loop.tick(5.0 + k * kDt);  // any clock origin
+  const std::string path = ::testing::TempDir() + "haptic_loop_log.csv";
+  ASSERT_TRUE(loop.writeLog(path));
+  Loaded<Trajectory> replayed = loadRecordedTrajectory(path);
+  ASSERT_TRUE(replayed) << replayed.error;
+  ScriptedDevice replay(*replayed.value, defaultDeviceLimits(), "replay");
+  for (double t : {0.0, 0.05, 0.15, 0.2, 0.333, 0.4}) {
+    const DeviceSample a = replay.read(t);  // the first read starts the replay at 0
+    const Pose b = script.poseAt(t);
+    EXPECT_NEAR(norm(a.pose.position - b.position), 0, 1e-6) << t;
+    EXPECT_NEAR(norm(toRotationVector(a.pose.orientation * conjugate(b.orientation))), 0, 1e-6);
+    EXPECT_EQ(a.buttons, script.buttonsAt(t)) << t;
+  }
+  std::remove(path.c_str());
+}
+
+TEST(HapticLoop, ThreadStartsTicksAndStopsWithZeroOutput) {
+  ScriptedDevice device(pushAlongX(0.05), defaultDeviceLimits(), "thread");
+  HapticLoop loop(device, HapticLoopSettings{});
+  loop.start();
+  // No speed is asserted: only that ticks happen at all, however loaded the machine is.
+  for (int wait = 0; wait < 1000 && loop.stats().ticks < 20; ++wait) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  }
+  loop.stop();
+  EXPECT_GE(loop.stats().ticks, 20u);
+  EXPECT_EQ(norm(device.lastWritten().force), 0.0);
+  EXPECT_FALSE(loop.running());
+}
+
+}  // namespace
+}  // namespace torsion::device
