@@ -1,0 +1,87 @@
+#pragma once
+// The simulation side of the haptic coupling for one hand (DESIGN.md section 4; the report's
+// chapter 5): it turns the loop's HandCommands into Hand::grab / moveTo / release before each
+// step, and after the step publishes what the loop renders: the wrench in the device frame, the
+// device pose it belongs to and the 6x6 local stiffness K_h.
+//
+// Rendering:
+//   - internal force (default): the wrench the body exerts on the grabbed nodes, F = sum f_l,
+//     tau = sum (p_l - O) x f_l, f_l elastic + damping forces, O the device's frame origin;
+//     K_h = PatchStiffness, refreshed every `stiffness_refresh_steps` steps;
+//   - frame difference (the report's Algorithm 4): F = -E c_f (O - Center - LocalRestPosition),
+//     tau = -E c_t theta(R Orientation^-1 LocalRestOrientation^-1), with Center the grabbed
+//     nodes' rest centroid, Orientation the body's rest orientation (identity), the Local* terms
+//     captured at grab (BeginInteraction); signs chosen so the feedback opposes the displacement
+//     (the report's section 6.2). c_f in m and c_t in m^3 make E c d newtons and E c theta N m;
+//     the report's single unitless "damping coefficient" is not dimensionally consistent.
+//     K_h = diag(-E c_f, -E c_t): the rendering is linear in the pose, so the local model is exact.
+// Buttons (report section 5.4): a new button-1 request grabs at the device's frame (and the loop
+// enables force), a new button-2 request releases (force off). Simulation thread only.
+
+#include <cstdint>
+#include <string>
+
+#include "torsion/constraints/hand.h"
+#include "torsion/device/device_types.h"
+#include "torsion/haptics/device_mapping.h"
+#include "torsion/haptics/patch_stiffness.h"
+#include "torsion/result.h"
+
+namespace torsion::haptics {
+
+enum class Rendering { kInternalForce, kFrameDifference };
+const char* toString(Rendering rendering);
+
+struct CouplingSettings {
+  Rendering rendering = Rendering::kInternalForce;
+  double force_coefficient = 0.1;     ///< c_f, m (frame difference)
+  double torque_coefficient = 0.05;   ///< c_t, m^3 (frame difference)
+  int stiffness_refresh_steps = 10;   ///< internal force: K_h every this many steps; 0: K_h = 0
+  double stiffness_tolerance = 1e-3;  ///< relative CG tolerance of the K_h solves
+
+  Status validate() const;
+};
+
+class HandCoupling {
+ public:
+  /// The hand must outlive the coupling. Settings must be valid.
+  HandCoupling(Hand& hand, const DeviceMapping& mapping, const CouplingSettings& settings);
+
+  /// Before FemWorld::step(): acts on `command` (grab, release, move). `now` is the world time.
+  /// Returns an error when a requested grab found nothing to hold (the hand stays empty).
+  Status apply(const device::HandCommand& command, double now);
+  /// After the step: the wrench for the loop, in device units. `step` is the world's step count.
+  device::SimulationWrench publish(std::uint64_t step);
+
+  /// The rendered wrench of the last publish(), world frame, about the device frame's origin.
+  const Wrench& worldWrench() const { return world_wrench_; }
+  /// K_h of the last publish(), world frame.
+  const Matrix6d& worldStiffness() const { return world_stiffness_; }
+  /// The device's frame in the world (the goal given to the hand).
+  const Frame& goal() const { return goal_; }
+  Hand& hand() { return hand_; }
+  const DeviceMapping& mapping() const { return mapping_; }
+
+ private:
+  Wrench frameDifferenceWrench() const;
+
+  Hand& hand_;
+  DeviceMapping mapping_;
+  CouplingSettings settings_;
+  std::uint32_t grabs_seen_ = 0, releases_seen_ = 0;
+  std::uint64_t command_tick_ = 0;
+  device::Pose goal_pose_;
+  Frame goal_;
+  // BeginInteraction (Algorithm 3)
+  Eigen::Vector3d rest_center_ = Eigen::Vector3d::Zero();
+  Eigen::Vector3d local_rest_position_ = Eigen::Vector3d::Zero();
+  Eigen::Quaterniond local_rest_orientation_ = Eigen::Quaterniond::Identity();
+  PatchStiffness stiffness_;
+  int steps_since_refresh_ = 0;
+  bool stiffness_valid_ = false;
+  Matrix6d stiffness_cache_ = Matrix6d::Zero();
+  Matrix6d world_stiffness_ = Matrix6d::Zero();
+  Wrench world_wrench_;
+};
+
+}  // namespace torsion::haptics

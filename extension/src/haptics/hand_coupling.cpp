@@ -1,0 +1,112 @@
+#include "torsion/haptics/hand_coupling.h"
+
+#include <Eigen/Geometry>
+#include <cmath>
+
+namespace torsion::haptics {
+
+namespace {
+
+Eigen::Vector3d rotationVector(const Eigen::Quaterniond& q) {
+  const Eigen::AngleAxisd aa(q.w() < 0 ? Eigen::Quaterniond(-q.coeffs()) : q);
+  return aa.angle() * aa.axis();
+}
+
+}  // namespace
+
+const char* toString(Rendering rendering) {
+  return rendering == Rendering::kInternalForce ? "internal_force" : "frame_difference";
+}
+
+Status CouplingSettings::validate() const {
+  if (!(force_coefficient >= 0 && std::isfinite(force_coefficient)))
+    return Error{"force_coefficient must be a non-negative number (m)"};
+  if (!(torque_coefficient >= 0 && std::isfinite(torque_coefficient)))
+    return Error{"torque_coefficient must be a non-negative number (m^3)"};
+  if (stiffness_refresh_steps < 0) return Error{"stiffness_refresh_steps must be >= 0"};
+  if (!(stiffness_tolerance > 0 && stiffness_tolerance < 1))
+    return Error{"stiffness_tolerance must be in (0, 1)"};
+  return Ok{};
+}
+
+HandCoupling::HandCoupling(Hand& hand, const DeviceMapping& mapping,
+                           const CouplingSettings& settings)
+    : hand_(hand), mapping_(mapping), settings_(settings), goal_(mapping.anchor) {}
+
+Status HandCoupling::apply(const device::HandCommand& command, double now) {
+  command_tick_ = command.tick;
+  if (command.alive) {  // a dead device's pose is stale: hold the last goal
+    goal_pose_ = command.pose;
+    goal_ = mapping_.toWorld(command.pose);
+  }
+  // Counters, not edges: several presses between two steps still count once each, in order.
+  const bool release = command.release_requests != releases_seen_;
+  const bool grab = command.grab_requests != grabs_seen_;
+  releases_seen_ = command.release_requests;
+  grabs_seen_ = command.grab_requests;
+  if (release) hand_.release();
+  if (grab && !release) {
+    Result<int> grabbed = hand_.grab(goal_, now);
+    stiffness_valid_ = false;
+    steps_since_refresh_ = 0;
+    if (!grabbed) return grabbed.error();
+    // BeginInteraction: Center and Orientation from the rest state, the hand's offset from them.
+    const TetMesh& mesh = hand_.body().model().mesh();
+    rest_center_.setZero();
+    for (int node : hand_.grabbedNodes())
+      rest_center_ += mesh.restPositions()[static_cast<size_t>(node)];
+    rest_center_ /= static_cast<double>(hand_.grabbedNodes().size());
+    local_rest_position_ = goal_.origin - rest_center_;
+    local_rest_orientation_ =
+        goal_.rotation;  // HapticOrientation * Orientation^-1, Orientation = I
+    return Ok{};
+  }
+  if (hand_.grabbed()) hand_.moveTo(goal_);
+  return Ok{};
+}
+
+Wrench HandCoupling::frameDifferenceWrench() const {
+  const double e = hand_.body().model().material().youngs_modulus;
+  const Eigen::Vector3d d = goal_.origin - rest_center_ - local_rest_position_;
+  const Eigen::Vector3d theta =
+      rotationVector(goal_.rotation * local_rest_orientation_.conjugate());
+  return {-e * settings_.force_coefficient * d, -e * settings_.torque_coefficient * theta};
+}
+
+device::SimulationWrench HandCoupling::publish(std::uint64_t step) {
+  device::SimulationWrench out;
+  out.step = step;
+  out.command_tick = command_tick_;
+  out.pose = goal_pose_;
+  out.grabbed = hand_.grabbed();
+  world_wrench_ = Wrench{};
+  world_stiffness_.setZero();
+  if (!out.grabbed) return out;
+
+  if (settings_.rendering == Rendering::kInternalForce) {
+    FemBody& body = hand_.body();
+    const bool stepped = body.stepper().elasticForces().size() == body.state().positions.size();
+    if (stepped) {
+      world_wrench_ = body.groupWrench(hand_.group(), goal_.origin);
+      if (settings_.stiffness_refresh_steps > 0 &&
+          (!stiffness_valid_ || ++steps_since_refresh_ >= settings_.stiffness_refresh_steps)) {
+        stiffness_cache_ =
+            stiffness_.compute(body, hand_.group(), goal_.origin, settings_.stiffness_tolerance);
+        stiffness_valid_ = true;
+        steps_since_refresh_ = 0;
+      }
+      if (stiffness_valid_) world_stiffness_ = stiffness_cache_;
+    }
+  } else {
+    world_wrench_ = frameDifferenceWrench();
+    const double e = hand_.body().model().material().youngs_modulus;
+    world_stiffness_.topLeftCorner<3, 3>().diagonal().setConstant(-e * settings_.force_coefficient);
+    world_stiffness_.bottomRightCorner<3, 3>().diagonal().setConstant(-e *
+                                                                      settings_.torque_coefficient);
+  }
+  out.wrench = mapping_.wrenchToDevice(world_wrench_);
+  mapping_.stiffnessToDevice(world_stiffness_, out.stiffness);
+  return out;
+}
+
+}  // namespace torsion::haptics

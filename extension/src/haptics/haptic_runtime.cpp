@@ -1,0 +1,85 @@
+#include "torsion/haptics/haptic_runtime.h"
+
+#include <chrono>
+#include <cmath>
+#include <thread>
+#include <utility>
+
+namespace torsion::haptics {
+
+HapticRuntime::HapticRuntime(FemWorld& world, std::vector<HapticBinding> bindings)
+    : world_(world), bindings_(std::move(bindings)) {}
+
+void HapticRuntime::beforeStep() {
+  for (HapticBinding& b : bindings_) {
+    device::HandCommand command;
+    b.loop->commands().read(command);
+    if (command.tick == 0) continue;  // the loop has not ticked yet
+    Status applied = b.coupling->apply(command, world_.time());
+    if (!applied && warnings_.size() < 100) {
+      warnings_.push_back("t = " + std::to_string(world_.time()) +
+                          " s: grab failed: " + applied.error().message);
+    }
+  }
+}
+
+void HapticRuntime::afterStep() {
+  for (HapticBinding& b : bindings_) {
+    b.loop->wrenches().write(b.coupling->publish(static_cast<std::uint64_t>(world_.stepCount())));
+  }
+}
+
+WorldStepReport HapticRuntime::step() {
+  beforeStep();
+  WorldStepReport report = world_.step();
+  if (report.ok) afterStep();
+  return report;
+}
+
+WorldStepReport HapticRuntime::stepLockstep() {
+  // Tick k happens at k / rate: count ticks rather than add up periods, so no drift.
+  const double dt = world_.settings().solver.time_step;
+  const double rate = bindings_.empty() ? 1000 : bindings_.front().rate_hz;
+  const double end = loop_clock_ + dt;
+  while (static_cast<double>(lockstep_ticks_) / rate < end - 1e-12) {
+    const double now = static_cast<double>(lockstep_ticks_) / rate;
+    for (HapticBinding& b : bindings_)
+      b.loop->tick(now);
+    ++lockstep_ticks_;
+  }
+  loop_clock_ = end;
+  return step();
+}
+
+WorldStepReport HapticRuntime::runThreaded(
+    int steps, bool real_time, const std::function<bool(const WorldStepReport&)>& after_step) {
+  using Clock = std::chrono::steady_clock;
+  for (HapticBinding& b : bindings_)
+    b.loop->start();
+  // Give the loops a first tick so the first step sees the device.
+  for (int wait = 0; wait < 1000; ++wait) {
+    bool all = true;
+    for (HapticBinding& b : bindings_)
+      all = all && b.loop->stats().ticks > 0;
+    if (all) break;
+    std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  }
+  const auto origin = Clock::now();
+  const double start_time = world_.time();
+  WorldStepReport report;
+  for (int k = 0; k < steps; ++k) {
+    if (real_time) {
+      const double due = world_.time() - start_time;  // this step starts at simulated time `due`
+      std::this_thread::sleep_until(
+          origin + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(due)));
+    }
+    report = step();
+    if (!report.ok) break;
+    if (after_step && !after_step(report)) break;
+  }
+  for (HapticBinding& b : bindings_)
+    b.loop->stop();
+  return report;
+}
+
+}  // namespace torsion::haptics

@@ -1,0 +1,153 @@
+#include "torsion/haptics/hand_coupling.h"
+
+#include <gtest/gtest.h>
+
+#include "coupling_rig.h"
+#include "torsion/device/scripted_device.h"
+#include "torsion/haptics/haptic_runtime.h"
+
+// The simulation side of the coupling on the 2430-tet cylinder (unit: a few hundred small steps).
+namespace torsion::haptics {
+namespace {
+
+SolverSettings quasiStatic() {
+  // Steps far longer than the slowest mode (bending, about 36 s for this soft cylinder) with a
+  // direct solve: backward Euler becomes a Newton iteration on statics.
+  SolverSettings s;
+  s.time_step = 1000.0;
+  s.linear_solver = LinearSolverKind::kCholmod;
+  return s;
+}
+
+TEST(HandCoupling, ZeroAtRestAndAfterRelease) {
+  CouplingRig rig(2430, quasiStatic());
+  rig.step(device::Pose{});
+  ASSERT_TRUE(rig.published.grabbed);
+  for (int k = 0; k < 2; ++k)
+    rig.step(device::Pose{});
+  EXPECT_LT(rig.coupling->worldWrench().force.norm(), 1e-6);  // N; rest state: no strain
+  EXPECT_LT(rig.coupling->worldWrench().torque.norm(), 1e-6);
+  for (int k = 0; k < 3; ++k)
+    rig.step(displaced(0, 0.2));
+  ASSERT_GT(rig.coupling->worldWrench().force.norm(), 1.0);
+  rig.step(displaced(0, 0.2), 1, 1);  // button 2
+  EXPECT_FALSE(rig.published.grabbed);
+  EXPECT_FALSE(rig.hand->grabbed());
+  EXPECT_EQ(rig.coupling->worldWrench().force.norm(), 0.0);
+  EXPECT_EQ(rig.published.wrench.force.x, 0.0);
+  EXPECT_EQ(rig.published.stiffness[0], 0.0);
+}
+
+TEST(HandCoupling, WrenchOpposesTheDisplacementOnEveryAxis) {
+  for (Rendering rendering : {Rendering::kInternalForce, Rendering::kFrameDifference}) {
+    for (int axis = 0; axis < 6; ++axis) {
+      CouplingSettings settings;
+      settings.rendering = rendering;
+      settings.stiffness_refresh_steps = 0;  // not needed here
+      CouplingRig rig(2430, quasiStatic(), settings);
+      rig.step(device::Pose{});
+      for (double sign : {1.0, -1.0}) {
+        const double amount = sign * (axis < 3 ? 0.1 : 0.05);  // m or rad
+        for (int k = 0; k < 3; ++k)
+          rig.step(displaced(axis, amount));
+        const double w = component(rig.coupling->worldWrench(), axis);
+        EXPECT_LT(w * sign, 0) << toString(rendering) << " axis " << axis << " sign " << sign;
+        EXPECT_GT(std::abs(w), 1e-2) << toString(rendering) << " axis " << axis;
+      }
+    }
+  }
+}
+
+TEST(HandCoupling, LocalStiffnessMatchesAFiniteDifferenceOfTheSimulatedWrench) {
+  // Twist the cylinder dynamically (dt = 0.01), pause, and compare K_h with what one more
+  // simulated step gives for a small pose change along each axis, from identical replicas.
+  SolverSettings dynamic;
+  dynamic.tolerance = 1e-8;  // the difference of two solves must not drown in CG noise
+  dynamic.max_iterations = 2000;
+  auto history = [](int k) { return displaced(5, 0.1 * std::min(k, 10) / 10.0); };
+  constexpr int kSteps = 15;
+  auto replay = [&](CouplingRig& rig) {
+    for (int k = 0; k <= kSteps; ++k)
+      rig.step(history(k));
+  };
+  CouplingSettings settings;
+  settings.stiffness_refresh_steps = 1;
+  settings.stiffness_tolerance = 1e-8;
+  CouplingRig reference(2430, dynamic, settings);
+  replay(reference);
+  const Matrix6d k_h = reference.coupling->worldStiffness();  // paused here
+  reference.step(history(kSteps + 1));
+  const Wrench w0 = reference.coupling->worldWrench();
+
+  constexpr double kDelta = 1e-4;  // m or rad
+  Matrix6d finite_difference;
+  for (int axis = 0; axis < 6; ++axis) {
+    CouplingRig rig(2430, dynamic, settings);
+    replay(rig);
+    device::Pose p = history(kSteps + 1);
+    double twist[6] = {};
+    twist[axis] = kDelta;
+    p.position = p.position + device::Vec3{twist[0], twist[1], twist[2]};
+    p.orientation = device::fromRotationVector({twist[3], twist[4], twist[5]}) * p.orientation;
+    rig.step(p);
+    const Wrench w = rig.coupling->worldWrench();
+    finite_difference.col(axis) << (w.force - w0.force) / kDelta, (w.torque - w0.torque) / kDelta;
+  }
+  // Column by column: the force-per-translation and torque-per-rotation blocks carry different
+  // units, so each column is compared on its own scale.
+  for (int axis = 0; axis < 6; ++axis) {
+    const double error = (k_h.col(axis) - finite_difference.col(axis)).norm();
+    EXPECT_LT(error, 0.1 * finite_difference.col(axis).norm())
+        << "axis " << axis << "\nK_h:\n"
+        << k_h.col(axis).transpose() << "\nfinite difference:\n"
+        << finite_difference.col(axis).transpose();
+  }
+}
+
+TEST(HandCoupling, PublishesInTheDeviceFrame) {
+  CouplingSettings settings;
+  settings.rendering = Rendering::kFrameDifference;
+  CouplingRig rig(2430, quasiStatic(), settings);
+  // A device turned a quarter turn about z relative to the world: its x is the world's y.
+  DeviceMapping mapping = rig.coupling->mapping();
+  mapping.anchor.rotation = Eigen::AngleAxisd(M_PI / 2, Eigen::Vector3d::UnitZ());
+  mapping.position_scale = 10;  // 1 cm on the desk is 10 cm in the scene
+  rig.coupling = std::make_unique<HandCoupling>(*rig.hand, mapping, settings);
+  rig.step(device::Pose{});
+  rig.step(displaced(0, 0.01));  // device x = world y, 0.1 m
+  EXPECT_NEAR(rig.coupling->worldWrench().force.y(), -1e5 * 0.1 * 0.1, 1e-6);
+  EXPECT_NEAR(rig.published.wrench.force.x, -1e5 * 0.1 * 0.1, 1e-6);  // back in device x
+  EXPECT_NEAR(rig.published.wrench.force.y, 0, 1e-6);
+  // K_d = R^T K R scaled: dF_x/dx_device = -E c_f * 10.
+  EXPECT_NEAR(rig.published.stiffness[0], -1e5 * 0.1 * 10, 1e-6);
+}
+
+TEST(HapticRuntime, LockstepLoopRendersAForceOpposingThePush) {
+  // Device -> loop -> coupling -> world -> coupling -> loop -> device, on a simulated clock.
+  // dt = 0.01, CG, as the twist scenes. Strong mass damping keeps this very soft cylinder (first
+  // bending period ~36 s) from ringing, so the sign of the reaction is that of statics.
+  SolverSettings solver;
+  CouplingRig rig(2430, solver, CouplingSettings{}, 50.0);
+  const device::Trajectory push({{0, device::Pose{}}, {0.5, displaced(0, 0.05)}}, {{0, 1u}});
+  device::ScriptedDevice scripted(push, device::defaultDeviceLimits(), "push");
+  device::HapticLoopSettings loop_settings;
+  loop_settings.log_capacity = 2000;
+  device::HapticLoop loop(scripted, loop_settings);
+  HapticRuntime runtime(*rig.world, {{rig.coupling.get(), &loop, 1000}});
+  for (int k = 0; k < 100; ++k)
+    ASSERT_TRUE(runtime.stepLockstep().ok);
+  EXPECT_TRUE(rig.hand->grabbed());
+  EXPECT_TRUE(runtime.warnings().empty());
+  EXPECT_LT(scripted.lastWritten().force.x, -0.1);  // N: resists the push along x
+  EXPECT_EQ(loop.stats().nonfinite, 0u);
+  // Ten loop ticks per step, and the wrench rendered is never older than one step.
+  EXPECT_EQ(loop.log().size(), 1000u);
+  for (const device::LoopLogRow& row : loop.log()) {
+    if (row.sim_step > 0) {
+      EXPECT_LE(row.wrench_age, 0.01 + 1e-9);
+    }
+  }
+}
+
+}  // namespace
+}  // namespace torsion::haptics
