@@ -12,9 +12,10 @@ cmake --build build -j"$jobs" --target torsion
 
 scene=demos/scenes/twist_cylinder_2430.json
 out=results/twist_cylinder_2430
-build/demos/torsion run "$scene" --out "$out"
+build/demos/torsion run "$scene" --out "$out" --render "$out/pictures" --render-every 100
 echo
 echo "Summary ($out/summary.json):"
 cat "$out/summary.json"
 echo
 echo "Results in $out/: summary.json, wrench.csv (force and torque on the hand and the fixed base), energy.csv, cylinder.vtk (open in ParaView)"
+echo "Pictures in $out/pictures/: frame_00000.png ... (every 100 steps; an MP4 too when ffmpeg is installed)"

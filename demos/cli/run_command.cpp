@@ -1,10 +1,12 @@
 #include "run_command.h"
 
+#include <cstdio>
 #include <iostream>
 #include <memory>
 
 #include "../scene/scene_parser.h"
 #include "../scene/scene_runner.h"
+#include "frame_recorder.h"
 #include "mesh_command.h"
 #include "progress_bar.h"
 
@@ -17,6 +19,9 @@ struct RunArguments {
   std::string out = "results";
   int steps = -1;
   int threads = -1;
+  std::string render;  // --render DIR: PNG pictures (and an MP4 with ffmpeg)
+  std::string render_size = "800x600";
+  int render_every = 10;
 };
 
 // Exit codes: 0 done and stable, 1 bad input or output error, 3 the simulation went unstable.
@@ -40,17 +45,51 @@ int run(const RunArguments& args) {
               << body->model().tetCount() << " tets\n";
   }
 
+  std::unique_ptr<render::FrameRecorder> recorder;
+  if (!args.render.empty()) {
+    render::RecorderOptions ro;
+    ro.directory = args.render;
+    ro.every = args.render_every;
+    if (std::sscanf(args.render_size.c_str(), "%dx%d", &ro.width, &ro.height) != 2) {
+      std::cerr << "error: --render-size '" << args.render_size
+                << "': expected WxH, e.g. 800x600\n";
+      return 1;
+    }
+    Result<std::unique_ptr<render::FrameRecorder>> made = render::FrameRecorder::create(ro);
+    if (!made) {
+      std::cerr << "error: --render: " << made.error().message << "\n";
+      return 1;
+    }
+    recorder = std::move(made).value();
+    if (Status drawn = recorder->capture(s, 0); !drawn) {
+      std::cerr << "error: --render: " << drawn.error().message << "\n";
+      return 1;
+    }
+  }
+
   ProgressBar bar(s.spec.name);
   scene::RunOptions options;
   options.output_directory = args.out;
   options.steps = args.steps;
-  options.progress = [&bar](int done, int total, double rate) { bar.update(done, total, rate); };
+  std::string render_error;
+  options.progress = [&](int done, int total, double rate) {
+    bar.update(done, total, rate);
+    if (recorder && render_error.empty()) {
+      Status drawn = done == total ? recorder->capture(s, rate) : recorder->onStep(s, rate);
+      if (!drawn) render_error = drawn.error().message;
+    }
+  };
   Result<scene::RunOutcome> outcome = scene::runScene(s, options);
   bar.finish();
   if (!outcome) {
     std::cerr << "error: " << outcome.error().message << "\n";
     return 1;
   }
+  if (!render_error.empty()) {
+    std::cerr << "error: --render: " << render_error << "\n";
+    return 1;
+  }
+  if (recorder) std::cerr << "pictures: " << recorder->finish(s.spec.name) << "\n";
   if (!outcome.value().stable) {
     std::cerr << "error: simulation unstable: " << outcome.value().failure << "\n"
               << "results up to the last good step are in " << args.out << "/\n";
@@ -73,6 +112,13 @@ void addRunCommand(CLI::App& app) {
   cmd->add_option("--threads", args->threads,
                   "Worker threads (default: the scene's; 0 = all cores)")
       ->check(CLI::NonNegativeNumber);
+  cmd->add_option("--render", args->render,
+                  "Also draw the scene (OSMesa) into PNG pictures in this directory, and an MP4 "
+                  "when ffmpeg is on PATH");
+  cmd->add_option("--render-size", args->render_size, "Picture size WxH")->capture_default_str();
+  cmd->add_option("--render-every", args->render_every, "Steps between pictures")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
   cmd->callback([args] { setExitCode(run(*args)); });
 }
 

@@ -1,0 +1,209 @@
+#include "frame_data.h"
+
+#include <BulletCollision/CollisionShapes/btBoxShape.h>
+#include <BulletCollision/CollisionShapes/btSphereShape.h>
+#include <BulletCollision/CollisionShapes/btStaticPlaneShape.h>
+
+#include <algorithm>
+#include <cmath>
+
+#include "torsion/fem/corotated_element.h"
+
+namespace torsion::render {
+
+namespace {
+
+Eigen::Vector3d toEigen(const btVector3& v) {
+  return {v.x(), v.y(), v.z()};
+}
+
+}  // namespace
+
+std::vector<double> tetVonMises(const FemBody& body) {
+  const FemModel& model = body.model();
+  const TetMesh& mesh = model.mesh();
+  const FemState& state = body.state();
+  const double mu = model.material().mu(), lambda = model.material().lambda();
+  std::vector<double> result(static_cast<size_t>(mesh.tetCount()));
+  for (int t = 0; t < mesh.tetCount(); ++t) {
+    const Tet& tet = mesh.tets()[static_cast<size_t>(t)];
+    std::array<Eigen::Vector3d, 4> x;
+    for (int a = 0; a < 4; ++a)
+      x[static_cast<size_t>(a)] = state.position(tet[static_cast<size_t>(a)]);
+    const Eigen::Matrix3d F =
+        deformationGradient(x, model.tetRestData()[static_cast<size_t>(t)].rest_shape_inverse);
+    const Eigen::Matrix3d R = static_cast<size_t>(t) < state.tet_rotations.size()
+                                  ? state.tet_rotations[static_cast<size_t>(t)].toRotationMatrix()
+                                  : Eigen::Matrix3d::Identity();
+    const Eigen::Matrix3d RtF = R.transpose() * F;
+    const Eigen::Matrix3d eps = 0.5 * (RtF + RtF.transpose()) - Eigen::Matrix3d::Identity();
+    const Eigen::Matrix3d s = 2 * mu * eps + lambda * eps.trace() * Eigen::Matrix3d::Identity();
+    const double vm2 = 0.5 * ((s(0, 0) - s(1, 1)) * (s(0, 0) - s(1, 1)) +
+                              (s(1, 1) - s(2, 2)) * (s(1, 1) - s(2, 2)) +
+                              (s(2, 2) - s(0, 0)) * (s(2, 2) - s(0, 0))) +
+                       3 * (s(0, 1) * s(0, 1) + s(1, 2) * s(1, 2) + s(0, 2) * s(0, 2));
+    result[static_cast<size_t>(t)] = std::sqrt(std::max(0.0, vm2));
+  }
+  return result;
+}
+
+double niceCeiling(double value) {
+  if (!(value > 0) || !std::isfinite(value)) return 1;
+  const double decade = std::pow(10.0, std::floor(std::log10(value)));
+  for (double m : {1.0, 2.0, 2.5, 5.0, 10.0}) {
+    if (m * decade >= value * (1 - 1e-12)) return m * decade;
+  }
+  return 10 * decade;
+}
+
+Eigen::Vector3d stressColour(double s) {
+  // Control points chosen for this project: lightness rises monotonically, so the map also
+  // reads in grey.
+  static const std::array<Eigen::Vector3d, 5> kStops = {
+      Eigen::Vector3d(0.16, 0.11, 0.42), Eigen::Vector3d(0.13, 0.38, 0.62),
+      Eigen::Vector3d(0.12, 0.62, 0.58), Eigen::Vector3d(0.50, 0.80, 0.32),
+      Eigen::Vector3d(0.98, 0.93, 0.30)};
+  s = std::clamp(std::isfinite(s) ? s : 0.0, 0.0, 1.0) * static_cast<double>(kStops.size() - 1);
+  const size_t i = std::min(static_cast<size_t>(s), kStops.size() - 2);
+  const double f = s - static_cast<double>(i);
+  return (1 - f) * kStops[i] + f * kStops[i + 1];
+}
+
+FrameData captureFrame(scene::BuiltScene& scene, double steps_per_second) {
+  FemWorld& world = *scene.world;
+  FrameData frame;
+  frame.title = scene.spec.name;
+  frame.time = world.time();
+  frame.step = world.stepCount();
+  frame.steps_per_second = steps_per_second;
+  frame.gravity = world.settings().gravity;
+  double stress_max = 0;
+
+  for (const auto& body_ptr : world.bodies()) {
+    const FemBody& body = *body_ptr;
+    const TetMesh& mesh = body.model().mesh();
+    const int n = mesh.nodeCount();
+    BodyDrawData d;
+    d.name = body.name();
+    d.positions.resize(static_cast<size_t>(n));
+    for (int i = 0; i < n; ++i) {
+      d.positions[static_cast<size_t>(i)] = body.state().position(i).cast<float>();
+      frame.bounds.extend(body.state().position(i));
+    }
+    std::vector<Eigen::Vector3d> normals(static_cast<size_t>(n), Eigen::Vector3d::Zero());
+    for (const Triangle& tri : mesh.surfaceTriangles()) {
+      const Eigen::Vector3d a = body.state().position(tri[0]);
+      const Eigen::Vector3d area_normal =
+          (body.state().position(tri[1]) - a).cross(body.state().position(tri[2]) - a);
+      for (int v : tri)
+        normals[static_cast<size_t>(v)] += area_normal;
+      d.triangles.push_back({tri[0], tri[1], tri[2]});
+    }
+    d.normals.resize(static_cast<size_t>(n));
+    for (int i = 0; i < n; ++i) {
+      const double len = normals[static_cast<size_t>(i)].norm();
+      d.normals[static_cast<size_t>(i)] =
+          (len > 0 ? Eigen::Vector3d(normals[static_cast<size_t>(i)] / len)
+                   : Eigen::Vector3d::UnitZ())
+              .cast<float>();
+    }
+    // Per node: volume-weighted mean of its tets' von Mises stress.
+    const std::vector<double> tet_stress = tetVonMises(body);
+    d.stress.resize(static_cast<size_t>(n));
+    for (int i = 0; i < n; ++i) {
+      double sum = 0, weight = 0;
+      for (int k = mesh.nodeTets().rowBegin(i); k < mesh.nodeTets().rowEnd(i); ++k) {
+        const int t = mesh.nodeTets().items[static_cast<size_t>(k)];
+        const double v = body.model().tetRestData()[static_cast<size_t>(t)].volume;
+        sum += v * tet_stress[static_cast<size_t>(t)];
+        weight += v;
+      }
+      d.stress[static_cast<size_t>(i)] = static_cast<float>(weight > 0 ? sum / weight : 0.0);
+    }
+    for (int i : mesh.surfaceNodes())
+      stress_max = std::max(stress_max, static_cast<double>(d.stress[static_cast<size_t>(i)]));
+    frame.bodies.push_back(std::move(d));
+  }
+
+  for (scene::SceneHand& h : scene.hands) {
+    HandDrawData d;
+    d.name = h.spec.name;
+    d.frame = h.hand->grabbed() ? h.hand->frame() : h.spec.frameAt(world.time());
+    d.holding = h.hand->grabbed();
+    // The drawn square covers the grabbed patch with a margin (or a tenth of the scene).
+    double reach = 0;
+    if (d.holding) {
+      const FemBody& body = h.hand->body();
+      for (int i : h.hand->grabbedNodes())
+        reach = std::max(reach, (body.state().position(i) - d.frame.origin).norm());
+      for (BodyDrawData& b : frame.bodies) {
+        if (b.name == body.name()) {
+          b.grabbed_nodes.insert(b.grabbed_nodes.end(), h.hand->grabbedNodes().begin(),
+                                 h.hand->grabbedNodes().end());
+        }
+      }
+    }
+    d.plane_half_size = reach > 0
+                            ? 1.3 * reach
+                            : 0.1 * (frame.bounds.isEmpty() ? 1.0 : frame.bounds.diagonal().norm());
+    frame.bounds.extend(d.frame.origin);
+    frame.hands.push_back(d);
+    const Wrench w = h.hand->wrench();
+    frame.wrenches.push_back({h.spec.name, w.force, w.torque});
+  }
+  for (scene::NodeSetHandle& s : scene.node_sets) {
+    const Wrench w = s.body->groupWrench(s.group, s.wrench_about);
+    frame.wrenches.push_back({s.name, w.force, w.torque});
+  }
+
+  for (btRigidBody* rb : world.rigidBodies()) {
+    RigidDrawData d;
+    const btTransform& t = rb->getWorldTransform();
+    d.pose.linear() = Eigen::Quaterniond(t.getRotation().w(), t.getRotation().x(),
+                                         t.getRotation().y(), t.getRotation().z())
+                          .toRotationMatrix();
+    d.pose.translation() = toEigen(t.getOrigin());
+    d.is_static = rb->getInvMass() == 0;
+    const btCollisionShape* shape = rb->getCollisionShape();
+    switch (shape->getShapeType()) {
+      case BOX_SHAPE_PROXYTYPE:
+        d.shape = RigidDrawData::Shape::kBox;
+        d.half_extents = toEigen(static_cast<const btBoxShape*>(shape)->getHalfExtentsWithMargin());
+        break;
+      case SPHERE_SHAPE_PROXYTYPE:
+        d.shape = RigidDrawData::Shape::kSphere;
+        d.radius = static_cast<const btSphereShape*>(shape)->getRadius();
+        break;
+      case STATIC_PLANE_PROXYTYPE: {
+        const auto* plane = static_cast<const btStaticPlaneShape*>(shape);
+        d.shape = RigidDrawData::Shape::kPlane;
+        d.normal = d.pose.linear() * toEigen(plane->getPlaneNormal());
+        d.offset = plane->getPlaneConstant() + d.normal.dot(d.pose.translation());
+        break;
+      }
+      default: {  // drawn as its bounding box
+        btVector3 lo, hi;
+        shape->getAabb(btTransform::getIdentity(), lo, hi);
+        d.shape = RigidDrawData::Shape::kOther;
+        d.half_extents = 0.5 * (toEigen(hi) - toEigen(lo));
+        d.pose.translation() += d.pose.linear() * (0.5 * (toEigen(hi) + toEigen(lo)));
+        break;
+      }
+    }
+    if (d.shape == RigidDrawData::Shape::kBox || d.shape == RigidDrawData::Shape::kOther) {
+      for (int c = 0; c < 8; ++c) {
+        const Eigen::Vector3d corner((c & 1) ? 1 : -1, (c & 2) ? 1 : -1, (c & 4) ? 1 : -1);
+        frame.bounds.extend(d.pose * corner.cwiseProduct(d.half_extents));
+      }
+    } else if (d.shape == RigidDrawData::Shape::kSphere) {
+      frame.bounds.extend(d.pose.translation() + Eigen::Vector3d::Constant(d.radius));
+      frame.bounds.extend(d.pose.translation() - Eigen::Vector3d::Constant(d.radius));
+    }
+    frame.rigids.push_back(d);
+  }
+  if (frame.bounds.isEmpty()) frame.bounds.extend(Eigen::Vector3d::Zero());
+  frame.stress_max = niceCeiling(stress_max);
+  return frame;
+}
+
+}  // namespace torsion::render

@@ -1,0 +1,82 @@
+#pragma once
+// What one picture shows, as plain data taken from a live scene: the surfaces of the FEM bodies
+// (positions, outward per-vertex normals, von Mises stress per vertex, grabbed nodes), the rigid
+// bodies, the hands (frame and plane), the wrenches and the HUD text. No GL here: the renderer
+// draws a FrameData, the tests perturb one (drop a body, flip normals) to prove the picture
+// comparison notices.
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+#include <array>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "scene_builder.h"
+#include "torsion/constraints/frame.h"
+
+namespace torsion::render {
+
+struct BodyDrawData {
+  std::string name;
+  std::vector<Eigen::Vector3f> positions;     ///< per node, m
+  std::vector<Eigen::Vector3f> normals;       ///< per node: area-weighted outward surface normal
+  std::vector<float> stress;                  ///< per node: von Mises stress, Pa (mean of its tets)
+  std::vector<int> grabbed_nodes;             ///< nodes held by a hand, drawn orange
+  std::vector<std::array<int, 3>> triangles;  ///< surface, counter-clockwise from outside
+};
+
+struct RigidDrawData {
+  enum class Shape { kBox, kSphere, kPlane, kOther } shape = Shape::kOther;
+  Eigen::Vector3d half_extents = Eigen::Vector3d::Zero();  ///< box, or the bounds of kOther
+  double radius = 0;                                       ///< sphere
+  Eigen::Vector3d normal = Eigen::Vector3d::UnitZ();       ///< plane: n . x = offset
+  double offset = 0;
+  Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
+  bool is_static = false;
+};
+
+struct HandDrawData {
+  std::string name;
+  Frame frame;  ///< O and R = [i j k]
+  bool holding = false;
+  double plane_half_size = 1;  ///< m, half the side of the drawn square of the plane
+};
+
+struct WrenchReadout {
+  std::string name;                                  ///< hand or node set
+  Eigen::Vector3d force = Eigen::Vector3d::Zero();   ///< N, what the body exerts on it
+  Eigen::Vector3d torque = Eigen::Vector3d::Zero();  ///< N m
+};
+
+struct FrameData {
+  std::string title;
+  double time = 0;  ///< s
+  int step = 0;
+  double steps_per_second = 0;  ///< <= 0: not shown
+  Eigen::Vector3d gravity = Eigen::Vector3d::Zero();
+  std::vector<BodyDrawData> bodies;
+  std::vector<RigidDrawData> rigids;
+  std::vector<HandDrawData> hands;
+  std::vector<WrenchReadout> wrenches;
+  double stress_max = 1;           ///< Pa, top of the colour map (bottom is 0)
+  Eigen::AlignedBox3d bounds;      ///< FEM bodies, finite rigid bodies and hand origins
+  std::vector<std::string> notes;  ///< extra HUD lines (the viewer's settings and keys)
+};
+
+/// Von Mises stress of the corotated linear material per tet, Pa: sigma = 2 mu eps +
+/// lambda tr(eps) I with eps = sym(R^T F) - I, R the tet's rotation of the last step.
+std::vector<double> tetVonMises(const FemBody& body);
+
+/// The smallest of 1, 2, 2.5, 5 times a power of ten that is >= value (> 0): a legend's top.
+double niceCeiling(double value);
+
+/// Takes a picture's worth of data from the scene as it is now. Wrenches are those of the last
+/// step (zero before the first). stress_max is niceCeiling of the largest surface value.
+FrameData captureFrame(scene::BuiltScene& scene, double steps_per_second = 0);
+
+/// The colour map of the stress: a dark-blue, teal, green, yellow ramp of increasing lightness
+/// (no orange, which marks grabbed nodes). s in [0, 1], clamped.
+Eigen::Vector3d stressColour(double s);
+
+}  // namespace torsion::render

@@ -1,0 +1,501 @@
+#include "renderer.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+
+#include "font.h"
+
+namespace torsion::render {
+
+namespace {
+
+const Eigen::Vector3d kGrabbedOrange(1.0, 0.5, 0.0);
+const Eigen::Vector3d kPlainBody(0.72, 0.74, 0.78);
+
+std::string number(double v) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.3g", std::abs(v) < 1e-12 ? 0.0 : v);
+  return buf;
+}
+
+std::string signedNumber(double v) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%+.2e", std::abs(v) < 1e-12 ? 0.0 : v);
+  return buf;
+}
+
+}  // namespace
+
+double textScale(int height, const RenderOptions& options) {
+  return std::max(1.0, std::round(height / options.pixel_scale / 360.0)) * options.pixel_scale;
+}
+
+int sceneViewportWidth(int width, int height, const RenderOptions& options) {
+  if (!options.legend || !options.stress) return width;
+  return std::max(1, width - static_cast<int>(std::lround(76 * textScale(height, options))));
+}
+
+void Renderer::draw(const FrameData& frame, const Camera& camera, int width, int height,
+                    const RenderOptions& options) {
+  const GlApi& gl = gl_;
+  const int scene_width = sceneViewportWidth(width, height, options);
+  gl.Viewport(0, 0, width, height);
+  gl.ClearColor(0.95f, 0.95f, 0.96f, 1.0f);
+  gl.Clear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
+  drawBackground();
+
+  gl.Viewport(0, 0, scene_width, height);
+  gl.MatrixMode(GL_PROJECTION);
+  const Eigen::Matrix4d projection =
+      camera.projection(static_cast<double>(scene_width) / std::max(1, height));
+  gl.LoadMatrixd(projection.data());
+  gl.MatrixMode(GL_MODELVIEW);
+  gl.LoadIdentity();
+  // A head light, up and to the left of the viewer, set in eye coordinates.
+  const GLfloat light_dir[4] = {-0.35f, 0.55f, 0.76f, 0.0f};
+  const GLfloat ambient[4] = {0.32f, 0.32f, 0.32f, 1.0f};
+  const GLfloat diffuse[4] = {0.72f, 0.72f, 0.72f, 1.0f};
+  const GLfloat none[4] = {0, 0, 0, 1};
+  gl.Lightfv(GL_LIGHT0, GL_POSITION, light_dir);
+  gl.Lightfv(GL_LIGHT0, GL_AMBIENT, none);
+  gl.Lightfv(GL_LIGHT0, GL_DIFFUSE, diffuse);
+  gl.Lightfv(GL_LIGHT0, GL_SPECULAR, none);
+  gl.LightModelfv(GL_LIGHT_MODEL_AMBIENT, ambient);
+  // One-sided on purpose: a surface whose normals point inward shows dark.
+  gl.LightModeli(GL_LIGHT_MODEL_TWO_SIDE, GL_FALSE);
+  gl.Enable(GL_LIGHT0);
+  gl.ColorMaterial(GL_FRONT_AND_BACK, GL_AMBIENT_AND_DIFFUSE);
+  gl.Materialfv(GL_FRONT_AND_BACK, GL_SPECULAR, none);
+  gl.Enable(GL_NORMALIZE);
+  gl.ShadeModel(GL_SMOOTH);
+  gl.LoadMatrixd(camera.view().data());
+
+  gl.Enable(GL_DEPTH_TEST);
+  gl.DepthFunc(GL_LEQUAL);
+  drawGround(frame, camera.up);
+  drawBodies(frame, options);
+  drawRigids(frame);
+  drawHands(frame, options);
+  gl.Viewport(0, 0, width, height);
+  drawOverlay(frame, width, height, options);
+  gl.Finish();
+}
+
+void Renderer::drawBackground() {
+  const GlApi& gl = gl_;
+  gl.Disable(GL_DEPTH_TEST);
+  gl.Disable(GL_LIGHTING);
+  gl.MatrixMode(GL_PROJECTION);
+  gl.LoadIdentity();
+  gl.MatrixMode(GL_MODELVIEW);
+  gl.LoadIdentity();
+  gl.Begin(GL_QUADS);
+  gl.Color4d(0.80, 0.84, 0.90, 1);
+  gl.Vertex2d(-1, -1);
+  gl.Vertex2d(1, -1);
+  gl.Color4d(0.97, 0.97, 0.98, 1);
+  gl.Vertex2d(1, 1);
+  gl.Vertex2d(-1, 1);
+  gl.End();
+}
+
+void Renderer::drawGround(const FrameData& frame, const Eigen::Vector3d& up) {
+  const GlApi& gl = gl_;
+  const double size = std::max(1e-3, frame.bounds.diagonal().norm());
+  const Eigen::Vector3d centre = frame.bounds.center();
+  bool has_plane = false;
+  for (const RigidDrawData& r : frame.rigids) {
+    if (r.shape != RigidDrawData::Shape::kPlane) continue;
+    has_plane = true;
+    // A checkered square around the scene's foot on the plane.
+    const Eigen::Vector3d n = r.normal.normalized();
+    const Eigen::Vector3d foot = centre - (n.dot(centre) - r.offset) * n;
+    const Eigen::Vector3d a = n.unitOrthogonal(), b = n.cross(a);
+    const int cells = 16;
+    const double half = 1.5 * size, cell = 2 * half / cells;
+    gl.Enable(GL_LIGHTING);
+    gl.Enable(GL_COLOR_MATERIAL);
+    gl.Enable(GL_POLYGON_OFFSET_FILL);
+    gl.PolygonOffset(1, 1);
+    gl.Begin(GL_QUADS);
+    gl.Normal3d(n.x(), n.y(), n.z());
+    for (int i = 0; i < cells; ++i) {
+      for (int j = 0; j < cells; ++j) {
+        const double shade = ((i + j) % 2) ? 0.78 : 0.86;
+        gl.Color4d(shade, shade, shade * 0.97, 1);
+        const Eigen::Vector3d o = foot + (-half + i * cell) * a + (-half + j * cell) * b;
+        for (const Eigen::Vector3d& p :
+             {o, Eigen::Vector3d(o + cell * a), Eigen::Vector3d(o + cell * a + cell * b),
+              Eigen::Vector3d(o + cell * b)})
+          gl.Vertex3d(p.x(), p.y(), p.z());
+      }
+    }
+    gl.End();
+    gl.Disable(GL_POLYGON_OFFSET_FILL);
+  }
+  if (has_plane) return;
+  // No ground in the scene: a faint grid below it, for orientation.
+  gl.Disable(GL_LIGHTING);
+  gl.Enable(GL_BLEND);
+  gl.BlendFunc(GL_SRC_ALPHA, GL_ONE_MINUS_SRC_ALPHA);
+  double low = 0;
+  for (int c = 0; c < 8; ++c) {
+    const Eigen::Vector3d corner((c & 1) ? frame.bounds.max().x() : frame.bounds.min().x(),
+                                 (c & 2) ? frame.bounds.max().y() : frame.bounds.min().y(),
+                                 (c & 4) ? frame.bounds.max().z() : frame.bounds.min().z());
+    low = c == 0 ? up.dot(corner) : std::min(low, up.dot(corner));
+  }
+  const Eigen::Vector3d foot = centre + (low - 0.05 * size - up.dot(centre)) * up;
+  const Eigen::Vector3d a = up.unitOrthogonal(), b = up.cross(a);
+  const int lines = 12;
+  const double half = 0.9 * size, cell = 2 * half / lines;
+  gl.Color4d(0.3, 0.35, 0.45, 0.35);
+  gl.LineWidth(1);
+  gl.Begin(GL_LINES);
+  for (int i = 0; i <= lines; ++i) {
+    for (const auto& [u, v] : {std::pair(a, b), std::pair(b, a)}) {
+      const Eigen::Vector3d p = foot + (-half + i * cell) * u - half * v;
+      const Eigen::Vector3d q = p + 2 * half * v;
+      gl.Vertex3d(p.x(), p.y(), p.z());
+      gl.Vertex3d(q.x(), q.y(), q.z());
+    }
+  }
+  gl.End();
+  gl.Disable(GL_BLEND);
+}
+
+void Renderer::drawBodies(const FrameData& frame, const RenderOptions& options) {
+  const GlApi& gl = gl_;
+  for (const BodyDrawData& body : frame.bodies) {
+    if (body.triangles.empty()) continue;
+    const size_t n = body.positions.size();
+    colours_.assign(3 * n, 0.0f);
+    for (size_t i = 0; i < n; ++i) {
+      const Eigen::Vector3d c =
+          options.stress && i < body.stress.size()
+              ? stressColour(static_cast<double>(body.stress[i]) / frame.stress_max)
+              : kPlainBody;
+      for (size_t k = 0; k < 3; ++k)
+        colours_[3 * i + k] = static_cast<float>(c[static_cast<Eigen::Index>(k)]);
+    }
+    for (int g : body.grabbed_nodes) {
+      for (size_t k = 0; k < 3; ++k)
+        colours_[3 * static_cast<size_t>(g) + k] =
+            static_cast<float>(kGrabbedOrange[static_cast<Eigen::Index>(k)]);
+    }
+    const auto* indices = reinterpret_cast<const GLuint*>(body.triangles.data());
+    const auto count = static_cast<GLsizei>(3 * body.triangles.size());
+    gl.EnableClientState(GL_VERTEX_ARRAY);
+    gl.VertexPointer(3, GL_FLOAT, sizeof(Eigen::Vector3f), body.positions.data());
+    gl.EnableClientState(GL_NORMAL_ARRAY);
+    gl.NormalPointer(GL_FLOAT, sizeof(Eigen::Vector3f), body.normals.data());
+    gl.EnableClientState(GL_COLOR_ARRAY);
+    gl.ColorPointer(3, GL_FLOAT, 0, colours_.data());
+    gl.Enable(GL_LIGHTING);
+    gl.Enable(GL_COLOR_MATERIAL);
+    gl.Enable(GL_POLYGON_OFFSET_FILL);  // the mesh lines and node points sit in front
+    gl.PolygonOffset(1, 1);
+    gl.DrawElements(GL_TRIANGLES, count, GL_UNSIGNED_INT, indices);
+    gl.Disable(GL_POLYGON_OFFSET_FILL);
+    gl.DisableClientState(GL_COLOR_ARRAY);
+    gl.DisableClientState(GL_NORMAL_ARRAY);
+    gl.Disable(GL_LIGHTING);
+    if (options.mesh_lines) {
+      gl.Enable(GL_BLEND);
+      gl.BlendFunc(GL_SRC_ALPHA, GL_ONE_MINUS_SRC_ALPHA);
+      gl.DepthMask(GL_FALSE);
+      gl.Color4d(0.05, 0.07, 0.12, 0.28);
+      gl.LineWidth(static_cast<GLfloat>(options.pixel_scale));
+      gl.PolygonMode(GL_FRONT_AND_BACK, GL_LINE);
+      gl.DrawElements(GL_TRIANGLES, count, GL_UNSIGNED_INT, indices);
+      gl.PolygonMode(GL_FRONT_AND_BACK, GL_FILL);
+      gl.DepthMask(GL_TRUE);
+      gl.Disable(GL_BLEND);
+    }
+    gl.DisableClientState(GL_VERTEX_ARRAY);
+    if (!body.grabbed_nodes.empty()) {
+      gl.PointSize(static_cast<GLfloat>(4 * options.pixel_scale));
+      gl.Color4d(kGrabbedOrange.x(), kGrabbedOrange.y(), kGrabbedOrange.z(), 1);
+      gl.Begin(GL_POINTS);
+      for (int g : body.grabbed_nodes) {
+        const Eigen::Vector3f& p = body.positions[static_cast<size_t>(g)];
+        gl.Vertex3d(static_cast<double>(p.x()), static_cast<double>(p.y()),
+                    static_cast<double>(p.z()));
+      }
+      gl.End();
+    }
+  }
+}
+
+void Renderer::drawRigids(const FrameData& frame) {
+  const GlApi& gl = gl_;
+  gl.Enable(GL_LIGHTING);
+  gl.Enable(GL_COLOR_MATERIAL);
+  for (const RigidDrawData& r : frame.rigids) {
+    if (r.shape == RigidDrawData::Shape::kPlane) continue;
+    if (r.is_static) {
+      gl.Color4d(0.55, 0.55, 0.58, 1);
+    } else {
+      gl.Color4d(0.78, 0.42, 0.36, 1);  // brick red: clearly not a stress colour
+    }
+    if (r.shape == RigidDrawData::Shape::kSphere) {
+      const int stacks = 16, slices = 24;
+      for (int i = 0; i < stacks; ++i) {
+        const double t0 = M_PI * i / stacks - M_PI / 2, t1 = M_PI * (i + 1) / stacks - M_PI / 2;
+        gl.Begin(GL_QUAD_STRIP);
+        for (int j = 0; j <= slices; ++j) {
+          const double phi = 2 * M_PI * j / slices;
+          for (double t : {t1, t0}) {
+            const Eigen::Vector3d n(std::cos(t) * std::cos(phi), std::cos(t) * std::sin(phi),
+                                    std::sin(t));
+            const Eigen::Vector3d wn = r.pose.linear() * n;
+            const Eigen::Vector3d p = r.pose * (r.radius * n);
+            gl.Normal3d(wn.x(), wn.y(), wn.z());
+            gl.Vertex3d(p.x(), p.y(), p.z());
+          }
+        }
+        gl.End();
+      }
+    } else {
+      gl.Begin(GL_QUADS);
+      for (int axis = 0; axis < 3; ++axis) {
+        for (int sign : {-1, 1}) {
+          Eigen::Vector3d n = Eigen::Vector3d::Zero();
+          n[axis] = sign;
+          const Eigen::Vector3d u = Eigen::Vector3d::Unit((axis + 1) % 3),
+                                v = Eigen::Vector3d::Unit((axis + 2) % 3);
+          const Eigen::Vector3d wn = r.pose.linear() * n;
+          gl.Normal3d(wn.x(), wn.y(), wn.z());
+          // Counter-clockwise seen from outside: u x v = +axis, so flip the order for -axis.
+          const double s = sign;
+          for (const auto& [cu, cv] :
+               {std::pair(-1.0, -1.0), std::pair(s, -s), std::pair(1.0, 1.0), std::pair(-s, s)}) {
+            const Eigen::Vector3d local = n + cu * u + cv * v;
+            const Eigen::Vector3d p = r.pose * local.cwiseProduct(r.half_extents);
+            gl.Vertex3d(p.x(), p.y(), p.z());
+          }
+        }
+      }
+      gl.End();
+    }
+  }
+  gl.Disable(GL_LIGHTING);
+}
+
+void Renderer::drawHands(const FrameData& frame, const RenderOptions& options) {
+  const GlApi& gl = gl_;
+  gl.Disable(GL_LIGHTING);
+  for (const HandDrawData& h : frame.hands) {
+    const Eigen::Matrix3d R = h.frame.rotation.toRotationMatrix();
+    const Eigen::Vector3d o = h.frame.origin;
+    const double s = h.plane_half_size;
+    // The plane: a translucent square spanned by i and j, and its outline.
+    gl.Enable(GL_BLEND);
+    gl.BlendFunc(GL_SRC_ALPHA, GL_ONE_MINUS_SRC_ALPHA);
+    gl.DepthMask(GL_FALSE);
+    gl.Color4d(1.0, 0.78, 0.25, h.holding ? 0.30 : 0.18);
+    const Eigen::Vector3d corners[4] = {
+        o + s * (-R.col(0) - R.col(1)), o + s * (R.col(0) - R.col(1)),
+        o + s * (R.col(0) + R.col(1)), o + s * (-R.col(0) + R.col(1))};
+    gl.Begin(GL_QUADS);
+    for (const Eigen::Vector3d& p : corners)
+      gl.Vertex3d(p.x(), p.y(), p.z());
+    gl.End();
+    gl.DepthMask(GL_TRUE);
+    gl.Color4d(0.75, 0.5, 0.05, 0.9);
+    gl.LineWidth(static_cast<GLfloat>(1.5 * options.pixel_scale));
+    gl.Begin(GL_LINE_LOOP);
+    for (const Eigen::Vector3d& p : corners)
+      gl.Vertex3d(p.x(), p.y(), p.z());
+    gl.End();
+    gl.Disable(GL_BLEND);
+    // The axes i, j, k, drawn through the body (depth test off) so the frame is always seen.
+    gl.Disable(GL_DEPTH_TEST);
+    gl.LineWidth(static_cast<GLfloat>(3 * options.pixel_scale));
+    gl.Begin(GL_LINES);
+    const double length = 0.8 * s;
+    for (int a = 0; a < 3; ++a) {
+      gl.Color4d(a == 0 ? 0.9 : 0.1, a == 1 ? 0.75 : 0.15, a == 2 ? 0.95 : 0.1, 1);
+      const Eigen::Vector3d tip = o + length * R.col(a);
+      gl.Vertex3d(o.x(), o.y(), o.z());
+      gl.Vertex3d(tip.x(), tip.y(), tip.z());
+    }
+    gl.End();
+    gl.Enable(GL_DEPTH_TEST);
+  }
+}
+
+void Renderer::quad2d(double x0, double y0, double x1, double y1) {
+  gl_.Vertex2d(x0, y0);
+  gl_.Vertex2d(x1, y0);
+  gl_.Vertex2d(x1, y1);
+  gl_.Vertex2d(x0, y1);
+}
+
+double Renderer::drawText(double x, double y, double scale, const std::string& text) {
+  gl_.Begin(GL_QUADS);
+  double pen = x;
+  for (char c : text) {
+    const auto& rows = glyph(c);
+    for (int r = 0; r < kGlyphHeight; ++r) {
+      for (int col = 0; col < kGlyphWidth; ++col) {
+        if (rows[static_cast<size_t>(r)] & (0x10 >> col)) {
+          quad2d(pen + col * scale, y + r * scale, pen + (col + 1) * scale, y + (r + 1) * scale);
+        }
+      }
+    }
+    pen += (kGlyphWidth + 1) * scale;
+  }
+  gl_.End();
+  return pen - x;
+}
+
+void Renderer::drawOverlay(const FrameData& frame, int width, int height,
+                           const RenderOptions& options) {
+  const GlApi& gl = gl_;
+  gl.Disable(GL_DEPTH_TEST);
+  gl.Disable(GL_LIGHTING);
+  gl.Enable(GL_BLEND);
+  gl.BlendFunc(GL_SRC_ALPHA, GL_ONE_MINUS_SRC_ALPHA);
+  gl.MatrixMode(GL_PROJECTION);
+  gl.LoadIdentity();
+  gl.Ortho(0, width, height, 0, -1, 1);  // pixels, y down
+  gl.MatrixMode(GL_MODELVIEW);
+  gl.LoadIdentity();
+  const double ts = textScale(height, options);
+  const double line = (kGlyphHeight + 4) * ts;
+  const double margin = 6 * ts;
+
+  if (options.hud) {
+    std::vector<std::string> lines;
+    lines.push_back(frame.title);
+    char buf[128];
+    std::snprintf(buf, sizeof buf, "T %.3f S  STEP %d", frame.time, frame.step);
+    std::string status = buf;
+    if (frame.steps_per_second > 0) {
+      std::snprintf(buf, sizeof buf, "  %.1f STEPS/S", frame.steps_per_second);
+      status += buf;
+    }
+    lines.push_back(status);
+    const size_t text_lines = lines.size();
+    // Wrenches: a line of numbers, then bars (force and torque scaled separately).
+    const double bar_height = 3 * ts, bar_width = 60 * ts;
+    double top = margin;
+    const double panel_height =
+        static_cast<double>(text_lines) * line +
+        static_cast<double>(frame.wrenches.size()) * (2 * line + 2 * bar_height + 6 * ts) + ts;
+    double panel_width = 0;
+    for (const WrenchReadout& w : frame.wrenches) {
+      const std::string f = w.name + " F " + signedNumber(w.force.x()) + " " +
+                            signedNumber(w.force.y()) + " " + signedNumber(w.force.z()) + " N";
+      panel_width = std::max(panel_width, (kGlyphWidth + 1) * ts * static_cast<double>(f.size()));
+    }
+    for (const std::string& l : lines)
+      panel_width = std::max(panel_width, (kGlyphWidth + 1) * ts * static_cast<double>(l.size()));
+    gl.Color4d(1, 1, 1, 0.6);
+    gl.Begin(GL_QUADS);
+    quad2d(margin - 3 * ts, top - 3 * ts, margin + panel_width + 3 * ts, top + panel_height);
+    gl.End();
+    gl.Color4d(0.08, 0.1, 0.16, 1);
+    for (const std::string& l : lines) {
+      drawText(margin, top, ts, l);
+      top += line;
+    }
+    for (const WrenchReadout& w : frame.wrenches) {
+      gl.Color4d(0.08, 0.1, 0.16, 1);
+      drawText(margin, top, ts,
+               w.name + " F " + signedNumber(w.force.x()) + " " + signedNumber(w.force.y()) + " " +
+                   signedNumber(w.force.z()) + " N");
+      top += line;
+      drawText(margin, top, ts,
+               std::string(w.name.size(), ' ') + " T " + signedNumber(w.torque.x()) + " " +
+                   signedNumber(w.torque.y()) + " " + signedNumber(w.torque.z()) + " NM");
+      top += line;
+      // Bars: x, y, z side by side, each signed about its centre; force above torque.
+      for (int row = 0; row < 2; ++row) {
+        const Eigen::Vector3d& v = row == 0 ? w.force : w.torque;
+        const double scale = std::max(v.cwiseAbs().maxCoeff(), 1e-9);
+        for (int a = 0; a < 3; ++a) {
+          const double x0 = margin + a * (bar_width + 4 * ts), mid = x0 + bar_width / 2;
+          gl.Color4d(0.6, 0.62, 0.68, 0.5);
+          gl.Begin(GL_QUADS);
+          quad2d(x0, top, x0 + bar_width, top + bar_height);
+          gl.Color4d(a == 0 ? 0.85 : 0.1, a == 1 ? 0.65 : 0.15, a == 2 ? 0.9 : 0.1, 1);
+          quad2d(mid, top, mid + 0.5 * bar_width * v[a] / scale, top + bar_height);
+          gl.End();
+        }
+        top += bar_height + 2 * ts;
+      }
+      top += 2 * ts;
+    }
+    // Extra notes (the viewer's settings and keys) at the bottom left.
+    double y = height - margin - line * static_cast<double>(frame.notes.size());
+    if (!frame.notes.empty()) {
+      double w = 0;
+      for (const std::string& l : frame.notes)
+        w = std::max(w, (kGlyphWidth + 1) * ts * static_cast<double>(l.size()));
+      gl.Color4d(1, 1, 1, 0.6);
+      gl.Begin(GL_QUADS);
+      quad2d(margin - 3 * ts, y - 3 * ts, margin + w + 3 * ts, height - margin + ts);
+      gl.End();
+    }
+    gl.Color4d(0.08, 0.1, 0.16, 1);
+    for (const std::string& l : frame.notes) {
+      drawText(margin, y, ts, l);
+      y += line;
+    }
+  }
+
+  if (options.legend && options.stress && !frame.bodies.empty()) {
+    const double bar_w = 14 * ts, bar_h = 0.45 * height;
+    const double x0 = width - margin - bar_w - 48 * ts, y0 = 0.5 * (height - bar_h);
+    gl.Color4d(1, 1, 1, 0.6);
+    gl.Begin(GL_QUADS);
+    quad2d(x0 - 4 * ts, y0 - 3 * line, width - margin + 2 * ts, y0 + bar_h + 2.5 * line);
+    const int segments = 32;
+    for (int i = 0; i < segments; ++i) {
+      const double s0 = double(i) / segments, s1 = double(i + 1) / segments;
+      const Eigen::Vector3d c0 = stressColour(s0), c1 = stressColour(s1);
+      const double ya = y0 + bar_h * (1 - s0), yb = y0 + bar_h * (1 - s1);
+      gl.Color4d(c0.x(), c0.y(), c0.z(), 1);
+      gl.Vertex2d(x0, ya);
+      gl.Vertex2d(x0 + bar_w, ya);
+      gl.Color4d(c1.x(), c1.y(), c1.z(), 1);
+      gl.Vertex2d(x0 + bar_w, yb);
+      gl.Vertex2d(x0, yb);
+    }
+    gl.End();
+    gl.Color4d(0.08, 0.1, 0.16, 1);
+    // Labels in Pa, kPa or MPa so that they stay short.
+    double unit = 1;
+    const char* unit_name = "PA";
+    if (frame.stress_max >= 1e6) {
+      unit = 1e6;
+      unit_name = "MPA";
+    } else if (frame.stress_max >= 1e3) {
+      unit = 1e3;
+      unit_name = "KPA";
+    }
+    drawText(x0 - 2 * ts, y0 - 2.6 * line, ts, "VON MISES");
+    drawText(x0 - 2 * ts, y0 - 1.6 * line, ts, std::string("STRESS ") + unit_name);
+    for (int k = 0; k <= 4; ++k) {
+      const double s = k / 4.0, y = y0 + bar_h * (1 - s);
+      gl.Begin(GL_QUADS);
+      quad2d(x0 + bar_w, y - 0.5 * ts, x0 + bar_w + 3 * ts, y + 0.5 * ts);
+      gl.End();
+      drawText(x0 + bar_w + 5 * ts, y - 3.5 * ts, ts, number(s * frame.stress_max / unit));
+    }
+    // The grabbed-node swatch under the bar.
+    gl.Color4d(kGrabbedOrange.x(), kGrabbedOrange.y(), kGrabbedOrange.z(), 1);
+    gl.Begin(GL_QUADS);
+    quad2d(x0, y0 + bar_h + 0.8 * line, x0 + bar_w, y0 + bar_h + 0.8 * line + 7 * ts);
+    gl.End();
+    gl.Color4d(0.08, 0.1, 0.16, 1);
+    drawText(x0 + bar_w + 5 * ts, y0 + bar_h + 0.8 * line, ts, "GRAB");
+  }
+  gl.Disable(GL_BLEND);
+  gl.Enable(GL_DEPTH_TEST);
+}
+
+}  // namespace torsion::render

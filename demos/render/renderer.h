@@ -1,0 +1,55 @@
+#pragma once
+// Draws a FrameData with OpenGL 1.x (compatibility profile; OSMesa and any desktop driver have
+// it): lit FEM surfaces coloured by von Mises stress with their mesh lines, grabbed nodes in
+// orange (the report's Figure 4.2), rigid bodies, the ground, each hand's axes (i red, j green,
+// k blue) and plane, and an overlay with the HUD (time, steps/s, wrenches as numbers and bars)
+// and the colour legend. Knows nothing of windows or files: the caller makes a context current.
+
+#include <string>
+#include <vector>
+
+#include "camera.h"
+#include "frame_data.h"
+#include "gl_api.h"
+
+namespace torsion::render {
+
+struct RenderOptions {
+  bool mesh_lines = true;  ///< surface triangle edges over the shading (they show the twist)
+  bool stress = true;      ///< colour by stress; otherwise a plain body colour
+  bool hud = true;
+  bool legend = true;
+  double pixel_scale = 1;  ///< line widths, points and text grow by this (supersampling)
+};
+
+/// Size of one pixel of the HUD font, in framebuffer pixels.
+double textScale(int height, const RenderOptions& options);
+/// Width of the 3D view: the picture minus the legend's strip on the right. Fit cameras with
+/// the aspect sceneViewportWidth / height.
+int sceneViewportWidth(int width, int height, const RenderOptions& options);
+
+class Renderer {
+ public:
+  /// `gl` must stay valid, and its context current, while draw() runs.
+  explicit Renderer(const GlApi& gl) : gl_(gl) {}
+
+  /// Draws into the current framebuffer of width x height pixels.
+  void draw(const FrameData& frame, const Camera& camera, int width, int height,
+            const RenderOptions& options);
+
+ private:
+  void drawBackground();
+  void drawGround(const FrameData& frame, const Eigen::Vector3d& up);
+  void drawBodies(const FrameData& frame, const RenderOptions& options);
+  void drawRigids(const FrameData& frame);
+  void drawHands(const FrameData& frame, const RenderOptions& options);
+  void drawOverlay(const FrameData& frame, int width, int height, const RenderOptions& options);
+  /// Text at pixel (x, y) = its top-left corner, y down; returns the width drawn.
+  double drawText(double x, double y, double scale, const std::string& text);
+  void quad2d(double x0, double y0, double x1, double y1);
+
+  const GlApi& gl_;
+  std::vector<float> colours_;  // scratch: per-vertex RGB of the body being drawn
+};
+
+}  // namespace torsion::render
