@@ -37,6 +37,7 @@ FemBody::FemBody(std::string name, std::shared_ptr<const FemModel> model,
   soft_body_->updateNodeTree(false, false);
   soft_body_->updateBounds();
   soft_body_->updateNormals();
+  contacts_ = std::make_unique<RigidContactSolver>(model_, soft_body_.get());
 }
 
 FemBody::~FemBody() = default;
@@ -56,6 +57,12 @@ void FemBody::releaseGroup(int group) {
 
 Wrench FemBody::groupWrench(int group, const Eigen::Vector3d& point) {
   return groups_[static_cast<size_t>(group)]->wrenchOn(stepper_.internalForces(), state_, point);
+}
+
+void FemBody::setVelocity(const Eigen::Vector3d& velocity) {
+  for (int i = 0; i < model_->nodeCount(); ++i)
+    state_.velocities.segment<3>(3 * i) = velocity;
+  writeBack();
 }
 
 void FemBody::setGravity(const Eigen::Vector3d& gravity) {
@@ -81,14 +88,24 @@ void FemBody::predict(double dt) {
   sb.updateBounds();
   sb.m_rcontacts.resizeNoInitialize(0);
   sb.m_scontacts.resizeNoInitialize(0);
+  contacts_->beginStep(dt);
 }
 
 const StepReport& FemBody::advance(double now, double dt) {
   constraints_.reset(model_->nodeCount());
   for (const auto& group : groups_)
     group->prescribe(now + dt, dt, state_, constraints_);
-  // Contacts with rigid bodies (btSoftBody::m_rcontacts) will prescribe normal velocities here.
+  // Contacts with rigid bodies: unilateral constraints in the same projected solve.
+  if (contacts_->detect(state_, constraints_, dt)) {
+    stepper_.setLinearSolveHook(
+        [this](const SystemOperator& op, const NodeConstraints& c, const Eigen::VectorXd& b,
+               const SolverSettings& s,
+               Eigen::VectorXd& v) { return contacts_->solve(op, c, b, s, v); });
+  } else {
+    stepper_.setLinearSolveHook({});
+  }
   last_report_ = stepper_.step(state_, constraints_, external_forces_);
+  if (!isFatal(last_report_.health)) contacts_->finish();
   if (!isFatal(last_report_.health)) writeBack();
   return last_report_;
 }

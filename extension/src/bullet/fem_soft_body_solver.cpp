@@ -32,7 +32,11 @@ void FemSoftBodySolver::updateSoftBodies() {
 }
 
 void FemSoftBodySolver::processCollision(btSoftBody* soft, const btCollisionObjectWrapper* rigid) {
-  soft->defaultCollisionHandler(rigid);
+  // A broadphase pair: our narrow phase runs in FemBody::advance, at the rigid body's pose after
+  // Bullet's rigid integration (docs/contact.md). Bullet's own CollideSDF_RS is not used.
+  for (FemBody* body : bodies_) {
+    if (body->softBody() == soft) body->contacts().addCandidate(rigid->getCollisionObject());
+  }
 }
 
 void FemSoftBodySolver::processCollision(btSoftBody* a, btSoftBody* b) {

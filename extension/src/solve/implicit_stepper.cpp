@@ -109,7 +109,9 @@ StepReport ImplicitStepper::step(FemState& state, const NodeConstraints& constra
     velocity_next_ = state.velocities;
   }
   previous_velocities_ = state.velocities;
-  if (settings_.linear_solver == LinearSolverKind::kCholmod) {
+  if (linear_solve_hook_) {
+    report.solve = linear_solve_hook_(system_, constraints, rhs_, settings_, velocity_next_);
+  } else if (settings_.linear_solver == LinearSolverKind::kCholmod) {
     if (!cholmod_) cholmod_ = std::make_unique<CholmodSolver>();
     report.solve = cholmod_->solve(system_, constraints, rhs_, velocity_next_);
   } else {

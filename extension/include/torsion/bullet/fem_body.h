@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "torsion/constraints/carried_nodes.h"
+#include "torsion/contact/rigid_contact.h"
 #include "torsion/fem/fem_model.h"
 #include "torsion/solve/implicit_stepper.h"
 
@@ -39,6 +40,9 @@ class FemBody {
   /// The wrench the body exerts on group `group` at the end of the last step, about `point`.
   Wrench groupWrench(int group, const Eigen::Vector3d& point);
 
+  /// Sets every node's velocity (m/s), e.g. an initial velocity before the first step.
+  void setVelocity(const Eigen::Vector3d& velocity);
+
   /// Sets gravity (m/s^2) as the external force m_i g on every node.
   void setGravity(const Eigen::Vector3d& gravity);
 
@@ -50,6 +54,9 @@ class FemBody {
   const StepReport& advance(double now, double dt);
 
   const StepReport& lastReport() const { return last_report_; }
+  /// Contact with rigid bodies (docs/contact.md): candidates, settings, last step's contacts.
+  RigidContactSolver& contacts() { return *contacts_; }
+  const RigidContactSolver& contacts() const { return *contacts_; }
   ImplicitStepper& stepper() { return stepper_; }
 
  private:
@@ -63,6 +70,7 @@ class FemBody {
   Eigen::VectorXd external_forces_;
   std::vector<std::unique_ptr<CarriedNodes>> groups_;
   std::unique_ptr<btSoftBody> soft_body_;
+  std::unique_ptr<RigidContactSolver> contacts_;
   StepReport last_report_;
 };
 

@@ -16,6 +16,7 @@
 // available afterwards, linearised: f_int = f(x) - (dt + beta) K v'.
 
 #include <Eigen/Core>
+#include <functional>
 #include <memory>
 #include <string>
 #include <vector>
@@ -73,6 +74,13 @@ class ImplicitStepper {
   const Eigen::VectorXd& elasticForces() const { return elastic_forces_; }
 
   const SolverSettings& settings() const { return settings_; }
+  /// Replaces stage 4's linear solve when set: hook(system, constraints, b, v), v holding the warm
+  /// start on entry and v' on return. Contacts with rigid bodies use it (contact/rigid_contact.h):
+  /// they add unilateral constraints and rigid-body unknowns to the same projected CG.
+  using LinearSolveHook = std::function<LinearSolveReport(
+      const SystemOperator&, const NodeConstraints&, const Eigen::VectorXd&, const SolverSettings&,
+      Eigen::VectorXd&)>;
+  void setLinearSolveHook(LinearSolveHook hook) { linear_solve_hook_ = std::move(hook); }
   void setSettings(const SolverSettings& settings) { settings_ = settings; }
   const FemModel& model() const { return *model_; }
   const SystemOperator& system() const { return system_; }
@@ -87,6 +95,7 @@ class ImplicitStepper {
   SystemOperator system_;
   ProjectedCg cg_;
   std::unique_ptr<CholmodSolver> cholmod_;
+  LinearSolveHook linear_solve_hook_;
 
   Eigen::VectorXd elastic_forces_, rhs_, velocity_next_, internal_forces_, scratch_;
   Eigen::VectorXd previous_velocities_;  // v of the step before, for the CG warm start

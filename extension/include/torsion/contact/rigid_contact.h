@@ -1,0 +1,163 @@
+#pragma once
+// Two-way contact between one FEM body and Bullet's rigid bodies, resolved inside the body's
+// implicit step (docs/contact.md). Touched only by the simulation thread.
+//
+// Per step:
+//   stage 2 (Bullet's collision detection)  the broadphase pairs (soft body, collision object)
+//                                            reach addCandidate through
+//                                            FemSoftBodySolver::processCollision
+//   stage 4, before the solve (detect)       each candidate object, at its pose after Bullet's
+//                                            rigid integration, is queried against the body's
+//                                            node tree (Bullet's DBVT); surface nodes near it get
+//                                            an exact signed distance (shape_distance.h)
+//   stage 4, the solve (solve)               velocity-level unilateral constraints, one per node,
+//                                            in the projected CG: a node in contact is prescribed
+//                                            along the normal (sliding) or fully (sticking) to
+//                                            the rigid body's surface velocity; a dynamic rigid
+//                                            body's 6 velocities join the CG unknowns, so the
+//                                            exchange of momentum is implicit and exact. An
+//                                            active-set loop releases pulling contacts, adds
+//                                            penetrating ones and switches stick/slide by
+//                                            Coulomb's law (friction coefficient per pair).
+//   after the step (finish)                  dynamic rigid bodies get their new velocities and
+//                                            the pose correction dt (v_new - v_bullet)
+//
+// A node held by a hand or a node group is never moved by a contact: it pushes a dynamic rigid
+// body away (a sequential-impulse pass on the rigid body alone) and ignores static or kinematic
+// ones.
+
+#include <BulletDynamics/Dynamics/btRigidBody.h>
+#include <BulletSoftBody/btSoftBody.h>
+
+#include <Eigen/Core>
+#include <memory>
+#include <vector>
+
+#include "torsion/fem/fem_model.h"
+#include "torsion/solve/fem_state.h"
+#include "torsion/solve/node_constraints.h"
+#include "torsion/solve/projected_cg.h"
+#include "torsion/solve/system_operator.h"
+
+namespace torsion {
+
+using Vector6d = Eigen::Matrix<double, 6, 1>;
+
+struct ContactSettings {
+  /// m: an inactive contact whose predicted end-of-step gap is below -this joins the active set.
+  double activation_tolerance = 1e-6;
+  /// Active-set / friction iterations per step (each one CG solve, warm-started).
+  int max_active_set_iterations = 30;
+  /// Sequential-impulse sweeps for held nodes against dynamic rigid bodies.
+  int held_iterations = 20;
+  /// Coulomb friction coefficient of the FEM body; a pair's is this times the rigid body's
+  /// (Bullet's combination rule).
+  double friction = 1.0;
+};
+
+/// One node in contact with one rigid object during a step.
+struct NodeContact {
+  enum class State { kInactive, kSlide, kStick };
+  int node = -1;
+  int partner = -1;        ///< index into partners()
+  Eigen::Vector3d normal;  ///< unit, world, out of the rigid body
+  double gap = 0;          ///< m, signed distance at the start of the step
+  Eigen::Vector3d lever;   ///< m, contact point minus centre of mass (start of step)
+  double friction = 0;     ///< pair coefficient
+  bool held = false;       ///< the node is prescribed (hand, node group)
+  State state = State::kInactive;
+  int releases = 0;  ///< times released this step (anti-cycling: never twice)
+  Eigen::Vector3d friction_impulse = Eigen::Vector3d::Zero();  ///< N s on the node (sliding)
+  Eigen::Vector3d impulse = Eigen::Vector3d::Zero();  ///< N s, total the rigid body gave the node
+  double normal_impulse = 0;                          ///< N s, impulse . normal
+};
+
+/// A rigid object touched this step.
+struct RigidPartner {
+  const btCollisionObject* object = nullptr;
+  btRigidBody* body = nullptr;  ///< null for a plain collision object
+  bool dynamic = false;         ///< velocities solved with the body's; else prescribed
+  /// A dynamic body touching a static or kinematic one in Bullet (a box on the ground): solved
+  /// as prescribed here, its contact impulse goes to Bullet's rigid solver (one step later), which
+  /// alone knows its other contacts.
+  bool supported = false;
+  double mass = 0;
+  Eigen::Matrix3d inertia = Eigen::Matrix3d::Zero();          ///< world, kg m^2 (dynamic)
+  Eigen::Matrix3d inverse_inertia = Eigen::Matrix3d::Zero();  ///< world (dynamic)
+  Eigen::Vector3d com = Eigen::Vector3d::Zero();
+  Vector6d entry_velocity = Vector6d::Zero();  ///< (v, omega) Bullet integrated with
+  Vector6d velocity = Vector6d::Zero();        ///< (v, omega) current estimate / result
+  Vector6d impulse = Vector6d::Zero();         ///< (force, torque about com) x dt from this body
+  int unknown = -1;                            ///< offset of its 6 unknowns in the CG vector
+};
+
+struct ContactStepStats {
+  int candidates = 0;             ///< surface nodes within the detection margin
+  int active = 0;                 ///< contacts in the active set at the end of the step
+  int sticking = 0;               ///< of which sticking
+  int active_set_iterations = 0;  ///< CG solves this step
+  bool active_set_converged = true;
+  double normal_impulse = 0;   ///< N s, sum over contacts (>= 0)
+  double max_penetration = 0;  ///< m, deepest start-of-step penetration (>= 0)
+};
+
+class RigidContactSolver {
+ public:
+  RigidContactSolver(std::shared_ptr<const FemModel> model, btSoftBody* soft_body);
+
+  ContactSettings& settings() { return settings_; }
+  const ContactSettings& settings() const { return settings_; }
+
+  /// Stage 1: forgets last step's candidates.
+  void beginStep(double dt);
+  /// Stage 2: a broadphase pair with `object`.
+  void addCandidate(const btCollisionObject* object);
+  /// Stage 4, before the solve: narrow phase. `constraints` holds the node groups' prescriptions
+  /// (held nodes). Returns whether any node is near a rigid object.
+  bool detect(const FemState& state, const NodeConstraints& constraints, double dt);
+  /// The linear solve of the step with contacts (ImplicitStepper's hook).
+  LinearSolveReport solve(const SystemOperator& op, const NodeConstraints& constraints,
+                          const Eigen::VectorXd& b, const SolverSettings& settings,
+                          Eigen::VectorXd& v);
+  /// After the step: velocities and pose corrections onto dynamic rigid bodies.
+  void finish();
+
+  const std::vector<NodeContact>& contacts() const { return contacts_; }
+  const std::vector<RigidPartner>& partners() const { return partners_; }
+  const ContactStepStats& stats() const { return stats_; }
+
+ private:
+  int partnerIndex(const btCollisionObject* object);
+  void expand(const Eigen::VectorXd& q, Eigen::VectorXd& v) const;
+  void contract(const Eigen::VectorXd& y, const Eigen::VectorXd& rigid_part,
+                Eigen::VectorXd& q) const;
+  void applyOperator(const SystemOperator& op, const Eigen::VectorXd& q, Eigen::VectorXd& out);
+  void buildPreconditioner(const SystemOperator& op);
+  void precondition(const Eigen::VectorXd& r, Eigen::VectorXd& z) const;
+  LinearSolveReport conjugateGradient(const SystemOperator& op, const Eigen::VectorXd& beta,
+                                      const SolverSettings& settings, Eigen::VectorXd& q);
+  bool updateActiveSet(const Eigen::VectorXd& v, const Eigen::VectorXd& p, double dt);
+  void solveHeld(const Eigen::VectorXd& v, double dt);
+
+  std::shared_ptr<const FemModel> model_;
+  btSoftBody* soft_body_;
+  ContactSettings settings_;
+  std::vector<char> surface_;
+  std::vector<const btCollisionObject*> candidates_;
+  std::vector<RigidPartner> partners_;
+  std::vector<NodeContact> contacts_;
+  std::vector<int> node_contact_;  // per node: index into contacts_ (free nodes only) or -1
+  std::vector<std::pair<int, const btCollisionObject*>> previous_active_;  // (node, object)
+  std::vector<NodeContact::State> previous_state_;
+  const NodeConstraints* base_ = nullptr;
+  double dt_ = 0;
+  int dynamic_count_ = 0;
+  ContactStepStats stats_;
+
+  // Solve workspace.
+  std::vector<Eigen::Matrix3d> block_inverse_;
+  std::vector<Eigen::Matrix<double, 6, 6>> rigid_inverse_;
+  Eigen::VectorXd v_c_, scratch_, product_, r_, z_, p_, w_, beta_, q_, rigid_scratch_;
+};
+
+}  // namespace torsion

@@ -1,0 +1,699 @@
+#include "torsion/contact/rigid_contact.h"
+
+#include <BulletCollision/BroadphaseCollision/btDbvt.h>
+#include <BulletCollision/BroadphaseCollision/btDispatcher.h>
+#include <BulletCollision/NarrowPhaseCollision/btPersistentManifold.h>
+#include <LinearMath/btTransformUtil.h>
+
+#include <Eigen/Dense>
+#include <algorithm>
+#include <cmath>
+
+#include "torsion/contact/shape_distance.h"
+
+namespace torsion {
+
+namespace {
+
+Eigen::Vector3d toEigen(const btVector3& v) {
+  return Eigen::Vector3d(v.x(), v.y(), v.z());
+}
+btVector3 toBt(const Eigen::Vector3d& v) {
+  return btVector3(v.x(), v.y(), v.z());
+}
+Eigen::Matrix3d toEigen(const btMatrix3x3& m) {
+  Eigen::Matrix3d out;
+  for (int r = 0; r < 3; ++r)
+    for (int c = 0; c < 3; ++c)
+      out(r, c) = m[r][c];
+  return out;
+}
+
+// Velocity of the rigid point at lever r: J V = v + omega x r.
+Eigen::Vector3d pointVelocity(const Vector6d& V, const Eigen::Vector3d& r) {
+  return V.head<3>() + V.tail<3>().cross(r);
+}
+// J^T y = (y, r x y): the wrench of a point impulse y at lever r.
+Vector6d pointWrench(const Eigen::Vector3d& y, const Eigen::Vector3d& r) {
+  Vector6d w;
+  w << y, r.cross(y);
+  return w;
+}
+
+// Collects the soft body's nodes whose tree leaves overlap a volume.
+struct NodeCollector : btDbvt::ICollide {
+  explicit NodeCollector(const btSoftBody& sb) : first(&sb.m_nodes[0]) {}
+  void Process(const btDbvtNode* leaf) override {
+    nodes.push_back(static_cast<int>(static_cast<const btSoftBody::Node*>(leaf->data) - first));
+  }
+  const btSoftBody::Node* first;
+  std::vector<int> nodes;
+};
+
+// The object's pose at the start of the step. Bullet has already moved dynamic bodies by their
+// velocity (stage 3) and kinematic ones to their scripted end pose (saveKinematicState); both
+// moved by exactly integrateTransform(start, v, omega, dt), which we invert.
+btTransform startPose(const btCollisionObject& object, double dt) {
+  const btRigidBody* body = btRigidBody::upcast(&object);
+  if (body == nullptr || body->isStaticObject()) return object.getWorldTransform();
+  btTransform start;
+  btTransformUtil::integrateTransform(object.getWorldTransform(), -body->getLinearVelocity(),
+                                      -body->getAngularVelocity(), dt, start);
+  return start;
+}
+
+// Whether Bullet's contact manifolds hold `body` against a static or kinematic object.
+bool touchesStaticOrKinematic(const btRigidBody& body, btSoftBody& soft) {
+  btDispatcher* dispatcher = soft.getWorldInfo()->m_dispatcher;
+  if (dispatcher == nullptr) return false;
+  for (int m = 0; m < dispatcher->getNumManifolds(); ++m) {
+    const btPersistentManifold* manifold = dispatcher->getManifoldByIndexInternal(m);
+    const btCollisionObject* other = nullptr;
+    if (manifold->getBody0() == &body) other = manifold->getBody1();
+    if (manifold->getBody1() == &body) other = manifold->getBody0();
+    if (other == nullptr || !other->isStaticOrKinematicObject()) continue;
+    for (int c = 0; c < manifold->getNumContacts(); ++c) {
+      if (manifold->getContactPoint(c).getDistance() <= manifold->getContactProcessingThreshold())
+        return true;
+    }
+  }
+  return false;
+}
+
+}  // namespace
+
+RigidContactSolver::RigidContactSolver(std::shared_ptr<const FemModel> model, btSoftBody* soft_body)
+    : model_(std::move(model)), soft_body_(soft_body) {
+  const int n = model_->nodeCount();
+  surface_.assign(static_cast<size_t>(n), 0);
+  for (const Triangle& tri : model_->mesh().surfaceTriangles()) {
+    for (int a = 0; a < 3; ++a)
+      surface_[static_cast<size_t>(tri[static_cast<size_t>(a)])] = 1;
+  }
+  node_contact_.assign(static_cast<size_t>(n), -1);
+}
+
+void RigidContactSolver::beginStep(double /*dt*/) {
+  candidates_.clear();
+}
+
+void RigidContactSolver::addCandidate(const btCollisionObject* object) {
+  // A concave object reaches us once per overlapping triangle: keep it once.
+  if (std::find(candidates_.begin(), candidates_.end(), object) == candidates_.end())
+    candidates_.push_back(object);
+}
+
+int RigidContactSolver::partnerIndex(const btCollisionObject* object) {
+  for (size_t k = 0; k < partners_.size(); ++k) {
+    if (partners_[k].object == object) return static_cast<int>(k);
+  }
+  RigidPartner p;
+  p.object = object;
+  p.body = const_cast<btRigidBody*>(btRigidBody::upcast(object));
+  if (p.body != nullptr) {
+    p.entry_velocity << toEigen(p.body->getLinearVelocity()), toEigen(p.body->getAngularVelocity());
+    p.dynamic = !p.body->isStaticOrKinematicObject() && p.body->getInvMass() > 0;
+  }
+  p.com = toEigen(startPose(*object, dt_).getOrigin());
+  if (p.dynamic) {
+    p.mass = 1.0 / p.body->getInvMass();
+    p.inverse_inertia = toEigen(p.body->getInvInertiaTensorWorld());
+    // A zero inverse inertia component (locked rotation) has no inverse: keep it rigid.
+    Eigen::Matrix3d regular = p.inverse_inertia;
+    regular.diagonal().array() += 1e-12 * std::max(1.0, regular.norm());
+    p.inertia = regular.inverse();
+    if (touchesStaticOrKinematic(*p.body, *soft_body_)) {
+      p.dynamic = false;
+      p.supported = true;
+    }
+  }
+  p.velocity = p.entry_velocity;
+  partners_.push_back(p);
+  return static_cast<int>(partners_.size()) - 1;
+}
+
+bool RigidContactSolver::detect(const FemState& state, const NodeConstraints& constraints,
+                                double dt) {
+  // Remember last step's active contacts: they start this step active (warm active set).
+  previous_active_.clear();
+  previous_state_.clear();
+  for (const NodeContact& c : contacts_) {
+    if (c.state != NodeContact::State::kInactive && !c.held) {
+      previous_active_.emplace_back(c.node, partners_[static_cast<size_t>(c.partner)].object);
+      previous_state_.push_back(c.state);
+    }
+  }
+  for (const NodeContact& c : contacts_) {
+    if (c.node >= 0 && !c.held) node_contact_[static_cast<size_t>(c.node)] = -1;
+  }
+  contacts_.clear();
+  partners_.clear();
+  stats_ = ContactStepStats{};
+  dt_ = dt;
+  dynamic_count_ = 0;
+  if (candidates_.empty()) return false;
+
+  const btSoftBody& sb = *soft_body_;
+  const double margin = sb.getCollisionShape()->getMargin();
+  double max_node_speed = 0;
+  for (int i = 0; i < model_->nodeCount(); ++i)
+    max_node_speed = std::max(max_node_speed, state.velocity(i).norm());
+
+  for (const btCollisionObject* object : candidates_) {
+    const btCollisionShape* shape = object->getCollisionShape();
+    const btTransform transform = startPose(*object, dt);
+    const btRigidBody* body = btRigidBody::upcast(object);
+    double rigid_speed = 0;
+    btVector3 lo, hi;
+    shape->getAabb(transform, lo, hi);
+    if (body != nullptr) {
+      const double radius = 0.5 * (hi - lo).length();
+      rigid_speed = body->getLinearVelocity().length() +
+                    body->getAngularVelocity().length() * std::min(radius, 1e6);
+    }
+    // Anything that can close the gap within the step, twice over, plus the soft margin.
+    const double reach = 2 * dt * (max_node_speed + rigid_speed) + 4 * margin;
+    const btVector3 pad(reach, reach, reach);
+    NodeCollector collector(sb);
+    sb.m_ndbvt.collideTV(sb.m_ndbvt.m_root, btDbvtVolume::FromMM(lo - pad, hi + pad), collector);
+    for (int i : collector.nodes) {
+      if (!surface_[static_cast<size_t>(i)]) continue;
+      const Eigen::Vector3d x = state.position(i);
+      std::optional<SurfacePoint> sp =
+          signedDistance(*shape, transform, x, reach, -toEigen(sb.m_nodes[i].m_n));
+      if (!sp) continue;
+      const bool held = constraints.kind(i) == NodeConstraints::Kind::kFull;
+      Eigen::Vector3d rigid_v = Eigen::Vector3d::Zero();
+      if (body != nullptr) {
+        rigid_v = toEigen(body->getVelocityInLocalPoint(toBt(x) - transform.getOrigin()));
+      }
+      const double closing = std::max(0.0, -sp->normal.dot(state.velocity(i) - rigid_v));
+      if (sp->distance > 2 * dt * closing + margin) continue;
+      NodeContact c;
+      c.node = i;
+      c.partner = partnerIndex(object);
+      c.normal = sp->normal;
+      c.gap = sp->distance;
+      c.lever = x - sp->distance * sp->normal - partners_[static_cast<size_t>(c.partner)].com;
+      c.friction = settings_.friction * object->getFriction();
+      c.held = held;
+      // One contact per free node: the deepest.
+      if (!held) {
+        int& slot = node_contact_[static_cast<size_t>(i)];
+        if (slot >= 0) {
+          if (contacts_[static_cast<size_t>(slot)].gap <= c.gap) continue;
+          contacts_[static_cast<size_t>(slot)] = c;
+          continue;
+        }
+        slot = static_cast<int>(contacts_.size());
+      }
+      contacts_.push_back(c);
+    }
+  }
+  // Warm active set.
+  for (NodeContact& c : contacts_) {
+    if (c.held) continue;
+    for (size_t k = 0; k < previous_active_.size(); ++k) {
+      if (previous_active_[k].first == c.node &&
+          previous_active_[k].second == partners_[static_cast<size_t>(c.partner)].object) {
+        c.state = c.friction > 0 ? previous_state_[k] : NodeContact::State::kSlide;
+      }
+    }
+  }
+  stats_.candidates = static_cast<int>(contacts_.size());
+  return !contacts_.empty();
+}
+
+// ---- the reduced system -------------------------------------------------------------------
+// Unknowns q = (u, V): u (3n) the free node velocity components, V (6 per dynamic partner) the
+// rigid velocities. Node velocities are v = T q + v_c:
+//   free node              v_i = u_i
+//   held node              v_i = S_i u_i (= 0 for a fully prescribed node)      + prescribed
+//   sliding on partner k   v_i = P_n u_i + n n.(J_i V_k)  (the second term if k is dynamic)
+//   sticking on partner k  v_i = J_i V_k                   (if k is dynamic)
+// with v_c holding the prescribed parts (node groups, the gap closure -gap/dt along n, a static
+// or kinematic partner's surface velocity). The reduced operator is T^T A T + diag(M_k), the
+// reduced right-hand side T^T (b - A v_c) + M_k V_k(Bullet) - sum J^T f (sliding friction).
+
+void RigidContactSolver::expand(const Eigen::VectorXd& q, Eigen::VectorXd& v) const {
+  const int n = model_->nodeCount();
+  v.resize(3 * n);
+  for (int i = 0; i < n; ++i) {
+    const int ci = node_contact_[static_cast<size_t>(i)];
+    Eigen::Vector3d u = q.segment<3>(3 * i);
+    if (base_->isConstrained(i)) {
+      v.segment<3>(3 * i) = base_->filterNode(i, u);
+      continue;
+    }
+    if (ci < 0 || contacts_[static_cast<size_t>(ci)].state == NodeContact::State::kInactive) {
+      v.segment<3>(3 * i) = u;
+      continue;
+    }
+    const NodeContact& c = contacts_[static_cast<size_t>(ci)];
+    const RigidPartner& k = partners_[static_cast<size_t>(c.partner)];
+    const Eigen::Vector3d& nrm = c.normal;
+    Eigen::Vector3d vi = Eigen::Vector3d::Zero();
+    Eigen::Vector3d rigid = Eigen::Vector3d::Zero();
+    if (k.dynamic) rigid = pointVelocity(q.segment<6>(k.unknown), c.lever);
+    if (c.state == NodeContact::State::kSlide) {
+      vi = u - nrm * nrm.dot(u) + nrm * nrm.dot(rigid);
+    } else {
+      vi = rigid;
+    }
+    v.segment<3>(3 * i) = vi;
+  }
+}
+
+void RigidContactSolver::contract(const Eigen::VectorXd& y, const Eigen::VectorXd& rigid_part,
+                                  Eigen::VectorXd& q) const {
+  const int n = model_->nodeCount();
+  q.resize(3 * n + 6 * dynamic_count_);
+  q.tail(6 * dynamic_count_) = rigid_part;
+  for (int i = 0; i < n; ++i) {
+    const int ci = node_contact_[static_cast<size_t>(i)];
+    const Eigen::Vector3d yi = y.segment<3>(3 * i);
+    if (base_->isConstrained(i)) {
+      q.segment<3>(3 * i) = base_->filterNode(i, yi);
+      continue;
+    }
+    if (ci < 0 || contacts_[static_cast<size_t>(ci)].state == NodeContact::State::kInactive) {
+      q.segment<3>(3 * i) = yi;
+      continue;
+    }
+    const NodeContact& c = contacts_[static_cast<size_t>(ci)];
+    const RigidPartner& k = partners_[static_cast<size_t>(c.partner)];
+    const Eigen::Vector3d& nrm = c.normal;
+    if (c.state == NodeContact::State::kSlide) {
+      q.segment<3>(3 * i) = yi - nrm * nrm.dot(yi);
+      if (k.dynamic) q.segment<6>(k.unknown) += pointWrench(nrm * nrm.dot(yi), c.lever);
+    } else {
+      q.segment<3>(3 * i).setZero();
+      if (k.dynamic) q.segment<6>(k.unknown) += pointWrench(yi, c.lever);
+    }
+  }
+}
+
+void RigidContactSolver::applyOperator(const SystemOperator& op, const Eigen::VectorXd& q,
+                                       Eigen::VectorXd& out) {
+  expand(q, scratch_);
+  op.multiply(scratch_, product_);
+  rigid_scratch_.resize(6 * dynamic_count_);
+  for (const RigidPartner& k : partners_) {
+    if (!k.dynamic) continue;
+    const int o = k.unknown - 3 * model_->nodeCount();
+    rigid_scratch_.segment<3>(o) = k.mass * q.segment<3>(k.unknown);
+    rigid_scratch_.segment<3>(o + 3) = k.inertia * q.segment<3>(k.unknown + 3);
+  }
+  contract(product_, rigid_scratch_, out);
+}
+
+void RigidContactSolver::buildPreconditioner(const SystemOperator& op) {
+  const int n = model_->nodeCount();
+  op.diagonalBlocks(block_inverse_);
+  rigid_inverse_.assign(partners_.size(), Eigen::Matrix<double, 6, 6>::Zero());
+  for (size_t k = 0; k < partners_.size(); ++k) {
+    if (!partners_[k].dynamic) continue;
+    rigid_inverse_[k].topLeftCorner<3, 3>() = partners_[k].mass * Eigen::Matrix3d::Identity();
+    rigid_inverse_[k].bottomRightCorner<3, 3>() = partners_[k].inertia;
+  }
+  for (int i = 0; i < n; ++i) {
+    const int ci = node_contact_[static_cast<size_t>(i)];
+    if (ci < 0 || base_->isConstrained(i)) continue;
+    const NodeContact& c = contacts_[static_cast<size_t>(ci)];
+    if (c.state == NodeContact::State::kInactive ||
+        !partners_[static_cast<size_t>(c.partner)].dynamic)
+      continue;
+    // G_i^T D_i G_i with G_i = n n^T J_i (slide) or J_i (stick).
+    Eigen::Matrix<double, 3, 6> J;
+    J << Eigen::Matrix3d::Identity(), -(Eigen::Matrix3d() << 0, -c.lever.z(), c.lever.y(),
+                                        c.lever.z(), 0, -c.lever.x(), -c.lever.y(), c.lever.x(), 0)
+                                           .finished();
+    Eigen::Matrix<double, 3, 6> G = J;
+    if (c.state == NodeContact::State::kSlide) G = c.normal * (c.normal.transpose() * J);
+    rigid_inverse_[static_cast<size_t>(c.partner)] +=
+        G.transpose() * block_inverse_[static_cast<size_t>(i)] * G;
+  }
+  for (auto& block : block_inverse_)
+    block = block.inverse().eval();
+  for (size_t k = 0; k < partners_.size(); ++k) {
+    if (partners_[k].dynamic) rigid_inverse_[k] = rigid_inverse_[k].inverse().eval();
+  }
+}
+
+void RigidContactSolver::precondition(const Eigen::VectorXd& r, Eigen::VectorXd& z) const {
+  const int n = model_->nodeCount();
+  z.resize(r.size());
+  for (int i = 0; i < n; ++i) {
+    const Eigen::Vector3d zi = block_inverse_[static_cast<size_t>(i)] * r.segment<3>(3 * i);
+    const int ci = node_contact_[static_cast<size_t>(i)];
+    if (base_->isConstrained(i)) {
+      z.segment<3>(3 * i) = base_->filterNode(i, zi);
+    } else if (ci < 0 ||
+               contacts_[static_cast<size_t>(ci)].state == NodeContact::State::kInactive) {
+      z.segment<3>(3 * i) = zi;
+    } else if (contacts_[static_cast<size_t>(ci)].state == NodeContact::State::kSlide) {
+      const Eigen::Vector3d& nrm = contacts_[static_cast<size_t>(ci)].normal;
+      z.segment<3>(3 * i) = zi - nrm * nrm.dot(zi);
+    } else {
+      z.segment<3>(3 * i).setZero();
+    }
+  }
+  for (size_t k = 0; k < partners_.size(); ++k) {
+    if (!partners_[k].dynamic) continue;
+    const int o = partners_[k].unknown;
+    z.segment<6>(o) = rigid_inverse_[k] * r.segment<6>(o);
+  }
+}
+
+LinearSolveReport RigidContactSolver::conjugateGradient(const SystemOperator& op,
+                                                        const Eigen::VectorXd& beta,
+                                                        const SolverSettings& settings,
+                                                        Eigen::VectorXd& q) {
+  LinearSolveReport report;
+  const double reference = beta.norm();
+  applyOperator(op, q, w_);
+  r_ = beta - w_;
+  double residual = r_.norm();
+  if (reference == 0.0 || residual <= settings.tolerance * reference) {
+    report.relative_residual = reference > 0 ? residual / reference : 0.0;
+    report.converged = true;
+    return report;
+  }
+  precondition(r_, z_);
+  p_ = z_;
+  double rz = r_.dot(z_);
+  for (int k = 0; k < settings.max_iterations; ++k) {
+    applyOperator(op, p_, w_);
+    const double pw = p_.dot(w_);
+    if (!(pw > 0)) {
+      report.breakdown = true;
+      break;
+    }
+    const double alpha = rz / pw;
+    q += alpha * p_;
+    r_ -= alpha * w_;
+    report.iterations = k + 1;
+    residual = r_.norm();
+    if (residual <= settings.tolerance * reference) {
+      report.converged = true;
+      break;
+    }
+    precondition(r_, z_);
+    const double rz_next = r_.dot(z_);
+    p_ = z_ + (rz_next / rz) * p_;
+    rz = rz_next;
+  }
+  report.relative_residual = residual / reference;
+  if (!std::isfinite(report.relative_residual)) report.breakdown = true;
+  return report;
+}
+
+bool RigidContactSolver::updateActiveSet(const Eigen::VectorXd& v, const Eigen::VectorXd& p,
+                                         double dt) {
+  bool changed = false;
+  const std::vector<double>& mass = model_->nodeMasses();
+  // Impulses below this are CG noise: a part in 1e4 of the largest one, or a micrometre per
+  // second of the node's own momentum.
+  double largest = 0;
+  for (const NodeContact& c : contacts_) {
+    if (!c.held && c.state != NodeContact::State::kInactive)
+      largest = std::max(largest, std::abs(c.normal.dot(p.segment<3>(3 * c.node))));
+  }
+  for (NodeContact& c : contacts_) {
+    if (c.held) continue;
+    const RigidPartner& k = partners_[static_cast<size_t>(c.partner)];
+    const Eigen::Vector3d vi = v.segment<3>(3 * c.node);
+    const Eigen::Vector3d pi = p.segment<3>(3 * c.node);
+    const double noise = std::max(1e-4 * largest, 1e-6 * mass[static_cast<size_t>(c.node)]);
+    const Eigen::Vector3d rigid_v = pointVelocity(k.velocity, c.lever);
+    switch (c.state) {
+      case NodeContact::State::kInactive: {
+        const double gap_end = c.gap + dt * c.normal.dot(vi - rigid_v);
+        if (gap_end < -settings_.activation_tolerance) {
+          c.state = c.friction > 0 ? NodeContact::State::kStick : NodeContact::State::kSlide;
+          c.friction_impulse.setZero();
+          changed = true;
+        }
+        break;
+      }
+      case NodeContact::State::kStick: {
+        const double lambda = c.normal.dot(pi);
+        const Eigen::Vector3d pt = pi - c.normal * lambda;
+        if (lambda < -noise && c.releases == 0) {
+          c.state = NodeContact::State::kInactive;
+          ++c.releases;
+          changed = true;
+        } else if (pt.norm() > c.friction * std::max(lambda, 0.0) + noise) {
+          c.state = NodeContact::State::kSlide;
+          c.friction_impulse = c.friction * std::max(lambda, 0.0) * pt.normalized();
+          changed = true;
+        }
+        break;
+      }
+      case NodeContact::State::kSlide: {
+        const double lambda = c.normal.dot(pi);
+        if (lambda < -noise && c.releases == 0) {
+          c.state = NodeContact::State::kInactive;
+          ++c.releases;
+          c.friction_impulse.setZero();
+          changed = true;
+          break;
+        }
+        if (c.friction <= 0) break;
+        Eigen::Vector3d slip = vi - rigid_v;
+        slip -= c.normal * c.normal.dot(slip);
+        const double speed = slip.norm();
+        if (speed < 1e-9 || (c.friction_impulse.norm() > 0 && slip.dot(c.friction_impulse) > 0)) {
+          // At rest relative to the surface, or the friction would reverse the slip: stick.
+          c.state = NodeContact::State::kStick;
+          c.friction_impulse.setZero();
+          changed = true;
+          break;
+        }
+        const Eigen::Vector3d f = -c.friction * std::max(lambda, 0.0) * slip / speed;
+        if ((f - c.friction_impulse).norm() > 1e-3 * (f.norm() + noise)) changed = true;
+        c.friction_impulse = f;
+        break;
+      }
+    }
+  }
+  return changed;
+}
+
+LinearSolveReport RigidContactSolver::solve(const SystemOperator& op,
+                                            const NodeConstraints& constraints,
+                                            const Eigen::VectorXd& b,
+                                            const SolverSettings& settings, Eigen::VectorXd& v) {
+  base_ = &constraints;
+  const int n = model_->nodeCount();
+  const double dt = dt_;
+  dynamic_count_ = 0;
+  for (RigidPartner& k : partners_) {
+    if (!k.dynamic) continue;
+    k.unknown = 3 * n + 6 * dynamic_count_++;
+  }
+  for (RigidPartner& k : partners_)
+    k.velocity = k.entry_velocity;
+
+  LinearSolveReport total;
+  Eigen::VectorXd b_friction;
+  Eigen::VectorXd rigid_rhs(6 * dynamic_count_);
+  // Warm start: the given node velocities, Bullet's rigid velocities.
+  q_.resize(3 * n + 6 * dynamic_count_);
+  q_.head(3 * n) = v;
+  for (const RigidPartner& k : partners_) {
+    if (k.dynamic) q_.segment<6>(k.unknown) = k.entry_velocity;
+  }
+  bool converged_set = false;
+  for (int iteration = 0; iteration < settings_.max_active_set_iterations; ++iteration) {
+    // Prescribed parts v_c and the friction impulses.
+    v_c_.setZero(3 * n);
+    constraints.impose(v_c_);
+    b_friction = b;
+    for (const RigidPartner& k : partners_) {
+      if (!k.dynamic) continue;
+      const int o = k.unknown - 3 * n;
+      rigid_rhs.segment<3>(o) = k.mass * k.entry_velocity.head<3>();
+      rigid_rhs.segment<3>(o + 3) = k.inertia * k.entry_velocity.tail<3>();
+    }
+    for (const NodeContact& c : contacts_) {
+      if (c.held || c.state == NodeContact::State::kInactive) continue;
+      const RigidPartner& k = partners_[static_cast<size_t>(c.partner)];
+      // End gap gap + dt n.(v_i - J_i V) = 0: the node closes the gap relative to the rigid
+      // surface, whose velocity is an unknown (dynamic) or given (static, kinematic).
+      Eigen::Vector3d vc = c.normal * (-c.gap / dt);
+      if (!k.dynamic) {
+        const Eigen::Vector3d rigid = pointVelocity(k.entry_velocity, c.lever);
+        vc += c.state == NodeContact::State::kStick
+                  ? rigid
+                  : Eigen::Vector3d(c.normal * c.normal.dot(rigid));
+      }
+      v_c_.segment<3>(3 * c.node) = vc;
+      if (c.state == NodeContact::State::kSlide) {
+        b_friction.segment<3>(3 * c.node) += c.friction_impulse;
+        if (k.dynamic)
+          rigid_rhs.segment<6>(k.unknown - 3 * n) -= pointWrench(c.friction_impulse, c.lever);
+      }
+    }
+    op.multiply(v_c_, product_);
+    contract(b_friction - product_, rigid_rhs, beta_);
+
+    // Keep the warm start inside the reduced space (the rigid part is kept as is).
+    {
+      Eigen::VectorXd u = q_.head(3 * n);
+      for (int i = 0; i < n; ++i) {
+        const int ci = node_contact_[static_cast<size_t>(i)];
+        Eigen::Vector3d ui = u.segment<3>(3 * i);
+        if (constraints.isConstrained(i)) {
+          ui = constraints.filterNode(i, ui);
+        } else if (ci >= 0) {
+          const NodeContact& c = contacts_[static_cast<size_t>(ci)];
+          if (c.state == NodeContact::State::kSlide) ui -= c.normal * c.normal.dot(ui);
+          if (c.state == NodeContact::State::kStick) ui.setZero();
+        }
+        q_.segment<3>(3 * i) = ui;
+      }
+    }
+    buildPreconditioner(op);
+    const LinearSolveReport r = conjugateGradient(op, beta_, settings, q_);
+    total.iterations += r.iterations;
+    total.relative_residual = r.relative_residual;
+    total.converged = r.converged;
+    total.breakdown = total.breakdown || r.breakdown;
+    ++stats_.active_set_iterations;
+
+    expand(q_, v);
+    v += v_c_;
+    for (RigidPartner& k : partners_) {
+      if (k.dynamic) k.velocity = q_.segment<6>(k.unknown);
+    }
+    // Constraint impulses on the nodes: A v - b (the friction is not a constraint impulse).
+    op.multiply(v, product_);
+    product_ -= b_friction;
+    if (r.breakdown) break;
+    if (!updateActiveSet(v, product_, dt)) {
+      converged_set = true;
+      break;
+    }
+  }
+  stats_.active_set_converged = converged_set;
+
+  // Impulses, statistics, and what the rigid bodies receive.
+  for (NodeContact& c : contacts_) {
+    if (c.held) continue;
+    if (c.state == NodeContact::State::kInactive) {
+      c.impulse.setZero();
+      c.normal_impulse = 0;
+      continue;
+    }
+    const Eigen::Vector3d pi = product_.segment<3>(3 * c.node);
+    c.impulse =
+        (c.state == NodeContact::State::kStick ? pi
+                                               : Eigen::Vector3d(c.normal * c.normal.dot(pi))) +
+        (c.state == NodeContact::State::kSlide ? c.friction_impulse : Eigen::Vector3d::Zero());
+    c.normal_impulse = c.normal.dot(c.impulse);
+    RigidPartner& k = partners_[static_cast<size_t>(c.partner)];
+    k.impulse -= pointWrench(c.impulse, c.lever);
+    ++stats_.active;
+    if (c.state == NodeContact::State::kStick) ++stats_.sticking;
+    stats_.normal_impulse += std::max(0.0, c.normal_impulse);
+  }
+  solveHeld(v, dt);
+  // The linearised end-of-step gap of every contact, with the final velocities.
+  for (const NodeContact& c : contacts_) {
+    const Eigen::Vector3d rigid =
+        pointVelocity(partners_[static_cast<size_t>(c.partner)].velocity, c.lever);
+    const double gap_end = c.gap + dt * c.normal.dot(v.segment<3>(3 * c.node) - rigid);
+    stats_.max_penetration = std::max(stats_.max_penetration, -gap_end);
+  }
+  return total;
+}
+
+void RigidContactSolver::solveHeld(const Eigen::VectorXd& v, double dt) {
+  // Held nodes are kinematic: each pushes its dynamic partner away (projected Gauss-Seidel on
+  // the rigid body alone, normal impulse >= 0, Coulomb friction), never the other way round.
+  std::vector<int> held;
+  for (size_t c = 0; c < contacts_.size(); ++c) {
+    const RigidPartner& k = partners_[static_cast<size_t>(contacts_[c].partner)];
+    if (contacts_[c].held && (k.dynamic || k.supported)) held.push_back(static_cast<int>(c));
+  }
+  if (held.empty()) return;
+  std::vector<Eigen::Vector3d> accumulated(held.size(), Eigen::Vector3d::Zero());
+  for (int sweep = 0; sweep < settings_.held_iterations; ++sweep) {
+    for (size_t h = 0; h < held.size(); ++h) {
+      NodeContact& c = contacts_[static_cast<size_t>(held[h])];
+      RigidPartner& k = partners_[static_cast<size_t>(c.partner)];
+      const Eigen::Vector3d w = v.segment<3>(3 * c.node);
+      auto response = [&](const Eigen::Vector3d& dir) {
+        // dir . W dir: the rigid point's speed change along dir per unit impulse along dir.
+        return dir.dot(dir / k.mass + (k.inverse_inertia * c.lever.cross(dir)).cross(c.lever));
+      };
+      // Normal: n . J V <= n . w + gap/dt, i.e. the end gap >= 0.
+      const double bound = c.normal.dot(w) + c.gap / dt;
+      const double violation = c.normal.dot(pointVelocity(k.velocity, c.lever)) - bound;
+      double& lambda = accumulated[h].x();
+      const double lambda_new = std::max(0.0, lambda + violation / response(c.normal));
+      const double d_lambda = lambda_new - lambda;
+      lambda = lambda_new;
+      Vector6d dV;
+      const Eigen::Vector3d impulse_on_rigid = -c.normal * d_lambda;
+      dV << impulse_on_rigid / k.mass, k.inverse_inertia * c.lever.cross(impulse_on_rigid);
+      k.velocity += dV;
+      k.impulse += pointWrench(impulse_on_rigid, c.lever);
+      c.impulse -= impulse_on_rigid;
+      // Friction: remove the tangential slip within mu lambda.
+      Eigen::Vector3d slip = pointVelocity(k.velocity, c.lever) - w;
+      slip -= c.normal * c.normal.dot(slip);
+      const double s = slip.norm();
+      if (s > 0 && c.friction > 0) {
+        const Eigen::Vector3d t = slip / s;
+        Eigen::Vector3d tangential = c.impulse - c.normal * c.normal.dot(c.impulse);
+        Eigen::Vector3d target = tangential + t * (s / response(t));  // on the node
+        const double cap = c.friction * lambda;
+        if (target.norm() > cap) target *= cap / target.norm();
+        const Eigen::Vector3d change_on_rigid = -(target - tangential);
+        Vector6d dVt;
+        dVt << change_on_rigid / k.mass, k.inverse_inertia * c.lever.cross(change_on_rigid);
+        k.velocity += dVt;
+        k.impulse += pointWrench(change_on_rigid, c.lever);
+        c.impulse -= change_on_rigid;
+      }
+      c.normal_impulse = c.normal.dot(c.impulse);
+    }
+  }
+  for (size_t h = 0; h < held.size(); ++h) {
+    const NodeContact& c = contacts_[static_cast<size_t>(held[h])];
+    if (accumulated[h].x() > 0) {
+      ++stats_.active;
+      stats_.normal_impulse += std::max(0.0, c.normal_impulse);
+    }
+  }
+}
+
+void RigidContactSolver::finish() {
+  for (RigidPartner& k : partners_) {
+    if (k.supported && k.body != nullptr) {
+      // Explicit: the impulse changes the velocity only; Bullet's rigid solver meets it next
+      // step together with the body's other contacts (the ground), which alone it knows.
+      k.body->applyCentralImpulse(toBt(k.impulse.head<3>()));
+      k.body->applyTorqueImpulse(toBt(k.impulse.tail<3>()));
+      k.body->activate();
+      continue;
+    }
+    if (!k.dynamic || k.body == nullptr) continue;
+    if (k.velocity == k.entry_velocity) continue;
+    // Bullet integrated the pose with entry_velocity; the step's velocity is `velocity`
+    // (symplectic Euler with the contact impulse inside the step).
+    const Vector6d dV = k.velocity - k.entry_velocity;
+    btTransform corrected;
+    btTransformUtil::integrateTransform(k.body->getCenterOfMassTransform(), toBt(dV.head<3>()),
+                                        toBt(dV.tail<3>()), dt_, corrected);
+    k.body->setLinearVelocity(toBt(k.velocity.head<3>()));
+    k.body->setAngularVelocity(toBt(k.velocity.tail<3>()));
+    k.body->setCenterOfMassTransform(corrected);
+    if (k.body->getMotionState() != nullptr) k.body->getMotionState()->setWorldTransform(corrected);
+    k.body->activate();
+  }
+}
+
+}  // namespace torsion

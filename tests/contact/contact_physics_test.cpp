@@ -1,0 +1,285 @@
+// Contact between FEM bodies and Bullet rigid bodies: physical facts (DESIGN.md section 5,
+// "rigid coexistence"; issue 6). Meshes are coarse on purpose: each case checks the contact
+// scheme, not the FEM discretisation (docs/validation.md covers that).
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <iostream>
+
+#include "contact_fixtures.h"
+#include "torsion/contact/shape_distance.h"
+
+namespace torsion::test {
+namespace {
+
+constexpr double kGravity = 9.81;
+
+// A deformable ball dropped on rigid ground at dt = 0.01 never falls through and comes to rest.
+TEST(ContactPhysics, DroppedBallRestsOnGround) {
+  FemWorld world(contactSettings(0.01));
+  addGround(world, 0.5);
+  const double radius = 0.25;
+  Result<TetMesh> mesh = makeBallTetMesh({0, 0, 1.0}, radius, 4);
+  ASSERT_TRUE(mesh.ok()) << mesh.error().message;
+  Material m = softMaterial(5e4, 500);
+  m.mass_damping = 0.5;
+  FemBody* ball = world.addBody("ball", mesh.value(), m).value();
+
+  double lowest = 1e300;
+  for (int k = 0; k < 300; ++k) {  // 3 s: falls 0.75 m (0.39 s), bounces, settles
+    ASSERT_TRUE(world.step().ok) << "step " << k;
+    lowest = std::min(lowest, minZ(*ball));
+  }
+  // Never through the ground: the deepest node penetration over the whole run.
+  EXPECT_GT(lowest, -1e-3 * radius);
+  // At rest on it: slow, touching, the centre near one radius up (squashed by its weight).
+  EXPECT_LT(ball->lastReport().max_speed, 0.02);
+  EXPECT_LT(minZ(*ball), 1e-3 * radius);
+  const Eigen::Vector3d c = centreOfMass(*ball);
+  EXPECT_GT(c.z(), 0.8 * radius);
+  EXPECT_LT(c.z(), 1.0 * radius);
+  EXPECT_GT(ball->contacts().stats().active, 0);
+  std::cout << "[figures] ball: deepest node " << lowest << " m, centre at rest " << c.z()
+            << " m, contacts " << ball->contacts().stats().active << "\n";
+}
+
+// The vertical force a slab exerts on its top patch [-a, a]^2 held at depth `depth` below its
+// rest height (bonded, the rest of the slab free, bottom fixed), at static equilibrium: the
+// reference for the resting box (a rigid flat punch, sticking, is exactly this load case).
+// Returns (force, weight of the patch's own nodes), N.
+std::pair<double, double> punchForce(double a, double depth, const Material& m, double top,
+                                     int steps) {
+  WorldSettings s = contactSettings(0.01);
+  FemWorld world(s);
+  Material damped = m;
+  damped.mass_damping = 20;  // only the equilibrium matters
+  FemBody* slab = addBox(world, "slab", {-0.5, -0.5, 0}, {0.5, 0.5, top}, 8, 8, 2, damped);
+  std::vector<int> base, patch;
+  for (int i = 0; i < slab->model().nodeCount(); ++i) {
+    const Eigen::Vector3d x = slab->state().position(i);
+    if (x.z() < 1e-9) base.push_back(i);
+    if (x.z() > top - 1e-9 && std::abs(x.x()) <= a + 1e-9 && std::abs(x.y()) <= a + 1e-9)
+      patch.push_back(i);
+  }
+  slab->carryNodes(
+      "base", base, [](double) { return Frame{}; }, 0.0);
+  const double ramp = 0.5 * steps * s.solver.time_step;
+  const int group = slab->carryNodes(
+      "patch", patch,
+      [=](double t) {
+        Frame f;
+        f.origin.z() = -depth * std::min(1.0, t / ramp);
+        return f;
+      },
+      0.0);
+  for (int k = 0; k < steps; ++k)
+    EXPECT_TRUE(world.step().ok);
+  double patch_mass = 0;
+  for (int i : patch)
+    patch_mass += slab->model().nodeMasses()[static_cast<size_t>(i)];
+  return {slab->groupWrench(group, Eigen::Vector3d::Zero()).force.z(), patch_mass * kGravity};
+}
+
+// A rigid box resting on a deformable slab stays at rest on it, penetration within tolerance over
+// 10 s, and the slab's sag under it matches the static equilibrium within 10 %.
+TEST(ContactPhysics, BoxRestsOnSlabWithStaticSag) {
+  const double top = 0.2, a = 0.25, box_mass = 20;
+  const Material m = softMaterial(2e4, 100);
+  FemWorld world(contactSettings(0.01));
+  FemBody* slab = addBox(world, "slab", {-0.5, -0.5, 0}, {0.5, 0.5, top}, 8, 8, 2, m);
+  std::vector<int> base;
+  for (int i = 0; i < slab->model().nodeCount(); ++i) {
+    if (slab->state().position(i).z() < 1e-9) base.push_back(i);
+  }
+  slab->carryNodes(
+      "base", base, [](double) { return Frame{}; }, 0.0);
+  // The box overhangs the patch of nodes [-a, a]^2 by 2 cm: no node sits exactly under an edge.
+  btRigidBody* box =
+      world.addRigidBody(std::make_unique<btBoxShape>(btVector3(a + 0.02, a + 0.02, 0.05)),
+                         box_mass, at({0, 0, top + 0.05 + 0.02}));
+  box->setFriction(1.0);
+
+  double worst_penetration = 0;  // measured on the geometry after each step
+  for (int k = 0; k < 1000; ++k) {
+    ASSERT_TRUE(world.step().ok) << "step " << k;
+    for (int i = 0; i < slab->model().nodeCount(); ++i) {
+      auto d = signedDistance(*box->getCollisionShape(), box->getWorldTransform(),
+                              slab->state().position(i), 0);
+      if (d) worst_penetration = std::max(worst_penetration, -d->distance);
+    }
+  }
+  const Eigen::Vector3d p = toEigen(box->getCenterOfMassPosition());
+  const double sag = top - (p.z() - 0.05);
+  // At rest above the slab, centred.
+  EXPECT_LT(toEigen(box->getLinearVelocity()).norm(), 1e-3);
+  EXPECT_LT(std::hypot(p.x(), p.y()), 1e-3);
+  EXPECT_LT(worst_penetration, 1e-4);  // 0.1 mm, against a sag of millimetres
+
+  // Reference: the patch must carry the box and its own nodes' weight; the slab's elastic force
+  // on it is linear in the depth (small strain): f(d) = f0 + (f1 - f0) d / 4 mm.
+  const auto [f0, patch_weight] = punchForce(a, 0.0, m, top, 400);
+  const double f1 = punchForce(a, 0.004, m, top, 400).first;
+  const double reference = 0.004 * (box_mass * kGravity + patch_weight - f0) / (f1 - f0);
+  std::cout << "[figures] box on slab: sag " << sag << " m, reference " << reference
+            << " m, worst penetration " << worst_penetration << " m, contacts "
+            << slab->contacts().stats().active << "\n";
+  EXPECT_NEAR(sag, reference, 0.1 * reference);
+}
+
+// A deformable block slides on frictionless ground into a free rigid box: the horizontal momentum
+// of the pair is conserved through the collision (the ground only pushes vertically).
+TEST(ContactPhysics, MomentumExchangedWithFreeBox) {
+  FemWorld world(contactSettings(0.01));
+  addGround(world, 0.0);
+  const Material m = softMaterial(5e4, 200);
+  FemBody* block = addBox(world, "block", {-0.6, -0.15, 0.0}, {-0.3, 0.15, 0.3}, 3, 3, 3, m);
+  block->setVelocity({2.0, 0, 0});
+  const double box_mass = 4;
+  btRigidBody* box = world.addRigidBody(std::make_unique<btBoxShape>(btVector3(0.15, 0.15, 0.15)),
+                                        box_mass, at({0.0, 0, 0.15}));
+  box->setFriction(0.0);
+  auto px = [&] { return momentum(*block).x() + box_mass * box->getLinearVelocity().x(); };
+  const double before = px();
+  double box_speed = 0;
+  for (int k = 0; k < 60; ++k) {  // contact at about 0.07 s, separated well before 0.6 s
+    ASSERT_TRUE(world.step().ok) << "step " << k;
+  }
+  box_speed = box->getLinearVelocity().x();
+  const double after = px();
+  std::cout << "[figures] momentum: before " << before << " after " << after << " N s, box "
+            << box_speed << " m/s, block " << momentum(*block).x() / block->model().totalMass()
+            << " m/s\n";
+  EXPECT_GT(box_speed, 0.5);  // the box was pushed: momentum went across
+  EXPECT_NEAR(after, before, 0.01 * std::abs(before));
+}
+
+// A block on a slope (gravity tilted by theta over flat ground) with friction mu: stays put when
+// tan(theta) < mu, slides with the Coulomb acceleration g (sin - mu cos) when above.
+double slideDistance(double theta, double mu, double seconds) {
+  WorldSettings s = contactSettings(0.01);
+  s.gravity = kGravity * Eigen::Vector3d(std::sin(theta), 0, -std::cos(theta));
+  FemWorld world(s);
+  addGround(world, mu);
+  const Material m = softMaterial(1e5, 500);
+  FemBody* block = addBox(world, "block", {-0.1, -0.1, 0}, {0.1, 0.1, 0.2}, 2, 2, 2, m);
+  // Settle without tilt first would change the set-up; start in contact, at rest.
+  const double x0 = centreOfMass(*block).x();
+  const int steps = static_cast<int>(std::lround(seconds / s.solver.time_step));
+  for (int k = 0; k < steps; ++k)
+    EXPECT_TRUE(world.step().ok);
+  EXPECT_GT(minZ(*block), -1e-4);
+  return centreOfMass(*block).x() - x0;
+}
+
+TEST(ContactPhysics, FrictionHoldsBelowAngleSlidesAbove) {
+  const double mu = 0.5;  // friction angle 26.6 degrees
+  const double t = 1.0;
+  const double below = slideDistance(20 * M_PI / 180, mu, t);
+  const double above_theta = 35 * M_PI / 180;
+  const double above = slideDistance(above_theta, mu, t);
+  const double coulomb =
+      0.5 * kGravity * (std::sin(above_theta) - mu * std::cos(above_theta)) * t * t;
+  std::cout << "[figures] slope: 20 deg moved " << below << " m; 35 deg moved " << above
+            << " m (Coulomb " << coulomb << " m)\n";
+  EXPECT_LT(std::abs(below), 2e-3);  // elastic creep of a soft block only
+  EXPECT_NEAR(above, coulomb, 0.15 * coulomb);
+}
+
+// Bullet's deformable world users report a soft cube pressed by a kinematic body flying away. A
+// kinematic plate presses a soft cube on the ground by a quarter of its height, holds, lifts off:
+// the cube stays in place, never exceeds a sane speed, and comes to rest.
+TEST(ContactPhysics, DISABLED_PressedCubeStaysPut) {
+  FemWorld world(contactSettings(0.01));
+  addGround(world, 0.8);
+  const Material m = softMaterial(5e4, 300);
+  FemBody* cube = addBox(world, "cube", {-0.1, -0.1, 0}, {0.1, 0.1, 0.2}, 3, 3, 3, m);
+  const double plate_half = 0.05;
+  btRigidBody* plate =
+      world.addRigidBody(std::make_unique<btBoxShape>(btVector3(0.3, 0.3, plate_half)), 0,
+                         at({0, 0, 0.2 + plate_half + 0.01}));
+  plate->setCollisionFlags(plate->getCollisionFlags() | btCollisionObject::CF_KINEMATIC_OBJECT);
+  plate->setActivationState(DISABLE_DEACTIVATION);
+  plate->setFriction(0.8);
+  // Down 6 cm at 0.1 m/s (0.6 s), hold 0.5 s, up at 0.1 m/s.
+  auto height = [&](double t) {
+    const double base = 0.2 + plate_half + 0.01;
+    if (t < 0.6) return base - 0.1 * t;
+    if (t < 1.1) return base - 0.06;
+    return base - 0.06 + 0.1 * (t - 1.1);
+  };
+  double fastest = 0, lowest_plate_gap = 1e300;
+  for (int k = 0; k < 250; ++k) {
+    const double t_next = (k + 1) * 0.01;
+    btTransform pose = at({0, 0, height(t_next)});
+    plate->getMotionState()->setWorldTransform(pose);
+    ASSERT_TRUE(world.step().ok) << "step " << k;
+    fastest = std::max(fastest, cube->lastReport().max_speed);
+    double top = -1e300;
+    for (int i = 0; i < cube->model().nodeCount(); ++i)
+      top = std::max(top, cube->state().position(i).z());
+    lowest_plate_gap = std::min(lowest_plate_gap, height(t_next) - plate_half - top);
+  }
+  const Eigen::Vector3d c = centreOfMass(*cube);
+  std::cout << "[figures] press: fastest node " << fastest << " m/s, plate penetration "
+            << std::max(0.0, -lowest_plate_gap) << " m, cube centre " << c.transpose() << "\n";
+  EXPECT_LT(fastest, 1.0);  // the plate moves at 0.1 m/s; a cube flying away moves at m/s
+  EXPECT_GT(lowest_plate_gap, -1e-4);
+  EXPECT_LT(std::hypot(c.x(), c.y()), 1e-3);
+  EXPECT_NEAR(c.z(), 0.1, 0.01);  // back to its rest height (minus its weight's squash)
+  EXPECT_LT(cube->lastReport().max_speed, 0.05);
+  EXPECT_GT(minZ(*cube), -1e-4);
+}
+
+// A rigid box squeezed between the ground and a deformable block whose top is held and driven
+// down (a hand): the box neither explodes nor is pushed out; the held nodes follow their script.
+TEST(ContactPhysics, SqueezedBoxUnderHeldBlockIsStable) {
+  FemWorld world(contactSettings(0.01));
+  addGround(world, 0.8);
+  btRigidBody* box = world.addRigidBody(std::make_unique<btBoxShape>(btVector3(0.1, 0.1, 0.05)), 2,
+                                        at({0, 0, 0.05}));
+  box->setFriction(0.8);
+  const Material m = softMaterial(5e4, 300);
+  FemBody* block = addBox(world, "block", {-0.15, -0.15, 0.11}, {0.15, 0.15, 0.31}, 3, 3, 2, m);
+  std::vector<int> top;
+  for (int i = 0; i < block->model().nodeCount(); ++i) {
+    if (block->state().position(i).z() > 0.31 - 1e-9) top.push_back(i);
+  }
+  // Down 5 cm in 1 s (the block's bottom meets the box after 1 cm), then hold.
+  auto frame = [](double t) {
+    Frame f;
+    f.origin.z() = -0.05 * std::min(1.0, t);
+    return f;
+  };
+  const int hand = block->carryNodes("hand", top, frame, 0.0);
+  (void)hand;
+  // The box's speed as its motion over each step (its velocity state carries, for one step, the
+  // impulse that Bullet's ground contact then cancels: docs/contact.md, supported bodies).
+  double fastest_box = 0, deepest = 0, worst_held = 0;
+  Eigen::Vector3d last = toEigen(box->getCenterOfMassPosition());
+  for (int k = 0; k < 200; ++k) {
+    ASSERT_TRUE(world.step().ok) << "step " << k;
+    const Eigen::Vector3d now = toEigen(box->getCenterOfMassPosition());
+    fastest_box = std::max(fastest_box, (now - last).norm() / 0.01);
+    last = now;
+    deepest = std::max(deepest, block->contacts().stats().max_penetration);
+    for (int i : top) {
+      const Eigen::Vector3d target = block->model().mesh().restPositions()[static_cast<size_t>(i)] +
+                                     frame(world.time()).origin;
+      worst_held = std::max(worst_held, (block->state().position(i) - target).norm());
+    }
+  }
+  const Eigen::Vector3d p = toEigen(box->getCenterOfMassPosition());
+  std::cout << "[figures] squeeze: fastest box " << fastest_box << " m/s, box at " << p.transpose()
+            << ", block contacts " << block->contacts().stats().active << ", held error "
+            << worst_held << " m\n";
+  EXPECT_LT(fastest_box, 0.5);
+  EXPECT_LT(std::hypot(p.x(), p.y()), 0.01);
+  EXPECT_NEAR(p.z(), 0.05, 0.005);  // still on the ground, not pushed into or off it
+  EXPECT_LT(worst_held, 1e-9);      // contacts never move held nodes
+  EXPECT_GT(block->contacts().stats().active, 0);
+  EXPECT_LT(deepest, 1e-3);
+}
+
+}  // namespace
+}  // namespace torsion::test
