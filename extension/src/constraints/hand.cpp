@@ -1,11 +1,50 @@
 #include "torsion/constraints/hand.h"
 
+#include <algorithm>
+#include <cassert>
+#include <cmath>
+#include <limits>
 #include <utility>
 
 namespace torsion {
 
-Hand::Hand(FemBody& body, std::string name)
-    : body_(&body), name_(std::move(name)), target_(std::make_shared<Frame>()) {}
+double HandSettings::speedLimit(const Material& material) const {
+  if (max_drag_strain <= 0) return std::numeric_limits<double>::infinity();
+  const double shear_modulus = material.youngs_modulus / (2 * (1 + material.poisson_ratio));
+  return max_drag_strain * std::sqrt(shear_modulus / material.density);
+}
+
+Status HandSettings::validate() const {
+  if (!(std::isfinite(max_drag_strain) && max_drag_strain >= 0))
+    return Error{"hand: max_drag_strain = " + std::to_string(max_drag_strain) +
+                 ": must be >= 0 (0 turns the speed limit off)"};
+  return Ok{};
+}
+
+void HandPursuit::advanceTo(double t) {
+  if (!(t > time)) return;
+  const double dt = t - time;
+  time = t;
+  const Eigen::Vector3d shift = goal.origin - patch.origin;
+  const double angle = patch.rotation.angularDistance(goal.rotation);  // shortest, in [0, pi]
+  const double travel = shift.norm() + angle * reach;  // bounds every grabbed node's travel
+  const double allowed = max_speed * dt;
+  if (travel <= allowed) {  // also when max_speed is infinite
+    patch = goal;
+    return;
+  }
+  const double s = allowed / travel;
+  patch.origin += s * shift;
+  patch.rotation = patch.rotation.slerp(s, goal.rotation).normalized();
+}
+
+Hand::Hand(FemBody& body, std::string name, HandSettings settings)
+    : body_(&body),
+      name_(std::move(name)),
+      speed_limit_(settings.speedLimit(body.model().material())),
+      pursuit_(std::make_shared<HandPursuit>()) {
+  assert(settings.validate().ok());
+}
 
 Result<int> Hand::grab(const Frame& frame, double now) {
   release();
@@ -13,15 +52,28 @@ Result<int> Hand::grab(const Frame& frame, double now) {
   if (selection_.status != HandSelectionStatus::kGrabbed) {
     return Error{"hand '" + name_ + "' on body '" + body_->name() + "': " + selection_.message};
   }
-  *target_ = frame;
-  std::shared_ptr<const Frame> target = target_;
+  // A fresh pursuit per grab: a motion still held by an earlier group never sees this one.
+  pursuit_ = std::make_shared<HandPursuit>();
+  pursuit_->goal = frame;
+  pursuit_->patch = frame;
+  pursuit_->time = now;
+  pursuit_->max_speed = speed_limit_;
+  for (int node : selection_.nodes)
+    pursuit_->reach =
+        std::max(pursuit_->reach, (body_->state().position(node) - frame.origin).norm());
+  std::shared_ptr<HandPursuit> pursuit = pursuit_;
   group_ = body_->carryNodes(
-      name_, selection_.nodes, [target](double) { return *target; }, now);
+      name_, selection_.nodes,
+      [pursuit](double t) {
+        pursuit->advanceTo(t);
+        return pursuit->patch;
+      },
+      now);
   return static_cast<int>(selection_.nodes.size());
 }
 
 void Hand::moveTo(const Frame& frame) {
-  *target_ = frame;
+  pursuit_->goal = frame;
 }
 
 void Hand::release() {
@@ -35,7 +87,7 @@ Wrench Hand::wrench() const {
   // Before the body's first step there are no internal forces yet (FemBody::groupWrench would
   // read an empty buffer).
   if (body_->stepper().elasticForces().size() != body_->state().positions.size()) return Wrench{};
-  return body_->groupWrench(group_, target_->origin);
+  return body_->groupWrench(group_, pursuit_->patch.origin);
 }
 
 const std::vector<int>& Hand::grabbedNodes() const {

@@ -19,7 +19,8 @@ struct Frame {
   }
 };
 
-/// A frame as a function of simulated time (s).
+/// A frame as a function of simulated time (s). Called once per step with that step's end time,
+/// in non-decreasing order; a motion may keep state between calls (the hand's pursuit does).
 using FrameMotion = std::function<Frame(double time)>;
 
 }  // namespace torsion

@@ -5,22 +5,29 @@
 //   Hand hand(*body);
 //   Result<int> n = hand.grab(device_frame, world.time());   // Initialize(O, R)
 //   while (...) {
-//     hand.moveTo(next_device_frame);   // the pose at the END of the next step
-//     world.step();                     // Update: nodes land on R p_hat + O
-//     Wrench w = hand.wrench();         // what the body pushes back with, about O
+//     hand.moveTo(next_device_frame);   // where the device wants the patch
+//     world.step();                     // Update: nodes land on R p_hat + O of the patch frame
+//     Wrench w = hand.wrench();         // what the body pushes back with, about the patch's O
 //   }
 //   hand.release();
 //
 // grab() selects the patch (selectGrabbedPatch) at the body's current positions and hands its
-// nodes to FemBody::carryNodes with a FrameMotion that reads the hand's target frame; the body's
+// nodes to FemBody::carryNodes with a FrameMotion that yields the hand's *patch frame*; the body's
 // CarriedNodes prescribe them, each step from t to t + dt, to R p_hat + O of that frame in
-// position and velocity. The motion ignores its time argument: the target is whatever moveTo set
-// last, so a frame given to moveTo is where the grabbed nodes are at the end of the next step, and
-// they stay there until moveTo is called again. Smoothing a fast device (substeps, rate limits)
-// belongs to the caller.
+// position and velocity (the implicit solve sees it; positions are never snapped afterwards).
+//
+// The patch frame pursues the device frame (the goal, set by moveTo) under a speed limit: it
+// reaches the goal at the end of the next step unless that would move some grabbed node faster
+// than `HandSettings::speedLimit`, and then gets there over as many steps as it takes. Why: a
+// surface patch dragged faster than the material's shear waves can carry the motion inward
+// over-deforms the tets between grabbed and free nodes, turning some inside out (the report's
+// complaint; docs/hand-plane.md measures it). That is physics, not a solver fault: smaller time
+// steps make it worse, not better. The bound is a fraction of the shear wave speed
+// c_s = sqrt(G / rho), since a boundary moving at speed v drives a strain of about v / c_s.
+// The lag between goal and patch is what a haptic coupling renders as a spring (issue 5).
 //
 // Simulation thread only, like the body. The body must outlive the hand's calls. Destroying a
-// grabbing hand does not touch the body: its nodes stay held at the last target (the motion owns
+// grabbing hand does not touch the body: its nodes stay held by the pursuit state (the motion owns
 // a shared copy of it); call release() first to let go.
 
 #include <memory>
@@ -35,10 +42,37 @@
 
 namespace torsion {
 
+struct HandSettings {
+  /// The grabbed nodes move at most this fraction of the body's shear wave speed
+  /// sqrt(G / rho), i.e. a drag induces a strain of about this much; 0 turns the limit off (the
+  /// patch lands on every goal after one step, however fast).
+  double max_drag_strain = 0.2;
+
+  /// The speed limit of grabbed nodes for `material`, m/s (infinity when the limit is off).
+  double speedLimit(const Material& material) const;
+  Status validate() const;
+};
+
+/// Where the patch is carried and where the device wants it. Shared by the Hand and the motion it
+/// gives the body, so the pursuit goes on if the Hand object is destroyed while grabbing.
+struct HandPursuit {
+  Frame goal;            ///< the device's frame (last moveTo)
+  Frame patch;           ///< the frame carrying the grabbed nodes, at `time`
+  double time = 0;       ///< s, world time of `patch`
+  double max_speed = 0;  ///< m/s, bound on any grabbed node's speed; infinity: no limit
+  double reach = 0;      ///< m, largest |p_hat| of a grabbed node (rotation moves it fastest)
+
+  /// Advances `patch` toward `goal` to time `t` (no-op when t <= time): all the way when the
+  /// fastest grabbed node stays under max_speed, else a fraction s of the way (translation lerp,
+  /// rotation slerp) with |dO| + angle * reach = max_speed (t - time).
+  void advanceTo(double t);
+};
+
 class Hand {
  public:
   /// A hand acting on `body`; `name` names its node groups in the body ("hand" by default).
-  explicit Hand(FemBody& body, std::string name = "hand");
+  /// Settings must be valid (HandSettings::validate); the scene parser checks them for users.
+  explicit Hand(FemBody& body, std::string name = "hand", HandSettings settings = {});
   Hand(const Hand&) = delete;  // one hand, one node group: hold it by pointer to share it
   Hand& operator=(const Hand&) = delete;
 
@@ -50,8 +84,9 @@ class Hand {
   /// world's time (FemWorld::time()).
   Result<int> grab(const Frame& frame, double now);
 
-  /// Update(O, R): the target frame, i.e. the pose of the hand at the end of the next step.
-  /// Has no effect on the body until the next step; harmless when not grabbing.
+  /// Update(O, R): the device's frame, the goal the patch frame pursues from the next step on
+  /// (reached at the end of that step unless the speed limit holds it back). Harmless when not
+  /// grabbing.
   void moveTo(const Frame& frame);
 
   /// Lets go: the grabbed nodes are free from the next step on (FemBody::releaseGroup). The hand
@@ -60,17 +95,20 @@ class Hand {
 
   bool grabbed() const { return group_ >= 0; }
 
-  /// The force and torque (about the target frame's origin O) that the body exerted on the grabbed
+  /// The force and torque (about the patch frame's origin O) that the body exerted on the grabbed
   /// nodes at the end of the last step; zero when not grabbing or before the body's first step.
-  /// Read it before moveTo() so that O is the origin the nodes were carried to.
   Wrench wrench() const;
 
   /// The grabbed nodes, ascending; empty when not grabbing.
   const std::vector<int>& grabbedNodes() const;
   /// The selection of the last grab() (also when it failed).
   const HandSelection& selection() const { return selection_; }
-  /// The target frame (the last one given to grab() or moveTo()).
-  const Frame& frame() const { return *target_; }
+  /// The goal: the last frame given to grab() or moveTo().
+  const Frame& goal() const { return pursuit_->goal; }
+  /// The frame the grabbed nodes were carried to in the last step (the goal when not lagging).
+  const Frame& frame() const { return pursuit_->patch; }
+  /// Speed limit of the grabbed nodes, m/s (infinity when off).
+  double speedLimit() const { return speed_limit_; }
   /// The body's node group carrying the patch, or -1 when not grabbing.
   int group() const { return group_; }
   const std::string& name() const { return name_; }
@@ -79,7 +117,8 @@ class Hand {
  private:
   FemBody* body_;
   std::string name_;
-  std::shared_ptr<Frame> target_;  // shared with the body's FrameMotion
+  double speed_limit_;
+  std::shared_ptr<HandPursuit> pursuit_;  // shared with the body's FrameMotion
   HandSelection selection_;
   int group_ = -1;
 };

@@ -1,0 +1,29 @@
+#pragma once
+// How badly a body's tets are deformed: the measure the report's over-deformation complaint is
+// about (tets with both grabbed and free nodes stretched or turned inside out by a fast hand).
+//
+// Per tet, F = Ds Bm and its singular values s1 >= s2 >= s3 (signed: s3 < 0 for an inverted tet,
+// the same sign convention as polar_rotation.h). The element strain is the largest principal
+// stretch deviation max_i |s_i - 1|: 0 at rest and under any rigid motion, 1 for a tet squashed
+// flat or doubled in length. It is a strain of the corotated model, so it is what the linear
+// stress-strain law inside each tet sees.
+
+#include <Eigen/Core>
+
+#include "torsion/fem/fem_model.h"
+
+namespace torsion {
+
+struct DeformationMetrics {
+  double max_strain = 0;  ///< largest max_i |s_i - 1| over all tets
+  int max_strain_tet = -1;
+  int inverted_tets = 0;  ///< tets with det F <= 0
+};
+
+/// Metrics of the configuration `positions` (3n) of `model`'s body.
+DeformationMetrics measureDeformation(const FemModel& model, const Eigen::VectorXd& positions);
+
+/// max_i |s_i - 1| of one deformation gradient (signed singular values).
+double elementStrain(const Eigen::Matrix3d& deformation_gradient);
+
+}  // namespace torsion
