@@ -91,8 +91,8 @@ Result<std::unique_ptr<BuiltScene>> buildScene(SceneSpec spec, int threads_overr
   for (size_t h = 0; h < spec.hands.size(); ++h) {
     SceneHand scene_hand;
     scene_hand.spec = spec.hands[h];
-    scene_hand.hand =
-        std::make_unique<Hand>(*world.body(scene_hand.spec.body), scene_hand.spec.name);
+    scene_hand.hand = std::make_unique<Hand>(*world.body(scene_hand.spec.body),
+                                             scene_hand.spec.name, scene_hand.spec.settings);
     built->hands.push_back(std::move(scene_hand));
   }
   // Hands that grab at t = 0 grab now, so a plane that misses is reported before any step.

@@ -167,6 +167,9 @@ HandSpec readHand(const JsonObject& h) {
     hand.release_at = h.number("release_at");
     if (!(hand.release_at > hand.grab_at)) h.fail("release_at", "must be after grab_at");
   }
+  hand.settings.max_drag_strain = h.number("max_drag_strain", hand.settings.max_drag_strain);
+  if (!hand.settings.validate().ok())
+    h.fail("max_drag_strain", "must be >= 0 (0 turns the hand's speed limit off)");
   h.finish();
   return hand;
 }

@@ -10,6 +10,7 @@
 
 #include "torsion/bullet/fem_world.h"
 #include "torsion/constraints/frame.h"
+#include "torsion/constraints/hand.h"
 #include "torsion/fem/material.h"
 
 namespace torsion::scene {
@@ -65,6 +66,7 @@ struct HandSpec {
   std::vector<std::pair<double, Frame>> keyframes;  ///< (time, frame), times strictly increasing
   double grab_at = 0;
   double release_at = std::numeric_limits<double>::infinity();
+  HandSettings settings;  ///< speed limit of the grabbed patch (max_drag_strain)
 
   /// The hand's frame at time t.
   Frame frameAt(double t) const;

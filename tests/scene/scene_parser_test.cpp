@@ -238,5 +238,18 @@ TEST(SceneHandsFaults, ReleaseBeforeGrabAndNonNumbers) {
                       {"hands[0].frame.origin: element 1: expected a number"}));
 }
 
+TEST(SceneHands, SpeedLimitDefaultsAndIsRead) {
+  Result<SceneSpec> plain = parseHand(kWithHand);
+  ASSERT_TRUE(plain.ok()) << plain.error().message;
+  EXPECT_EQ(plain.value().hands[0].settings.max_drag_strain, HandSettings{}.max_drag_strain);
+  Result<SceneSpec> off =
+      parseHand(with(R"("release_at": 3)", R"("release_at": 3, "max_drag_strain": 0)"));
+  ASSERT_TRUE(off.ok()) << off.error().message;
+  EXPECT_EQ(off.value().hands[0].settings.max_drag_strain, 0.0);
+  EXPECT_TRUE(test::failsWith(
+      parseHand(with(R"("release_at": 3)", R"("release_at": 3, "max_drag_strain": -1)")),
+      {"h.json: hands[0].max_drag_strain: must be >= 0"}));
+}
+
 }  // namespace
 }  // namespace torsion::scene
