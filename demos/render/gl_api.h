@@ -14,7 +14,8 @@ namespace torsion::render {
 // declaration (decltype is unevaluated: no link-time reference to the symbol).
 #define TORSION_GL_FUNCTIONS(X)                                                                    \
   X(Viewport)                                                                                      \
-  X(ClearColor) X(Clear) X(Enable) X(Disable) X(BlendFunc) X(DepthMask) X(DepthFunc) X(MatrixMode) \
+  X(ClearColor)                                                                                    \
+  X(Clear) X(Enable) X(Disable) X(BlendFunc) X(DepthMask) X(DepthFunc) X(MatrixMode)               \
       X(LoadIdentity) X(LoadMatrixd) X(PushMatrix) X(PopMatrix) X(Ortho) X(Lightfv)                \
           X(LightModelfv) X(LightModeli) X(Materialfv) X(Materialf) X(ColorMaterial) X(ShadeModel) \
               X(Begin) X(End) X(Vertex3d) X(Vertex2d) X(Normal3d) X(Color4d) X(LineWidth)          \
