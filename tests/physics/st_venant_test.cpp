@@ -10,6 +10,7 @@
 
 #include "torsion/analysis/twist_profile.h"
 #include "torsion/bullet/fem_world.h"
+#include "torsion/constraints/hand.h"
 #include "torsion/mesh/mesh_io.h"
 #include "validation_output.h"
 
@@ -140,9 +141,60 @@ TEST_F(StVenant, TorqueConvergesToGJThetaPrimeWithRefinement) {
   EXPECT_LT(ratios.back().second, 1.07);  // the fine mesh: within 7 %
 }
 
-// The report's case (section 6.1.2): the medium cylinder twisted by 2 pi at 0.1 rad/s with
-// dt = 0.01, one end fixed. It must stay stable, and the angle stay linear along the middle 60 %.
-TEST(StVenantLargeTwist, TwoPiTwistStaysStableAndLinear) {
+// Through the hand plane (DESIGN.md section 5): the same small twist, applied by a hand whose
+// plane z = 9.9 grabs the ring of surface triangles it cuts (the end cap and the interior stay
+// free). The twist is still uniform in the middle, the hand's torque balances the fixed base's,
+// and T / (G J theta') is the mesh's own ratio from the end-rotation test above: the hand adds no
+// error of its own. That ratio is 1.15 on 8332 tets, not the 5 % (see the convergence
+// test and docs/validation.md).
+TEST_F(StVenant, SmallTwistThroughAHandMatchesTheEndRotation) {
+  const TetMesh mesh = cylinder(8332);
+  WorldSettings settings;
+  settings.gravity.setZero();
+  settings.solver.time_step = 1.0;  // quasi-static, as in smallTwist
+  settings.solver.linear_solver = LinearSolverKind::kCholmod;
+  FemWorld world(settings);
+  Material material;
+  FemBody* body = world.addBody("cylinder", mesh, material).value();
+  const int base = body->carryNodes(
+      "base", nodesAtZ(mesh, 0), [](double) { return Frame{}; }, 0);
+  Hand hand(*body);
+  Frame frame;
+  frame.origin = Eigen::Vector3d(0, 0, 9.9);
+  ASSERT_TRUE(hand.grab(frame, 0).ok());
+  const double angle = 0.05;
+  for (int k = 1; k <= 12; ++k) {
+    frame.rotation = Eigen::AngleAxisd(angle * std::min(k / 3.0, 1.0), Eigen::Vector3d::UnitZ());
+    hand.moveTo(frame);
+    const WorldStepReport r = world.step();
+    ASSERT_TRUE(r.ok) << r.message;
+  }
+  const auto profile =
+      twistProfile(mesh.restPositions(), body->state().positions, sliceCentres(0.5), 0.26);
+  const double rate = twistRate(profile, 2, 8);
+  const double J = polarMomentOfSection(mesh.restPositions(), mesh.tets(), kLength);
+  const double torque = -hand.wrench().torque.z();
+  const double base_torque = body->groupWrench(base, Eigen::Vector3d::Zero()).torque.z();
+  const double ratio = torque / (material.mu() * J * rate);
+  const TorsionResult& end_rotation = at(8332);
+  std::printf(
+      "through a hand: theta' = %.6f rad/m, T = %.3f N m, base %.3f N m, "
+      "T / (G J theta') = %.4f (end rotation: %.4f)\n",
+      rate, torque, base_torque, ratio, end_rotation.torque / end_rotation.expected);
+  EXPECT_LT(twistNonlinearity(profile, 2, 8), 0.01);
+  // The grabbed band reaches from about z = 9.6 to the rim at z = 10: theta' is the angle over
+  // the free length, between 0.05 / 10 and 0.05 / 9.6.
+  EXPECT_GT(rate, angle / kLength);
+  EXPECT_LT(rate, angle / 9.6);
+  EXPECT_NEAR(base_torque, torque, 0.01 * torque);  // quasi-static: the torques balance
+  EXPECT_NEAR(ratio, end_rotation.torque / end_rotation.expected, 0.01);
+  EXPECT_GT(ratio, 1.0);
+}
+
+// The report's case (section 6.1.2): the medium cylinder, its base fixed, twisted by 2 pi at
+// 0.1 rad/s with dt = 0.01 by a hand at z = 9.9, then held 2 s. It must stay stable, the angle
+// linear along the middle 60 %, the twist rate that of the free length.
+TEST(StVenantLargeTwist, TwoPiTwistThroughAHandStaysStableAndLinear) {
   const TetMesh mesh = cylinder(8332);
   WorldSettings settings;
   settings.gravity.setZero();
@@ -150,11 +202,15 @@ TEST(StVenantLargeTwist, TwoPiTwistStaysStableAndLinear) {
   FemBody* body = world.addBody("cylinder", mesh, Material{}).value();
   body->carryNodes(
       "base", nodesAtZ(mesh, 0), [](double) { return Frame{}; }, 0);
-  const double omega = 0.1, total = 2 * M_PI;
-  body->carryNodes("end", nodesAtZ(mesh, kLength),
-                   turnAboutZ([=](double t) { return std::min(omega * t, total); }), 0);
-  const int steps = static_cast<int>(std::ceil(total / omega / settings.solver.time_step)) + 200;
-  for (int k = 0; k < steps; ++k) {
+  Hand hand(*body);
+  Frame frame;
+  frame.origin = Eigen::Vector3d(0, 0, 9.9);
+  ASSERT_TRUE(hand.grab(frame, 0).ok());
+  const double omega = 0.1, total = 2 * M_PI, dt = settings.solver.time_step;
+  const int steps = static_cast<int>(std::ceil(total / omega / dt)) + 200;
+  for (int k = 1; k <= steps; ++k) {
+    frame.rotation = Eigen::AngleAxisd(std::min(omega * k * dt, total), Eigen::Vector3d::UnitZ());
+    hand.moveTo(frame);
     const WorldStepReport r = world.step();
     ASSERT_TRUE(r.ok) << r.message;
   }
@@ -162,14 +218,17 @@ TEST(StVenantLargeTwist, TwoPiTwistStaysStableAndLinear) {
       twistProfile(mesh.restPositions(), body->state().positions, sliceCentres(0.5), 0.26);
   const double rate = twistRate(profile, 2, 8);
   const double nonlinearity = twistNonlinearity(profile, 2, 8);
-  std::printf("2 pi twist: theta' = %.5f rad/m (uniform %.5f), nonlinearity %.2f %%\n", rate,
-              total / kLength, 100 * nonlinearity);
+  std::printf(
+      "2 pi twist through a hand: theta' = %.5f rad/m (2 pi / L = %.5f), "
+      "nonlinearity %.2f %%\n",
+      rate, total / kLength, 100 * nonlinearity);
   if (auto csv = test::validationCsv("st_venant_two_pi_profile.csv", "z,angle,st_venant")) {
     for (const SliceRotation& slice : profile)
       *csv << slice.z << "," << slice.angle << "," << total * slice.z / kLength << "\n";
   }
   EXPECT_LT(nonlinearity, 0.03);
-  EXPECT_NEAR(rate, total / kLength, 0.05 * total / kLength);
+  EXPECT_GT(rate, 0.98 * total / kLength);
+  EXPECT_LT(rate, 1.02 * total / 9.6);
 }
 
 }  // namespace
