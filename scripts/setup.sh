@@ -13,6 +13,8 @@ packages=(
   libbullet-dev libeigen3-dev libsuitesparse-dev libccd-dev libtbb-dev
   libcli11-dev nlohmann-json3-dev libpng-dev
   libosmesa6-dev libglfw3-dev
+  # the viewer's test: a virtual X server and Mesa's software GLX
+  xvfb xauth libgl1-mesa-dri libglx-mesa0
   # tests and benchmarks; clang + its runtime for the libFuzzer targets
   libgtest-dev libbenchmark-dev clang libclang-rt-14-dev
   # mesh generation (`torsion mesh cylinder` runs the tetgen command)

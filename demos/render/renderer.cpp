@@ -381,6 +381,13 @@ void Renderer::drawOverlay(const FrameData& frame, int width, int height,
     const size_t text_lines = lines.size();
     // Wrenches: a line of numbers, then bars (force and torque scaled separately).
     const double bar_height = 3 * ts, bar_width = 60 * ts;
+    // Bars of a readout are scaled to its largest component, but never below 1e-3 of the
+    // largest force (torque) on screen, so round-off shows as no bar.
+    double force_floor = 1e-12, torque_floor = 1e-12;
+    for (const WrenchReadout& w : frame.wrenches) {
+      force_floor = std::max(force_floor, 1e-3 * w.force.cwiseAbs().maxCoeff());
+      torque_floor = std::max(torque_floor, 1e-3 * w.torque.cwiseAbs().maxCoeff());
+    }
     double top = margin;
     const double panel_height =
         static_cast<double>(text_lines) * line +
@@ -415,7 +422,8 @@ void Renderer::drawOverlay(const FrameData& frame, int width, int height,
       // Bars: x, y, z side by side, each signed about its centre; force above torque.
       for (int row = 0; row < 2; ++row) {
         const Eigen::Vector3d& v = row == 0 ? w.force : w.torque;
-        const double scale = std::max(v.cwiseAbs().maxCoeff(), 1e-9);
+        const double scale =
+            std::max(v.cwiseAbs().maxCoeff(), row == 0 ? force_floor : torque_floor);
         for (int a = 0; a < 3; ++a) {
           const double x0 = margin + a * (bar_width + 4 * ts), mid = x0 + bar_width / 2;
           gl.Color4d(0.6, 0.62, 0.68, 0.5);

@@ -1,0 +1,10 @@
+#pragma once
+// `torsion view SCENE`: the scene in a GLFW window (see docs/rendering.md for the controls).
+
+#include <CLI/CLI.hpp>
+
+namespace torsion::cli {
+
+void addViewCommand(CLI::App& app);
+
+}  // namespace torsion::cli

@@ -1,0 +1,507 @@
+#include "viewer.h"
+
+#include <GLFW/glfw3.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <iostream>
+#include <limits>
+#include <sstream>
+#include <vector>
+
+#include "camera.h"
+#include "frame_data.h"
+#include "image.h"
+#include "renderer.h"
+#include "scene_builder.h"
+#include "scene_parser.h"
+
+namespace torsion::viewer {
+
+namespace {
+
+using render::Camera;
+
+// One input event, from GLFW or from a script line "<frame> key NAME [shift]",
+// "<frame> drag left|right|middle DX DY [ctrl]", "<frame> scroll DY".
+struct InputEvent {
+  int frame = 0;
+  enum class Kind { kKey, kDrag, kScroll } kind = Kind::kKey;
+  int key = 0;
+  bool shift = false, ctrl = false;
+  int button = 0;  // GLFW_MOUSE_BUTTON_*
+  double dx = 0, dy = 0;
+};
+
+int keyFromName(const std::string& name) {
+  static const std::pair<const char*, int> kNamed[] = {
+      {"SPACE", GLFW_KEY_SPACE},    {"ESCAPE", GLFW_KEY_ESCAPE},
+      {"LEFT", GLFW_KEY_LEFT},      {"RIGHT", GLFW_KEY_RIGHT},
+      {"UP", GLFW_KEY_UP},          {"DOWN", GLFW_KEY_DOWN},
+      {"PAGEUP", GLFW_KEY_PAGE_UP}, {"PAGEDOWN", GLFW_KEY_PAGE_DOWN}};
+  for (const auto& [n, k] : kNamed) {
+    if (name == n) return k;
+  }
+  if (name.size() == 1 && std::isalpha(static_cast<unsigned char>(name[0])))
+    return GLFW_KEY_A + (std::toupper(static_cast<unsigned char>(name[0])) - 'A');
+  return -1;
+}
+
+Result<std::vector<InputEvent>> readScript(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) return Error{path + ": cannot open the input script"};
+  std::vector<InputEvent> events;
+  std::string line;
+  for (int number = 1; std::getline(in, line); ++number) {
+    std::istringstream words(line);
+    InputEvent e;
+    std::string kind;
+    if (!(words >> e.frame) || line.empty() || line[0] == '#') {
+      if (line.find_first_not_of(" \t") == std::string::npos || line[0] == '#') continue;
+      return Error{path + ":" + std::to_string(number) + ": expected '<frame> <event> ...'"};
+    }
+    words >> kind;
+    std::string extra;
+    if (kind == "key") {
+      std::string name;
+      words >> name;
+      e.key = keyFromName(name);
+      if (e.key < 0) return Error{path + ":" + std::to_string(number) + ": unknown key " + name};
+      e.shift = (words >> extra) && extra == "shift";
+    } else if (kind == "drag") {
+      std::string button;
+      words >> button >> e.dx >> e.dy;
+      e.kind = InputEvent::Kind::kDrag;
+      e.button = button == "left"    ? GLFW_MOUSE_BUTTON_LEFT
+                 : button == "right" ? GLFW_MOUSE_BUTTON_RIGHT
+                                     : GLFW_MOUSE_BUTTON_MIDDLE;
+      e.ctrl = (words >> extra) && extra == "ctrl";
+      if (!words.eof() && words.fail())
+        return Error{path + ":" + std::to_string(number) + ": drag wants BUTTON DX DY [ctrl]"};
+    } else if (kind == "scroll") {
+      words >> e.dy;
+      e.kind = InputEvent::Kind::kScroll;
+    } else {
+      return Error{path + ":" + std::to_string(number) + ": unknown event '" + kind + "'"};
+    }
+    events.push_back(e);
+  }
+  return events;
+}
+
+class Viewer {
+ public:
+  Viewer(const ViewerOptions& options, scene::SceneSpec spec)
+      : options_(options), spec_(std::move(spec)) {}
+
+  Status rebuild() {
+    auto built = scene::buildScene(spec_, options_.threads);
+    if (!built) return built.error();
+    scene_ = std::move(built).value();
+    manual_ = false;
+    unstable_.clear();
+    return Ok{};
+  }
+
+  void frameAll(int width, int height) {
+    const render::FrameData f = render::captureFrame(*scene_);
+    camera_ = render::frameCamera(
+        f, double(render::sceneViewportWidth(width, height, {})) / std::max(1, height));
+  }
+
+  // ---- input ----
+  void onKey(int key, bool shift) {
+    const double size = sceneSize();
+    const double step = 0.05 * size, angle = 5 * M_PI / 180;
+    const Eigen::Vector3d axis =
+        key == GLFW_KEY_LEFT || key == GLFW_KEY_RIGHT ? Eigen::Vector3d::UnitX()
+        : key == GLFW_KEY_UP || key == GLFW_KEY_DOWN  ? Eigen::Vector3d::UnitY()
+                                                      : Eigen::Vector3d::UnitZ();
+    const double sign =
+        key == GLFW_KEY_RIGHT || key == GLFW_KEY_UP || key == GLFW_KEY_PAGE_UP ? 1.0 : -1.0;
+    switch (key) {
+      case GLFW_KEY_ESCAPE:
+      case GLFW_KEY_Q:
+        quit_ = true;
+        break;
+      case GLFW_KEY_SPACE:
+        paused_ = !paused_;
+        break;
+      case GLFW_KEY_N:
+        single_step_ = true;
+        break;
+      case GLFW_KEY_R:
+        reset();
+        break;
+      case GLFW_KEY_F:
+        reframe_ = true;
+        break;
+      case GLFW_KEY_M:
+        toggleManual();
+        break;
+      case GLFW_KEY_G:
+        grab();
+        break;
+      case GLFW_KEY_U:
+        if (manual_ && hand()) hand()->hand->release();
+        break;
+      case GLFW_KEY_LEFT:
+      case GLFW_KEY_RIGHT:
+      case GLFW_KEY_UP:
+      case GLFW_KEY_DOWN:
+      case GLFW_KEY_PAGE_UP:
+      case GLFW_KEY_PAGE_DOWN:
+        if (!manual_) toggleManual();
+        if (shift) {
+          manual_frame_.rotation =
+              (Eigen::AngleAxisd(sign * angle, axis) * manual_frame_.rotation).normalized();
+        } else {
+          manual_frame_.origin += sign * step * axis;
+        }
+        break;
+      case GLFW_KEY_T:
+        editSettings([&] { spec_.world.solver.time_step *= shift ? 0.5 : 2.0; });
+        break;
+      case GLFW_KEY_E:
+        editSettings([&] {
+          for (auto& b : spec_.bodies)
+            b.material.youngs_modulus *= shift ? 1 / 1.5 : 1.5;
+        });
+        break;
+      case GLFW_KEY_P:
+        editSettings([&] {
+          for (auto& b : spec_.bodies)
+            b.material.poisson_ratio =
+                std::clamp(b.material.poisson_ratio + (shift ? -0.02 : 0.02), 0.0, 0.48);
+        });
+        break;
+      case GLFW_KEY_D:
+        editSettings([&] {
+          for (auto& b : spec_.bodies)
+            b.material.stiffness_damping *= shift ? 0.5 : 2.0;
+        });
+        break;
+      case GLFW_KEY_C:
+        editSettings([&] {
+          SolverSettings& s = spec_.world.solver;
+          if (s.linear_solver == LinearSolverKind::kCholmod) {
+            s.linear_solver = LinearSolverKind::kConjugateGradient;
+            s.preconditioner = PreconditionerKind::kJacobi;
+          } else if (s.preconditioner == PreconditionerKind::kJacobi) {
+            s.preconditioner = PreconditionerKind::kBlockJacobi;
+          } else {
+            s.linear_solver = LinearSolverKind::kCholmod;
+          }
+        });
+        break;
+      default:
+        break;
+    }
+  }
+
+  // dx, dy in pixels of a window `height` pixels high.
+  void onDrag(int button, double dx, double dy, bool ctrl, int height) {
+    const double h = std::max(1, height);
+    if (ctrl && button == GLFW_MOUSE_BUTTON_LEFT) {
+      if (!manual_) toggleManual();
+      const Eigen::Matrix4d v = camera_.view();
+      const double visible = 2 * camera_.distance * std::tan(camera_.fov_y / 2);
+      manual_frame_.origin +=
+          visible / h *
+          (dx * v.block<1, 3>(0, 0).transpose() - dy * v.block<1, 3>(1, 0).transpose());
+    } else if (button == GLFW_MOUSE_BUTTON_LEFT) {
+      camera_.orbit(-dx / h * 3, dy / h * 3);
+    } else {
+      camera_.pan(-dx / h, dy / h);
+    }
+  }
+
+  void onScroll(double dy) { camera_.zoom(std::pow(0.9, dy)); }
+
+  void apply(const InputEvent& e, int height) {
+    switch (e.kind) {
+      case InputEvent::Kind::kKey:
+        onKey(e.key, e.shift);
+        break;
+      case InputEvent::Kind::kDrag:
+        onDrag(e.button, e.dx, e.dy, e.ctrl, height);
+        break;
+      case InputEvent::Kind::kScroll:
+        onScroll(e.dy);
+        break;
+    }
+  }
+
+  // ---- simulation ----
+  void advance() {
+    if (!unstable_.empty()) return;
+    if (paused_ && !single_step_) return;
+    single_step_ = false;
+    Status driven = scene::driveHands(*scene_);
+    if (!driven) {
+      unstable_ = driven.error().message;
+      return;
+    }
+    if (manual_ && hand() && hand()->hand->grabbed()) hand()->hand->moveTo(manual_frame_);
+    const auto t0 = std::chrono::steady_clock::now();
+    const WorldStepReport r = scene_->world->step();
+    const double seconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    rate_ = seconds > 0 ? 0.9 * rate_ + 0.1 / seconds : rate_;
+    ++steps_;
+    if (!r.ok) unstable_ = r.message;
+  }
+
+  render::FrameData frame() {
+    render::FrameData f = render::captureFrame(*scene_, rate_);
+    const Material& m = spec_.bodies.front().material;
+    const SolverSettings& s = spec_.world.solver;
+    char buf[200];
+    std::snprintf(buf, sizeof buf, "DT %g S  E %g PA  NU %.2f  BETA %g S  %s%s", s.time_step,
+                  m.youngs_modulus, m.poisson_ratio, m.stiffness_damping, toString(s.linear_solver),
+                  s.linear_solver == LinearSolverKind::kCholmod
+                      ? ""
+                      : (std::string(" ") + toString(s.preconditioner)).c_str());
+    f.notes.push_back(buf);
+    f.notes.push_back(
+        std::string(paused_ ? "PAUSED" : "RUNNING") +
+        (manual_ ? "  HAND: MANUAL (G GRAB, U RELEASE)" : "  HAND: SCRIPT (M MANUAL)"));
+    if (!unstable_.empty()) f.notes.push_back("STOPPED: " + unstable_.substr(0, 60));
+    f.notes.push_back("KEYS SPACE N R F  T E P D C  M G U ARROWS PGUP PGDN");
+    if (manual_ && hand() && !hand()->hand->grabbed()) {
+      render::HandDrawData d;
+      d.name = hand()->spec.name;
+      d.frame = manual_frame_;
+      d.plane_half_size = 0.1 * sceneSize();
+      for (render::HandDrawData& existing : f.hands) {
+        if (existing.name == d.name) existing = d;
+      }
+    }
+    return f;
+  }
+
+  bool quit() const { return quit_; }
+  bool takeReframe() {
+    const bool r = reframe_;
+    reframe_ = false;
+    return r;
+  }
+  const Camera& camera() const { return camera_; }
+  int steps() const { return steps_; }
+  bool stable() const { return unstable_.empty(); }
+  const std::string& failure() const { return unstable_; }
+  bool manual() const { return manual_; }
+  int grabbedNodes() {
+    return hand() && hand()->hand->grabbed() ? static_cast<int>(hand()->hand->grabbedNodes().size())
+                                             : 0;
+  }
+
+ private:
+  double sceneSize() const {
+    Eigen::AlignedBox3d b;
+    for (const auto& body : scene_->world->bodies()) {
+      for (int i = 0; i < body->model().nodeCount(); ++i)
+        b.extend(body->state().position(i));
+    }
+    return b.isEmpty() ? 1.0 : std::max(1e-3, b.diagonal().norm());
+  }
+
+  scene::SceneHand* hand() { return scene_->hands.empty() ? nullptr : &scene_->hands.front(); }
+
+  void toggleManual() {
+    if (manual_) {
+      manual_ = false;
+      return;
+    }
+    if (scene_->hands.empty()) {  // a hand of our own on the first body
+      scene::SceneHand h;
+      h.spec.name = "mouse";
+      h.spec.body = scene_->world->bodies().front()->name();
+      h.spec.grab_at = std::numeric_limits<double>::infinity();
+      FemBody& body = *scene_->world->bodies().front();
+      h.hand = std::make_unique<Hand>(body, "mouse");
+      Eigen::Vector3d centre = Eigen::Vector3d::Zero();
+      for (int i = 0; i < body.model().nodeCount(); ++i)
+        centre += body.state().position(i);
+      h.spec.initial.origin = centre / std::max(1, body.model().nodeCount());
+      scene_->hands.push_back(std::move(h));
+    }
+    scene::SceneHand& h = *hand();
+    h.released = true;  // the script neither grabs nor moves it any more
+    h.spec.release_at = std::numeric_limits<double>::infinity();
+    manual_frame_ = h.hand->grabbed() ? h.hand->frame() : h.spec.frameAt(scene_->world->time());
+    manual_ = true;
+  }
+
+  void grab() {
+    if (!manual_) toggleManual();
+    Result<int> n = hand()->hand->grab(manual_frame_, scene_->world->time());
+    if (!n) std::cerr << "viewer: grab: " << n.error().message << "\n";
+  }
+
+  template <class Edit>
+  void editSettings(Edit edit) {
+    scene::SceneSpec before = spec_;
+    edit();
+    if (Status s = spec_.world.validate(); !s) {
+      std::cerr << "viewer: " << s.error().message << "\n";
+      spec_ = before;
+      return;
+    }
+    reset();
+  }
+
+  void reset() {
+    if (Status s = rebuild(); !s) std::cerr << "viewer: reset: " << s.error().message << "\n";
+  }
+
+  ViewerOptions options_;
+  scene::SceneSpec spec_;
+  std::unique_ptr<scene::BuiltScene> scene_;
+  Camera camera_;
+  Frame manual_frame_;
+  bool manual_ = false, paused_ = false, single_step_ = false, quit_ = false, reframe_ = false;
+  double rate_ = 0;
+  int steps_ = 0;
+  std::string unstable_;
+};
+
+// GLFW callbacks reach the viewer through the window's user pointer.
+struct WindowState {
+  Viewer* viewer = nullptr;
+  double last_x = 0, last_y = 0;
+  int height = 1;
+};
+
+WindowState* stateOf(GLFWwindow* w) {
+  return static_cast<WindowState*>(glfwGetWindowUserPointer(w));
+}
+
+}  // namespace
+
+int runViewer(const ViewerOptions& options) {
+  Result<scene::SceneSpec> spec = scene::loadScene(options.scene);
+  if (!spec) {
+    std::cerr << "error: " << spec.error().message << "\n";
+    return 1;
+  }
+  std::vector<InputEvent> script;
+  if (!options.script.empty()) {
+    auto read = readScript(options.script);
+    if (!read) {
+      std::cerr << "error: " << read.error().message << "\n";
+      return 1;
+    }
+    script = std::move(read).value();
+  }
+  Viewer viewer(options, std::move(spec).value());
+  if (Status built = viewer.rebuild(); !built) {
+    std::cerr << "error: " << built.error().message << "\n";
+    return 1;
+  }
+
+  glfwSetErrorCallback([](int code, const char* text) {
+    std::cerr << "glfw error " << code << ": " << text << "\n";
+  });
+  if (!glfwInit()) {
+    std::cerr << "error: no display for a window (set DISPLAY, or run under xvfb-run)\n";
+    return 1;
+  }
+  glfwWindowHint(GLFW_CONTEXT_VERSION_MAJOR, 2);
+  glfwWindowHint(GLFW_CONTEXT_VERSION_MINOR, 1);
+  glfwWindowHint(GLFW_SAMPLES, 4);
+  GLFWwindow* window = glfwCreateWindow(
+      options.width, options.height, ("torsion view: " + options.scene).c_str(), nullptr, nullptr);
+  if (!window) {
+    glfwTerminate();
+    std::cerr << "error: could not open an OpenGL 2.1 window\n";
+    return 1;
+  }
+  glfwMakeContextCurrent(window);
+  glfwSwapInterval(options.frames > 0 ? 0 : 1);
+  render::GlApi gl;
+  const std::string missing = render::loadGlApi(gl, [](const char* name) -> void* {
+    return reinterpret_cast<void*>(glfwGetProcAddress(name));
+  });
+  if (!missing.empty()) {
+    std::cerr << "error: the OpenGL context lacks " << missing << "\n";
+    glfwDestroyWindow(window);
+    glfwTerminate();
+    return 1;
+  }
+  gl.Enable(GL_MULTISAMPLE);
+  render::Renderer renderer(gl);
+
+  WindowState state;
+  state.viewer = &viewer;
+  glfwSetWindowUserPointer(window, &state);
+  glfwSetKeyCallback(window, [](GLFWwindow* w, int key, int, int action, int mods) {
+    if (action == GLFW_PRESS || action == GLFW_REPEAT)
+      stateOf(w)->viewer->onKey(key, (mods & GLFW_MOD_SHIFT) != 0);
+  });
+  glfwSetCursorPosCallback(window, [](GLFWwindow* w, double x, double y) {
+    WindowState& s = *stateOf(w);
+    const double dx = x - s.last_x, dy = y - s.last_y;
+    s.last_x = x;
+    s.last_y = y;
+    const bool ctrl = glfwGetKey(w, GLFW_KEY_LEFT_CONTROL) == GLFW_PRESS ||
+                      glfwGetKey(w, GLFW_KEY_RIGHT_CONTROL) == GLFW_PRESS;
+    for (int b : {GLFW_MOUSE_BUTTON_LEFT, GLFW_MOUSE_BUTTON_RIGHT, GLFW_MOUSE_BUTTON_MIDDLE}) {
+      if (glfwGetMouseButton(w, b) == GLFW_PRESS) {
+        s.viewer->onDrag(b, dx, dy, ctrl, s.height);
+        break;
+      }
+    }
+  });
+  glfwSetScrollCallback(window,
+                        [](GLFWwindow* w, double, double dy) { stateOf(w)->viewer->onScroll(dy); });
+
+  int width = 0, height = 0;
+  glfwGetFramebufferSize(window, &width, &height);
+  viewer.frameAll(width, height);
+  size_t next_event = 0;
+  int frames = 0;
+  std::vector<unsigned char> pixels;
+  while (!glfwWindowShouldClose(window) && !viewer.quit()) {
+    glfwPollEvents();
+    while (next_event < script.size() && script[next_event].frame <= frames)
+      viewer.apply(script[next_event++], height);
+    glfwGetFramebufferSize(window, &width, &height);
+    state.height = height;
+    if (viewer.takeReframe()) viewer.frameAll(width, height);
+    viewer.advance();
+    render::RenderOptions ro;
+    renderer.draw(viewer.frame(), viewer.camera(), width, height, ro);
+    ++frames;
+    const bool last = options.frames > 0 && frames >= options.frames;
+    if ((last || viewer.quit()) && !options.screenshot.empty()) {
+      render::Image image;
+      image.width = width;
+      image.height = height;
+      pixels.resize(static_cast<size_t>(width) * static_cast<size_t>(height) * 3);
+      gl.PixelStorei(GL_PACK_ALIGNMENT, 1);
+      gl.ReadPixels(0, 0, width, height, GL_RGB, GL_UNSIGNED_BYTE, pixels.data());
+      image.rgb.resize(pixels.size());
+      for (int y = 0; y < height; ++y) {  // GL rows go bottom to top
+        std::copy_n(&pixels[3 * static_cast<size_t>(height - 1 - y) * static_cast<size_t>(width)],
+                    3 * static_cast<size_t>(width), image.pixel(0, y));
+      }
+      if (Status w = render::writePng(image, options.screenshot); !w)
+        std::cerr << "error: " << w.error().message << "\n";
+    }
+    glfwSwapBuffers(window);
+    if (last) break;
+  }
+  glfwDestroyWindow(window);
+  glfwTerminate();
+  std::cout << "viewer: " << frames << " frames, " << viewer.steps() << " steps, hand "
+            << (viewer.manual() ? "manual" : "scripted") << ", " << viewer.grabbedNodes()
+            << " nodes grabbed, " << (viewer.stable() ? "stable" : "unstable: " + viewer.failure())
+            << "\n";
+  return viewer.stable() ? 0 : 3;
+}
+
+}  // namespace torsion::viewer

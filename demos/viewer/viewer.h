@@ -1,0 +1,29 @@
+#pragma once
+// The interactive viewer: a scene stepping live in a GLFW window, drawn by torsion_render's
+// Renderer. Input (real, or synthetic from a script for tests) goes through one set of handlers:
+//   camera   left drag orbit, right or middle drag pan, wheel zoom, F reframe
+//   hand     M take or leave manual control of the first hand (a new one when the scene has
+//            none); arrows / PageUp / PageDown move it along x / y / z, with Shift rotate about
+//            those axes; Ctrl + left drag moves it in the screen plane; G grab, U release
+//   run      Space pause / run, N one step, R reset, Q or Escape quit
+//   settings T / Shift+T dt x2 / /2, E / Shift+E Young's modulus x1.5 / /1.5, P / Shift+P
+//            Poisson's ratio +-0.02, D / Shift+D stiffness damping x2 / /2, C next solver; a
+//            change rebuilds the scene with it and restarts at t = 0
+
+#include <string>
+
+namespace torsion::viewer {
+
+struct ViewerOptions {
+  std::string scene;
+  int width = 1024, height = 720;
+  int threads = -1;
+  int frames = 0;          ///< > 0: quit after this many frames (tests)
+  std::string script;      ///< synthetic input, one event per line (see viewer.cpp)
+  std::string screenshot;  ///< PNG of the last frame, written on exit
+};
+
+/// Returns the process exit code: 0 clean exit, 1 bad input or no window, 3 simulation unstable.
+int runViewer(const ViewerOptions& options);
+
+}  // namespace torsion::viewer
