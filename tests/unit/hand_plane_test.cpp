@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <iterator>
 #include <limits>
 #include <map>
 #include <numeric>
@@ -592,6 +593,54 @@ TEST(Hand, FailedGrabIsAnErrorAndTheHandGrabsAgainElsewhere) {
                  (body.model().mesh().restPositions()[static_cast<size_t>(node)].z() + 0.01)));
   }
   EXPECT_GT(moved, 1e-6);
+}
+
+TEST(Hand, TwoHandsAndFixedNodesOnOneBodyHoldTheirOwnPatchesInEquilibrium) {
+  TwistRig rig(dampedMaterial());
+  FemBody& body = *rig.body;
+  Hand middle(body, "middle"), end(body, "end");
+  const Eigen::Vector3d a(0, 0, 5), b(0, 0, 9.9);
+  ASSERT_TRUE(middle.grab(makeFrame(a), rig.world.time()).ok());
+  ASSERT_TRUE(end.grab(makeFrame(b), rig.world.time()).ok());
+  std::set<int> shared;
+  std::set_intersection(middle.grabbedNodes().begin(), middle.grabbedNodes().end(),
+                        end.grabbedNodes().begin(), end.grabbedNodes().end(),
+                        std::inserter(shared, shared.begin()));
+  EXPECT_TRUE(shared.empty());
+  std::vector<Eigen::Vector3d> rest;
+  for (int n = 0; n < body.model().nodeCount(); ++n)
+    rest.push_back(body.state().position(n));
+
+  // The middle ring turns 0.1 rad one way, the end ring 0.2 rad the other, then both hold.
+  const Frame turned_a = makeFrame(a, about(Eigen::Vector3d::UnitZ(), 0.1));
+  const Frame turned_b = makeFrame(b, about(Eigen::Vector3d::UnitZ(), -0.2));
+  for (int s = 1; s <= 300; ++s) {
+    const double f = std::min(1.0, s / 20.0);
+    middle.moveTo(makeFrame(a, about(Eigen::Vector3d::UnitZ(), 0.1 * f)));
+    end.moveTo(makeFrame(b, about(Eigen::Vector3d::UnitZ(), -0.2 * f)));
+    const WorldStepReport r = rig.world.step();
+    ASSERT_TRUE(r.ok) << r.message;
+  }
+  for (int node : middle.grabbedNodes()) {
+    EXPECT_LT((body.state().position(node) - turned_a.toWorld(rest[size_t(node)] - a)).norm(),
+              1e-12);
+  }
+  for (int node : end.grabbedNodes()) {
+    EXPECT_LT((body.state().position(node) - turned_b.toWorld(rest[size_t(node)] - b)).norm(),
+              1e-12);
+  }
+  // At rest the three supports balance: the torques about the axis sum to zero.
+  const double t_middle = middle.wrench().torque.z();
+  const double t_end = end.wrench().torque.z();
+  const double t_base = body.groupWrench(0, Eigen::Vector3d::Zero()).torque.z();
+  EXPECT_LT(t_middle, 0);  // the body resists the middle's +z turn
+  EXPECT_GT(t_end, 0);
+  EXPECT_LT(std::abs(t_middle + t_end + t_base), 0.01 * std::abs(t_end));
+  // Between the hands the twist is -0.3 rad over 4.9 m, below them 0.1 rad over 5 m: the end
+  // hand carries 0.3 / 4.9 against 0.1 / 5 of the base's rate, torque in proportion (+-10 %:
+  // the rings' grabbed bands shorten the free lengths a little).
+  EXPECT_GT(t_base, 0);  // the body drags the base along the middle's turn
+  EXPECT_NEAR(t_end / t_base, (0.3 / 4.9) / (0.1 / 5), 0.1 * (0.3 / 4.9) / (0.1 / 5));
 }
 
 }  // namespace
