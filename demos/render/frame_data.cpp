@@ -7,17 +7,10 @@
 #include <algorithm>
 #include <cmath>
 
+#include "torsion/bullet/bt_conversions.h"
 #include "torsion/fem/corotated_element.h"
 
 namespace torsion::render {
-
-namespace {
-
-Eigen::Vector3d toEigen(const btVector3& v) {
-  return {v.x(), v.y(), v.z()};
-}
-
-}  // namespace
 
 std::vector<double> tetVonMises(const FemBody& body) {
   const FemModel& model = body.model();

@@ -6,6 +6,7 @@
 
 #include <memory>
 
+#include "torsion/bullet/bt_conversions.h"
 #include "torsion/bullet/fem_world.h"
 #include "torsion/contact/ball_mesh.h"
 #include "torsion/mesh/box_mesh.h"
@@ -52,10 +53,6 @@ inline FemBody* addBox(FemWorld& world, const std::string& name, const Eigen::Ve
   Result<FemBody*> body = world.addBody(name, mesh.value(), m);
   EXPECT_TRUE(body.ok()) << (body.ok() ? "" : body.error().message);
   return body.value();
-}
-
-inline Eigen::Vector3d toEigen(const btVector3& v) {
-  return Eigen::Vector3d(v.x(), v.y(), v.z());
 }
 
 inline Eigen::Vector3d centreOfMass(const FemBody& body) {

@@ -80,8 +80,7 @@ TEST(BuildTetMesh, FoldedMeshWithoutBoundaryIsRefused) {
   // twice, so no boundary surface at all.
   const std::string nodes =
       "8 3\n0 0 0 0\n1 1 0 0\n2 0 1 0\n3 1 1 0\n4 0 4 1\n5 1 0 1\n6 0 1 5\n7 1 1 9\n";
-  const std::string tets =
-      "5 4 0\n0 0 1 2 4\n1 0 2 1 7\n2 0 1 4 7\n3 1 4 2 7\n4 0 2 4 7\n";
+  const std::string tets = "5 4 0\n0 0 1 2 4\n1 0 2 1 7\n2 0 1 4 7\n3 1 4 2 7\n4 0 2 4 7\n";
   Result<RawTetMesh> raw = parseTetGen(nodes, "m.node", tets, "m.ele");
   ASSERT_TRUE(raw.ok()) << raw.error().message;
   EXPECT_TRUE(failsWith(buildTetMesh(std::move(raw).value()), {"m.ele:", "overlap"}));

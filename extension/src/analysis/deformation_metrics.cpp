@@ -1,7 +1,7 @@
 #include "torsion/analysis/deformation_metrics.h"
 
-#include <Eigen/LU>
 #include <Eigen/Eigenvalues>
+#include <Eigen/LU>
 #include <algorithm>
 #include <cmath>
 

@@ -1,12 +1,7 @@
 #include "torsion/bullet/fem_body.h"
 
+#include "torsion/bullet/bt_conversions.h"
 namespace torsion {
-
-namespace {
-btVector3 toBt(const Eigen::Vector3d& v) {
-  return btVector3(v.x(), v.y(), v.z());
-}
-}  // namespace
 
 FemBody::FemBody(std::string name, std::shared_ptr<const FemModel> model,
                  const SolverSettings& settings, const Parallel& parallel,

@@ -9,25 +9,13 @@
 #include <algorithm>
 #include <cmath>
 
+#include "torsion/bullet/bt_conversions.h"
 #include "torsion/contact/shape_distance.h"
+#include "torsion/solve/pcg_iterations.h"
 
 namespace torsion {
 
 namespace {
-
-Eigen::Vector3d toEigen(const btVector3& v) {
-  return Eigen::Vector3d(v.x(), v.y(), v.z());
-}
-btVector3 toBt(const Eigen::Vector3d& v) {
-  return btVector3(v.x(), v.y(), v.z());
-}
-Eigen::Matrix3d toEigen(const btMatrix3x3& m) {
-  Eigen::Matrix3d out;
-  for (int r = 0; r < 3; ++r)
-    for (int c = 0; c < 3; ++c)
-      out(r, c) = m[r][c];
-  return out;
-}
 
 // Velocity of the rigid point at lever r: J V = v + omega x r.
 Eigen::Vector3d pointVelocity(const Vector6d& V, const Eigen::Vector3d& r) {
@@ -369,43 +357,12 @@ LinearSolveReport RigidContactSolver::conjugateGradient(const SystemOperator& op
                                                         const Eigen::VectorXd& beta,
                                                         const SolverSettings& settings,
                                                         Eigen::VectorXd& q) {
-  LinearSolveReport report;
-  const double reference = beta.norm();
-  applyOperator(op, q, w_);
-  r_ = beta - w_;
-  double residual = r_.norm();
-  if (reference == 0.0 || residual <= settings.tolerance * reference) {
-    report.relative_residual = reference > 0 ? residual / reference : 0.0;
-    report.converged = true;
-    return report;
-  }
-  precondition(r_, z_);
-  p_ = z_;
-  double rz = r_.dot(z_);
-  for (int k = 0; k < settings.max_iterations; ++k) {
-    applyOperator(op, p_, w_);
-    const double pw = p_.dot(w_);
-    if (!(pw > 0)) {
-      report.breakdown = true;
-      break;
-    }
-    const double alpha = rz / pw;
-    q += alpha * p_;
-    r_ -= alpha * w_;
-    report.iterations = k + 1;
-    residual = r_.norm();
-    if (residual <= settings.tolerance * reference) {
-      report.converged = true;
-      break;
-    }
-    precondition(r_, z_);
-    const double rz_next = r_.dot(z_);
-    p_ = z_ + (rz_next / rz) * p_;
-    rz = rz_next;
-  }
-  report.relative_residual = residual / reference;
-  if (!std::isfinite(report.relative_residual)) report.breakdown = true;
-  return report;
+  applyOperator(op, q, cg_.q);
+  r_ = beta - cg_.q;
+  return pcgIterations(
+      [&](const Eigen::VectorXd& in, Eigen::VectorXd& out) { applyOperator(op, in, out); },
+      [&](const Eigen::VectorXd& in, Eigen::VectorXd& out) { precondition(in, out); }, beta.norm(),
+      settings, q, r_, cg_);
 }
 
 bool RigidContactSolver::updateActiveSet(const Eigen::VectorXd& v, const Eigen::VectorXd& p,

@@ -13,16 +13,10 @@
 #include <cmath>
 #include <limits>
 
+#include "torsion/bullet/bt_conversions.h"
 namespace torsion {
 
 namespace {
-
-Eigen::Vector3d toEigen(const btVector3& v) {
-  return Eigen::Vector3d(v.x(), v.y(), v.z());
-}
-btVector3 toBt(const Eigen::Vector3d& v) {
-  return btVector3(v.x(), v.y(), v.z());
-}
 
 // Closed forms in the shape's local frame; the caller rotates the normal back.
 std::optional<SurfacePoint> sphereDistance(double radius, const Eigen::Vector3d& p) {

@@ -3,6 +3,8 @@
 #include <Eigen/LU>
 #include <cmath>
 
+#include "torsion/solve/pcg_iterations.h"
+
 namespace torsion {
 
 void ProjectedCg::precondition(const NodeConstraints& constraints, PreconditionerKind kind,
@@ -21,7 +23,6 @@ void ProjectedCg::precondition(const NodeConstraints& constraints, Preconditione
 LinearSolveReport ProjectedCg::solve(const SystemOperator& op, const NodeConstraints& constraints,
                                      const Eigen::VectorXd& b, const SolverSettings& settings,
                                      Eigen::VectorXd& v) {
-  LinearSolveReport report;
   const int n = constraints.nodeCount();
 
   // Preconditioner: inverse diagonal (stored as a diagonal matrix) or inverse 3x3 node blocks.
@@ -50,41 +51,15 @@ LinearSolveReport ProjectedCg::solve(const SystemOperator& op, const NodeConstra
   op.multiply(v, q_);
   r_ = b - q_;
   constraints.filter(r_);
-  double residual = r_.norm();
-  if (reference == 0.0 || residual <= settings.tolerance * reference) {
-    report.relative_residual = reference > 0 ? residual / reference : 0.0;
-    report.converged = true;
-    return report;
-  }
-
-  precondition(constraints, settings.preconditioner, r_, z_);
-  p_ = z_;
-  double rz = r_.dot(z_);
-  for (int k = 0; k < settings.max_iterations; ++k) {
-    op.multiply(p_, q_);
-    constraints.filter(q_);
-    const double pq = p_.dot(q_);
-    if (!(pq > 0)) {  // A is SPD on the free subspace: anything else means a broken system
-      report.breakdown = true;
-      break;
-    }
-    const double alpha = rz / pq;
-    v += alpha * p_;
-    r_ -= alpha * q_;
-    report.iterations = k + 1;
-    residual = r_.norm();
-    if (residual <= settings.tolerance * reference) {
-      report.converged = true;
-      break;
-    }
-    precondition(constraints, settings.preconditioner, r_, z_);
-    const double rz_next = r_.dot(z_);
-    p_ = z_ + (rz_next / rz) * p_;
-    rz = rz_next;
-  }
-  report.relative_residual = residual / reference;
-  if (!std::isfinite(report.relative_residual)) report.breakdown = true;
-  return report;
+  return pcgIterations(
+      [&](const Eigen::VectorXd& in, Eigen::VectorXd& out) {
+        op.multiply(in, out);
+        constraints.filter(out);
+      },
+      [&](const Eigen::VectorXd& in, Eigen::VectorXd& out) {
+        precondition(constraints, settings.preconditioner, in, out);
+      },
+      reference, settings, v, r_, scratch_);
 }
 
 }  // namespace torsion

@@ -157,7 +157,8 @@ class RigidContactSolver {
   // Solve workspace.
   std::vector<Eigen::Matrix3d> block_inverse_;
   std::vector<Eigen::Matrix<double, 6, 6>> rigid_inverse_;
-  Eigen::VectorXd v_c_, scratch_, product_, r_, z_, p_, w_, beta_, q_, rigid_scratch_;
+  Eigen::VectorXd v_c_, scratch_, product_, r_, beta_, q_, rigid_scratch_;
+  PcgScratch cg_;
 };
 
 }  // namespace torsion

@@ -11,6 +11,10 @@
 
 namespace torsion {
 
+struct PcgScratch {
+  Eigen::VectorXd z, p, q;  ///< workspace of pcgIterations (pcg_iterations.h)
+};
+
 struct LinearSolveReport {
   int iterations = 0;
   double relative_residual = 0;  ///< |S(b - A v)| / |S(b - A v_prescribed)|
@@ -33,7 +37,8 @@ class ProjectedCg {
                     const Eigen::VectorXd& r, Eigen::VectorXd& z) const;
 
   std::vector<Eigen::Matrix3d> block_inverse_;
-  Eigen::VectorXd r_, z_, p_, q_, prescribed_only_;
+  Eigen::VectorXd r_, q_, prescribed_only_;
+  PcgScratch scratch_;
 };
 
 }  // namespace torsion
