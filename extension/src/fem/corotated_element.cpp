@@ -28,9 +28,18 @@ Eigen::Matrix3d deformationGradient(const std::array<Eigen::Vector3d, 4>& x,
 
 std::array<Eigen::Vector3d, 4> corotatedForces(const Eigen::Matrix3d& F, const Eigen::Matrix3d& R,
                                                const TetRestData& rest, double mu, double lambda) {
+  return corotatedResponse(F, R, rest, mu, lambda).forces;
+}
+
+CorotatedResponse corotatedResponse(const Eigen::Matrix3d& F, const Eigen::Matrix3d& R,
+                                    const TetRestData& rest, double mu, double lambda) {
   const Eigen::Matrix3d RtF = R.transpose() * F;
   const Eigen::Matrix3d strain = 0.5 * (RtF + RtF.transpose()) - Eigen::Matrix3d::Identity();
-  return nodeForces(R * linearStress(strain, mu, lambda), rest);
+  const double trace = strain.trace();
+  CorotatedResponse response;
+  response.forces = nodeForces(R * linearStress(strain, mu, lambda), rest);
+  response.energy = rest.volume * (mu * strain.squaredNorm() + 0.5 * lambda * trace * trace);
+  return response;
 }
 
 std::array<Eigen::Vector3d, 4> corotatedForceDifferential(const std::array<Eigen::Vector3d, 4>& dx,
@@ -45,10 +54,7 @@ std::array<Eigen::Vector3d, 4> corotatedForceDifferential(const std::array<Eigen
 
 double corotatedEnergy(const Eigen::Matrix3d& F, const Eigen::Matrix3d& R, const TetRestData& rest,
                        double mu, double lambda) {
-  const Eigen::Matrix3d RtF = R.transpose() * F;
-  const Eigen::Matrix3d strain = 0.5 * (RtF + RtF.transpose()) - Eigen::Matrix3d::Identity();
-  const double trace = strain.trace();
-  return rest.volume * (mu * strain.squaredNorm() + 0.5 * lambda * trace * trace);
+  return corotatedResponse(F, R, rest, mu, lambda).energy;
 }
 
 std::array<Eigen::Matrix3d, 4> corotatedDiagonalBlocks(const Eigen::Matrix3d& R,

@@ -30,9 +30,15 @@ Eigen::Matrix3d extractRotation(const Eigen::Matrix3d& F, Eigen::Quaterniond& q,
         R.col(0).cross(F.col(0)) + R.col(1).cross(F.col(1)) + R.col(2).cross(F.col(2));
     const double omega_den =
         std::abs(R.col(0).dot(F.col(0)) + R.col(1).dot(F.col(1)) + R.col(2).dot(F.col(2))) + 1e-9;
-    const Eigen::Vector3d omega = omega_num / omega_den;
+    Eigen::Vector3d omega = omega_num / omega_den;
     const double angle_sq = omega.squaredNorm();
     if (angle_sq < tolerance * tolerance) break;
+    // Near the fixed point omega is (tr(S) I - S) / tr(S) times the remaining rotation (S the
+    // stretch), i.e. 2/3 of it for a nearly rigid tet. Scaling by 3/2 makes that a full step;
+    // for any positive stretch the gain 1.5 (1 - s_i / tr S) stays in (0, 1.5), inside the
+    // (0, 2) that converges, so large stretch only slows it. Far from the fixed point (cold
+    // starts) the plain step is kept.
+    if (angle_sq < 0.25) omega *= 1.5;
     // Rotate q by omega. The paper uses the exact exponential; a normalised first-order
     // quaternion (1, omega / 2) has the same fixed point and needs no sin/cos. Large first
     // steps (cold starts) still move toward the fixed point, just less than the full angle.

@@ -57,8 +57,9 @@ double ImplicitStepper::computeElasticForces(FemState& state) {
         x[a] = state.positions.segment<3>(3 * tet[a]);
       const Eigen::Matrix3d F = deformationGradient(x, rest.rest_shape_inverse);
       rotations[ti] = extractRotation(F, state.tet_rotations[ti]);
-      tet_forces_[ti] = corotatedForces(F, rotations[ti], rest, mu, lambda);
-      tet_energy_[ti] = corotatedEnergy(F, rotations[ti], rest, mu, lambda);
+      const CorotatedResponse response = corotatedResponse(F, rotations[ti], rest, mu, lambda);
+      tet_forces_[ti] = response.forces;
+      tet_energy_[ti] = response.energy;
     }
   });
   system_.gather(tet_forces_, 1.0, elastic_forces_);

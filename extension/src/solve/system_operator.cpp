@@ -1,19 +1,25 @@
 #include "torsion/solve/system_operator.h"
 
-#include "torsion/fem/corotated_element.h"
+#include <algorithm>
 
 namespace torsion {
 
 namespace {
 constexpr int kTetGrain = 512;
-constexpr int kNodeGrain = 512;
+constexpr int kNodeGrain = 256;
+
+// Shape-function gradients of a tet's four nodes from its inverse rest shape.
+std::array<Eigen::Vector3d, 4> shapeGradients(const Eigen::Matrix3d& B) {
+  return {Eigen::Vector3d(-(B.row(0) + B.row(1) + B.row(2)).transpose()), B.row(0).transpose(),
+          B.row(1).transpose(), B.row(2).transpose()};
+}
 }  // namespace
 
 SystemOperator::SystemOperator(std::shared_ptr<const FemModel> model, const Parallel& parallel)
     : model_(std::move(model)), parallel_(parallel) {
   const TetMesh& mesh = model_->mesh();
   rotations_.assign(static_cast<size_t>(mesh.tetCount()), Eigen::Matrix3d::Identity());
-  tet_scratch_.resize(static_cast<size_t>(mesh.tetCount()));
+  rotated_gradients_.resize(static_cast<size_t>(mesh.tetCount()));
   const CompressedRows& node_tets = mesh.nodeTets();
   node_offsets_ = node_tets.offsets;
   node_entries_.resize(node_tets.items.size());
@@ -27,6 +33,93 @@ SystemOperator::SystemOperator(std::shared_ptr<const FemModel> model, const Para
       node_entries_[static_cast<size_t>(k)] = 4 * t + local;
     }
   }
+  buildPattern();
+}
+
+void SystemOperator::buildPattern() {
+  const TetMesh& mesh = model_->mesh();
+  const int n = mesh.nodeCount();
+  row_offsets_.assign(static_cast<size_t>(n) + 1, 0);
+  block_columns_.clear();
+  entry_slots_.assign(4 * node_entries_.size(), -1);
+  diagonal_slots_.assign(static_cast<size_t>(n), -1);
+  std::vector<int> columns;
+  for (int row = 0; row < n; ++row) {
+    const int begin = node_offsets_[static_cast<size_t>(row)];
+    const int end = node_offsets_[static_cast<size_t>(row) + 1];
+    columns.assign(1, row);  // a node without tets still gets its (mass) diagonal block
+    for (int k = begin; k < end; ++k) {
+      const Tet& tet = mesh.tets()[static_cast<size_t>(node_entries_[static_cast<size_t>(k)] / 4)];
+      columns.insert(columns.end(), tet.begin(), tet.end());
+    }
+    std::sort(columns.begin(), columns.end());
+    columns.erase(std::unique(columns.begin(), columns.end()), columns.end());
+    const int row_begin = static_cast<int>(block_columns_.size());
+    block_columns_.insert(block_columns_.end(), columns.begin(), columns.end());
+    row_offsets_[static_cast<size_t>(row) + 1] = static_cast<int>(block_columns_.size());
+    auto slot_of = [&](int column) {
+      return row_begin + static_cast<int>(std::lower_bound(columns.begin(), columns.end(), column) -
+                                          columns.begin());
+    };
+    diagonal_slots_[static_cast<size_t>(row)] = slot_of(row);
+    for (int k = begin; k < end; ++k) {
+      const Tet& tet = mesh.tets()[static_cast<size_t>(node_entries_[static_cast<size_t>(k)] / 4)];
+      for (size_t b = 0; b < 4; ++b)
+        entry_slots_[4 * static_cast<size_t>(k) + b] = slot_of(tet[b]);
+    }
+  }
+  block_values_.assign(block_columns_.size(), Eigen::Matrix3d::Zero());
+  assembled_ = false;
+}
+
+void SystemOperator::assemble() const {
+  if (assembled_) return;
+  const TetMesh& mesh = model_->mesh();
+  const double mu = model_->material().mu();
+  const double lambda = model_->material().lambda();
+  // Pass 1, per tet: the rotated shape gradients R g_a.
+  parallel_.forRange(mesh.tetCount(), kTetGrain, [&](int begin, int end) {
+    for (int t = begin; t < end; ++t) {
+      const size_t ti = static_cast<size_t>(t);
+      const std::array<Eigen::Vector3d, 4> g =
+          shapeGradients(model_->tetRestData()[ti].rest_shape_inverse);
+      for (size_t a = 0; a < 4; ++a)
+        rotated_gradients_[ti][a] = rotations_[ti] * g[a];
+    }
+  });
+  // Pass 2, per block row: K_ab = V (mu (g_a . g_b) I + mu (R g_b)(R g_a)^T + lambda (R g_a)(R
+  // g_b)^T) for every tet of the row's node a (rotating the rest-frame block R Ke_ab R^T).
+  parallel_.forRange(mesh.nodeCount(), kNodeGrain, [&](int begin, int end) {
+    for (int row = begin; row < end; ++row) {
+      const size_t r = static_cast<size_t>(row);
+      for (int s = row_offsets_[r]; s < row_offsets_[r + 1]; ++s)
+        block_values_[static_cast<size_t>(s)].setZero();
+      for (int k = node_offsets_[r]; k < node_offsets_[r + 1]; ++k) {
+        const int entry = node_entries_[static_cast<size_t>(k)];
+        const size_t t = static_cast<size_t>(entry / 4), a = static_cast<size_t>(entry % 4);
+        const TetRestData& rest = model_->tetRestData()[t];
+        const std::array<Eigen::Vector3d, 4>& rg = rotated_gradients_[t];
+        const double mu_v = mu * rest.volume, lambda_v = lambda * rest.volume;
+        const Eigen::Vector3d& u = rg[a];
+        const Eigen::Vector3d q = lambda_v * u;
+        for (size_t b = 0; b < 4; ++b) {
+          const Eigen::Vector3d& w = rg[b];
+          const Eigen::Vector3d p = mu_v * w;
+          // g_a . g_b is rotation-invariant: take it from the rotated gradients.
+          const double diagonal = mu_v * u.dot(w);
+          double* block =
+              block_values_[static_cast<size_t>(entry_slots_[4 * static_cast<size_t>(k) + b])]
+                  .data();  // column-major
+          for (int c = 0; c < 3; ++c) {
+            for (int i = 0; i < 3; ++i)
+              block[3 * c + i] += p[i] * u[c] + q[i] * w[c];
+            block[4 * c] += diagonal;
+          }
+        }
+      }
+    }
+  });
+  assembled_ = true;
 }
 
 void SystemOperator::setCoefficients(double mass_coefficient, double stiffness_coefficient) {
@@ -36,28 +129,21 @@ void SystemOperator::setCoefficients(double mass_coefficient, double stiffness_c
 
 void SystemOperator::apply(const Eigen::VectorXd& y, Eigen::VectorXd& out, double mass_scale,
                            double stiffness_scale) const {
-  const TetMesh& mesh = model_->mesh();
-  const double mu = model_->material().mu();
-  const double lambda = model_->material().lambda();
-  parallel_.forRange(mesh.tetCount(), kTetGrain, [&](int begin, int end) {
-    for (int t = begin; t < end; ++t) {
-      const Tet& tet = mesh.tets()[static_cast<size_t>(t)];
-      std::array<Eigen::Vector3d, 4> dx;
-      for (size_t a = 0; a < 4; ++a)
-        dx[a] = y.segment<3>(3 * tet[a]);
-      tet_scratch_[static_cast<size_t>(t)] =
-          corotatedForceDifferential(dx, rotations_[static_cast<size_t>(t)],
-                                     model_->tetRestData()[static_cast<size_t>(t)], mu, lambda);
+  assemble();
+  const std::vector<double>& mass = model_->nodeMasses();
+  out.resize(y.size());
+  parallel_.forRange(model_->nodeCount(), kNodeGrain, [&](int begin, int end) {
+    for (int row = begin; row < end; ++row) {
+      const size_t r = static_cast<size_t>(row);
+      Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+      for (int s = row_offsets_[r]; s < row_offsets_[r + 1]; ++s) {
+        sum.noalias() += block_values_[static_cast<size_t>(s)] *
+                         y.segment<3>(3 * block_columns_[static_cast<size_t>(s)]);
+      }
+      out.segment<3>(3 * row) =
+          stiffness_scale * sum + (mass_scale * mass[r]) * y.segment<3>(3 * row);
     }
   });
-  out.resize(y.size());
-  gather(tet_scratch_, -stiffness_scale, out);
-  if (mass_scale != 0.0) {
-    const std::vector<double>& mass = model_->nodeMasses();
-    for (int n = 0; n < mesh.nodeCount(); ++n) {
-      out.segment<3>(3 * n) += mass_scale * mass[static_cast<size_t>(n)] * y.segment<3>(3 * n);
-    }
-  }
 }
 
 void SystemOperator::gather(const std::vector<std::array<Eigen::Vector3d, 4>>& tet_values,
@@ -86,35 +172,13 @@ void SystemOperator::multiplyStiffness(const Eigen::VectorXd& y, Eigen::VectorXd
 }
 
 void SystemOperator::diagonalBlocks(std::vector<Eigen::Matrix3d>& blocks) const {
-  // K_aa of one tet is R V (mu |g|^2 I + (mu + lambda) g g^T) R^T with g = grad N_a, which is
-  // V (mu |g|^2 I + (mu + lambda) (R g)(R g)^T): built per node straight from the tet's rotation,
-  // with no per-tet buffer (see corotatedDiagonalBlocks for the same formula per tet).
-  const TetMesh& mesh = model_->mesh();
-  const double mu = model_->material().mu();
-  const double mu_plus_lambda = mu + model_->material().lambda();
+  assemble();
   const std::vector<double>& mass = model_->nodeMasses();
-  blocks.resize(static_cast<size_t>(mesh.nodeCount()));
-  parallel_.forRange(mesh.nodeCount(), kNodeGrain, [&](int begin, int end) {
-    for (int n = begin; n < end; ++n) {
-      Eigen::Matrix3d k = Eigen::Matrix3d::Zero();
-      for (int e = node_offsets_[static_cast<size_t>(n)];
-           e < node_offsets_[static_cast<size_t>(n) + 1]; ++e) {
-        const int entry = node_entries_[static_cast<size_t>(e)];
-        const int t = entry / 4, a = entry % 4;
-        const TetRestData& rest = model_->tetRestData()[static_cast<size_t>(t)];
-        const Eigen::Matrix3d& B = rest.rest_shape_inverse;
-        const Eigen::Vector3d g =
-            a == 0 ? Eigen::Vector3d(-(B.row(0) + B.row(1) + B.row(2)).transpose())
-                   : Eigen::Vector3d(B.row(a - 1).transpose());
-        const Eigen::Vector3d rg = rotations_[static_cast<size_t>(t)] * g;
-        k.diagonal().array() += rest.volume * mu * g.squaredNorm();
-        k.noalias() += (rest.volume * mu_plus_lambda) * rg * rg.transpose();
-      }
-      blocks[static_cast<size_t>(n)] =
-          mass_coefficient_ * mass[static_cast<size_t>(n)] * Eigen::Matrix3d::Identity() +
-          stiffness_coefficient_ * k;
-    }
-  });
+  blocks.resize(static_cast<size_t>(model_->nodeCount()));
+  for (size_t n = 0; n < blocks.size(); ++n) {
+    blocks[n] = mass_coefficient_ * mass[n] * Eigen::Matrix3d::Identity() +
+                stiffness_coefficient_ * block_values_[static_cast<size_t>(diagonal_slots_[n])];
+  }
 }
 
 }  // namespace torsion

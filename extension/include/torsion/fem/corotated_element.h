@@ -25,6 +25,14 @@ Eigen::Matrix3d deformationGradient(const std::array<Eigen::Vector3d, 4>& x,
 std::array<Eigen::Vector3d, 4> corotatedForces(const Eigen::Matrix3d& F, const Eigen::Matrix3d& R,
                                                const TetRestData& rest, double mu, double lambda);
 
+/// Forces and energy together (one strain evaluation): what a time step needs.
+struct CorotatedResponse {
+  std::array<Eigen::Vector3d, 4> forces;
+  double energy = 0;
+};
+CorotatedResponse corotatedResponse(const Eigen::Matrix3d& F, const Eigen::Matrix3d& R,
+                                    const TetRestData& rest, double mu, double lambda);
+
 /// df = -K dx for nodal displacements dx (R held fixed): the stiffness product, negated.
 std::array<Eigen::Vector3d, 4> corotatedForceDifferential(const std::array<Eigen::Vector3d, 4>& dx,
                                                           const Eigen::Matrix3d& R,
