@@ -37,6 +37,9 @@ SystemOperator::SystemOperator(std::shared_ptr<const FemModel> model, const Para
 }
 
 void SystemOperator::buildPattern() {
+  // K is symmetric, so a block row stores only its diagonal block and the blocks right of it
+  // (columns > row); the blocks left of the diagonal are read, transposed, from the rows that
+  // store them. Assembly computes 10 blocks per tet instead of 16.
   const TetMesh& mesh = model_->mesh();
   const int n = mesh.nodeCount();
   row_offsets_.assign(static_cast<size_t>(n) + 1, 0);
@@ -50,22 +53,44 @@ void SystemOperator::buildPattern() {
     columns.assign(1, row);  // a node without tets still gets its (mass) diagonal block
     for (int k = begin; k < end; ++k) {
       const Tet& tet = mesh.tets()[static_cast<size_t>(node_entries_[static_cast<size_t>(k)] / 4)];
-      columns.insert(columns.end(), tet.begin(), tet.end());
+      for (int node : tet)
+        if (node > row) columns.push_back(node);
     }
     std::sort(columns.begin(), columns.end());
     columns.erase(std::unique(columns.begin(), columns.end()), columns.end());
     const int row_begin = static_cast<int>(block_columns_.size());
     block_columns_.insert(block_columns_.end(), columns.begin(), columns.end());
     row_offsets_[static_cast<size_t>(row) + 1] = static_cast<int>(block_columns_.size());
-    auto slot_of = [&](int column) {
-      return row_begin + static_cast<int>(std::lower_bound(columns.begin(), columns.end(), column) -
-                                          columns.begin());
-    };
-    diagonal_slots_[static_cast<size_t>(row)] = slot_of(row);
+    diagonal_slots_[static_cast<size_t>(row)] = row_begin;  // columns[0] == row
     for (int k = begin; k < end; ++k) {
       const Tet& tet = mesh.tets()[static_cast<size_t>(node_entries_[static_cast<size_t>(k)] / 4)];
-      for (size_t b = 0; b < 4; ++b)
-        entry_slots_[4 * static_cast<size_t>(k) + b] = slot_of(tet[b]);
+      for (size_t b = 0; b < 4; ++b) {
+        if (tet[b] < row) continue;
+        entry_slots_[4 * static_cast<size_t>(k) + b] =
+            row_begin + static_cast<int>(std::lower_bound(columns.begin(), columns.end(), tet[b]) -
+                                         columns.begin());
+      }
+    }
+  }
+  // Blocks left of the diagonal of row c: the stored blocks (row r < c, column c), by row.
+  lower_offsets_.assign(static_cast<size_t>(n) + 1, 0);
+  for (int row = 0; row < n; ++row) {
+    for (int s = row_offsets_[static_cast<size_t>(row)] + 1;
+         s < row_offsets_[static_cast<size_t>(row) + 1]; ++s)
+      ++lower_offsets_[static_cast<size_t>(block_columns_[static_cast<size_t>(s)]) + 1];
+  }
+  for (int row = 0; row < n; ++row)
+    lower_offsets_[static_cast<size_t>(row) + 1] += lower_offsets_[static_cast<size_t>(row)];
+  lower_slots_.assign(static_cast<size_t>(lower_offsets_.back()), -1);
+  lower_columns_.assign(lower_slots_.size(), -1);
+  std::vector<int> fill(lower_offsets_.begin(), lower_offsets_.end() - 1);
+  for (int row = 0; row < n; ++row) {  // ascending rows: each list comes out sorted
+    for (int s = row_offsets_[static_cast<size_t>(row)] + 1;
+         s < row_offsets_[static_cast<size_t>(row) + 1]; ++s) {
+      const size_t at =
+          static_cast<size_t>(fill[static_cast<size_t>(block_columns_[static_cast<size_t>(s)])]++);
+      lower_slots_[at] = s;
+      lower_columns_[at] = row;
     }
   }
   block_values_.assign(block_columns_.size(), Eigen::Matrix3d::Zero());
@@ -103,13 +128,13 @@ void SystemOperator::assemble() const {
         const Eigen::Vector3d& u = rg[a];
         const Eigen::Vector3d q = lambda_v * u;
         for (size_t b = 0; b < 4; ++b) {
+          const int slot = entry_slots_[4 * static_cast<size_t>(k) + b];
+          if (slot < 0) continue;  // left of the diagonal: stored by the other node's row
           const Eigen::Vector3d& w = rg[b];
           const Eigen::Vector3d p = mu_v * w;
           // g_a . g_b is rotation-invariant: take it from the rotated gradients.
           const double diagonal = mu_v * u.dot(w);
-          double* block =
-              block_values_[static_cast<size_t>(entry_slots_[4 * static_cast<size_t>(k) + b])]
-                  .data();  // column-major
+          double* block = block_values_[static_cast<size_t>(slot)].data();  // column-major
           for (int c = 0; c < 3; ++c) {
             for (int i = 0; i < 3; ++i)
               block[3 * c + i] += p[i] * u[c] + q[i] * w[c];
@@ -139,6 +164,11 @@ void SystemOperator::apply(const Eigen::VectorXd& y, Eigen::VectorXd& out, doubl
       for (int s = row_offsets_[r]; s < row_offsets_[r + 1]; ++s) {
         sum.noalias() += block_values_[static_cast<size_t>(s)] *
                          y.segment<3>(3 * block_columns_[static_cast<size_t>(s)]);
+      }
+      for (int l = lower_offsets_[r]; l < lower_offsets_[r + 1]; ++l) {
+        sum.noalias() +=
+            block_values_[static_cast<size_t>(lower_slots_[static_cast<size_t>(l)])].transpose() *
+            y.segment<3>(3 * lower_columns_[static_cast<size_t>(l)]);
       }
       out.segment<3>(3 * row) =
           stiffness_scale * sum + (mass_scale * mass[r]) * y.segment<3>(3 * row);

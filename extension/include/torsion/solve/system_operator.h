@@ -3,8 +3,10 @@
 //   A = M (1 + dt alpha) + (dt^2 + dt beta) K,   K = sum over tets of Re Ke Re^T,
 // with the rotations Re of this step. K is assembled once per step into 3x3 node blocks (block
 // rows = nodes, a row holds the node and its tet neighbours), so each CG product is a sparse
-// block product instead of a pass over every tet: measured 2.6x cheaper per product than the
-// matrix-free tet loop, and assembling costs about one such loop (docs/performance.md).
+// block product instead of a pass over every tet. Measured on the 8332-tet twist (callgrind,
+// docs/performance.md): a product takes 4.9x fewer instructions than the matrix-free tet loop
+// did and assembling costs about three such loops, so it pays from four products per step on
+// (a step at E = 1e5 takes about six; stiffer materials take more).
 // Assembly runs per block row over the row node's tets in ascending order, so K and every
 // product are identical for any thread count.
 
@@ -65,13 +67,18 @@ class SystemOperator {
   // Node -> its tets: entry k of row n is 4 * tet + local index, rows in node_offsets_.
   std::vector<int> node_entries_;
   std::vector<int> node_offsets_;
-  // Block-sparse K: block row n spans [row_offsets_[n], row_offsets_[n + 1]) of block_columns_ /
-  // block_values_; entry_slots_[4 k + b] is where node entry k's coupling to its tet's local
-  // node b lands; diagonal_slots_[n] is K_nn.
+  // Block-sparse K, upper triangle: block row n spans [row_offsets_[n], row_offsets_[n + 1]) of
+  // block_columns_ / block_values_, diagonal first; entry_slots_[4 k + b] is where node entry k's
+  // coupling to its tet's local node b lands (-1 left of the diagonal); diagonal_slots_[n] is K_nn.
   std::vector<int> row_offsets_;
   std::vector<int> block_columns_;
   std::vector<int> entry_slots_;
   std::vector<int> diagonal_slots_;
+  // Upper-triangle storage: row n also reads the blocks (row r < n, column n) transposed; they
+  // are lower_slots_[l] with r = lower_columns_[l], l in [lower_offsets_[n], lower_offsets_[n+1]).
+  std::vector<int> lower_offsets_;
+  std::vector<int> lower_slots_;
+  std::vector<int> lower_columns_;
   mutable std::vector<Eigen::Matrix3d> block_values_;
   mutable std::vector<std::array<Eigen::Vector3d, 4>> rotated_gradients_;  // R_t grad N_a
   mutable bool assembled_ = false;
