@@ -70,7 +70,12 @@ FrameData captureFrame(scene::BuiltScene& scene, double steps_per_second) {
   frame.step = world.stepCount();
   frame.steps_per_second = steps_per_second;
   frame.gravity = world.settings().gravity;
+  frame.camera = scene.spec.camera;
+  // Floor of the scale: the stress of a 1e-6 strain. Below it the values are round-off (a body
+  // at rest shows ~1e-11 Pa), and a scale fitted to them would paint noise.
   double stress_max = 0;
+  for (const auto& body : world.bodies())
+    stress_max = std::max(stress_max, 1e-6 * body->model().material().youngs_modulus);
 
   for (const auto& body_ptr : world.bodies()) {
     const FemBody& body = *body_ptr;

@@ -22,11 +22,18 @@ struct RenderOptions {
   double pixel_scale = 1;  ///< line widths, points and text grow by this (supersampling)
 };
 
-/// Size of one pixel of the HUD font, in framebuffer pixels.
+/// Grabbed nodes (the report's Figure 4.2): orange, a colour the stress map never takes.
+inline const Eigen::Vector3d kGrabbedOrange{1.0, 0.5, 0.0};
+
+/// Size of one pixel of the HUD font, in framebuffer pixels: about height / 480 picture pixels,
+/// a whole number of drawn pixels (half pixels when supersampled).
 double textScale(int height, const RenderOptions& options);
 /// Width of the 3D view: the picture minus the legend's strip on the right. Fit cameras with
 /// the aspect sceneViewportWidth / height.
 int sceneViewportWidth(int width, int height, const RenderOptions& options);
+/// Fraction of the picture's height covered by the HUD panel at the top left (0 without HUD):
+/// frameCamera keeps the scene below it.
+double hudHeightFraction(const FrameData& frame, int height, const RenderOptions& options);
 
 class Renderer {
  public:
@@ -43,7 +50,16 @@ class Renderer {
   void drawBodies(const FrameData& frame, const RenderOptions& options);
   void drawRigids(const FrameData& frame);
   void drawHands(const FrameData& frame, const RenderOptions& options);
+  // The 2D overlay (overlay.cpp), in pixels with y down.
   void drawOverlay(const FrameData& frame, int width, int height, const RenderOptions& options);
+  void drawHud(const FrameData& frame, double scale);
+  void drawNotes(const FrameData& frame, int height, double scale);
+  void drawLegend(const FrameData& frame, int width, int height, double scale);
+  void drawWrenchPlot(const WrenchHistory& history, double x, double y, double width, double scale);
+  /// A signed bar: a grey track of `width` with a coloured part from its middle, value / scale
+  /// of half the width long.
+  void drawBar(double x, double y, double width, double height, double value, double scale,
+               const Eigen::Vector3d& colour);
   /// Text at pixel (x, y) = its top-left corner, y down; returns the width drawn.
   double drawText(double x, double y, double scale, const std::string& text);
   void quad2d(double x0, double y0, double x1, double y1);
