@@ -62,6 +62,37 @@ Eigen::Vector3d stressColour(double s) {
   return (1 - f) * kStops[i] + f * kStops[i + 1];
 }
 
+std::vector<std::vector<int>> restStripes(const TetMesh& mesh) {
+  const Eigen::Vector3d lo = mesh.boundsMin(), hi = mesh.boundsMax();
+  const Eigen::Vector3d extent = hi - lo, centre = 0.5 * (lo + hi);
+  int a = 0;
+  extent.maxCoeff(&a);
+  const int b = (a + 1) % 3, c = (a + 2) % 3;
+  if (extent[a] < 2 * std::max(extent[b], extent[c]) || extent[b] <= 0 || extent[c] <= 0) return {};
+  // Nodes near the outline of the cross-section within +-0.15 rad of each quarter direction.
+  std::vector<std::vector<std::pair<double, int>>> lines(4);
+  for (int i : mesh.surfaceNodes()) {
+    const Eigen::Vector3d& p = mesh.restPositions()[static_cast<size_t>(i)];
+    const double u = 2 * (p[b] - centre[b]) / extent[b], v = 2 * (p[c] - centre[c]) / extent[c];
+    if (std::hypot(u, v) < 0.8) continue;  // an end face, inside the outline
+    const double angle = std::atan2(v, u);
+    for (int k = 0; k < 4; ++k) {
+      const double off = std::remainder(angle - k * M_PI / 2, 2 * M_PI);
+      if (std::abs(off) < 0.15) lines[static_cast<size_t>(k)].emplace_back(p[a], i);
+    }
+  }
+  std::vector<std::vector<int>> stripes;
+  for (auto& line : lines) {
+    if (line.size() < 3) continue;
+    std::sort(line.begin(), line.end());
+    std::vector<int> nodes;
+    for (const auto& entry : line)
+      nodes.push_back(entry.second);
+    stripes.push_back(std::move(nodes));
+  }
+  return stripes;
+}
+
 FrameData captureFrame(scene::BuiltScene& scene, double steps_per_second) {
   FemWorld& world = *scene.world;
   FrameData frame;
@@ -97,6 +128,7 @@ FrameData captureFrame(scene::BuiltScene& scene, double steps_per_second) {
         normals[static_cast<size_t>(v)] += area_normal;
       d.triangles.push_back({tri[0], tri[1], tri[2]});
     }
+    d.stripes = restStripes(mesh);
     d.normals.resize(static_cast<size_t>(n));
     for (int i = 0; i < n; ++i) {
       const double len = normals[static_cast<size_t>(i)].norm();

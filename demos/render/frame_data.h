@@ -24,7 +24,14 @@ struct BodyDrawData {
   std::vector<float> stress;                  ///< per node: von Mises stress, Pa (mean of its tets)
   std::vector<int> grabbed_nodes;             ///< nodes held by a hand, drawn orange
   std::vector<std::array<int, 3>> triangles;  ///< surface, counter-clockwise from outside
+  /// Surface nodes that lie on straight lines along an elongated body's rest shape (four, a
+  /// quarter turn apart), each in order: drawn as lines, they wind into helices when the body
+  /// twists and curve when it bends. Empty for a body that is not at least twice as long as wide.
+  std::vector<std::vector<int>> stripes;
 };
+
+/// The stripes of BodyDrawData for `mesh` (from its rest positions).
+std::vector<std::vector<int>> restStripes(const TetMesh& mesh);
 
 struct RigidDrawData {
   enum class Shape { kBox, kSphere, kPlane, kOther } shape = Shape::kOther;

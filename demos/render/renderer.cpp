@@ -18,6 +18,7 @@ void Renderer::draw(const FrameData& frame, const Camera& camera, int width, int
                     const RenderOptions& options) {
   const GlApi& gl = gl_;
   const int scene_width = sceneViewportWidth(width, height, options);
+  eye_ = camera.eye();
   gl.Viewport(0, 0, width, height);
   gl.ClearColor(0.95f, 0.95f, 0.96f, 1.0f);
   gl.Clear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
@@ -192,6 +193,7 @@ void Renderer::drawBodies(const FrameData& frame, const RenderOptions& options) 
       gl.Disable(GL_BLEND);
     }
     gl.DisableClientState(GL_VERTEX_ARRAY);
+    drawStripes(body, options);
     if (!body.grabbed_nodes.empty()) {
       gl.PointSize(static_cast<GLfloat>(4 * options.pixel_scale));
       gl.Color4d(kGrabbedOrange.x(), kGrabbedOrange.y(), kGrabbedOrange.z(), 1);
@@ -327,6 +329,31 @@ double Renderer::drawText(double x, double y, double scale, const std::string& t
   }
   gl_.End();
   return pen - x;
+}
+
+void Renderer::drawStripes(const BodyDrawData& body, const RenderOptions& options) {
+  // Without the depth test (the chords between nodes would dip under the bumpy surface and show
+  // dashed), but only segments whose both ends face the eye: the front of the body.
+  auto facing = [&](int i) {
+    const Eigen::Vector3f& p = body.positions[static_cast<size_t>(i)];
+    return body.normals[static_cast<size_t>(i)].cast<double>().dot(eye_ - p.cast<double>()) > 0;
+  };
+  gl_.Disable(GL_DEPTH_TEST);
+  gl_.LineWidth(static_cast<GLfloat>(1.5 * options.pixel_scale));
+  gl_.Color4d(0.97, 0.97, 0.99, 1);
+  gl_.Begin(GL_LINES);
+  for (const std::vector<int>& stripe : body.stripes) {
+    for (size_t k = 1; k < stripe.size(); ++k) {
+      if (!facing(stripe[k - 1]) || !facing(stripe[k])) continue;
+      for (int i : {stripe[k - 1], stripe[k]}) {
+        const Eigen::Vector3f& p = body.positions[static_cast<size_t>(i)];
+        gl_.Vertex3d(static_cast<double>(p.x()), static_cast<double>(p.y()),
+                     static_cast<double>(p.z()));
+      }
+    }
+  }
+  gl_.End();
+  gl_.Enable(GL_DEPTH_TEST);
 }
 
 }  // namespace torsion::render

@@ -1,9 +1,11 @@
 #pragma once
 // Draws a FrameData with OpenGL 1.x (compatibility profile; OSMesa and any desktop driver have
 // it): lit FEM surfaces coloured by von Mises stress with their mesh lines, grabbed nodes in
-// orange (the report's Figure 4.2), rigid bodies, the ground, each hand's axes (i red, j green,
-// k blue) and plane, and an overlay with the HUD (time, steps/s, wrenches as numbers and bars)
-// and the colour legend. Knows nothing of windows or files: the caller makes a context current.
+// orange (the report's Figure 4.2), light stripes along elongated bodies (they wind when twisted),
+// rigid bodies, the ground, each hand's axes (i red, j green, k blue) and plane, and an overlay
+// (overlay.cpp) with the HUD (time, steps/s, wrenches as magnitudes and bars), the colour legend
+// and the viewer's notes and wrench plot. Knows nothing of windows or files: the caller makes a
+// context current.
 
 #include <string>
 #include <vector>
@@ -48,6 +50,8 @@ class Renderer {
   void drawBackground();
   void drawGround(const FrameData& frame, const Eigen::Vector3d& up);
   void drawBodies(const FrameData& frame, const RenderOptions& options);
+  /// The body's stripes (BodyDrawData::stripes) as light lines on its surface.
+  void drawStripes(const BodyDrawData& body, const RenderOptions& options);
   void drawRigids(const FrameData& frame);
   void drawHands(const FrameData& frame, const RenderOptions& options);
   // The 2D overlay (overlay.cpp), in pixels with y down.
@@ -66,6 +70,7 @@ class Renderer {
 
   const GlApi& gl_;
   std::vector<float> colours_;  // scratch: per-vertex RGB of the body being drawn
+  Eigen::Vector3d eye_ = Eigen::Vector3d::Zero();  // the camera's position in this draw()
 };
 
 }  // namespace torsion::render
