@@ -69,26 +69,36 @@ std::vector<std::vector<int>> restStripes(const TetMesh& mesh) {
   extent.maxCoeff(&a);
   const int b = (a + 1) % 3, c = (a + 2) % 3;
   if (extent[a] < 2 * std::max(extent[b], extent[c]) || extent[b] <= 0 || extent[c] <= 0) return {};
-  // Nodes near the outline of the cross-section within +-0.15 rad of each quarter direction.
-  std::vector<std::vector<std::pair<double, int>>> lines(4);
+  // Nodes on the outline of the cross-section within +-0.15 rad of each quarter direction; of
+  // those, one per slice of the length (the closest in angle), so a fine mesh gives a straight
+  // line, not a zigzag between neighbours side by side.
+  constexpr int kSlices = 48;
+  struct Pick {
+    double off = 1e9;
+    int node = -1;
+  };
+  std::vector<std::array<Pick, kSlices>> lines(4);
   for (int i : mesh.surfaceNodes()) {
     const Eigen::Vector3d& p = mesh.restPositions()[static_cast<size_t>(i)];
     const double u = 2 * (p[b] - centre[b]) / extent[b], v = 2 * (p[c] - centre[c]) / extent[c];
     if (std::hypot(u, v) < 0.8) continue;  // an end face, inside the outline
     const double angle = std::atan2(v, u);
-    for (int k = 0; k < 4; ++k) {
-      const double off = std::remainder(angle - k * M_PI / 2, 2 * M_PI);
-      if (std::abs(off) < 0.15) lines[static_cast<size_t>(k)].emplace_back(p[a], i);
+    const int slice =
+        std::clamp(static_cast<int>((p[a] - lo[a]) / extent[a] * kSlices), 0, kSlices - 1);
+    for (size_t k = 0; k < 4; ++k) {
+      const double off =
+          std::abs(std::remainder(angle - static_cast<double>(k) * M_PI / 2, 2 * M_PI));
+      Pick& pick = lines[k][static_cast<size_t>(slice)];
+      if (off < 0.15 && off < pick.off) pick = {off, i};
     }
   }
   std::vector<std::vector<int>> stripes;
-  for (auto& line : lines) {
-    if (line.size() < 3) continue;
-    std::sort(line.begin(), line.end());
+  for (const auto& line : lines) {
     std::vector<int> nodes;
-    for (const auto& entry : line)
-      nodes.push_back(entry.second);
-    stripes.push_back(std::move(nodes));
+    for (const Pick& pick : line) {
+      if (pick.node >= 0) nodes.push_back(pick.node);
+    }
+    if (nodes.size() >= 3) stripes.push_back(std::move(nodes));
   }
   return stripes;
 }
