@@ -69,10 +69,13 @@ void Camera::zoom(double factor) {
   distance = std::clamp(distance * factor, 1e-3, 1e6);
 }
 
-Camera frameCamera(const FrameData& frame, double aspect) {
+Camera frameCamera(const FrameData& frame, double aspect, double top_reserved) {
   Camera camera;
   const Eigen::Vector3d extent = frame.bounds.sizes();
-  if (frame.gravity.norm() > 1e-12) {
+  const double free_height = 1 - std::clamp(top_reserved, 0.0, 0.5);
+  if (frame.camera.up) {
+    camera.up = *frame.camera.up;
+  } else if (frame.gravity.norm() > 1e-12) {
     camera.up = -frame.gravity.normalized();
   } else {
     int longest = 0;
@@ -84,14 +87,15 @@ Camera frameCamera(const FrameData& frame, double aspect) {
   const double along_a = std::abs(a.dot(extent.cwiseProduct(a.cwiseSign()))),
                along_b = std::abs(b.dot(extent.cwiseProduct(b.cwiseSign())));
   // Look mostly across the longer horizontal extent, a little along it.
-  camera.yaw = along_a >= along_b ? 1.2 : 0.37;
-  camera.pitch = 0.38;
+  camera.yaw = frame.camera.yaw.value_or(along_a >= along_b ? 1.2 : 0.37);
+  camera.pitch = frame.camera.pitch.value_or(0.38);
   camera.target = frame.bounds.center();
   // Distance: each bounding-box corner must fit in both fields of view.
   camera.distance = 1;
   const Eigen::Matrix4d v = camera.view();
   const Eigen::Matrix3d rot = v.block<3, 3>(0, 0);
-  const double tan_y = std::tan(camera.fov_y / 2), tan_x = tan_y * aspect;
+  const double tan_y = std::tan(camera.fov_y / 2) * free_height,
+               tan_x = std::tan(camera.fov_y / 2) * aspect;
   double needed = 1e-3;
   for (int c = 0; c < 8; ++c) {
     const Eigen::Vector3d corner((c & 1) ? frame.bounds.max().x() : frame.bounds.min().x(),
@@ -101,7 +105,10 @@ Camera frameCamera(const FrameData& frame, double aspect) {
     needed = std::max(needed, std::abs(q.x()) / tan_x + q.z());
     needed = std::max(needed, std::abs(q.y()) / tan_y + q.z());
   }
-  camera.distance = 1.12 * needed;
+  camera.distance = 1.12 * needed / frame.camera.zoom;
+  // Look above the scene's centre so that it sits in the middle of the free part of the picture.
+  const Eigen::Vector3d screen_up = rot.row(1).transpose();
+  camera.target += screen_up * ((1 - free_height) * std::tan(camera.fov_y / 2) * camera.distance);
   return camera;
 }
 

@@ -62,6 +62,47 @@ Eigen::Vector3d stressColour(double s) {
   return (1 - f) * kStops[i] + f * kStops[i + 1];
 }
 
+std::vector<std::vector<int>> restStripes(const TetMesh& mesh) {
+  const Eigen::Vector3d lo = mesh.boundsMin(), hi = mesh.boundsMax();
+  const Eigen::Vector3d extent = hi - lo, centre = 0.5 * (lo + hi);
+  int a = 0;
+  extent.maxCoeff(&a);
+  const int b = (a + 1) % 3, c = (a + 2) % 3;
+  if (extent[a] < 2 * std::max(extent[b], extent[c]) || extent[b] <= 0 || extent[c] <= 0) return {};
+  // Nodes on the outline of the cross-section within +-0.15 rad of each quarter direction; of
+  // those, one per slice of the length (the closest in angle), so a fine mesh gives a straight
+  // line, not a zigzag between neighbours side by side.
+  constexpr int kSlices = 48;
+  struct Pick {
+    double off = 1e9;
+    int node = -1;
+  };
+  std::vector<std::array<Pick, kSlices>> lines(4);
+  for (int i : mesh.surfaceNodes()) {
+    const Eigen::Vector3d& p = mesh.restPositions()[static_cast<size_t>(i)];
+    const double u = 2 * (p[b] - centre[b]) / extent[b], v = 2 * (p[c] - centre[c]) / extent[c];
+    if (std::hypot(u, v) < 0.8) continue;  // an end face, inside the outline
+    const double angle = std::atan2(v, u);
+    const int slice =
+        std::clamp(static_cast<int>((p[a] - lo[a]) / extent[a] * kSlices), 0, kSlices - 1);
+    for (size_t k = 0; k < 4; ++k) {
+      const double off =
+          std::abs(std::remainder(angle - static_cast<double>(k) * M_PI / 2, 2 * M_PI));
+      Pick& pick = lines[k][static_cast<size_t>(slice)];
+      if (off < 0.15 && off < pick.off) pick = {off, i};
+    }
+  }
+  std::vector<std::vector<int>> stripes;
+  for (const auto& line : lines) {
+    std::vector<int> nodes;
+    for (const Pick& pick : line) {
+      if (pick.node >= 0) nodes.push_back(pick.node);
+    }
+    if (nodes.size() >= 3) stripes.push_back(std::move(nodes));
+  }
+  return stripes;
+}
+
 FrameData captureFrame(scene::BuiltScene& scene, double steps_per_second) {
   FemWorld& world = *scene.world;
   FrameData frame;
@@ -70,7 +111,12 @@ FrameData captureFrame(scene::BuiltScene& scene, double steps_per_second) {
   frame.step = world.stepCount();
   frame.steps_per_second = steps_per_second;
   frame.gravity = world.settings().gravity;
+  frame.camera = scene.spec.camera;
+  // Floor of the scale: the stress of a 1e-6 strain. Below it the values are round-off (a body
+  // at rest shows ~1e-11 Pa), and a scale fitted to them would paint noise.
   double stress_max = 0;
+  for (const auto& body : world.bodies())
+    stress_max = std::max(stress_max, 1e-6 * body->model().material().youngs_modulus);
 
   for (const auto& body_ptr : world.bodies()) {
     const FemBody& body = *body_ptr;
@@ -92,6 +138,7 @@ FrameData captureFrame(scene::BuiltScene& scene, double steps_per_second) {
         normals[static_cast<size_t>(v)] += area_normal;
       d.triangles.push_back({tri[0], tri[1], tri[2]});
     }
+    d.stripes = restStripes(mesh);
     d.normals.resize(static_cast<size_t>(n));
     for (int i = 0; i < n; ++i) {
       const double len = normals[static_cast<size_t>(i)].norm();

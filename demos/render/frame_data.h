@@ -24,7 +24,14 @@ struct BodyDrawData {
   std::vector<float> stress;                  ///< per node: von Mises stress, Pa (mean of its tets)
   std::vector<int> grabbed_nodes;             ///< nodes held by a hand, drawn orange
   std::vector<std::array<int, 3>> triangles;  ///< surface, counter-clockwise from outside
+  /// Surface nodes that lie on straight lines along an elongated body's rest shape (four, a
+  /// quarter turn apart), each in order: drawn as lines, they wind into helices when the body
+  /// twists and curve when it bends. Empty for a body that is not at least twice as long as wide.
+  std::vector<std::vector<int>> stripes;
 };
+
+/// The stripes of BodyDrawData for `mesh` (from its rest positions).
+std::vector<std::vector<int>> restStripes(const TetMesh& mesh);
 
 struct RigidDrawData {
   enum class Shape { kBox, kSphere, kPlane, kOther } shape = Shape::kOther;
@@ -49,6 +56,14 @@ struct WrenchReadout {
   Eigen::Vector3d torque = Eigen::Vector3d::Zero();  ///< N m
 };
 
+/// The recent history of one wrench, oldest first, for the viewer's scrolling plot.
+struct WrenchHistory {
+  std::string name;
+  std::vector<double> times;             ///< s
+  std::vector<Eigen::Vector3d> forces;   ///< N
+  std::vector<Eigen::Vector3d> torques;  ///< N m
+};
+
 struct FrameData {
   std::string title;
   double time = 0;  ///< s
@@ -59,9 +74,11 @@ struct FrameData {
   std::vector<RigidDrawData> rigids;
   std::vector<HandDrawData> hands;
   std::vector<WrenchReadout> wrenches;
-  double stress_max = 1;           ///< Pa, top of the colour map (bottom is 0)
-  Eigen::AlignedBox3d bounds;      ///< FEM bodies, finite rigid bodies and hand origins
-  std::vector<std::string> notes;  ///< extra HUD lines (the viewer's settings and keys)
+  double stress_max = 1;             ///< Pa, top of the colour map (bottom is 0)
+  Eigen::AlignedBox3d bounds;        ///< FEM bodies, finite rigid bodies and hand origins
+  std::vector<std::string> notes;    ///< extra HUD lines (the viewer's settings and keys)
+  std::vector<WrenchHistory> plots;  ///< scrolling force and torque plots (the viewer's hand)
+  scene::CameraSpec camera;          ///< the scene's camera wishes (frameCamera)
 };
 
 /// Von Mises stress of the corotated linear material per tet, Pa: sigma = 2 mu eps +
@@ -72,7 +89,8 @@ std::vector<double> tetVonMises(const FemBody& body);
 double niceCeiling(double value);
 
 /// Takes a picture's worth of data from the scene as it is now. Wrenches are those of the last
-/// step (zero before the first). stress_max is niceCeiling of the largest surface value.
+/// step (zero before the first). stress_max is niceCeiling of the largest surface value, and at
+/// least the stress of a 1e-6 strain (so a body at rest shows uniform blue, not round-off).
 FrameData captureFrame(scene::BuiltScene& scene, double steps_per_second = 0);
 
 /// The colour map of the stress: a dark-blue, teal, green, yellow ramp of increasing lightness

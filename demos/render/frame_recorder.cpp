@@ -62,8 +62,7 @@ Status FrameRecorder::capture(scene::BuiltScene& scene, double steps_per_second)
   stress_max_ = std::max(stress_max_, frame.stress_max);
   frame.stress_max = stress_max_;
   if (!camera_) {
-    camera_ = frameCamera(
-        frame, double(sceneViewportWidth(options_.width, options_.height, {})) / options_.height);
+    camera_ = renderer_->fitCamera(frame);
   }
   const Image image = renderer_->render(frame, *camera_);
   char name[32];

@@ -100,4 +100,11 @@ Image OffscreenRenderer::render(const FrameData& frame, const Camera& camera,
   return downsample(big, supersample_);
 }
 
+Camera OffscreenRenderer::fitCamera(const FrameData& frame, RenderOptions options) const {
+  const int w = width_ * supersample_, h = height_ * supersample_;
+  options.pixel_scale = supersample_;
+  return frameCamera(frame, double(sceneViewportWidth(w, h, options)) / h,
+                     hudHeightFraction(frame, h, options));
+}
+
 }  // namespace torsion::render

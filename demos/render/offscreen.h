@@ -26,6 +26,10 @@ class OffscreenRenderer {
   /// Draws `frame` from `camera` (options.pixel_scale is set from the supersampling).
   Image render(const FrameData& frame, const Camera& camera, RenderOptions options = {});
 
+  /// The camera that fits `frame` into this renderer's pictures drawn with `options`: the 3D
+  /// view's aspect, and the scene kept below the HUD panel (frameCamera).
+  Camera fitCamera(const FrameData& frame, RenderOptions options = {}) const;
+
   int width() const { return width_; }
   int height() const { return height_; }
 

@@ -10,36 +10,15 @@ namespace torsion::render {
 
 namespace {
 
-const Eigen::Vector3d kGrabbedOrange(1.0, 0.5, 0.0);
 const Eigen::Vector3d kPlainBody(0.72, 0.74, 0.78);
 
-std::string number(double v) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%.3g", std::abs(v) < 1e-12 ? 0.0 : v);
-  return buf;
-}
-
-std::string signedNumber(double v) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%+.2e", std::abs(v) < 1e-12 ? 0.0 : v);
-  return buf;
-}
-
 }  // namespace
-
-double textScale(int height, const RenderOptions& options) {
-  return std::max(1.0, std::round(height / options.pixel_scale / 360.0)) * options.pixel_scale;
-}
-
-int sceneViewportWidth(int width, int height, const RenderOptions& options) {
-  if (!options.legend || !options.stress) return width;
-  return std::max(1, width - static_cast<int>(std::lround(76 * textScale(height, options))));
-}
 
 void Renderer::draw(const FrameData& frame, const Camera& camera, int width, int height,
                     const RenderOptions& options) {
   const GlApi& gl = gl_;
   const int scene_width = sceneViewportWidth(width, height, options);
+  eye_ = camera.eye();
   gl.Viewport(0, 0, width, height);
   gl.ClearColor(0.95f, 0.95f, 0.96f, 1.0f);
   gl.Clear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
@@ -214,6 +193,7 @@ void Renderer::drawBodies(const FrameData& frame, const RenderOptions& options) 
       gl.Disable(GL_BLEND);
     }
     gl.DisableClientState(GL_VERTEX_ARRAY);
+    drawStripes(body, options);
     if (!body.grabbed_nodes.empty()) {
       gl.PointSize(static_cast<GLfloat>(4 * options.pixel_scale));
       gl.Color4d(kGrabbedOrange.x(), kGrabbedOrange.y(), kGrabbedOrange.z(), 1);
@@ -351,159 +331,29 @@ double Renderer::drawText(double x, double y, double scale, const std::string& t
   return pen - x;
 }
 
-void Renderer::drawOverlay(const FrameData& frame, int width, int height,
-                           const RenderOptions& options) {
-  const GlApi& gl = gl_;
-  gl.Disable(GL_DEPTH_TEST);
-  gl.Disable(GL_LIGHTING);
-  gl.Enable(GL_BLEND);
-  gl.BlendFunc(GL_SRC_ALPHA, GL_ONE_MINUS_SRC_ALPHA);
-  gl.MatrixMode(GL_PROJECTION);
-  gl.LoadIdentity();
-  gl.Ortho(0, width, height, 0, -1, 1);  // pixels, y down
-  gl.MatrixMode(GL_MODELVIEW);
-  gl.LoadIdentity();
-  const double ts = textScale(height, options);
-  const double line = (kGlyphHeight + 4) * ts;
-  const double margin = 6 * ts;
-
-  if (options.hud) {
-    std::vector<std::string> lines;
-    lines.push_back(frame.title);
-    char buf[128];
-    std::snprintf(buf, sizeof buf, "T %.3f S  STEP %d", frame.time, frame.step);
-    std::string status = buf;
-    if (frame.steps_per_second > 0) {
-      std::snprintf(buf, sizeof buf, "  %.1f STEPS/S", frame.steps_per_second);
-      status += buf;
-    }
-    lines.push_back(status);
-    const size_t text_lines = lines.size();
-    // Wrenches: a line of numbers, then bars (force and torque scaled separately).
-    const double bar_height = 3 * ts, bar_width = 60 * ts;
-    // Bars of a readout are scaled to its largest component, but never below 1e-3 of the
-    // largest force (torque) on screen, so round-off shows as no bar.
-    double force_floor = 1e-12, torque_floor = 1e-12;
-    for (const WrenchReadout& w : frame.wrenches) {
-      force_floor = std::max(force_floor, 1e-3 * w.force.cwiseAbs().maxCoeff());
-      torque_floor = std::max(torque_floor, 1e-3 * w.torque.cwiseAbs().maxCoeff());
-    }
-    double top = margin;
-    const double panel_height =
-        static_cast<double>(text_lines) * line +
-        static_cast<double>(frame.wrenches.size()) * (2 * line + 2 * bar_height + 6 * ts) + ts;
-    double panel_width = 0;
-    for (const WrenchReadout& w : frame.wrenches) {
-      const std::string f = w.name + " F " + signedNumber(w.force.x()) + " " +
-                            signedNumber(w.force.y()) + " " + signedNumber(w.force.z()) + " N";
-      panel_width = std::max(panel_width, (kGlyphWidth + 1) * ts * static_cast<double>(f.size()));
-    }
-    for (const std::string& l : lines)
-      panel_width = std::max(panel_width, (kGlyphWidth + 1) * ts * static_cast<double>(l.size()));
-    gl.Color4d(1, 1, 1, 0.6);
-    gl.Begin(GL_QUADS);
-    quad2d(margin - 3 * ts, top - 3 * ts, margin + panel_width + 3 * ts, top + panel_height);
-    gl.End();
-    gl.Color4d(0.08, 0.1, 0.16, 1);
-    for (const std::string& l : lines) {
-      drawText(margin, top, ts, l);
-      top += line;
-    }
-    for (const WrenchReadout& w : frame.wrenches) {
-      gl.Color4d(0.08, 0.1, 0.16, 1);
-      drawText(margin, top, ts,
-               w.name + " F " + signedNumber(w.force.x()) + " " + signedNumber(w.force.y()) + " " +
-                   signedNumber(w.force.z()) + " N");
-      top += line;
-      drawText(margin, top, ts,
-               std::string(w.name.size(), ' ') + " T " + signedNumber(w.torque.x()) + " " +
-                   signedNumber(w.torque.y()) + " " + signedNumber(w.torque.z()) + " NM");
-      top += line;
-      // Bars: x, y, z side by side, each signed about its centre; force above torque.
-      for (int row = 0; row < 2; ++row) {
-        const Eigen::Vector3d& v = row == 0 ? w.force : w.torque;
-        const double scale =
-            std::max(v.cwiseAbs().maxCoeff(), row == 0 ? force_floor : torque_floor);
-        for (int a = 0; a < 3; ++a) {
-          const double x0 = margin + a * (bar_width + 4 * ts), mid = x0 + bar_width / 2;
-          gl.Color4d(0.6, 0.62, 0.68, 0.5);
-          gl.Begin(GL_QUADS);
-          quad2d(x0, top, x0 + bar_width, top + bar_height);
-          gl.Color4d(a == 0 ? 0.85 : 0.1, a == 1 ? 0.65 : 0.15, a == 2 ? 0.9 : 0.1, 1);
-          quad2d(mid, top, mid + 0.5 * bar_width * v[a] / scale, top + bar_height);
-          gl.End();
-        }
-        top += bar_height + 2 * ts;
+void Renderer::drawStripes(const BodyDrawData& body, const RenderOptions& options) {
+  // Without the depth test (the chords between nodes would dip under the bumpy surface and show
+  // dashed), but only segments whose both ends face the eye: the front of the body.
+  auto facing = [&](int i) {
+    const Eigen::Vector3f& p = body.positions[static_cast<size_t>(i)];
+    return body.normals[static_cast<size_t>(i)].cast<double>().dot(eye_ - p.cast<double>()) > 0;
+  };
+  gl_.Disable(GL_DEPTH_TEST);
+  gl_.LineWidth(static_cast<GLfloat>(1.5 * options.pixel_scale));
+  gl_.Color4d(0.97, 0.97, 0.99, 1);
+  gl_.Begin(GL_LINES);
+  for (const std::vector<int>& stripe : body.stripes) {
+    for (size_t k = 1; k < stripe.size(); ++k) {
+      if (!facing(stripe[k - 1]) || !facing(stripe[k])) continue;
+      for (int i : {stripe[k - 1], stripe[k]}) {
+        const Eigen::Vector3f& p = body.positions[static_cast<size_t>(i)];
+        gl_.Vertex3d(static_cast<double>(p.x()), static_cast<double>(p.y()),
+                     static_cast<double>(p.z()));
       }
-      top += 2 * ts;
-    }
-    // Extra notes (the viewer's settings and keys) at the bottom left.
-    double y = height - margin - line * static_cast<double>(frame.notes.size());
-    if (!frame.notes.empty()) {
-      double w = 0;
-      for (const std::string& l : frame.notes)
-        w = std::max(w, (kGlyphWidth + 1) * ts * static_cast<double>(l.size()));
-      gl.Color4d(1, 1, 1, 0.6);
-      gl.Begin(GL_QUADS);
-      quad2d(margin - 3 * ts, y - 3 * ts, margin + w + 3 * ts, height - margin + ts);
-      gl.End();
-    }
-    gl.Color4d(0.08, 0.1, 0.16, 1);
-    for (const std::string& l : frame.notes) {
-      drawText(margin, y, ts, l);
-      y += line;
     }
   }
-
-  if (options.legend && options.stress && !frame.bodies.empty()) {
-    const double bar_w = 14 * ts, bar_h = 0.45 * height;
-    const double x0 = width - margin - bar_w - 48 * ts, y0 = 0.5 * (height - bar_h);
-    gl.Color4d(1, 1, 1, 0.6);
-    gl.Begin(GL_QUADS);
-    quad2d(x0 - 4 * ts, y0 - 3 * line, width - margin + 2 * ts, y0 + bar_h + 2.5 * line);
-    const int segments = 32;
-    for (int i = 0; i < segments; ++i) {
-      const double s0 = double(i) / segments, s1 = double(i + 1) / segments;
-      const Eigen::Vector3d c0 = stressColour(s0), c1 = stressColour(s1);
-      const double ya = y0 + bar_h * (1 - s0), yb = y0 + bar_h * (1 - s1);
-      gl.Color4d(c0.x(), c0.y(), c0.z(), 1);
-      gl.Vertex2d(x0, ya);
-      gl.Vertex2d(x0 + bar_w, ya);
-      gl.Color4d(c1.x(), c1.y(), c1.z(), 1);
-      gl.Vertex2d(x0 + bar_w, yb);
-      gl.Vertex2d(x0, yb);
-    }
-    gl.End();
-    gl.Color4d(0.08, 0.1, 0.16, 1);
-    // Labels in Pa, kPa or MPa so that they stay short.
-    double unit = 1;
-    const char* unit_name = "PA";
-    if (frame.stress_max >= 1e6) {
-      unit = 1e6;
-      unit_name = "MPA";
-    } else if (frame.stress_max >= 1e3) {
-      unit = 1e3;
-      unit_name = "KPA";
-    }
-    drawText(x0 - 2 * ts, y0 - 2.6 * line, ts, "VON MISES");
-    drawText(x0 - 2 * ts, y0 - 1.6 * line, ts, std::string("STRESS ") + unit_name);
-    for (int k = 0; k <= 4; ++k) {
-      const double s = k / 4.0, y = y0 + bar_h * (1 - s);
-      gl.Begin(GL_QUADS);
-      quad2d(x0 + bar_w, y - 0.5 * ts, x0 + bar_w + 3 * ts, y + 0.5 * ts);
-      gl.End();
-      drawText(x0 + bar_w + 5 * ts, y - 3.5 * ts, ts, number(s * frame.stress_max / unit));
-    }
-    // The grabbed-node swatch under the bar.
-    gl.Color4d(kGrabbedOrange.x(), kGrabbedOrange.y(), kGrabbedOrange.z(), 1);
-    gl.Begin(GL_QUADS);
-    quad2d(x0, y0 + bar_h + 0.8 * line, x0 + bar_w, y0 + bar_h + 0.8 * line + 7 * ts);
-    gl.End();
-    gl.Color4d(0.08, 0.1, 0.16, 1);
-    drawText(x0 + bar_w + 5 * ts, y0 + bar_h + 0.8 * line, ts, "GRAB");
-  }
-  gl.Disable(GL_BLEND);
-  gl.Enable(GL_DEPTH_TEST);
+  gl_.End();
+  gl_.Enable(GL_DEPTH_TEST);
 }
 
 }  // namespace torsion::render

@@ -2,6 +2,7 @@
 
 #include <filesystem>
 
+#include "camera_spec.h"
 #include "json_reader.h"
 #include "torsion/mesh/mesh_io.h"
 
@@ -325,6 +326,7 @@ Result<SceneSpec> parseScene(std::string_view text, const std::string& file_name
     }
     for (const JsonObject& r : root.objects("rigid_bodies"))
       scene.rigid_bodies.push_back(readRigidBody(r));
+    scene.camera = readCameraSpec(root);
     root.finish();
     Status world_ok = scene.world.validate();
     if (!world_ok) return Error{file_name + ": " + world_ok.error().message};

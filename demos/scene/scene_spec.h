@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "camera_spec.h"
 #include "torsion/bullet/fem_world.h"
 #include "torsion/constraints/frame.h"
 #include "torsion/constraints/hand.h"
@@ -92,6 +93,7 @@ struct SceneSpec {
   std::vector<NodeSetSpec> node_sets;
   std::vector<HandSpec> hands;
   std::vector<RigidBodySpec> rigid_bodies;
+  CameraSpec camera;  ///< how pictures look at the scene (camera_spec.h)
 };
 
 }  // namespace torsion::scene

@@ -103,13 +103,15 @@ class Viewer {
     scene_ = std::move(built).value();
     manual_ = false;
     unstable_.clear();
+    history_ = render::WrenchHistory{};
     return Ok{};
   }
 
   void frameAll(int width, int height) {
-    const render::FrameData f = render::captureFrame(*scene_);
+    const render::FrameData f = frame();
     camera_ = render::frameCamera(
-        f, double(render::sceneViewportWidth(width, height, {})) / std::max(1, height));
+        f, double(render::sceneViewportWidth(width, height, {})) / std::max(1, height),
+        render::hudHeightFraction(f, height, {}));
   }
 
   // ---- input ----
@@ -163,30 +165,21 @@ class Viewer {
         }
         break;
       case GLFW_KEY_T:
-        editSettings([&] { spec_.world.solver.time_step *= shift ? 0.5 : 2.0; });
+        editSolver([&](SolverSettings& s) { s.time_step *= shift ? 0.5 : 2.0; });
         break;
       case GLFW_KEY_E:
-        editSettings([&] {
-          for (auto& b : spec_.bodies)
-            b.material.youngs_modulus *= shift ? 1 / 1.5 : 1.5;
-        });
+        editMaterial([&](Material& m) { m.youngs_modulus *= shift ? 1 / 1.5 : 1.5; });
         break;
       case GLFW_KEY_P:
-        editSettings([&] {
-          for (auto& b : spec_.bodies)
-            b.material.poisson_ratio =
-                std::clamp(b.material.poisson_ratio + (shift ? -0.02 : 0.02), 0.0, 0.48);
+        editMaterial([&](Material& m) {
+          m.poisson_ratio = std::clamp(m.poisson_ratio + (shift ? -0.02 : 0.02), 0.0, 0.48);
         });
         break;
       case GLFW_KEY_D:
-        editSettings([&] {
-          for (auto& b : spec_.bodies)
-            b.material.stiffness_damping *= shift ? 0.5 : 2.0;
-        });
+        editMaterial([&](Material& m) { m.stiffness_damping *= shift ? 0.5 : 2.0; });
         break;
       case GLFW_KEY_C:
-        editSettings([&] {
-          SolverSettings& s = spec_.world.solver;
+        editSolver([&](SolverSettings& s) {
           if (s.linear_solver == LinearSolverKind::kCholmod) {
             s.linear_solver = LinearSolverKind::kConjugateGradient;
             s.preconditioner = PreconditionerKind::kJacobi;
@@ -253,19 +246,34 @@ class Viewer {
     rate_ = seconds > 0 ? 0.9 * rate_ + 0.1 / seconds : rate_;
     ++steps_;
     if (!r.ok) unstable_ = r.message;
+    recordWrench();
   }
 
-  render::FrameData frame() {
-    render::FrameData f = render::captureFrame(*scene_, rate_);
-    const Material& m = spec_.bodies.front().material;
-    const SolverSettings& s = spec_.world.solver;
+  /// The world's live settings: dt, the first body's material, the solver.
+  std::string settingsText() const {
+    const Material& m = scene_->world->bodies().front()->model().material();
+    const SolverSettings& s = scene_->world->settings().solver;
     char buf[200];
     std::snprintf(buf, sizeof buf, "DT %g S  E %g PA  NU %.2f  BETA %g S  %s%s", s.time_step,
                   m.youngs_modulus, m.poisson_ratio, m.stiffness_damping, toString(s.linear_solver),
                   s.linear_solver == LinearSolverKind::kCholmod
                       ? ""
                       : (std::string(" ") + toString(s.preconditioner)).c_str());
-    f.notes.push_back(buf);
+    return buf;
+  }
+
+  /// "world at step N, t = T s; DT ..." for the log and the exit summary.
+  std::string worldText() const {
+    char buf[96];
+    std::snprintf(buf, sizeof buf, "world at step %d, t = %.6g s; ", scene_->world->stepCount(),
+                  scene_->world->time());
+    return buf + settingsText();
+  }
+
+  render::FrameData frame() {
+    render::FrameData f = render::captureFrame(*scene_, rate_);
+    f.notes.push_back(settingsText());
+    if (!history_.times.empty()) f.plots.push_back(history_);
     f.notes.push_back(
         std::string(paused_ ? "PAUSED" : "RUNNING") +
         (manual_ ? "  HAND: MANUAL (G GRAB, U RELEASE)" : "  HAND: SCRIPT (M MANUAL)"));
@@ -342,16 +350,55 @@ class Viewer {
     if (!n) std::cerr << "viewer: grab: " << n.error().message << "\n";
   }
 
+  // Live edits: the running world takes them between two steps and goes on from its current
+  // state (FemWorld::setSolverSettings, FemBody::setMaterial); the scene spec follows, so a
+  // reset (R) restarts with them. A refused value leaves everything as it was.
   template <class Edit>
-  void editSettings(Edit edit) {
-    scene::SceneSpec before = spec_;
-    edit();
-    if (Status s = spec_.world.validate(); !s) {
-      std::cerr << "viewer: " << s.error().message << "\n";
-      spec_ = before;
+  void editSolver(Edit edit) {
+    SolverSettings s = scene_->world->settings().solver;
+    edit(s);
+    if (Status ok = scene_->world->setSolverSettings(s); !ok) {
+      std::cerr << "viewer: refused: " << ok.error().message << "\n";
       return;
     }
-    reset();
+    const int threads = spec_.world.solver.threads;  // may differ from the world's (--threads)
+    spec_.world.solver = s;
+    spec_.world.solver.threads = threads;
+    std::cout << "viewer: live edit, " << worldText() << std::endl;
+  }
+
+  template <class Edit>
+  void editMaterial(Edit edit) {
+    for (const auto& body : scene_->world->bodies()) {
+      Material m = body->model().material();
+      edit(m);
+      if (Status ok = body->setMaterial(m); !ok) {
+        std::cerr << "viewer: refused: " << ok.error().message << "\n";
+        return;
+      }
+      for (scene::BodySpec& b : spec_.bodies) {
+        if (b.name == body->name()) b.material = m;
+      }
+    }
+    for (scene::SceneHand& h : scene_->hands)
+      h.hand->updateSpeedLimit();  // a fraction of the new shear wave speed
+    std::cout << "viewer: live edit, " << worldText() << std::endl;
+  }
+
+  // The first hand's wrench after each step, for the scrolling plot (the last kHistory steps).
+  void recordWrench() {
+    static constexpr size_t kHistory = 300;
+    if (!hand()) return;
+    const Wrench w = hand()->hand->wrench();
+    history_.name = hand()->spec.name;
+    history_.times.push_back(scene_->world->time());
+    history_.forces.push_back(w.force);
+    history_.torques.push_back(w.torque);
+    if (history_.times.size() > kHistory) {
+      history_.times.erase(history_.times.begin());
+      history_.forces.erase(history_.forces.begin());
+      history_.torques.erase(history_.torques.begin());
+    }
   }
 
   void reset() {
@@ -367,6 +414,7 @@ class Viewer {
   double rate_ = 0;
   int steps_ = 0;
   std::string unstable_;
+  render::WrenchHistory history_;
 };
 
 // GLFW callbacks reach the viewer through the window's user pointer.
@@ -501,6 +549,7 @@ int runViewer(const ViewerOptions& options) {
             << (viewer.manual() ? "manual" : "scripted") << ", " << viewer.grabbedNodes()
             << " nodes grabbed, " << (viewer.stable() ? "stable" : "unstable: " + viewer.failure())
             << "\n";
+  std::cout << "viewer: " << viewer.worldText() << "\n";
   return viewer.stable() ? 0 : 3;
 }
 

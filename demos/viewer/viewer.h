@@ -8,7 +8,10 @@
 //   run      Space pause / run, N one step, R reset, Q or Escape quit
 //   settings T / Shift+T dt x2 / /2, E / Shift+E Young's modulus x1.5 / /1.5, P / Shift+P
 //            Poisson's ratio +-0.02, D / Shift+D stiffness damping x2 / /2, C next solver; a
-//            change rebuilds the scene with it and restarts at t = 0
+//            change takes effect at the next step of the running simulation (no restart), is
+//            logged on stdout ("viewer: live edit, world at step N, t = T s; DT ...") and kept
+//            by a reset
+// The HUD shows the live settings and a scrolling plot of the first hand's force and torque.
 
 #include <string>
 

@@ -47,6 +47,8 @@ struct Rendered {
   Camera camera;
 };
 
+OffscreenRenderer& offscreen();
+
 // The twist_bar scene after 40 steps (0.8 rad of twist), captured as a FrameData.
 const Rendered& twistBar() {
   static const Rendered rendered = [] {
@@ -62,8 +64,7 @@ const Rendered& twistBar() {
     }
     Rendered r;
     r.frame = captureFrame(s);
-    r.camera =
-        frameCamera(r.frame, double(sceneViewportWidth(kWidth, kHeight, optionsFor())) / kHeight);
+    r.camera = offscreen().fitCamera(r.frame, optionsFor());
     return r;
   }();
   return rendered;

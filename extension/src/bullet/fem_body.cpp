@@ -61,9 +61,22 @@ void FemBody::setVelocity(const Eigen::Vector3d& velocity) {
 }
 
 void FemBody::setGravity(const Eigen::Vector3d& gravity) {
+  gravity_ = gravity;
   for (int i = 0; i < model_->nodeCount(); ++i) {
     external_forces_.segment<3>(3 * i) = model_->nodeMasses()[static_cast<size_t>(i)] * gravity;
   }
+}
+
+Status FemBody::setMaterial(const Material& material) {
+  Result<std::shared_ptr<const FemModel>> model = FemModel::create(model_->meshPtr(), material);
+  if (!model) return Error{"body '" + name_ + "': " + model.error().message};
+  model_ = std::move(model).value();
+  stepper_.replaceModel(model_);
+  contacts_->replaceModel(model_);
+  setGravity(gravity_);  // m_i g with the new masses
+  for (int i = 0; i < model_->nodeCount(); ++i)
+    soft_body_->m_nodes[i].m_im = 1 / model_->nodeMasses()[static_cast<size_t>(i)];
+  return Ok{};
 }
 
 void FemBody::predict(double dt) {

@@ -96,4 +96,18 @@ WorldStepReport FemWorld::step() {
   return report;
 }
 
+Status FemWorld::setSolverSettings(const SolverSettings& solver) {
+  if (Status valid = solver.validate(); !valid) return valid;
+  if (solver.threads != settings_.solver.threads) {
+    return Error{"solver: threads = " + std::to_string(solver.threads) +
+                 ": cannot change while the world runs (it has " +
+                 std::to_string(settings_.solver.threads) + "); build a new world"};
+  }
+  settings_.solver = solver;
+  soft_solver_->setTimeStep(solver.time_step);
+  for (const auto& body : bodies_)
+    body->stepper().setSettings(solver);
+  return Ok{};
+}
+
 }  // namespace torsion

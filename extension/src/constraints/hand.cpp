@@ -41,6 +41,7 @@ void HandPursuit::advanceTo(double t) {
 Hand::Hand(FemBody& body, std::string name, HandSettings settings)
     : body_(&body),
       name_(std::move(name)),
+      settings_(settings),
       speed_limit_(settings.speedLimit(body.model().material())),
       pursuit_(std::make_shared<HandPursuit>()) {
   assert(settings.validate().ok());
@@ -94,6 +95,11 @@ const std::vector<int>& Hand::grabbedNodes() const {
   static const std::vector<int> kNone;
   if (!grabbed()) return kNone;
   return body_->groups()[static_cast<size_t>(group_)]->nodes();
+}
+
+void Hand::updateSpeedLimit() {
+  speed_limit_ = settings_.speedLimit(body_->model().material());
+  pursuit_->max_speed = speed_limit_;
 }
 
 }  // namespace torsion

@@ -178,4 +178,10 @@ const Eigen::VectorXd& ImplicitStepper::internalForces() {
   return internal_forces_;
 }
 
+void ImplicitStepper::replaceModel(std::shared_ptr<const FemModel> model) {
+  internalForces();  // freeze the last step's forces before K and beta change under them
+  model_ = std::move(model);
+  system_.replaceModel(model_);
+}
+
 }  // namespace torsion

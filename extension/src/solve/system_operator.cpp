@@ -1,6 +1,7 @@
 #include "torsion/solve/system_operator.h"
 
 #include <algorithm>
+#include <cassert>
 
 namespace torsion {
 
@@ -209,6 +210,12 @@ void SystemOperator::diagonalBlocks(std::vector<Eigen::Matrix3d>& blocks) const 
     blocks[n] = mass_coefficient_ * mass[n] * Eigen::Matrix3d::Identity() +
                 stiffness_coefficient_ * block_values_[static_cast<size_t>(diagonal_slots_[n])];
   }
+}
+
+void SystemOperator::replaceModel(std::shared_ptr<const FemModel> model) {
+  assert(&model->mesh() == &model_->mesh() && "replaceModel wants a model of the same mesh");
+  model_ = std::move(model);
+  assembled_ = false;  // K holds the old material's mu and lambda
 }
 
 }  // namespace torsion

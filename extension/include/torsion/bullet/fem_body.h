@@ -46,6 +46,14 @@ class FemBody {
   /// Sets gravity (m/s^2) as the external force m_i g on every node.
   void setGravity(const Eigen::Vector3d& gravity);
 
+  /// Live edit between steps (the viewer's E, nu, damping keys): the body goes on from its
+  /// current state (positions, velocities, rotations, held groups, contacts) with `material`.
+  /// Rest data are recomputed for the same mesh; the lumped masses, and with them the gravity
+  /// forces, follow a new density. groupWrench() keeps reporting the last step as it was taken
+  /// until the next step. Errors: an invalid material ("material: poisson_ratio = 0.5: ..."),
+  /// and then nothing changes. References from model() taken before the call are stale after it.
+  Status setMaterial(const Material& material);
+
   // ---- called by FemSoftBodySolver, in this order, each step ----
   /// Bullet's predictor: m_q = x_n, m_x = x_n + dt v_n, bounds and node tree refreshed, contacts
   /// cleared, so Bullet's collision detection runs on this step's motion.
@@ -68,6 +76,7 @@ class FemBody {
   ImplicitStepper stepper_;
   NodeConstraints constraints_;
   Eigen::VectorXd external_forces_;
+  Eigen::Vector3d gravity_ = Eigen::Vector3d::Zero();  // m/s^2, for external_forces_
   std::vector<std::unique_ptr<CarriedNodes>> groups_;
   std::unique_ptr<btSoftBody> soft_body_;
   std::unique_ptr<RigidContactSolver> contacts_;

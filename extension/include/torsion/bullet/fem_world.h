@@ -58,6 +58,12 @@ class FemWorld {
   /// One step of dt.
   WorldStepReport step();
 
+  /// Live edit between steps (the viewer's dt and solver keys): the next steps use `solver`
+  /// (time step, linear solver, preconditioner, tolerance, caps); time and state go on. Errors,
+  /// leaving the settings as they were: invalid settings, or a different thread count (the
+  /// worker pool is made once per world).
+  Status setSolverSettings(const SolverSettings& solver);
+
   double time() const { return time_; }
   int stepCount() const { return steps_; }
   const WorldSettings& settings() const { return settings_; }

@@ -109,6 +109,9 @@ class Hand {
   const Frame& frame() const { return pursuit_->patch; }
   /// Speed limit of the grabbed nodes, m/s (infinity when off).
   double speedLimit() const { return speed_limit_; }
+  /// Re-derives the speed limit from the body's material after a live edit
+  /// (FemBody::setMaterial): a held patch obeys the new limit from the next step on.
+  void updateSpeedLimit();
   /// The body's node group carrying the patch, or -1 when not grabbing.
   int group() const { return group_; }
   const std::string& name() const { return name_; }
@@ -117,6 +120,7 @@ class Hand {
  private:
   FemBody* body_;
   std::string name_;
+  HandSettings settings_;
   double speed_limit_;
   std::shared_ptr<HandPursuit> pursuit_;  // shared with the body's FrameMotion
   HandSelection selection_;

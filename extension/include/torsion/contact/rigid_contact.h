@@ -106,6 +106,8 @@ class RigidContactSolver {
   RigidContactSolver(std::shared_ptr<const FemModel> model, btSoftBody* soft_body);
 
   ContactSettings& settings() { return settings_; }
+  /// Live material edit (FemBody::setMaterial): the same mesh, new masses.
+  void replaceModel(std::shared_ptr<const FemModel> model) { model_ = std::move(model); }
   const ContactSettings& settings() const { return settings_; }
 
   /// Stage 1: forgets last step's candidates.

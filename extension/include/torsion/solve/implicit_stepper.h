@@ -81,7 +81,12 @@ class ImplicitStepper {
       const SystemOperator&, const NodeConstraints&, const Eigen::VectorXd&, const SolverSettings&,
       Eigen::VectorXd&)>;
   void setLinearSolveHook(LinearSolveHook hook) { linear_solve_hook_ = std::move(hook); }
+  /// Takes effect at the next step (dt, linear solver, tolerance...); the caller validates.
   void setSettings(const SolverSettings& settings) { settings_ = settings; }
+  /// Live material edit between steps (FemBody::setMaterial): `model` has the same mesh. The
+  /// state's warm starts stay; internalForces() keeps reporting the last step as it was taken
+  /// (with the material it was taken with) until the next step.
+  void replaceModel(std::shared_ptr<const FemModel> model);
   const FemModel& model() const { return *model_; }
   const SystemOperator& system() const { return system_; }
 

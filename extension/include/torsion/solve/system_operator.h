@@ -47,6 +47,10 @@ class SystemOperator {
   void diagonalBlocks(std::vector<Eigen::Matrix3d>& blocks) const;
 
   const FemModel& model() const { return *model_; }
+  /// Live edits (FemBody::setMaterial): the same mesh with another material. The node-tet tables,
+  /// the block pattern and this step's rotations stay; K is re-assembled with the new material
+  /// constants at the next product, and the masses are the new model's.
+  void replaceModel(std::shared_ptr<const FemModel> model);
   double massCoefficient() const { return mass_coefficient_; }
   double stiffnessCoefficient() const { return stiffness_coefficient_; }
 
