@@ -95,6 +95,10 @@ void HapticLoop::tick(double now, double deadline) {
     ++stats_.nonfinite;
     desired = Wrench{};
   }
+  if (force_enabled_ &&
+      (norm(desired.force) > limits_.max_force || norm(desired.torque) > limits_.max_torque)) {
+    ++stats_.saturated;
+  }
 
   // 5. safety, then the device
   SafetyInputs inputs;
@@ -162,6 +166,11 @@ void HapticLoop::run() {
     }
     tick(now, deadline);
   }
+}
+
+void HapticLoop::setLogCapacity(std::size_t rows) {
+  settings_.log_capacity = rows;
+  log_.reserve(rows);
 }
 
 bool HapticLoop::writeLog(const std::string& path) const {

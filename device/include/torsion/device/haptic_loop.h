@@ -60,6 +60,7 @@ struct LoopStats {
   std::atomic<std::uint64_t> overruns{0};     ///< ticks that started a full period late
   std::atomic<std::uint64_t> log_dropped{0};  ///< rows not logged: capacity reached
   std::atomic<std::uint64_t> nonfinite{0};    ///< rendered wrenches with NaN/inf (zeroed)
+  std::atomic<std::uint64_t> saturated{0};    ///< ticks whose wrench exceeded a device limit
 };
 
 class HapticLoop {
@@ -88,6 +89,8 @@ class HapticLoop {
   const LoopStats& stats() const { return stats_; }
   /// The log so far; only while the loop is not running (or from the ticking thread).
   const std::vector<LoopLogRow>& log() const { return log_; }
+  /// Keeps at most `rows` log rows (reserved now); only while the loop is not running.
+  void setLogCapacity(std::size_t rows);
   /// Writes the log as CSV; false when the file cannot be written.
   bool writeLog(const std::string& path) const;
   const Wrench& lastOutput() const { return safety_.output(); }
