@@ -65,6 +65,10 @@ void readCoupling(const JsonObject& d, DeviceSpec& spec) {
   c.stiffness_refresh_steps = o.integer("stiffness_refresh_steps", c.stiffness_refresh_steps);
   if (c.stiffness_refresh_steps < 0)
     o.fail("stiffness_refresh_steps", "must be >= 0 (0: no local stiffness)");
+  c.stiffness_columns_per_step =
+      o.integer("stiffness_columns_per_step", c.stiffness_columns_per_step);
+  if (c.stiffness_columns_per_step < 1 || c.stiffness_columns_per_step > 6)
+    o.fail("stiffness_columns_per_step", "must be in [1, 6]");
   o.finish();
 }
 
