@@ -13,6 +13,8 @@ packages=(
   libbullet-dev libeigen3-dev libsuitesparse-dev libccd-dev libtbb-dev
   libcli11-dev nlohmann-json3-dev libpng-dev
   libosmesa6-dev libglfw3-dev
+  # the SpaceMouse device (optional in CMake; the spacenavd daemon is the user's to install)
+  libspnav-dev
   # the viewer's test: a virtual X server and Mesa's software GLX
   xvfb xauth libgl1-mesa-dri libglx-mesa0
   # tests and benchmarks; clang + its runtime for the libFuzzer targets

@@ -4,6 +4,8 @@
 #include <iostream>
 #include <memory>
 
+#include "../scene/device_parser.h"
+#include "../scene/scene_haptics.h"
 #include "../scene/scene_parser.h"
 #include "../scene/scene_runner.h"
 #include "frame_recorder.h"
@@ -22,6 +24,8 @@ struct RunArguments {
   std::string render;  // --render DIR: PNG pictures (and an MP4 with ffmpeg)
   std::string render_size = "800x600";
   int render_every = 10;
+  std::vector<std::string> devices;  // --device HAND=TYPE[:ARG], repeatable
+  std::string haptics;               // --haptics lockstep|threaded
 };
 
 // Exit codes: 0 done and stable, 1 bad input or output error, 3 the simulation went unstable.
@@ -30,6 +34,20 @@ int run(const RunArguments& args) {
   if (!spec) {
     std::cerr << "error: " << spec.error().message << "\n";
     return 1;
+  }
+  for (const std::string& d : args.devices) {
+    if (Status applied = scene::applyDeviceOverride(spec.value(), d); !applied) {
+      std::cerr << "error: " << applied.error().message << "\n";
+      return 1;
+    }
+  }
+  if (!args.haptics.empty()) {
+    Result<scene::HapticsMode> mode = scene::parseHapticsMode(args.haptics);
+    if (!mode) {
+      std::cerr << "error: " << mode.error().message << "\n";
+      return 1;
+    }
+    spec.value().haptics_mode = mode.value();
   }
   Result<std::unique_ptr<scene::BuiltScene>> built =
       scene::buildScene(std::move(spec).value(), args.threads);
@@ -43,6 +61,10 @@ int run(const RunArguments& args) {
   for (const auto& body : s.world->bodies()) {
     std::cerr << "body '" << body->name() << "': " << body->model().nodeCount() << " nodes, "
               << body->model().tetCount() << " tets\n";
+  }
+  if (s.haptics) {
+    for (const std::string& line : s.haptics->describe())
+      std::cerr << line << "\n";
   }
 
   std::unique_ptr<render::FrameRecorder> recorder;
@@ -89,6 +111,10 @@ int run(const RunArguments& args) {
     std::cerr << "error: --render: " << render_error << "\n";
     return 1;
   }
+  if (s.haptics) {
+    for (const std::string& w : s.haptics->warnings())
+      std::cerr << "warning: haptics: " << w << "\n";
+  }
   if (recorder) std::cerr << "pictures: " << recorder->finish(s.spec.name) << "\n";
   if (!outcome.value().stable) {
     std::cerr << "error: simulation unstable: " << outcome.value().failure << "\n"
@@ -96,7 +122,8 @@ int run(const RunArguments& args) {
     return 3;
   }
   std::cerr << "done: " << outcome.value().steps_done << " steps; results in " << args.out
-            << "/ (summary.json, wrench.csv, energy.csv, one .vtk per body)\n";
+            << "/ (summary.json, wrench.csv, energy.csv, one .vtk per body"
+            << (s.haptics ? ", haptic_<hand>.csv per device hand" : "") << ")\n";
   return 0;
 }
 
@@ -119,6 +146,14 @@ void addRunCommand(CLI::App& app) {
   cmd->add_option("--render-every", args->render_every, "Steps between pictures")
       ->check(CLI::PositiveNumber)
       ->capture_default_str();
+  cmd->add_option("--device", args->devices,
+                  "Drive a hand with a device instead of its script (repeatable): "
+                  "HAND=scripted:FILE, HAND=replay:LOG.csv, HAND=network[:[HOST:]PORT], "
+                  "HAND=spacemouse");
+  cmd->add_option("--haptics", args->haptics,
+                  "Haptic loops: lockstep (simulated clock, deterministic; default for scripted "
+                  "and replay devices) or threaded (1 kHz threads, simulation paced to wall-clock "
+                  "time; default for network and SpaceMouse)");
   cmd->callback([args] { setExitCode(run(*args)); });
 }
 

@@ -1,5 +1,6 @@
 #include "scene_builder.h"
 
+#include "scene_haptics.h"
 #include "torsion/mesh/mesh_io.h"
 
 namespace torsion::scene {
@@ -33,6 +34,7 @@ Status driveHands(BuiltScene& scene) {
   const double reached = now + 0.5 * dt;
   for (size_t h = 0; h < scene.hands.size(); ++h) {
     SceneHand& s = scene.hands[h];
+    if (s.spec.device) continue;  // moved by its device through SceneHaptics
     if (s.hand->grabbed() && reached >= s.spec.release_at) {
       s.hand->release();
       s.released = true;
@@ -126,6 +128,13 @@ Result<std::unique_ptr<BuiltScene>> buildScene(SceneSpec spec, int threads_overr
     world.addRigidBody(std::move(shape), r.mass, transform);
   }
   built->spec = std::move(spec);
+  for (const SceneHand& h : built->hands) {
+    if (!h.spec.device) continue;
+    Result<std::unique_ptr<SceneHaptics>> haptics = SceneHaptics::attach(*built);
+    if (!haptics) return Error{built->spec.file + ": " + haptics.error().message};
+    built->haptics = std::move(haptics).value();
+    break;
+  }
   return built;
 }
 

@@ -29,19 +29,25 @@ struct SceneHand {
   bool released = false;
 };
 
+class SceneHaptics;  // scene_haptics.h
+
 struct BuiltScene {
   SceneSpec spec;
   std::unique_ptr<FemWorld> world;
   std::vector<NodeSetHandle> node_sets;
   std::vector<SceneHand> hands;
   std::vector<std::string> warnings;  ///< from mesh loading
+  /// Devices, haptic loops and couplings of the device hands (null when none); last, so it is
+  /// destroyed first: it holds the hands and the world by reference.
+  std::shared_ptr<SceneHaptics> haptics;
 };
 
 /// Nodes of `mesh` whose rest positions fall in `selection`.
 std::vector<int> selectNodes(const TetMesh& mesh, const NodeSelection& selection);
 
-/// Grabs, releases and moves every scene hand for the step from world time t to t + dt: call
-/// before each FemWorld::step(). Errors: a scripted grab whose plane misses the body.
+/// Grabs, releases and moves every scripted scene hand (device hands are the haptics' job) for the
+/// step from world time t to t + dt: call before each FemWorld::step(). Errors: a scripted grab
+/// whose plane misses the body.
 Status driveHands(BuiltScene& scene);
 
 /// threads >= 0 overrides the scene's solver.threads.

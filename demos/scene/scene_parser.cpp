@@ -3,6 +3,7 @@
 #include <filesystem>
 
 #include "camera_spec.h"
+#include "device_parser.h"
 #include "json_reader.h"
 #include "torsion/mesh/mesh_io.h"
 
@@ -140,10 +141,11 @@ MotionSpec readMotion(const JsonObject& m) {
   return motion;
 }
 
-HandSpec readHand(const JsonObject& h) {
+HandSpec readHand(const JsonObject& h, const std::string& base_directory) {
   HandSpec hand;
   hand.name = h.string("name");
   hand.body = h.string("body");
+  if (h.has("device")) hand.device = readDevice(h, base_directory);  // device_parser.cpp
   if (h.has("keyframes")) {
     if (h.has("frame") || h.has("motion"))
       h.fail("keyframes", "give either keyframes or frame (+ motion), not both");
@@ -314,7 +316,7 @@ Result<SceneSpec> parseScene(std::string_view text, const std::string& file_name
       scene.node_sets.push_back(std::move(set));
     }
     for (const JsonObject& h : root.objects("hands")) {
-      HandSpec hand = readHand(h);
+      HandSpec hand = readHand(h, base_directory);
       bool known = false;
       for (const BodySpec& body : scene.bodies)
         known = known || body.name == hand.body;

@@ -6,6 +6,7 @@
 #include <fstream>
 #include <nlohmann/json.hpp>
 
+#include "scene_haptics.h"
 #include "torsion/mesh/mesh_io.h"
 #include "torsion/mesh/vtk_format.h"
 
@@ -80,11 +81,13 @@ Result<RunOutcome> runScene(BuiltScene& scene, const RunOptions& options) {
   long iteration_sum = 0;
   int iteration_max = 0;
   const auto run_start = std::chrono::steady_clock::now();
+  if (scene.haptics) scene.haptics->prepareRun(steps);
   for (int k = 0; k < steps; ++k) {
-    Status hands_driven = driveHands(scene);
-    if (!hands_driven) return Error{scene.spec.file + ": " + hands_driven.error().message};
+    if (scene.haptics) scene.haptics->pace();  // threaded: wall-clock pacing, not step time
     const auto t0 = std::chrono::steady_clock::now();
-    const WorldStepReport report = world.step();
+    Result<WorldStepReport> stepped = stepScene(scene);
+    if (!stepped) return Error{scene.spec.file + ": " + stepped.error().message};
+    const WorldStepReport& report = stepped.value();
     step_ms.push_back(
         std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
     if (!report.ok) {
@@ -171,6 +174,12 @@ Result<RunOutcome> runScene(BuiltScene& scene, const RunOptions& options) {
          {"body", h.spec.body},
          {"grabbed_nodes", static_cast<int>(h.hand->selection().nodes.size())},
          {"holding_at_end", h.hand->grabbed()}});
+  }
+  if (scene.haptics) {  // stops the haptic threads, writes haptic_<hand>.csv
+    Result<nlohmann::json> haptics = scene.haptics->finish(out.string());
+    if (!haptics) return haptics.error();
+    summary["haptics"] = std::move(haptics).value();
+    summary["haptic_warnings"] = scene.haptics->warnings();
   }
   summary["stable"] = outcome.stable;
   if (!outcome.stable) summary["failure"] = outcome.failure;

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "camera_spec.h"
+#include "device_spec.h"
 #include "torsion/bullet/fem_world.h"
 #include "torsion/constraints/frame.h"
 #include "torsion/constraints/hand.h"
@@ -68,6 +69,8 @@ struct HandSpec {
   double grab_at = 0;
   double release_at = std::numeric_limits<double>::infinity();
   HandSettings settings;  ///< speed limit of the grabbed patch (max_drag_strain)
+  /// A device moves the hand instead of the script; `initial` is its anchor (device_spec.h).
+  std::optional<DeviceSpec> device;
 
   /// The hand's frame at time t.
   Frame frameAt(double t) const;
@@ -94,6 +97,7 @@ struct SceneSpec {
   std::vector<HandSpec> hands;
   std::vector<RigidBodySpec> rigid_bodies;
   CameraSpec camera;  ///< how pictures look at the scene (camera_spec.h)
+  HapticsMode haptics_mode = HapticsMode::kAuto;  ///< not in the file: the CLI's --haptics
 };
 
 }  // namespace torsion::scene

@@ -17,6 +17,7 @@
 #include "image.h"
 #include "renderer.h"
 #include "scene_builder.h"
+#include "scene_haptics.h"
 #include "scene_parser.h"
 
 namespace torsion::viewer {
@@ -240,7 +241,8 @@ class Viewer {
     }
     if (manual_ && hand() && hand()->hand->grabbed()) hand()->hand->moveTo(manual_frame_);
     const auto t0 = std::chrono::steady_clock::now();
-    const WorldStepReport r = scene_->world->step();
+    // Device hands (if any) step through their haptic loops.
+    const WorldStepReport r = scene_->haptics ? scene_->haptics->step() : scene_->world->step();
     const double seconds =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     rate_ = seconds > 0 ? 0.9 * rate_ + 0.1 / seconds : rate_;

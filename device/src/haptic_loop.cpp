@@ -1,5 +1,7 @@
 #include "torsion/device/haptic_loop.h"
 
+#include <pthread.h>
+#include <sched.h>
 #include <time.h>
 
 #include <cmath>
@@ -39,6 +41,8 @@ std::string HapticLoopSettings::validate() const {
   if (!(rate_hz > 0 && rate_hz <= 20000)) return "rate_hz must be in (0, 20000]";
   if (!(damper.linear >= 0) || !(damper.angular >= 0)) return "damper must be non-negative";
   if (!(twist_cutoff_hz > 0)) return "twist_cutoff_hz must be positive";
+  if (realtime_priority < 0 || realtime_priority > 99)
+    return "realtime_priority must be in [0, 99]";
   return safety.validate();
 }
 
@@ -95,6 +99,10 @@ void HapticLoop::tick(double now, double deadline) {
     ++stats_.nonfinite;
     desired = Wrench{};
   }
+  if (force_enabled_ &&
+      (norm(desired.force) > limits_.max_force || norm(desired.torque) > limits_.max_torque)) {
+    ++stats_.saturated;
+  }
 
   // 5. safety, then the device
   SafetyInputs inputs;
@@ -147,6 +155,14 @@ void HapticLoop::stop() {
 }
 
 void HapticLoop::run() {
+  // Real-time priority, when the process may have it (root or CAP_SYS_NICE): the loop then
+  // preempts the simulation and other ordinary jobs on its core instead of waiting its turn.
+  // It sleeps most of each period, so it cannot starve them.
+  if (settings_.realtime_priority > 0) {
+    sched_param param{};
+    param.sched_priority = settings_.realtime_priority;
+    stats_.realtime = pthread_setschedparam(pthread_self(), SCHED_FIFO, &param) == 0;
+  }
   const double period = 1.0 / settings_.rate_hz;
   const double origin = monotonicSeconds();
   double deadline = 0;
@@ -162,6 +178,11 @@ void HapticLoop::run() {
     }
     tick(now, deadline);
   }
+}
+
+void HapticLoop::setLogCapacity(std::size_t rows) {
+  settings_.log_capacity = rows;
+  log_.reserve(rows);
 }
 
 bool HapticLoop::writeLog(const std::string& path) const {

@@ -36,6 +36,15 @@ std::uint32_t Trajectory::buttonsAt(double time) const {
   return held;
 }
 
+Trajectory Trajectory::playedAt(double speed) const {
+  Trajectory faster = *this;
+  for (TrajectoryKeyframe& k : faster.keyframes_)
+    k.time /= speed;
+  for (ButtonEvent& b : faster.buttons_)
+    b.time /= speed;
+  return faster;
+}
+
 double Trajectory::duration() const {
   double end = keyframes_.empty() ? 0.0 : keyframes_.back().time;
   if (!buttons_.empty()) end = std::max(end, buttons_.back().time);

@@ -1,9 +1,11 @@
 // Haptic loop benchmark and headless Figure 6.7 runs (issue 5). Not a test: it measures.
 //
-//   bench_haptic_loop threaded MESH_TETS SECONDS [LOG.csv]
+//   bench_haptic_loop threaded MESH_TETS SECONDS [LOG.csv] [--priority P] [--kh-columns N]
 //       The 1 kHz loop on its own thread (scripted Figure 6.7 device) while the simulation thread
 //       steps the cylinder as fast as it can; prints loop rate, period jitter p50/p99/max,
-//       overruns, wrench age and simulation steps per second.
+//       overruns, wrench age, simulation step time p50/p99/max and steps per second, and
+//       whether the loop got SCHED_FIFO. --priority 0 keeps the default scheduling (default: the
+//       loop's 80); --kh-columns 6 refreshes K_h in one step (default 1 column per step).
 //   bench_haptic_loop figure67 internal_force|frame_difference LOG.csv [MESH_TETS]
 //       The Figure 6.7 sequence on a simulated clock (lockstep, deterministic), loop log to CSV
 //       for docs/haptics.md (tests/bench/plot_haptics.py draws it).
@@ -32,7 +34,7 @@ struct Cylinder {
   std::unique_ptr<haptics::HandCoupling> coupling;
 };
 
-Cylinder makeCylinder(int tets, haptics::Rendering rendering, int threads) {
+Cylinder makeCylinder(int tets, haptics::Rendering rendering, int threads, int kh_columns = 1) {
   Result<LoadedMesh> mesh =
       readMesh(std::string(TORSION_ASSETS_DIR) + "/cylinder_" + std::to_string(tets) + ".node");
   if (!mesh) {
@@ -60,6 +62,7 @@ Cylinder makeCylinder(int tets, haptics::Rendering rendering, int threads) {
   mapping.position_scale = 10;  // 5 cm on the desk: 0.5 m on the 10 m cylinder
   haptics::CouplingSettings settings;
   settings.rendering = rendering;
+  settings.stiffness_columns_per_step = kh_columns;
   c.coupling = std::make_unique<haptics::HandCoupling>(*c.hand, mapping, settings);
   return c;
 }
@@ -79,19 +82,25 @@ double percentile(std::vector<double> v, double p) {
   return v[static_cast<size_t>(p * static_cast<double>(v.size() - 1))];
 }
 
-int threaded(int tets, double seconds, const char* log_path) {
-  Cylinder c = makeCylinder(tets, haptics::Rendering::kInternalForce, 1);
+int threaded(int tets, double seconds, const char* log_path, int priority, int kh_columns) {
+  Cylinder c = makeCylinder(tets, haptics::Rendering::kInternalForce, 1, kh_columns);
   device::ScriptedDevice scripted(figure67(), device::defaultDeviceLimits(), "figure_6_7");
   device::HapticLoopSettings settings;
   settings.log_capacity = static_cast<size_t>(seconds * 1000 * 1.2) + 1000;
+  settings.realtime_priority = priority;
   device::HapticLoop loop(scripted, settings);
   haptics::HapticRuntime runtime(*c.world, {{c.coupling.get(), &loop, 1000}});
   const auto start = std::chrono::steady_clock::now();
   int steps = 0;
+  std::vector<double> step_ms;
+  auto previous = start;
   runtime.runThreaded(1 << 30, false, [&](const WorldStepReport&) {
     ++steps;
-    return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count() <
-           seconds;
+    const auto now = std::chrono::steady_clock::now();
+    if (steps > 1)
+      step_ms.push_back(std::chrono::duration<double, std::milli>(now - previous).count());
+    previous = now;
+    return std::chrono::duration<double>(now - start).count() < seconds;
   });
   const double wall =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
@@ -106,11 +115,14 @@ int threaded(int tets, double seconds, const char* log_path) {
   std::printf(
       "{\"tets\": %d, \"seconds\": %.1f, \"loop_rate_hz\": %.1f, \"period_error_ms\": {\"p50\": "
       "%.4f, \"p99\": %.4f, \"max\": %.3f}, \"overruns\": %llu, \"wrench_age_ms\": {\"p50\": "
-      "%.2f, \"p99\": %.2f, \"max\": %.2f}, \"sim_steps_per_s\": %.1f, \"sim_step_ms\": %.2f}\n",
+      "%.2f, \"p99\": %.2f, \"max\": %.2f}, \"sim_steps_per_s\": %.1f, \"sim_step_ms\": {\"p50\": "
+      "%.2f, \"p99\": %.2f, \"max\": %.2f}, \"kh_columns_per_step\": %d, \"realtime\": %s}\n",
       tets, wall, span > 0 ? static_cast<double>(log.size() - 1) / span : 0.0,
       percentile(period_error, 0.5), percentile(period_error, 0.99), percentile(period_error, 1.0),
       static_cast<unsigned long long>(loop.stats().overruns.load()), percentile(age, 0.5),
-      percentile(age, 0.99), percentile(age, 1.0), steps / wall, 1e3 * wall / steps);
+      percentile(age, 0.99), percentile(age, 1.0), steps / wall, percentile(step_ms, 0.5),
+      percentile(step_ms, 0.99), percentile(step_ms, 1.0), kh_columns,
+      loop.stats().realtime ? "true" : "false");
   if (log_path && !loop.writeLog(log_path)) return 1;
   return 0;
 }
@@ -143,14 +155,26 @@ int figure(const std::string& rendering, const char* log_path, int tets) {
 int main(int argc, char** argv) {
   const std::string mode = argc > 1 ? argv[1] : "";
   if (mode == "threaded" && argc >= 4) {
-    return threaded(std::atoi(argv[2]), std::atof(argv[3]), argc > 4 ? argv[4] : nullptr);
+    const char* log = nullptr;
+    int priority = device::HapticLoopSettings{}.realtime_priority, kh_columns = 1;
+    for (int k = 4; k < argc; ++k) {
+      const std::string a = argv[k];
+      if (a == "--priority" && k + 1 < argc) {
+        priority = std::atoi(argv[++k]);
+      } else if (a == "--kh-columns" && k + 1 < argc) {
+        kh_columns = std::atoi(argv[++k]);
+      } else {
+        log = argv[k];
+      }
+    }
+    return threaded(std::atoi(argv[2]), std::atof(argv[3]), log, priority, kh_columns);
   }
   if (mode == "figure67" && argc >= 4) {
     return figure(argv[2], argv[3], argc > 4 ? std::atoi(argv[4]) : 2430);
   }
   std::fprintf(
       stderr,
-      "usage: bench_haptic_loop threaded TETS SECONDS [LOG.csv]\n"
+      "usage: bench_haptic_loop threaded TETS SECONDS [LOG.csv] [--priority P] [--kh-columns N]\n"
       "       bench_haptic_loop figure67 internal_force|frame_difference LOG.csv [TETS]\n");
   return 2;
 }

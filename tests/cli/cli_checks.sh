@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # The torsion tool as a user runs it: one check per call, named by its first argument.
-#   cli_checks.sh CASE TORSION ASSETS_DIR
+#   cli_checks.sh CASE TORSION ASSETS_DIR [HAPTIC_PEER]
 # Exit 0: pass; 77: skipped (e.g. no tetgen on PATH; CTest SKIP_RETURN_CODE); anything else: fail.
 # Each case works in a fresh temporary directory, removed afterwards.
 set -uo pipefail
@@ -8,6 +8,7 @@ set -uo pipefail
 case_name=$1
 torsion=$2
 assets=$3
+peer=${4:-}
 scenes=$(cd "$(dirname "$0")/../../demos/scenes" && pwd)
 
 work=$(mktemp -d "${TMPDIR:-/tmp}/torsion-cli-test-XXXXXX")
@@ -146,6 +147,40 @@ check_cube_mesh() {  # check_cube_mesh MESH: a valid mesh of volume exactly 8
   [[ -n $tets && $tets -ge 6 ]] || fail "expected at least 6 tets in $1, got '$tets'"
   [[ $volume == 8 ]] || fail "expected volume 8 for the cube in $1, got '$volume'"
   echo "ok: $1: $tets tets, volume $volume"
+}
+
+# A short device trajectory: button 1 at 0 s grabs, a turn about z at 0.5 rad/s for 0.6 s, a
+# hold, button 2 at 0.8 s releases; the peer holds the end for 0.5 s more.
+write_short_turn() {
+  cat >"$1" <<'EOF'
+{"segments": [{"duration": 0.6, "angular_velocity": [0, 0, 0.5]}, {"duration": 0.4}],
+ "buttons": [{"time": 0, "held": [1]}, {"time": 0.8, "held": [2]}]}
+EOF
+}
+
+# check_haptic_outputs DIR MODE: the haptic log and stats exist; the wrench written to the device
+# is non-zero while the hand holds the cylinder and exactly zero 0.25 s after button 2 (the
+# safety filter ramps it down at 300 N/s and 30 N m/s from at most 30 N and 3 N m: 0.1 s).
+check_haptic_outputs() {
+  local dir=$1 mode=$2
+  for f in summary.json wrench.csv haptic_hand.csv; do [[ -s $dir/$f ]] || fail "missing $dir/$f"; done
+  grep -q "\"mode\": \"$mode\"" "$dir/summary.json" || fail "$dir/summary.json: no $mode haptics stats"
+  for key in achieved_rate_hz period_error_ms wrench_age_ms saturated_ticks; do
+    grep -q "\"$key\"" "$dir/summary.json" || fail "$dir/summary.json lacks $key"
+  done
+  awk -F, '
+    NR == 1 { for (i = 1; i <= NF; i++) c[$i] = i; next }
+    { t = $c["time"]; b = $c["buttons"]
+      m = 0; for (k = 0; k < 6; k++) { v = $(c["fx"] + k); if (v < 0) v = -v; if (v > m) m = v }
+      if ($c["grabbed"] == 1 && m > 0.1) held++
+      if (b == 2 && release == "") release = t
+      if (release != "" && t > release + 0.25) { after++; if (m != 0) bad++ } }
+    END {
+      if (held < 100) { print "only " held " ticks with a wrench while grabbed"; exit 1 }
+      if (after < 100) { print "only " after " ticks logged after the release"; exit 1 }
+      if (bad > 0) { print bad " ticks with a non-zero wrench after the release"; exit 1 } }
+  ' "$dir/haptic_hand.csv" || fail "$dir/haptic_hand.csv: wrench not sane"
+  echo "ok: $dir: haptic log and stats"
 }
 
 case $case_name in
@@ -409,6 +444,76 @@ EOF
     expect_out "^error: simulation unstable: body 'cylinder', step [0-9]+: blow-up: a node moves at"
     grep -q '"stable": false' out/summary.json || fail "summary does not say unstable"
     ! grep -qi nan out/cylinder.vtk || fail "NaN written to the final mesh"
+    ;;
+
+  run_haptic_scripted_replay)
+    # A scripted device drives the cylinder's hand from the CLI (lockstep haptics); its loop log
+    # is then replayed as a device and must reproduce the run.
+    sed "s|../../assets/meshes|$assets|" "$scenes/twist_cylinder_2430.json" > twist.json
+    write_short_turn turn.json
+    run "$torsion" run twist.json --device hand=scripted:turn.json --out rec --steps 120 --threads 1
+    expect_rc 0
+    expect_out "hand 'hand': device scripted\(turn.json\), lockstep haptic loop at 1000 Hz"
+    check_haptic_outputs rec lockstep
+    run "$torsion" run twist.json --device hand=replay:rec/haptic_hand.csv --out rep --steps 120 --threads 1
+    expect_rc 0
+    expect_out "hand 'hand': device replay\(haptic_hand.csv\), lockstep"
+    check_haptic_outputs rep lockstep
+    # Same poses at the same ticks: the hand's torque at the end of the grab (step 70) agrees to
+    # 1e-4 relative (the log keeps 10 significant digits of each pose).
+    a=$(awk -F, 'NR == 1 { for (i = 1; i <= NF; i++) if ($i == "hand.tz") c = i } NR == 71 { print $c }' rec/wrench.csv)
+    b=$(awk -F, 'NR == 1 { for (i = 1; i <= NF; i++) if ($i == "hand.tz") c = i } NR == 71 { print $c }' rep/wrench.csv)
+    awk -v a="$a" -v b="$b" 'BEGIN { d = a - b; if (d < 0) d = -d; m = a < 0 ? -a : a;
+      exit !(m > 1 && d <= 1e-4 * m) }' || fail "replayed torque $b differs from recorded $a"
+    ;;
+
+  run_haptic_network)
+    # The reference peer plays a trajectory over UDP loopback; torsion drives the hand with it
+    # (threaded haptics: the loop at 1 kHz on its own thread, the simulation paced to the clock).
+    [[ -x $peer ]] || fail "no torsion_haptic_peer given"
+    sed "s|../../assets/meshes|$assets|" "$scenes/twist_cylinder_2430.json" > twist.json
+    write_short_turn turn.json
+    port=$((20000 + RANDOM % 20000))
+    "$torsion" run twist.json --device "hand=network:$port" --out net --steps 200 --threads 1 \
+      >torsion.log 2>&1 &
+    sim=$!
+    for _ in $(seq 100); do
+      grep -q "device network" torsion.log && break
+      sleep 0.1
+    done
+    grep -q "hand 'hand': device network(udp port $port), threaded haptic loop" torsion.log ||
+      { kill "$sim"; cat torsion.log; fail "torsion did not open the network device"; }
+    "$peer" --trajectory turn.json --port "$port" --log peer.csv || fail "the peer failed"
+    wait "$sim"
+    rc=$?
+    out=$(cat torsion.log)
+    printf '%s\n' "$out"
+    expect_rc 0
+    check_haptic_outputs net threaded
+    grep -q '"accepted": [1-9][0-9][0-9]' net/summary.json || fail "fewer than 100 poses accepted"
+    # The peer received the wrench: some packet carried a torque about z.
+    awk -F, 'NR > 1 && ($7 > 0.1 || $7 < -0.1) { found = 1 } END { exit !found }' peer.csv ||
+      fail "the peer never received a non-zero torque"
+    ;;
+
+  run_haptic_bad_device)
+    sed "s|../../assets/meshes|$assets|" "$scenes/twist_cylinder_2430.json" > twist.json
+    run "$torsion" run twist.json --device hand=network:5750 --haptics lockstep --out out --steps 5
+    expect_rc nonzero
+    expect_out "^error: twist.json: hands\[0\] 'hand': device: a network device lives in wall-clock time and cannot tick in lockstep: use --haptics threaded$"
+    run "$torsion" run twist.json --device hand=scripted:missing.json --out out --steps 5
+    expect_rc nonzero
+    expect_out "^error: twist.json: hands\[0\] 'hand': device: missing.json: cannot open the trajectory file$"
+    run "$torsion" run twist.json --device foot=spacemouse --out out --steps 5
+    expect_rc nonzero
+    expect_out "^error: --device 'foot=spacemouse': the scene has no hand named 'foot' \(hands: 'hand'\)$"
+    # No spacenavd runs here: the SpaceMouse says what is missing (daemon, or libspnav itself).
+    if [[ ! -e /var/run/spnav.sock ]]; then
+      run "$torsion" run twist.json --device hand=spacemouse --out out --steps 5
+      expect_rc nonzero
+      expect_out "^error: twist.json: hands\[0\] 'hand': device: SpaceMouse: (cannot connect to the spacenavd daemon|this build of Torsion has no libspnav)"
+    fi
+    [[ ! -e out/summary.json ]] || fail "no output may be written when a device cannot open"
     ;;
 
   *)

@@ -72,6 +72,7 @@ TEST(HandCoupling, LocalStiffnessMatchesAFiniteDifferenceOfTheSimulatedWrench) {
   };
   CouplingSettings settings;
   settings.stiffness_refresh_steps = 1;
+  settings.stiffness_columns_per_step = 6;  // all six from the paused state
   settings.stiffness_tolerance = 1e-8;
   CouplingRig reference(2430, dynamic, settings);
   replay(reference);

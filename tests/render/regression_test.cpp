@@ -21,6 +21,7 @@
 #include <sstream>
 
 #include "scene_builder.h"
+#include "scene_haptics.h"
 #include "scene_parser.h"
 
 namespace torsion::scene {
@@ -117,12 +118,12 @@ Metrics runScenePath(const std::string& path, int steps, int threads, double sti
   }
   BuiltScene& s = *built.value();
   for (int k = 0; k < steps; ++k) {
-    Status driven = driveHands(s);
-    if (!driven) {
-      ADD_FAILURE() << driven.error().message;
+    Result<WorldStepReport> stepped = stepScene(s);  // device hands: lockstep haptics
+    if (!stepped) {
+      ADD_FAILURE() << stepped.error().message;
       return m;
     }
-    const WorldStepReport r = s.world->step();
+    const WorldStepReport& r = stepped.value();
     if (!r.ok) {
       ADD_FAILURE() << path << ": " << r.message;
       return m;

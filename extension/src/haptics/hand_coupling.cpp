@@ -24,6 +24,8 @@ Status CouplingSettings::validate() const {
   if (!(torque_coefficient >= 0 && std::isfinite(torque_coefficient)))
     return Error{"torque_coefficient must be a non-negative number (m^3)"};
   if (stiffness_refresh_steps < 0) return Error{"stiffness_refresh_steps must be >= 0"};
+  if (stiffness_columns_per_step < 1 || stiffness_columns_per_step > 6)
+    return Error{"stiffness_columns_per_step must be in [1, 6]"};
   if (!(stiffness_tolerance > 0 && stiffness_tolerance < 1))
     return Error{"stiffness_tolerance must be in (0, 1)"};
   return Ok{};
@@ -49,6 +51,7 @@ Status HandCoupling::apply(const device::HandCommand& command, double now) {
     Result<int> grabbed = hand_.grab(goal_, now);
     stiffness_valid_ = false;
     steps_since_refresh_ = 0;
+    stiffness_.reset();
     if (!grabbed) return grabbed.error();
     // BeginInteraction: Center and Orientation from the rest state, the hand's offset from them.
     const TetMesh& mesh = hand_.body().model().mesh();
@@ -88,10 +91,14 @@ device::SimulationWrench HandCoupling::publish(std::uint64_t step) {
     const bool stepped = body.stepper().elasticForces().size() == body.state().positions.size();
     if (stepped) {
       world_wrench_ = body.groupWrench(hand_.group(), goal_.origin);
-      if (settings_.stiffness_refresh_steps > 0 &&
-          (!stiffness_valid_ || ++steps_since_refresh_ >= settings_.stiffness_refresh_steps)) {
-        stiffness_cache_ =
-            stiffness_.compute(body, hand_.group(), goal_.origin, settings_.stiffness_tolerance);
+      ++steps_since_refresh_;
+      const bool due =
+          settings_.stiffness_refresh_steps > 0 &&
+          (!stiffness_valid_ || steps_since_refresh_ >= settings_.stiffness_refresh_steps);
+      if ((due || stiffness_.inProgress()) &&
+          stiffness_.advance(body, hand_.group(), goal_.origin, settings_.stiffness_tolerance,
+                             settings_.stiffness_columns_per_step)) {
+        stiffness_cache_ = stiffness_.matrix();
         stiffness_valid_ = true;
         steps_since_refresh_ = 0;
       }

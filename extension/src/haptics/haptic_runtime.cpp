@@ -51,9 +51,7 @@ WorldStepReport HapticRuntime::stepLockstep() {
   return step();
 }
 
-WorldStepReport HapticRuntime::runThreaded(
-    int steps, bool real_time, const std::function<bool(const WorldStepReport&)>& after_step) {
-  using Clock = std::chrono::steady_clock;
+void HapticRuntime::startThreads() {
   for (HapticBinding& b : bindings_)
     b.loop->start();
   // Give the loops a first tick so the first step sees the device.
@@ -64,21 +62,37 @@ WorldStepReport HapticRuntime::runThreaded(
     if (all) break;
     std::this_thread::sleep_for(std::chrono::milliseconds(1));
   }
-  const auto origin = Clock::now();
-  const double start_time = world_.time();
+  threads_origin_ = std::chrono::steady_clock::now();
+  threads_start_time_ = world_.time();
+}
+
+void HapticRuntime::pace() {
+  using Clock = std::chrono::steady_clock;
+  const double due = world_.time() - threads_start_time_;  // the coming step starts at `due`
+  std::this_thread::sleep_until(threads_origin_ + std::chrono::duration_cast<Clock::duration>(
+                                                      std::chrono::duration<double>(due)));
+}
+
+WorldStepReport HapticRuntime::stepPaced(bool real_time) {
+  if (real_time) pace();
+  return step();
+}
+
+void HapticRuntime::stopThreads() {
+  for (HapticBinding& b : bindings_)
+    b.loop->stop();
+}
+
+WorldStepReport HapticRuntime::runThreaded(
+    int steps, bool real_time, const std::function<bool(const WorldStepReport&)>& after_step) {
+  startThreads();
   WorldStepReport report;
   for (int k = 0; k < steps; ++k) {
-    if (real_time) {
-      const double due = world_.time() - start_time;  // this step starts at simulated time `due`
-      std::this_thread::sleep_until(
-          origin + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(due)));
-    }
-    report = step();
+    report = stepPaced(real_time);
     if (!report.ok) break;
     if (after_step && !after_step(report)) break;
   }
-  for (HapticBinding& b : bindings_)
-    b.loop->stop();
+  stopThreads();
   return report;
 }
 

@@ -32,6 +32,9 @@ struct HapticLoopSettings {
   CouplingDamper damper;
   double twist_cutoff_hz = 50;   ///< low-pass of the velocity the damper sees
   std::size_t log_capacity = 0;  ///< rows kept in memory (one per tick); 0: no log
+  /// SCHED_FIFO priority (1-99) the loop's thread asks for; it keeps the default policy,
+  /// silently, when that is not permitted (LoopStats::realtime says which). 0: do not ask.
+  int realtime_priority = 80;
 
   /// Empty when valid, else the message naming the field.
   std::string validate() const;
@@ -60,6 +63,8 @@ struct LoopStats {
   std::atomic<std::uint64_t> overruns{0};     ///< ticks that started a full period late
   std::atomic<std::uint64_t> log_dropped{0};  ///< rows not logged: capacity reached
   std::atomic<std::uint64_t> nonfinite{0};    ///< rendered wrenches with NaN/inf (zeroed)
+  std::atomic<std::uint64_t> saturated{0};    ///< ticks whose wrench exceeded a device limit
+  std::atomic<bool> realtime{false};          ///< the thread runs under SCHED_FIFO
 };
 
 class HapticLoop {
@@ -88,6 +93,8 @@ class HapticLoop {
   const LoopStats& stats() const { return stats_; }
   /// The log so far; only while the loop is not running (or from the ticking thread).
   const std::vector<LoopLogRow>& log() const { return log_; }
+  /// Keeps at most `rows` log rows (reserved now); only while the loop is not running.
+  void setLogCapacity(std::size_t rows);
   /// Writes the log as CSV; false when the file cannot be written.
   bool writeLog(const std::string& path) const;
   const Wrench& lastOutput() const { return safety_.output(); }

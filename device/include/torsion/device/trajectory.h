@@ -36,6 +36,9 @@ class Trajectory {
   /// Time of the last keyframe or button event, s.
   double duration() const;
   const std::vector<TrajectoryKeyframe>& keyframes() const { return keyframes_; }
+  /// The same motion played `speed` times faster (keyframe and button times divided by it).
+  /// `speed` must be positive.
+  Trajectory playedAt(double speed) const;
 
  private:
   std::vector<TrajectoryKeyframe> keyframes_;

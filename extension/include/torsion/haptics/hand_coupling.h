@@ -7,7 +7,8 @@
 // Rendering:
 //   - internal force (default): the wrench the body exerts on the grabbed nodes, F = sum f_l,
 //     tau = sum (p_l - O) x f_l, f_l elastic + damping forces, O the device's frame origin;
-//     K_h = PatchStiffness, refreshed every `stiffness_refresh_steps` steps;
+//     K_h = PatchStiffness, refreshed every `stiffness_refresh_steps` steps, computed a few
+//     columns per step (`stiffness_columns_per_step`);
 //   - frame difference (the report's Algorithm 4): F = -E c_f (O - Center - LocalRestPosition),
 //     tau = -E c_t theta(R Orientation^-1 LocalRestOrientation^-1), with Center the grabbed
 //     nodes' rest centroid, Orientation the body's rest orientation (identity), the Local* terms
@@ -34,9 +35,13 @@ const char* toString(Rendering rendering);
 
 struct CouplingSettings {
   Rendering rendering = Rendering::kInternalForce;
-  double force_coefficient = 0.1;     ///< c_f, m (frame difference)
-  double torque_coefficient = 0.05;   ///< c_t, m^3 (frame difference)
-  int stiffness_refresh_steps = 10;   ///< internal force: K_h every this many steps; 0: K_h = 0
+  double force_coefficient = 0.1;    ///< c_f, m (frame difference)
+  double torque_coefficient = 0.05;  ///< c_t, m^3 (frame difference)
+  int stiffness_refresh_steps = 10;  ///< internal force: K_h every this many steps; 0: K_h = 0
+  /// K_h columns (one CG solve each) computed per step; 6: the whole refresh in one step. 1
+  /// keeps every step about as long as the others (after a grab the first K_h is then ready
+  /// 6 steps later; until then the loop holds the simulated wrench).
+  int stiffness_columns_per_step = 1;
   double stiffness_tolerance = 1e-3;  ///< relative CG tolerance of the K_h solves
 
   Status validate() const;

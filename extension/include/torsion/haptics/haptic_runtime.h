@@ -13,6 +13,7 @@
 //   haptic loop (HapticLoop::start) | its device; its buffers as the other side
 // The haptic thread never touches the world.
 
+#include <chrono>
 #include <functional>
 #include <string>
 #include <vector>
@@ -43,6 +44,16 @@ class HapticRuntime {
   /// Ticks every loop on the simulated clock up to the end of the coming step, then step().
   WorldStepReport stepLockstep();
 
+  /// Threaded mode in pieces, for callers that own the stepping loop (the scene runner):
+  /// startThreads() starts every loop's thread and waits for its first tick (at most 1 s);
+  /// stepPaced() is step(), first waiting until wall-clock time since startThreads() has caught
+  /// up with simulated time when `real_time`; stopThreads() stops them (zero wrench written).
+  void startThreads();
+  WorldStepReport stepPaced(bool real_time);
+  /// The wait of stepPaced(true) alone: returns when the coming step is due.
+  void pace();
+  void stopThreads();
+
   /// Starts the loops' threads, runs `steps` steps on this thread (paced so that simulated time
   /// never runs ahead of wall-clock time when `real_time`), stops the loops. `after_step` may
   /// stop the run early by returning false. Returns the last step's report.
@@ -56,6 +67,8 @@ class HapticRuntime {
   std::vector<HapticBinding> bindings_;
   std::vector<std::string> warnings_;
   double loop_clock_ = 0;  // s, simulated clock of the lockstep mode
+  std::chrono::steady_clock::time_point threads_origin_;
+  double threads_start_time_ = 0;  // world time at startThreads()
   std::uint64_t lockstep_ticks_ = 0;
 };
 

@@ -7,7 +7,9 @@
 //   A_ff dv_f = -A_fg dv_g     (A the step's system matrix, projected CG)
 // and the internal force changes by df = -(dt + beta) K dv, so column k is
 //   [sum df ; sum (x - O) x df] + the lever-arm term sum [f]x [x - O]x e_rot.
-// Six solves: refresh it every few steps, not every step. Simulation thread only.
+// Six solves: refresh it every few steps, not every step, and if need be a column per step
+// (advance()), so that no single step is several times longer than the others. Simulation
+// thread only.
 
 #include <Eigen/Core>
 #include <vector>
@@ -23,14 +25,28 @@ class PatchStiffness {
   /// dW/dpose of group `group` of `body` about `point`, with the body's current step system.
   /// `tolerance`: relative CG tolerance of the six solves (warm-started from the last call).
   Matrix6d compute(FemBody& body, int group, const Eigen::Vector3d& point, double tolerance);
-  /// Total CG iterations of the last compute().
+  /// One part of a refresh: up to `columns` more columns (starting a refresh when none is under
+  /// way), each with the body's system at the time. True when the sixth is done: matrix() is then
+  /// the new K_h (its lever-arm term from the state at that time).
+  bool advance(FemBody& body, int group, const Eigen::Vector3d& point, double tolerance,
+               int columns);
+  bool inProgress() const { return next_column_ > 0; }
+  /// Abandons a refresh under way (the grabbed patch changed).
+  void reset() { next_column_ = 0; }
+  const Matrix6d& matrix() const { return matrix_; }
+  /// Total CG iterations of the last complete refresh.
   int lastIterations() const { return iterations_; }
 
  private:
+  Eigen::Matrix<double, 6, 1> column(FemBody& body, int group, const Eigen::Vector3d& point,
+                                     double tolerance, int c);
+
   ProjectedCg cg_;
   std::vector<Eigen::VectorXd> warm_;  // last solution per column
   Eigen::VectorXd zero_rhs_, stiffness_times_;
-  int iterations_ = 0;
+  int iterations_ = 0, partial_iterations_ = 0;
+  int next_column_ = 0;  // 0: no refresh under way
+  Matrix6d partial_ = Matrix6d::Zero(), matrix_ = Matrix6d::Zero();
 };
 
 }  // namespace torsion::haptics

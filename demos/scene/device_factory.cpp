@@ -1,0 +1,63 @@
+#include "device_factory.h"
+
+#include <filesystem>
+
+#include "torsion/device/network_device.h"
+#include "torsion/device/scripted_device.h"
+#include "torsion/device/spacemouse_device.h"
+#include "torsion/device/udp_socket.h"
+
+namespace torsion::scene {
+
+namespace {
+
+device::DeviceLimits limitsOf(const DeviceSpec& spec) {
+  device::DeviceLimits limits = device::defaultDeviceLimits();
+  limits.max_force = spec.max_force;
+  limits.max_torque = spec.max_torque;
+  return limits;
+}
+
+std::unique_ptr<device::HapticDevice> scripted(device::Trajectory trajectory,
+                                               const DeviceSpec& spec) {
+  const std::string name = std::string(toString(spec.kind)) + "(" +
+                           std::filesystem::path(spec.file).filename().string() + ")";
+  return std::make_unique<device::ScriptedDevice>(trajectory.playedAt(spec.speed), limitsOf(spec),
+                                                  name);
+}
+
+}  // namespace
+
+Result<std::unique_ptr<device::HapticDevice>> openDevice(const DeviceSpec& spec) {
+  switch (spec.kind) {
+    case DeviceSpec::Kind::kScripted: {
+      device::Loaded<device::Trajectory> t = device::loadTrajectory(spec.file);
+      if (!t) return Error{t.error};
+      return scripted(std::move(*t.value), spec);
+    }
+    case DeviceSpec::Kind::kReplay: {
+      device::Loaded<device::Trajectory> t = device::loadRecordedTrajectory(spec.file);
+      if (!t) return Error{t.error};
+      return scripted(std::move(*t.value), spec);
+    }
+    case DeviceSpec::Kind::kNetwork: {
+      device::NetworkDeviceSettings settings;
+      if (!device::parseIpv4(spec.host, settings.local.address))
+        return Error{"'" + spec.host + "' is not an IPv4 address"};
+      settings.local.port = static_cast<std::uint16_t>(spec.port);
+      settings.timeout = spec.timeout;
+      settings.limits = limitsOf(spec);
+      auto opened = device::NetworkDevice::open(settings);
+      if (!opened) return Error{opened.error};
+      return std::unique_ptr<device::HapticDevice>(std::move(*opened.value));
+    }
+    case DeviceSpec::Kind::kSpaceMouse: {
+      auto opened = device::openSpaceMouse(spec.spacemouse);
+      if (!opened) return Error{opened.error};
+      return std::move(*opened.value);
+    }
+  }
+  return Error{"unknown device kind"};
+}
+
+}  // namespace torsion::scene

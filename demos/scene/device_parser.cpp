@@ -1,0 +1,248 @@
+#include "device_parser.h"
+
+#include <filesystem>
+
+#include "torsion/device/udp_socket.h"
+
+namespace torsion::scene {
+
+namespace {
+
+std::string resolve(const std::string& path, const std::string& base_directory) {
+  const std::filesystem::path p(path);
+  return p.is_absolute() ? path : (std::filesystem::path(base_directory) / p).string();
+}
+
+double positive(const JsonObject& o, const std::string& key, double fallback,
+                const std::string& unit) {
+  const double v = o.number(key, fallback);
+  if (!(v > 0)) o.fail(key, "must be > 0" + unit);
+  return v;
+}
+
+double nonNegative(const JsonObject& o, const std::string& key, double fallback,
+                   const std::string& unit) {
+  const double v = o.number(key, fallback);
+  if (!(v >= 0)) o.fail(key, "must be >= 0" + unit);
+  return v;
+}
+
+void readNetwork(const JsonObject& d, DeviceSpec& spec) {
+  spec.host = d.string("host", spec.host);
+  std::uint32_t address = 0;
+  if (!device::parseIpv4(spec.host, address))
+    d.fail("host", "'" + spec.host + "' is not an IPv4 address");
+  spec.port = d.integer("port", spec.port);
+  if (spec.port < 0 || spec.port > 65535)
+    d.fail("port", "must be in [0, 65535] (0: any free port)");
+  spec.timeout = positive(d, "timeout", spec.timeout, " s");
+}
+
+void readSpaceMouse(const JsonObject& d, DeviceSpec& spec) {
+  device::SpaceMouseSettings& s = spec.spacemouse;
+  s.max_linear_speed = nonNegative(d, "max_linear_speed", s.max_linear_speed, " m/s");
+  s.max_angular_speed = nonNegative(d, "max_angular_speed", s.max_angular_speed, " rad/s");
+  s.full_scale = positive(d, "full_scale", s.full_scale, " counts");
+  s.dead_zone = d.integer("dead_zone", s.dead_zone);
+  if (s.dead_zone < 0 || s.dead_zone >= s.full_scale)
+    d.fail("dead_zone", "must be in [0, full_scale)");
+}
+
+void readCoupling(const JsonObject& d, DeviceSpec& spec) {
+  haptics::CouplingSettings& c = spec.coupling;
+  const std::string rendering = d.string("rendering", "internal_force");
+  if (rendering == "internal_force") {
+    c.rendering = haptics::Rendering::kInternalForce;
+  } else if (rendering == "frame_difference") {
+    c.rendering = haptics::Rendering::kFrameDifference;
+  } else {
+    d.fail("rendering", "'" + rendering + "' is not one of: internal_force, frame_difference");
+  }
+  if (!d.has("coupling")) return;
+  const JsonObject o = d.object("coupling");
+  c.force_coefficient = nonNegative(o, "force_coefficient", c.force_coefficient, " m");
+  c.torque_coefficient = nonNegative(o, "torque_coefficient", c.torque_coefficient, " m^3");
+  c.stiffness_refresh_steps = o.integer("stiffness_refresh_steps", c.stiffness_refresh_steps);
+  if (c.stiffness_refresh_steps < 0)
+    o.fail("stiffness_refresh_steps", "must be >= 0 (0: no local stiffness)");
+  c.stiffness_columns_per_step =
+      o.integer("stiffness_columns_per_step", c.stiffness_columns_per_step);
+  if (c.stiffness_columns_per_step < 1 || c.stiffness_columns_per_step > 6)
+    o.fail("stiffness_columns_per_step", "must be in [1, 6]");
+  o.finish();
+}
+
+void readLoop(const JsonObject& d, DeviceSpec& spec) {
+  device::HapticLoopSettings& l = spec.loop;
+  l.rate_hz = d.number("rate_hz", l.rate_hz);
+  if (!(l.rate_hz > 0 && l.rate_hz <= 20000)) d.fail("rate_hz", "must be in (0, 20000] Hz");
+  if (d.has("damper")) {
+    const JsonObject o = d.object("damper");
+    l.damper.linear = nonNegative(o, "linear", l.damper.linear, " N s/m");
+    l.damper.angular = nonNegative(o, "angular", l.damper.angular, " N m s/rad");
+    o.finish();
+  }
+  if (d.has("safety")) {
+    const JsonObject o = d.object("safety");
+    device::SafetySettings& s = l.safety;
+    s.max_force_rate = positive(o, "max_force_rate", s.max_force_rate, " N/s");
+    s.max_torque_rate = positive(o, "max_torque_rate", s.max_torque_rate, " N m/s");
+    s.stale_after = positive(o, "stale_after", s.stale_after, " s");
+    s.fade_time = positive(o, "fade_time", s.fade_time, " s");
+    o.finish();
+  }
+}
+
+}  // namespace
+
+const char* toString(DeviceSpec::Kind kind) {
+  switch (kind) {
+    case DeviceSpec::Kind::kScripted:
+      return "scripted";
+    case DeviceSpec::Kind::kReplay:
+      return "replay";
+    case DeviceSpec::Kind::kNetwork:
+      return "network";
+    case DeviceSpec::Kind::kSpaceMouse:
+      return "spacemouse";
+  }
+  return "?";
+}
+
+const char* toString(HapticsMode mode) {
+  switch (mode) {
+    case HapticsMode::kAuto:
+      return "auto";
+    case HapticsMode::kLockstep:
+      return "lockstep";
+    case HapticsMode::kThreaded:
+      return "threaded";
+  }
+  return "?";
+}
+
+DeviceSpec readDevice(const JsonObject& hand, const std::string& base_directory) {
+  for (const char* scripted : {"keyframes", "motion", "grab_at", "release_at"}) {
+    if (hand.has(scripted)) {
+      hand.fail(scripted,
+                "a hand with a device is moved by the device and grabs and releases with its "
+                "buttons 1 and 2; remove this key (the hand's frame is where the device's zero "
+                "pose sits)");
+    }
+  }
+  const JsonObject d = hand.object("device");
+  DeviceSpec spec;
+  const std::string type = d.string("type");
+  if (type == "scripted") {
+    spec.kind = DeviceSpec::Kind::kScripted;
+    spec.file = resolve(d.string("trajectory"), base_directory);
+  } else if (type == "replay") {
+    spec.kind = DeviceSpec::Kind::kReplay;
+    spec.file = resolve(d.string("log"), base_directory);
+  } else if (type == "network") {
+    spec.kind = DeviceSpec::Kind::kNetwork;
+    readNetwork(d, spec);
+  } else if (type == "spacemouse") {
+    spec.kind = DeviceSpec::Kind::kSpaceMouse;
+    readSpaceMouse(d, spec);
+  } else {
+    d.fail("type", "'" + type + "' is not one of: scripted, replay, network, spacemouse");
+  }
+  if (spec.kind == DeviceSpec::Kind::kScripted || spec.kind == DeviceSpec::Kind::kReplay)
+    spec.speed = positive(d, "speed", spec.speed, " (playback speed)");
+  if (spec.kind != DeviceSpec::Kind::kSpaceMouse && d.has("limits")) {
+    // A SpaceMouse has no motors: it takes no force limits.
+    const JsonObject o = d.object("limits");
+    spec.max_force = nonNegative(o, "max_force", spec.max_force, " N");
+    spec.max_torque = nonNegative(o, "max_torque", spec.max_torque, " N m");
+    o.finish();
+  }
+  if (d.has("mapping")) {
+    const JsonObject o = d.object("mapping");
+    spec.position_scale =
+        positive(o, "position_scale", spec.position_scale, " (world m per device m)");
+    spec.force_scale = nonNegative(o, "force_scale", spec.force_scale, " (device N per world N)");
+    spec.torque_scale = nonNegative(o, "torque_scale", spec.torque_scale, "");
+    o.finish();
+  }
+  readCoupling(d, spec);
+  readLoop(d, spec);
+  d.finish();
+  return spec;
+}
+
+Status applyDeviceOverride(SceneSpec& scene, const std::string& text) {
+  const std::string flag = "--device '" + text + "'";
+  const size_t equals = text.find('=');
+  if (equals == std::string::npos || equals == 0) {
+    return Error{flag +
+                 ": expected HAND=TYPE[:ARG], e.g. hand=network:5750 or hand=replay:log.csv"};
+  }
+  const std::string name = text.substr(0, equals);
+  HandSpec* hand = nullptr;
+  std::string names;
+  for (HandSpec& h : scene.hands) {
+    if (h.name == name) hand = &h;
+    names += (names.empty() ? "'" : ", '") + h.name + "'";
+  }
+  if (!hand) {
+    return Error{flag + ": the scene has no hand named '" + name + "'" +
+                 (names.empty() ? std::string(" (it has no hands)") : " (hands: " + names + ")")};
+  }
+  const std::string value = text.substr(equals + 1);
+  const size_t colon = value.find(':');
+  const std::string type = value.substr(0, colon);
+  const std::string arg = colon == std::string::npos ? "" : value.substr(colon + 1);
+
+  DeviceSpec spec = hand->device ? *hand->device : DeviceSpec{};
+  spec.file.clear();
+  if (type == "scripted" || type == "replay") {
+    if (arg.empty()) return Error{flag + ": " + type + " needs a file: " + type + ":FILE"};
+    spec.kind = type == "scripted" ? DeviceSpec::Kind::kScripted : DeviceSpec::Kind::kReplay;
+    spec.file = arg;
+  } else if (type == "network") {
+    spec.kind = DeviceSpec::Kind::kNetwork;
+    std::string port = arg;
+    const size_t host_end = arg.rfind(':');
+    if (host_end != std::string::npos) {
+      spec.host = arg.substr(0, host_end);
+      port = arg.substr(host_end + 1);
+      std::uint32_t address = 0;
+      if (!device::parseIpv4(spec.host, address))
+        return Error{flag + ": '" + spec.host + "' is not an IPv4 address"};
+    }
+    if (!port.empty()) {
+      size_t used = 0;
+      int p = -1;
+      try {
+        p = std::stoi(port, &used);
+      } catch (const std::exception&) {
+        used = 0;
+      }
+      if (used != port.size() || p < 0 || p > 65535)
+        return Error{flag + ": port '" + port + "' is not a number in [0, 65535]"};
+      spec.port = p;
+    }
+  } else if (type == "spacemouse") {
+    if (!arg.empty()) return Error{flag + ": spacemouse takes no argument"};
+    spec.kind = DeviceSpec::Kind::kSpaceMouse;
+  } else {
+    return Error{flag + ": unknown device type '" + type +
+                 "' (known: scripted, replay, network, spacemouse)"};
+  }
+  if (!hand->keyframes.empty()) {  // the scripted motion gives way; its start is the anchor
+    hand->initial = hand->keyframes.front().second;
+    hand->keyframes.clear();
+  }
+  hand->motion = MotionSpec{};
+  hand->device = spec;
+  return Ok{};
+}
+
+Result<HapticsMode> parseHapticsMode(const std::string& text) {
+  if (text == "lockstep") return HapticsMode::kLockstep;
+  if (text == "threaded") return HapticsMode::kThreaded;
+  return Error{"--haptics '" + text + "': expected lockstep or threaded"};
+}
+
+}  // namespace torsion::scene

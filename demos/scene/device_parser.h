@@ -1,0 +1,25 @@
+#pragma once
+// The `device` entry of a scene hand, and the CLI's `--device HAND=TYPE[:ARG]` override.
+
+#include <string>
+
+#include "json_reader.h"
+#include "scene_spec.h"
+#include "torsion/result.h"
+
+namespace torsion::scene {
+
+/// Reads hand.device (`hand` is the hand's object; it must not also script a motion or grab
+/// times). Relative paths are resolved against `base_directory`. Throws JsonFault naming the key.
+DeviceSpec readDevice(const JsonObject& hand, const std::string& base_directory);
+
+/// Applies `--device HAND=TYPE[:ARG]`: scripted:FILE, replay:FILE, network[:PORT] or
+/// network:HOST:PORT, spacemouse. A hand that had a scripted motion keeps its starting frame as
+/// the device's anchor; one that had a device keeps its mapping, limits and coupling. FILE is
+/// relative to the working directory.
+Status applyDeviceOverride(SceneSpec& scene, const std::string& text);
+
+/// "lockstep" or "threaded" (the CLI's --haptics).
+Result<HapticsMode> parseHapticsMode(const std::string& text);
+
+}  // namespace torsion::scene

@@ -1,0 +1,199 @@
+#include "scene_haptics.h"
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+
+#include "device_factory.h"
+#include "torsion/device/network_device.h"
+#include "torsion/device/pose_math.h"
+
+namespace torsion::scene {
+
+namespace {
+
+// A whole run's ticks in memory (the loop does no I/O while it runs); 10 minutes at 1 kHz at
+// most (about 130 MB), beyond which rows are dropped and counted.
+constexpr double kMaxLogRows = 600000;
+
+bool livesInWallClockTime(DeviceSpec::Kind kind) {
+  return kind == DeviceSpec::Kind::kNetwork || kind == DeviceSpec::Kind::kSpaceMouse;
+}
+
+double percentile(std::vector<double> values, double p) {
+  if (values.empty()) return 0;
+  std::sort(values.begin(), values.end());
+  return values[static_cast<size_t>(std::lround(p * static_cast<double>(values.size() - 1)))];
+}
+
+nlohmann::json spread(const std::vector<double>& values) {
+  return {{"p50", percentile(values, 0.5)},
+          {"p99", percentile(values, 0.99)},
+          {"max", percentile(values, 1.0)}};
+}
+
+std::string fileSafe(const std::string& name) {
+  std::string out = name;
+  for (char& c : out) {
+    if (!std::isalnum(static_cast<unsigned char>(c)) && c != '-' && c != '_') c = '_';
+  }
+  return out;
+}
+
+}  // namespace
+
+Result<std::unique_ptr<SceneHaptics>> SceneHaptics::attach(BuiltScene& scene) {
+  std::unique_ptr<SceneHaptics> h(new SceneHaptics());
+  h->dt_ = scene.world->settings().solver.time_step;
+  bool live = false;
+  for (const SceneHand& s : scene.hands)
+    live = live || (s.spec.device && livesInWallClockTime(s.spec.device->kind));
+  h->mode_ = scene.spec.haptics_mode;
+  if (h->mode_ == HapticsMode::kAuto)
+    h->mode_ = live ? HapticsMode::kThreaded : HapticsMode::kLockstep;
+
+  std::vector<haptics::HapticBinding> bindings;
+  for (size_t i = 0; i < scene.hands.size(); ++i) {
+    SceneHand& s = scene.hands[i];
+    if (!s.spec.device) continue;
+    const DeviceSpec& spec = *s.spec.device;
+    const std::string entry = "hands[" + std::to_string(i) + "] '" + s.spec.name + "': device";
+    if (h->mode_ == HapticsMode::kLockstep && livesInWallClockTime(spec.kind)) {
+      return Error{entry + ": a " + std::string(toString(spec.kind)) +
+                   " device lives in wall-clock time and cannot tick in lockstep: use "
+                   "--haptics threaded"};
+    }
+    if (!bindings.empty() && h->mode_ == HapticsMode::kLockstep &&
+        spec.loop.rate_hz != bindings.front().rate_hz) {
+      return Error{entry + ".rate_hz: in lockstep every device hand ticks at the same rate"};
+    }
+    if (Status ok = spec.coupling.validate(); !ok) return Error{entry + ": " + ok.error().message};
+    if (std::string bad = spec.loop.validate(); !bad.empty()) return Error{entry + ": " + bad};
+    Result<std::unique_ptr<device::HapticDevice>> opened = openDevice(spec);
+    if (!opened) return Error{entry + ": " + opened.error().message};
+
+    Channel c;
+    c.hand = s.spec.name;
+    c.device = std::move(opened).value();
+    haptics::DeviceMapping mapping;
+    mapping.anchor = s.spec.initial;
+    mapping.position_scale = spec.position_scale;
+    mapping.force_scale = spec.force_scale;
+    mapping.torque_scale = spec.torque_scale;
+    c.coupling = std::make_unique<haptics::HandCoupling>(*s.hand, mapping, spec.coupling);
+    c.loop = std::make_unique<device::HapticLoop>(*c.device, spec.loop);
+    c.rate_hz = spec.loop.rate_hz;
+    bindings.push_back({c.coupling.get(), c.loop.get(), c.rate_hz});
+    h->channels_.push_back(std::move(c));
+  }
+  h->runtime_ = std::make_unique<haptics::HapticRuntime>(*scene.world, std::move(bindings));
+  h->prepareRun(scene.spec.steps);
+  return h;
+}
+
+SceneHaptics::~SceneHaptics() {
+  if (runtime_ && threads_started_ && !finished_) runtime_->stopThreads();
+}
+
+void SceneHaptics::prepareRun(int steps) {
+  for (Channel& c : channels_) {
+    double rows = std::ceil(steps * dt_ * c.rate_hz) + 2;
+    if (mode_ == HapticsMode::kThreaded) rows = 1.25 * rows + 5 * c.rate_hz;  // a slow step
+    c.loop->setLogCapacity(static_cast<size_t>(std::min(rows, kMaxLogRows)));
+  }
+}
+
+void SceneHaptics::pace() {
+  if (mode_ == HapticsMode::kLockstep) return;
+  if (!threads_started_) {
+    runtime_->startThreads();
+    threads_started_ = true;
+  }
+  runtime_->pace();
+}
+
+WorldStepReport SceneHaptics::step() {
+  if (mode_ == HapticsMode::kLockstep) return runtime_->stepLockstep();
+  pace();
+  return runtime_->step();
+}
+
+nlohmann::json SceneHaptics::statistics(const Channel& c) const {
+  const std::vector<device::LoopLogRow>& log = c.loop->log();
+  std::vector<double> period_error, age, lateness;
+  double max_force = 0, max_torque = 0;
+  for (size_t k = 0; k < log.size(); ++k) {
+    const device::LoopLogRow& r = log[k];
+    if (k > 0) period_error.push_back(1e3 * std::abs(r.period - 1.0 / c.rate_hz));
+    if (r.sim_step > 0) age.push_back(1e3 * r.wrench_age);
+    max_force = std::max(max_force, device::norm(r.output.force));
+    max_torque = std::max(max_torque, device::norm(r.output.torque));
+  }
+  const double span = log.size() > 1 ? log.back().time - log.front().time : 0;
+  const device::LoopStats& st = c.loop->stats();
+  nlohmann::json j = {
+      {"hand", c.hand},
+      {"device", c.device->name()},
+      {"mode", toString(mode_)},
+      {"clock", mode_ == HapticsMode::kLockstep ? "simulated" : "wall"},
+      {"log", "haptic_" + fileSafe(c.hand) + ".csv"},
+      {"rate_hz", c.rate_hz},
+      {"achieved_rate_hz", span > 0 ? static_cast<double>(log.size() - 1) / span : 0.0},
+      {"ticks", st.ticks.load()},
+      {"period_error_ms", spread(period_error)},
+      {"wrench_age_ms", spread(age)},
+      {"saturated_ticks", st.saturated.load()},
+      {"overruns", st.overruns.load()},
+      {"nonfinite", st.nonfinite.load()},
+      {"log_dropped", st.log_dropped.load()},
+      {"max_output", {{"force", max_force}, {"torque", max_torque}}},
+      {"limits",
+       {{"max_force", c.device->limits().max_force},
+        {"max_torque", c.device->limits().max_torque}}}};
+  if (const auto* net = dynamic_cast<const device::NetworkDevice*>(c.device.get())) {
+    const device::PacketStats& p = net->stats();
+    j["packets"] = {{"accepted", p.accepted.load()},
+                    {"truncated", p.truncated.load()},
+                    {"malformed", p.malformed.load()},
+                    {"out_of_order", p.out_of_order.load()},
+                    {"duplicate", p.duplicate.load()},
+                    {"lost", p.lost.load()},
+                    {"sent", p.sent.load()}};
+  }
+  return j;
+}
+
+Result<nlohmann::json> SceneHaptics::finish(const std::string& directory) {
+  if (threads_started_ && !finished_) {
+    runtime_->stopThreads();
+  } else if (!finished_) {
+    for (Channel& c : channels_)
+      c.device->write(device::Wrench{});  // lockstep: the loop does not stop, so zero it here
+  }
+  finished_ = true;
+  nlohmann::json hands = nlohmann::json::array();
+  for (const Channel& c : channels_) {
+    const std::filesystem::path path =
+        std::filesystem::path(directory) / ("haptic_" + fileSafe(c.hand) + ".csv");
+    if (!c.loop->writeLog(path.string())) return Error{path.string() + ": cannot write"};
+    hands.push_back(statistics(c));
+  }
+  return hands;
+}
+
+std::vector<std::string> SceneHaptics::describe() const {
+  std::vector<std::string> lines;
+  for (const Channel& c : channels_) {
+    lines.push_back("hand '" + c.hand + "': device " + c.device->name() + ", " + toString(mode_) +
+                    " haptic loop at " + std::to_string(static_cast<int>(c.rate_hz)) + " Hz");
+  }
+  return lines;
+}
+
+Result<WorldStepReport> stepScene(BuiltScene& scene) {
+  Status driven = driveHands(scene);
+  if (!driven) return driven.error();
+  return scene.haptics ? scene.haptics->step() : scene.world->step();
+}
+
+}  // namespace torsion::scene

@@ -1,0 +1,71 @@
+#pragma once
+// The haptic side of a scene: for every hand with a device, the open device, its 1 kHz
+// HapticLoop and the HandCoupling between them, run by one HapticRuntime in lockstep or threaded
+// mode (device_spec.h). buildScene attaches it; stepScene steps a scene with or without it.
+//
+//   Threads (threaded mode) | may touch
+//   simulation (the caller of stepScene / finish) | the world, hands, couplings; the loops'
+//       buffers as reader of commands and writer of wrenches
+//   one haptic thread per device hand | its device; its loop's buffers as the other side
+// In lockstep mode everything runs on the caller's thread.
+
+#include <memory>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
+
+#include "scene_builder.h"
+#include "torsion/device/haptic_device.h"
+#include "torsion/device/haptic_loop.h"
+#include "torsion/haptics/haptic_runtime.h"
+
+namespace torsion::scene {
+
+class SceneHaptics {
+ public:
+  /// Opens the devices of the scene's device hands and couples them. Errors name the hand.
+  static Result<std::unique_ptr<SceneHaptics>> attach(BuiltScene& scene);
+  ~SceneHaptics();
+
+  HapticsMode mode() const { return mode_; }
+  /// Sizes the loops' logs for a run of `steps` steps (before the first step).
+  void prepareRun(int steps);
+  /// One step: lockstep ticks the loops over it first; threaded starts the loops' threads on
+  /// the first call and paces the simulation to wall-clock time.
+  WorldStepReport step();
+  /// Threaded: starts the threads if needed and waits until the coming step is due in
+  /// wall-clock time (step() does it too; call it first to keep the wait out of a step's
+  /// timing). Lockstep: nothing.
+  void pace();
+  /// Stops the threads (zero wrench to every device), writes haptic_<hand>.csv per device hand
+  /// into `directory` and returns per-hand statistics for summary.json.
+  Result<nlohmann::json> finish(const std::string& directory);
+
+  /// One line per device hand: "hand 'h': device scripted(f.json), lockstep at 1000 Hz".
+  std::vector<std::string> describe() const;
+  const std::vector<std::string>& warnings() const { return runtime_->warnings(); }
+
+ private:
+  struct Channel {
+    std::string hand;
+    std::unique_ptr<device::HapticDevice> device;
+    std::unique_ptr<haptics::HandCoupling> coupling;
+    std::unique_ptr<device::HapticLoop> loop;
+    double rate_hz = 1000;
+  };
+  SceneHaptics() = default;
+  nlohmann::json statistics(const Channel& channel) const;
+
+  HapticsMode mode_ = HapticsMode::kLockstep;
+  double dt_ = 0.01;
+  std::vector<Channel> channels_;
+  std::unique_ptr<haptics::HapticRuntime> runtime_;
+  bool threads_started_ = false;
+  bool finished_ = false;
+};
+
+/// One step of a built scene: scripted hands are driven (driveHands), then the world steps,
+/// through the haptic runtime when the scene has device hands. Errors: a scripted grab missed.
+Result<WorldStepReport> stepScene(BuiltScene& scene);
+
+}  // namespace torsion::scene

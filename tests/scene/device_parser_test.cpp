@@ -1,0 +1,156 @@
+// The `device` entry of a scene hand and the CLI's --device / --haptics: a complete device of
+// each kind, and one case per kind of bad input, each checking the error names the key.
+#include "device_parser.h"
+
+#include <gtest/gtest.h>
+
+#include "../unit/error_matchers.h"
+#include "scene_parser.h"
+
+namespace torsion::scene {
+namespace {
+
+using test::failsWith;
+
+// A scene whose one hand carries `device` (a JSON object text) or `extra` hand keys.
+std::string sceneWith(const std::string& device, const std::string& extra = "") {
+  return R"({"bodies": [{"name": "cyl", "mesh": "cyl.node",
+              "material": {"youngs_modulus": 1e5, "poisson_ratio": 0.3, "density": 1000}}],
+  "hands": [{"name": "hand", "body": "cyl",
+             "frame": {"origin": [0, 0, 9.9], "i": [1, 0, 0], "j": [0, 1, 0]})" +
+         (device.empty() ? "" : ", \"device\": " + device) + extra + "}]}";
+}
+
+Result<SceneSpec> parse(const std::string& text) {
+  return parseScene(text, "s.json", "/base");
+}
+
+TEST(DeviceParser, ReadsAScriptedDeviceWithEverySetting) {
+  Result<SceneSpec> r = parse(sceneWith(R"({"type": "scripted", "trajectory": "t/fig.json",
+      "speed": 10, "mapping": {"position_scale": 10, "force_scale": 0.1, "torque_scale": 0.01},
+      "rendering": "frame_difference",
+      "coupling": {"force_coefficient": 0.2, "torque_coefficient": 0.04, "stiffness_refresh_steps": 5},
+      "limits": {"max_force": 12, "max_torque": 1.5}, "rate_hz": 500,
+      "damper": {"linear": 2, "angular": 0.1},
+      "safety": {"max_force_rate": 100, "max_torque_rate": 10, "stale_after": 0.05, "fade_time": 0.3}})"));
+  ASSERT_TRUE(r.ok()) << r.error().message;
+  const HandSpec& h = r.value().hands.at(0);
+  ASSERT_TRUE(h.device.has_value());
+  const DeviceSpec& d = *h.device;
+  EXPECT_EQ(d.kind, DeviceSpec::Kind::kScripted);
+  EXPECT_EQ(d.file, "/base/t/fig.json");  // relative to the scene file
+  EXPECT_EQ(d.speed, 10);
+  EXPECT_EQ(d.position_scale, 10);
+  EXPECT_EQ(d.force_scale, 0.1);
+  EXPECT_EQ(d.torque_scale, 0.01);
+  EXPECT_EQ(d.coupling.rendering, haptics::Rendering::kFrameDifference);
+  EXPECT_EQ(d.coupling.force_coefficient, 0.2);
+  EXPECT_EQ(d.coupling.stiffness_refresh_steps, 5);
+  EXPECT_EQ(d.max_force, 12);
+  EXPECT_EQ(d.max_torque, 1.5);
+  EXPECT_EQ(d.loop.rate_hz, 500);
+  EXPECT_EQ(d.loop.damper.linear, 2);
+  EXPECT_EQ(d.loop.safety.fade_time, 0.3);
+  EXPECT_EQ(h.initial.origin.z(), 9.9);  // the device's anchor
+}
+
+TEST(DeviceParser, ReadsNetworkReplayAndSpaceMouse) {
+  Result<SceneSpec> net =
+      parse(sceneWith(R"({"type": "network", "host": "127.0.0.1", "port": 6001, "timeout": 0.1})"));
+  ASSERT_TRUE(net.ok()) << net.error().message;
+  EXPECT_EQ(net.value().hands[0].device->kind, DeviceSpec::Kind::kNetwork);
+  EXPECT_EQ(net.value().hands[0].device->port, 6001);
+  Result<SceneSpec> replay = parse(sceneWith(R"({"type": "replay", "log": "/abs/run.csv"})"));
+  ASSERT_TRUE(replay.ok()) << replay.error().message;
+  EXPECT_EQ(replay.value().hands[0].device->file, "/abs/run.csv");
+  Result<SceneSpec> mouse =
+      parse(sceneWith(R"({"type": "spacemouse", "max_linear_speed": 0.05, "dead_zone": 20})"));
+  ASSERT_TRUE(mouse.ok()) << mouse.error().message;
+  EXPECT_EQ(mouse.value().hands[0].device->spacemouse.dead_zone, 20);
+}
+
+TEST(DeviceParser, BadInputNamesTheKey) {
+  EXPECT_TRUE(failsWith(parse(sceneWith(R"({"type": "joystick"})")),
+                        {"s.json: hands[0].device.type: 'joystick' is not one of"}));
+  EXPECT_TRUE(failsWith(parse(sceneWith(R"({"type": "scripted"})")),
+                        {"hands[0].device.trajectory: missing (required)"}));
+  EXPECT_TRUE(failsWith(parse(sceneWith(R"({"type": "scripted", "trajectory": 3})")),
+                        {"hands[0].device.trajectory: expected a string, found a number"}));
+  EXPECT_TRUE(failsWith(parse(sceneWith(R"({"type": "scripted", "trajectory": "a", "sped": 2})")),
+                        {"hands[0].device.sped: unknown key"}));
+  // Keys of another device type are unknown here, not silently ignored.
+  EXPECT_TRUE(failsWith(parse(sceneWith(R"({"type": "scripted", "trajectory": "a", "port": 1})")),
+                        {"hands[0].device.port: unknown key"}));
+  EXPECT_TRUE(failsWith(parse(sceneWith(R"({"type": "network", "port": 70000})")),
+                        {"hands[0].device.port: must be in [0, 65535]"}));
+  EXPECT_TRUE(failsWith(parse(sceneWith(R"({"type": "network", "host": "localhost"})")),
+                        {"hands[0].device.host: 'localhost' is not an IPv4 address"}));
+  EXPECT_TRUE(failsWith(
+      parse(sceneWith(R"({"type": "replay", "log": "a", "mapping": {"position_scale": 0}})")),
+      {"hands[0].device.mapping.position_scale: must be > 0"}));
+  EXPECT_TRUE(
+      failsWith(parse(sceneWith(R"({"type": "replay", "log": "a", "rendering": "spring"})")),
+                {"hands[0].device.rendering: 'spring' is not one of"}));
+  EXPECT_TRUE(
+      failsWith(parse(sceneWith(R"({"type": "replay", "log": "a", "limits": {"max_force": -1}})")),
+                {"hands[0].device.limits.max_force: must be >= 0"}));
+  EXPECT_TRUE(failsWith(parse(sceneWith(R"({"type": "spacemouse", "limits": {"max_force": 1}})")),
+                        {"hands[0].device.limits: unknown key"}));  // no motors, no force limits
+  EXPECT_TRUE(failsWith(parse(sceneWith(R"({"type": "replay", "log": "a", "speed": 0})")),
+                        {"hands[0].device.speed: must be > 0"}));
+  EXPECT_TRUE(failsWith(parse(sceneWith(R"("scripted")")),
+                        {"hands[0].device: expected an object, found a string"}));
+}
+
+TEST(DeviceParser, ADeviceHandHasNoScript) {
+  for (const char* key :
+       {"\"motion\": {\"angular_velocity\": [0, 0, 1]}", "\"grab_at\": 1", "\"release_at\": 2"}) {
+    EXPECT_TRUE(
+        failsWith(parse(sceneWith(R"({"type": "replay", "log": "a"})", std::string(", ") + key)),
+                  {"s.json: hands[0].", "a hand with a device is moved by the device"}))
+        << key;
+  }
+}
+
+TEST(DeviceOverride, TurnsAScriptedHandIntoADeviceHand) {
+  Result<SceneSpec> r = parse(
+      sceneWith("", R"(, "motion": {"angular_velocity": [0, 0, 0.1], "pivot": [0, 0, 9.9]})"));
+  ASSERT_TRUE(r.ok()) << r.error().message;
+  SceneSpec s = r.value();
+  ASSERT_TRUE(applyDeviceOverride(s, "hand=network:10.0.0.2:6100").ok());
+  ASSERT_TRUE(s.hands[0].device.has_value());
+  EXPECT_EQ(s.hands[0].device->kind, DeviceSpec::Kind::kNetwork);
+  EXPECT_EQ(s.hands[0].device->host, "10.0.0.2");
+  EXPECT_EQ(s.hands[0].device->port, 6100);
+  EXPECT_EQ(s.hands[0].motion.angular_velocity.norm(), 0);  // the script gives way
+  EXPECT_EQ(s.hands[0].initial.origin.z(), 9.9);            // its start is the anchor
+
+  ASSERT_TRUE(applyDeviceOverride(s, "hand=network:6200").ok());
+  EXPECT_EQ(s.hands[0].device->port, 6200);
+  ASSERT_TRUE(applyDeviceOverride(s, "hand=replay:log.csv").ok());
+  EXPECT_EQ(s.hands[0].device->kind, DeviceSpec::Kind::kReplay);
+  EXPECT_EQ(s.hands[0].device->file, "log.csv");
+}
+
+TEST(DeviceOverride, KeepsTheScenesMappingAndNamesFaults) {
+  Result<SceneSpec> r = parse(sceneWith(
+      R"({"type": "scripted", "trajectory": "a.json", "mapping": {"position_scale": 10}})"));
+  ASSERT_TRUE(r.ok()) << r.error().message;
+  SceneSpec s = r.value();
+  ASSERT_TRUE(applyDeviceOverride(s, "hand=spacemouse").ok());
+  EXPECT_EQ(s.hands[0].device->kind, DeviceSpec::Kind::kSpaceMouse);
+  EXPECT_EQ(s.hands[0].device->position_scale, 10);
+
+  EXPECT_TRUE(failsWith(applyDeviceOverride(s, "foot=network:1"),
+                        {"--device 'foot=network:1'", "no hand named 'foot'", "'hand'"}));
+  EXPECT_TRUE(failsWith(applyDeviceOverride(s, "network:1"), {"expected HAND=TYPE[:ARG]"}));
+  EXPECT_TRUE(
+      failsWith(applyDeviceOverride(s, "hand=network:port"), {"port 'port' is not a number"}));
+  EXPECT_TRUE(failsWith(applyDeviceOverride(s, "hand=scripted"), {"scripted needs a file"}));
+  EXPECT_TRUE(failsWith(applyDeviceOverride(s, "hand=glove"), {"unknown device type 'glove'"}));
+  EXPECT_TRUE(failsWith(parseHapticsMode("fast"), {"--haptics 'fast'", "lockstep or threaded"}));
+  EXPECT_TRUE(parseHapticsMode("threaded").ok());
+}
+
+}  // namespace
+}  // namespace torsion::scene
