@@ -66,7 +66,9 @@ struct NodeContact {
   double friction = 0;     ///< pair coefficient
   bool held = false;       ///< the node is prescribed (hand, node group)
   State state = State::kInactive;
-  int releases = 0;  ///< times released this step (anti-cycling: never twice)
+  int releases = 0;              ///< times released this step (anti-cycling: never twice)
+  int slips = 0;                 ///< stick-to-slide switches this step (anti-cycling: at most two)
+  int friction_refinements = 0;  ///< sliding friction updates this step that reopened the loop
   Eigen::Vector3d friction_impulse = Eigen::Vector3d::Zero();  ///< N s on the node (sliding)
   Eigen::Vector3d impulse = Eigen::Vector3d::Zero();  ///< N s, total the rigid body gave the node
   double normal_impulse = 0;                          ///< N s, impulse . normal
