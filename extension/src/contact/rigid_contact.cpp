@@ -214,6 +214,8 @@ bool RigidContactSolver::detect(const FemState& state, const NodeConstraints& co
     }
   }
   stats_.candidates = static_cast<int>(contacts_.size());
+  for (const NodeContact& c : contacts_)
+    stats_.max_penetration = std::max(stats_.max_penetration, -c.gap);
   return !contacts_.empty();
 }
 
@@ -595,7 +597,7 @@ LinearSolveReport RigidContactSolver::solve(const SystemOperator& op,
     const Eigen::Vector3d rigid =
         pointVelocity(partners_[static_cast<size_t>(c.partner)].velocity, c.lever);
     const double gap_end = c.gap + dt * c.normal.dot(v.segment<3>(3 * c.node) - rigid);
-    stats_.max_penetration = std::max(stats_.max_penetration, -gap_end);
+    stats_.max_end_penetration = std::max(stats_.max_end_penetration, -gap_end);
   }
   return total;
 }

@@ -99,8 +99,10 @@ struct ContactStepStats {
   int sticking = 0;               ///< of which sticking
   int active_set_iterations = 0;  ///< CG solves this step
   bool active_set_converged = true;
-  double normal_impulse = 0;   ///< N s, sum over contacts (>= 0)
-  double max_penetration = 0;  ///< m, deepest start-of-step penetration (>= 0)
+  double normal_impulse = 0;       ///< N s, sum over contacts (>= 0)
+  double max_penetration = 0;      ///< m, deepest node inside a rigid body at the step's start
+                                   ///< (measured: the result of the previous step)
+  double max_end_penetration = 0;  ///< m, deepest linearised end-of-step gap after the solve
 };
 
 class RigidContactSolver {
