@@ -50,7 +50,9 @@ class ScriptedMotionState : public btMotionState {
   bool armed_ = false;
 };
 
-std::unique_ptr<btCollisionShape> makeShape(const RigidBodySpec& r) {
+}  // namespace
+
+std::unique_ptr<btCollisionShape> makeRigidShape(const RigidBodySpec& r) {
   switch (r.shape) {
     case RigidBodySpec::Shape::kBox:
       return std::make_unique<btBoxShape>(toBt(r.half_extents));
@@ -84,13 +86,11 @@ std::unique_ptr<btCollisionShape> makeShape(const RigidBodySpec& r) {
   return nullptr;
 }
 
-}  // namespace
-
 SceneRigidBody addSceneRigidBody(FemWorld& world, const RigidBodySpec& spec) {
   SceneRigidBody added;
   added.name = spec.name;
   added.kinematic = spec.isKinematic();
-  btRigidBody* body = world.addRigidBody(makeShape(spec), spec.mass, toTransform(spec.pose));
+  btRigidBody* body = world.addRigidBody(makeRigidShape(spec), spec.mass, toTransform(spec.pose));
   body->setFriction(spec.friction);
   body->setRestitution(spec.restitution);
   if (spec.mass > 0) {

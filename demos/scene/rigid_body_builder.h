@@ -23,6 +23,10 @@ struct SceneRigidBody {
   std::unique_ptr<btMotionState> script;
 };
 
+/// The collision shape of `spec` (also used by tests/bench to build the same bodies in Bullet's own
+/// deformable world).
+std::unique_ptr<btCollisionShape> makeRigidShape(const RigidBodySpec& spec);
+
 /// Adds `spec` to `world`. The spec is copied where needed.
 SceneRigidBody addSceneRigidBody(FemWorld& world, const RigidBodySpec& spec);
 
