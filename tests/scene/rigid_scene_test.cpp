@@ -2,6 +2,7 @@
 // kinematic script, and the faults, each naming the key; then a built scene whose kinematic plate
 // follows its script and whose run writes rigid.csv and the contact figures.
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <filesystem>
 #include <fstream>
@@ -131,7 +132,8 @@ TEST(RigidScene, KinematicPlateFollowsItsScriptAndRunWritesOutputs) {
   BuiltScene& s = *built.value();
   ASSERT_EQ(s.rigid_bodies.size(), 1u);
   const std::filesystem::path out =
-      std::filesystem::temp_directory_path() / "torsion_rigid_scene_test";
+      std::filesystem::temp_directory_path() /
+      ("torsion_rigid_scene_test_" + std::to_string(::getpid()));  // one per process
   RunOptions options;
   options.output_directory = out.string();
   Result<RunOutcome> outcome = runScene(s, options);
