@@ -77,9 +77,20 @@ fi
 "$torsion" mesh tetrahedralize "$work/dragon_surface.off" -o "$meshes/dragon_4300.node" \
   --keep-surface --min-dihedral 10
 
+# ---- Contact scenes (issue 6): a small rod (tetgen), structured boxes and a ball (no tetgen) ----
+echo "== rod_1200, slab_768, block_162, paddle_108, ball_384"
+"$torsion" mesh cylinder --radius 0.15 --length 1.2 --tets 1200 -o "$meshes/rod_1200.node"
+"$torsion" mesh box --min -0.5 -0.5 0 --max 0.5 0.5 0.2 --cells 8 8 2 -o "$meshes/slab_768.node"
+"$torsion" mesh box --min -0.1 -0.1 0 --max 0.1 0.1 0.2 --cells 3 3 3 -o "$meshes/block_162.node"
+"$torsion" mesh box --min -0.3 -0.04 0 --max 0.3 0.04 0.3 --cells 6 1 3 \
+  -o "$meshes/paddle_108.node"
+"$torsion" mesh ball --radius 0.25 --cells 4 -o "$meshes/ball_384.node"
+
 echo "== torsion mesh info"
 for f in "$meshes"/cylinder_2430.node "$meshes"/cylinder_4323.node "$meshes"/cylinder_8332.node \
-  "$meshes"/cylinder_31558.node "$meshes"/dragon_4300.node; do
+  "$meshes"/cylinder_31558.node "$meshes"/dragon_4300.node "$meshes"/rod_1200.node \
+  "$meshes"/slab_768.node "$meshes"/block_162.node "$meshes"/paddle_108.node \
+  "$meshes"/ball_384.node; do
   (cd "$meshes" && "$torsion" mesh info "$(basename "$f")")
   echo
 done

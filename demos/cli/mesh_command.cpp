@@ -5,6 +5,7 @@
 #include <memory>
 
 #include "../meshgen/mesh_generate_command.h"
+#include "../meshgen/structured_mesh_command.h"
 #include "torsion/mesh/mesh_io.h"
 #include "torsion/mesh/mesh_quality.h"
 
@@ -102,6 +103,7 @@ void addMeshCommand(CLI::App& app) {
   convert_cmd->callback([convert] { setExitCode(runConvert(*convert)); });
 
   addMeshGenerateCommands(*mesh);
+  addStructuredMeshCommands(*mesh);
 }
 
 }  // namespace torsion::cli

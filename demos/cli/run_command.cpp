@@ -122,7 +122,8 @@ int run(const RunArguments& args) {
     return 3;
   }
   std::cerr << "done: " << outcome.value().steps_done << " steps; results in " << args.out
-            << "/ (summary.json, wrench.csv, energy.csv, one .vtk per body"
+            << "/ (summary.json, wrench.csv, energy.csv, "
+            << (s.rigid_bodies.empty() ? "" : "rigid.csv, ") << "one .vtk per body"
             << (s.haptics ? ", haptic_<hand>.csv per device hand" : "") << ")\n";
   return 0;
 }

@@ -127,6 +127,46 @@ std::vector<JsonObject> JsonObject::objects(const std::string& key) const {
   return out;
 }
 
+std::vector<Eigen::Vector3d> JsonObject::vector3List(const std::string& key) const {
+  std::vector<Eigen::Vector3d> out;
+  if (!has(key)) return out;
+  const nlohmann::json& j = at(key);
+  if (!j.is_array()) fail(key, "expected an array of [x, y, z], found " + typeName(j));
+  for (size_t i = 0; i < j.size(); ++i) {
+    const std::string item = "element " + std::to_string(i);
+    if (!j[i].is_array() || j[i].size() != 3) fail(key, item + ": expected an array of 3 numbers");
+    Eigen::Vector3d v;
+    for (size_t a = 0; a < 3; ++a) {
+      if (!j[i][a].is_number()) fail(key, item + ": expected a number, found " + typeName(j[i][a]));
+      v[static_cast<Eigen::Index>(a)] = j[i][a].get<double>();
+    }
+    if (!v.allFinite()) fail(key, item + ": must be finite");
+    out.push_back(v);
+  }
+  return out;
+}
+
+std::vector<std::array<int, 3>> JsonObject::integerTriples(const std::string& key) const {
+  std::vector<std::array<int, 3>> out;
+  if (!has(key)) return out;
+  const nlohmann::json& j = at(key);
+  if (!j.is_array()) fail(key, "expected an array of [i, j, k], found " + typeName(j));
+  for (size_t i = 0; i < j.size(); ++i) {
+    const std::string item = "element " + std::to_string(i);
+    if (!j[i].is_array() || j[i].size() != 3) fail(key, item + ": expected an array of 3 integers");
+    std::array<int, 3> t{};
+    for (size_t a = 0; a < 3; ++a) {
+      if (!j[i][a].is_number_integer())
+        fail(key, item + ": expected an integer, found " + typeName(j[i][a]));
+      const auto value = j[i][a].get<long long>();
+      if (value < 0 || value > 2147483647LL) fail(key, item + ": index out of range");
+      t[a] = static_cast<int>(value);
+    }
+    out.push_back(t);
+  }
+  return out;
+}
+
 std::string JsonObject::oneOf(const std::vector<std::string>& choices) const {
   std::string found;
   std::string list;

@@ -4,6 +4,7 @@
 // key that was never asked for, so a misspelt key never passes silently.
 
 #include <Eigen/Core>
+#include <array>
 #include <nlohmann/json.hpp>
 #include <set>
 #include <stdexcept>
@@ -32,6 +33,10 @@ class JsonObject {
   JsonObject object(const std::string& key) const;
   std::vector<JsonObject> objects(
       const std::string& key) const;  ///< an array of objects; [] if absent
+  /// An array of 3-vectors, e.g. points: [[x, y, z], ...]; [] if absent.
+  std::vector<Eigen::Vector3d> vector3List(const std::string& key) const;
+  /// An array of integer triples, e.g. triangles: [[i, j, k], ...]; [] if absent.
+  std::vector<std::array<int, 3>> integerTriples(const std::string& key) const;
   /// The single key present among `choices` (exactly one must be).
   std::string oneOf(const std::vector<std::string>& choices) const;
 

@@ -105,28 +105,9 @@ Result<std::unique_ptr<BuiltScene>> buildScene(SceneSpec spec, int threads_overr
     break;
   }
 
-  for (const RigidBodySpec& r : spec.rigid_bodies) {
-    std::unique_ptr<btCollisionShape> shape;
-    btTransform transform;
-    transform.setIdentity();
-    switch (r.shape) {
-      case RigidBodySpec::Shape::kBox:
-        shape = std::make_unique<btBoxShape>(
-            btVector3(r.half_extents.x(), r.half_extents.y(), r.half_extents.z()));
-        break;
-      case RigidBodySpec::Shape::kSphere:
-        shape = std::make_unique<btSphereShape>(r.radius);
-        break;
-      case RigidBodySpec::Shape::kPlane:
-        shape = std::make_unique<btStaticPlaneShape>(
-            btVector3(r.plane_normal.x(), r.plane_normal.y(), r.plane_normal.z()), r.plane_offset);
-        break;
-    }
-    transform.setOrigin(btVector3(r.pose.origin.x(), r.pose.origin.y(), r.pose.origin.z()));
-    transform.setRotation(btQuaternion(r.pose.rotation.x(), r.pose.rotation.y(),
-                                       r.pose.rotation.z(), r.pose.rotation.w()));
-    world.addRigidBody(std::move(shape), r.mass, transform);
-  }
+  for (const RigidBodySpec& r : spec.rigid_bodies)
+    built->rigid_bodies.push_back(addSceneRigidBody(world, r));
+  if (spec.ground) addSceneRigidBody(world, *spec.ground);
   built->spec = std::move(spec);
   for (const SceneHand& h : built->hands) {
     if (!h.spec.device) continue;

@@ -6,6 +6,7 @@
 #include <string>
 #include <vector>
 
+#include "rigid_body_builder.h"
 #include "scene_spec.h"
 #include "torsion/bullet/fem_world.h"
 #include "torsion/constraints/hand.h"
@@ -33,6 +34,9 @@ class SceneHaptics;  // scene_haptics.h
 
 struct BuiltScene {
   SceneSpec spec;
+  /// rigid_bodies[] in file order (not the ground). Declared before `world`, so the kinematic
+  /// bodies' motion states outlive the world that points to them.
+  std::vector<SceneRigidBody> rigid_bodies;
   std::unique_ptr<FemWorld> world;
   std::vector<NodeSetHandle> node_sets;
   std::vector<SceneHand> hands;

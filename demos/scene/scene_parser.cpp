@@ -5,6 +5,7 @@
 #include "camera_spec.h"
 #include "device_parser.h"
 #include "json_reader.h"
+#include "rigid_body_parser.h"
 #include "torsion/mesh/mesh_io.h"
 
 namespace torsion::scene {
@@ -177,38 +178,6 @@ HandSpec readHand(const JsonObject& h, const std::string& base_directory) {
   return hand;
 }
 
-RigidBodySpec readRigidBody(const JsonObject& r) {
-  RigidBodySpec spec;
-  spec.name = r.string("name");
-  const JsonObject shape = r.object("shape");
-  const std::string kind = shape.oneOf({"box", "sphere", "plane"});
-  const JsonObject s = shape.object(kind);
-  if (kind == "box") {
-    spec.shape = RigidBodySpec::Shape::kBox;
-    spec.half_extents = s.vector3("half_extents");
-    if (!(spec.half_extents.minCoeff() > 0)) s.fail("half_extents", "must be > 0");
-  } else if (kind == "sphere") {
-    spec.shape = RigidBodySpec::Shape::kSphere;
-    spec.radius = s.number("radius");
-    if (!(spec.radius > 0)) s.fail("radius", "must be > 0");
-  } else {
-    spec.shape = RigidBodySpec::Shape::kPlane;
-    const Eigen::Vector3d n = s.vector3("normal");
-    if (n.norm() < 1e-12) s.fail("normal", "must not be zero");
-    spec.plane_normal = n.normalized();
-    spec.plane_offset = s.number("offset", 0.0);
-  }
-  s.finish();
-  shape.finish();
-  spec.mass = r.number("mass", spec.shape == RigidBodySpec::Shape::kPlane ? 0.0 : 1.0);
-  if (!(spec.mass >= 0)) r.fail("mass", "must be >= 0 kg (0: static)");
-  if (spec.shape == RigidBodySpec::Shape::kPlane && spec.mass != 0)
-    r.fail("mass", "a plane must be static (mass 0)");
-  spec.pose = readPose(r, "pose");
-  r.finish();
-  return spec;
-}
-
 std::string lineAndColumn(std::string_view text, size_t byte) {
   int line = 1, column = 1;
   for (size_t i = 0; i < byte && i < text.size(); ++i) {
@@ -223,6 +192,14 @@ std::string lineAndColumn(std::string_view text, size_t byte) {
 }
 
 }  // namespace
+
+Frame parsePose(const JsonObject& parent, const std::string& key) {
+  return readPose(parent, key);
+}
+
+MotionSpec parseMotion(const JsonObject& m) {
+  return readMotion(m);
+}
 
 Frame MotionSpec::frameAt(double t) const {
   const double tau = std::clamp(t - start, 0.0, duration);
@@ -327,7 +304,8 @@ Result<SceneSpec> parseScene(std::string_view text, const std::string& file_name
       scene.hands.push_back(std::move(hand));
     }
     for (const JsonObject& r : root.objects("rigid_bodies"))
-      scene.rigid_bodies.push_back(readRigidBody(r));
+      scene.rigid_bodies.push_back(readRigidBody(r, scene.rigid_bodies));
+    if (root.has("ground")) scene.ground = readGround(root.object("ground"));
     scene.camera = readCameraSpec(root);
     root.finish();
     Status world_ok = scene.world.validate();

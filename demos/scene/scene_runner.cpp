@@ -41,6 +41,56 @@ Status writeFinalMesh(const FemBody& body, const Eigen::VectorXd& positions, con
   return writeTextFile(path, formatVtk(mesh, x, fields, body.name()));
 }
 
+// Per step: each rigid body's centre of mass, orientation quaternion and linear velocity.
+void writeRigidRow(std::ofstream& csv, const BuiltScene& scene, int step, double time) {
+  csv << step << "," << time;
+  for (const SceneRigidBody& r : scene.rigid_bodies) {
+    const btTransform& t = r.body->getCenterOfMassTransform();
+    const btQuaternion q = t.getRotation();
+    const btVector3& v = r.body->getLinearVelocity();
+    csv << "," << t.getOrigin().x() << "," << t.getOrigin().y() << "," << t.getOrigin().z() << ","
+        << q.x() << "," << q.y() << "," << q.z() << "," << q.w() << "," << v.x() << "," << v.y()
+        << "," << v.z();
+  }
+  csv << "\n";
+}
+
+// FEM-rigid contact figures over the run (docs/contact.md), summed over the FEM bodies per step.
+struct ContactTotals {
+  int steps = 0;
+  long active_sum = 0;
+  int active_max = 0;
+  double normal_impulse = 0;   // N s
+  double max_penetration = 0;  // m, measured at the start of a step
+  int active_set_iterations_max = 0;
+  int unconverged_steps = 0;
+
+  void add(const FemWorld& world) {
+    int active = 0;
+    bool converged = true;
+    for (const auto& body : world.bodies()) {
+      const ContactStepStats& s = body->contacts().stats();
+      active += s.active;
+      normal_impulse += s.normal_impulse;
+      max_penetration = std::max(max_penetration, s.max_penetration);
+      active_set_iterations_max = std::max(active_set_iterations_max, s.active_set_iterations);
+      converged = converged && s.active_set_converged;
+    }
+    ++steps;
+    active_sum += active;
+    active_max = std::max(active_max, active);
+    if (!converged) ++unconverged_steps;
+  }
+  nlohmann::json json() const {
+    return {{"active_mean", steps > 0 ? double(active_sum) / steps : 0.0},
+            {"active_max", active_max},
+            {"normal_impulse_total_Ns", normal_impulse},
+            {"max_penetration_m", max_penetration},
+            {"active_set_iterations_max", active_set_iterations_max},
+            {"active_set_unconverged_steps", unconverged_steps}};
+  }
+};
+
 }  // namespace
 
 Result<RunOutcome> runScene(BuiltScene& scene, const RunOptions& options) {
@@ -70,6 +120,21 @@ Result<RunOutcome> runScene(BuiltScene& scene, const RunOptions& options) {
   energy_csv << ",iterations,relative_residual\n";
   wrench_csv.precision(10);
   energy_csv.precision(10);
+
+  // Rigid bodies' poses per step (only when the scene has some).
+  std::ofstream rigid_csv;
+  if (!scene.rigid_bodies.empty()) {
+    rigid_csv.open(out / "rigid.csv");
+    if (!rigid_csv) return Error{out.string() + ": cannot write rigid.csv"};
+    rigid_csv << "step,time";
+    for (const SceneRigidBody& r : scene.rigid_bodies) {
+      for (const char* c : {"x", "y", "z", "qx", "qy", "qz", "qw", "vx", "vy", "vz"})
+        rigid_csv << "," << r.name << "." << c;
+    }
+    rigid_csv << "\n";
+    rigid_csv.precision(10);
+  }
+  ContactTotals contact_totals;
 
   std::vector<Eigen::VectorXd> last_good;
   for (const auto& body : world.bodies())
@@ -126,6 +191,8 @@ Result<RunOutcome> runScene(BuiltScene& scene, const RunOptions& options) {
                  << body->lastReport().elastic_energy;
     }
     energy_csv << "," << iterations << "," << residual << "\n";
+    if (rigid_csv.is_open()) writeRigidRow(rigid_csv, scene, report.step, world.time());
+    contact_totals.add(world);
     if (options.progress) {
       const double elapsed =
           std::chrono::duration<double>(std::chrono::steady_clock::now() - run_start).count();
@@ -181,6 +248,7 @@ Result<RunOutcome> runScene(BuiltScene& scene, const RunOptions& options) {
     summary["haptics"] = std::move(haptics).value();
     summary["haptic_warnings"] = scene.haptics->warnings();
   }
+  if (!scene.rigid_bodies.empty() || scene.spec.ground) summary["contacts"] = contact_totals.json();
   summary["stable"] = outcome.stable;
   if (!outcome.stable) summary["failure"] = outcome.failure;
   std::ofstream(out / "summary.json") << summary.dump(2) << "\n";

@@ -4,6 +4,8 @@
 // job.
 
 #include <Eigen/Core>
+#include <array>
+#include <limits>
 #include <optional>
 #include <string>
 #include <vector>
@@ -76,15 +78,33 @@ struct HandSpec {
   Frame frameAt(double t) const;
 };
 
+/// A Bullet rigid body (docs/scene-format.md, rigid_bodies[]). Dynamic when mass > 0, static when
+/// mass is 0, kinematic when `kinematic` holds a motion: its pose is then scripted (the motions
+/// composed in order, applied to `pose`) and it pushes FEM and rigid bodies without being pushed.
 struct RigidBodySpec {
   std::string name;
-  enum class Shape { kBox, kSphere, kPlane } shape = Shape::kBox;
+  enum class Shape { kBox, kSphere, kCapsule, kConvexHull, kPlane, kTriangleMesh };
+  Shape shape = Shape::kBox;
   Eigen::Vector3d half_extents = Eigen::Vector3d::Constant(0.5);  ///< box
-  double radius = 0.5;                                            ///< sphere
-  Eigen::Vector3d plane_normal = Eigen::Vector3d::UnitZ();        ///< static plane
-  double plane_offset = 0;                                        ///< n . x = offset
-  double mass = 1;                                                ///< kg; 0 = static
+  double radius = 0.5;                                            ///< sphere, capsule
+  double half_height = 0.5;             ///< capsule: half the distance between its cap centres
+  int axis = 2;                         ///< capsule: 0, 1, 2 = local x, y, z
+  std::vector<Eigen::Vector3d> points;  ///< convex hull points / mesh vertices, local
+  std::vector<std::array<int, 3>> triangles;  ///< triangle mesh
+  double margin = 1e-3;  ///< m, convex hull collision margin (Bullet's default is 0.04)
+  Eigen::Vector3d plane_normal = Eigen::Vector3d::UnitZ();  ///< static plane
+  double plane_offset = 0;                                  ///< n . x = offset
+  double mass = 1;                                          ///< kg; 0 = static
   Frame pose;
+  Eigen::Vector3d linear_velocity = Eigen::Vector3d::Zero();   ///< m/s, initial (dynamic)
+  Eigen::Vector3d angular_velocity = Eigen::Vector3d::Zero();  ///< rad/s, initial (dynamic)
+  double friction = 0.5;              ///< Bullet's default; a pair's coefficient is the product
+  double restitution = 0;             ///< rigid-rigid only (FEM-rigid contact is inelastic)
+  std::vector<MotionSpec> kinematic;  ///< non-empty: kinematic, motions composed in order
+
+  bool isKinematic() const { return !kinematic.empty(); }
+  /// The scripted pose at time t (kinematic), else `pose`.
+  Frame poseAt(double t) const;
 };
 
 struct SceneSpec {
@@ -96,6 +116,7 @@ struct SceneSpec {
   std::vector<NodeSetSpec> node_sets;
   std::vector<HandSpec> hands;
   std::vector<RigidBodySpec> rigid_bodies;
+  std::optional<RigidBodySpec> ground;  ///< a static plane, from the top-level "ground"
   CameraSpec camera;  ///< how pictures look at the scene (camera_spec.h)
   HapticsMode haptics_mode = HapticsMode::kAuto;  ///< not in the file: the CLI's --haptics
 };

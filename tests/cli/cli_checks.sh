@@ -516,6 +516,49 @@ EOF
     [[ ! -e out/summary.json ]] || fail "no output may be written when a device cannot open"
     ;;
 
+  run_press)
+    # The kinematic press: runs stable, writes rigid.csv (the plate on its script) and contact
+    # figures with no node left inside the plate or the ground.
+    sed "s|../../assets/meshes|$assets|" "$scenes/press.json" > press.json
+    run "$torsion" run press.json --out out --steps 80 --threads 1
+    expect_rc 0
+    expect_out "done: 80 steps; results in out/ \\(summary.json, wrench.csv, energy.csv, rigid.csv,"
+    [[ $(wc -l < out/rigid.csv) -eq 81 ]] || fail "rigid.csv should have a header and 80 rows"
+    head -1 out/rigid.csv | grep -q "^step,time,plate.x,plate.y,plate.z,plate.qx" || fail "rigid.csv header"
+    # Down at 0.1 m/s for 0.6 s from 0.26: at step 80 (t = 0.8 s) it holds at 0.2.
+    awk -F, 'NR == 81 { exit !($5 > 0.2 - 1e-9 && $5 < 0.2 + 1e-9) }' out/rigid.csv ||
+      fail "the plate is not on its script"
+    python3 - out/summary.json <<'PY' || fail "contact figures"
+import json, sys
+c = json.load(open(sys.argv[1]))["contacts"]
+assert c["active_max"] >= 32 and c["normal_impulse_total_Ns"] > 0, c
+assert c["max_penetration_m"] < 1e-4 and c["active_set_unconverged_steps"] == 0, c
+PY
+    ;;
+
+  run_bad_rigid_body)
+    # A kinematic body with a mass: refused before any step, naming the key.
+    sed "s|../../assets/meshes|$assets|; s|\"friction\": 0.8,|\"friction\": 0.8, \"mass\": 3,|" \
+      "$scenes/press.json" > bad.json
+    run "$torsion" run bad.json --out out
+    expect_rc nonzero
+    expect_out "^error: bad.json: rigid_bodies\\[0\\].mass: a kinematic body has no mass"
+    [[ ! -e out/summary.json ]] || fail "no output may be written for a bad scene"
+    ;;
+
+  mesh_box_and_ball)
+    run "$torsion" mesh box --min 0 0 0 --max 1 2 0.5 --cells 2 4 1 -o box.node
+    expect_rc 0
+    [[ $(info_field tets box.node) == 48 ]] || fail "box: 2 x 4 x 1 cells should give 48 tets"
+    [[ $(info_field volume box.node) == 1 ]] || fail "box: volume should be 1"
+    run "$torsion" mesh ball --radius 0.5 --cells 4 -o ball.vtk
+    expect_rc 0
+    [[ $(info_field tets ball.vtk) == 384 ]] || fail "ball: 4^3 cells should give 384 tets"
+    run "$torsion" mesh box --min 0 0 0 --max 1 0 1 --cells 1 1 1 -o flat.node
+    expect_rc nonzero
+    expect_out "^error: torsion mesh box: --max must exceed --min"
+    ;;
+
   *)
     fail "unknown case '$case_name'"
     ;;

@@ -188,8 +188,11 @@ TEST(ContactPhysics, FrictionHoldsBelowAngleSlidesAbove) {
 
 // Bullet's deformable world users report a soft cube pressed by a kinematic body flying away. A
 // kinematic plate presses a soft cube on the ground by a quarter of its height, holds, lifts off:
-// the cube stays in place, never exceeds a sane speed, and comes to rest.
-TEST(ContactPhysics, DISABLED_PressedCubeStaysPut) {
+// the cube stays in place, never exceeds a sane speed, and comes to rest. The plate is made the
+// way Bullet's demos make kinematic bodies (mass 0, then CF_KINEMATIC_OBJECT), so it carries
+// CF_STATIC_OBJECT too: taking it for static made the nodes lag a step behind it and, when it
+// stopped, lose it and spring 2 cm into it at 1.9 m/s (docs/contact.md, "the kinematic press").
+TEST(ContactPhysics, PressedCubeStaysPut) {
   FemWorld world(contactSettings(0.01));
   addGround(world, 0.8);
   const Material m = softMaterial(5e4, 300);
@@ -208,7 +211,8 @@ TEST(ContactPhysics, DISABLED_PressedCubeStaysPut) {
     if (t < 1.1) return base - 0.06;
     return base - 0.06 + 0.1 * (t - 1.1);
   };
-  double fastest = 0, lowest_plate_gap = 1e300;
+  double fastest = 0, lowest_plate_gap = 1e300, largest_lag = 0;
+  int unconverged = 0, most_iterations = 0;
   for (int k = 0; k < 250; ++k) {
     const double t_next = (k + 1) * 0.01;
     btTransform pose = at({0, 0, height(t_next)});
@@ -218,13 +222,24 @@ TEST(ContactPhysics, DISABLED_PressedCubeStaysPut) {
     double top = -1e300;
     for (int i = 0; i < cube->model().nodeCount(); ++i)
       top = std::max(top, cube->state().position(i).z());
-    lowest_plate_gap = std::min(lowest_plate_gap, height(t_next) - plate_half - top);
+    const double gap = height(t_next) - plate_half - top;
+    lowest_plate_gap = std::min(lowest_plate_gap, gap);
+    if (t_next > 0.15 && t_next <= 1.1) largest_lag = std::max(largest_lag, gap);  // pressed
+    const ContactStepStats& stats = cube->contacts().stats();
+    if (!stats.active_set_converged) ++unconverged;
+    most_iterations = std::max(most_iterations, stats.active_set_iterations);
   }
   const Eigen::Vector3d c = centreOfMass(*cube);
   std::cout << "[figures] press: fastest node " << fastest << " m/s, plate penetration "
-            << std::max(0.0, -lowest_plate_gap) << " m, cube centre " << c.transpose() << "\n";
-  EXPECT_LT(fastest, 1.0);  // the plate moves at 0.1 m/s; a cube flying away moves at m/s
-  EXPECT_GT(lowest_plate_gap, -1e-4);
+            << std::max(0.0, -lowest_plate_gap) << " m, lag behind the plate " << largest_lag
+            << " m, active-set iterations max " << most_iterations << ", unconverged steps "
+            << unconverged << ", cube centre " << c.transpose() << "\n";
+  EXPECT_LT(fastest, 0.2);  // the plate moves at 0.1 m/s; the failure this guards moved at 1.9
+  EXPECT_GT(lowest_plate_gap, -1e-4);  // 0.1 mm against a 6 cm press
+  // Pressed, the top follows the plate itself, not its pose one step (1 mm) earlier.
+  EXPECT_LT(largest_lag, 1e-5);
+  // The active set settles every step (anti-cycling of stick/slide and of the friction).
+  EXPECT_EQ(unconverged, 0);
   EXPECT_LT(std::hypot(c.x(), c.y()), 1e-3);
   EXPECT_NEAR(c.z(), 0.1, 0.01);  // back to its rest height (minus its weight's squash)
   EXPECT_LT(cube->lastReport().max_speed, 0.05);

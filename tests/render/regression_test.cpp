@@ -157,7 +157,7 @@ Metrics runScenePath(const std::string& path, int steps, int threads, double sti
   if (!s.world->rigidBodies().empty()) {
     m.contacts = 0;
     for (const auto& body : s.world->bodies())
-      m.contacts += body->softBody()->m_rcontacts.size();
+      m.contacts += body->contacts().stats().active;  // FEM-rigid contacts (docs/contact.md)
     for (btRigidBody* rb : s.world->rigidBodies()) {
       const btTransform& t = rb->getWorldTransform();
       for (int a = 0; a < 3; ++a) {

@@ -17,6 +17,9 @@ namespace torsion {
 
 namespace {
 
+constexpr int kMaxSlipsPerStep = 2;
+constexpr int kMaxFrictionRefinements = 8;
+
 // Velocity of the rigid point at lever r: J V = v + omega x r.
 Eigen::Vector3d pointVelocity(const Vector6d& V, const Eigen::Vector3d& r) {
   return V.head<3>() + V.tail<3>().cross(r);
@@ -43,7 +46,12 @@ struct NodeCollector : btDbvt::ICollide {
 // moved by exactly integrateTransform(start, v, omega, dt), which we invert.
 btTransform startPose(const btCollisionObject& object, double dt) {
   const btRigidBody* body = btRigidBody::upcast(&object);
-  if (body == nullptr || body->isStaticObject()) return object.getWorldTransform();
+  // Kinematic first: a mass-0 body made kinematic (Bullet's own recipe) keeps CF_STATIC_OBJECT
+  // too, yet Bullet has moved it to its end pose. Taking that pose as the start pose shifted the
+  // plate by one step's motion: nodes lagged a step behind a pressing plate and, when it stopped,
+  // were taken as separating and dropped (docs/contact.md, the kinematic press).
+  if (body == nullptr || (!body->isKinematicObject() && body->isStaticObject()))
+    return object.getWorldTransform();
   btTransform start;
   btTransformUtil::integrateTransform(object.getWorldTransform(), -body->getLinearVelocity(),
                                       -body->getAngularVelocity(), dt, start);
@@ -171,12 +179,9 @@ bool RigidContactSolver::detect(const FemState& state, const NodeConstraints& co
           signedDistance(*shape, transform, x, reach, -toEigen(sb.m_nodes[i].m_n));
       if (!sp) continue;
       const bool held = constraints.kind(i) == NodeConstraints::Kind::kFull;
-      Eigen::Vector3d rigid_v = Eigen::Vector3d::Zero();
-      if (body != nullptr) {
-        rigid_v = toEigen(body->getVelocityInLocalPoint(toBt(x) - transform.getOrigin()));
-      }
-      const double closing = std::max(0.0, -sp->normal.dot(state.velocity(i) - rigid_v));
-      if (sp->distance > 2 * dt * closing + margin) continue;
+      // Every node within reach is a candidate, separating or not: the active set decides.
+      // Filtering by the start-of-step closing speed dropped nodes of a compressed body that were
+      // moving away but sprang back within the implicit step (the kinematic press).
       NodeContact c;
       c.node = i;
       c.partner = partnerIndex(object);
@@ -209,6 +214,8 @@ bool RigidContactSolver::detect(const FemState& state, const NodeConstraints& co
     }
   }
   stats_.candidates = static_cast<int>(contacts_.size());
+  for (const NodeContact& c : contacts_)
+    stats_.max_penetration = std::max(stats_.max_penetration, -c.gap);
   return !contacts_.empty();
 }
 
@@ -400,7 +407,14 @@ bool RigidContactSolver::updateActiveSet(const Eigen::VectorXd& v, const Eigen::
           c.state = NodeContact::State::kInactive;
           ++c.releases;
           changed = true;
-        } else if (pt.norm() > c.friction * std::max(lambda, 0.0) + noise) {
+        } else if (pt.norm() > c.friction * std::max(lambda, 0.0) + noise &&
+                   c.slips < kMaxSlipsPerStep) {
+          // Anti-cycling, as for releases: in a body pressed between two surfaces the nodes'
+          // tangential and normal impulses are coupled through the body, and per-node stick/slide
+          // switching can cycle. After kMaxSlipsPerStep slips in a step a contact stays stuck for
+          // the rest of the step (its friction may then exceed mu lambda for that step; it is
+          // re-examined from the next step on).
+          ++c.slips;
           c.state = NodeContact::State::kSlide;
           c.friction_impulse = c.friction * std::max(lambda, 0.0) * pt.normalized();
           changed = true;
@@ -420,15 +434,37 @@ bool RigidContactSolver::updateActiveSet(const Eigen::VectorXd& v, const Eigen::
         Eigen::Vector3d slip = vi - rigid_v;
         slip -= c.normal * c.normal.dot(slip);
         const double speed = slip.norm();
+        const double bound = c.friction * std::max(lambda, 0.0);
         if (speed < 1e-9 || (c.friction_impulse.norm() > 0 && slip.dot(c.friction_impulse) > 0)) {
-          // At rest relative to the surface, or the friction would reverse the slip: stick.
+          // The slip stopped or turned along the friction: the friction was too strong. If it
+          // exceeds mu lambda of this very solve it was stale (set from an earlier, larger
+          // normal impulse: pressing a soft body, its normal and tangential impulses are coupled
+          // by the Poisson effect): bring it down to mu lambda and solve again. Sticking on a
+          // stale friction and sliding again on the stick's tangential impulse was the cycle of
+          // the kinematic press (docs/contact.md). Friction within its bound that stops the
+          // slip: stick.
+          const double magnitude = c.friction_impulse.norm();
+          if (magnitude > bound + noise) {
+            c.friction_impulse *= bound / magnitude;
+            changed = true;
+            break;
+          }
           c.state = NodeContact::State::kStick;
           c.friction_impulse.setZero();
           changed = true;
           break;
         }
-        const Eigen::Vector3d f = -c.friction * std::max(lambda, 0.0) * slip / speed;
-        if ((f - c.friction_impulse).norm() > 1e-3 * (f.norm() + noise)) changed = true;
+        // Under-relaxed: lambda itself depends on the friction (coupled through the body), and
+        // the plain fixed point f = mu lambda(f) can oscillate; half steps converge.
+        const Eigen::Vector3d target = -bound * slip / speed;
+        const Eigen::Vector3d f = c.friction_impulse.norm() > 0
+                                      ? Eigen::Vector3d(0.5 * (target + c.friction_impulse))
+                                      : target;
+        // Each refinement is a CG solve; after kMaxFrictionRefinements a slip that keeps its
+        // state no longer holds the loop open (the friction still follows mu lambda).
+        if ((target - c.friction_impulse).norm() > 1e-2 * (target.norm() + noise) &&
+            c.friction_refinements++ < kMaxFrictionRefinements)
+          changed = true;
         c.friction_impulse = f;
         break;
       }
@@ -561,7 +597,7 @@ LinearSolveReport RigidContactSolver::solve(const SystemOperator& op,
     const Eigen::Vector3d rigid =
         pointVelocity(partners_[static_cast<size_t>(c.partner)].velocity, c.lever);
     const double gap_end = c.gap + dt * c.normal.dot(v.segment<3>(3 * c.node) - rigid);
-    stats_.max_penetration = std::max(stats_.max_penetration, -gap_end);
+    stats_.max_end_penetration = std::max(stats_.max_end_penetration, -gap_end);
   }
   return total;
 }

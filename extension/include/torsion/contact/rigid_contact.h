@@ -66,7 +66,9 @@ struct NodeContact {
   double friction = 0;     ///< pair coefficient
   bool held = false;       ///< the node is prescribed (hand, node group)
   State state = State::kInactive;
-  int releases = 0;  ///< times released this step (anti-cycling: never twice)
+  int releases = 0;              ///< times released this step (anti-cycling: never twice)
+  int slips = 0;                 ///< stick-to-slide switches this step (anti-cycling: at most two)
+  int friction_refinements = 0;  ///< sliding friction updates this step that reopened the loop
   Eigen::Vector3d friction_impulse = Eigen::Vector3d::Zero();  ///< N s on the node (sliding)
   Eigen::Vector3d impulse = Eigen::Vector3d::Zero();  ///< N s, total the rigid body gave the node
   double normal_impulse = 0;                          ///< N s, impulse . normal
@@ -97,8 +99,10 @@ struct ContactStepStats {
   int sticking = 0;               ///< of which sticking
   int active_set_iterations = 0;  ///< CG solves this step
   bool active_set_converged = true;
-  double normal_impulse = 0;   ///< N s, sum over contacts (>= 0)
-  double max_penetration = 0;  ///< m, deepest start-of-step penetration (>= 0)
+  double normal_impulse = 0;       ///< N s, sum over contacts (>= 0)
+  double max_penetration = 0;      ///< m, deepest node inside a rigid body at the step's start
+                                   ///< (measured: the result of the previous step)
+  double max_end_penetration = 0;  ///< m, deepest linearised end-of-step gap after the solve
 };
 
 class RigidContactSolver {

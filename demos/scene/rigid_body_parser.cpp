@@ -1,0 +1,147 @@
+#include "rigid_body_parser.h"
+
+#include <algorithm>
+
+namespace torsion::scene {
+
+namespace {
+
+void readShape(const JsonObject& shape, RigidBodySpec& spec) {
+  const std::string kind =
+      shape.oneOf({"box", "sphere", "capsule", "convex_hull", "plane", "triangle_mesh"});
+  const JsonObject s = shape.object(kind);
+  if (kind == "box") {
+    spec.shape = RigidBodySpec::Shape::kBox;
+    spec.half_extents = s.vector3("half_extents");
+    if (!(spec.half_extents.minCoeff() > 0)) s.fail("half_extents", "must be > 0");
+  } else if (kind == "sphere") {
+    spec.shape = RigidBodySpec::Shape::kSphere;
+    spec.radius = s.number("radius");
+    if (!(spec.radius > 0)) s.fail("radius", "must be > 0");
+  } else if (kind == "capsule") {
+    spec.shape = RigidBodySpec::Shape::kCapsule;
+    spec.radius = s.number("radius");
+    if (!(spec.radius > 0)) s.fail("radius", "must be > 0");
+    spec.half_height = s.number("half_height");
+    if (!(spec.half_height > 0)) s.fail("half_height", "must be > 0");
+    const std::string axis = s.string("axis", "z");
+    if (axis != "x" && axis != "y" && axis != "z")
+      s.fail("axis", "'" + axis + "' is not one of: x, y, z");
+    spec.axis = axis[0] - 'x';
+  } else if (kind == "convex_hull") {
+    spec.shape = RigidBodySpec::Shape::kConvexHull;
+    spec.points = s.vector3List("points");
+    if (spec.points.size() < 4) s.fail("points", "a convex hull needs at least 4 points");
+    // Not flat: some point off the plane of the first three (or of any line, if collinear).
+    Eigen::Vector3d extent = Eigen::Vector3d::Zero();
+    for (const Eigen::Vector3d& p : spec.points)
+      extent = extent.cwiseMax((p - spec.points[0]).cwiseAbs());
+    double volume = 0;
+    for (size_t a = 1; a < spec.points.size(); ++a) {
+      for (size_t b = a + 1; b < spec.points.size(); ++b) {
+        for (size_t c = b + 1; c < spec.points.size(); ++c) {
+          volume = std::max(volume, std::abs((spec.points[a] - spec.points[0])
+                                                 .cross(spec.points[b] - spec.points[0])
+                                                 .dot(spec.points[c] - spec.points[0])));
+        }
+      }
+    }
+    if (!(volume > 1e-9 * std::pow(extent.maxCoeff(), 3)))
+      s.fail("points", "the points are flat (coplanar): a convex hull needs volume");
+    spec.margin = s.number("margin", spec.margin);
+    if (!(spec.margin >= 0)) s.fail("margin", "must be >= 0 m");
+  } else if (kind == "plane") {
+    spec.shape = RigidBodySpec::Shape::kPlane;
+    const Eigen::Vector3d n = s.vector3("normal");
+    if (n.norm() < 1e-12) s.fail("normal", "must not be zero");
+    spec.plane_normal = n.normalized();
+    spec.plane_offset = s.number("offset", 0.0);
+  } else {
+    spec.shape = RigidBodySpec::Shape::kTriangleMesh;
+    spec.points = s.vector3List("vertices");
+    spec.triangles = s.integerTriples("triangles");
+    if (spec.triangles.empty()) s.fail("triangles", "a triangle mesh needs triangles");
+    for (size_t t = 0; t < spec.triangles.size(); ++t) {
+      for (int i : spec.triangles[t]) {
+        if (i >= static_cast<int>(spec.points.size())) {
+          s.fail("triangles", "element " + std::to_string(t) + ": vertex " + std::to_string(i) +
+                                  " does not exist (" + std::to_string(spec.points.size()) +
+                                  " vertices)");
+        }
+      }
+    }
+  }
+  s.finish();
+  shape.finish();
+}
+
+double readCoefficient(const JsonObject& r, const std::string& key, double fallback) {
+  const double value = r.number(key, fallback);
+  if (!(value >= 0)) r.fail(key, "must be >= 0");
+  return value;
+}
+
+}  // namespace
+
+RigidBodySpec readRigidBody(const JsonObject& r, const std::vector<RigidBodySpec>& earlier) {
+  RigidBodySpec spec;
+  spec.name = r.string("name");
+  for (const RigidBodySpec& other : earlier) {
+    if (other.name == spec.name) r.fail("name", "duplicate rigid body name '" + spec.name + "'");
+  }
+  readShape(r.object("shape"), spec);
+  const bool always_static = spec.shape == RigidBodySpec::Shape::kPlane ||
+                             spec.shape == RigidBodySpec::Shape::kTriangleMesh;
+  if (r.has("kinematic")) {
+    for (const JsonObject& m : r.objects("kinematic"))
+      spec.kinematic.push_back(parseMotion(m));
+    if (spec.kinematic.empty())
+      r.fail("kinematic", "needs at least one motion (an empty list: leave the key out)");
+    if (always_static) r.fail("kinematic", "planes and triangle meshes are static only");
+  }
+  spec.mass = r.number("mass", always_static || spec.isKinematic() ? 0.0 : 1.0);
+  if (!(spec.mass >= 0)) r.fail("mass", "must be >= 0 kg (0: static)");
+  if (always_static && spec.mass != 0)
+    r.fail("mass", "planes and triangle meshes are static (mass 0)");
+  if (spec.isKinematic() && spec.mass != 0)
+    r.fail("mass", "a kinematic body has no mass (leave it out or give 0)");
+  spec.pose = parsePose(r, "pose");
+  spec.linear_velocity = r.vector3("linear_velocity", Eigen::Vector3d::Zero());
+  spec.angular_velocity = r.vector3("angular_velocity", Eigen::Vector3d::Zero());
+  if (spec.mass == 0 && (spec.linear_velocity.norm() > 0 || spec.angular_velocity.norm() > 0)) {
+    r.fail(r.has("linear_velocity") ? "linear_velocity" : "angular_velocity",
+           "only a dynamic body (mass > 0) starts with a velocity; a kinematic one moves by "
+           "its 'kinematic' motions");
+  }
+  spec.friction = readCoefficient(r, "friction", spec.friction);
+  spec.restitution = readCoefficient(r, "restitution", spec.restitution);
+  if (spec.restitution > 1) r.fail("restitution", "must be <= 1");
+  r.finish();
+  return spec;
+}
+
+RigidBodySpec readGround(const JsonObject& g) {
+  RigidBodySpec spec;
+  spec.name = "ground";
+  spec.shape = RigidBodySpec::Shape::kPlane;
+  spec.mass = 0;
+  spec.plane_offset = g.number("height", 0.0);
+  spec.friction = readCoefficient(g, "friction", spec.friction);
+  spec.restitution = readCoefficient(g, "restitution", spec.restitution);
+  if (spec.restitution > 1) g.fail("restitution", "must be <= 1");
+  g.finish();
+  return spec;
+}
+
+Frame RigidBodySpec::poseAt(double t) const {
+  // Motions compose in order: F = M_n(t) o ... o M_1(t), each acting on world points.
+  Frame moved = pose;
+  for (const MotionSpec& m : kinematic) {
+    const Frame f = m.frameAt(t);
+    moved.origin = f.toWorld(moved.origin);
+    moved.rotation = (f.rotation * moved.rotation).normalized();
+  }
+  return moved;
+}
+
+}  // namespace torsion::scene
