@@ -12,35 +12,10 @@
 #include <set>
 #include <sstream>
 
+#include "bullet_deformable_world.h"
 #include "rigid_body_builder.h"
 #include "scene_builder.h"
 #include "torsion/mesh/mesh_io.h"
-
-#if defined(__GNUC__)
-#pragma GCC diagnostic push
-#pragma GCC diagnostic ignored "-Wold-style-cast"
-#pragma GCC diagnostic ignored "-Wshadow"
-#pragma GCC diagnostic ignored "-Wunused-parameter"
-#pragma GCC diagnostic ignored "-Wpedantic"
-#pragma GCC diagnostic ignored "-Woverloaded-virtual"
-#pragma GCC diagnostic ignored "-Wdouble-promotion"
-#pragma GCC diagnostic ignored "-Wcast-align"
-#pragma GCC diagnostic ignored "-Wnon-virtual-dtor"
-#pragma GCC diagnostic ignored "-Wunused-variable"
-#pragma GCC diagnostic ignored "-Wsign-compare"
-#pragma GCC diagnostic ignored "-Wreorder"
-#pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
-#endif
-#include "BulletSoftBody/btDeformableBodySolver.h"
-#include "BulletSoftBody/btDeformableGravityForce.h"
-#include "BulletSoftBody/btDeformableLinearElasticityForce.h"
-#include "BulletSoftBody/btDeformableMultiBodyConstraintSolver.h"
-#include "BulletSoftBody/btDeformableMultiBodyDynamicsWorld.h"
-#include "BulletSoftBody/btSoftBodyRigidBodyCollisionConfiguration.h"
-#include "btBulletDynamicsCommon.h"
-#if defined(__GNUC__)
-#pragma GCC diagnostic pop
-#endif
 
 namespace torsion::bench {
 

@@ -41,34 +41,8 @@
 #include <sstream>
 #include <utility>
 
+#include "bullet_deformable_world.h"
 #include "twist_protocol.h"
-
-#if defined(__GNUC__)
-#pragma GCC diagnostic push
-#pragma GCC diagnostic ignored "-Wold-style-cast"
-#pragma GCC diagnostic ignored "-Wshadow"
-#pragma GCC diagnostic ignored "-Wunused-parameter"
-#pragma GCC diagnostic ignored "-Wpedantic"
-#pragma GCC diagnostic ignored "-Woverloaded-virtual"
-#pragma GCC diagnostic ignored "-Wdouble-promotion"
-#pragma GCC diagnostic ignored "-Wcast-align"
-#pragma GCC diagnostic ignored "-Wnon-virtual-dtor"
-#pragma GCC diagnostic ignored "-Wunused-variable"
-#pragma GCC diagnostic ignored "-Wsign-compare"
-#pragma GCC diagnostic ignored "-Wreorder"
-#endif
-#include "BulletSoftBody/btDeformableBodySolver.h"
-#include "BulletSoftBody/btDeformableCorotatedForce.h"
-#include "BulletSoftBody/btDeformableGravityForce.h"
-#include "BulletSoftBody/btDeformableLinearElasticityForce.h"
-#include "BulletSoftBody/btDeformableMultiBodyConstraintSolver.h"
-#include "BulletSoftBody/btDeformableMultiBodyDynamicsWorld.h"
-#include "BulletSoftBody/btSoftBodyRigidBodyCollisionConfiguration.h"
-#include "LinearMath/btQuickprof.h"
-#include "btBulletDynamicsCommon.h"
-#if defined(__GNUC__)
-#pragma GCC diagnostic pop
-#endif
 
 namespace torsion::bench {
 namespace {
