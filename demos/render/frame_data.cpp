@@ -1,13 +1,8 @@
 #include "frame_data.h"
 
-#include <BulletCollision/CollisionShapes/btBoxShape.h>
-#include <BulletCollision/CollisionShapes/btSphereShape.h>
-#include <BulletCollision/CollisionShapes/btStaticPlaneShape.h>
-
 #include <algorithm>
 #include <cmath>
 
-#include "torsion/bullet/bt_conversions.h"
 #include "torsion/fem/corotated_element.h"
 
 namespace torsion::render {
@@ -196,50 +191,9 @@ FrameData captureFrame(scene::BuiltScene& scene, double steps_per_second) {
     frame.wrenches.push_back({s.name, w.force, w.torque});
   }
 
-  for (btRigidBody* rb : world.rigidBodies()) {
-    RigidDrawData d;
-    const btTransform& t = rb->getWorldTransform();
-    d.pose.linear() = Eigen::Quaterniond(t.getRotation().w(), t.getRotation().x(),
-                                         t.getRotation().y(), t.getRotation().z())
-                          .toRotationMatrix();
-    d.pose.translation() = toEigen(t.getOrigin());
-    d.is_static = rb->getInvMass() == 0;
-    const btCollisionShape* shape = rb->getCollisionShape();
-    switch (shape->getShapeType()) {
-      case BOX_SHAPE_PROXYTYPE:
-        d.shape = RigidDrawData::Shape::kBox;
-        d.half_extents = toEigen(static_cast<const btBoxShape*>(shape)->getHalfExtentsWithMargin());
-        break;
-      case SPHERE_SHAPE_PROXYTYPE:
-        d.shape = RigidDrawData::Shape::kSphere;
-        d.radius = static_cast<const btSphereShape*>(shape)->getRadius();
-        break;
-      case STATIC_PLANE_PROXYTYPE: {
-        const auto* plane = static_cast<const btStaticPlaneShape*>(shape);
-        d.shape = RigidDrawData::Shape::kPlane;
-        d.normal = d.pose.linear() * toEigen(plane->getPlaneNormal());
-        d.offset = plane->getPlaneConstant() + d.normal.dot(d.pose.translation());
-        break;
-      }
-      default: {  // drawn as its bounding box
-        btVector3 lo, hi;
-        shape->getAabb(btTransform::getIdentity(), lo, hi);
-        d.shape = RigidDrawData::Shape::kOther;
-        d.half_extents = 0.5 * (toEigen(hi) - toEigen(lo));
-        d.pose.translation() += d.pose.linear() * (0.5 * (toEigen(hi) + toEigen(lo)));
-        break;
-      }
-    }
-    if (d.shape == RigidDrawData::Shape::kBox || d.shape == RigidDrawData::Shape::kOther) {
-      for (int c = 0; c < 8; ++c) {
-        const Eigen::Vector3d corner((c & 1) ? 1 : -1, (c & 2) ? 1 : -1, (c & 4) ? 1 : -1);
-        frame.bounds.extend(d.pose * corner.cwiseProduct(d.half_extents));
-      }
-    } else if (d.shape == RigidDrawData::Shape::kSphere) {
-      frame.bounds.extend(d.pose.translation() + Eigen::Vector3d::Constant(d.radius));
-      frame.bounds.extend(d.pose.translation() - Eigen::Vector3d::Constant(d.radius));
-    }
-    frame.rigids.push_back(d);
+  for (const btRigidBody* rb : world.rigidBodies()) {
+    frame.rigids.push_back(rigidDrawData(*rb));
+    extendBounds(frame.rigids.back(), frame.bounds);
   }
   if (frame.bounds.isEmpty()) frame.bounds.extend(Eigen::Vector3d::Zero());
   frame.stress_max = niceCeiling(stress_max);

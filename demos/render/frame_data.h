@@ -12,6 +12,7 @@
 #include <string>
 #include <vector>
 
+#include "rigid_geometry.h"
 #include "scene_builder.h"
 #include "torsion/constraints/frame.h"
 
@@ -32,16 +33,6 @@ struct BodyDrawData {
 
 /// The stripes of BodyDrawData for `mesh` (from its rest positions).
 std::vector<std::vector<int>> restStripes(const TetMesh& mesh);
-
-struct RigidDrawData {
-  enum class Shape { kBox, kSphere, kPlane, kOther } shape = Shape::kOther;
-  Eigen::Vector3d half_extents = Eigen::Vector3d::Zero();  ///< box, or the bounds of kOther
-  double radius = 0;                                       ///< sphere
-  Eigen::Vector3d normal = Eigen::Vector3d::UnitZ();       ///< plane: n . x = offset
-  double offset = 0;
-  Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
-  bool is_static = false;
-};
 
 struct HandDrawData {
   std::string name;

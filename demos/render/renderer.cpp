@@ -208,61 +208,6 @@ void Renderer::drawBodies(const FrameData& frame, const RenderOptions& options) 
   }
 }
 
-void Renderer::drawRigids(const FrameData& frame) {
-  const GlApi& gl = gl_;
-  gl.Enable(GL_LIGHTING);
-  gl.Enable(GL_COLOR_MATERIAL);
-  for (const RigidDrawData& r : frame.rigids) {
-    if (r.shape == RigidDrawData::Shape::kPlane) continue;
-    if (r.is_static) {
-      gl.Color4d(0.55, 0.55, 0.58, 1);
-    } else {
-      gl.Color4d(0.78, 0.42, 0.36, 1);  // brick red: clearly not a stress colour
-    }
-    if (r.shape == RigidDrawData::Shape::kSphere) {
-      const int stacks = 16, slices = 24;
-      for (int i = 0; i < stacks; ++i) {
-        const double t0 = M_PI * i / stacks - M_PI / 2, t1 = M_PI * (i + 1) / stacks - M_PI / 2;
-        gl.Begin(GL_QUAD_STRIP);
-        for (int j = 0; j <= slices; ++j) {
-          const double phi = 2 * M_PI * j / slices;
-          for (double t : {t1, t0}) {
-            const Eigen::Vector3d n(std::cos(t) * std::cos(phi), std::cos(t) * std::sin(phi),
-                                    std::sin(t));
-            const Eigen::Vector3d wn = r.pose.linear() * n;
-            const Eigen::Vector3d p = r.pose * (r.radius * n);
-            gl.Normal3d(wn.x(), wn.y(), wn.z());
-            gl.Vertex3d(p.x(), p.y(), p.z());
-          }
-        }
-        gl.End();
-      }
-    } else {
-      gl.Begin(GL_QUADS);
-      for (int axis = 0; axis < 3; ++axis) {
-        for (int sign : {-1, 1}) {
-          Eigen::Vector3d n = Eigen::Vector3d::Zero();
-          n[axis] = sign;
-          const Eigen::Vector3d u = Eigen::Vector3d::Unit((axis + 1) % 3),
-                                v = Eigen::Vector3d::Unit((axis + 2) % 3);
-          const Eigen::Vector3d wn = r.pose.linear() * n;
-          gl.Normal3d(wn.x(), wn.y(), wn.z());
-          // Counter-clockwise seen from outside: u x v = +axis, so flip the order for -axis.
-          const double s = sign;
-          for (const auto& [cu, cv] :
-               {std::pair(-1.0, -1.0), std::pair(s, -s), std::pair(1.0, 1.0), std::pair(-s, s)}) {
-            const Eigen::Vector3d local = n + cu * u + cv * v;
-            const Eigen::Vector3d p = r.pose * local.cwiseProduct(r.half_extents);
-            gl.Vertex3d(p.x(), p.y(), p.z());
-          }
-        }
-      }
-      gl.End();
-    }
-  }
-  gl.Disable(GL_LIGHTING);
-}
-
 void Renderer::drawHands(const FrameData& frame, const RenderOptions& options) {
   const GlApi& gl = gl_;
   gl.Disable(GL_LIGHTING);

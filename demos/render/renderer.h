@@ -52,7 +52,14 @@ class Renderer {
   void drawBodies(const FrameData& frame, const RenderOptions& options);
   /// The body's stripes (BodyDrawData::stripes) as light lines on its surface.
   void drawStripes(const BodyDrawData& body, const RenderOptions& options);
+  // Rigid bodies (renderer_rigids.cpp).
   void drawRigids(const FrameData& frame);
+  /// A capsule of `radius` whose cap centres lie +-half_height along local `axis` (0 x, 1 y,
+  /// 2 z); half_height 0 is a sphere.
+  void drawRound(const Eigen::Isometry3d& pose, double radius, double half_height, int axis);
+  void drawBox(const Eigen::Isometry3d& pose, const Eigen::Vector3d& half_extents);
+  /// A hull's or mesh's triangles, flat-shaded with their right-hand-rule normals.
+  void drawTriangles(const RigidDrawData& rigid);
   void drawHands(const FrameData& frame, const RenderOptions& options);
   // The 2D overlay (overlay.cpp), in pixels with y down.
   void drawOverlay(const FrameData& frame, int width, int height, const RenderOptions& options);

@@ -8,135 +8,37 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
-#include <cstdlib>
 #include <filesystem>
-#include <iostream>
 
-#include "camera.h"
-#include "frame_data.h"
-#include "image.h"
-#include "offscreen.h"
-#include "scene_parser.h"
-#include "scene_runner.h"
+#include "render_fixture.h"
 
 namespace torsion::render {
 namespace {
 
 namespace fs = std::filesystem;
-
-// Tolerances: a picture passes when the mean absolute difference is at most kMaxMeanAbs (of 255,
-// per channel) and at most kMaxDifferingFraction of its pixels differ by more than
-// kPixelThreshold in some channel. Another rasteriser (Mesa's llvmpipe vs softpipe, or a new
-// Mesa) moves anti-aliased edge pixels and rounds shading differently by a few levels; that
-// stays far below these bounds. Mesh lines are off in the compared pictures: a 1-pixel line
-// rasterised one pixel over is the largest driver-dependent change and is not what these tests
-// are about. What they are about changes 3 % to 30 % of the pixels (see the perturbation tests).
-constexpr int kPixelThreshold = 24;
-constexpr double kMaxMeanAbs = 1.5;
-constexpr double kMaxDifferingFraction = 0.01;
-constexpr int kWidth = 400, kHeight = 300;
-
-RenderOptions optionsFor() {
-  RenderOptions o;
-  o.mesh_lines = false;
-  return o;
-}
-
-struct Rendered {
-  FrameData frame;
-  Camera camera;
-};
-
-OffscreenRenderer& offscreen();
+using namespace test;
 
 // The twist_bar scene after 40 steps (0.8 rad of twist), captured as a FrameData.
 const Rendered& twistBar() {
-  static const Rendered rendered = [] {
-    Result<scene::SceneSpec> spec =
-        scene::loadScene(std::string(TORSION_TEST_DATA) + "/render/twist_bar.json");
-    EXPECT_TRUE(spec.ok()) << (spec.ok() ? "" : spec.error().message);
-    auto built = scene::buildScene(std::move(spec).value(), 1);
-    EXPECT_TRUE(built.ok()) << (built.ok() ? "" : built.error().message);
-    scene::BuiltScene& s = *built.value();
-    for (int k = 0; k < s.spec.steps; ++k) {
-      EXPECT_TRUE(scene::driveHands(s).ok());
-      EXPECT_TRUE(s.world->step().ok);
-    }
-    Rendered r;
-    r.frame = captureFrame(s);
-    r.camera = offscreen().fitCamera(r.frame, optionsFor());
-    return r;
-  }();
+  static const Rendered rendered = loadAndCapture("twist_bar", 40);
   return rendered;
 }
 
-OffscreenRenderer& offscreen() {
-  static std::unique_ptr<OffscreenRenderer> r = [] {
-    auto made = OffscreenRenderer::create(kWidth, kHeight, 2);
-    if (!made) {
-      ADD_FAILURE() << made.error().message;
-      return std::unique_ptr<OffscreenRenderer>();
-    }
-    return std::move(made).value();
-  }();
-  return *r;
-}
-
 Image draw(const FrameData& frame) {
-  return offscreen().render(frame, twistBar().camera, optionsFor());
+  return test::draw(twistBar(), frame);
 }
 
-std::string referencePath() {
-  return std::string(TORSION_TEST_DATA) + "/render/twist_bar.png";
-}
-
-ImageDifference against(const Image& reference, const Image& picture) {
-  Result<ImageDifference> d = compareImages(reference, picture, kPixelThreshold);
-  EXPECT_TRUE(d.ok()) << (d.ok() ? "" : d.error().message);
-  return d.ok() ? d.value() : ImageDifference{255, 1, kPixelThreshold};
-}
-
-bool passes(const ImageDifference& d) {
-  return d.mean_abs <= kMaxMeanAbs && d.differing_fraction <= kMaxDifferingFraction;
-}
-
-Image reference() {
-  Result<Image> ref = readPng(referencePath());
-  if (!ref) {
-    ADD_FAILURE() << ref.error().message
-                  << " (make it with TORSION_UPDATE_REFERENCES=1, see tests/data/README.md)";
-    return {};
-  }
-  return std::move(ref).value();
+void expectCaught(const FrameData& perturbed, const char* what) {
+  test::expectCaught("twist_bar", twistBar(), perturbed, what);
 }
 
 TEST(Render, TwistBarMatchesReference) {
-  const Image picture = draw(twistBar().frame);
-  const fs::path actual = fs::current_path() / "render_actual_twist_bar.png";
-  ASSERT_TRUE(writePng(picture, actual.string()).ok());
-  if (std::getenv("TORSION_UPDATE_REFERENCES")) {
-    ASSERT_TRUE(writePng(picture, referencePath()).ok());
-    GTEST_SKIP() << "reference written to " << referencePath() << ": look at it";
-  }
-  const ImageDifference d = against(reference(), picture);
-  EXPECT_TRUE(passes(d)) << "mean |diff| " << d.mean_abs << ", differing pixels "
-                         << d.differing_fraction << "; this run's picture: " << actual;
+  expectMatchesReference("twist_bar", twistBar());
 }
 
 TEST(Render, SameFrameDrawsTheSamePicture) {
   const Image a = draw(twistBar().frame), b = draw(twistBar().frame);
   EXPECT_EQ(a.rgb, b.rgb);
-}
-
-// Each perturbation must fail the comparison with a margin, so the tolerances above are not so
-// loose that they hide what a reader of the picture would call wrong.
-void expectCaught(const FrameData& perturbed, const char* what) {
-  const ImageDifference d = against(reference(), draw(perturbed));
-  EXPECT_FALSE(passes(d)) << what << ": mean |diff| " << d.mean_abs << ", differing pixels "
-                          << d.differing_fraction;
-  EXPECT_GT(d.differing_fraction, 2 * kMaxDifferingFraction) << what;
-  std::cout << what << ": mean |diff| " << d.mean_abs << ", differing " << d.differing_fraction
-            << "\n";
 }
 
 TEST(Render, MissingBodyIsCaught) {
