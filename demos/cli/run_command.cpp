@@ -4,10 +4,10 @@
 #include <iostream>
 #include <memory>
 
-#include "../scene/device_parser.h"
 #include "../scene/scene_haptics.h"
 #include "../scene/scene_parser.h"
 #include "../scene/scene_runner.h"
+#include "device_options.h"
 #include "frame_recorder.h"
 #include "mesh_command.h"
 #include "progress_bar.h"
@@ -24,8 +24,7 @@ struct RunArguments {
   std::string render;  // --render DIR: PNG pictures (and an MP4 with ffmpeg)
   std::string render_size = "800x600";
   int render_every = 10;
-  std::vector<std::string> devices;  // --device HAND=TYPE[:ARG], repeatable
-  std::string haptics;               // --haptics lockstep|threaded
+  scene::DeviceOverrides devices;  // --device HAND=TYPE[:ARG] (repeatable), --haptics MODE
 };
 
 // Exit codes: 0 done and stable, 1 bad input or output error, 3 the simulation went unstable.
@@ -35,19 +34,9 @@ int run(const RunArguments& args) {
     std::cerr << "error: " << spec.error().message << "\n";
     return 1;
   }
-  for (const std::string& d : args.devices) {
-    if (Status applied = scene::applyDeviceOverride(spec.value(), d); !applied) {
-      std::cerr << "error: " << applied.error().message << "\n";
-      return 1;
-    }
-  }
-  if (!args.haptics.empty()) {
-    Result<scene::HapticsMode> mode = scene::parseHapticsMode(args.haptics);
-    if (!mode) {
-      std::cerr << "error: " << mode.error().message << "\n";
-      return 1;
-    }
-    spec.value().haptics_mode = mode.value();
+  if (Status applied = scene::applyDeviceOverrides(spec.value(), args.devices); !applied) {
+    std::cerr << "error: " << applied.error().message << "\n";
+    return 1;
   }
   Result<std::unique_ptr<scene::BuiltScene>> built =
       scene::buildScene(std::move(spec).value(), args.threads);
@@ -147,14 +136,7 @@ void addRunCommand(CLI::App& app) {
   cmd->add_option("--render-every", args->render_every, "Steps between pictures")
       ->check(CLI::PositiveNumber)
       ->capture_default_str();
-  cmd->add_option("--device", args->devices,
-                  "Drive a hand with a device instead of its script (repeatable): "
-                  "HAND=scripted:FILE, HAND=replay:LOG.csv, HAND=network[:[HOST:]PORT], "
-                  "HAND=spacemouse");
-  cmd->add_option("--haptics", args->haptics,
-                  "Haptic loops: lockstep (simulated clock, deterministic; default for scripted "
-                  "and replay devices) or threaded (1 kHz threads, simulation paced to wall-clock "
-                  "time; default for network and SpaceMouse)");
+  addDeviceOptions(*cmd, args->devices);
   cmd->callback([args] { setExitCode(run(*args)); });
 }
 

@@ -245,4 +245,16 @@ Result<HapticsMode> parseHapticsMode(const std::string& text) {
   return Error{"--haptics '" + text + "': expected lockstep or threaded"};
 }
 
+Status applyDeviceOverrides(SceneSpec& scene, const DeviceOverrides& overrides) {
+  for (const std::string& d : overrides.devices) {
+    if (Status applied = applyDeviceOverride(scene, d); !applied) return applied;
+  }
+  if (!overrides.haptics.empty()) {
+    Result<HapticsMode> mode = parseHapticsMode(overrides.haptics);
+    if (!mode) return mode.error();
+    scene.haptics_mode = mode.value();
+  }
+  return Ok{};
+}
+
 }  // namespace torsion::scene

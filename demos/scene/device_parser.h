@@ -2,6 +2,7 @@
 // The `device` entry of a scene hand, and the CLI's `--device HAND=TYPE[:ARG]` override.
 
 #include <string>
+#include <vector>
 
 #include "json_reader.h"
 #include "scene_spec.h"
@@ -21,5 +22,15 @@ Status applyDeviceOverride(SceneSpec& scene, const std::string& text);
 
 /// "lockstep" or "threaded" (the CLI's --haptics).
 Result<HapticsMode> parseHapticsMode(const std::string& text);
+
+/// The command line's device choices, the same for `torsion run` and `torsion view`.
+struct DeviceOverrides {
+  std::vector<std::string> devices;  ///< `--device HAND=TYPE[:ARG]`, repeatable
+  std::string haptics;               ///< `--haptics lockstep|threaded`; empty: the default
+};
+
+/// Applies every --device (applyDeviceOverride), then --haptics, to `scene`; the first fault
+/// is the error.
+Status applyDeviceOverrides(SceneSpec& scene, const DeviceOverrides& overrides);
 
 }  // namespace torsion::scene

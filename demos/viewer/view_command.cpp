@@ -4,6 +4,7 @@
 #include <iostream>
 #include <memory>
 
+#include "../cli/device_options.h"
 #include "../cli/mesh_command.h"
 #include "viewer.h"
 
@@ -24,6 +25,7 @@ void addViewCommand(CLI::App& app) {
                   "Synthetic input, one event a line: '<frame> key NAME [shift]', '<frame> drag "
                   "left|right|middle DX DY [ctrl]', '<frame> scroll DY'");
   cmd->add_option("--screenshot", options->screenshot, "Write the last frame to this PNG");
+  addDeviceOptions(*cmd, options->devices);
   cmd->callback([options, size] {
     if (std::sscanf(size->c_str(), "%dx%d", &options->width, &options->height) != 2 ||
         options->width < 64 || options->height < 64) {

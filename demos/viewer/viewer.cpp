@@ -157,7 +157,7 @@ class Viewer {
       case GLFW_KEY_DOWN:
       case GLFW_KEY_PAGE_UP:
       case GLFW_KEY_PAGE_DOWN:
-        if (!manual_) toggleManual();
+        if (!manual_ && !toggleManual()) break;
         if (shift) {
           manual_frame_.rotation =
               (Eigen::AngleAxisd(sign * angle, axis) * manual_frame_.rotation).normalized();
@@ -200,7 +200,7 @@ class Viewer {
   void onDrag(int button, double dx, double dy, bool ctrl, int height) {
     const double h = std::max(1, height);
     if (ctrl && button == GLFW_MOUSE_BUTTON_LEFT) {
-      if (!manual_) toggleManual();
+      if (!manual_ && !toggleManual()) return;
       const Eigen::Matrix4d v = camera_.view();
       const double visible = 2 * camera_.distance * std::tan(camera_.fov_y / 2);
       manual_frame_.origin +=
@@ -276,9 +276,10 @@ class Viewer {
     render::FrameData f = render::captureFrame(*scene_, rate_);
     f.notes.push_back(settingsText());
     if (!history_.times.empty()) f.plots.push_back(history_);
-    f.notes.push_back(
-        std::string(paused_ ? "PAUSED" : "RUNNING") +
-        (manual_ ? "  HAND: MANUAL (G GRAB, U RELEASE)" : "  HAND: SCRIPT (M MANUAL)"));
+    f.notes.push_back(std::string(paused_ ? "PAUSED" : "RUNNING") +
+                      (manual_        ? "  HAND: MANUAL (G GRAB, U RELEASE)"
+                       : deviceHand() ? "  HAND: DEVICE"
+                                      : "  HAND: SCRIPT (M MANUAL)"));
     if (!unstable_.empty()) f.notes.push_back("STOPPED: " + unstable_.substr(0, 60));
     f.notes.push_back("KEYS SPACE N R F  T E P D C  M G U ARROWS PGUP PGDN");
     if (manual_ && hand() && !hand()->hand->grabbed()) {
@@ -300,10 +301,45 @@ class Viewer {
     return r;
   }
   const Camera& camera() const { return camera_; }
+  std::vector<std::string> hapticsDescription() const {
+    return scene_->haptics ? scene_->haptics->describe() : std::vector<std::string>{};
+  }
   int steps() const { return steps_; }
   bool stable() const { return unstable_.empty(); }
   const std::string& failure() const { return unstable_; }
   bool manual() const { return manual_; }
+  /// The first hand follows a device (the scene's, or --device).
+  bool deviceHand() const {
+    return !scene_->hands.empty() && scene_->hands.front().spec.device.has_value();
+  }
+  /// One line per hand: where its goal (the device's or the script's frame) and its grabbed
+  /// patch are, as origin and rotation vector (angle times axis of R = [i j k]).
+  std::vector<std::string> handReport() const {
+    auto pose = [](const Frame& f) {
+      const Eigen::AngleAxisd turn(f.rotation);
+      const Eigen::Vector3d r = turn.angle() * turn.axis();
+      char buf[160];
+      std::snprintf(buf, sizeof buf, "at (%.6g, %.6g, %.6g) m turned (%.6g, %.6g, %.6g) rad",
+                    f.origin.x(), f.origin.y(), f.origin.z(), r.x(), r.y(), r.z());
+      return std::string(buf);
+    };
+    std::vector<std::string> lines;
+    for (const scene::SceneHand& h : scene_->hands) {
+      std::string line = "hand '" + h.spec.name + "' (" +
+                         (h.spec.device                             ? "device"
+                          : manual_ && &h == &scene_->hands.front() ? "manual"
+                                                                    : "scripted") +
+                         "): goal " + pose(h.hand->goal());
+      if (h.hand->grabbed()) {
+        line += ", patch " + pose(h.hand->frame()) + ", " +
+                std::to_string(h.hand->grabbedNodes().size()) + " nodes grabbed";
+      } else {
+        line += ", nothing grabbed";
+      }
+      lines.push_back(line);
+    }
+    return lines;
+  }
   int grabbedNodes() {
     return hand() && hand()->hand->grabbed() ? static_cast<int>(hand()->hand->grabbedNodes().size())
                                              : 0;
@@ -321,10 +357,16 @@ class Viewer {
 
   scene::SceneHand* hand() { return scene_->hands.empty() ? nullptr : &scene_->hands.front(); }
 
-  void toggleManual() {
+  // Returns whether the hand is under manual control now.
+  bool toggleManual() {
     if (manual_) {
       manual_ = false;
-      return;
+      return false;
+    }
+    if (deviceHand()) {  // the device moves it: two masters would fight
+      std::cerr << "viewer: hand '" << hand()->spec.name
+                << "' follows its device: no manual control\n";
+      return false;
     }
     if (scene_->hands.empty()) {  // a hand of our own on the first body
       scene::SceneHand h;
@@ -344,10 +386,11 @@ class Viewer {
     h.spec.release_at = std::numeric_limits<double>::infinity();
     manual_frame_ = h.hand->grabbed() ? h.hand->frame() : h.spec.frameAt(scene_->world->time());
     manual_ = true;
+    return true;
   }
 
   void grab() {
-    if (!manual_) toggleManual();
+    if (!manual_ && !toggleManual()) return;
     Result<int> n = hand()->hand->grab(manual_frame_, scene_->world->time());
     if (!n) std::cerr << "viewer: grab: " << n.error().message << "\n";
   }
@@ -447,11 +490,18 @@ int runViewer(const ViewerOptions& options) {
     }
     script = std::move(read).value();
   }
+  if (Status applied = scene::applyDeviceOverrides(spec.value(), options.devices); !applied) {
+    std::cerr << "error: " << applied.error().message << "\n";
+    return 1;
+  }
   Viewer viewer(options, std::move(spec).value());
+  // Opens the devices too: a SpaceMouse without its daemon stops here, before any window.
   if (Status built = viewer.rebuild(); !built) {
     std::cerr << "error: " << built.error().message << "\n";
     return 1;
   }
+  for (const std::string& line : viewer.hapticsDescription())
+    std::cerr << line << "\n";
 
   glfwSetErrorCallback([](int code, const char* text) {
     std::cerr << "glfw error " << code << ": " << text << "\n";
@@ -548,10 +598,14 @@ int runViewer(const ViewerOptions& options) {
   glfwDestroyWindow(window);
   glfwTerminate();
   std::cout << "viewer: " << frames << " frames, " << viewer.steps() << " steps, hand "
-            << (viewer.manual() ? "manual" : "scripted") << ", " << viewer.grabbedNodes()
-            << " nodes grabbed, " << (viewer.stable() ? "stable" : "unstable: " + viewer.failure())
-            << "\n";
+            << (viewer.manual()       ? "manual"
+                : viewer.deviceHand() ? "device"
+                                      : "scripted")
+            << ", " << viewer.grabbedNodes() << " nodes grabbed, "
+            << (viewer.stable() ? "stable" : "unstable: " + viewer.failure()) << "\n";
   std::cout << "viewer: " << viewer.worldText() << "\n";
+  for (const std::string& line : viewer.handReport())
+    std::cout << "viewer: " << line << "\n";
   return viewer.stable() ? 0 : 3;
 }
 

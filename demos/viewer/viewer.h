@@ -12,8 +12,12 @@
 //            logged on stdout ("viewer: live edit, world at step N, t = T s; DT ...") and kept
 //            by a reset
 // The HUD shows the live settings and a scrolling plot of the first hand's force and torque.
+// Hands with a device (the scene's `device`, or --device HAND=TYPE[:ARG] as for `torsion run`)
+// follow it through their haptic loops; M, G, U and the hand keys leave such a hand to its device.
 
 #include <string>
+
+#include "device_parser.h"
 
 namespace torsion::viewer {
 
@@ -21,9 +25,10 @@ struct ViewerOptions {
   std::string scene;
   int width = 1024, height = 720;
   int threads = -1;
-  int frames = 0;          ///< > 0: quit after this many frames (tests)
-  std::string script;      ///< synthetic input, one event per line (see viewer.cpp)
-  std::string screenshot;  ///< PNG of the last frame, written on exit
+  int frames = 0;                  ///< > 0: quit after this many frames (tests)
+  std::string script;              ///< synthetic input, one event per line (see viewer.cpp)
+  std::string screenshot;          ///< PNG of the last frame, written on exit
+  scene::DeviceOverrides devices;  ///< --device / --haptics, as for `torsion run`
 };
 
 /// Returns the process exit code: 0 clean exit, 1 bad input or no window, 3 simulation unstable.

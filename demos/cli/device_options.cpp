@@ -1,0 +1,16 @@
+#include "device_options.h"
+
+namespace torsion::cli {
+
+void addDeviceOptions(CLI::App& command, scene::DeviceOverrides& into) {
+  command.add_option("--device", into.devices,
+                     "Drive a hand with a device instead of its script (repeatable): "
+                     "HAND=scripted:FILE, HAND=replay:LOG.csv, HAND=network[:[HOST:]PORT], "
+                     "HAND=spacemouse");
+  command.add_option("--haptics", into.haptics,
+                     "Haptic loops: lockstep (simulated clock, deterministic; default for "
+                     "scripted and replay devices) or threaded (1 kHz threads, simulation paced "
+                     "to wall-clock time; default for network and SpaceMouse)");
+}
+
+}  // namespace torsion::cli

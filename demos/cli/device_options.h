@@ -1,0 +1,13 @@
+#pragma once
+// `--device HAND=TYPE[:ARG]` (repeatable) and `--haptics MODE`: one definition for the commands
+// that step a scene (`torsion run`, `torsion view`); scene::applyDeviceOverrides applies them.
+
+#include <CLI/CLI.hpp>
+
+#include "../scene/device_parser.h"
+
+namespace torsion::cli {
+
+void addDeviceOptions(CLI::App& command, scene::DeviceOverrides& into);
+
+}  // namespace torsion::cli
