@@ -71,7 +71,15 @@ void Camera::zoom(double factor) {
 
 Camera frameCamera(const FrameData& frame, double aspect, double top_reserved) {
   Camera camera;
-  const Eigen::Vector3d extent = frame.bounds.sizes();
+  // The bounds reach down to the ground, if any (the foot of their centre on each plane): a body
+  // dropped from above lands in the picture.
+  Eigen::AlignedBox3d bounds = frame.bounds;
+  for (const RigidDrawData& r : frame.rigids) {
+    if (r.shape != RigidDrawData::Shape::kPlane || frame.bounds.isEmpty()) continue;
+    const Eigen::Vector3d n = r.normal.normalized(), c = frame.bounds.center();
+    bounds.extend(c - (n.dot(c) - r.offset) * n);
+  }
+  const Eigen::Vector3d extent = bounds.sizes();
   const double free_height = 1 - std::clamp(top_reserved, 0.0, 0.5);
   if (frame.camera.up) {
     camera.up = *frame.camera.up;
@@ -89,7 +97,7 @@ Camera frameCamera(const FrameData& frame, double aspect, double top_reserved) {
   // Look mostly across the longer horizontal extent, a little along it.
   camera.yaw = frame.camera.yaw.value_or(along_a >= along_b ? 1.2 : 0.37);
   camera.pitch = frame.camera.pitch.value_or(0.38);
-  camera.target = frame.bounds.center();
+  camera.target = bounds.center();
   // Distance: each bounding-box corner must fit in both fields of view.
   camera.distance = 1;
   const Eigen::Matrix4d v = camera.view();
@@ -98,9 +106,9 @@ Camera frameCamera(const FrameData& frame, double aspect, double top_reserved) {
                tan_x = std::tan(camera.fov_y / 2) * aspect;
   double needed = 1e-3;
   for (int c = 0; c < 8; ++c) {
-    const Eigen::Vector3d corner((c & 1) ? frame.bounds.max().x() : frame.bounds.min().x(),
-                                 (c & 2) ? frame.bounds.max().y() : frame.bounds.min().y(),
-                                 (c & 4) ? frame.bounds.max().z() : frame.bounds.min().z());
+    const Eigen::Vector3d corner((c & 1) ? bounds.max().x() : bounds.min().x(),
+                                 (c & 2) ? bounds.max().y() : bounds.min().y(),
+                                 (c & 4) ? bounds.max().z() : bounds.min().z());
     const Eigen::Vector3d q = rot * (corner - camera.target);  // camera looks down -z
     needed = std::max(needed, std::abs(q.x()) / tan_x + q.z());
     needed = std::max(needed, std::abs(q.y()) / tan_y + q.z());

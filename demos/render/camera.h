@@ -31,7 +31,8 @@ struct Camera {
 /// The scene's `camera` entry (frame.camera) chooses up, yaw, pitch and zoom; by default up is
 /// against gravity, and without gravity z unless z is the scene's longest extent (a standing
 /// cylinder is then shown lying across the picture), and the view is oblique, looking across the
-/// longest horizontal extent. The distance fits the bounds with a margin into the picture's
+/// longest horizontal extent. The distance fits the bounds (down to the ground plane, when the
+/// scene has one) with a margin into the picture's
 /// height minus the top `top_reserved` fraction (the HUD, hudHeightFraction), and the view is
 /// shifted so the scene sits centred below it.
 Camera frameCamera(const FrameData& frame, double aspect, double top_reserved = 0);

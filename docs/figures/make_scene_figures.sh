@@ -20,6 +20,9 @@ declare -A STEPS=(
   [twist_cylinder_4323]=1600   # 1.6 rad of the 2 pi turn
   [twist_cylinder_8332]=1600
   [twist_cylinder_31558]=800   # 0.8 rad; ~1 min on 2 cores
+  [press]=100                  # the plate down 6 cm and holding (it lifts at 1.1 s)
+  [haptic_cylinder]=700        # device at 70 s of Figure 6.7 (speed 10): turned 0.5 rad about z
+  [haptic_dragon]=350          # neck turned 90 degrees and held; button 2 releases it at 4 s
 )
 
 scenes=("$@")
