@@ -122,7 +122,10 @@ int run(const RunArguments& args) {
 void addRunCommand(CLI::App& app) {
   auto args = std::make_shared<RunArguments>();
   CLI::App* cmd = app.add_subcommand("run", "Run a scene headless and write its results");
-  cmd->add_option("scene", args->scene, "Scene file (JSON, see docs/scene-format.md)")->required();
+  cmd->add_option("scene", args->scene,
+                  "Scene file (JSON, see docs/scene-format.md) or the name of a demo scene (drop, "
+                  "twist_cylinder_2430, ...)")
+      ->required();
   cmd->add_option("--out", args->out, "Output directory")->capture_default_str();
   cmd->add_option("--steps", args->steps, "Number of steps (default: the scene's)")
       ->check(CLI::PositiveNumber);

@@ -6,6 +6,7 @@
 #include "device_parser.h"
 #include "json_reader.h"
 #include "rigid_body_parser.h"
+#include "scene_catalog.h"
 #include "torsion/mesh/mesh_io.h"
 
 namespace torsion::scene {
@@ -316,10 +317,13 @@ Result<SceneSpec> parseScene(std::string_view text, const std::string& file_name
   }
 }
 
-Result<SceneSpec> loadScene(const std::string& path) {
-  Result<std::string> text = readTextFile(path);
+Result<SceneSpec> loadScene(const std::string& path_or_name) {
+  Result<std::string> path = resolveScene(path_or_name);
+  if (!path) return path.error();
+  Result<std::string> text = readTextFile(path.value());
   if (!text) return text.error();
-  return parseScene(text.value(), path, std::filesystem::path(path).parent_path().string());
+  return parseScene(text.value(), path.value(),
+                    std::filesystem::path(path.value()).parent_path().string());
 }
 
 }  // namespace torsion::scene

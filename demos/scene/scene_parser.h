@@ -15,7 +15,8 @@ namespace torsion::scene {
 Result<SceneSpec> parseScene(std::string_view text, const std::string& file_name,
                              const std::string& base_directory);
 
-/// Reads and parses a scene file.
-Result<SceneSpec> loadScene(const std::string& path);
+/// Reads and parses a scene file, or a named demo scene (scene_catalog.h: `drop` finds
+/// demos/scenes/drop.json).
+Result<SceneSpec> loadScene(const std::string& path_or_name);
 
 }  // namespace torsion::scene

@@ -14,7 +14,8 @@ void addViewCommand(CLI::App& app) {
   auto options = std::make_shared<viewer::ViewerOptions>();
   auto size = std::make_shared<std::string>("1024x720");
   CLI::App* cmd = app.add_subcommand("view", "Open a scene in a window and drive it live");
-  cmd->add_option("scene", options->scene, "Scene file (JSON, see docs/scene-format.md)")
+  cmd->add_option("scene", options->scene,
+                  "Scene file (JSON, see docs/scene-format.md) or the name of a demo scene")
       ->required();
   cmd->add_option("--size", *size, "Window size WxH")->capture_default_str();
   cmd->add_option("--threads", options->threads, "Worker threads (default: the scene's)")

@@ -418,6 +418,17 @@ EOF
     [[ ! -e out/summary.json ]] || fail "no output may be written for a bad scene"
     ;;
 
+  run_scene_by_name)
+    # A demo scene by its name runs from any directory; an unknown name lists the scenes.
+    run "$torsion" run press --out out --steps 3 --threads 1
+    expect_rc 0
+    expect_out "done: 3 steps; results in out/"
+    run "$torsion" run no_such_scene --out out2
+    expect_rc nonzero
+    expect_out "^error: no_such_scene: no such scene file, and no scene of that name in .*demos/scenes \\(scenes:.* press .*twist_cylinder_2430.*\\)$"
+    [[ ! -e out2 ]] || fail "no output may be written for an unknown scene"
+    ;;
+
   run_missing_mesh)
     printf '{"bodies": [{"name": "b", "mesh": "nowhere.node", "material": {"youngs_modulus": 1e5, "poisson_ratio": 0.3, "density": 1000}}]}' > s.json
     run "$torsion" run s.json --out out
