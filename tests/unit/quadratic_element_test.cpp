@@ -87,9 +87,9 @@ TEST(QuadraticElement, ZeroForceAtRest) {
   Tet10Fixture tet;
   for (const auto& f : tet.forces(tet.rest))
     EXPECT_LT(f.norm(), 1e-9);
-  EXPECT_NEAR(quadraticResponse(tet.rest, Eigen::Matrix3d::Identity(), tet.data, kMu, kLambda)
-                  .energy,
-              0, 1e-12);
+  EXPECT_NEAR(
+      quadraticResponse(tet.rest, Eigen::Matrix3d::Identity(), tet.data, kMu, kLambda).energy, 0,
+      1e-12);
 }
 
 TEST(QuadraticElement, ZeroForceUnderRigidMotions) {
@@ -183,10 +183,10 @@ TEST(QuadraticElement, StiffnessBlocksMatchTheForceDifferential) {
   const Matrix30 K = tet.stiffness(R);
   for (int a = 0; a < 10; ++a) {
     for (int b = 0; b < 10; ++b) {
-      EXPECT_LT((quadraticStiffnessBlock(R, tet.data, kMu, kLambda, a, b) -
-                 K.block<3, 3>(3 * a, 3 * b))
-                    .norm(),
-                1e-12 * K.norm())
+      EXPECT_LT(
+          (quadraticStiffnessBlock(R, tet.data, kMu, kLambda, a, b) - K.block<3, 3>(3 * a, 3 * b))
+              .norm(),
+          1e-12 * K.norm())
           << a << "," << b;
     }
   }
@@ -272,9 +272,9 @@ TEST(QuadraticElement, GradientsReproduceConstantsAndTheRestShape) {
     for (const Eigen::Vector3d& g : tet.data.gradients[static_cast<size_t>(q)])
       sum += g;
     EXPECT_LT(sum.norm(), 1e-12);
-    EXPECT_LT((quadraticDeformationGradient(tet.rest, tet.data, q) - Eigen::Matrix3d::Identity())
-                  .norm(),
-              1e-13);
+    EXPECT_LT(
+        (quadraticDeformationGradient(tet.rest, tet.data, q) - Eigen::Matrix3d::Identity()).norm(),
+        1e-13);
   }
 }
 

@@ -2,8 +2,6 @@
 // the model (HRZ masses), the assembled operator against the element differentials and against
 // CHOLMOD's matrix, the patch test through the implicit stepper, inverted-element recovery and
 // thread-count determinism.
-#include "torsion/mesh/quadratic_tet_mesh.h"
-
 #include <gtest/gtest.h>
 
 #include <Eigen/Geometry>
@@ -12,6 +10,7 @@
 
 #include "torsion/fem/polar_rotation.h"
 #include "torsion/mesh/box_mesh.h"
+#include "torsion/mesh/quadratic_tet_mesh.h"
 #include "torsion/solve/cholmod_solver.h"
 #include "torsion/solve/implicit_stepper.h"
 
@@ -53,11 +52,10 @@ TEST(QuadraticTetMesh, AddsOneMidpointPerEdgeAndSplitsEachTetAndFaceExactly) {
     for (size_t a = 0; a < 4; ++a)
       EXPECT_EQ(element[a], linear->tets()[e][a]);  // corners keep their indices
     for (size_t k = 0; k < 6; ++k) {
-      const Eigen::Vector3d mid =
-          0.5 * (refined.restPositions()[static_cast<size_t>(
-                     element[static_cast<size_t>(kTet10Edges[k][0])])] +
-                 refined.restPositions()[static_cast<size_t>(
-                     element[static_cast<size_t>(kTet10Edges[k][1])])]);
+      const Eigen::Vector3d mid = 0.5 * (refined.restPositions()[static_cast<size_t>(
+                                             element[static_cast<size_t>(kTet10Edges[k][0])])] +
+                                         refined.restPositions()[static_cast<size_t>(
+                                             element[static_cast<size_t>(kTet10Edges[k][1])])]);
       EXPECT_EQ(refined.restPositions()[static_cast<size_t>(element[4 + k])], mid);
     }
     // The 8 sub-tets (8 e .. 8 e + 7) tile the element: positive, volumes add up.
@@ -269,7 +267,7 @@ TEST(QuadraticElementStep, InvertedElementRecovers) {
   // implicit step gives an inverting element angular momentum (the linear tet gets twice as
   // much), and the spin (~3 rad/s) stretches it by about rho omega^2 r^2 / E ~ 2.5 %.
   EXPECT_NEAR(six_volume(), 1.0, 0.04);
-  for (size_t k = 0; k < 6; ++k) {       // and the edges straight again
+  for (size_t k = 0; k < 6; ++k) {  // and the edges straight again
     const int a = nodes[kTet10Edges[k][0]], b = nodes[kTet10Edges[k][1]];
     EXPECT_LT((state.position(nodes[4 + k]) - 0.5 * (state.position(a) + state.position(b))).norm(),
               0.02);
@@ -293,14 +291,15 @@ TEST(QuadraticElementStep, BodyAtRestStaysAtRestAndThreadsGiveTheSameSteps) {
     for (int i = 0; i < model->nodeCount(); ++i)
       gravity.segment<3>(3 * i) =
           model->nodeMasses()[static_cast<size_t>(i)] * Eigen::Vector3d(0, 0, -9.81);
-    const StepReport still = stepper.step(state, constraints, Eigen::VectorXd::Zero(gravity.size()));
+    const StepReport still =
+        stepper.step(state, constraints, Eigen::VectorXd::Zero(gravity.size()));
     EXPECT_LT(still.max_speed, 1e-12);  // no force, no motion (round-off of the rest forces)
     for (int k = 0; k < 10; ++k)
       EXPECT_FALSE(isFatal(stepper.step(state, constraints, gravity).health));
     return state.positions;
   };
   const Eigen::VectorXd one = run(1), two = run(2);
-  EXPECT_EQ(one, two);  // bit-identical for any thread count
+  EXPECT_EQ(one, two);               // bit-identical for any thread count
   EXPECT_LT(one.minCoeff(), -1e-6);  // and it did sag
 }
 

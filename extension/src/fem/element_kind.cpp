@@ -2,7 +2,9 @@
 
 namespace torsion {
 
-const char* toString(ElementKind kind) { return kind == ElementKind::kTet10 ? "tet10" : "tet4"; }
+const char* toString(ElementKind kind) {
+  return kind == ElementKind::kTet10 ? "tet10" : "tet4";
+}
 
 std::optional<ElementKind> parseElementKind(const std::string& name) {
   if (name == "tet4") return ElementKind::kTet4;

@@ -12,7 +12,8 @@ TetRestData linearRestData(const TetMesh& mesh, const Tet& tet) {
   const auto& x = mesh.restPositions();
   Eigen::Matrix3d Dm;
   for (int k = 0; k < 3; ++k)
-    Dm.col(k) = x[static_cast<size_t>(tet[static_cast<size_t>(k + 1)])] - x[static_cast<size_t>(tet[0])];
+    Dm.col(k) =
+        x[static_cast<size_t>(tet[static_cast<size_t>(k + 1)])] - x[static_cast<size_t>(tet[0])];
   TetRestData rest;
   rest.rest_shape_inverse = Dm.inverse();
   rest.volume = Dm.determinant() / 6.0;  // positive: TetMesh guarantees orientation

@@ -53,8 +53,8 @@ QuadraticRestData quadraticRestData(const Eigen::Matrix3d& corner_rest_shape_inv
     }
   }
   for (size_t e = 0; e < 6; ++e) {
-    rest.centroid_edge_gradients[e] = gL[static_cast<size_t>(kTet10Edges[e][0])] +
-                                      gL[static_cast<size_t>(kTet10Edges[e][1])];
+    rest.centroid_edge_gradients[e] =
+        gL[static_cast<size_t>(kTet10Edges[e][0])] + gL[static_cast<size_t>(kTet10Edges[e][1])];
   }
   return rest;
 }

@@ -49,9 +49,9 @@ std::array<Tet, 8> splitQuadraticTet(const Tet10& element,
   double best_length = std::numeric_limits<double>::infinity();
   for (int d = 0; d < 3; ++d) {
     const auto& [i, j, k, l] = diagonals[static_cast<size_t>(d)];
-    const double length = (positions[static_cast<size_t>(mid(i, j))] -
-                           positions[static_cast<size_t>(mid(k, l))])
-                              .squaredNorm();
+    const double length =
+        (positions[static_cast<size_t>(mid(i, j))] - positions[static_cast<size_t>(mid(k, l))])
+            .squaredNorm();
     if (length < best_length * (1 - 1e-12)) {  // ties keep the first: deterministic
       best = d;
       best_length = length;
@@ -60,9 +60,9 @@ std::array<Tet, 8> splitQuadraticTet(const Tet10& element,
   const auto& [i, j, k, l] = diagonals[static_cast<size_t>(best)];
   const std::array<int, 4> ring = {mid(i, k), mid(i, l), mid(j, l), mid(j, k)};
   for (int r = 0; r < 4; ++r) {
-    sub[static_cast<size_t>(4 + r)] = oriented(
-        {mid(i, j), mid(k, l), ring[static_cast<size_t>(r)], ring[static_cast<size_t>((r + 1) % 4)]},
-        positions);
+    sub[static_cast<size_t>(4 + r)] = oriented({mid(i, j), mid(k, l), ring[static_cast<size_t>(r)],
+                                                ring[static_cast<size_t>((r + 1) % 4)]},
+                                               positions);
   }
   return sub;
 }
@@ -83,9 +83,8 @@ QuadraticTetMesh buildQuadraticTetMesh(const TetMesh& linear) {
   std::vector<Eigen::Vector3d> positions = linear.restPositions();
   positions.reserve(positions.size() + edges.size());
   for (const auto& [p, q] : edges) {
-    positions.push_back(
-        0.5 * (linear.restPositions()[static_cast<size_t>(p)] +
-               linear.restPositions()[static_cast<size_t>(q)]));
+    positions.push_back(0.5 * (linear.restPositions()[static_cast<size_t>(p)] +
+                               linear.restPositions()[static_cast<size_t>(q)]));
   }
 
   QuadraticTetMesh result;

@@ -15,7 +15,7 @@ struct CholmodSolver::Impl {
   std::vector<std::array<int, 9>> block_values;
   // Per element, per (a, b) of its N nodes: block id at [N^2 e + N a + b], -1 if i < j.
   std::vector<int> element_block;
-  std::vector<int> diagonal_block;             // per node
+  std::vector<int> diagonal_block;  // per node
   bool analysed = false;
   Eigen::CholmodDecomposition<Eigen::SparseMatrix<double>, Eigen::Lower> factor;
   Eigen::VectorXd rhs, prescribed, q, solution;

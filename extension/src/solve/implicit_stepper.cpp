@@ -74,11 +74,10 @@ double ImplicitStepper::computeElasticForces(FemState& state) {
         Tet10Vectors x;
         for (size_t a = 0; a < 10; ++a)
           x[a] = state.positions.segment<3>(3 * nodes[10 * ei + a]);
-        rotations[ei] = extractRotation(quadraticCentroidGradient(x, rest),
-                                        state.element_rotations[ei]);
+        rotations[ei] =
+            extractRotation(quadraticCentroidGradient(x, rest), state.element_rotations[ei]);
         const QuadraticResponse response = quadraticResponse(x, rotations[ei], rest, mu, lambda);
-        std::copy(response.forces.begin(), response.forces.end(),
-                  element_forces_.begin() + 10 * e);
+        std::copy(response.forces.begin(), response.forces.end(), element_forces_.begin() + 10 * e);
         element_energy_[ei] = response.energy;
       }
     });

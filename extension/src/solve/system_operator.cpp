@@ -24,7 +24,8 @@ SystemOperator::SystemOperator(std::shared_ptr<const FemModel> model, const Para
   nodes_per_element_ = n_per;
   rotations_.assign(static_cast<size_t>(elements), Eigen::Matrix3d::Identity());
   const int quadrature = model_->elementKind() == ElementKind::kTet10 ? kTet10QuadraturePoints : 1;
-  rotated_gradients_.resize(static_cast<size_t>(elements) * static_cast<size_t>(quadrature * n_per));
+  rotated_gradients_.resize(static_cast<size_t>(elements) *
+                            static_cast<size_t>(quadrature * n_per));
   // Node -> (element, local index), elements ascending per node.
   const int node_count = model_->nodeCount();
   node_offsets_.assign(static_cast<size_t>(node_count) + 1, 0);
@@ -77,9 +78,9 @@ void SystemOperator::buildPattern() {
       for (size_t b = 0; b < n_per; ++b) {
         if (nodes[b] < row) continue;
         entry_slots_[n_per * static_cast<size_t>(k) + b] =
-            row_begin + static_cast<int>(std::lower_bound(columns.begin(), columns.end(),
-                                                          nodes[b]) -
-                                         columns.begin());
+            row_begin +
+            static_cast<int>(std::lower_bound(columns.begin(), columns.end(), nodes[b]) -
+                             columns.begin());
       }
     }
   }

@@ -16,6 +16,8 @@ const char* toString(ElementKind kind);
 /// The inverse of toString; nullopt for anything else.
 std::optional<ElementKind> parseElementKind(const std::string& name);
 /// 4 or 10.
-inline int nodesPerElement(ElementKind kind) { return kind == ElementKind::kTet10 ? 10 : 4; }
+inline int nodesPerElement(ElementKind kind) {
+  return kind == ElementKind::kTet10 ? 10 : 4;
+}
 
 }  // namespace torsion

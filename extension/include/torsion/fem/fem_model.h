@@ -47,9 +47,7 @@ class FemModel {
 
   ElementKind elementKind() const { return element_kind_; }
   int nodesPerElement() const { return torsion::nodesPerElement(element_kind_); }
-  int elementCount() const {
-    return static_cast<int>(element_nodes_.size()) / nodesPerElement();
-  }
+  int elementCount() const { return static_cast<int>(element_nodes_.size()) / nodesPerElement(); }
   /// Element e's nodes are elementNodes()[N e .. N e + N), N = nodesPerElement(); for tet4 the
   /// tets of mesh(), for tet10 the Tet10 order of quadratic_tet_mesh.h.
   const std::vector<int>& elementNodes() const { return element_nodes_; }

@@ -104,7 +104,7 @@ class ImplicitStepper {
   LinearSolveHook linear_solve_hook_;
 
   Eigen::VectorXd elastic_forces_, rhs_, velocity_next_, internal_forces_, scratch_;
-  Eigen::VectorXd previous_velocities_;  // v of the step before, for the CG warm start
+  Eigen::VectorXd previous_velocities_;          // v of the step before, for the CG warm start
   std::vector<Eigen::Vector3d> element_forces_;  // N per element (SystemOperator::gather)
   std::vector<double> element_energy_;
   bool internal_forces_valid_ = false;

@@ -4,10 +4,10 @@
 // with the rotations Re of this step. K is assembled once per step into 3x3 node blocks (block
 // rows = nodes, a row holds the node and its element neighbours), so each CG product is a sparse
 // block product instead of a pass over every element. Elements are the model's (tet4: 4 nodes,
-// one point; tet10: 10 nodes, 4 quadrature points): the same assembly, templated on both. Measured on the 8332-tet twist (callgrind,
-// docs/performance.md): a product takes 4.9x fewer instructions than the matrix-free tet loop
-// did and assembling costs about three such loops, so it pays from four products per step on
-// (a step at E = 1e5 takes about six; stiffer materials take more).
+// one point; tet10: 10 nodes, 4 quadrature points): the same assembly, templated on both. Measured
+// on the 8332-tet twist (callgrind, docs/performance.md): a product takes 4.9x fewer instructions
+// than the matrix-free tet loop did and assembling costs about three such loops, so it pays from
+// four products per step on (a step at E = 1e5 takes about six; stiffer materials take more).
 // Assembly runs per block row over the row node's tets in ascending order, so K and every
 // product are identical for any thread count.
 
