@@ -8,6 +8,7 @@
 #include <random>
 #include <set>
 
+#include "torsion/analysis/twist_profile.h"
 #include "torsion/fem/polar_rotation.h"
 #include "torsion/mesh/box_mesh.h"
 #include "torsion/mesh/quadratic_tet_mesh.h"
@@ -78,6 +79,17 @@ TEST(QuadraticTetMesh, AddsOneMidpointPerEdgeAndSplitsEachTetAndFaceExactly) {
                   refined.surfaceTriangleNeighbours().rowBegin(t),
               3);
   }
+}
+
+TEST(QuadraticTetMesh, SectionPolarMomentIsTheLinearMeshes) {
+  // The analysis takes a body's mesh(): for tet10 the sub-tets, whose straight-sided geometry is
+  // the linear mesh's, so J of the meshed section is the same.
+  const auto linear = box(4, 3, 2, {2, 1.5, 1});
+  const QuadraticTetMesh p2 = buildQuadraticTetMesh(*linear);
+  const double j_linear =
+      polarMomentOfSection(linear->restPositions(), linear->tets(), 1.0, 1, 0.7);
+  EXPECT_NEAR(polarMomentOfSection(p2.refined->restPositions(), p2.refined->tets(), 1.0, 1, 0.7),
+              j_linear, 1e-12 * j_linear);
 }
 
 TEST(QuadraticFemModel, HrzMassesArePositiveAndAddUpToTheBodyMass) {
