@@ -49,7 +49,9 @@ int run(const RunArguments& args) {
     std::cerr << "warning: " << w << "\n";
   for (const auto& body : s.world->bodies()) {
     std::cerr << "body '" << body->name() << "': " << body->model().nodeCount() << " nodes, "
-              << body->model().tetCount() << " tets\n";
+              << body->model().elementCount()
+              << (body->model().elementKind() == ElementKind::kTet10 ? " tet10 elements\n"
+                                                                     : " tets\n");
   }
   if (s.haptics) {
     for (const std::string& line : s.haptics->describe())

@@ -20,8 +20,10 @@ std::vector<double> tetVonMises(const FemBody& body) {
       x[static_cast<size_t>(a)] = state.position(tet[static_cast<size_t>(a)]);
     const Eigen::Matrix3d F =
         deformationGradient(x, model.tetRestData()[static_cast<size_t>(t)].rest_shape_inverse);
-    const Eigen::Matrix3d R = static_cast<size_t>(t) < state.tet_rotations.size()
-                                  ? state.tet_rotations[static_cast<size_t>(t)].toRotationMatrix()
+    // The rotation of the element the tet belongs to (tet10: the sub-tet's element).
+    const size_t element = static_cast<size_t>(model.elementOfTet(t));
+    const Eigen::Matrix3d R = element < state.element_rotations.size()
+                                  ? state.element_rotations[element].toRotationMatrix()
                                   : Eigen::Matrix3d::Identity();
     const Eigen::Matrix3d RtF = R.transpose() * F;
     const Eigen::Matrix3d eps = 0.5 * (RtF + RtF.transpose()) - Eigen::Matrix3d::Identity();

@@ -64,7 +64,8 @@ Result<std::unique_ptr<BuiltScene>> buildScene(SceneSpec spec, int threads_overr
     if (!mesh) return Error{entry + ": " + mesh.error().message};
     for (const std::string& w : mesh.value().warnings)
       built->warnings.push_back(w);
-    Result<FemBody*> added = world.addBody(body.name, mesh.value().mesh, body.material, body.pose);
+    Result<FemBody*> added =
+        world.addBody(body.name, mesh.value().mesh, body.material, body.pose, body.element);
     if (!added) return Error{entry + ": " + added.error().message};
   }
 

@@ -270,6 +270,12 @@ Result<SceneSpec> parseScene(std::string_view text, const std::string& file_name
                            : (std::filesystem::path(base_directory) / mesh_path).string();
       body.material = readMaterial(b.object("material"));
       body.pose = readPose(b, "pose");
+      const std::string element = b.string("element", "tet4");
+      if (auto kind = parseElementKind(element)) {
+        body.element = *kind;
+      } else {
+        b.fail("element", "'" + element + "' is not an element kind (tet4 or tet10)");
+      }
       b.finish();
       scene.bodies.push_back(std::move(body));
     }

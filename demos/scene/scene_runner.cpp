@@ -226,7 +226,8 @@ Result<RunOutcome> runScene(BuiltScene& scene, const RunOptions& options) {
   for (const auto& body : world.bodies()) {
     summary["bodies"].push_back({{"name", body->name()},
                                  {"nodes", body->model().nodeCount()},
-                                 {"tets", body->model().tetCount()},
+                                 {"element", toString(body->model().elementKind())},
+                                 {"tets", body->model().elementCount()},
                                  {"mass_kg", body->model().totalMass()}});
   }
   summary["node_sets"] = nlohmann::json::array();

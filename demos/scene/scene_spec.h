@@ -15,6 +15,7 @@
 #include "torsion/bullet/fem_world.h"
 #include "torsion/constraints/frame.h"
 #include "torsion/constraints/hand.h"
+#include "torsion/fem/element_kind.h"
 #include "torsion/fem/material.h"
 
 namespace torsion::scene {
@@ -24,6 +25,7 @@ struct BodySpec {
   std::string mesh_path;  ///< resolved
   Material material;
   Frame pose;
+  ElementKind element = ElementKind::kTet4;  ///< "element": "tet4" | "tet10"
 };
 
 /// Which nodes of a body a set takes (rest positions, after the body's pose).

@@ -35,7 +35,7 @@ struct CouplingRig {
   device::SimulationWrench published;
 
   CouplingRig(int tets, const SolverSettings& solver, const CouplingSettings& settings = {},
-              double mass_damping = 0) {
+              double mass_damping = 0, ElementKind element = ElementKind::kTet4) {
     WorldSettings ws;
     ws.gravity.setZero();
     ws.solver = solver;
@@ -43,8 +43,8 @@ struct CouplingRig {
     Material material;  // E = 1e5 Pa, nu = 0.3, rho = 1000, as the twist scenes
     material.stiffness_damping = 0.01;
     material.mass_damping = mass_damping;  // 1/s
-    const TetMesh& mesh = cylinderMesh(tets);
-    body = world->addBody("cylinder", mesh, material).value();
+    body = world->addBody("cylinder", cylinderMesh(tets), material, Frame{}, element).value();
+    const TetMesh& mesh = body->model().mesh();  // all nodes (tet10: also the mid-edge ones)
     std::vector<int> base;
     for (int i = 0; i < mesh.nodeCount(); ++i) {
       if (std::abs(mesh.restPositions()[static_cast<size_t>(i)].z()) < 1e-6) base.push_back(i);

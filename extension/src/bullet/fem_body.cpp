@@ -21,6 +21,7 @@ FemBody::FemBody(std::string name, std::shared_ptr<const FemModel> model,
   }
   // Nodes and surface faces only: our solver never uses Bullet's links, and soft-rigid contact
   // (SDF_RS) is node-based. No VF_SS/SDF_RD flags: without links their tree build would hang.
+  // For tet10 bodies the nodes are all P2 nodes and the faces the split surface triangles.
   soft_body_ = std::make_unique<btSoftBody>(&world_info, n, x.data(), m.data());
   for (const Triangle& tri : model_->mesh().surfaceTriangles()) {
     soft_body_->appendFace(tri[0], tri[1], tri[2]);
@@ -68,7 +69,7 @@ void FemBody::setGravity(const Eigen::Vector3d& gravity) {
 }
 
 Status FemBody::setMaterial(const Material& material) {
-  Result<std::shared_ptr<const FemModel>> model = FemModel::create(model_->meshPtr(), material);
+  Result<std::shared_ptr<const FemModel>> model = model_->withMaterial(material);
   if (!model) return Error{"body '" + name_ + "': " + model.error().message};
   model_ = std::move(model).value();
   stepper_.replaceModel(model_);

@@ -40,13 +40,14 @@ FemWorld::~FemWorld() {
 }
 
 Result<FemBody*> FemWorld::addBody(const std::string& name, const TetMesh& mesh,
-                                   const Material& material, const Frame& pose) {
+                                   const Material& material, const Frame& pose,
+                                   ElementKind element) {
   if (body(name) != nullptr) return Error{"body '" + name + "' already exists"};
   std::vector<Eigen::Vector3d> placed = mesh.restPositions();
   for (Eigen::Vector3d& p : placed)
     p = pose.toWorld(p);
   auto placed_mesh = std::make_shared<const TetMesh>(std::move(placed), mesh.tets());
-  Result<std::shared_ptr<const FemModel>> model = FemModel::create(placed_mesh, material);
+  Result<std::shared_ptr<const FemModel>> model = FemModel::create(placed_mesh, material, element);
   if (!model) return Error{"body '" + name + "': " + model.error().message};
   auto body = std::make_unique<FemBody>(name, std::move(model).value(), settings_.solver, parallel_,
                                         world_->getWorldInfo());

@@ -3,6 +3,8 @@
 #include <Eigen/CholmodSupport>
 #include <cmath>
 
+#include "torsion/fem/quadratic_element.h"
+
 namespace torsion {
 
 struct CholmodSolver::Impl {
@@ -11,8 +13,9 @@ struct CholmodSolver::Impl {
   // (row-major within the block; -1 for the upper triangle of a diagonal block).
   std::vector<std::pair<int, int>> blocks;
   std::vector<std::array<int, 9>> block_values;
-  std::vector<std::array<int, 16>> tet_block;  // per tet, per (a, b): block id, -1 if i < j
-  std::vector<int> diagonal_block;             // per node
+  // Per element, per (a, b) of its N nodes: block id at [N^2 e + N a + b], -1 if i < j.
+  std::vector<int> element_block;
+  std::vector<int> diagonal_block;  // per node
   bool analysed = false;
   Eigen::CholmodDecomposition<Eigen::SparseMatrix<double>, Eigen::Lower> factor;
   Eigen::VectorXd rhs, prescribed, q, solution;
@@ -22,20 +25,22 @@ CholmodSolver::CholmodSolver() : impl_(std::make_unique<Impl>()) {}
 CholmodSolver::~CholmodSolver() = default;
 
 void CholmodSolver::buildPattern(const SystemOperator& op) {
-  const TetMesh& mesh = op.model().mesh();
-  const int n = mesh.nodeCount();
-  // Node-pair blocks (i >= j) present in some tet. Lower triangle of the scalar matrix: in a
+  const FemModel& model = op.model();
+  const int n = model.nodeCount();
+  const size_t n_per = static_cast<size_t>(model.nodesPerElement());
+  const std::vector<int>& element_nodes = model.elementNodes();
+  const size_t elements = static_cast<size_t>(model.elementCount());
+  // Node-pair blocks (i >= j) present in some element. Lower triangle of the scalar matrix: in a
   // diagonal block keep entries r >= c only; off-diagonal blocks (i > j) are dense.
   std::vector<std::pair<int, int>> pairs;
-  pairs.reserve(static_cast<size_t>(mesh.tetCount()) * 10 + static_cast<size_t>(n));
+  pairs.reserve(elements * n_per * (n_per - 1) / 2 + static_cast<size_t>(n));
   for (int i = 0; i < n; ++i)
     pairs.emplace_back(i, i);
-  for (const Tet& tet : mesh.tets()) {
-    for (int a = 0; a < 4; ++a) {
-      for (int b = 0; b < 4; ++b) {
-        if (tet[static_cast<size_t>(a)] > tet[static_cast<size_t>(b)]) {
-          pairs.emplace_back(tet[static_cast<size_t>(a)], tet[static_cast<size_t>(b)]);
-        }
+  for (size_t e = 0; e < elements; ++e) {
+    const int* nodes = element_nodes.data() + n_per * e;
+    for (size_t a = 0; a < n_per; ++a) {
+      for (size_t b = 0; b < n_per; ++b) {
+        if (nodes[a] > nodes[b]) pairs.emplace_back(nodes[a], nodes[b]);
       }
     }
   }
@@ -82,14 +87,13 @@ void CholmodSolver::buildPattern(const SystemOperator& op) {
   m.diagonal_block.resize(static_cast<size_t>(n));
   for (int i = 0; i < n; ++i)
     m.diagonal_block[static_cast<size_t>(i)] = block_of(i, i);
-  m.tet_block.resize(static_cast<size_t>(mesh.tetCount()));
-  for (int t = 0; t < mesh.tetCount(); ++t) {
-    const Tet& tet = mesh.tets()[static_cast<size_t>(t)];
-    for (int a = 0; a < 4; ++a) {
-      for (int b = 0; b < 4; ++b) {
-        const int i = tet[static_cast<size_t>(a)], j = tet[static_cast<size_t>(b)];
-        m.tet_block[static_cast<size_t>(t)][static_cast<size_t>(4 * a + b)] =
-            i >= j ? block_of(i, j) : -1;
+  m.element_block.assign(elements * n_per * n_per, -1);
+  for (size_t e = 0; e < elements; ++e) {
+    const int* nodes = element_nodes.data() + n_per * e;
+    for (size_t a = 0; a < n_per; ++a) {
+      for (size_t b = 0; b < n_per; ++b) {
+        if (nodes[a] >= nodes[b])
+          m.element_block[n_per * n_per * e + n_per * a + b] = block_of(nodes[a], nodes[b]);
       }
     }
   }
@@ -99,9 +103,9 @@ const Eigen::SparseMatrix<double>& CholmodSolver::assemble(const SystemOperator&
                                                            const NodeConstraints& constraints) {
   Impl& m = *impl_;
   if (m.matrix.rows() != 3 * op.model().nodeCount()) buildPattern(op);
-  const TetMesh& mesh = op.model().mesh();
-  const double mu = op.model().material().mu();
-  const double lambda = op.model().material().lambda();
+  const FemModel& model = op.model();
+  const double mu = model.material().mu();
+  const double lambda = model.material().lambda();
   const double c = op.stiffnessCoefficient();
   double* values = m.matrix.valuePtr();
   std::fill(values, values + m.matrix.nonZeros(), 0.0);
@@ -116,27 +120,43 @@ const Eigen::SparseMatrix<double>& CholmodSolver::assemble(const SystemOperator&
     }
   };
 
-  // K_ab = V R (mu (g_a . g_b) I + mu g_b g_a^T + lambda g_a g_b^T) R^T.
-  for (int t = 0; t < mesh.tetCount(); ++t) {
-    const TetRestData& rest = op.model().tetRestData()[static_cast<size_t>(t)];
-    const Eigen::Matrix3d& R = op.rotations()[static_cast<size_t>(t)];
-    const Eigen::Matrix3d& B = rest.rest_shape_inverse;
-    const std::array<Eigen::Vector3d, 4> g = {-(B.row(0) + B.row(1) + B.row(2)).transpose(),
-                                              B.row(0).transpose(), B.row(1).transpose(),
-                                              B.row(2).transpose()};
-    for (size_t a = 0; a < 4; ++a) {
-      for (size_t b = 0; b < 4; ++b) {
-        const int block = m.tet_block[static_cast<size_t>(t)][4 * a + b];
-        if (block < 0) continue;
-        const Eigen::Matrix3d local =
-            rest.volume * (mu * g[a].dot(g[b]) * Eigen::Matrix3d::Identity() +
-                           mu * g[b] * g[a].transpose() + lambda * g[a] * g[b].transpose());
-        add_block(block, c * (R * local * R.transpose()));
+  if (model.elementKind() == ElementKind::kTet4) {
+    // K_ab = V R (mu (g_a . g_b) I + mu g_b g_a^T + lambda g_a g_b^T) R^T.
+    for (int t = 0; t < model.elementCount(); ++t) {
+      const TetRestData& rest = model.tetRestData()[static_cast<size_t>(t)];
+      const Eigen::Matrix3d& R = op.rotations()[static_cast<size_t>(t)];
+      const Eigen::Matrix3d& B = rest.rest_shape_inverse;
+      const std::array<Eigen::Vector3d, 4> g = {-(B.row(0) + B.row(1) + B.row(2)).transpose(),
+                                                B.row(0).transpose(), B.row(1).transpose(),
+                                                B.row(2).transpose()};
+      for (size_t a = 0; a < 4; ++a) {
+        for (size_t b = 0; b < 4; ++b) {
+          const int block = m.element_block[16 * static_cast<size_t>(t) + 4 * a + b];
+          if (block < 0) continue;
+          const Eigen::Matrix3d local =
+              rest.volume * (mu * g[a].dot(g[b]) * Eigen::Matrix3d::Identity() +
+                             mu * g[b] * g[a].transpose() + lambda * g[a] * g[b].transpose());
+          add_block(block, c * (R * local * R.transpose()));
+        }
+      }
+    }
+  } else {
+    // The quadrature sum of quadratic_element.h per block.
+    for (int e = 0; e < model.elementCount(); ++e) {
+      const QuadraticRestData& rest = model.quadraticRestData()[static_cast<size_t>(e)];
+      const Eigen::Matrix3d& R = op.rotations()[static_cast<size_t>(e)];
+      for (int a = 0; a < 10; ++a) {
+        for (int b = 0; b < 10; ++b) {
+          const int block = m.element_block[100 * static_cast<size_t>(e) +
+                                            10 * static_cast<size_t>(a) + static_cast<size_t>(b)];
+          if (block < 0) continue;
+          add_block(block, c * quadraticStiffnessBlock(R, rest, mu, lambda, a, b));
+        }
       }
     }
   }
-  const std::vector<double>& mass = op.model().nodeMasses();
-  for (int i = 0; i < mesh.nodeCount(); ++i) {
+  const std::vector<double>& mass = model.nodeMasses();
+  for (int i = 0; i < model.nodeCount(); ++i) {
     add_block(m.diagonal_block[static_cast<size_t>(i)],
               op.massCoefficient() * mass[static_cast<size_t>(i)] * Eigen::Matrix3d::Identity());
   }

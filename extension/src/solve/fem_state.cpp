@@ -9,7 +9,8 @@ FemState FemState::atRest(const FemModel& model) {
   for (int i = 0; i < n; ++i)
     s.positions.segment<3>(3 * i) = model.mesh().restPositions()[static_cast<size_t>(i)];
   s.velocities.setZero(3 * n);
-  s.tet_rotations.assign(static_cast<size_t>(model.tetCount()), Eigen::Quaterniond::Identity());
+  s.element_rotations.assign(static_cast<size_t>(model.elementCount()),
+                             Eigen::Quaterniond::Identity());
   return s;
 }
 

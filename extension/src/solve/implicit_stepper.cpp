@@ -1,10 +1,12 @@
 #include "torsion/solve/implicit_stepper.h"
 
+#include <algorithm>
 #include <cmath>
 #include <sstream>
 
 #include "torsion/fem/corotated_element.h"
 #include "torsion/fem/polar_rotation.h"
+#include "torsion/fem/quadratic_element.h"
 #include "torsion/solve/cholmod_solver.h"
 
 namespace torsion {
@@ -36,35 +38,53 @@ ImplicitStepper::ImplicitStepper(std::shared_ptr<const FemModel> model,
       settings_(settings),
       parallel_(parallel),
       system_(model_, parallel) {
-  tet_forces_.resize(static_cast<size_t>(model_->tetCount()));
-  tet_energy_.resize(static_cast<size_t>(model_->tetCount()));
+  element_forces_.resize(static_cast<size_t>(model_->elementCount()) *
+                         static_cast<size_t>(model_->nodesPerElement()));
+  element_energy_.resize(static_cast<size_t>(model_->elementCount()));
 }
 
 ImplicitStepper::~ImplicitStepper() = default;
 
 double ImplicitStepper::computeElasticForces(FemState& state) {
-  const TetMesh& mesh = model_->mesh();
   const double mu = model_->material().mu();
   const double lambda = model_->material().lambda();
+  const std::vector<int>& nodes = model_->elementNodes();
   std::vector<Eigen::Matrix3d>& rotations = system_.mutableRotations();
-  parallel_.forRange(mesh.tetCount(), kTetGrain, [&](int begin, int end) {
-    for (int t = begin; t < end; ++t) {
-      const size_t ti = static_cast<size_t>(t);
-      const Tet& tet = mesh.tets()[ti];
-      const TetRestData& rest = model_->tetRestData()[ti];
-      std::array<Eigen::Vector3d, 4> x;
-      for (size_t a = 0; a < 4; ++a)
-        x[a] = state.positions.segment<3>(3 * tet[a]);
-      const Eigen::Matrix3d F = deformationGradient(x, rest.rest_shape_inverse);
-      rotations[ti] = extractRotation(F, state.tet_rotations[ti]);
-      const CorotatedResponse response = corotatedResponse(F, rotations[ti], rest, mu, lambda);
-      tet_forces_[ti] = response.forces;
-      tet_energy_[ti] = response.energy;
-    }
-  });
-  system_.gather(tet_forces_, 1.0, elastic_forces_);
+  if (model_->elementKind() == ElementKind::kTet4) {
+    parallel_.forRange(model_->elementCount(), kTetGrain, [&](int begin, int end) {
+      for (int t = begin; t < end; ++t) {
+        const size_t ti = static_cast<size_t>(t);
+        const TetRestData& rest = model_->tetRestData()[ti];
+        std::array<Eigen::Vector3d, 4> x;
+        for (size_t a = 0; a < 4; ++a)
+          x[a] = state.positions.segment<3>(3 * nodes[4 * ti + a]);
+        const Eigen::Matrix3d F = deformationGradient(x, rest.rest_shape_inverse);
+        rotations[ti] = extractRotation(F, state.element_rotations[ti]);
+        const CorotatedResponse response = corotatedResponse(F, rotations[ti], rest, mu, lambda);
+        std::copy(response.forces.begin(), response.forces.end(), element_forces_.begin() + 4 * t);
+        element_energy_[ti] = response.energy;
+      }
+    });
+  } else {
+    // One rotation per element, from its mean deformation gradient (quadratic_element.h).
+    parallel_.forRange(model_->elementCount(), kTetGrain / 4, [&](int begin, int end) {
+      for (int e = begin; e < end; ++e) {
+        const size_t ei = static_cast<size_t>(e);
+        const QuadraticRestData& rest = model_->quadraticRestData()[ei];
+        Tet10Vectors x;
+        for (size_t a = 0; a < 10; ++a)
+          x[a] = state.positions.segment<3>(3 * nodes[10 * ei + a]);
+        rotations[ei] =
+            extractRotation(quadraticCentroidGradient(x, rest), state.element_rotations[ei]);
+        const QuadraticResponse response = quadraticResponse(x, rotations[ei], rest, mu, lambda);
+        std::copy(response.forces.begin(), response.forces.end(), element_forces_.begin() + 10 * e);
+        element_energy_[ei] = response.energy;
+      }
+    });
+  }
+  system_.gather(element_forces_, 1.0, elastic_forces_);
   double energy = 0;
-  for (double e : tet_energy_)
+  for (double e : element_energy_)
     energy += e;
   return energy;
 }

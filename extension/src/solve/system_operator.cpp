@@ -18,44 +18,54 @@ std::array<Eigen::Vector3d, 4> shapeGradients(const Eigen::Matrix3d& B) {
 
 SystemOperator::SystemOperator(std::shared_ptr<const FemModel> model, const Parallel& parallel)
     : model_(std::move(model)), parallel_(parallel) {
-  const TetMesh& mesh = model_->mesh();
-  rotations_.assign(static_cast<size_t>(mesh.tetCount()), Eigen::Matrix3d::Identity());
-  rotated_gradients_.resize(static_cast<size_t>(mesh.tetCount()));
-  const CompressedRows& node_tets = mesh.nodeTets();
-  node_offsets_ = node_tets.offsets;
-  node_entries_.resize(node_tets.items.size());
-  for (int n = 0; n < mesh.nodeCount(); ++n) {
-    for (int k = node_tets.rowBegin(n); k < node_tets.rowEnd(n); ++k) {
-      const int t = node_tets.items[static_cast<size_t>(k)];
-      const Tet& tet = mesh.tets()[static_cast<size_t>(t)];
-      int local = 0;
-      while (tet[static_cast<size_t>(local)] != n)
-        ++local;
-      node_entries_[static_cast<size_t>(k)] = 4 * t + local;
-    }
-  }
+  const int elements = model_->elementCount();
+  const int n_per = model_->nodesPerElement();
+  const std::vector<int>& element_nodes = model_->elementNodes();
+  nodes_per_element_ = n_per;
+  rotations_.assign(static_cast<size_t>(elements), Eigen::Matrix3d::Identity());
+  const int quadrature = model_->elementKind() == ElementKind::kTet10 ? kTet10QuadraturePoints : 1;
+  rotated_gradients_.resize(static_cast<size_t>(elements) *
+                            static_cast<size_t>(quadrature * n_per));
+  // Node -> (element, local index), elements ascending per node.
+  const int node_count = model_->nodeCount();
+  node_offsets_.assign(static_cast<size_t>(node_count) + 1, 0);
+  for (int node : element_nodes)
+    ++node_offsets_[static_cast<size_t>(node) + 1];
+  for (int i = 0; i < node_count; ++i)
+    node_offsets_[static_cast<size_t>(i) + 1] += node_offsets_[static_cast<size_t>(i)];
+  node_entries_.assign(element_nodes.size(), -1);
+  std::vector<int> fill(node_offsets_.begin(), node_offsets_.end() - 1);
+  for (size_t entry = 0; entry < element_nodes.size(); ++entry)  // ascending elements
+    node_entries_[static_cast<size_t>(fill[static_cast<size_t>(element_nodes[entry])]++)] =
+        static_cast<int>(entry);
   buildPattern();
 }
 
 void SystemOperator::buildPattern() {
   // K is symmetric, so a block row stores only its diagonal block and the blocks right of it
   // (columns > row); the blocks left of the diagonal are read, transposed, from the rows that
-  // store them. Assembly computes 10 blocks per tet instead of 16.
-  const TetMesh& mesh = model_->mesh();
-  const int n = mesh.nodeCount();
+  // store them. Assembly computes 10 blocks per tet4 instead of 16 (55 of 100 per tet10).
+  const int n = model_->nodeCount();
+  const size_t n_per = static_cast<size_t>(nodes_per_element_);
+  const std::vector<int>& element_nodes = model_->elementNodes();
+  // The nodes of the element of node entry k.
+  auto element_of = [&](int k) {
+    return element_nodes.data() +
+           n_per * static_cast<size_t>(node_entries_[static_cast<size_t>(k)] / nodes_per_element_);
+  };
   row_offsets_.assign(static_cast<size_t>(n) + 1, 0);
   block_columns_.clear();
-  entry_slots_.assign(4 * node_entries_.size(), -1);
+  entry_slots_.assign(n_per * node_entries_.size(), -1);
   diagonal_slots_.assign(static_cast<size_t>(n), -1);
   std::vector<int> columns;
   for (int row = 0; row < n; ++row) {
     const int begin = node_offsets_[static_cast<size_t>(row)];
     const int end = node_offsets_[static_cast<size_t>(row) + 1];
-    columns.assign(1, row);  // a node without tets still gets its (mass) diagonal block
+    columns.assign(1, row);  // a node without elements still gets its (mass) diagonal block
     for (int k = begin; k < end; ++k) {
-      const Tet& tet = mesh.tets()[static_cast<size_t>(node_entries_[static_cast<size_t>(k)] / 4)];
-      for (int node : tet)
-        if (node > row) columns.push_back(node);
+      const int* nodes = element_of(k);
+      for (size_t b = 0; b < n_per; ++b)
+        if (nodes[b] > row) columns.push_back(nodes[b]);
     }
     std::sort(columns.begin(), columns.end());
     columns.erase(std::unique(columns.begin(), columns.end()), columns.end());
@@ -64,12 +74,13 @@ void SystemOperator::buildPattern() {
     row_offsets_[static_cast<size_t>(row) + 1] = static_cast<int>(block_columns_.size());
     diagonal_slots_[static_cast<size_t>(row)] = row_begin;  // columns[0] == row
     for (int k = begin; k < end; ++k) {
-      const Tet& tet = mesh.tets()[static_cast<size_t>(node_entries_[static_cast<size_t>(k)] / 4)];
-      for (size_t b = 0; b < 4; ++b) {
-        if (tet[b] < row) continue;
-        entry_slots_[4 * static_cast<size_t>(k) + b] =
-            row_begin + static_cast<int>(std::lower_bound(columns.begin(), columns.end(), tet[b]) -
-                                         columns.begin());
+      const int* nodes = element_of(k);
+      for (size_t b = 0; b < n_per; ++b) {
+        if (nodes[b] < row) continue;
+        entry_slots_[n_per * static_cast<size_t>(k) + b] =
+            row_begin +
+            static_cast<int>(std::lower_bound(columns.begin(), columns.end(), nodes[b]) -
+                             columns.begin());
       }
     }
   }
@@ -100,52 +111,77 @@ void SystemOperator::buildPattern() {
 
 void SystemOperator::assemble() const {
   if (assembled_) return;
-  const TetMesh& mesh = model_->mesh();
+  if (model_->elementKind() == ElementKind::kTet10) {
+    assembleElements<10, kTet10QuadraturePoints>();
+  } else {
+    assembleElements<4, 1>();
+  }
+  assembled_ = true;
+}
+
+template <int N, int Q>
+void SystemOperator::assembleElements() const {
   const double mu = model_->material().mu();
   const double lambda = model_->material().lambda();
-  // Pass 1, per tet: the rotated shape gradients R g_a.
-  parallel_.forRange(mesh.tetCount(), kTetGrain, [&](int begin, int end) {
-    for (int t = begin; t < end; ++t) {
-      const size_t ti = static_cast<size_t>(t);
-      const std::array<Eigen::Vector3d, 4> g =
-          shapeGradients(model_->tetRestData()[ti].rest_shape_inverse);
-      for (size_t a = 0; a < 4; ++a)
-        rotated_gradients_[ti][a] = rotations_[ti] * g[a];
+  constexpr size_t kPerElement = static_cast<size_t>(N * Q);
+  // Pass 1, per element: the rotated shape gradients R g_a at each quadrature point.
+  parallel_.forRange(model_->elementCount(), kTetGrain, [&](int begin, int end) {
+    for (int e = begin; e < end; ++e) {
+      const size_t ei = static_cast<size_t>(e);
+      Eigen::Vector3d* out = rotated_gradients_.data() + kPerElement * ei;
+      if constexpr (N == 4) {
+        const std::array<Eigen::Vector3d, 4> g =
+            shapeGradients(model_->tetRestData()[ei].rest_shape_inverse);
+        for (size_t a = 0; a < 4; ++a)
+          out[a] = rotations_[ei] * g[a];
+      } else {
+        const QuadraticRestData& rest = model_->quadraticRestData()[ei];
+        for (size_t q = 0; q < static_cast<size_t>(Q); ++q)
+          for (size_t a = 0; a < static_cast<size_t>(N); ++a)
+            out[static_cast<size_t>(N) * q + a] = rotations_[ei] * rest.gradients[q][a];
+      }
     }
   });
-  // Pass 2, per block row: K_ab = V (mu (g_a . g_b) I + mu (R g_b)(R g_a)^T + lambda (R g_a)(R
-  // g_b)^T) for every tet of the row's node a (rotating the rest-frame block R Ke_ab R^T).
-  parallel_.forRange(mesh.nodeCount(), kNodeGrain, [&](int begin, int end) {
+  // Pass 2, per block row: K_ab = sum_q w_q (mu (g_a . g_b) I + mu (R g_b)(R g_a)^T +
+  // lambda (R g_a)(R g_b)^T) for every element of the row's node a (rotating the rest-frame block
+  // R Ke_ab R^T); w is V for tet4 (one point), V / 4 for tet10.
+  parallel_.forRange(model_->nodeCount(), kNodeGrain, [&](int begin, int end) {
     for (int row = begin; row < end; ++row) {
       const size_t r = static_cast<size_t>(row);
       for (int s = row_offsets_[r]; s < row_offsets_[r + 1]; ++s)
         block_values_[static_cast<size_t>(s)].setZero();
       for (int k = node_offsets_[r]; k < node_offsets_[r + 1]; ++k) {
         const int entry = node_entries_[static_cast<size_t>(k)];
-        const size_t t = static_cast<size_t>(entry / 4), a = static_cast<size_t>(entry % 4);
-        const TetRestData& rest = model_->tetRestData()[t];
-        const std::array<Eigen::Vector3d, 4>& rg = rotated_gradients_[t];
-        const double mu_v = mu * rest.volume, lambda_v = lambda * rest.volume;
-        const Eigen::Vector3d& u = rg[a];
-        const Eigen::Vector3d q = lambda_v * u;
-        for (size_t b = 0; b < 4; ++b) {
-          const int slot = entry_slots_[4 * static_cast<size_t>(k) + b];
+        const size_t e = static_cast<size_t>(entry / N), a = static_cast<size_t>(entry % N);
+        double weight;
+        if constexpr (N == 4) {
+          weight = model_->tetRestData()[e].volume;
+        } else {
+          weight = model_->quadraticRestData()[e].volume / Q;
+        }
+        const Eigen::Vector3d* rg = rotated_gradients_.data() + kPerElement * e;
+        const double mu_v = mu * weight, lambda_v = lambda * weight;
+        for (size_t b = 0; b < static_cast<size_t>(N); ++b) {
+          const int slot = entry_slots_[static_cast<size_t>(N) * static_cast<size_t>(k) + b];
           if (slot < 0) continue;  // left of the diagonal: stored by the other node's row
-          const Eigen::Vector3d& w = rg[b];
-          const Eigen::Vector3d p = mu_v * w;
-          // g_a . g_b is rotation-invariant: take it from the rotated gradients.
-          const double diagonal = mu_v * u.dot(w);
           double* block = block_values_[static_cast<size_t>(slot)].data();  // column-major
-          for (int c = 0; c < 3; ++c) {
-            for (int i = 0; i < 3; ++i)
-              block[3 * c + i] += p[i] * u[c] + q[i] * w[c];
-            block[4 * c] += diagonal;
+          for (size_t q = 0; q < static_cast<size_t>(Q); ++q) {
+            const Eigen::Vector3d& u = rg[static_cast<size_t>(N) * q + a];
+            const Eigen::Vector3d& w = rg[static_cast<size_t>(N) * q + b];
+            const Eigen::Vector3d p = mu_v * w;
+            const Eigen::Vector3d qv = lambda_v * u;
+            // g_a . g_b is rotation-invariant: take it from the rotated gradients.
+            const double diagonal = mu_v * u.dot(w);
+            for (int c = 0; c < 3; ++c) {
+              for (int i = 0; i < 3; ++i)
+                block[3 * c + i] += p[i] * u[c] + qv[i] * w[c];
+              block[4 * c] += diagonal;
+            }
           }
         }
       }
     }
   });
-  assembled_ = true;
 }
 
 void SystemOperator::setCoefficients(double mass_coefficient, double stiffness_coefficient) {
@@ -177,18 +213,16 @@ void SystemOperator::apply(const Eigen::VectorXd& y, Eigen::VectorXd& out, doubl
   });
 }
 
-void SystemOperator::gather(const std::vector<std::array<Eigen::Vector3d, 4>>& tet_values,
-                            double scale, Eigen::VectorXd& out) const {
+void SystemOperator::gather(const std::vector<Eigen::Vector3d>& element_values, double scale,
+                            Eigen::VectorXd& out) const {
   const int node_count = model_->nodeCount();
   out.resize(3 * node_count);
   parallel_.forRange(node_count, kNodeGrain, [&](int begin, int end) {
     for (int n = begin; n < end; ++n) {
       Eigen::Vector3d sum = Eigen::Vector3d::Zero();
       for (int k = node_offsets_[static_cast<size_t>(n)];
-           k < node_offsets_[static_cast<size_t>(n) + 1]; ++k) {
-        const int entry = node_entries_[static_cast<size_t>(k)];
-        sum += tet_values[static_cast<size_t>(entry / 4)][static_cast<size_t>(entry % 4)];
-      }
+           k < node_offsets_[static_cast<size_t>(n) + 1]; ++k)
+        sum += element_values[static_cast<size_t>(node_entries_[static_cast<size_t>(k)])];
       out.segment<3>(3 * n) = scale * sum;
     }
   });
@@ -213,7 +247,8 @@ void SystemOperator::diagonalBlocks(std::vector<Eigen::Matrix3d>& blocks) const 
 }
 
 void SystemOperator::replaceModel(std::shared_ptr<const FemModel> model) {
-  assert(&model->mesh() == &model_->mesh() && "replaceModel wants a model of the same mesh");
+  assert(&model->mesh() == &model_->mesh() && model->elementKind() == model_->elementKind() &&
+         "replaceModel wants a model of the same mesh and elements");
   model_ = std::move(model);
   assembled_ = false;  // K holds the old material's mu and lambda
 }

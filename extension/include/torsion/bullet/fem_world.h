@@ -47,10 +47,11 @@ class FemWorld {
   FemWorld(const FemWorld&) = delete;
   FemWorld& operator=(const FemWorld&) = delete;
 
-  /// Adds an FEM body whose rest shape is `mesh` placed at `pose`. Errors: bad material, a
-  /// duplicate name.
+  /// Adds an FEM body whose rest shape is `mesh` (linear tets) placed at `pose`, discretised with
+  /// `element` (tet10: a mid-edge node on every edge, see mesh/quadratic_tet_mesh.h). Errors: bad
+  /// material, a duplicate name.
   Result<FemBody*> addBody(const std::string& name, const TetMesh& mesh, const Material& material,
-                           const Frame& pose = {});
+                           const Frame& pose = {}, ElementKind element = ElementKind::kTet4);
   /// Adds a rigid body (mass 0: static). The world owns the shape.
   btRigidBody* addRigidBody(std::unique_ptr<btCollisionShape> shape, double mass,
                             const btTransform& transform);

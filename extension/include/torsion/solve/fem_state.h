@@ -12,8 +12,8 @@ namespace torsion {
 struct FemState {
   Eigen::VectorXd positions;   ///< 3n, m (node i at [3i, 3i+3))
   Eigen::VectorXd velocities;  ///< 3n, m/s
-  /// Per-tet rotation of the last step, warm start of the polar decomposition.
-  std::vector<Eigen::Quaterniond> tet_rotations;
+  /// Per-element rotation of the last step, warm start of the polar decomposition.
+  std::vector<Eigen::Quaterniond> element_rotations;
 
   /// The body at rest in its mesh's rest shape.
   static FemState atRest(const FemModel& model);

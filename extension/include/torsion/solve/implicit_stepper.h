@@ -2,7 +2,8 @@
 // One linearised backward-Euler step of one FEM body (Baraff & Witkin 1998; the report's
 // integrator), as named stages:
 //
-//   1. kRotations      F = Ds Bm and its rotation R per tet (warm-started polar decomposition)
+//   1. kRotations      F = Ds Bm (tet4) or the element's mean F (tet10) and its rotation R per
+//                      element (warm-started polar decomposition)
 //   2. kElasticForces  f(x) = -Re Ke (Re^T x - X) gathered per node; elastic energy
 //   3. kRightHandSide  b = M v + dt (f(x) + f_ext)
 //   4. kSolve          (M (1 + dt alpha) + (dt^2 + dt beta) K) v' = b, prescribed components of v'
@@ -103,9 +104,9 @@ class ImplicitStepper {
   LinearSolveHook linear_solve_hook_;
 
   Eigen::VectorXd elastic_forces_, rhs_, velocity_next_, internal_forces_, scratch_;
-  Eigen::VectorXd previous_velocities_;  // v of the step before, for the CG warm start
-  std::vector<std::array<Eigen::Vector3d, 4>> tet_forces_;
-  std::vector<double> tet_energy_;
+  Eigen::VectorXd previous_velocities_;          // v of the step before, for the CG warm start
+  std::vector<Eigen::Vector3d> element_forces_;  // N per element (SystemOperator::gather)
+  std::vector<double> element_energy_;
   bool internal_forces_valid_ = false;
 };
 

@@ -1,12 +1,13 @@
 #pragma once
 // The linearised backward-Euler system of one body at the current positions,
-//   A = M (1 + dt alpha) + (dt^2 + dt beta) K,   K = sum over tets of Re Ke Re^T,
+//   A = M (1 + dt alpha) + (dt^2 + dt beta) K,   K = sum over elements of Re Ke Re^T,
 // with the rotations Re of this step. K is assembled once per step into 3x3 node blocks (block
-// rows = nodes, a row holds the node and its tet neighbours), so each CG product is a sparse
-// block product instead of a pass over every tet. Measured on the 8332-tet twist (callgrind,
-// docs/performance.md): a product takes 4.9x fewer instructions than the matrix-free tet loop
-// did and assembling costs about three such loops, so it pays from four products per step on
-// (a step at E = 1e5 takes about six; stiffer materials take more).
+// rows = nodes, a row holds the node and its element neighbours), so each CG product is a sparse
+// block product instead of a pass over every element. Elements are the model's (tet4: 4 nodes,
+// one point; tet10: 10 nodes, 4 quadrature points): the same assembly, templated on both. Measured
+// on the 8332-tet twist (callgrind, docs/performance.md): a product takes 4.9x fewer instructions
+// than the matrix-free tet loop did and assembling costs about three such loops, so it pays from
+// four products per step on (a step at E = 1e5 takes about six; stiffer materials take more).
 // Assembly runs per block row over the row node's tets in ascending order, so K and every
 // product are identical for any thread count.
 
@@ -24,7 +25,7 @@ class SystemOperator {
  public:
   SystemOperator(std::shared_ptr<const FemModel> model, const Parallel& parallel);
 
-  /// The rotation of every tet for this step. Writing through mutableRotations() marks K stale;
+  /// The rotation of every element for this step. Writing through mutableRotations() marks K stale;
   /// the next product or diagonalBlocks() call re-assembles it (products are not thread-safe
   /// with each other: one solver thread drives a body).
   const std::vector<Eigen::Matrix3d>& rotations() const { return rotations_; }
@@ -39,9 +40,10 @@ class SystemOperator {
   void multiply(const Eigen::VectorXd& y, Eigen::VectorXd& out) const;
   /// out = K y.
   void multiplyStiffness(const Eigen::VectorXd& y, Eigen::VectorXd& out) const;
-  /// out_i = scale * sum of the per-tet values of node i (tet_values[t][a] belongs to node
-  /// tets[t][a]), summed over the node's tets in ascending order.
-  void gather(const std::vector<std::array<Eigen::Vector3d, 4>>& tet_values, double scale,
+  /// out_i = scale * sum of the per-element values of node i (element_values[N e + a] belongs to
+  /// node elementNodes()[N e + a], N nodes per element), summed over the node's elements in
+  /// ascending order.
+  void gather(const std::vector<Eigen::Vector3d>& element_values, double scale,
               Eigen::VectorXd& out) const;
   /// The 3x3 diagonal blocks of A, one per node.
   void diagonalBlocks(std::vector<Eigen::Matrix3d>& blocks) const;
@@ -61,6 +63,9 @@ class SystemOperator {
   void buildPattern();
   // Fills block_values_ from this step's rotations (if stale).
   void assemble() const;
+  // The two passes of assemble() for N-node elements with Q quadrature points.
+  template <int N, int Q>
+  void assembleElements() const;
 
   std::shared_ptr<const FemModel> model_;
   const Parallel& parallel_;
@@ -68,12 +73,14 @@ class SystemOperator {
   double mass_coefficient_ = 1;
   double stiffness_coefficient_ = 0;
 
-  // Node -> its tets: entry k of row n is 4 * tet + local index, rows in node_offsets_.
+  int nodes_per_element_ = 4;
+  // Node -> its elements: entry k of row n is N * element + local index, rows in node_offsets_.
   std::vector<int> node_entries_;
   std::vector<int> node_offsets_;
   // Block-sparse K, upper triangle: block row n spans [row_offsets_[n], row_offsets_[n + 1]) of
-  // block_columns_ / block_values_, diagonal first; entry_slots_[4 k + b] is where node entry k's
-  // coupling to its tet's local node b lands (-1 left of the diagonal); diagonal_slots_[n] is K_nn.
+  // block_columns_ / block_values_, diagonal first; entry_slots_[N k + b] is where node entry k's
+  // coupling to its element's local node b lands (-1 left of the diagonal); diagonal_slots_[n] is
+  // K_nn.
   std::vector<int> row_offsets_;
   std::vector<int> block_columns_;
   std::vector<int> entry_slots_;
@@ -84,7 +91,8 @@ class SystemOperator {
   std::vector<int> lower_slots_;
   std::vector<int> lower_columns_;
   mutable std::vector<Eigen::Matrix3d> block_values_;
-  mutable std::vector<std::array<Eigen::Vector3d, 4>> rotated_gradients_;  // R_t grad N_a
+  // R_e grad N_a at each quadrature point: index (Q e + q) N + a.
+  mutable std::vector<Eigen::Vector3d> rotated_gradients_;
   mutable bool assembled_ = false;
 };
 
