@@ -119,7 +119,7 @@ struct SceneSpec {
   std::vector<HandSpec> hands;
   std::vector<RigidBodySpec> rigid_bodies;
   std::optional<RigidBodySpec> ground;  ///< a static plane, from the top-level "ground"
-  CameraSpec camera;  ///< how pictures look at the scene (camera_spec.h)
+  CameraSpec camera;                    ///< how pictures look at the scene (camera_spec.h)
   HapticsMode haptics_mode = HapticsMode::kAuto;  ///< not in the file: the CLI's --haptics
 };
 

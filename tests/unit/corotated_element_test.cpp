@@ -166,18 +166,6 @@ TEST(CorotatedElement, DifferentialCloseToFiniteDifferenceUnderSmallStrain) {
   EXPECT_LT(std::sqrt(err / ref), 1e-2);
 }
 
-TEST(CorotatedElement, DiagonalBlocksMatchStiffness) {
-  TetFixture tet;
-  std::mt19937 rng(5);
-  const Eigen::Matrix3d R = randomRotation(rng);
-  const auto K = tet.stiffness(R);
-  const auto blocks = corotatedDiagonalBlocks(R, tet.data, kMu, kLambda);
-  for (int a = 0; a < 4; ++a) {
-    EXPECT_LT((blocks[static_cast<size_t>(a)] - K.block<3, 3>(3 * a, 3 * a)).norm(),
-              1e-9 * K.norm());
-  }
-}
-
 TEST(CorotatedElement, EnergyIsZeroAtRestAndGrowsQuadratically) {
   TetFixture tet;
   auto energy = [&](double s) {

@@ -57,23 +57,4 @@ double corotatedEnergy(const Eigen::Matrix3d& F, const Eigen::Matrix3d& R, const
   return corotatedResponse(F, R, rest, mu, lambda).energy;
 }
 
-std::array<Eigen::Matrix3d, 4> corotatedDiagonalBlocks(const Eigen::Matrix3d& R,
-                                                       const TetRestData& rest, double mu,
-                                                       double lambda) {
-  // Displacing node a alone by dx gives, in the rotated frame y = R^T dx, a force
-  // -V (mu |g|^2 y + (mu + lambda) g (g . y)) with g = grad N_a.
-  const Eigen::Matrix3d& B = rest.rest_shape_inverse;
-  const std::array<Eigen::Vector3d, 4> g = {-(B.row(0) + B.row(1) + B.row(2)).transpose(),
-                                            B.row(0).transpose(), B.row(1).transpose(),
-                                            B.row(2).transpose()};
-  std::array<Eigen::Matrix3d, 4> blocks;
-  for (size_t a = 0; a < 4; ++a) {
-    const Eigen::Matrix3d local =
-        rest.volume * (mu * g[a].squaredNorm() * Eigen::Matrix3d::Identity() +
-                       (mu + lambda) * g[a] * g[a].transpose());
-    blocks[a] = R * local * R.transpose();
-  }
-  return blocks;
-}
-
 }  // namespace torsion

@@ -43,9 +43,4 @@ std::array<Eigen::Vector3d, 4> corotatedForceDifferential(const std::array<Eigen
 double corotatedEnergy(const Eigen::Matrix3d& F, const Eigen::Matrix3d& R, const TetRestData& rest,
                        double mu, double lambda);
 
-/// The 3x3 diagonal blocks K_aa of the warped stiffness (for block-Jacobi preconditioning).
-std::array<Eigen::Matrix3d, 4> corotatedDiagonalBlocks(const Eigen::Matrix3d& R,
-                                                       const TetRestData& rest, double mu,
-                                                       double lambda);
-
 }  // namespace torsion
