@@ -13,7 +13,6 @@ namespace torsion {
 
 namespace {
 constexpr int kTetGrain = 256;
-constexpr int kNodeGrain = 512;
 }  // namespace
 
 const char* toString(StepHealth health) {
