@@ -20,17 +20,6 @@ namespace {
 constexpr int kMaxSlipsPerStep = 2;
 constexpr int kMaxFrictionRefinements = 8;
 
-// Velocity of the rigid point at lever r: J V = v + omega x r.
-Eigen::Vector3d pointVelocity(const Vector6d& V, const Eigen::Vector3d& r) {
-  return V.head<3>() + V.tail<3>().cross(r);
-}
-// J^T y = (y, r x y): the wrench of a point impulse y at lever r.
-Vector6d pointWrench(const Eigen::Vector3d& y, const Eigen::Vector3d& r) {
-  Vector6d w;
-  w << y, r.cross(y);
-  return w;
-}
-
 // Collects the soft body's nodes whose tree leaves overlap a volume.
 struct NodeCollector : btDbvt::ICollide {
   explicit NodeCollector(const btSoftBody& sb) : first(&sb.m_nodes[0]) {}
@@ -79,7 +68,7 @@ bool touchesStaticOrKinematic(const btRigidBody& body, btSoftBody& soft) {
 }  // namespace
 
 RigidContactSolver::RigidContactSolver(std::shared_ptr<const FemModel> model, btSoftBody* soft_body)
-    : model_(std::move(model)), soft_body_(soft_body) {
+    : model_(std::move(model)), soft_body_(soft_body), faces_(model_->mesh()) {
   const int n = model_->nodeCount();
   surface_.assign(static_cast<size_t>(n), 0);
   for (const Triangle& tri : model_->mesh().surfaceTriangles()) {
@@ -142,6 +131,7 @@ bool RigidContactSolver::detect(const FemState& state, const NodeConstraints& co
   for (const NodeContact& c : contacts_) {
     if (c.node >= 0 && !c.held) node_contact_[static_cast<size_t>(c.node)] = -1;
   }
+  faces_.beginStep(partners_);
   contacts_.clear();
   partners_.clear();
   stats_ = ContactStepStats{};
@@ -155,6 +145,8 @@ bool RigidContactSolver::detect(const FemState& state, const NodeConstraints& co
   for (int i = 0; i < model_->nodeCount(); ++i)
     max_node_speed = std::max(max_node_speed, state.velocity(i).norm());
 
+  // A triangle that overlaps an object's box has its nodes within the longest edge of it.
+  const double longest_edge = faces_.longestEdge(state);
   for (const btCollisionObject* object : candidates_) {
     const btCollisionShape* shape = object->getCollisionShape();
     const btTransform transform = startPose(*object, dt);
@@ -170,11 +162,15 @@ bool RigidContactSolver::detect(const FemState& state, const NodeConstraints& co
     // Anything that can close the gap within the step, twice over, plus the soft margin.
     const double reach = 2 * dt * (max_node_speed + rigid_speed) + 4 * margin;
     const btVector3 pad(reach, reach, reach);
+    const btVector3 face_pad = pad + btVector3(longest_edge, longest_edge, longest_edge);
     NodeCollector collector(sb);
-    sb.m_ndbvt.collideTV(sb.m_ndbvt.m_root, btDbvtVolume::FromMM(lo - pad, hi + pad), collector);
+    sb.m_ndbvt.collideTV(sb.m_ndbvt.m_root, btDbvtVolume::FromMM(lo - face_pad, hi + face_pad),
+                         collector);
+    const Eigen::Vector3d node_lo = toEigen(lo - pad), node_hi = toEigen(hi + pad);
     for (int i : collector.nodes) {
       if (!surface_[static_cast<size_t>(i)]) continue;
       const Eigen::Vector3d x = state.position(i);
+      if ((x.array() < node_lo.array()).any() || (x.array() > node_hi.array()).any()) continue;
       std::optional<SurfacePoint> sp =
           signedDistance(*shape, transform, x, reach, -toEigen(sb.m_nodes[i].m_n));
       if (!sp) continue;
@@ -202,6 +198,19 @@ bool RigidContactSolver::detect(const FemState& state, const NodeConstraints& co
       }
       contacts_.push_back(c);
     }
+    const int partner = partnerIndex(object);
+    faces_.detect(state, constraints, collector.nodes, *shape, transform, toEigen(lo), toEigen(hi),
+                  reach, partner, partners_[static_cast<size_t>(partner)],
+                  settings_.friction * object->getFriction());
+  }
+  // A candidate object that nothing touches keeps Bullet's velocity untouched: not an unknown.
+  std::vector<char> touched(partners_.size(), 0);
+  for (const NodeContact& c : contacts_)
+    touched[static_cast<size_t>(c.partner)] = 1;
+  for (const FaceContact& c : faces_.contacts())
+    touched[static_cast<size_t>(c.partner)] = 1;
+  for (size_t k = 0; k < partners_.size(); ++k) {
+    if (!touched[k]) partners_[k].dynamic = partners_[k].supported = false;
   }
   // Warm active set.
   for (NodeContact& c : contacts_) {
@@ -214,9 +223,12 @@ bool RigidContactSolver::detect(const FemState& state, const NodeConstraints& co
     }
   }
   stats_.candidates = static_cast<int>(contacts_.size());
+  stats_.face_candidates = static_cast<int>(faces_.contacts().size());
   for (const NodeContact& c : contacts_)
     stats_.max_penetration = std::max(stats_.max_penetration, -c.gap);
-  return !contacts_.empty();
+  for (const FaceContact& c : faces_.contacts())
+    stats_.max_penetration = std::max(stats_.max_penetration, -c.gap);
+  return !contacts_.empty() || !faces_.empty();
 }
 
 // ---- the reduced system -------------------------------------------------------------------
@@ -299,6 +311,7 @@ void RigidContactSolver::applyOperator(const SystemOperator& op, const Eigen::Ve
     rigid_scratch_.segment<3>(o) = k.mass * q.segment<3>(k.unknown);
     rigid_scratch_.segment<3>(o + 3) = k.inertia * q.segment<3>(k.unknown + 3);
   }
+  faces_.addProduct(scratch_, q, partners_, 3 * model_->nodeCount(), product_, rigid_scratch_);
   contract(product_, rigid_scratch_, out);
 }
 
@@ -311,6 +324,7 @@ void RigidContactSolver::buildPreconditioner(const SystemOperator& op) {
     rigid_inverse_[k].topLeftCorner<3, 3>() = partners_[k].mass * Eigen::Matrix3d::Identity();
     rigid_inverse_[k].bottomRightCorner<3, 3>() = partners_[k].inertia;
   }
+  faces_.addPreconditioner(block_inverse_, rigid_inverse_, partners_);
   for (int i = 0; i < n; ++i) {
     const int ci = node_contact_[static_cast<size_t>(i)];
     if (ci < 0 || base_->isConstrained(i)) continue;
@@ -497,8 +511,21 @@ LinearSolveReport RigidContactSolver::solve(const SystemOperator& op,
   for (const RigidPartner& k : partners_) {
     if (k.dynamic) q_.segment<6>(k.unknown) = k.entry_velocity;
   }
+  if (!faces_.empty()) {
+    op.diagonalBlocks(block_inverse_);
+    faces_.setPenalties(block_inverse_, settings_.face_penalty);
+  }
   bool converged_set = false;
   for (int iteration = 0; iteration < settings_.max_active_set_iterations; ++iteration) {
+    // Face contacts whose nodes are all prescribed along their normal sit this solve out.
+    faces_.markDetermined([&](int node, const Eigen::Vector3d& normal) {
+      if (constraints.kind(node) == NodeConstraints::Kind::kFull) return true;
+      const int ci = node_contact_[static_cast<size_t>(node)];
+      if (ci < 0) return false;
+      const NodeContact& c = contacts_[static_cast<size_t>(ci)];
+      return c.state == NodeContact::State::kStick ||
+             (c.state == NodeContact::State::kSlide && std::abs(c.normal.dot(normal)) > 0.99);
+    });
     // Prescribed parts v_c and the friction impulses.
     v_c_.setZero(3 * n);
     constraints.impose(v_c_);
@@ -528,8 +555,10 @@ LinearSolveReport RigidContactSolver::solve(const SystemOperator& op,
           rigid_rhs.segment<6>(k.unknown - 3 * n) -= pointWrench(c.friction_impulse, c.lever);
       }
     }
+    b_solve_ = b_friction;
+    faces_.addRightHandSide(v_c_, partners_, dt, 3 * n, b_solve_, rigid_rhs);
     op.multiply(v_c_, product_);
-    contract(b_friction - product_, rigid_rhs, beta_);
+    contract(b_solve_ - product_, rigid_rhs, beta_);
 
     // Keep the warm start inside the reduced space (the rigid part is kept as is).
     {
@@ -560,11 +589,16 @@ LinearSolveReport RigidContactSolver::solve(const SystemOperator& op,
     for (RigidPartner& k : partners_) {
       if (k.dynamic) k.velocity = q_.segment<6>(k.unknown);
     }
-    // Constraint impulses on the nodes: A v - b (the friction is not a constraint impulse).
+    // Constraint impulses on the nodes: A v - b less the friction and the face contacts'
+    // impulses (neither is a node's constraint impulse).
     op.multiply(v, product_);
     product_ -= b_friction;
+    faces_.takeImpulses(v, partners_, dt, product_);
     if (r.breakdown) break;
-    if (!updateActiveSet(v, product_, dt)) {
+    const bool nodes_changed = updateActiveSet(v, product_, dt);
+    const bool faces_changed = faces_.update(v, partners_, dt, settings_.activation_tolerance,
+                                             settings_.face_gap_tolerance);
+    if (!nodes_changed && !faces_changed) {
       converged_set = true;
       break;
     }
@@ -591,6 +625,13 @@ LinearSolveReport RigidContactSolver::solve(const SystemOperator& op,
     if (c.state == NodeContact::State::kStick) ++stats_.sticking;
     stats_.normal_impulse += std::max(0.0, c.normal_impulse);
   }
+  for (const FaceContact& c : faces_.contacts()) {
+    if (c.state == FaceContact::State::kInactive || c.determined) continue;
+    partners_[static_cast<size_t>(c.partner)].impulse -= pointWrench(c.impulse, c.lever);
+    ++stats_.active;
+    ++stats_.face_active;
+    stats_.normal_impulse += std::max(0.0, c.normal.dot(c.impulse));
+  }
   solveHeld(v, dt);
   // The linearised end-of-step gap of every contact, with the final velocities.
   for (const NodeContact& c : contacts_) {
@@ -598,6 +639,10 @@ LinearSolveReport RigidContactSolver::solve(const SystemOperator& op,
         pointVelocity(partners_[static_cast<size_t>(c.partner)].velocity, c.lever);
     const double gap_end = c.gap + dt * c.normal.dot(v.segment<3>(3 * c.node) - rigid);
     stats_.max_end_penetration = std::max(stats_.max_end_penetration, -gap_end);
+  }
+  for (const FaceContact& c : faces_.contacts()) {
+    stats_.max_end_penetration =
+        std::max(stats_.max_end_penetration, -faces_.endGap(c, v, partners_, dt));
   }
   return total;
 }

@@ -14,6 +14,8 @@
 #include <limits>
 
 #include "torsion/bullet/bt_conversions.h"
+#include "torsion/contact/face_distance.h"
+
 namespace torsion {
 
 namespace {
@@ -70,7 +72,7 @@ class ClosestTriangle : public btTriangleCallback {
     const double area2 = n.norm();
     if (area2 == 0) return;
     n /= area2;
-    const Eigen::Vector3d q = closestPoint(a, b, c);
+    const Eigen::Vector3d q = closestPointOnTriangle(p_, a, b, c);
     const double unsigned_distance = (p_ - q).norm();
     if (unsigned_distance >= best_unsigned_) return;
     best_unsigned_ = unsigned_distance;
@@ -87,29 +89,6 @@ class ClosestTriangle : public btTriangleCallback {
   const std::optional<SurfacePoint>& best() const { return best_; }
 
  private:
-  // Ericson, Real-Time Collision Detection, 5.1.5.
-  Eigen::Vector3d closestPoint(const Eigen::Vector3d& a, const Eigen::Vector3d& b,
-                               const Eigen::Vector3d& c) const {
-    const Eigen::Vector3d ab = b - a, ac = c - a, ap = p_ - a;
-    const double d1 = ab.dot(ap), d2 = ac.dot(ap);
-    if (d1 <= 0 && d2 <= 0) return a;
-    const Eigen::Vector3d bp = p_ - b;
-    const double d3 = ab.dot(bp), d4 = ac.dot(bp);
-    if (d3 >= 0 && d4 <= d3) return b;
-    const double vc = d1 * d4 - d3 * d2;
-    if (vc <= 0 && d1 >= 0 && d3 <= 0) return a + ab * (d1 / (d1 - d3));
-    const Eigen::Vector3d cp = p_ - c;
-    const double d5 = ab.dot(cp), d6 = ac.dot(cp);
-    if (d6 >= 0 && d5 <= d6) return c;
-    const double vb = d5 * d2 - d1 * d6;
-    if (vb <= 0 && d2 >= 0 && d6 <= 0) return a + ac * (d2 / (d2 - d6));
-    const double va = d3 * d6 - d5 * d4;
-    if (va <= 0 && (d4 - d3) >= 0 && (d5 - d6) >= 0)
-      return b + (c - b) * ((d4 - d3) / ((d4 - d3) + (d5 - d6)));
-    const double denom = 1 / (va + vb + vc);
-    return a + ab * (vb * denom) + ac * (vc * denom);
-  }
-
   Eigen::Vector3d p_;
   double best_unsigned_ = std::numeric_limits<double>::infinity();
   std::optional<SurfacePoint> best_;

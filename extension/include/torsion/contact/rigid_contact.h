@@ -9,7 +9,10 @@
 //   stage 4, before the solve (detect)       each candidate object, at its pose after Bullet's
 //                                            rigid integration, is queried against the body's
 //                                            node tree (Bullet's DBVT); surface nodes near it get
-//                                            an exact signed distance (shape_distance.h)
+//                                            an exact signed distance (shape_distance.h), and
+//                                            surface triangles near it the shape's distance
+//                                            (face_distance.h): face contacts hold rigid
+//                                            features that fall between nodes
 //   stage 4, the solve (solve)               velocity-level unilateral constraints, one per node,
 //                                            in the projected CG: a node in contact is prescribed
 //                                            along the normal (sliding) or fully (sticking) to
@@ -19,6 +22,8 @@
 //                                            active-set loop releases pulling contacts, adds
 //                                            penetrating ones and switches stick/slide by
 //                                            Coulomb's law (friction coefficient per pair).
+//                                            Face contacts join the same solves as an augmented
+//                                            Lagrangian (face_contacts.h).
 //   after the step (finish)                  dynamic rigid bodies get their new velocities and
 //                                            the pose correction dt (v_new - v_bullet)
 //
@@ -33,6 +38,8 @@
 #include <memory>
 #include <vector>
 
+#include "torsion/contact/face_contacts.h"
+#include "torsion/contact/rigid_partner.h"
 #include "torsion/fem/fem_model.h"
 #include "torsion/solve/fem_state.h"
 #include "torsion/solve/node_constraints.h"
@@ -40,8 +47,6 @@
 #include "torsion/solve/system_operator.h"
 
 namespace torsion {
-
-using Vector6d = Eigen::Matrix<double, 6, 1>;
 
 struct ContactSettings {
   /// m: an inactive contact whose predicted end-of-step gap is below -this joins the active set.
@@ -53,6 +58,13 @@ struct ContactSettings {
   /// Coulomb friction coefficient of the FEM body; a pair's is this times the rigid body's
   /// (Bullet's combination rule).
   double friction = 1.0;
+  /// Face contacts (face_contacts.h): the augmented Lagrangian's penalty rho, in units of the
+  /// face point's effective mass from the system's diagonal blocks. Larger closes the gap in fewer
+  /// solves but slows each CG solve.
+  double face_penalty = 20;
+  /// m: face contacts iterate until every active one's end-of-step gap is within this (the
+  /// stated penetration tolerance of a rigid feature between nodes).
+  double face_gap_tolerance = 1e-5;
 };
 
 /// One node in contact with one rigid object during a step.
@@ -74,33 +86,17 @@ struct NodeContact {
   double normal_impulse = 0;                          ///< N s, impulse . normal
 };
 
-/// A rigid object touched this step.
-struct RigidPartner {
-  const btCollisionObject* object = nullptr;
-  btRigidBody* body = nullptr;  ///< null for a plain collision object
-  bool dynamic = false;         ///< velocities solved with the body's; else prescribed
-  /// A dynamic body touching a static or kinematic one in Bullet (a box on the ground): solved
-  /// as prescribed here, its contact impulse goes to Bullet's rigid solver (one step later), which
-  /// alone knows its other contacts.
-  bool supported = false;
-  double mass = 0;
-  Eigen::Matrix3d inertia = Eigen::Matrix3d::Zero();          ///< world, kg m^2 (dynamic)
-  Eigen::Matrix3d inverse_inertia = Eigen::Matrix3d::Zero();  ///< world (dynamic)
-  Eigen::Vector3d com = Eigen::Vector3d::Zero();
-  Vector6d entry_velocity = Vector6d::Zero();  ///< (v, omega) Bullet integrated with
-  Vector6d velocity = Vector6d::Zero();        ///< (v, omega) current estimate / result
-  Vector6d impulse = Vector6d::Zero();         ///< (force, torque about com) x dt from this body
-  int unknown = -1;                            ///< offset of its 6 unknowns in the CG vector
-};
-
 struct ContactStepStats {
   int candidates = 0;             ///< surface nodes within the detection margin
-  int active = 0;                 ///< contacts in the active set at the end of the step
+  int face_candidates = 0;        ///< surface triangles (or edges) with a face contact candidate
+  int active = 0;                 ///< node and face contacts active at the end of the step
+  int face_active = 0;            ///< of which face contacts
   int sticking = 0;               ///< of which sticking
   int active_set_iterations = 0;  ///< CG solves this step
   bool active_set_converged = true;
   double normal_impulse = 0;       ///< N s, sum over contacts (>= 0)
-  double max_penetration = 0;      ///< m, deepest node inside a rigid body at the step's start
+  double max_penetration = 0;      ///< m, deepest node or face point inside a rigid body at the
+                                   ///< step's start
                                    ///< (measured: the result of the previous step)
   double max_end_penetration = 0;  ///< m, deepest linearised end-of-step gap after the solve
 };
@@ -129,6 +125,7 @@ class RigidContactSolver {
   void finish();
 
   const std::vector<NodeContact>& contacts() const { return contacts_; }
+  const std::vector<FaceContact>& faceContacts() const { return faces_.contacts(); }
   const std::vector<RigidPartner>& partners() const { return partners_; }
   const ContactStepStats& stats() const { return stats_; }
 
@@ -152,6 +149,7 @@ class RigidContactSolver {
   std::vector<const btCollisionObject*> candidates_;
   std::vector<RigidPartner> partners_;
   std::vector<NodeContact> contacts_;
+  FaceContactSet faces_;
   std::vector<int> node_contact_;  // per node: index into contacts_ (free nodes only) or -1
   std::vector<std::pair<int, const btCollisionObject*>> previous_active_;  // (node, object)
   std::vector<NodeContact::State> previous_state_;
@@ -163,7 +161,7 @@ class RigidContactSolver {
   // Solve workspace.
   std::vector<Eigen::Matrix3d> block_inverse_;
   std::vector<Eigen::Matrix<double, 6, 6>> rigid_inverse_;
-  Eigen::VectorXd v_c_, scratch_, product_, r_, beta_, q_, rigid_scratch_;
+  Eigen::VectorXd v_c_, scratch_, product_, r_, beta_, q_, rigid_scratch_, b_solve_;
   PcgScratch cg_;
 };
 

@@ -1,0 +1,45 @@
+#pragma once
+// A rigid object that FEM nodes or faces touch during one step (docs/contact.md), and the
+// kinematics of a point on it. Touched only by the simulation thread.
+
+#include <BulletDynamics/Dynamics/btRigidBody.h>
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+
+namespace torsion {
+
+using Vector6d = Eigen::Matrix<double, 6, 1>;
+
+/// A rigid object touched this step.
+struct RigidPartner {
+  const btCollisionObject* object = nullptr;
+  btRigidBody* body = nullptr;  ///< null for a plain collision object
+  bool dynamic = false;         ///< velocities solved with the body's; else prescribed
+  /// A dynamic body touching a static or kinematic one in Bullet (a box on the ground): solved
+  /// as prescribed here, its contact impulse goes to Bullet's rigid solver (one step later), which
+  /// alone knows its other contacts.
+  bool supported = false;
+  double mass = 0;
+  Eigen::Matrix3d inertia = Eigen::Matrix3d::Zero();          ///< world, kg m^2 (dynamic)
+  Eigen::Matrix3d inverse_inertia = Eigen::Matrix3d::Zero();  ///< world (dynamic)
+  Eigen::Vector3d com = Eigen::Vector3d::Zero();
+  Vector6d entry_velocity = Vector6d::Zero();  ///< (v, omega) Bullet integrated with
+  Vector6d velocity = Vector6d::Zero();        ///< (v, omega) current estimate / result
+  Vector6d impulse = Vector6d::Zero();         ///< (force, torque about com) x dt from this body
+  int unknown = -1;                            ///< offset of its 6 unknowns in the CG vector
+};
+
+/// Velocity of the rigid point at lever r (from the centre of mass): J V = v + omega x r.
+inline Eigen::Vector3d pointVelocity(const Vector6d& V, const Eigen::Vector3d& r) {
+  return V.head<3>() + V.tail<3>().cross(r);
+}
+
+/// J^T y = (y, r x y): the wrench about the centre of mass of a point impulse y at lever r.
+inline Vector6d pointWrench(const Eigen::Vector3d& y, const Eigen::Vector3d& r) {
+  Vector6d w;
+  w << y, r.cross(y);
+  return w;
+}
+
+}  // namespace torsion

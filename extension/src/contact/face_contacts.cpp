@@ -1,0 +1,330 @@
+#include "torsion/contact/face_contacts.h"
+
+#include <Eigen/Dense>
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "torsion/contact/face_distance.h"
+#include "torsion/contact/shape_distance.h"
+
+namespace torsion {
+
+namespace {
+
+// A weight below this puts the contact point on the opposite edge (or corner): the contact is the
+// edge's (or the node's), whichever triangle found it.
+constexpr double kEdgeWeight = 1e-6;
+constexpr int kMaxStalls = 3;
+// A face point must come this fraction of the detection reach nearer the shape than its nodes'
+// interpolated distances to be a contact of its own (round-off on flat-on-flat is far below).
+constexpr double kDuplicateMargin = 1e-3;
+constexpr int kMaxSwitches = 1;
+
+Eigen::Matrix<double, 3, 6> pointJacobian(const Eigen::Vector3d& r) {
+  Eigen::Matrix<double, 3, 6> J;
+  J << Eigen::Matrix3d::Identity(),
+      (Eigen::Matrix3d() << 0, r.z(), -r.y(), -r.z(), 0, r.x(), r.y(), -r.x(), 0).finished();
+  return J;  // J V = v + omega x r = v - [r]x omega
+}
+
+bool mayStick(const FaceContact& c, const RigidPartner& /*p*/) {
+  return c.friction > 0;
+}
+
+// Whether the contact takes part in this solve.
+bool participates(const FaceContact& c) {
+  return c.state != FaceContact::State::kInactive && !c.determined;
+}
+
+Eigen::Matrix3d projector(const FaceContact& c) {
+  return c.state == FaceContact::State::kStick ? Eigen::Matrix3d::Identity()
+                                               : Eigen::Matrix3d(c.normal * c.normal.transpose());
+}
+
+}  // namespace
+
+FaceContactSet::FaceContactSet(const TetMesh& mesh) : triangles_(mesh.surfaceTriangles()) {
+  const int n = mesh.nodeCount();
+  node_triangle_start_.assign(static_cast<size_t>(n) + 1, 0);
+  for (const Triangle& t : triangles_) {
+    for (int node : t)
+      ++node_triangle_start_[static_cast<size_t>(node) + 1];
+  }
+  for (int i = 0; i < n; ++i)
+    node_triangle_start_[static_cast<size_t>(i) + 1] +=
+        node_triangle_start_[static_cast<size_t>(i)];
+  node_triangles_.resize(static_cast<size_t>(node_triangle_start_.back()));
+  std::vector<int> fill(node_triangle_start_.begin(), node_triangle_start_.end() - 1);
+  for (size_t t = 0; t < triangles_.size(); ++t) {
+    for (int node : triangles_[t])
+      node_triangles_[static_cast<size_t>(fill[static_cast<size_t>(node)]++)] = static_cast<int>(t);
+  }
+  triangle_stamp_.assign(triangles_.size(), 0);
+}
+
+void FaceContactSet::beginStep(const std::vector<RigidPartner>& partners) {
+  previous_.clear();
+  for (const FaceContact& c : contacts_) {
+    if (c.state == FaceContact::State::kInactive) continue;
+    previous_[{c.key, partners[static_cast<size_t>(c.partner)].object}] = {c.state, c.multiplier};
+  }
+  contacts_.clear();
+  index_.clear();
+}
+
+double FaceContactSet::longestEdge(const FemState& state) const {
+  double longest = 0;
+  for (const Triangle& t : triangles_) {
+    for (size_t k = 0; k < 3; ++k) {
+      longest = std::max(longest, (state.position(t[k]) - state.position(t[(k + 1) % 3])).norm());
+    }
+  }
+  return longest;
+}
+
+void FaceContactSet::detect(const FemState& state, const NodeConstraints& held,
+                            const std::vector<int>& nearby_nodes, const btCollisionShape& shape,
+                            const btTransform& transform, const Eigen::Vector3d& lo,
+                            const Eigen::Vector3d& hi, double reach, int partner,
+                            const RigidPartner& p, double friction) {
+  ++stamp_;
+  const Eigen::Vector3d pad = Eigen::Vector3d::Constant(reach);
+  for (int node : nearby_nodes) {
+    for (int k = node_triangle_start_[static_cast<size_t>(node)];
+         k < node_triangle_start_[static_cast<size_t>(node) + 1]; ++k) {
+      const int t = node_triangles_[static_cast<size_t>(k)];
+      if (triangle_stamp_[static_cast<size_t>(t)] == stamp_) continue;
+      triangle_stamp_[static_cast<size_t>(t)] = stamp_;
+      const Triangle& tri = triangles_[static_cast<size_t>(t)];
+      const Eigen::Vector3d a = state.position(tri[0]), b = state.position(tri[1]),
+                            c = state.position(tri[2]);
+      const Eigen::Vector3d tlo = a.cwiseMin(b).cwiseMin(c), thi = a.cwiseMax(b).cwiseMax(c);
+      if ((tlo.array() > (hi + pad).array()).any() || (thi.array() < (lo - pad).array()).any())
+        continue;
+      bool all_held = true;
+      for (int node_id : tri)
+        all_held = all_held && held.kind(node_id) == NodeConstraints::Kind::kFull;
+      if (all_held && !p.dynamic) continue;
+      // A supported partner (resting on the ground: coupled explicitly, one step late) gets node
+      // contacts only. Face contacts at its edges, with their levers and oblique normals, spun a
+      // box squeezed under a deformable faster each step through that explicit coupling (its
+      // rotation is resolved against the ground by Bullet only the step after).
+      if (p.supported) continue;
+      const std::optional<FacePoint> f = shapeToTriangle(shape, transform, a, b, c, reach);
+      if (!f || f->distance > reach) continue;
+      // At a corner: the node's own contact measures the same distance.
+      if (f->barycentric.maxCoeff() > 1 - kEdgeWeight) continue;
+      // A face point no nearer the shape than its nodes' own distances, interpolated, is held by
+      // the node contacts (a flat rigid face on a flat soft face): a face contact there would only
+      // duplicate them, and duplicates slow the active set. What is left are rigid features that
+      // come nearer between the nodes than at them: corners, edges, curved shapes.
+      double interpolated = 0;
+      for (size_t j = 0; j < 3; ++j) {
+        const std::optional<SurfacePoint> d =
+            signedDistance(shape, transform, state.position(tri[j]), reach);
+        interpolated += f->barycentric[static_cast<Eigen::Index>(j)] *
+                        (d ? d->distance : std::numeric_limits<double>::infinity());
+      }
+      if (f->distance >= interpolated - kDuplicateMargin * reach) continue;
+      FaceContact fc;
+      fc.nodes = {tri[0], tri[1], tri[2]};
+      fc.weights = f->barycentric;
+      fc.key = {-1, -1, -1};
+      std::vector<int> key;
+      for (size_t j = 0; j < 3; ++j) {
+        if (fc.weights[static_cast<Eigen::Index>(j)] > kEdgeWeight) key.push_back(tri[j]);
+      }
+      std::sort(key.begin(), key.end());
+      std::copy(key.begin(), key.end(), fc.key.begin());
+      fc.partner = partner;
+      fc.normal = f->normal;
+      fc.gap = f->distance;
+      fc.lever = f->shape_point - p.com;
+      fc.friction = friction;
+      const auto found = index_.find({fc.key, partner});
+      if (found != index_.end()) {
+        // An edge seen from its two triangles: keep the nearer reading.
+        FaceContact& existing = contacts_[static_cast<size_t>(found->second)];
+        if (fc.gap < existing.gap) {
+          fc.state = existing.state;
+          fc.multiplier = existing.multiplier;
+          existing = fc;
+        }
+        continue;
+      }
+      const auto remembered = previous_.find({fc.key, p.object});
+      if (remembered != previous_.end()) {
+        fc.state = mayStick(fc, p) ? remembered->second.state : FaceContact::State::kSlide;
+        fc.multiplier = remembered->second.multiplier;
+      }
+      index_[{fc.key, partner}] = static_cast<int>(contacts_.size());
+      contacts_.push_back(fc);
+    }
+  }
+}
+
+void FaceContactSet::setPenalties(const std::vector<Eigen::Matrix3d>& diagonal_blocks,
+                                  double scale) {
+  for (FaceContact& c : contacts_) {
+    double compliance = 0;  // 1 / kg: the face point's velocity change per unit impulse along n
+    for (size_t j = 0; j < 3; ++j) {
+      const double w = c.weights[static_cast<Eigen::Index>(j)];
+      if (w <= 0) continue;
+      compliance +=
+          w * w *
+          c.normal.dot(diagonal_blocks[static_cast<size_t>(c.nodes[j])].ldlt().solve(c.normal));
+    }
+    c.penalty = compliance > 0 ? scale / compliance : 0;
+  }
+}
+
+Eigen::Vector3d FaceContactSet::relativeVelocity(const FaceContact& c, const Eigen::VectorXd& v,
+                                                 const Eigen::Vector3d& rigid) const {
+  Eigen::Vector3d u = -rigid;
+  for (size_t j = 0; j < 3; ++j)
+    u += c.weights[static_cast<Eigen::Index>(j)] * v.segment<3>(3 * c.nodes[j]);
+  return u;
+}
+
+void FaceContactSet::addProduct(const Eigen::VectorXd& v, const Eigen::VectorXd& q,
+                                const std::vector<RigidPartner>& partners, int rigid_offset,
+                                Eigen::VectorXd& node_out, Eigen::VectorXd& rigid_out) const {
+  for (const FaceContact& c : contacts_) {
+    if (!participates(c)) continue;
+    const RigidPartner& k = partners[static_cast<size_t>(c.partner)];
+    const Eigen::Vector3d rigid =
+        k.dynamic ? pointVelocity(q.segment<6>(k.unknown), c.lever) : Eigen::Vector3d::Zero();
+    const Eigen::Vector3d y = c.penalty * (projector(c) * relativeVelocity(c, v, rigid));
+    for (size_t j = 0; j < 3; ++j)
+      node_out.segment<3>(3 * c.nodes[j]) += c.weights[static_cast<Eigen::Index>(j)] * y;
+    if (k.dynamic) rigid_out.segment<6>(k.unknown - rigid_offset) -= pointWrench(y, c.lever);
+  }
+}
+
+void FaceContactSet::addRightHandSide(const Eigen::VectorXd& prescribed,
+                                      const std::vector<RigidPartner>& partners, double dt,
+                                      int rigid_offset, Eigen::VectorXd& node_rhs,
+                                      Eigen::VectorXd& rigid_rhs) const {
+  for (const FaceContact& c : contacts_) {
+    if (!participates(c)) continue;
+    const RigidPartner& k = partners[static_cast<size_t>(c.partner)];
+    const Eigen::Vector3d rigid =
+        k.dynamic ? Eigen::Vector3d::Zero() : pointVelocity(k.entry_velocity, c.lever);
+    const Eigen::Vector3d h0 = relativeVelocity(c, prescribed, rigid) + c.normal * (c.gap / dt);
+    const Eigen::Vector3d y = c.multiplier - c.penalty * (projector(c) * h0);
+    for (size_t j = 0; j < 3; ++j)
+      node_rhs.segment<3>(3 * c.nodes[j]) += c.weights[static_cast<Eigen::Index>(j)] * y;
+    if (k.dynamic) rigid_rhs.segment<6>(k.unknown - rigid_offset) -= pointWrench(y, c.lever);
+  }
+}
+
+void FaceContactSet::addPreconditioner(std::vector<Eigen::Matrix3d>& node_blocks,
+                                       std::vector<Eigen::Matrix<double, 6, 6>>& rigid_blocks,
+                                       const std::vector<RigidPartner>& partners) const {
+  for (const FaceContact& c : contacts_) {
+    if (!participates(c)) continue;
+    const Eigen::Matrix3d P = c.penalty * projector(c);
+    for (size_t j = 0; j < 3; ++j) {
+      const double w = c.weights[static_cast<Eigen::Index>(j)];
+      node_blocks[static_cast<size_t>(c.nodes[j])] += w * w * P;
+    }
+    if (partners[static_cast<size_t>(c.partner)].dynamic) {
+      const Eigen::Matrix<double, 3, 6> J = pointJacobian(c.lever);
+      rigid_blocks[static_cast<size_t>(c.partner)] += J.transpose() * P * J;
+    }
+  }
+}
+
+double FaceContactSet::endGap(const FaceContact& c, const Eigen::VectorXd& v,
+                              const std::vector<RigidPartner>& partners, double dt) const {
+  const Eigen::Vector3d rigid =
+      pointVelocity(partners[static_cast<size_t>(c.partner)].velocity, c.lever);
+  return c.gap + dt * c.normal.dot(relativeVelocity(c, v, rigid));
+}
+
+void FaceContactSet::takeImpulses(const Eigen::VectorXd& v,
+                                  const std::vector<RigidPartner>& partners, double dt,
+                                  Eigen::VectorXd& node_impulse) {
+  for (FaceContact& c : contacts_) {
+    if (!participates(c)) {
+      c.impulse.setZero();
+      continue;
+    }
+    const Eigen::Vector3d rigid =
+        pointVelocity(partners[static_cast<size_t>(c.partner)].velocity, c.lever);
+    const Eigen::Vector3d h = relativeVelocity(c, v, rigid) + c.normal * (c.gap / dt);
+    c.impulse = c.multiplier - c.penalty * (projector(c) * h);
+    for (size_t j = 0; j < 3; ++j)
+      node_impulse.segment<3>(3 * c.nodes[j]) -=
+          c.weights[static_cast<Eigen::Index>(j)] * c.impulse;
+  }
+}
+
+bool FaceContactSet::update(const Eigen::VectorXd& v, const std::vector<RigidPartner>& partners,
+                            double dt, double activation_tolerance, double gap_tolerance) {
+  bool again = false;
+  for (FaceContact& c : contacts_) {
+    const Eigen::Vector3d rigid =
+        pointVelocity(partners[static_cast<size_t>(c.partner)].velocity, c.lever);
+    const Eigen::Vector3d h = relativeVelocity(c, v, rigid) + c.normal * (c.gap / dt);
+    const double end_gap = dt * c.normal.dot(h);
+    if (c.determined) continue;
+    if (c.state == FaceContact::State::kInactive) {
+      // Within the stated tolerance a face stays out: activating an edge contact for a
+      // micrometre, releasing it the next solve, and the nodes' friction following each time,
+      // was most of the active-set iterations of rigid_mix.
+      if (end_gap < -std::max(activation_tolerance, gap_tolerance)) {
+        c.state = mayStick(c, partners[static_cast<size_t>(c.partner)])
+                      ? FaceContact::State::kStick
+                      : FaceContact::State::kSlide;
+        c.multiplier.setZero();
+        again = true;
+      }
+      continue;
+    }
+    // A violation that does not shrink is a constraint the others leave no room for (a rigid
+    // body squeezed between held faces, or nodes held by another body): after kMaxStalls
+    // updates its multiplier stops growing for the rest of the step, and its rigid partner
+    // takes the violation instead of an unbounded impulse.
+    const double violation = std::abs(end_gap);
+    if (c.last_violation > 0 && violation > gap_tolerance && violation > 0.95 * c.last_violation)
+      ++c.stalls;
+    c.last_violation = violation;
+    if (c.stalls > kMaxStalls) continue;
+    // Uzawa: the multiplier moves by -rho h, then onto Coulomb's cone.
+    const Eigen::Vector3d trial = c.multiplier - c.penalty * h;
+    const double lambda = c.normal.dot(trial);
+    if (lambda <= 0) {
+      if (c.releases == 0) {
+        ++c.releases;
+        c.state = FaceContact::State::kInactive;
+        c.multiplier.setZero();
+        again = true;
+      } else {
+        c.multiplier.setZero();  // released once already this step: stays, pushing nothing
+      }
+      continue;
+    }
+    const Eigen::Vector3d tangential = trial - c.normal * lambda;
+    const double bound = c.friction * lambda;
+    const FaceContact::State before = c.state;
+    if (mayStick(c, partners[static_cast<size_t>(c.partner)]) && tangential.norm() <= bound) {
+      c.state = FaceContact::State::kStick;
+      c.multiplier = trial;
+    } else {
+      c.state = FaceContact::State::kSlide;
+      c.multiplier = c.normal * lambda;
+      if (c.friction > 0) c.multiplier += bound * tangential.normalized();
+    }
+    // Another solve while the end gap is off, or for a stick/slide switch, at most kMaxSwitches
+    // per step: the tangential impulses of neighbouring contacts are coupled through the body and
+    // switching can cycle (as for nodes). The stick's slip is not a criterion: its penalty keeps
+    // it at the scale of the gap tolerance, and friction needs no more.
+    if (c.state != before && c.switches++ < kMaxSwitches) again = true;
+    if (violation > gap_tolerance) again = true;
+  }
+  return again;
+}
+
+}  // namespace torsion
