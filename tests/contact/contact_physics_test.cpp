@@ -8,7 +8,7 @@
 #include <iostream>
 
 #include "contact_fixtures.h"
-#include "torsion/contact/shape_distance.h"
+#include "resting_box.h"
 
 namespace torsion::test {
 namespace {
@@ -44,87 +44,41 @@ TEST(ContactPhysics, DroppedBallRestsOnGround) {
             << " m, contacts " << ball->contacts().stats().active << "\n";
 }
 
-// The vertical force a slab exerts on its top patch [-a, a]^2 held at depth `depth` below its
-// rest height (bonded, the rest of the slab free, bottom fixed), at static equilibrium: the
-// reference for the resting box (a rigid flat punch, sticking, is exactly this load case).
-// Returns (force, weight of the patch's own nodes), N.
-std::pair<double, double> punchForce(double a, double depth, const Material& m, double top,
-                                     int steps) {
-  WorldSettings s = contactSettings(0.01);
-  FemWorld world(s);
-  Material damped = m;
-  damped.mass_damping = 20;  // only the equilibrium matters
-  FemBody* slab = addBox(world, "slab", {-0.5, -0.5, 0}, {0.5, 0.5, top}, 8, 8, 2, damped);
-  std::vector<int> base, patch;
-  for (int i = 0; i < slab->model().nodeCount(); ++i) {
-    const Eigen::Vector3d x = slab->state().position(i);
-    if (x.z() < 1e-9) base.push_back(i);
-    if (x.z() > top - 1e-9 && std::abs(x.x()) <= a + 1e-9 && std::abs(x.y()) <= a + 1e-9)
-      patch.push_back(i);
-  }
-  slab->carryNodes(
-      "base", base, [](double) { return Frame{}; }, 0.0);
-  const double ramp = 0.5 * steps * s.solver.time_step;
-  const int group = slab->carryNodes(
-      "patch", patch,
-      [=](double t) {
-        Frame f;
-        f.origin.z() = -depth * std::min(1.0, t / ramp);
-        return f;
-      },
-      0.0);
-  for (int k = 0; k < steps; ++k)
-    EXPECT_TRUE(world.step().ok);
-  double patch_mass = 0;
-  for (int i : patch)
-    patch_mass += slab->model().nodeMasses()[static_cast<size_t>(i)];
-  return {slab->groupWrench(group, Eigen::Vector3d::Zero()).force.z(), patch_mass * kGravity};
-}
-
 // A rigid box resting on a deformable slab stays at rest on it, penetration within tolerance over
-// 10 s, and the slab's sag under it matches the static equilibrium within 10 %.
+// 10 s, and the slab's sag under it is the slab's static equilibrium under the box's weight.
+//
+// The slab is meshed for the box (punch_reference.h): node rows 1 mm inside the box's edges, so
+// the nodes under the box are its footprint. Its static equilibrium on the same mesh (bonded
+// rigid punch) is what the contact scheme must reach; the mesh-converged reference and the 10 %
+// of issue 6 are checked on a tet10 slab (ContactTet10.BoxRestsOnSlabWithConvergedSag): tet4 is
+// stiff here, 22 % below the converged sag on these 8x8x2 cells, still 9 % below on 24x24x4
+// (3125 nodes, 24 s a run), while tet10 on 8x8x2 cells (1445 nodes) is 7 % below.
 TEST(ContactPhysics, BoxRestsOnSlabWithStaticSag) {
-  const double top = 0.2, a = 0.25, box_mass = 20;
-  const Material m = softMaterial(2e4, 100);
-  FemWorld world(contactSettings(0.01));
-  FemBody* slab = addBox(world, "slab", {-0.5, -0.5, 0}, {0.5, 0.5, top}, 8, 8, 2, m);
-  std::vector<int> base;
-  for (int i = 0; i < slab->model().nodeCount(); ++i) {
-    if (slab->state().position(i).z() < 1e-9) base.push_back(i);
-  }
-  slab->carryNodes(
-      "base", base, [](double) { return Frame{}; }, 0.0);
-  // The box overhangs the patch of nodes [-a, a]^2 by 2 cm: no node sits exactly under an edge.
-  btRigidBody* box =
-      world.addRigidBody(std::make_unique<btBoxShape>(btVector3(a + 0.02, a + 0.02, 0.05)),
-                         box_mass, at({0, 0, top + 0.05 + 0.02}));
-  box->setFriction(1.0);
-
-  double worst_penetration = 0;  // measured on the geometry after each step
-  for (int k = 0; k < 1000; ++k) {
-    ASSERT_TRUE(world.step().ok) << "step " << k;
-    for (int i = 0; i < slab->model().nodeCount(); ++i) {
-      auto d = signedDistance(*box->getCollisionShape(), box->getWorldTransform(),
-                              slab->state().position(i), 0);
-      if (d) worst_penetration = std::max(worst_penetration, -d->distance);
-    }
-  }
-  const Eigen::Vector3d p = toEigen(box->getCenterOfMassPosition());
-  const double sag = top - (p.z() - 0.05);
-  // At rest above the slab, centred.
-  EXPECT_LT(toEigen(box->getLinearVelocity()).norm(), 1e-3);
-  EXPECT_LT(std::hypot(p.x(), p.y()), 1e-3);
-  EXPECT_LT(worst_penetration, 1e-4);  // 0.1 mm, against a sag of millimetres
-
-  // Reference: the patch must carry the box and its own nodes' weight; the slab's elastic force
-  // on it is linear in the depth (small strain): f(d) = f0 + (f1 - f0) d / 4 mm.
-  const auto [f0, patch_weight] = punchForce(a, 0.0, m, top, 400);
-  const double f1 = punchForce(a, 0.004, m, top, 400).first;
-  const double reference = 0.004 * (box_mass * kGravity + patch_weight - f0) / (f1 - f0);
-  std::cout << "[figures] box on slab: sag " << sag << " m, reference " << reference
-            << " m, worst penetration " << worst_penetration << " m, contacts "
-            << slab->contacts().stats().active << "\n";
-  EXPECT_NEAR(sag, reference, 0.1 * reference);
+  PunchProblem p;
+  p.punch_half_width = 0.27;  // the box's footprint, 0.54 m square
+  p.load = 20 * kGravity;     // a 20 kg box
+  p.material = softMaterial(2e4, 100);
+  const double row = p.punch_half_width - 0.001;
+  const RestingBoxRun run = runRestingBox(p, 8, 2, ElementKind::kTet4, 10.0, row);
+  const PunchSolution same_mesh = staticPunchSag(p, 8, 2, ElementKind::kTet4, row);
+  std::cout << "[figures] box on slab (tet4 8x8x2, " << run.slab_nodes << " nodes): sag " << run.sag
+            << " m, static on the same mesh " << same_mesh.sag << " m, worst penetration "
+            << run.worst_penetration << " m, contacts " << run.contacts << " of "
+            << same_mesh.patch_nodes << " nodes under the box, active-set iterations max "
+            << run.most_active_set_iterations << ", unconverged steps " << run.unconverged_steps
+            << "\n";
+  // At rest above the slab, centred: 1 mm/s and 1 mm against a 2 cm drop settled for 10 s.
+  EXPECT_LT(run.box_speed, 1e-3);
+  EXPECT_LT(run.off_centre, 1e-3);
+  EXPECT_LT(run.worst_penetration, 1e-4);  // 0.1 mm, against a sag of millimetres
+  EXPECT_EQ(run.unconverged_steps, 0);
+  // The dynamic rest is the static equilibrium of the same discrete slab: the only differences
+  // are the corotated (vs linear) force and the contact's sticking (vs bonded) nodes, each well
+  // below 1 % here (measured 0.2 %); 2 % flags a contact scheme that holds the box off its
+  // equilibrium, e.g. by a penalty stiffness or a lost contact.
+  EXPECT_NEAR(run.sag, same_mesh.sag, 0.02 * same_mesh.sag);
+  // Every node under the box carries it (sticking, bonded-like).
+  EXPECT_EQ(run.contacts, same_mesh.patch_nodes);
 }
 
 // A deformable block slides on frictionless ground into a free rigid box: the horizontal momentum
