@@ -77,8 +77,12 @@ TEST(ContactPhysics, BoxRestsOnSlabWithStaticSag) {
   // below 1 % here (measured 0.2 %); 2 % flags a contact scheme that holds the box off its
   // equilibrium, e.g. by a penalty stiffness or a lost contact.
   EXPECT_NEAR(run.sag, same_mesh.sag, 0.02 * same_mesh.sag);
-  // Every node under the box carries it (sticking, bonded-like).
-  EXPECT_EQ(run.contacts, same_mesh.patch_nodes);
+  // The slab follows the box: no node under it hangs below it by more than 10 % of the sag (the
+  // box is carried by the interior nodes and, 1 mm beyond the rim row, by face contacts along its
+  // edges; measured 9 node and 16 face contacts).
+  EXPECT_LT(run.largest_gap_under_box, 0.1 * run.sag);
+  EXPECT_GT(run.contacts, 0);
+  EXPECT_GT(run.face_contacts, 0);
 }
 
 // A deformable block slides on frictionless ground into a free rigid box: the horizontal momentum

@@ -20,6 +20,7 @@ struct RestingBoxRun {
   double box_speed = 0;          ///< m/s, at the end
   double off_centre = 0;         ///< m, horizontal drift of the box's centre
   int contacts = 0;              ///< active node contacts at the end
+  int face_contacts = 0;         ///< face contacts (docs/contact.md), not in `contacts`
   int corner_contacts = 0;       ///< of which at nodes of the linear mesh (tet10: element corners)
   /// m, at the end: the largest distance of a node under the box (top nodes within its
   /// footprint) below the box's bottom face: how well the slab's surface follows the box.
@@ -76,7 +77,9 @@ inline RestingBoxRun runRestingBox(const PunchProblem& p, int cells_across, int 
   run.sag = p.top - (centre.z() - box_half_height);
   run.box_speed = toEigen(box->getLinearVelocity()).norm();
   run.off_centre = std::hypot(centre.x(), centre.y());
-  run.contacts = slab->contacts().stats().active;
+  // Node contacts (face contacts are counted apart: they hold the box's edges between nodes).
+  run.contacts = slab->contacts().stats().active - slab->contacts().stats().face_active;
+  run.face_contacts = slab->contacts().stats().face_active;
   const int corners = slab->model().linearMeshPtr()->nodeCount();  // P2 nodes come after them
   for (const NodeContact& contact : slab->contacts().contacts()) {
     if (contact.state != NodeContact::State::kInactive && contact.node < corners)
