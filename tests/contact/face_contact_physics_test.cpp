@@ -13,7 +13,6 @@
 namespace torsion::test {
 namespace {
 
-constexpr double kGravity = 9.81;
 
 // Deepest penetration of the rigid shape into the body's surface (faces and nodes), m, >= 0.
 double surfacePenetration(const FemBody& body, const btRigidBody& rigid) {
