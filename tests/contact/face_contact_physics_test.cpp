@@ -13,7 +13,6 @@
 namespace torsion::test {
 namespace {
 
-
 // Deepest penetration of the rigid shape into the body's surface (faces and nodes), m, >= 0.
 double surfacePenetration(const FemBody& body, const btRigidBody& rigid) {
   double deepest = 0;
