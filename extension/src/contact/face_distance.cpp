@@ -105,20 +105,35 @@ std::optional<FacePoint> gjkToTriangle(const btConvexShape& convex, double margi
   return std::nullopt;
 }
 
-// GJK stops within about 1e-4 of the distance; the point-to-shape distance at the face point it
-// found is exact (closed form for boxes) and can only be nearer: take it, with its normal, when
+// GJK stops within about 1e-4 of the distance and its face point can be off by as much.
+// Alternating projections (the shape's exact closest point to the face point, then the face's to
+// that) converge to the closest pair of two convex sets and only ever shorten the distance: a few
+// of them polish GJK's answer, with the exact point distance (closed form for boxes). Only while
 // both are clear of the shape (inside, the nearest exit of a point may run along the face).
 std::optional<FacePoint> polish(const btCollisionShape& shape, const btTransform& transform,
                                 const Corners& t, std::optional<FacePoint> f) {
   if (!f || f->distance <= 0) return f;
-  const Eigen::Vector3d on_face =
-      f->barycentric[0] * t[0] + f->barycentric[1] * t[1] + f->barycentric[2] * t[2];
-  const std::optional<SurfacePoint> exact = signedDistance(shape, transform, on_face, 0);
-  if (!exact || exact->distance <= 0 || exact->distance > f->distance) return f;
-  if (exact->normal.dot(unitNormal(t)) >= 0) return f;
-  f->distance = exact->distance;
-  f->normal = exact->normal;
-  f->shape_point = on_face - exact->distance * exact->normal;
+  Eigen::Vector3d weights = f->barycentric;
+  Eigen::Vector3d on_face = weights[0] * t[0] + weights[1] * t[1] + weights[2] * t[2];
+  std::optional<SurfacePoint> best;
+  Eigen::Vector3d best_weights = weights;
+  for (int k = 0; k < 32; ++k) {
+    const std::optional<SurfacePoint> exact = signedDistance(shape, transform, on_face, 0);
+    if (!exact || exact->distance <= 0 || exact->normal.dot(unitNormal(t)) >= 0) break;
+    if (best && exact->distance >= best->distance) break;
+    best = exact;
+    best_weights = weights;
+    const Eigen::Vector3d on_shape = on_face - exact->distance * exact->normal;
+    const Eigen::Vector3d next = closestPointOnTriangle(on_shape, t[0], t[1], t[2], &weights);
+    if ((next - on_face).norm() < 1e-13) break;
+    on_face = next;
+  }
+  if (!best || best->distance > f->distance) return f;
+  f->barycentric = best_weights;
+  on_face = best_weights[0] * t[0] + best_weights[1] * t[1] + best_weights[2] * t[2];
+  f->distance = best->distance;
+  f->normal = best->normal;
+  f->shape_point = on_face - best->distance * best->normal;
   return f;
 }
 
