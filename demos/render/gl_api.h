@@ -12,18 +12,53 @@ namespace torsion::render {
 
 // Each entry: the name without its "gl" prefix. The member's type is taken from <GL/gl.h>'s
 // declaration (decltype is unevaluated: no link-time reference to the symbol).
-#define TORSION_GL_FUNCTIONS(X)                                                                   \
-  X(Viewport)                                                                                     \
-  X(ClearColor)                                                                                   \
-  X(Clear)                                                                                        \
-  X(Enable)                                                                                       \
-  X(Disable) X(BlendFunc) X(DepthMask) X(DepthFunc) X(MatrixMode) X(LoadIdentity) X(LoadMatrixd)  \
-      X(PushMatrix) X(PopMatrix) X(Ortho) X(Lightfv) X(LightModelfv) X(LightModeli) X(Materialfv) \
-          X(Materialf) X(ColorMaterial) X(ShadeModel) X(Begin) X(End) X(Vertex3d) X(Vertex2d)     \
-              X(Normal3d) X(Color4d) X(LineWidth) X(PointSize) X(PolygonOffset)                   \
-                  X(EnableClientState) X(DisableClientState) X(VertexPointer) X(NormalPointer)    \
-                      X(ColorPointer) X(DrawElements) X(ReadPixels) X(PixelStorei) X(Finish)      \
-                          X(GetError) X(Hint) X(GetString) X(PolygonMode)
+// One entry per line; the formatter would staircase the macro list.
+// clang-format off
+#define TORSION_GL_FUNCTIONS(X) \
+  X(Viewport) \
+  X(ClearColor) \
+  X(Clear) \
+  X(Enable) \
+  X(Disable) \
+  X(BlendFunc) \
+  X(DepthMask) \
+  X(DepthFunc) \
+  X(MatrixMode) \
+  X(LoadIdentity) \
+  X(LoadMatrixd) \
+  X(PushMatrix) \
+  X(PopMatrix) \
+  X(Ortho) \
+  X(Lightfv) \
+  X(LightModelfv) \
+  X(LightModeli) \
+  X(Materialfv) \
+  X(Materialf) \
+  X(ColorMaterial) \
+  X(ShadeModel) \
+  X(Begin) \
+  X(End) \
+  X(Vertex3d) \
+  X(Vertex2d) \
+  X(Normal3d) \
+  X(Color4d) \
+  X(LineWidth) \
+  X(PointSize) \
+  X(PolygonOffset) \
+  X(EnableClientState) \
+  X(DisableClientState) \
+  X(VertexPointer) \
+  X(NormalPointer) \
+  X(ColorPointer) \
+  X(DrawElements) \
+  X(ReadPixels) \
+  X(PixelStorei) \
+  X(Finish) \
+  X(GetError) \
+  X(Hint) \
+  X(GetString) \
+  X(PolygonMode)
+// clang-format on
 
 struct GlApi {
 #define TORSION_GL_MEMBER(name) decltype(&::gl##name) name = nullptr;

@@ -28,10 +28,6 @@ Eigen::Matrix<double, 3, 6> pointJacobian(const Eigen::Vector3d& r) {
   return J;  // J V = v + omega x r = v - [r]x omega
 }
 
-bool mayStick(const FaceContact& c, const RigidPartner& /*p*/) {
-  return c.friction > 0;
-}
-
 // Whether the contact takes part in this solve.
 bool participates(const FaceContact& c) {
   return c.state != FaceContact::State::kInactive && !c.determined;
@@ -130,13 +126,13 @@ void FaceContactSet::detect(const FemState& state, const NodeConstraints& held,
       FaceContact fc;
       fc.nodes = {tri[0], tri[1], tri[2]};
       fc.weights = f->barycentric;
+      // Sorted nodes of non-zero weight, -1 padded (no per-triangle allocation: a hot loop).
       fc.key = {-1, -1, -1};
-      std::vector<int> key;
+      size_t used = 0;
       for (size_t j = 0; j < 3; ++j) {
-        if (fc.weights[static_cast<Eigen::Index>(j)] > kEdgeWeight) key.push_back(tri[j]);
+        if (fc.weights[static_cast<Eigen::Index>(j)] > kEdgeWeight) fc.key[used++] = tri[j];
       }
-      std::sort(key.begin(), key.end());
-      std::copy(key.begin(), key.end(), fc.key.begin());
+      std::sort(fc.key.begin(), fc.key.begin() + static_cast<std::ptrdiff_t>(used));
       fc.partner = partner;
       fc.normal = f->normal;
       fc.gap = f->distance;
@@ -155,7 +151,7 @@ void FaceContactSet::detect(const FemState& state, const NodeConstraints& held,
       }
       const auto remembered = previous_.find({fc.key, p.object});
       if (remembered != previous_.end()) {
-        fc.state = mayStick(fc, p) ? remembered->second.state : FaceContact::State::kSlide;
+        fc.state = fc.friction > 0 ? remembered->second.state : FaceContact::State::kSlide;
         fc.multiplier = remembered->second.multiplier;
       }
       index_[{fc.key, partner}] = static_cast<int>(contacts_.size());
@@ -275,9 +271,7 @@ bool FaceContactSet::update(const Eigen::VectorXd& v, const std::vector<RigidPar
       // micrometre, releasing it the next solve, and the nodes' friction following each time,
       // was most of the active-set iterations of rigid_mix.
       if (end_gap < -std::max(activation_tolerance, gap_tolerance)) {
-        c.state = mayStick(c, partners[static_cast<size_t>(c.partner)])
-                      ? FaceContact::State::kStick
-                      : FaceContact::State::kSlide;
+        c.state = c.friction > 0 ? FaceContact::State::kStick : FaceContact::State::kSlide;
         c.multiplier.setZero();
         again = true;
       }
@@ -309,7 +303,7 @@ bool FaceContactSet::update(const Eigen::VectorXd& v, const std::vector<RigidPar
     const Eigen::Vector3d tangential = trial - c.normal * lambda;
     const double bound = c.friction * lambda;
     const FaceContact::State before = c.state;
-    if (mayStick(c, partners[static_cast<size_t>(c.partner)]) && tangential.norm() <= bound) {
+    if (c.friction > 0 && tangential.norm() <= bound) {
       c.state = FaceContact::State::kStick;
       c.multiplier = trial;
     } else {
