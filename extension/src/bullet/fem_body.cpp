@@ -61,11 +61,31 @@ void FemBody::setVelocity(const Eigen::Vector3d& velocity) {
   writeBack();
 }
 
-void FemBody::setGravity(const Eigen::Vector3d& gravity) {
-  gravity_ = gravity;
-  for (int i = 0; i < model_->nodeCount(); ++i) {
-    external_forces_.segment<3>(3 * i) = model_->nodeMasses()[static_cast<size_t>(i)] * gravity;
+Status FemBody::setExternalForces(const Eigen::VectorXd& forces) {
+  if (forces.size() != external_forces_.size()) {
+    return Error{"body '" + name_ + "': external forces have " + std::to_string(forces.size()) +
+                 " components, the body has " + std::to_string(model_->nodeCount()) +
+                 " nodes (3 each)"};
   }
+  for (int i = 0; i < model_->nodeCount(); ++i) {
+    if (!forces.segment<3>(3 * i).allFinite())
+      return Error{"body '" + name_ + "': external force on node " + std::to_string(i) +
+                   " is not finite"};
+  }
+  external_forces_ = forces;
+  return Ok{};
+}
+
+Status FemBody::setNodeForce(int node, const Eigen::Vector3d& force) {
+  if (node < 0 || node >= model_->nodeCount()) {
+    return Error{"body '" + name_ + "': node " + std::to_string(node) + " out of range [0, " +
+                 std::to_string(model_->nodeCount()) + ")"};
+  }
+  if (!force.allFinite())
+    return Error{"body '" + name_ + "': external force on node " + std::to_string(node) +
+                 " is not finite"};
+  external_forces_.segment<3>(3 * node) = force;
+  return Ok{};
 }
 
 Status FemBody::setMaterial(const Material& material) {
@@ -73,8 +93,7 @@ Status FemBody::setMaterial(const Material& material) {
   if (!model) return Error{"body '" + name_ + "': " + model.error().message};
   model_ = std::move(model).value();
   stepper_.replaceModel(model_);
-  contacts_->replaceModel(model_);
-  setGravity(gravity_);  // m_i g with the new masses
+  contacts_->replaceModel(model_);  // gravity follows the new masses at the next step
   for (int i = 0; i < model_->nodeCount(); ++i)
     soft_body_->m_nodes[i].m_im = 1 / model_->nodeMasses()[static_cast<size_t>(i)];
   return Ok{};
@@ -100,10 +119,14 @@ void FemBody::predict(double dt) {
   contacts_->beginStep(dt);
 }
 
-const StepReport& FemBody::advance(double now, double dt) {
+const StepReport& FemBody::advance(const StepContext& ctx) {
+  const double dt = ctx.dt;
   constraints_.reset(model_->nodeCount());
   for (const auto& group : groups_)
-    group->prescribe(now + dt, dt, state_, constraints_);
+    group->prescribe(ctx.endTime(), dt, state_, constraints_);
+  step_forces_ = external_forces_;
+  for (int i = 0; i < model_->nodeCount(); ++i)
+    step_forces_.segment<3>(3 * i) += model_->nodeMasses()[static_cast<size_t>(i)] * ctx.gravity;
   // Contacts with rigid bodies: unilateral constraints in the same projected solve.
   if (contacts_->detect(state_, constraints_, dt)) {
     stepper_.setLinearSolveHook(
@@ -113,7 +136,7 @@ const StepReport& FemBody::advance(double now, double dt) {
   } else {
     stepper_.setLinearSolveHook({});
   }
-  last_report_ = stepper_.step(state_, constraints_, external_forces_);
+  last_report_ = stepper_.step(state_, constraints_, step_forces_, dt);
   if (!isFatal(last_report_.health)) contacts_->finish();
   if (!isFatal(last_report_.health)) writeBack();
   return last_report_;

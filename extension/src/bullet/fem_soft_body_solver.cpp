@@ -1,46 +1,284 @@
 #include "torsion/bullet/fem_soft_body_solver.h"
 
+#include <BulletSoftBody/btSoftMultiBodyDynamicsWorld.h>
+#include <BulletSoftBody/btSoftRigidDynamicsWorld.h>
+
 #include <algorithm>
+#include <sstream>
+
+#include "torsion/bullet/bt_conversions.h"
 
 namespace torsion {
 
-void FemSoftBodySolver::unregisterBody(FemBody* body) {
-  bodies_.erase(std::remove(bodies_.begin(), bodies_.end(), body), bodies_.end());
+namespace {
+
+// Whether the broadphase pair really touches: some node of one within both bodies' margins of a
+// node of the other (Bullet's node trees, whose leaves are the nodes' boxes grown by the margin).
+// Bounding boxes alone overlap long before bodies touch (a ball over a slab's corner).
+bool nodesTouch(btSoftBody& a, btSoftBody& b) {
+  struct Probe : btDbvt::ICollide {
+    bool hit = false;
+    void Process(const btDbvtNode* /*na*/, const btDbvtNode* /*nb*/) override { hit = true; }
+    bool Descent(const btDbvtNode* /*node*/) override { return !hit; }
+  } probe;
+  if (a.m_ndbvt.m_root == nullptr || b.m_ndbvt.m_root == nullptr) return false;
+  a.m_ndbvt.collideTT(a.m_ndbvt.m_root, b.m_ndbvt.m_root, probe);
+  return probe.hit;
 }
 
-void FemSoftBodySolver::optimize(btAlignedObjectArray<btSoftBody*>& /*soft_bodies*/,
-                                 bool /*force_update*/) {
-  // Our bodies register themselves through FemWorld; nothing to rebuild per step.
+const char* const kNotOurSolver =
+    "the world steps its soft bodies with another solver: construct it with a "
+    "torsion::FemSoftBodySolver as its last argument (Bullet takes the soft-body solver only at "
+    "construction), e.g. btSoftRigidDynamicsWorld world(&dispatcher, &broadphase, &solver, "
+    "&config, &fem)";
+
+// Bullet's worlds do not say which soft-body solver they were built with, but they hand it to
+// every soft body they take in: ask with a one-node probe, added and removed at once.
+template <class World>
+btSoftBodySolver* softBodySolverOf(World& world) {
+  btVector3 origin(0, 0, 0);
+  btScalar mass = 0;
+  btSoftBody probe(&world.getWorldInfo(), 1, &origin, &mass);
+  world.addSoftBody(&probe);
+  btSoftBodySolver* solver = probe.getSoftBodySolver();
+  world.removeSoftBody(&probe);
+  return solver;
 }
 
-void FemSoftBodySolver::predictMotion(btScalar /*solver_dt*/) {
-  for (FemBody* body : bodies_)
-    body->predict(time_step_);
+template <class World>
+Result<FemSoftBodySolver*> attachTo(World& world) {
+  auto* fem = dynamic_cast<FemSoftBodySolver*>(softBodySolverOf(world));
+  if (fem == nullptr) return Error{kNotOurSolver};
+  if (Status bound = fem->bind(world); !bound) return bound.error();
+  return fem;
 }
 
-void FemSoftBodySolver::solveConstraints(btScalar /*solver_dt*/) {
-  reports_.clear();
-  for (FemBody* body : bodies_)
-    reports_.push_back(&body->advance(time_, time_step_));
+}  // namespace
+
+FemSoftBodySolver::FemSoftBodySolver(const SolverSettings& settings)
+    : settings_(settings), parallel_(settings.threads) {}
+
+// The world uses this solver until it is destroyed, and destroys its collision objects' broadphase
+// proxies then: the world must go first (documented), so here the bodies are only freed.
+FemSoftBodySolver::~FemSoftBodySolver() = default;
+
+Status FemSoftBodySolver::bind(btSoftRigidDynamicsWorld& world) {
+  if (world_ != &world && softBodySolverOf(world) != this) return Error{kNotOurSolver};
+  return bindWorld(
+      &world, &world.getWorldInfo(), [&world](btSoftBody* soft) { world.addSoftBody(soft); },
+      [&world](btSoftBody* soft) { world.removeSoftBody(soft); });
+}
+
+Status FemSoftBodySolver::bind(btSoftMultiBodyDynamicsWorld& world) {
+  if (world_ != &world && softBodySolverOf(world) != this) return Error{kNotOurSolver};
+  return bindWorld(
+      &world, &world.getWorldInfo(), [&world](btSoftBody* soft) { world.addSoftBody(soft); },
+      [&world](btSoftBody* soft) { world.removeSoftBody(soft); });
+}
+
+Status FemSoftBodySolver::bindWorld(btDiscreteDynamicsWorld* world, btSoftBodyWorldInfo* info,
+                                    std::function<void(btSoftBody*)> add,
+                                    std::function<void(btSoftBody*)> remove) {
+  if (world_ == world) return Ok{};
+  if (world_ != nullptr) {
+    return Error{
+        "this FemSoftBodySolver is already attached to another world: a world needs its own "
+        "solver"};
+  }
+  world_ = world;
+  world_info_ = info;
+  add_to_world_ = std::move(add);
+  remove_from_world_ = std::move(remove);
+  return Ok{};
+}
+
+Result<FemBody*> FemSoftBodySolver::addBody(const std::string& name, const TetMesh& mesh,
+                                            const Material& material, const Frame& pose,
+                                            ElementKind element) {
+  if (!bound()) {
+    return Error{"body '" + name +
+                 "': the solver is not attached to a world yet (torsion::attach(world) first)"};
+  }
+  if (body(name) != nullptr) return Error{"body '" + name + "' already exists"};
+  std::vector<Eigen::Vector3d> placed = mesh.restPositions();
+  for (Eigen::Vector3d& p : placed)
+    p = pose.toWorld(p);
+  auto placed_mesh = std::make_shared<const TetMesh>(std::move(placed), mesh.tets());
+  Result<std::shared_ptr<const FemModel>> model = FemModel::create(placed_mesh, material, element);
+  if (!model) return Error{"body '" + name + "': " + model.error().message};
+  auto body =
+      std::make_unique<FemBody>(name, std::move(model).value(), settings_, parallel_, *world_info_);
+  add_to_world_(body->softBody());
+  bodies_.push_back(std::move(body));
+  return bodies_.back().get();
+}
+
+void FemSoftBodySolver::removeBody(FemBody* body) {
+  auto it = std::find_if(bodies_.begin(), bodies_.end(),
+                         [body](const std::unique_ptr<FemBody>& b) { return b.get() == body; });
+  if (it == bodies_.end()) return;
+  remove_from_world_((*it)->softBody());
+  bodies_.erase(it);
+}
+
+FemBody* FemSoftBodySolver::body(const std::string& name) const {
+  for (const auto& b : bodies_) {
+    if (b->name() == name) return b.get();
+  }
+  return nullptr;
+}
+
+FemBody* FemSoftBodySolver::femBodyOf(const btSoftBody* soft) const {
+  for (const auto& b : bodies_) {
+    if (b->softBody() == soft) return b.get();
+  }
+  return nullptr;
+}
+
+Status FemSoftBodySolver::setSolverSettings(const SolverSettings& settings) {
+  if (Status valid = settings.validate(); !valid) return valid;
+  if (settings.threads != settings_.threads) {
+    return Error{"solver: threads = " + std::to_string(settings.threads) +
+                 ": cannot change while the world runs (it has " +
+                 std::to_string(settings_.threads) + "); build a new world"};
+  }
+  settings_ = settings;
+  for (const auto& body : bodies_)
+    body->stepper().setSettings(settings);
+  return Ok{};
+}
+
+void FemSoftBodySolver::addStepListener(StepListener* listener) {
+  listeners_.push_back(listener);
+}
+
+void FemSoftBodySolver::removeStepListener(StepListener* listener) {
+  listeners_.erase(std::remove(listeners_.begin(), listeners_.end(), listener), listeners_.end());
+}
+
+void FemSoftBodySolver::fail(std::string message) {
+  if (!status_.ok) return;  // the first failure is the one to read
+  status_.ok = false;
+  status_.failed_step = steps_ + 1;
+  status_.message = std::move(message);
+}
+
+// ---- Bullet's calls, in the order of one substep ----
+
+void FemSoftBodySolver::optimize(btAlignedObjectArray<btSoftBody*>& soft_bodies,
+                                 bool force_update) {
+  // Bullet's own soft bodies go to Bullet's default solver; ours are stepped below.
+  bullet_bodies_.resize(0);
+  for (int i = 0; i < soft_bodies.size(); ++i) {
+    if (femBodyOf(soft_bodies[i]) == nullptr) bullet_bodies_.push_back(soft_bodies[i]);
+  }
+  bullet_solver_.optimize(bullet_bodies_, force_update);
+}
+
+void FemSoftBodySolver::predictMotion(btScalar solver_dt) {
+  // Bullet's worlds pass float(dt) here (the exact dt arrives in solveConstraints): it only
+  // predicts the motion that collision detection looks along.
+  const double dt = static_cast<double>(solver_dt);
+  if (status_.ok) {
+    for (const auto& body : bodies_)
+      body->predict(dt);
+  }
+  bullet_solver_.predictMotion(solver_dt);
+}
+
+void FemSoftBodySolver::solveConstraints(btScalar solver_dt) {
+  bullet_solver_.solveConstraints(solver_dt);
+  if (!status_.ok || bodies_.empty() || !(solver_dt > 0)) return;
+
+  StepContext ctx;
+  ctx.time = time_;
+  ctx.dt = static_cast<double>(solver_dt);
+  ctx.index = steps_ + 1;
+  ctx.gravity = toEigen(world_->getGravity());
+
+  for (StepListener* listener : listeners_)
+    listener->beforeFemStep(ctx);
+  bool ok = status_.ok;  // an unsupported contact found in this substep's detection fails it
+  for (const auto& body : bodies_) {
+    if (!ok) break;
+    const StepReport& report = body->advance(ctx);
+    if (isFatal(report.health)) {
+      std::ostringstream s;
+      s << "body '" << body->name() << "', step " << ctx.index << ": " << toString(report.health)
+        << ": " << report.message;
+      fail(s.str());
+      ok = false;
+    }
+  }
+  time_ += ctx.dt;
+  last_dt_ = ctx.dt;
+  ++steps_;
+  for (StepListener* listener : listeners_)
+    listener->afterFemStep(ctx, ok);
 }
 
 void FemSoftBodySolver::updateSoftBodies() {
-  for (FemBody* body : bodies_) {
+  for (const auto& body : bodies_) {
     body->softBody()->updateNormals();
     body->softBody()->updateBounds();
   }
+  bullet_solver_.updateSoftBodies();
 }
 
-void FemSoftBodySolver::processCollision(btSoftBody* soft, const btCollisionObjectWrapper* rigid) {
+void FemSoftBodySolver::processCollision(btSoftBody* soft, const btCollisionObjectWrapper* other) {
   // A broadphase pair: our narrow phase runs in FemBody::advance, at the rigid body's pose after
-  // Bullet's rigid integration (docs/contact.md). Bullet's own CollideSDF_RS is not used.
-  for (FemBody* body : bodies_) {
-    if (body->softBody() == soft) body->contacts().addCandidate(rigid->getCollisionObject());
+  // Bullet's rigid integration (docs/contact.md). Bullet's soft bodies collide as Bullet does.
+  if (FemBody* body = femBodyOf(soft)) {
+    body->contacts().addCandidate(other->getCollisionObject());
+  } else {
+    soft->defaultCollisionHandler(other);
   }
 }
 
 void FemSoftBodySolver::processCollision(btSoftBody* a, btSoftBody* b) {
-  a->defaultCollisionHandler(b);
+  const bool a_fem = femBodyOf(a) != nullptr;
+  const bool b_fem = femBodyOf(b) != nullptr;
+  if (!a_fem && !b_fem) {
+    a->defaultCollisionHandler(b);
+    return;
+  }
+  if (a != b && nodesTouch(*a, *b)) unsupportedPair(a, b);
+}
+
+std::string FemSoftBodySolver::describe(const btSoftBody* soft) const {
+  if (FemBody* body = femBodyOf(soft)) return "FEM body '" + body->name() + "'";
+  std::ostringstream s;
+  s << "Bullet soft body at " << static_cast<const void*>(soft) << " (" << soft->m_nodes.size()
+    << " nodes)";
+  return s.str();
+}
+
+void FemSoftBodySolver::unsupportedPair(const btSoftBody* a, const btSoftBody* b) {
+  const auto key = std::minmax(a, b);
+  if (!reported_pairs_.insert(key).second) return;
+  const bool both_fem = femBodyOf(a) != nullptr && femBodyOf(b) != nullptr;
+  std::ostringstream s;
+  s << describe(a) << " and " << describe(b) << " touch at step " << steps_ + 1 << " (t = " << time_
+    << " s): "
+    << (both_fem ? "contact between FEM bodies is not supported: they would pass through each "
+                   "other"
+                 : "Torsion's FEM bodies do not collide with Bullet's soft bodies: they would pass "
+                   "through each other")
+    << ". To let them, put them in collision filter groups that do not collide, or set "
+       "UnsupportedContact::kWarn";
+  if (unsupported_contact_ == UnsupportedContact::kError) {
+    fail(s.str());
+  } else {
+    warnings_.push_back(s.str());
+  }
+}
+
+Result<FemSoftBodySolver*> attach(btSoftRigidDynamicsWorld& world) {
+  return attachTo(world);
+}
+
+Result<FemSoftBodySolver*> attach(btSoftMultiBodyDynamicsWorld& world) {
+  return attachTo(world);
 }
 
 }  // namespace torsion

@@ -2,8 +2,6 @@
 
 #include <BulletSoftBody/btSoftBodyRigidBodyCollisionConfiguration.h>
 
-#include "torsion/bullet/fem_soft_body_solver.h"
-
 namespace torsion {
 
 Status WorldSettings::validate() const {
@@ -13,12 +11,11 @@ Status WorldSettings::validate() const {
 
 FemWorld::FemWorld(const WorldSettings& settings)
     : settings_(settings),
-      parallel_(settings.solver.threads),
       collision_configuration_(std::make_unique<btSoftBodyRigidBodyCollisionConfiguration>()),
       dispatcher_(std::make_unique<btCollisionDispatcher>(collision_configuration_.get())),
       broadphase_(std::make_unique<btDbvtBroadphase>()),
       constraint_solver_(std::make_unique<btSequentialImpulseConstraintSolver>()),
-      soft_solver_(std::make_unique<FemSoftBodySolver>(settings.solver.time_step)) {
+      soft_solver_(std::make_unique<FemSoftBodySolver>(settings.solver)) {
   world_ = std::make_unique<btSoftRigidDynamicsWorld>(
       dispatcher_.get(), broadphase_.get(), constraint_solver_.get(),
       collision_configuration_.get(), soft_solver_.get());
@@ -27,43 +24,31 @@ FemWorld::FemWorld(const WorldSettings& settings)
   btSoftBodyWorldInfo& info = world_->getWorldInfo();
   info.m_gravity = g;
   info.m_sparsesdf.Initialize();
+  Status attached = soft_solver_->bind(*world_);
+  (void)attached;  // cannot fail: the world was built with this solver a line above
 }
 
 FemWorld::~FemWorld() {
-  for (auto& body : bodies_)
-    world_->removeSoftBody(body->softBody());
   for (btRigidBody* rigid : rigid_bodies_) {
     world_->removeRigidBody(rigid);
     delete rigid;
   }
-  world_.reset();
+  world_.reset();  // before the solver, which Bullet calls until then
 }
 
 Result<FemBody*> FemWorld::addBody(const std::string& name, const TetMesh& mesh,
                                    const Material& material, const Frame& pose,
                                    ElementKind element) {
-  if (body(name) != nullptr) return Error{"body '" + name + "' already exists"};
-  std::vector<Eigen::Vector3d> placed = mesh.restPositions();
-  for (Eigen::Vector3d& p : placed)
-    p = pose.toWorld(p);
-  auto placed_mesh = std::make_shared<const TetMesh>(std::move(placed), mesh.tets());
-  Result<std::shared_ptr<const FemModel>> model = FemModel::create(placed_mesh, material, element);
-  if (!model) return Error{"body '" + name + "': " + model.error().message};
-  auto body = std::make_unique<FemBody>(name, std::move(model).value(), settings_.solver, parallel_,
-                                        world_->getWorldInfo());
-  body->setGravity(settings_.gravity);
-  world_->addSoftBody(body->softBody());
-  soft_solver_->registerBody(body.get());
-  bodies_.push_back(std::move(body));
-  return bodies_.back().get();
+  return soft_solver_->addBody(name, mesh, material, pose, element);
 }
 
 btRigidBody* FemWorld::addRigidBody(std::unique_ptr<btCollisionShape> shape, double mass,
                                     const btTransform& transform) {
   btVector3 inertia(0, 0, 0);
-  if (mass > 0) shape->calculateLocalInertia(mass, inertia);
+  if (mass > 0) shape->calculateLocalInertia(static_cast<btScalar>(mass), inertia);
   auto motion = std::make_unique<btDefaultMotionState>(transform);
-  btRigidBody::btRigidBodyConstructionInfo info(mass, motion.get(), shape.get(), inertia);
+  btRigidBody::btRigidBodyConstructionInfo info(static_cast<btScalar>(mass), motion.get(),
+                                                shape.get(), inertia);
   auto* rigid = new btRigidBody(info);
   world_->addRigidBody(rigid);
   shapes_.push_back(std::move(shape));
@@ -72,42 +57,41 @@ btRigidBody* FemWorld::addRigidBody(std::unique_ptr<btCollisionShape> shape, dou
   return rigid;
 }
 
+double FemWorld::time() const {
+  return soft_solver_->time();
+}
+
+int FemWorld::stepCount() const {
+  return static_cast<int>(soft_solver_->stepCount());
+}
+
+const std::vector<std::unique_ptr<FemBody>>& FemWorld::bodies() const {
+  return soft_solver_->bodies();
+}
+
 FemBody* FemWorld::body(const std::string& name) const {
-  for (const auto& b : bodies_) {
-    if (b->name() == name) return b.get();
-  }
-  return nullptr;
+  return soft_solver_->body(name);
 }
 
 WorldStepReport FemWorld::step() {
   WorldStepReport report;
-  soft_solver_->setTime(time_);
-  world_->stepSimulation(settings_.solver.time_step, 0);  // exactly one internal step of dt
-  time_ += settings_.solver.time_step;
-  report.step = ++steps_;
-  for (const auto& body : bodies_) {
-    const StepReport& r = body->lastReport();
-    if (isFatal(r.health)) {
-      report.ok = false;
-      report.message = "body '" + body->name() + "', step " + std::to_string(steps_) + ": " +
-                       toString(r.health) + ": " + r.message;
-      break;
-    }
+  if (soft_solver_->status().ok) {
+    // One variable step: Bullet makes exactly one internal substep of dt, the FEM step.
+    world_->stepSimulation(static_cast<btScalar>(settings_.solver.time_step), 0);
+  }
+  report.step = stepCount();
+  const FemSolverStatus& status = soft_solver_->status();
+  if (!status.ok) {
+    report.ok = false;
+    report.step = static_cast<int>(status.failed_step);
+    report.message = status.message;
   }
   return report;
 }
 
 Status FemWorld::setSolverSettings(const SolverSettings& solver) {
-  if (Status valid = solver.validate(); !valid) return valid;
-  if (solver.threads != settings_.solver.threads) {
-    return Error{"solver: threads = " + std::to_string(solver.threads) +
-                 ": cannot change while the world runs (it has " +
-                 std::to_string(settings_.solver.threads) + "); build a new world"};
-  }
+  if (Status applied = soft_solver_->setSolverSettings(solver); !applied) return applied;
   settings_.solver = solver;
-  soft_solver_->setTimeStep(solver.time_step);
-  for (const auto& body : bodies_)
-    body->stepper().setSettings(solver);
   return Ok{};
 }
 

@@ -1,5 +1,6 @@
 #include "torsion/haptics/haptic_runtime.h"
 
+#include <cassert>
 #include <chrono>
 #include <cmath>
 #include <thread>
@@ -7,47 +8,56 @@
 
 namespace torsion::haptics {
 
-HapticRuntime::HapticRuntime(FemWorld& world, std::vector<HapticBinding> bindings)
-    : world_(world), bindings_(std::move(bindings)) {}
+HapticRuntime::HapticRuntime(FemSoftBodySolver& fem, std::vector<HapticBinding> bindings)
+    : fem_(fem), bindings_(std::move(bindings)) {
+  fem_.addStepListener(this);
+}
 
-void HapticRuntime::beforeStep() {
+HapticRuntime::HapticRuntime(FemWorld& world, std::vector<HapticBinding> bindings)
+    : HapticRuntime(world.femSolver(), std::move(bindings)) {
+  world_ = &world;
+}
+
+HapticRuntime::~HapticRuntime() {
+  fem_.removeStepListener(this);
+}
+
+void HapticRuntime::beforeFemStep(const StepContext& ctx) {
+  if (lockstep_) {
+    // Tick k happens at k / rate: count ticks rather than add up periods, so no drift.
+    const double rate = bindings_.empty() ? 1000 : bindings_.front().rate_hz;
+    while (static_cast<double>(lockstep_ticks_) / rate < ctx.endTime() - 1e-12) {
+      const double now = static_cast<double>(lockstep_ticks_) / rate;
+      for (HapticBinding& b : bindings_)
+        b.loop->tick(now);
+      ++lockstep_ticks_;
+    }
+  }
   for (HapticBinding& b : bindings_) {
     device::HandCommand command;
     b.loop->commands().read(command);
     if (command.tick == 0) continue;  // the loop has not ticked yet
-    Status applied = b.coupling->apply(command, world_.time());
+    Status applied = b.coupling->apply(command, ctx.time);
     if (!applied && warnings_.size() < 100) {
-      warnings_.push_back("t = " + std::to_string(world_.time()) +
+      warnings_.push_back("t = " + std::to_string(ctx.time) +
                           " s: grab failed: " + applied.error().message);
     }
   }
 }
 
-void HapticRuntime::afterStep() {
-  for (HapticBinding& b : bindings_) {
-    b.loop->wrenches().write(b.coupling->publish(static_cast<std::uint64_t>(world_.stepCount())));
-  }
+void HapticRuntime::afterFemStep(const StepContext& ctx, bool ok) {
+  if (!ok) return;  // a failed step has no wrench to render; the loops fade on their own
+  for (HapticBinding& b : bindings_)
+    b.loop->wrenches().write(b.coupling->publish(static_cast<std::uint64_t>(ctx.index)));
 }
 
 WorldStepReport HapticRuntime::step() {
-  beforeStep();
-  WorldStepReport report = world_.step();
-  if (report.ok) afterStep();
-  return report;
+  assert(world_ != nullptr && "step() needs a HapticRuntime built on a FemWorld");
+  return world_->step();
 }
 
 WorldStepReport HapticRuntime::stepLockstep() {
-  // Tick k happens at k / rate: count ticks rather than add up periods, so no drift.
-  const double dt = world_.settings().solver.time_step;
-  const double rate = bindings_.empty() ? 1000 : bindings_.front().rate_hz;
-  const double end = loop_clock_ + dt;
-  while (static_cast<double>(lockstep_ticks_) / rate < end - 1e-12) {
-    const double now = static_cast<double>(lockstep_ticks_) / rate;
-    for (HapticBinding& b : bindings_)
-      b.loop->tick(now);
-    ++lockstep_ticks_;
-  }
-  loop_clock_ = end;
+  lockstep_ = true;
   return step();
 }
 
@@ -63,12 +73,12 @@ void HapticRuntime::startThreads() {
     std::this_thread::sleep_for(std::chrono::milliseconds(1));
   }
   threads_origin_ = std::chrono::steady_clock::now();
-  threads_start_time_ = world_.time();
+  threads_start_time_ = fem_.time();
 }
 
 void HapticRuntime::pace() {
   using Clock = std::chrono::steady_clock;
-  const double due = world_.time() - threads_start_time_;  // the coming step starts at `due`
+  const double due = fem_.time() - threads_start_time_;  // the coming step starts at `due`
   std::this_thread::sleep_until(threads_origin_ + std::chrono::duration_cast<Clock::duration>(
                                                       std::chrono::duration<double>(due)));
 }

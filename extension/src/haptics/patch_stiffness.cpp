@@ -48,7 +48,7 @@ Eigen::Matrix<double, 6, 1> PatchStiffness::column(FemBody& body, int group,
                                                    int c) {
   const int n = body.model().nodeCount();
   const SystemOperator& system = body.stepper().system();
-  const double dt = body.stepper().settings().time_step;
+  const double dt = body.stepper().lastTimeStep();
   const double beta = body.model().material().stiffness_damping;
   const std::vector<int>& grabbed = body.groups()[static_cast<size_t>(group)]->nodes();
   const Eigen::VectorXd& x = body.state().positions;

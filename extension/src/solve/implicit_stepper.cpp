@@ -36,7 +36,8 @@ ImplicitStepper::ImplicitStepper(std::shared_ptr<const FemModel> model,
     : model_(std::move(model)),
       settings_(settings),
       parallel_(parallel),
-      system_(model_, parallel) {
+      system_(model_, parallel),
+      last_dt_(settings.time_step) {
   element_forces_.resize(static_cast<size_t>(model_->elementCount()) *
                          static_cast<size_t>(model_->nodesPerElement()));
   element_energy_.resize(static_cast<size_t>(model_->elementCount()));
@@ -89,10 +90,10 @@ double ImplicitStepper::computeElasticForces(FemState& state) {
 }
 
 StepReport ImplicitStepper::step(FemState& state, const NodeConstraints& constraints,
-                                 const Eigen::VectorXd& external_forces) {
+                                 const Eigen::VectorXd& external_forces, double dt) {
   StepReport report;
   internal_forces_valid_ = false;
-  const double dt = settings_.time_step;
+  last_dt_ = dt;
   const Material& material = model_->material();
   const std::vector<double>& mass = model_->nodeMasses();
   const int n = model_->nodeCount();
@@ -191,7 +192,7 @@ const Eigen::VectorXd& ImplicitStepper::internalForces() {
   if (!internal_forces_valid_) {
     system_.multiplyStiffness(velocity_next_, scratch_);
     internal_forces_ =
-        elastic_forces_ - (settings_.time_step + model_->material().stiffness_damping) * scratch_;
+        elastic_forces_ - (last_dt_ + model_->material().stiffness_damping) * scratch_;
     internal_forces_valid_ = true;
   }
   return internal_forces_;

@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "torsion/bullet/step_context.h"
 #include "torsion/constraints/carried_nodes.h"
 #include "torsion/contact/rigid_contact.h"
 #include "torsion/fem/fem_model.h"
@@ -43,8 +44,14 @@ class FemBody {
   /// Sets every node's velocity (m/s), e.g. an initial velocity before the first step.
   void setVelocity(const Eigen::Vector3d& velocity);
 
-  /// Sets gravity (m/s^2) as the external force m_i g on every node.
-  void setGravity(const Eigen::Vector3d& gravity);
+  /// External forces on the nodes besides gravity (which the body takes from its world each
+  /// step, m_i g), N, 3n: they stay applied every step until changed. Errors: wrong size,
+  /// non-finite values ("body 'cyl': external force on node 12 is not finite").
+  Status setExternalForces(const Eigen::VectorXd& forces);
+  /// One node's external force (N), kept until changed; node must be in [0, nodeCount()).
+  Status setNodeForce(int node, const Eigen::Vector3d& force);
+  /// The external forces besides gravity, N, 3n.
+  const Eigen::VectorXd& externalForces() const { return external_forces_; }
 
   /// Live edit between steps (the viewer's E, nu, damping keys): the body goes on from its
   /// current state (positions, velocities, rotations, held groups, contacts) with `material`.
@@ -58,8 +65,8 @@ class FemBody {
   /// Bullet's predictor: m_q = x_n, m_x = x_n + dt v_n, bounds and node tree refreshed, contacts
   /// cleared, so Bullet's collision detection runs on this step's motion.
   void predict(double dt);
-  /// The FEM step from time `now` to now + dt; writes the result back into the btSoftBody.
-  const StepReport& advance(double now, double dt);
+  /// The FEM step from ctx.time to ctx.endTime(); writes the result back into the btSoftBody.
+  const StepReport& advance(const StepContext& ctx);
 
   const StepReport& lastReport() const { return last_report_; }
   /// Contact with rigid bodies (docs/contact.md): candidates, settings, last step's contacts.
@@ -75,8 +82,8 @@ class FemBody {
   FemState state_;
   ImplicitStepper stepper_;
   NodeConstraints constraints_;
-  Eigen::VectorXd external_forces_;
-  Eigen::Vector3d gravity_ = Eigen::Vector3d::Zero();  // m/s^2, for external_forces_
+  Eigen::VectorXd external_forces_;  // N, 3n, the user's (setExternalForces)
+  Eigen::VectorXd step_forces_;      // N, 3n, this step's: external_forces_ + m_i g
   std::vector<std::unique_ptr<CarriedNodes>> groups_;
   std::unique_ptr<btSoftBody> soft_body_;
   std::unique_ptr<RigidContactSolver> contacts_;

@@ -1,10 +1,15 @@
 #pragma once
-// A Bullet world with FEM bodies beside rigid bodies: the small API the issue asks for.
+// A ready-made Bullet world with FEM bodies beside rigid bodies, for programs that do not have a
+// world of their own:
 //
 //   FemWorld world(settings);
 //   FemBody* cyl = world.addBody("cyl", mesh, material).value();
 //   world.addRigidBody(std::make_unique<btBoxShape>(...), 1.0, transform);
 //   while (...) { WorldStepReport r = world.step(); if (!r.ok) ... }
+//
+// A thin convenience over exactly the path a user's own world takes (fem_soft_body_solver.h):
+// it builds a btSoftRigidDynamicsWorld with a FemSoftBodySolver, attaches it, and step() is
+// stepSimulation(dt, 0), one FEM step of settings.solver.time_step. The clock is the solver's.
 //
 // The world owns every Bullet object and FEM body it creates; pointers it returns stay valid for
 // its lifetime. Single-threaded API: call it from the simulation thread only (the solver's own
@@ -18,14 +23,13 @@
 #include <vector>
 
 #include "torsion/bullet/fem_body.h"
+#include "torsion/bullet/fem_soft_body_solver.h"
 #include "torsion/constraints/frame.h"
 #include "torsion/mesh/tet_mesh.h"
 #include "torsion/solve/parallel.h"
 #include "torsion/solve/solver_settings.h"
 
 namespace torsion {
-
-class FemSoftBodySolver;
 
 struct WorldSettings {
   Eigen::Vector3d gravity = Eigen::Vector3d(0, 0, -9.81);  ///< m/s^2, for FEM and rigid bodies
@@ -52,11 +56,12 @@ class FemWorld {
   /// material, a duplicate name.
   Result<FemBody*> addBody(const std::string& name, const TetMesh& mesh, const Material& material,
                            const Frame& pose = {}, ElementKind element = ElementKind::kTet4);
-  /// Adds a rigid body (mass 0: static). The world owns the shape.
+  /// Adds a rigid body (mass 0: static). The world owns the shape and the body.
   btRigidBody* addRigidBody(std::unique_ptr<btCollisionShape> shape, double mass,
                             const btTransform& transform);
 
-  /// One step of dt.
+  /// One step of settings().solver.time_step. After a failed step (ok false) the FEM bodies stay
+  /// where they were and every later step reports the same failure.
   WorldStepReport step();
 
   /// Live edit between steps (the viewer's dt and solver keys): the next steps use `solver`
@@ -65,29 +70,27 @@ class FemWorld {
   /// worker pool is made once per world).
   Status setSolverSettings(const SolverSettings& solver);
 
-  double time() const { return time_; }
-  int stepCount() const { return steps_; }
+  double time() const;
+  int stepCount() const;
   const WorldSettings& settings() const { return settings_; }
-  const std::vector<std::unique_ptr<FemBody>>& bodies() const { return bodies_; }
+  const std::vector<std::unique_ptr<FemBody>>& bodies() const;
   FemBody* body(const std::string& name) const;
   const std::vector<btRigidBody*>& rigidBodies() const { return rigid_bodies_; }
   btSoftRigidDynamicsWorld& bulletWorld() { return *world_; }
+  FemSoftBodySolver& femSolver() { return *soft_solver_; }
+  const FemSoftBodySolver& femSolver() const { return *soft_solver_; }
 
  private:
   WorldSettings settings_;
-  Parallel parallel_;
   std::unique_ptr<btCollisionConfiguration> collision_configuration_;
   std::unique_ptr<btCollisionDispatcher> dispatcher_;
   std::unique_ptr<btBroadphaseInterface> broadphase_;
   std::unique_ptr<btSequentialImpulseConstraintSolver> constraint_solver_;
   std::unique_ptr<FemSoftBodySolver> soft_solver_;
-  std::unique_ptr<btSoftRigidDynamicsWorld> world_;
-  std::vector<std::unique_ptr<FemBody>> bodies_;
+  std::unique_ptr<btSoftRigidDynamicsWorld> world_;  // destroyed before soft_solver_
   std::vector<std::unique_ptr<btCollisionShape>> shapes_;
   std::vector<std::unique_ptr<btMotionState>> motion_states_;
   std::vector<btRigidBody*> rigid_bodies_;  // owned; deleted after removal from the world
-  double time_ = 0;
-  int steps_ = 0;
 };
 
 }  // namespace torsion

@@ -1,14 +1,20 @@
 #pragma once
-// Ties the world, the hand couplings and their haptic loops together. Two ways to run:
-//   - threaded (interactive): each HapticLoop ticks on its own thread at 1 kHz (start()), and
-//     the caller's thread is the simulation thread: runThreaded() steps the world as fast as it
-//     can or paced to wall-clock time, handing poses and wrenches through the loops' lock-free
-//     buffers;
-//   - lockstep (headless, deterministic, for tests and plots): stepLockstep() ticks every loop
-//     on a simulated clock for one step's worth of ticks, then steps the world.
+// Ties the FEM solver, the hand couplings and their haptic loops together. It listens to the
+// solver's steps (FemSoftBodySolver::addStepListener), so it works in any world the solver is
+// attached to, whoever calls stepSimulation and with whatever substeps:
+//   before each FEM step   newest command of each loop -> its coupling, at the step's time (and,
+//                          in lockstep mode, every loop ticked on the simulated clock up to the
+//                          step's end first);
+//   after each FEM step    each coupling publishes its wrench to its loop.
+// Two ways to run:
+//   - threaded (interactive): each HapticLoop ticks on its own thread at 1 kHz (startThreads()),
+//     and the thread that steps the world is the simulation thread, handing poses and wrenches
+//     through the loops' lock-free buffers;
+//   - lockstep (headless, deterministic, for tests and plots): setLockstep(true).
+// On a FemWorld the runtime can also step the world itself (step, stepLockstep, runThreaded).
 //
 //   Threads | may touch
-//   simulation (caller of step*/runThreaded) | the world, hands, couplings; loops' buffers as
+//   simulation (the one stepping the world) | the world, hands, couplings; loops' buffers as
 //       reader of commands() and writer of wrenches()
 //   haptic loop (HapticLoop::start) | its device; its buffers as the other side
 // The haptic thread never touches the world.
@@ -18,6 +24,7 @@
 #include <string>
 #include <vector>
 
+#include "torsion/bullet/fem_soft_body_solver.h"
 #include "torsion/bullet/fem_world.h"
 #include "torsion/device/haptic_loop.h"
 #include "torsion/haptics/hand_coupling.h"
@@ -30,24 +37,35 @@ struct HapticBinding {
   double rate_hz = 1000;  ///< the loop's rate, for lockstep ticking
 };
 
-class HapticRuntime {
+class HapticRuntime : public StepListener {
  public:
+  /// On a user's own world: the solver (attached to it) tells the runtime of every FEM step.
+  HapticRuntime(FemSoftBodySolver& fem, std::vector<HapticBinding> bindings);
+  /// On a FemWorld: the same, and step()/stepLockstep()/runThreaded() step the world.
   HapticRuntime(FemWorld& world, std::vector<HapticBinding> bindings);
+  ~HapticRuntime() override;
+  HapticRuntime(const HapticRuntime&) = delete;
+  HapticRuntime& operator=(const HapticRuntime&) = delete;
 
-  /// Before FemWorld::step(): newest command of each loop -> its coupling. Grab failures are
-  /// collected in warnings() (the user pressed the button over nothing), not fatal.
-  void beforeStep();
-  /// After FemWorld::step(): each coupling publishes to its loop.
-  void afterStep();
-  /// beforeStep, world step, afterStep.
+  /// Lockstep: before each FEM step every loop ticks on the simulated clock, k / rate, up to the
+  /// step's end (headless, deterministic). Off: the loops tick on their own threads.
+  void setLockstep(bool lockstep) { lockstep_ = lockstep; }
+
+  // ---- StepListener (called by the solver inside stepSimulation) ----
+  void beforeFemStep(const StepContext& ctx) override;
+  void afterFemStep(const StepContext& ctx, bool ok) override;
+
+  // ---- stepping a FemWorld ----
+  /// One world step (the world's own dt).
   WorldStepReport step();
-  /// Ticks every loop on the simulated clock up to the end of the coming step, then step().
+  /// setLockstep(true), then step().
   WorldStepReport stepLockstep();
 
-  /// Threaded mode in pieces, for callers that own the stepping loop (the scene runner):
-  /// startThreads() starts every loop's thread and waits for its first tick (at most 1 s);
-  /// stepPaced() is step(), first waiting until wall-clock time since startThreads() has caught
-  /// up with simulated time when `real_time`; stopThreads() stops them (zero wrench written).
+  /// Threaded mode in pieces, for callers that own the stepping loop (the scene runner, or a
+  /// user's stepSimulation loop): startThreads() starts every loop's thread and waits for its
+  /// first tick (at most 1 s); stepPaced() is step(), first waiting until wall-clock time since
+  /// startThreads() has caught up with simulated time when `real_time`; stopThreads() stops them
+  /// (zero wrench written).
   void startThreads();
   WorldStepReport stepPaced(bool real_time);
   /// The wait of stepPaced(true) alone: returns when the coming step is due.
@@ -63,12 +81,13 @@ class HapticRuntime {
   const std::vector<std::string>& warnings() const { return warnings_; }
 
  private:
-  FemWorld& world_;
+  FemSoftBodySolver& fem_;
+  FemWorld* world_ = nullptr;  // set when built on a FemWorld
   std::vector<HapticBinding> bindings_;
   std::vector<std::string> warnings_;
-  double loop_clock_ = 0;  // s, simulated clock of the lockstep mode
+  bool lockstep_ = false;
   std::chrono::steady_clock::time_point threads_origin_;
-  double threads_start_time_ = 0;  // world time at startThreads()
+  double threads_start_time_ = 0;  // FEM time at startThreads()
   std::uint64_t lockstep_ticks_ = 0;
 };
 

@@ -63,11 +63,19 @@ class ImplicitStepper {
   ImplicitStepper(const ImplicitStepper&) = delete;
   ImplicitStepper& operator=(const ImplicitStepper&) = delete;
 
-  /// Advances `state` by one step. external_forces: 3n, N (e.g. m g per node).
+  /// Advances `state` by one step of `dt` seconds. external_forces: 3n, N (e.g. m g per node).
   /// Non-finite forces are caught before the state is touched; on any fatal report callers stop
-  /// and report instead of writing the state out.
+  /// and report instead of writing the state out. Inside a Bullet world dt is the world's substep
+  /// (StepContext::dt) and may change from one step to the next.
   StepReport step(FemState& state, const NodeConstraints& constraints,
-                  const Eigen::VectorXd& external_forces);
+                  const Eigen::VectorXd& external_forces, double dt);
+  /// A stepper used on its own (tests, benchmarks): one step of settings().time_step.
+  StepReport step(FemState& state, const NodeConstraints& constraints,
+                  const Eigen::VectorXd& external_forces) {
+    return step(state, constraints, external_forces, settings_.time_step);
+  }
+  /// s, the length of the last step taken (settings().time_step before the first).
+  double lastTimeStep() const { return last_dt_; }
 
   /// Elastic + stiffness-damping forces on each node at the end of the last step, 3n, N.
   const Eigen::VectorXd& internalForces();
@@ -82,7 +90,7 @@ class ImplicitStepper {
       const SystemOperator&, const NodeConstraints&, const Eigen::VectorXd&, const SolverSettings&,
       Eigen::VectorXd&)>;
   void setLinearSolveHook(LinearSolveHook hook) { linear_solve_hook_ = std::move(hook); }
-  /// Takes effect at the next step (dt, linear solver, tolerance...); the caller validates.
+  /// Takes effect at the next step (linear solver, tolerance...); the caller validates.
   void setSettings(const SolverSettings& settings) { settings_ = settings; }
   /// Live material edit between steps (FemBody::setMaterial): `model` has the same mesh. The
   /// state's warm starts stay; internalForces() keeps reporting the last step as it was taken
@@ -108,6 +116,7 @@ class ImplicitStepper {
   std::vector<Eigen::Vector3d> element_forces_;  // N per element (SystemOperator::gather)
   std::vector<double> element_energy_;
   bool internal_forces_valid_ = false;
+  double last_dt_;  // s, dt of the last step (the internal forces' linearisation uses it)
 };
 
 }  // namespace torsion

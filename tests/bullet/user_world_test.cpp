@@ -1,0 +1,327 @@
+// Torsion inside a world the user built and steps: Bullet's clock and substeps, Bullet's rigid and
+// soft bodies beside FEM bodies, multibody worlds.
+#include "user_world.h"
+
+#include <BulletDynamics/Featherstone/btMultiBodyConstraintSolver.h>
+#include <BulletSoftBody/btSoftBodyHelpers.h>
+#include <BulletSoftBody/btSoftMultiBodyDynamicsWorld.h>
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "torsion/bullet/bt_conversions.h"
+#include "torsion/contact/ball_mesh.h"
+#include "torsion/mesh/box_mesh.h"
+
+namespace torsion {
+namespace {
+
+using testing::UserWorld;
+
+std::vector<int> nodesWhere(const FemBody& body,
+                            const std::function<bool(const Eigen::Vector3d&)>& pick) {
+  std::vector<int> nodes;
+  for (int i = 0; i < body.model().nodeCount(); ++i) {
+    if (pick(body.model().mesh().restPositions()[static_cast<size_t>(i)])) nodes.push_back(i);
+  }
+  return nodes;
+}
+
+// A soft beam clamped at x = 0: it sags and swings under gravity, so its trajectory is a sharp
+// witness of every step's dt and time.
+FemBody* addClampedBeam(FemSoftBodySolver& fem, const Eigen::Vector3d& offset) {
+  Material material;
+  material.youngs_modulus = 2e4;
+  FemBody* body = fem.addBody("beam", makeBoxTetMesh({0, 0, 0}, {2, 0.4, 0.4}, 10, 2, 2).value(),
+                              material, Frame{offset, Eigen::Quaterniond::Identity()})
+                      .value();
+  body->carryNodes(
+      "clamp",
+      nodesWhere(*body, [&](const Eigen::Vector3d& p) { return p.x() < offset.x() + 1e-9; }),
+      [](double) { return Frame{}; }, fem.time());
+  return body;
+}
+
+double maxDifference(const FemState& a, const FemState& b) {
+  return (a.positions - b.positions).cwiseAbs().maxCoeff();
+}
+
+TEST(UserWorld, SubstepsGiveTheSameTrajectoryAsSteppingAtTheSubstepRate) {
+  UserWorld sixty, direct;
+  FemBody* a = addClampedBeam(sixty.fem, Eigen::Vector3d::Zero());
+  FemBody* b = addClampedBeam(direct.fem, Eigen::Vector3d::Zero());
+  for (int call = 0; call < 60; ++call)
+    sixty.world.stepSimulation(btScalar(1 / 60.), 10, btScalar(1 / 240.));
+  ASSERT_TRUE(sixty.fem.status().ok) << sixty.fem.status().message;
+  // Bullet's accumulator decides how many substeps the 60 calls make (240, give or take one
+  // rounding); the other world takes exactly as many steps of 1/240 s.
+  const std::int64_t substeps = sixty.fem.stepCount();
+  EXPECT_NEAR(static_cast<double>(substeps), 240, 1);
+  for (std::int64_t k = 0; k < substeps; ++k)
+    direct.world.stepSimulation(btScalar(1 / 240.), 0);
+  ASSERT_TRUE(direct.fem.status().ok) << direct.fem.status().message;
+
+  EXPECT_NEAR(sixty.fem.time(), static_cast<double>(substeps) / 240, 1e-12);
+  EXPECT_EQ(sixty.fem.time(), direct.fem.time());
+  const double sag = a->state().position(a->model().nodeCount() - 1).z() - 0.4;
+  ASSERT_LT(sag, -0.01) << "the beam must move for the comparison to mean anything";
+  EXPECT_EQ(maxDifference(a->state(), b->state()), 0.0);  // the same steps, bit for bit
+}
+
+TEST(UserWorld, FemBodyFallsLikeARigidBody) {
+  UserWorld user;
+  Material material;
+  material.youngs_modulus = 1e6;
+  FemBody* ball =
+      user.fem.addBody("ball", makeBallTetMesh({0, 0, 10}, 0.5, 3).value(), material).value();
+  btRigidBody* rigid =
+      user.addRigid(std::make_unique<btSphereShape>(btScalar(0.5)), 1.0, btVector3(5, 0, 10));
+  for (int call = 0; call < 60; ++call)
+    user.world.stepSimulation(btScalar(1 / 60.), 10, btScalar(1 / 240.));
+  ASSERT_TRUE(user.fem.status().ok) << user.fem.status().message;
+
+  // Centre of mass of the FEM ball (lumped masses).
+  const std::vector<double>& m = ball->model().nodeMasses();
+  Eigen::Vector3d com = Eigen::Vector3d::Zero();
+  double mass = 0;
+  for (int i = 0; i < ball->model().nodeCount(); ++i) {
+    com += m[static_cast<size_t>(i)] * ball->state().position(i);
+    mass += m[static_cast<size_t>(i)];
+  }
+  com /= mass;
+  const double fem_fall = 10 - com.z();
+  const double rigid_fall = 10 - static_cast<double>(rigid->getWorldTransform().getOrigin().z());
+  // Both integrators give g dt^2 n (n + 1) / 2 after n steps: the same fall, 0.4 % above the
+  // continuous g t^2 / 2 at 240 Hz.
+  const double t = user.fem.time();
+  EXPECT_NEAR(t, 1.0, 1.0 / 240 + 1e-9);
+  EXPECT_NEAR(fem_fall, rigid_fall, 1e-3 * rigid_fall);
+  EXPECT_NEAR(fem_fall, 0.5 * 9.81 * t * t, 0.01 * fem_fall);
+}
+
+TEST(UserWorld, ScriptedNodesFollowTheSubstepClock) {
+  UserWorld user;
+  FemBody* beam = addClampedBeam(user.fem, Eigen::Vector3d::Zero());
+  // A second group, the free end, pulled along x at 0.1 m/s by a scripted motion.
+  const std::vector<int> tip =
+      nodesWhere(*beam, [](const Eigen::Vector3d& p) { return p.x() > 2 - 1e-9; });
+  beam->carryNodes(
+      "pull", tip,
+      [](double t) {
+        return Frame{Eigen::Vector3d(0.1 * t, 0, 0), Eigen::Quaterniond::Identity()};
+      },
+      user.fem.time());
+  for (int call = 0; call < 30; ++call)
+    user.world.stepSimulation(btScalar(1 / 60.), 10, btScalar(1 / 240.));
+  ASSERT_TRUE(user.fem.status().ok) << user.fem.status().message;
+  const double t = user.fem.time();
+  EXPECT_GT(t, 0.49);
+  for (int i : tip) {
+    const double x0 = beam->model().mesh().restPositions()[static_cast<size_t>(i)].x();
+    EXPECT_NEAR(beam->state().position(i).x(), x0 + 0.1 * t, 1e-12);
+  }
+}
+
+TEST(UserWorld, ChangingTheSubstepBetweenCallsIsExact) {
+  // The implicit step takes any dt: a world whose fixed substep changes between calls gives the
+  // same trajectory as one stepped directly with the same sequence of steps.
+  UserWorld varying, direct;
+  FemBody* a = addClampedBeam(varying.fem, Eigen::Vector3d::Zero());
+  FemBody* b = addClampedBeam(direct.fem, Eigen::Vector3d::Zero());
+  const double substeps[] = {1 / 240., 1 / 120., 1 / 480.};
+  std::vector<double> taken;
+  for (int call = 0; call < 30; ++call) {
+    const double h = substeps[call % 3];
+    const std::int64_t before = varying.fem.stepCount();
+    varying.world.stepSimulation(btScalar(1 / 60.), 10, btScalar(h));
+    for (std::int64_t k = before; k < varying.fem.stepCount(); ++k)
+      taken.push_back(varying.fem.lastTimeStep());
+    ASSERT_TRUE(varying.fem.status().ok) << varying.fem.status().message;
+  }
+  double sum = 0;
+  for (double h : taken) {
+    direct.world.stepSimulation(btScalar(h), 0);
+    sum += h;
+  }
+  EXPECT_NEAR(varying.fem.time(), sum, 1e-12);
+  EXPECT_EQ(maxDifference(a->state(), b->state()), 0.0);
+}
+
+TEST(UserWorld, BulletClothBesideFemBodiesFallsAndLands) {
+  UserWorld user;
+  addClampedBeam(user.fem, Eigen::Vector3d(10, 0, 1));
+  user.addRigid(std::make_unique<btBoxShape>(btVector3(5, 5, btScalar(0.5))), 0.0,
+                btVector3(0, 0, btScalar(-0.5)));  // ground, top at z = 0
+  btSoftBody* cloth = btSoftBodyHelpers::CreatePatch(
+      user.world.getWorldInfo(), btVector3(-1, -1, 2), btVector3(1, -1, 2), btVector3(-1, 1, 2),
+      btVector3(1, 1, 2), 9, 9, 0, true);
+  cloth->getCollisionShape()->setMargin(btScalar(0.02));
+  cloth->setTotalMass(btScalar(0.5));
+  user.world.addSoftBody(cloth);
+
+  double lowest_mean_z = 2;
+  for (int call = 0; call < 120; ++call) {
+    user.world.stepSimulation(btScalar(1 / 60.), 10, btScalar(1 / 240.));
+    double mean_z = 0;
+    for (int i = 0; i < cloth->m_nodes.size(); ++i)
+      mean_z += static_cast<double>(cloth->m_nodes[i].m_x.z());
+    mean_z /= cloth->m_nodes.size();
+    lowest_mean_z = std::min(lowest_mean_z, mean_z);
+  }
+  ASSERT_TRUE(user.fem.status().ok) << user.fem.status().message;
+  EXPECT_EQ(user.fem.stepCount(), 480);
+  double mean_z = 0, max_speed = 0;
+  for (int i = 0; i < cloth->m_nodes.size(); ++i) {
+    mean_z += static_cast<double>(cloth->m_nodes[i].m_x.z());
+    max_speed = std::max(max_speed, static_cast<double>(cloth->m_nodes[i].m_v.length()));
+  }
+  mean_z /= cloth->m_nodes.size();
+  EXPECT_LT(mean_z, 0.1) << "the cloth fell from z = 2 to the ground";
+  EXPECT_GT(lowest_mean_z, -0.05) << "and did not pass through it";
+  EXPECT_LT(max_speed, 0.5) << "it lies still";
+  user.world.removeSoftBody(cloth);
+  delete cloth;
+}
+
+btSoftBody* clothOver(btSoftBodyWorldInfo& info, double z) {
+  btSoftBody* cloth = btSoftBodyHelpers::CreatePatch(
+      info, btVector3(btScalar(-0.5), btScalar(-0.5), btScalar(z)),
+      btVector3(btScalar(0.5), btScalar(-0.5), btScalar(z)),
+      btVector3(btScalar(-0.5), btScalar(0.5), btScalar(z)),
+      btVector3(btScalar(0.5), btScalar(0.5), btScalar(z)), 5, 5, 0, true);
+  cloth->getCollisionShape()->setMargin(btScalar(0.02));
+  return cloth;
+}
+
+TEST(UserWorld, BulletClothFallingOnAnFemBodyIsRefusedByNameNotPassedThrough) {
+  for (UnsupportedContact policy : {UnsupportedContact::kError, UnsupportedContact::kWarn}) {
+    UserWorld user;
+    user.fem.setUnsupportedContact(policy);
+    FemBody* slab =
+        user.fem
+            .addBody("slab", makeBoxTetMesh({-1, -1, 0}, {1, 1, 0.2}, 4, 4, 1).value(), Material{})
+            .value();
+    slab->carryNodes(
+        "base", nodesWhere(*slab, [](const Eigen::Vector3d& p) { return p.z() < 1e-9; }),
+        [](double) { return Frame{}; }, 0.0);
+    btSoftBody* cloth = clothOver(user.world.getWorldInfo(), 0.6);
+    user.world.addSoftBody(cloth);
+    for (int call = 0; call < 60 && user.fem.status().ok; ++call)
+      user.world.stepSimulation(btScalar(1 / 60.), 10, btScalar(1 / 240.));
+    if (policy == UnsupportedContact::kError) {
+      ASSERT_FALSE(user.fem.status().ok);
+      EXPECT_NE(user.fem.status().message.find("FEM body 'slab'"), std::string::npos);
+      EXPECT_NE(user.fem.status().message.find("do not collide with Bullet's soft bodies"),
+                std::string::npos)
+          << user.fem.status().message;
+      // It was said when they met, not at the start: the cloth fell 0.4 m first (0.28 s).
+      EXPECT_GT(user.fem.status().failed_step, 60);
+    } else {
+      EXPECT_TRUE(user.fem.status().ok) << user.fem.status().message;
+      ASSERT_EQ(user.fem.warnings().size(), 1u);
+      EXPECT_NE(user.fem.warnings()[0].find("pass through each other"), std::string::npos);
+    }
+    user.world.removeSoftBody(cloth);
+    delete cloth;
+  }
+}
+
+TEST(UserWorld, TwoFemBodiesThatTouchAreReportedAndFarApartAreNot) {
+  UserWorld user;
+  Material material;
+  material.youngs_modulus = 1e6;
+  user.fem.addBody("left", makeBallTetMesh({0, 0, 0}, 0.5, 2).value(), material).value();
+  user.fem.addBody("right", makeBallTetMesh({1.5, 0, 0}, 0.5, 2).value(), material).value();
+  // No gravity: they sit 0.5 m apart, their boxes apart too; then "right" is thrown at "left".
+  user.world.setGravity(btVector3(0, 0, 0));
+  for (int call = 0; call < 10; ++call)
+    user.world.stepSimulation(btScalar(1 / 60.), 10, btScalar(1 / 240.));
+  ASSERT_TRUE(user.fem.status().ok) << user.fem.status().message;
+  user.fem.body("right")->setVelocity(Eigen::Vector3d(-2, 0, 0));
+  for (int call = 0; call < 60 && user.fem.status().ok; ++call)
+    user.world.stepSimulation(btScalar(1 / 60.), 10, btScalar(1 / 240.));
+  ASSERT_FALSE(user.fem.status().ok);
+  EXPECT_NE(user.fem.status().message.find("contact between FEM bodies is not supported"),
+            std::string::npos)
+      << user.fem.status().message;
+}
+
+TEST(UserWorld, AttachRefusesAWorldBuiltWithBulletsSolver) {
+  btSoftBodyRigidBodyCollisionConfiguration config;
+  btCollisionDispatcher dispatcher(&config);
+  btDbvtBroadphase broadphase;
+  btSequentialImpulseConstraintSolver solver;
+  btSoftRigidDynamicsWorld world(&dispatcher, &broadphase, &solver, &config);
+  Result<FemSoftBodySolver*> attached = attach(world);
+  ASSERT_FALSE(attached.ok());
+  EXPECT_NE(attached.error().message.find("torsion::FemSoftBodySolver"), std::string::npos);
+}
+
+TEST(UserWorld, OneSolverServesOneWorld) {
+  UserWorld user;
+  btSoftRigidDynamicsWorld other(&user.dispatcher, &user.broadphase, &user.solver, &user.config,
+                                 &user.fem);
+  Result<FemSoftBodySolver*> attached = attach(other);
+  ASSERT_FALSE(attached.ok());
+  EXPECT_NE(attached.error().message.find("already attached"), std::string::npos);
+  EXPECT_TRUE(attach(user.world).ok()) << "attaching again to its own world is harmless";
+}
+
+TEST(UserWorld, FemBodiesFallInAMultibodyWorld) {
+  btSoftBodyRigidBodyCollisionConfiguration config;
+  btCollisionDispatcher dispatcher(&config);
+  btDbvtBroadphase broadphase;
+  btMultiBodyConstraintSolver solver;
+  FemSoftBodySolver fem;
+  {
+    btSoftMultiBodyDynamicsWorld world(&dispatcher, &broadphase, &solver, &config, &fem);
+    world.setGravity(btVector3(0, 0, btScalar(-9.81)));
+    ASSERT_TRUE(attach(world).ok());
+    Material material;
+    material.youngs_modulus = 1e6;
+    FemBody* ball =
+        fem.addBody("ball", makeBallTetMesh({0, 0, 0}, 0.5, 2).value(), material).value();
+    for (int call = 0; call < 60; ++call)
+      world.stepSimulation(btScalar(1 / 60.), 10, btScalar(1 / 240.));
+    ASSERT_TRUE(fem.status().ok) << fem.status().message;
+    const double t = fem.time();
+    const double n = static_cast<double>(fem.stepCount());
+    // Backward Euler from rest: every node falls g dt^2 n (n + 1) / 2 (to the CG's tolerance).
+    const double expected = 9.81 * (t / n) * (t / n) * n * (n + 1) / 2;
+    EXPECT_NEAR(t, 1.0, 1.0 / 240 + 1e-9);
+    EXPECT_NEAR(ball->state().position(0).z() - ball->model().mesh().restPositions()[0].z(),
+                -expected, 1e-4 * expected);
+  }
+}
+
+TEST(UserWorld, PerNodeExternalForcesActEveryStepUntilChanged) {
+  UserWorld user(btVector3(0, 0, 0));
+  Material material;
+  material.youngs_modulus = 1e6;
+  FemBody* ball =
+      user.fem.addBody("ball", makeBallTetMesh({0, 0, 0}, 0.5, 2).value(), material).value();
+  // A uniform force field: F_i = m_i a moves the body as a rigid whole at acceleration a.
+  const Eigen::Vector3d a(1, 0, 0);
+  Eigen::VectorXd forces(3 * ball->model().nodeCount());
+  for (int i = 0; i < ball->model().nodeCount(); ++i)
+    forces.segment<3>(3 * i) = ball->model().nodeMasses()[static_cast<size_t>(i)] * a;
+  ASSERT_TRUE(ball->setExternalForces(forces).ok());
+  for (int k = 0; k < 100; ++k)
+    user.world.stepSimulation(btScalar(0.01), 0);
+  ASSERT_TRUE(user.fem.status().ok);
+  // a t after 1 s (applied once only, it would be 0.01 m/s), to the CG's tolerance.
+  double momentum = 0, mass = 0;
+  for (int i = 0; i < ball->model().nodeCount(); ++i) {
+    const double m = ball->model().nodeMasses()[static_cast<size_t>(i)];
+    momentum += m * ball->state().velocity(i).x();
+    mass += m;
+    EXPECT_NEAR(ball->state().velocity(i).x(), 1.0, 1e-4);
+  }
+  EXPECT_NEAR(momentum / mass, 1.0, 1e-4);  // once only would give 0.01
+  EXPECT_FALSE(ball->setNodeForce(ball->model().nodeCount(), a).ok());
+  EXPECT_FALSE(ball->setNodeForce(0, Eigen::Vector3d(NAN, 0, 0)).ok());
+  EXPECT_FALSE(ball->setExternalForces(Eigen::VectorXd::Zero(5)).ok());
+}
+
+}  // namespace
+}  // namespace torsion
