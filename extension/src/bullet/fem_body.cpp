@@ -142,6 +142,38 @@ const StepReport& FemBody::advance(const StepContext& ctx) {
   return last_report_;
 }
 
+FemBodyCheckpoint FemBody::checkpoint() {
+  FemBodyCheckpoint c;
+  c.model = model_;
+  c.state = state_;
+  c.external_forces = external_forces_;
+  c.stepper = stepper_.memory();
+  c.groups.reserve(groups_.size());
+  for (const auto& group : groups_)
+    c.groups.push_back(*group);
+  c.contacts = std::make_shared<const RigidContactSolver>(*contacts_);
+  c.last_report = last_report_;
+  return c;
+}
+
+void FemBody::restore(const FemBodyCheckpoint& c) {
+  if (c.model != model_) {
+    model_ = c.model;
+    stepper_.replaceModel(model_);
+    for (int i = 0; i < model_->nodeCount(); ++i)
+      soft_body_->m_nodes[i].m_im = 1 / model_->nodeMasses()[static_cast<size_t>(i)];
+  }
+  state_ = c.state;
+  external_forces_ = c.external_forces;
+  stepper_.restore(c.stepper);
+  groups_.clear();
+  for (const CarriedNodes& group : c.groups)
+    groups_.push_back(std::make_unique<CarriedNodes>(group));
+  *contacts_ = *c.contacts;
+  last_report_ = c.last_report;
+  writeBack();
+}
+
 void FemBody::writeBack() {
   btSoftBody& sb = *soft_body_;
   for (int i = 0; i < model_->nodeCount(); ++i) {

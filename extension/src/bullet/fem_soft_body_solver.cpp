@@ -135,6 +135,32 @@ FemBody* FemSoftBodySolver::femBodyOf(const btSoftBody* soft) const {
   return nullptr;
 }
 
+FemCheckpoint FemSoftBodySolver::checkpoint() {
+  FemCheckpoint c;
+  c.time = time_;
+  c.steps = steps_;
+  c.last_dt = last_dt_;
+  c.status = status_;
+  for (const auto& body : bodies_)
+    c.bodies.emplace_back(body.get(), body->checkpoint());
+  return c;
+}
+
+Status FemSoftBodySolver::restore(const FemCheckpoint& c) {
+  for (const auto& [body, saved] : c.bodies) {
+    if (std::none_of(bodies_.begin(), bodies_.end(),
+                     [body = body](const std::unique_ptr<FemBody>& b) { return b.get() == body; }))
+      return Error{"restore: a body of the checkpoint has been removed since"};
+  }
+  for (const auto& [body, saved] : c.bodies)
+    const_cast<FemBody*>(body)->restore(saved);
+  time_ = c.time;
+  steps_ = c.steps;
+  last_dt_ = c.last_dt;
+  status_ = c.status;
+  return Ok{};
+}
+
 Status FemSoftBodySolver::setSolverSettings(const SolverSettings& settings) {
   if (Status valid = settings.validate(); !valid) return valid;
   if (settings.threads != settings_.threads) {

@@ -57,6 +57,37 @@ btRigidBody* FemWorld::addRigidBody(std::unique_ptr<btCollisionShape> shape, dou
   return rigid;
 }
 
+WorldCheckpoint FemWorld::checkpoint() {
+  WorldCheckpoint c;
+  c.fem = soft_solver_->checkpoint();
+  for (const btRigidBody* rigid : rigid_bodies_) {
+    c.rigid.push_back(WorldCheckpoint::RigidState{
+        rigid->getWorldTransform(), rigid->getLinearVelocity(), rigid->getAngularVelocity()});
+  }
+  return c;
+}
+
+Status FemWorld::restore(const WorldCheckpoint& c) {
+  if (c.rigid.size() != rigid_bodies_.size()) {
+    return Error{"restore: the world has " + std::to_string(rigid_bodies_.size()) +
+                 " rigid bodies, the checkpoint " + std::to_string(c.rigid.size())};
+  }
+  if (Status restored = soft_solver_->restore(c.fem); !restored) return restored;
+  for (size_t k = 0; k < rigid_bodies_.size(); ++k) {
+    btRigidBody* rigid = rigid_bodies_[k];
+    const WorldCheckpoint::RigidState& r = c.rigid[k];
+    rigid->setWorldTransform(r.pose);
+    rigid->setInterpolationWorldTransform(r.pose);
+    rigid->setLinearVelocity(r.linear_velocity);
+    rigid->setAngularVelocity(r.angular_velocity);
+    rigid->setInterpolationLinearVelocity(r.linear_velocity);
+    rigid->setInterpolationAngularVelocity(r.angular_velocity);
+    rigid->clearForces();
+    if (rigid->getMotionState() != nullptr) rigid->getMotionState()->setWorldTransform(r.pose);
+  }
+  return Ok{};
+}
+
 double FemWorld::time() const {
   return soft_solver_->time();
 }

@@ -102,4 +102,16 @@ void Hand::updateSpeedLimit() {
   pursuit_->max_speed = speed_limit_;
 }
 
+HandCheckpoint Hand::checkpoint() const {
+  return HandCheckpoint{pursuit_, *pursuit_, selection_, group_, speed_limit_};
+}
+
+void Hand::restore(const HandCheckpoint& checkpoint) {
+  pursuit_ = checkpoint.pursuit;
+  *pursuit_ = checkpoint.values;
+  selection_ = checkpoint.selection;
+  group_ = checkpoint.group;
+  speed_limit_ = checkpoint.speed_limit;
+}
+
 }  // namespace torsion

@@ -198,6 +198,25 @@ const Eigen::VectorXd& ImplicitStepper::internalForces() {
   return internal_forces_;
 }
 
+ImplicitStepper::Memory ImplicitStepper::memory() {
+  Memory m;
+  m.internal_forces = internalForces();  // now, while K is the last step's
+  m.previous_velocities = previous_velocities_;
+  m.velocity_next = velocity_next_;
+  m.elastic_forces = elastic_forces_;
+  m.last_dt = last_dt_;
+  return m;
+}
+
+void ImplicitStepper::restore(const Memory& memory) {
+  previous_velocities_ = memory.previous_velocities;
+  velocity_next_ = memory.velocity_next;
+  elastic_forces_ = memory.elastic_forces;
+  internal_forces_ = memory.internal_forces;
+  internal_forces_valid_ = true;  // K is rebuilt at the next step; until then, the remembered ones
+  last_dt_ = memory.last_dt;
+}
+
 void ImplicitStepper::replaceModel(std::shared_ptr<const FemModel> model) {
   internalForces();  // freeze the last step's forces before K and beta change under them
   model_ = std::move(model);

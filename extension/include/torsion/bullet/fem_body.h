@@ -18,6 +18,17 @@
 
 namespace torsion {
 
+/// Everything a body needs to go on from a moment as it went on then (FemBody::checkpoint).
+struct FemBodyCheckpoint {
+  std::shared_ptr<const FemModel> model;  ///< the material then (live edits are undone too)
+  FemState state;
+  Eigen::VectorXd external_forces;
+  ImplicitStepper::Memory stepper;
+  std::vector<CarriedNodes> groups;  ///< node groups then (hands: see Hand::checkpoint)
+  std::shared_ptr<const RigidContactSolver> contacts;  ///< warm starts of the contact solve
+  StepReport last_report;
+};
+
 class FemBody {
  public:
   FemBody(std::string name, std::shared_ptr<const FemModel> model, const SolverSettings& settings,
@@ -69,6 +80,13 @@ class FemBody {
   const StepReport& advance(const StepContext& ctx);
 
   const StepReport& lastReport() const { return last_report_; }
+
+  /// A copy of the body's state and everything its next step reads (warm starts, node groups,
+  /// contact multipliers), to go back to with restore(): the continuation is then bit for bit
+  /// the one that followed checkpoint(), given the same world around it.
+  FemBodyCheckpoint checkpoint();
+  /// Back to `checkpoint` (taken from this body). The btSoftBody mirror follows at once.
+  void restore(const FemBodyCheckpoint& checkpoint);
   /// Contact with rigid bodies (docs/contact.md): candidates, settings, last step's contacts.
   RigidContactSolver& contacts() { return *contacts_; }
   const RigidContactSolver& contacts() const { return *contacts_; }

@@ -69,6 +69,15 @@ struct FemSolverStatus {
   std::string message;           ///< "body 'cyl', step 123: blow-up: ..."
 };
 
+/// The solver's clock, health and every FEM body at a moment (FemSoftBodySolver::checkpoint).
+struct FemCheckpoint {
+  double time = 0;
+  std::int64_t steps = 0;
+  double last_dt = 0;
+  FemSolverStatus status;
+  std::vector<std::pair<const FemBody*, FemBodyCheckpoint>> bodies;
+};
+
 /// What to do when an FEM body touches a body it has no contact with (another FEM body, or one of
 /// Bullet's soft bodies): they would pass through each other.
 enum class UnsupportedContact {
@@ -110,6 +119,15 @@ class FemSoftBodySolver : public btSoftBodySolver {
   std::int64_t stepCount() const { return steps_; }
   /// s, length of the last FEM step (0 before the first).
   double lastTimeStep() const { return last_dt_; }
+
+  // ---- checkpoints ----
+  /// Clock, health and every FEM body's state and warm starts now (hands: Hand::checkpoint;
+  /// Bullet's rigid bodies are the world's: FemWorld::checkpoint saves its own).
+  FemCheckpoint checkpoint();
+  /// Back to `checkpoint`: the FEM steps that follow are bit for bit the ones that followed it,
+  /// given the same world around the bodies. Bodies added since are left as they are. Errors,
+  /// changing nothing: a body of the checkpoint has been removed since.
+  Status restore(const FemCheckpoint& checkpoint);
 
   // ---- health, warnings, settings ----
   const FemSolverStatus& status() const { return status_; }

@@ -44,6 +44,16 @@ struct WorldStepReport {
   std::string message;  ///< "body 'cyl', step 123: blow-up: ..." when not ok
 };
 
+/// A FemWorld at a moment: the FEM solver's checkpoint and the world's rigid bodies.
+struct WorldCheckpoint {
+  struct RigidState {
+    btTransform pose;
+    btVector3 linear_velocity, angular_velocity;
+  };
+  FemCheckpoint fem;
+  std::vector<RigidState> rigid;  ///< in rigidBodies() order
+};
+
 class FemWorld {
  public:
   explicit FemWorld(const WorldSettings& settings);
@@ -69,6 +79,13 @@ class FemWorld {
   /// leaving the settings as they were: invalid settings, or a different thread count (the
   /// worker pool is made once per world).
   Status setSolverSettings(const SolverSettings& solver);
+
+  /// Everything the next steps read: FEM bodies (their warm starts and node groups), the clock,
+  /// the rigid bodies' poses and velocities. Not in it: hands (Hand::checkpoint) and Bullet's
+  /// contact caches between rigid bodies (their persistent manifolds), which Bullet rebuilds.
+  WorldCheckpoint checkpoint();
+  /// Back to `checkpoint`. Errors, changing nothing: bodies removed or rigid bodies added since.
+  Status restore(const WorldCheckpoint& checkpoint);
 
   double time() const;
   int stepCount() const;

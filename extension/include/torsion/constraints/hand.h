@@ -68,6 +68,15 @@ struct HandPursuit {
   void advanceTo(double t);
 };
 
+/// A hand's state at a moment (Hand::checkpoint), to go back to with the body's checkpoint.
+struct HandCheckpoint {
+  std::shared_ptr<HandPursuit> pursuit;  ///< the pursuit the body's node group follows then
+  HandPursuit values;                    ///< its values then
+  HandSelection selection;
+  int group = -1;
+  double speed_limit = 0;
+};
+
 class Hand {
  public:
   /// A hand acting on `body`; `name` names its node groups in the body ("hand" by default).
@@ -112,6 +121,11 @@ class Hand {
   /// Re-derives the speed limit from the body's material after a live edit
   /// (FemBody::setMaterial): a held patch obeys the new limit from the next step on.
   void updateSpeedLimit();
+  /// The hand's state, to restore together with its body's FemBody::checkpoint() of the same
+  /// moment (the body's node groups hold the hand's patch motion).
+  HandCheckpoint checkpoint() const;
+  void restore(const HandCheckpoint& checkpoint);
+
   /// The body's node group carrying the patch, or -1 when not grabbing.
   int group() const { return group_; }
   const std::string& name() const { return name_; }

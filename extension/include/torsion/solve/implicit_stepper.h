@@ -99,6 +99,16 @@ class ImplicitStepper {
   const FemModel& model() const { return *model_; }
   const SystemOperator& system() const { return system_; }
 
+  /// What the next step and the force queries remember of the last step besides the FemState:
+  /// the CG's warm start and the end-of-step internal forces (checkpoints, FemBody::checkpoint).
+  struct Memory {
+    Eigen::VectorXd previous_velocities, velocity_next, elastic_forces, internal_forces;
+    double last_dt = 0;
+  };
+  Memory memory();
+  /// Back to a remembered step: the next step continues bit for bit as it did after memory().
+  void restore(const Memory& memory);
+
   /// Stage 1 and 2 alone: rotations and elastic forces at `state` (also used by tests).
   double computeElasticForces(FemState& state);
 

@@ -1,0 +1,59 @@
+// A haptic device driving a hand on an FEM body in a world the user steps with substeps.
+#include <gtest/gtest.h>
+
+#include "torsion/constraints/hand.h"
+#include "torsion/device/scripted_device.h"
+#include "torsion/haptics/haptic_runtime.h"
+#include "torsion/mesh/box_mesh.h"
+#include "user_world.h"
+
+namespace torsion {
+namespace {
+
+using testing::UserWorld;
+
+TEST(UserWorldHaptics, LockstepLoopTicksThroughEverySubstepAndFeelsThePush) {
+  UserWorld user(btVector3(0, 0, 0));
+  Material material;
+  material.youngs_modulus = 1e5;
+  material.mass_damping = 20;  // quasi-static: the reaction has the sign of statics
+  FemBody* bar =
+      user.fem.addBody("bar", makeBoxTetMesh({0, 0, 0}, {0.4, 0.4, 2}, 2, 2, 8).value(), material)
+          .value();
+  std::vector<int> base;
+  for (int i = 0; i < bar->model().nodeCount(); ++i) {
+    if (bar->model().mesh().restPositions()[static_cast<size_t>(i)].z() < 1e-9) base.push_back(i);
+  }
+  bar->carryNodes(
+      "base", base, [](double) { return Frame{}; }, 0.0);
+  Hand hand(*bar);
+  haptics::DeviceMapping mapping;
+  mapping.anchor.origin = Eigen::Vector3d(0.2, 0.2, 1.9);  // the device's zero is the hand plane
+  haptics::HandCoupling coupling(hand, mapping, haptics::CouplingSettings{});
+
+  device::Pose pushed;
+  pushed.position.x = 0.05;  // m along x, over 0.5 s
+  const device::Trajectory push({{0, device::Pose{}}, {0.5, pushed}}, {{0, 1u}});
+  device::ScriptedDevice scripted(push, device::defaultDeviceLimits(), "push");
+  device::HapticLoopSettings loop_settings;
+  loop_settings.log_capacity = 2000;
+  device::HapticLoop loop(scripted, loop_settings);
+  haptics::HapticRuntime runtime(user.fem, {{&coupling, &loop, 1000}});
+  runtime.setLockstep(true);
+
+  for (int call = 0; call < 60; ++call) {
+    user.world.stepSimulation(btScalar(1 / 60.), 10, btScalar(1 / 240.));
+    ASSERT_TRUE(user.fem.status().ok) << user.fem.status().message;
+  }
+  EXPECT_TRUE(hand.grabbed());
+  EXPECT_TRUE(runtime.warnings().empty());
+  // The loop ticked at 1 kHz on the FEM clock, through the end of the last substep.
+  EXPECT_NEAR(static_cast<double>(loop.log().size()), 1000 * user.fem.time(), 1.0);
+  // Each substep published its wrench: the ticks leading up to a step render the step before's,
+  // so the last tick rendered the last-but-one FEM step.
+  EXPECT_EQ(loop.log().back().sim_step, static_cast<std::uint64_t>(user.fem.stepCount() - 1));
+  EXPECT_LT(scripted.lastWritten().force.x, -0.1);  // N: the bar resists the push along x
+}
+
+}  // namespace
+}  // namespace torsion
