@@ -10,7 +10,7 @@ packages=(
   # build
   cmake ninja-build g++ pkg-config
   # libraries
-  libbullet-dev libeigen3-dev libsuitesparse-dev libccd-dev libtbb-dev
+  libbullet-dev libbullet-extras-dev libeigen3-dev libsuitesparse-dev libccd-dev libtbb-dev
   libcli11-dev nlohmann-json3-dev libpng-dev
   libosmesa6-dev libglfw3-dev
   # the SpaceMouse device (optional in CMake; the spacenavd daemon is the user's to install)
