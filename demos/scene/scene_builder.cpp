@@ -1,5 +1,6 @@
 #include "scene_builder.h"
 
+#include "bullet_file_import.h"
 #include "scene_haptics.h"
 #include "torsion/mesh/mesh_io.h"
 
@@ -109,6 +110,14 @@ Result<std::unique_ptr<BuiltScene>> buildScene(SceneSpec spec, int threads_overr
   for (const RigidBodySpec& r : spec.rigid_bodies)
     built->rigid_bodies.push_back(addSceneRigidBody(world, r));
   if (spec.ground) addSceneRigidBody(world, *spec.ground);
+  if (!spec.bullet_file.empty()) {
+    Result<std::shared_ptr<BulletFileImport>> imported =
+        BulletFileImport::load(spec.bullet_file, world);
+    if (!imported) return Error{spec.file + ": bullet_file: " + imported.error().message};
+    built->bullet_import = std::move(imported).value();
+    for (SceneRigidBody& body : built->bullet_import->bodies())
+      built->rigid_bodies.push_back(std::move(body));
+  }
   built->spec = std::move(spec);
   for (const SceneHand& h : built->hands) {
     if (!h.spec.device) continue;

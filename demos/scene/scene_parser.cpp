@@ -313,6 +313,12 @@ Result<SceneSpec> parseScene(std::string_view text, const std::string& file_name
     for (const JsonObject& r : root.objects("rigid_bodies"))
       scene.rigid_bodies.push_back(readRigidBody(r, scene.rigid_bodies));
     if (root.has("ground")) scene.ground = readGround(root.object("ground"));
+    if (root.has("bullet_file")) {
+      const std::filesystem::path bullet_path(root.string("bullet_file"));
+      scene.bullet_file = bullet_path.is_absolute()
+                              ? bullet_path.string()
+                              : (std::filesystem::path(base_directory) / bullet_path).string();
+    }
     scene.camera = readCameraSpec(root);
     root.finish();
     Status world_ok = scene.world.validate();

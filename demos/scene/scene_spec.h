@@ -119,6 +119,9 @@ struct SceneSpec {
   std::vector<HandSpec> hands;
   std::vector<RigidBodySpec> rigid_bodies;
   std::optional<RigidBodySpec> ground;  ///< a static plane, from the top-level "ground"
+  /// Rigid bodies (and their constraints) from a Bullet .bullet file, resolved against the scene
+  /// file's directory; empty: none.
+  std::string bullet_file;
   CameraSpec camera;                    ///< how pictures look at the scene (camera_spec.h)
   HapticsMode haptics_mode = HapticsMode::kAuto;  ///< not in the file: the CLI's --haptics
 };

@@ -2,6 +2,8 @@
 
 #include <BulletSoftBody/btSoftBodyRigidBodyCollisionConfiguration.h>
 
+#include <algorithm>
+
 namespace torsion {
 
 Status WorldSettings::validate() const {
@@ -30,6 +32,7 @@ FemWorld::FemWorld(const WorldSettings& settings)
 
 FemWorld::~FemWorld() {
   for (btRigidBody* rigid : rigid_bodies_) {
+    if (std::find(tracked_.begin(), tracked_.end(), rigid) != tracked_.end()) continue;
     world_->removeRigidBody(rigid);
     delete rigid;
   }
@@ -86,6 +89,11 @@ Status FemWorld::restore(const WorldCheckpoint& c) {
     if (rigid->getMotionState() != nullptr) rigid->getMotionState()->setWorldTransform(r.pose);
   }
   return Ok{};
+}
+
+void FemWorld::trackRigidBody(btRigidBody* body) {
+  rigid_bodies_.push_back(body);
+  tracked_.push_back(body);
 }
 
 double FemWorld::time() const {

@@ -70,6 +70,11 @@ class FemWorld {
   btRigidBody* addRigidBody(std::unique_ptr<btCollisionShape> shape, double mass,
                             const btTransform& transform);
 
+  /// Tracks a rigid body that someone else created and added to bulletWorld() (e.g. Bullet's
+  /// btBulletWorldImporter): it is listed in rigidBodies() (drawing, checkpoints) but neither
+  /// removed from the world nor deleted by this FemWorld; its owner must keep it alive as long.
+  void trackRigidBody(btRigidBody* body);
+
   /// One step of settings().solver.time_step. After a failed step (ok false) the FEM bodies stay
   /// where they were and every later step reports the same failure.
   WorldStepReport step();
@@ -107,7 +112,8 @@ class FemWorld {
   std::unique_ptr<btSoftRigidDynamicsWorld> world_;  // destroyed before soft_solver_
   std::vector<std::unique_ptr<btCollisionShape>> shapes_;
   std::vector<std::unique_ptr<btMotionState>> motion_states_;
-  std::vector<btRigidBody*> rigid_bodies_;  // owned; deleted after removal from the world
+  std::vector<btRigidBody*> rigid_bodies_;  // owned ones deleted after removal from the world
+  std::vector<btRigidBody*> tracked_;       // not owned (trackRigidBody)
 };
 
 }  // namespace torsion

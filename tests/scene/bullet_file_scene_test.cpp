@@ -1,0 +1,68 @@
+// A scene's "bullet_file": rigid bodies that Bullet's serializer wrote, brought into the scene by
+// Bullet's own importer, in contact with the scene's FEM bodies.
+#include <gtest/gtest.h>
+
+#include <string>
+
+#include "scene_builder.h"
+#include "scene_parser.h"
+
+namespace torsion::scene {
+namespace {
+
+TEST(BulletFileScene, ImportedBoxesFallOntoTheFemSlabAndRestOnIt) {
+  Result<SceneSpec> spec = loadScene(std::string(TORSION_SCENES_DIR) + "/bullet_boxes.json");
+  ASSERT_TRUE(spec.ok()) << spec.error().message;
+  Result<std::unique_ptr<BuiltScene>> built = buildScene(std::move(spec).value());
+  ASSERT_TRUE(built.ok()) << built.error().message;
+  BuiltScene& scene = *built.value();
+  // The file holds a static ground and three 0.2 m boxes dropped from 0.8, 1.1 and 1.4 m.
+  ASSERT_EQ(scene.rigid_bodies.size(), 4u);
+  EXPECT_EQ(scene.rigid_bodies[1].name, "boxes_1");
+  EXPECT_NEAR(scene.world->bulletWorld().getGravity().z(), -9.81, 1e-12) << "the scene's gravity";
+  for (int k = 0; k < 150; ++k) {
+    ASSERT_TRUE(driveHands(scene).ok());
+    const WorldStepReport r = scene.world->step();
+    ASSERT_TRUE(r.ok) << r.message;
+  }
+  // Each box rests on the slab (top at z = 0.2 m): its centre 0.1 m above the sagging surface,
+  // within the sag of this soft slab (a few mm) and at rest.
+  for (size_t k = 1; k < 4; ++k) {
+    const btRigidBody* box = scene.rigid_bodies[k].body;
+    EXPECT_NEAR(box->getWorldTransform().getOrigin().z(), 0.3, 0.01) << "box " << k;
+    EXPECT_LT(box->getLinearVelocity().length(), 0.05) << "box " << k;
+  }
+}
+
+TEST(BulletFileScene, AFileBulletCannotReadIsAnErrorNamingTheKey) {
+  const std::string text =
+      R"({"bodies": [{"name": "slab", "mesh": ")" + std::string(TORSION_ASSETS_DIR) +
+      R"(/slab_768.node", "material": {"youngs_modulus": 5e4, "poisson_ratio": 0.3, "density": 300}}],
+      "bullet_file": ")" +
+      std::string(TORSION_ASSETS_DIR) + R"(/slab_768.node"})";
+  Result<SceneSpec> spec = parseScene(text, "b.json", "/base");
+  ASSERT_TRUE(spec.ok()) << spec.error().message;
+  Result<std::unique_ptr<BuiltScene>> built = buildScene(std::move(spec).value());
+  ASSERT_FALSE(built.ok());
+  EXPECT_NE(built.error().message.find("b.json: bullet_file: "), std::string::npos)
+      << built.error().message;
+  EXPECT_NE(built.error().message.find("slab_768.node: not a file Bullet's serializer wrote"),
+            std::string::npos)
+      << built.error().message;
+}
+
+TEST(BulletFileScene, AMissingFileIsAnErrorNamingIt) {
+  const std::string text =
+      R"({"bodies": [{"name": "slab", "mesh": ")" + std::string(TORSION_ASSETS_DIR) +
+      R"(/slab_768.node", "material": {"youngs_modulus": 5e4, "poisson_ratio": 0.3, "density": 300}}],
+      "bullet_file": "nowhere.bullet"})";
+  Result<SceneSpec> spec = parseScene(text, "b.json", "/base");
+  ASSERT_TRUE(spec.ok()) << spec.error().message;
+  Result<std::unique_ptr<BuiltScene>> built = buildScene(std::move(spec).value());
+  ASSERT_FALSE(built.ok());
+  EXPECT_NE(built.error().message.find("/base/nowhere.bullet"), std::string::npos)
+      << built.error().message;
+}
+
+}  // namespace
+}  // namespace torsion::scene
