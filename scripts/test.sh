@@ -14,6 +14,14 @@ cmake --build build -j"$jobs"
 echo "== Test suite"
 ctest --test-dir build -j"$jobs" --output-on-failure --timeout 900
 
+echo "== ThreadSanitizer build (build-tsan/, clang): the haptic loop's thread, its buffers, the runtime"
+cmake -S . -B build-tsan -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_CXX_COMPILER=clang++ \
+  -DTORSION_TSAN=ON -DTORSION_BUILD_BENCHMARKS=OFF -DTORSION_BUILD_DEMOS=OFF
+cmake --build build-tsan -j"$jobs" --target torsion_device_tests torsion_bullet_tests
+TSAN_OPTIONS="halt_on_error=1 second_deadlock_stack=1" \
+  ctest --test-dir build-tsan -j"$jobs" --output-on-failure --timeout 900 \
+  -R "HapticLoop|TripleBuffer|NetworkDevice|UserWorldHaptics"
+
 echo "== Sanitizer + fuzz build (build-asan/, clang, ASan+UBSan)"
 cmake -S . -B build-asan -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_CXX_COMPILER=clang++ \
   -DTORSION_SANITIZE=ON -DTORSION_FUZZ=ON -DTORSION_BUILD_BENCHMARKS=OFF

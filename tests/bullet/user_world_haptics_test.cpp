@@ -55,5 +55,33 @@ TEST(UserWorldHaptics, LockstepLoopTicksThroughEverySubstepAndFeelsThePush) {
   EXPECT_LT(scripted.lastWritten().force.x, -0.1);  // N: the bar resists the push along x
 }
 
+TEST(UserWorldHaptics, ThreadedLoopRunsBesideTheUsersSteppingLoop) {
+  // The haptic loop on its own thread, the user's stepSimulation on this one: they meet only in
+  // the lock-free buffers (the ThreadSanitizer build runs this test).
+  UserWorld user(btVector3(0, 0, 0));
+  Material material;
+  material.youngs_modulus = 1e5;
+  FemBody* bar =
+      user.fem.addBody("bar", makeBoxTetMesh({0, 0, 0}, {0.4, 0.4, 2}, 1, 1, 4).value(), material)
+          .value();
+  Hand hand(*bar);
+  haptics::DeviceMapping mapping;
+  mapping.anchor.origin = Eigen::Vector3d(0.2, 0.2, 1.9);
+  haptics::HandCoupling coupling(hand, mapping, haptics::CouplingSettings{});
+  const device::Trajectory hold({{0, device::Pose{}}, {10, device::Pose{}}}, {{0, 1u}});
+  device::ScriptedDevice scripted(hold, device::defaultDeviceLimits(), "hold");
+  device::HapticLoop loop(scripted, device::HapticLoopSettings{});
+  haptics::HapticRuntime runtime(user.fem, {{&coupling, &loop, 1000}});
+  runtime.startThreads();
+  for (int call = 0; call < 20; ++call) {
+    user.world.stepSimulation(btScalar(1 / 60.), 10, btScalar(1 / 240.));
+    ASSERT_TRUE(user.fem.status().ok) << user.fem.status().message;
+  }
+  runtime.stopThreads();
+  EXPECT_GT(loop.stats().ticks, 0u);
+  EXPECT_TRUE(hand.grabbed()) << "the button pressed on the loop's thread reached the hand";
+  EXPECT_EQ(user.fem.stepCount(), 80);
+}
+
 }  // namespace
 }  // namespace torsion

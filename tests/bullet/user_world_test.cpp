@@ -246,6 +246,34 @@ TEST(UserWorld, TwoFemBodiesThatTouchAreReportedAndFarApartAreNot) {
       << user.fem.status().message;
 }
 
+TEST(UserWorld, RigidBallDroppedOnAnFemSlabRestsOnItUnderSubsteps) {
+  UserWorld user;
+  Material foam;
+  foam.youngs_modulus = 1e5;
+  foam.mass_damping = 1;
+  FemBody* slab = user.fem
+                      .addBody("slab", makeBoxTetMesh({-0.5, -0.5, 0}, {0.5, 0.5, 0.2}, 5, 5, 1).value(),
+                               foam)
+                      .value();
+  slab->carryNodes(
+      "base", nodesWhere(*slab, [](const Eigen::Vector3d& p) { return p.z() < 1e-9; }),
+      [](double) { return Frame{}; }, 0.0);
+  btRigidBody* ball =
+      user.addRigid(std::make_unique<btSphereShape>(btScalar(0.1)), 0.5, btVector3(0, 0, 0.6));
+  double lowest = 1;
+  for (int call = 0; call < 120; ++call) {
+    user.world.stepSimulation(btScalar(1 / 60.), 10, btScalar(1 / 240.));
+    ASSERT_TRUE(user.fem.status().ok) << user.fem.status().message;
+    lowest = std::min(lowest, static_cast<double>(ball->getWorldTransform().getOrigin().z()));
+  }
+  // It lands on the slab's top (z = 0.2) and stays there: its centre one radius above the
+  // surface, less the dent a 0.5 kg ball makes in this foam (a few mm), never through it.
+  const double z = static_cast<double>(ball->getWorldTransform().getOrigin().z());
+  EXPECT_NEAR(z, 0.3, 0.01);
+  EXPECT_GT(lowest, 0.28);
+  EXPECT_LT(static_cast<double>(ball->getLinearVelocity().length()), 0.05);
+}
+
 TEST(UserWorld, AttachRefusesAWorldBuiltWithBulletsSolver) {
   btSoftBodyRigidBodyCollisionConfiguration config;
   btCollisionDispatcher dispatcher(&config);

@@ -1,13 +1,15 @@
 #pragma once
 // Threading for the solver kernels, on TBB. Kernels take index ranges [begin, end) so they can be
 // split without new signatures. Results are identical for any thread count: loops write disjoint
-// outputs, and sums use a fixed split into chunks whose partial sums are added in chunk order.
+// outputs, and sums are left to the callers, which add per-chunk results in a fixed order.
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 #include <tbb/parallel_reduce.h>
 #include <tbb/task_arena.h>
 
+#include <atomic>
+#include <cstdint>
 #include <memory>
 
 namespace torsion {
@@ -26,39 +28,21 @@ class Parallel {
       if (n > 0) fn(0, n);
       return;
     }
+    split_calls_.fetch_add(1, std::memory_order_relaxed);
     arena_->execute([&] {
       tbb::parallel_for(tbb::blocked_range<int>(0, n, grain),
                         [&](const tbb::blocked_range<int>& r) { fn(r.begin(), r.end()); });
     });
   }
 
-  /// Sum of fn(begin, end) over fixed chunks of `grain`, added in chunk order.
-  template <class Fn>
-  double sum(int n, int grain, Fn&& fn) const {
-    if (threads_ == 1 || n <= grain) {
-      // Same chunking as the parallel path, so the rounding is identical.
-      double total = 0;
-      for (int begin = 0; begin < n; begin += grain)
-        total += fn(begin, std::min(n, begin + grain));
-      return total;
-    }
-    const int chunks = (n + grain - 1) / grain;
-    partial_.resize(static_cast<size_t>(chunks));
-    forRange(chunks, 1, [&](int c0, int c1) {
-      for (int c = c0; c < c1; ++c) {
-        partial_[static_cast<size_t>(c)] = fn(c * grain, std::min(n, (c + 1) * grain));
-      }
-    });
-    double total = 0;
-    for (double p : partial_)
-      total += p;
-    return total;
-  }
+  /// How many forRange calls were split across threads so far (tests check that a parallel
+  /// run really ran in parallel).
+  std::int64_t splitCalls() const { return split_calls_.load(std::memory_order_relaxed); }
 
  private:
   int threads_;
   std::unique_ptr<tbb::task_arena> arena_;
-  mutable std::vector<double> partial_;
+  mutable std::atomic<std::int64_t> split_calls_{0};
 };
 
 }  // namespace torsion
