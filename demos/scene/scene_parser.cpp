@@ -39,7 +39,8 @@ Material readMaterial(const JsonObject& m) {
   material.density = m.number("density");
   material.mass_damping = m.number("mass_damping", material.mass_damping);
   material.stiffness_damping = m.number("stiffness_damping", material.stiffness_damping);
-  const std::string volumetric = m.string("volumetric_strain", toString(material.volumetric_strain));
+  const std::string volumetric =
+      m.string("volumetric_strain", toString(material.volumetric_strain));
   if (auto kind = parseVolumetricStrain(volumetric)) {
     material.volumetric_strain = *kind;
   } else {
@@ -285,7 +286,8 @@ Result<SceneSpec> parseScene(std::string_view text, const std::string& file_name
       }
       if (body.element == ElementKind::kTet10 &&
           body.material.volumetric_strain == VolumetricStrain::kNodalAverage) {
-        b.fail("material", "volumetric_strain nodal_average is a tet4 option (tet10 does not lock)");
+        b.fail("material",
+               "volumetric_strain nodal_average is a tet4 option (tet10 does not lock)");
       }
       b.finish();
       scene.bodies.push_back(std::move(body));

@@ -43,7 +43,8 @@ TEST(BoxMeshSymmetry, FreeVibrationStaysInTheVerticalPlane) {
   }
   std::printf("2.5 s of free vibration: max |tip z| %.3e m, max |tip y| %.3e m (ratio %.2e)\n",
               max_vertical, max_sideways, max_sideways / max_vertical);
-  EXPECT_GT(max_vertical, test::eulerBernoulliTip(beam.spec()));  // it swung past the static deflection
+  EXPECT_GT(max_vertical,
+            test::eulerBernoulliTip(beam.spec()));  // it swung past the static deflection
   EXPECT_LT(max_sideways, 0.005 * max_vertical);
 }
 

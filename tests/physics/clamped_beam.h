@@ -5,7 +5,8 @@
 //    contraction, which beam theory leaves free; the stiffening that adds grows with nu.
 //  - kPlaneSection: the end face's nodes held in x only (the section stays plane and normal to
 //    the axis), the neutral-axis row z = h/2 on it fixed (no rigid motion). The section contracts
-//    freely, as beam theory assumes (needs an even cell count across for the mid-height row). Quasi-statics (1 s steps, the
+//    freely, as beam theory assumes (needs an even cell count across for the mid-height row).
+//    Quasi-statics (1 s steps, the
 // velocity zeroed after each: damped Newton on the static equilibrium, M / dt^2 is 1e-9 of K at
 // E = 1 GPa) or dynamics (any dt).
 
@@ -24,7 +25,7 @@ enum class Clamp { kFull, kPlaneSection };
 struct BeamSpec {
   double length = 10, side = 1;  ///< m
   Clamp clamp = Clamp::kFull;
-  int cells_across = 4;          ///< n: 10 n x n x n cells
+  int cells_across = 4;  ///< n: 10 n x n x n cells
   Material material = defaultMaterial();
   ElementKind element = ElementKind::kTet4;
   SolverSettings solver = quasiStatic();
@@ -58,20 +59,21 @@ inline double eulerBernoulliTip(const BeamSpec& spec) {
 inline double timoshenkoTip(const BeamSpec& spec) {
   const double q = spec.material.density * spec.gravity * spec.side * spec.side;
   return eulerBernoulliTip(spec) +
-         q * spec.length * spec.length / (2 * (5.0 / 6.0) * spec.material.mu() * spec.side * spec.side);
+         q * spec.length * spec.length /
+             (2 * (5.0 / 6.0) * spec.material.mu() * spec.side * spec.side);
 }
 
 class ClampedBeam {
  public:
   explicit ClampedBeam(const BeamSpec& spec)
       : spec_(spec),
-        model_(FemModel::create(std::make_shared<TetMesh>(
-                                    makeBoxTetMesh(Eigen::Vector3d::Zero(),
-                                                   Eigen::Vector3d(spec.length, spec.side, spec.side),
-                                                   10 * spec.cells_across, spec.cells_across,
-                                                   spec.cells_across)
-                                        .value()),
-                                spec.material, spec.element)
+        model_(FemModel::create(
+                   std::make_shared<TetMesh>(
+                       makeBoxTetMesh(Eigen::Vector3d::Zero(),
+                                      Eigen::Vector3d(spec.length, spec.side, spec.side),
+                                      10 * spec.cells_across, spec.cells_across, spec.cells_across)
+                           .value()),
+                   spec.material, spec.element)
                    .value()),
         parallel_(0),
         stepper_(model_, spec.solver, parallel_),

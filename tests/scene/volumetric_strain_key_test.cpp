@@ -25,14 +25,14 @@ TEST(SceneVolumetricStrainKey, DefaultsToPerElementAndReadsNodalAverage) {
 }
 
 TEST(SceneVolumetricStrainKey, UnknownValueAndTet10AreRefusedNamingTheKey) {
+  EXPECT_TRUE(
+      test::failsWith(parseScene(sceneWith(R"(, "volumetric_strain": "fbar")"), "s.json", "/base"),
+                      {"s.json: bodies[0].material.volumetric_strain",
+                       "'fbar' is not a volumetric strain (element or nodal_average)"}));
   EXPECT_TRUE(test::failsWith(
-      parseScene(sceneWith(R"(, "volumetric_strain": "fbar")"), "s.json", "/base"),
-      {"s.json: bodies[0].material.volumetric_strain",
-       "'fbar' is not a volumetric strain (element or nodal_average)"}));
-  EXPECT_TRUE(test::failsWith(parseScene(sceneWith(R"(, "volumetric_strain": "nodal_average")",
-                                                   R"( "element": "tet10",)"),
-                                         "s.json", "/base"),
-                              {"s.json: bodies[0].material", "tet4 option"}));
+      parseScene(sceneWith(R"(, "volumetric_strain": "nodal_average")", R"( "element": "tet10",)"),
+                 "s.json", "/base"),
+      {"s.json: bodies[0].material", "tet4 option"}));
 }
 
 }  // namespace

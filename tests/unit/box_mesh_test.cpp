@@ -91,7 +91,8 @@ TEST(BoxMesh, MirrorsOntoItselfAboutMidPlanesOfEvenCellCounts) {
     auto mirrored = [&](int n) {
       std::array<int, 3> ijk = {n % (nx + 1), (n / (nx + 1)) % (ny + 1), n / ((nx + 1) * (ny + 1))};
       const std::array<int, 3> counts = {nx, ny, nz};
-      ijk[static_cast<size_t>(axis)] = counts[static_cast<size_t>(axis)] - ijk[static_cast<size_t>(axis)];
+      ijk[static_cast<size_t>(axis)] =
+          counts[static_cast<size_t>(axis)] - ijk[static_cast<size_t>(axis)];
       return node(ijk[0], ijk[1], ijk[2]);
     };
     for (const std::array<int, 4>& t : tets) {

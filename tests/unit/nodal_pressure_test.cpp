@@ -62,7 +62,8 @@ double referenceEnergy(const FemModel& model, const std::vector<Eigen::Matrix3d>
     Eigen::Matrix3d Ds;
     for (int k = 0; k < 3; ++k)
       Ds.col(k) = x.segment<3>(3 * tet[static_cast<size_t>(k + 1)]) - x.segment<3>(3 * tet[0]);
-    const Eigen::Matrix3d RtF = R[static_cast<size_t>(t)].transpose() * Ds * rest.rest_shape_inverse;
+    const Eigen::Matrix3d RtF =
+        R[static_cast<size_t>(t)].transpose() * Ds * rest.rest_shape_inverse;
     const Eigen::Matrix3d eps = 0.5 * (RtF + RtF.transpose()) - Eigen::Matrix3d::Identity();
     const Eigen::Matrix3d dev = eps - eps.trace() / 3 * Eigen::Matrix3d::Identity();
     energy += rest.volume * mu * dev.squaredNorm();
@@ -167,7 +168,8 @@ TEST(NodalPressure, StiffnessIsTheHessianOfTheEnergyInEverySolverForm) {
 // A homogeneous strain has the same trace in every tet, so every node average equals it and the
 // pressure is the plain tet4's: forces identical to round-off.
 TEST(NodalPressure, HomogeneousStrainGivesThePlainTet4Forces) {
-  Material nodal = nearlyIncompressible(), plain = nearlyIncompressible(VolumetricStrain::kPerElement);
+  Material nodal = nearlyIncompressible(),
+           plain = nearlyIncompressible(VolumetricStrain::kPerElement);
   auto nodal_model = blockModel(nodal), plain_model = blockModel(plain);
   Parallel parallel(1);
   ImplicitStepper nodal_stepper(nodal_model, SolverSettings{}, parallel);
@@ -177,7 +179,8 @@ TEST(NodalPressure, HomogeneousStrainGivesThePlainTet4Forces) {
       Eigen::AngleAxisd(0.4, Eigen::Vector3d::UnitY()).toRotationMatrix() *
       (Eigen::Matrix3d() << 1.03, 0.01, 0, 0.01, 0.97, 0.02, 0, 0.02, 1.05).finished();
   for (int i = 0; i < nodal_model->nodeCount(); ++i)
-    state.positions.segment<3>(3 * i) = F * nodal_model->mesh().restPositions()[static_cast<size_t>(i)];
+    state.positions.segment<3>(3 * i) =
+        F * nodal_model->mesh().restPositions()[static_cast<size_t>(i)];
   FemState plain_state = state;
   const double nodal_energy = nodal_stepper.computeElasticForces(state);
   const double plain_energy = plain_stepper.computeElasticForces(plain_state);
@@ -210,12 +213,12 @@ TEST(NodalPressure, RigidMotionOnlyTurnsTheForces) {
 }
 
 TEST(NodalPressure, ForcesAndProductsAreTheSameForAnyThreadCount) {
-  auto model = FemModel::create(std::make_shared<TetMesh>(
-                                    makeBoxTetMesh(Eigen::Vector3d(0, 0, 0),
-                                                   Eigen::Vector3d(4, 1, 1), 24, 6, 6)
-                                        .value()),
-                                nearlyIncompressible())
-                   .value();  // 5184 tets: several chunks per pass
+  auto model =
+      FemModel::create(
+          std::make_shared<TetMesh>(
+              makeBoxTetMesh(Eigen::Vector3d(0, 0, 0), Eigen::Vector3d(4, 1, 1), 24, 6, 6).value()),
+          nearlyIncompressible())
+          .value();  // 5184 tets: several chunks per pass
   Eigen::VectorXd forces[2], products[2];
   std::vector<Eigen::Matrix3d> blocks[2];
   for (int k = 0; k < 2; ++k) {

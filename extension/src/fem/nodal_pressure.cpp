@@ -23,11 +23,11 @@ void averageOverTetNodes(const FemModel& model, const std::vector<double>& node_
   const std::vector<int>& nodes = model.elementNodes();
   for (int t = begin; t < end; ++t) {
     const size_t i = 4 * static_cast<size_t>(t);
-    tet_values[static_cast<size_t>(t)] =
-        0.25 * scale *
-        (node_values[static_cast<size_t>(nodes[i])] + node_values[static_cast<size_t>(nodes[i + 1])] +
-         node_values[static_cast<size_t>(nodes[i + 2])] +
-         node_values[static_cast<size_t>(nodes[i + 3])]);
+    tet_values[static_cast<size_t>(t)] = 0.25 * scale *
+                                         (node_values[static_cast<size_t>(nodes[i])] +
+                                          node_values[static_cast<size_t>(nodes[i + 1])] +
+                                          node_values[static_cast<size_t>(nodes[i + 2])] +
+                                          node_values[static_cast<size_t>(nodes[i + 3])]);
   }
 }
 

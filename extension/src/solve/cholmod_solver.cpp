@@ -230,7 +230,8 @@ const Eigen::SparseMatrix<double>& CholmodSolver::assemble(const SystemOperator&
         }
       }
       const double scale = c * kappa / model.nodeVolumes()[static_cast<size_t>(node)];
-      const int* blocks = m.patch_pair_blocks.data() + m.patch_pair_offsets[static_cast<size_t>(node)];
+      const int* blocks =
+          m.patch_pair_blocks.data() + m.patch_pair_offsets[static_cast<size_t>(node)];
       for (size_t a = 0, pair = 0; a < static_cast<size_t>(size); ++a) {
         for (size_t bi = 0; bi <= a; ++bi, ++pair)
           add_block(blocks[pair], scale * b[a] * b[bi].transpose());

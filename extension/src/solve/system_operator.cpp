@@ -288,7 +288,8 @@ void SystemOperator::diagonalBlocks(std::vector<Eigen::Matrix3d>& blocks) const 
 
 void SystemOperator::addNodalPressureDiagonal(std::vector<Eigen::Matrix3d>& blocks) const {
   // Block (i, i) of sum_n kappa V_n b_n b_n^T: for each node n sharing a tet with i,
-  // c_n = (b_n)_i = sum_{e ∋ n, i} (V_e / 4) R_e g_i / V_n, and the block gains kappa V_n c_n c_n^T.
+  // c_n = (b_n)_i = sum_{e ∋ n, i} (V_e / 4) R_e g_i / V_n, and the block gains kappa V_n c_n
+  // c_n^T.
   const double scale = stiffness_coefficient_ * model_->material().bulkModulus();
   const std::vector<int>& nodes = model_->elementNodes();
   const std::vector<double>& node_volume = model_->nodeVolumes();
@@ -313,7 +314,8 @@ void SystemOperator::addNodalPressureDiagonal(std::vector<Eigen::Matrix3d>& bloc
         }
       }
       for (const auto& [n, sum] : c)
-        blocks[r].noalias() += (scale / node_volume[static_cast<size_t>(n)]) * sum * sum.transpose();
+        blocks[r].noalias() +=
+            (scale / node_volume[static_cast<size_t>(n)]) * sum * sum.transpose();
     }
   });
 }

@@ -20,8 +20,8 @@
 //   K = K_dev + sum_n kappa V_n b_n b_n^T,   b_n = d theta_n / dx: (b_n)_a = sum_{e ∋ n, a}
 //   (V_e / 4) R_e g_a / V_n,
 // whose product K_vol y takes the same three passes as the force: per tet the trace increment
-// dt_e = sum_a (R_e g_a) . y_a, per node dtheta_n, per tet dpbar_e, then f_a = -V_e dpbar_e R_e g_a.
-// K_vol couples nodes two tets apart, so it is applied in that factored form (CG) and only
+// dt_e = sum_a (R_e g_a) . y_a, per node dtheta_n, per tet dpbar_e, then f_a = -V_e dpbar_e R_e
+// g_a. K_vol couples nodes two tets apart, so it is applied in that factored form (CG) and only
 // assembled where a matrix is needed (CHOLMOD, diagonal blocks for the preconditioner).
 //
 // Why it cures locking: a mesh of N nodes has about 5 N tets; per-tet volume constraints (the
