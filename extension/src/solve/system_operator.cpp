@@ -41,6 +41,7 @@ SystemOperator::SystemOperator(std::shared_ptr<const FemModel> model, const Para
     node_entries_[static_cast<size_t>(fill[static_cast<size_t>(element_nodes[entry])]++)] =
         static_cast<int>(entry);
   buildPattern();
+  if (model_->elementKind() == ElementKind::kTet4) buildPatches();
 }
 
 void SystemOperator::buildPattern() {
@@ -286,36 +287,60 @@ void SystemOperator::diagonalBlocks(std::vector<Eigen::Matrix3d>& blocks) const 
   if (model_->nodalPressure()) addNodalPressureDiagonal(blocks);
 }
 
+void SystemOperator::buildPatches() {
+  // Row i's patch: the nodes of its tets, sorted; the patch slot of every (node entry, local node).
+  const std::vector<int>& nodes = model_->elementNodes();
+  const int n = model_->nodeCount();
+  patch_offsets_.assign(1, 0);
+  patch_nodes_.clear();
+  patch_slots_.assign(4 * node_entries_.size(), -1);
+  std::vector<int> patch;
+  for (int row = 0; row < n; ++row) {
+    const size_t r = static_cast<size_t>(row);
+    patch.clear();
+    for (int k = node_offsets_[r]; k < node_offsets_[r + 1]; ++k) {
+      const size_t t = static_cast<size_t>(node_entries_[static_cast<size_t>(k)] / 4);
+      patch.insert(patch.end(), nodes.begin() + static_cast<std::ptrdiff_t>(4 * t),
+                   nodes.begin() + static_cast<std::ptrdiff_t>(4 * t + 4));
+    }
+    std::sort(patch.begin(), patch.end());
+    patch.erase(std::unique(patch.begin(), patch.end()), patch.end());
+    for (int k = node_offsets_[r]; k < node_offsets_[r + 1]; ++k) {
+      const size_t t = static_cast<size_t>(node_entries_[static_cast<size_t>(k)] / 4);
+      for (size_t b = 0; b < 4; ++b) {
+        patch_slots_[4 * static_cast<size_t>(k) + b] = static_cast<int>(
+            std::lower_bound(patch.begin(), patch.end(), nodes[4 * t + b]) - patch.begin());
+      }
+    }
+    patch_nodes_.insert(patch_nodes_.end(), patch.begin(), patch.end());
+    patch_offsets_.push_back(static_cast<int>(patch_nodes_.size()));
+  }
+}
+
 void SystemOperator::addNodalPressureDiagonal(std::vector<Eigen::Matrix3d>& blocks) const {
   // Block (i, i) of sum_n kappa V_n b_n b_n^T: for each node n sharing a tet with i,
-  // c_n = (b_n)_i = sum_{e ∋ n, i} (V_e / 4) R_e g_i / V_n, and the block gains kappa V_n c_n
-  // c_n^T.
+  // c_n = (b_n)_i = sum_{e ∋ n, i} (V_e / 4) R_e g_i / V_n, and the block gains kappa V_n c_n c_n^T.
   const double scale = stiffness_coefficient_ * model_->material().bulkModulus();
-  const std::vector<int>& nodes = model_->elementNodes();
   const std::vector<double>& node_volume = model_->nodeVolumes();
   parallel_.forRange(model_->nodeCount(), kNodeGrain, [&](int begin, int end) {
-    std::vector<std::pair<int, Eigen::Vector3d>> c;  // (n, c_n), in first-seen order
+    std::vector<Eigen::Vector3d> c;  // V_n c_n per patch slot
     for (int row = begin; row < end; ++row) {
       const size_t r = static_cast<size_t>(row);
-      c.clear();
+      const int first = patch_offsets_[r];
+      c.assign(static_cast<size_t>(patch_offsets_[r + 1] - first), Eigen::Vector3d::Zero());
       for (int k = node_offsets_[r]; k < node_offsets_[r + 1]; ++k) {
         const int entry = node_entries_[static_cast<size_t>(k)];
-        const size_t t = static_cast<size_t>(entry / 4);
-        const Eigen::Vector3d g = (0.25 * model_->tetRestData()[t].volume) *
-                                  rotated_gradients_[static_cast<size_t>(entry)];
-        for (size_t b = 0; b < 4; ++b) {
-          const int n = nodes[4 * t + b];
-          auto it = std::find_if(c.begin(), c.end(), [n](const auto& p) { return p.first == n; });
-          if (it == c.end()) {
-            c.emplace_back(n, g);
-          } else {
-            it->second += g;
-          }
-        }
+        const Eigen::Vector3d g =
+            (0.25 * model_->tetRestData()[static_cast<size_t>(entry / 4)].volume) *
+            rotated_gradients_[static_cast<size_t>(entry)];
+        for (size_t b = 0; b < 4; ++b)
+          c[static_cast<size_t>(patch_slots_[4 * static_cast<size_t>(k) + b])] += g;
       }
-      for (const auto& [n, sum] : c)
-        blocks[r].noalias() +=
-            (scale / node_volume[static_cast<size_t>(n)]) * sum * sum.transpose();
+      for (size_t j = 0; j < c.size(); ++j) {
+        const double weight =
+            scale / node_volume[static_cast<size_t>(patch_nodes_[static_cast<size_t>(first) + j])];
+        blocks[r].noalias() += weight * c[j] * c[j].transpose();
+      }
     }
   });
 }

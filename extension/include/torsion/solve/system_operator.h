@@ -69,6 +69,7 @@ class SystemOperator {
   // tet_scalars_[e] = V_e dpbar_e(y), the volumetric stiffness's tet pressures for y.
   void nodalPressureIncrements(const Eigen::VectorXd& y) const;
   void addNodalPressureDiagonal(std::vector<Eigen::Matrix3d>& blocks) const;
+  void buildPatches();
   // Fills block_values_ from this step's rotations (if stale).
   void assemble() const;
   // The two passes of assemble() for N-node elements with Q quadrature points.
@@ -102,6 +103,10 @@ class SystemOperator {
   // R_e grad N_a at each quadrature point: index (Q e + q) N + a.
   mutable std::vector<Eigen::Vector3d> rotated_gradients_;
   mutable bool assembled_ = false;
+  // tet4 node patches (for the nodal-pressure diagonal): row n's patch, the nodes of its tets
+  // sorted, is patch_nodes_[patch_offsets_[n] ..]; patch_slots_[4 k + b] is where local node b of
+  // node entry k's tet sits in its row's patch.
+  std::vector<int> patch_offsets_, patch_nodes_, patch_slots_;
   // Nodal pressure scratch: per tet and per node scalars of one product.
   mutable std::vector<double> tet_scalars_, node_scalars_;
 };
