@@ -39,6 +39,14 @@ Material readMaterial(const JsonObject& m) {
   material.density = m.number("density");
   material.mass_damping = m.number("mass_damping", material.mass_damping);
   material.stiffness_damping = m.number("stiffness_damping", material.stiffness_damping);
+  const std::string volumetric =
+      m.string("volumetric_strain", toString(material.volumetric_strain));
+  if (auto kind = parseVolumetricStrain(volumetric)) {
+    material.volumetric_strain = *kind;
+  } else {
+    m.fail("volumetric_strain",
+           "'" + volumetric + "' is not a volumetric strain (element or nodal_average)");
+  }
   m.finish();
   Status valid = material.validate();
   if (!valid) m.fail("", valid.error().message.substr(valid.error().message.find(':') + 2));
@@ -275,6 +283,11 @@ Result<SceneSpec> parseScene(std::string_view text, const std::string& file_name
         body.element = *kind;
       } else {
         b.fail("element", "'" + element + "' is not an element kind (tet4 or tet10)");
+      }
+      if (body.element == ElementKind::kTet10 &&
+          body.material.volumetric_strain == VolumetricStrain::kNodalAverage) {
+        b.fail("material",
+               "volumetric_strain nodal_average is a tet4 option (tet10 does not lock)");
       }
       b.finish();
       scene.bodies.push_back(std::move(body));

@@ -76,7 +76,7 @@ constexpr Protocol kRamped{1.0, 3, 12};
 constexpr Protocol kStatic{1000.0, 1, 4};
 
 TorsionResult smallTwist(int tets, double angle, ElementKind element = ElementKind::kTet4,
-                         const Protocol& protocol = kRamped) {
+                         const Protocol& protocol = kRamped, const Material& material = {}) {
   const double ramp = protocol.ramp_steps * protocol.time_step;
   const int steps = protocol.steps;
   const TetMesh linear = cylinder(tets);
@@ -85,7 +85,6 @@ TorsionResult smallTwist(int tets, double angle, ElementKind element = ElementKi
   settings.solver.time_step = protocol.time_step;
   settings.solver.linear_solver = LinearSolverKind::kCholmod;
   FemWorld world(settings);
-  Material material;  // E = 1e5, nu = 0.3, rho = 1000
   FemBody* body = world.addBody("cylinder", linear, material, Frame{}, element).value();
   const TetMesh& mesh = body->model().mesh();
   body->carryNodes(
@@ -210,6 +209,44 @@ TEST_F(StVenant, Tet10TorqueIsConvergedWhereTet4IsStillConverging) {
     highest = std::max(highest, ratio);
   }
   EXPECT_LT(highest - lowest, 0.005);
+}
+
+// Nearly incompressible (docs/validation.md, "Nearly incompressible tet4"): St-Venant's torsion is
+// pure shear, so T / (G J theta') must not depend on nu. Statics on 8332 tets. The plain tet4
+// locks: its ratio climbs with nu (every tet's volume constraint fights the twist). With the
+// nodal-average volumetric strain (fem/nodal_pressure.h) it stays within 2 % of its nu = 0.3
+// value at every nu up to 0.499.
+TEST(StVenantNearlyIncompressible, NodalPressureTorqueDoesNotDependOnNu) {
+  std::printf(
+      "| nu | tet4 T / (G J theta') | vs nu = 0.3 | nodal-pressure T / (G J theta') | vs nu = 0.3 "
+      "|\n|---|---|---|---|---|\n");
+  auto csv = test::validationCsv("st_venant_nearly_incompressible.csv",
+                                 "nu,tet4_ratio,nodal_pressure_ratio");
+  double base[2] = {0, 0};
+  for (double nu : {0.3, 0.45, 0.49, 0.499}) {
+    double ratio[2];
+    for (int k = 0; k < 2; ++k) {
+      Material material;
+      material.poisson_ratio = nu;
+      material.volumetric_strain =
+          k == 0 ? VolumetricStrain::kPerElement : VolumetricStrain::kNodalAverage;
+      const TorsionResult r = smallTwist(8332, 0.05, ElementKind::kTet4, kStatic, material);
+      ratio[k] = r.torque / r.expected;
+      // The locked plain tet4 does not even twist uniformly at nu = 0.499 (2 %).
+      if (k == 1) {
+        EXPECT_LT(r.nonlinearity, 0.01) << "nu = " << nu;
+      }
+      if (nu == 0.3) base[k] = ratio[k];
+    }
+    std::printf("| %.3f | %.4f | %+.1f %% | %.4f | %+.1f %% |\n", nu, ratio[0],
+                100 * (ratio[0] / base[0] - 1), ratio[1], 100 * (ratio[1] / base[1] - 1));
+    if (csv) *csv << nu << "," << ratio[0] << "," << ratio[1] << "\n";
+    EXPECT_NEAR(ratio[1], base[1], 0.02 * base[1]) << "nu = " << nu;
+    EXPECT_GT(ratio[1], 1.0) << "a conforming tet is not softer than St-Venant, nu = " << nu;
+    if (nu >= 0.49) {
+      EXPECT_GT(ratio[0], 1.1 * base[0]) << "the plain tet4 no longer locks at nu = " << nu;
+    }
+  }
 }
 
 // Through the hand plane (DESIGN.md section 5): the same small twist, applied by a hand whose

@@ -20,12 +20,24 @@ TetRestData linearRestData(const TetMesh& mesh, const Tet& tet) {
   return rest;
 }
 
+Status checkElementSupports(const Material& material, ElementKind element) {
+  Status valid = material.validate();
+  if (!valid) return valid;
+  if (element == ElementKind::kTet10 &&
+      material.volumetric_strain == VolumetricStrain::kNodalAverage) {
+    return Error{
+        "material: volumetric_strain = nodal_average is a tet4 option (quadratic tets do not "
+        "lock)"};
+  }
+  return Ok{};
+}
+
 }  // namespace
 
 Result<std::shared_ptr<const FemModel>> FemModel::create(std::shared_ptr<const TetMesh> mesh,
                                                          const Material& material,
                                                          ElementKind element) {
-  Status valid = material.validate();
+  Status valid = checkElementSupports(material, element);
   if (!valid) return valid.error();
 
   std::shared_ptr<FemModel> model(new FemModel());
@@ -54,12 +66,19 @@ Result<std::shared_ptr<const FemModel>> FemModel::create(std::shared_ptr<const T
   model->rest_.reserve(static_cast<size_t>(m.tetCount()));
   for (const Tet& tet : m.tets())
     model->rest_.push_back(linearRestData(m, tet));
+  if (element == ElementKind::kTet4) {
+    model->node_volume_.assign(static_cast<size_t>(m.nodeCount()), 0.0);
+    for (size_t t = 0; t < model->rest_.size(); ++t) {
+      for (int n : m.tets()[t])
+        model->node_volume_[static_cast<size_t>(n)] += model->rest_[t].volume / 4.0;
+    }
+  }
   model->computeMasses();
   return std::shared_ptr<const FemModel>(std::move(model));
 }
 
 Result<std::shared_ptr<const FemModel>> FemModel::withMaterial(const Material& material) const {
-  Status valid = material.validate();
+  Status valid = checkElementSupports(material, element_kind_);
   if (!valid) return valid.error();
   std::shared_ptr<FemModel> model(new FemModel(*this));
   model->material_ = material;

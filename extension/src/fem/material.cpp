@@ -5,6 +5,16 @@
 
 namespace torsion {
 
+const char* toString(VolumetricStrain kind) {
+  return kind == VolumetricStrain::kNodalAverage ? "nodal_average" : "element";
+}
+
+std::optional<VolumetricStrain> parseVolumetricStrain(const std::string& name) {
+  if (name == "element") return VolumetricStrain::kPerElement;
+  if (name == "nodal_average") return VolumetricStrain::kNodalAverage;
+  return std::nullopt;
+}
+
 Status Material::validate() const {
   auto bad = [](const char* field, double value, const char* rule) {
     return Error{std::string("material: ") + field + " = " + std::to_string(value) + ": " + rule};

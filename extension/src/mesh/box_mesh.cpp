@@ -29,14 +29,19 @@ Result<TetMesh> makeBoxTetMesh(const Eigen::Vector3d& min_corner, const Eigen::V
   for (int k = 0; k < nz; ++k) {
     for (int j = 0; j < ny; ++j) {
       for (int i = 0; i < nx; ++i) {
-        // One tet per path from corner (0,0,0) to (1,1,1) along the axes in some order.
+        // The cell's diagonal runs from its even corner (every grid index even) to the opposite
+        // one: along an axis the corner is the lower one in even cells, the upper one in odd
+        // cells. One tet per path along that diagonal, stepping the axes in some order.
+        const std::array<int, 3> start = {i + i % 2, j + j % 2, k + k % 2};
+        const std::array<int, 3> step = {i % 2 ? -1 : 1, j % 2 ? -1 : 1, k % 2 ? -1 : 1};
         std::sort(axes.begin(), axes.end());
         do {
-          std::array<int, 3> c = {i, j, k};
+          std::array<int, 3> c = start;
           Tet tet;
           tet[0] = node(c[0], c[1], c[2]);
           for (size_t s = 0; s < 3; ++s) {
-            ++c[static_cast<size_t>(axes[s])];
+            const size_t axis = static_cast<size_t>(axes[s]);
+            c[axis] += step[axis];
             tet[s + 1] = node(c[0], c[1], c[2]);
           }
           const auto& x = positions;

@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "torsion/fem/quadratic_element.h"
+#include "torsion/mesh/tet_mesh.h"
 
 namespace torsion {
 
@@ -16,6 +17,11 @@ struct CholmodSolver::Impl {
   // Per element, per (a, b) of its N nodes: block id at [N^2 e + N a + b], -1 if i < j.
   std::vector<int> element_block;
   std::vector<int> diagonal_block;  // per node
+  // Nodal pressure (nodal_pressure.h): node n's patch (the nodes of its tets, sorted) in
+  // patch_nodes[patch_offsets[n] ..], and the block of every patch pair (i >= j), row by row of
+  // the lower triangle, from patch_pair_offsets[n].
+  bool nodal_pressure = false;
+  std::vector<int> patch_offsets, patch_nodes, patch_pair_offsets, patch_pair_blocks;
   bool analysed = false;
   Eigen::CholmodDecomposition<Eigen::SparseMatrix<double>, Eigen::Lower> factor;
   Eigen::VectorXd rhs, prescribed, q, solution;
@@ -44,6 +50,30 @@ void CholmodSolver::buildPattern(const SystemOperator& op) {
       }
     }
   }
+  // The volumetric stiffness of nodal pressure couples every pair of nodes of a node's patch.
+  Impl& m = *impl_;
+  m.nodal_pressure = model.nodalPressure();
+  m.patch_offsets.assign(1, 0);
+  m.patch_nodes.clear();
+  if (m.nodal_pressure) {
+    const CompressedRows& node_tets = model.mesh().nodeTets();
+    std::vector<int> patch;
+    for (int node = 0; node < n; ++node) {
+      patch.clear();
+      for (int k = node_tets.rowBegin(node); k < node_tets.rowEnd(node); ++k) {
+        const int* nodes = element_nodes.data() + 4 * node_tets.items[static_cast<size_t>(k)];
+        patch.insert(patch.end(), nodes, nodes + 4);
+      }
+      std::sort(patch.begin(), patch.end());
+      patch.erase(std::unique(patch.begin(), patch.end()), patch.end());
+      for (size_t a = 0; a < patch.size(); ++a) {
+        for (size_t b = 0; b < a; ++b)
+          pairs.emplace_back(patch[a], patch[b]);
+      }
+      m.patch_nodes.insert(m.patch_nodes.end(), patch.begin(), patch.end());
+      m.patch_offsets.push_back(static_cast<int>(m.patch_nodes.size()));
+    }
+  }
   std::sort(pairs.begin(), pairs.end());
   pairs.erase(std::unique(pairs.begin(), pairs.end()), pairs.end());
 
@@ -57,7 +87,6 @@ void CholmodSolver::buildPattern(const SystemOperator& op) {
       }
     }
   }
-  Impl& m = *impl_;
   m.matrix.resize(3 * n, 3 * n);
   m.matrix.setFromTriplets(triplets.begin(), triplets.end());
   m.matrix.makeCompressed();
@@ -87,6 +116,20 @@ void CholmodSolver::buildPattern(const SystemOperator& op) {
   m.diagonal_block.resize(static_cast<size_t>(n));
   for (int i = 0; i < n; ++i)
     m.diagonal_block[static_cast<size_t>(i)] = block_of(i, i);
+  m.patch_pair_offsets.assign(1, 0);
+  m.patch_pair_blocks.clear();
+  if (m.nodal_pressure) {
+    for (int node = 0; node < n; ++node) {
+      const int* patch = m.patch_nodes.data() + m.patch_offsets[static_cast<size_t>(node)];
+      const int size = m.patch_offsets[static_cast<size_t>(node) + 1] -
+                       m.patch_offsets[static_cast<size_t>(node)];
+      for (int a = 0; a < size; ++a) {
+        for (int b = 0; b <= a; ++b)
+          m.patch_pair_blocks.push_back(block_of(patch[a], patch[b]));
+      }
+      m.patch_pair_offsets.push_back(static_cast<int>(m.patch_pair_blocks.size()));
+    }
+  }
   m.element_block.assign(elements * n_per * n_per, -1);
   for (size_t e = 0; e < elements; ++e) {
     const int* nodes = element_nodes.data() + n_per * e;
@@ -102,10 +145,16 @@ void CholmodSolver::buildPattern(const SystemOperator& op) {
 const Eigen::SparseMatrix<double>& CholmodSolver::assemble(const SystemOperator& op,
                                                            const NodeConstraints& constraints) {
   Impl& m = *impl_;
-  if (m.matrix.rows() != 3 * op.model().nodeCount()) buildPattern(op);
+  if (m.matrix.rows() != 3 * op.model().nodeCount() ||
+      m.nodal_pressure != op.model().nodalPressure()) {
+    buildPattern(op);
+    m.analysed = false;
+  }
   const FemModel& model = op.model();
   const double mu = model.material().mu();
-  const double lambda = model.material().lambda();
+  // With nodal pressure the element blocks are deviatoric (lambda -> -2 mu / 3) and the
+  // volumetric part is added per node patch below (nodal_pressure.h).
+  const double lambda = model.nodalPressure() ? -2.0 * mu / 3.0 : model.material().lambda();
   const double c = op.stiffnessCoefficient();
   double* values = m.matrix.valuePtr();
   std::fill(values, values + m.matrix.nonZeros(), 0.0);
@@ -152,6 +201,40 @@ const Eigen::SparseMatrix<double>& CholmodSolver::assemble(const SystemOperator&
           if (block < 0) continue;
           add_block(block, c * quadraticStiffnessBlock(R, rest, mu, lambda, a, b));
         }
+      }
+    }
+  }
+  if (m.nodal_pressure) {
+    // kappa V_n b_n b_n^T per node n, (b_n)_a = sum_{e ∋ n, a} (V_e / 4) R_e g_a / V_n.
+    const CompressedRows& node_tets = model.mesh().nodeTets();
+    const std::vector<int>& element_nodes = model.elementNodes();
+    const double kappa = model.material().bulkModulus();
+    std::vector<Eigen::Vector3d> b;
+    for (int node = 0; node < model.nodeCount(); ++node) {
+      const int* patch = m.patch_nodes.data() + m.patch_offsets[static_cast<size_t>(node)];
+      const int size = m.patch_offsets[static_cast<size_t>(node) + 1] -
+                       m.patch_offsets[static_cast<size_t>(node)];
+      b.assign(static_cast<size_t>(size), Eigen::Vector3d::Zero());
+      for (int k = node_tets.rowBegin(node); k < node_tets.rowEnd(node); ++k) {
+        const size_t t = static_cast<size_t>(node_tets.items[static_cast<size_t>(k)]);
+        const TetRestData& rest = model.tetRestData()[t];
+        const Eigen::Matrix3d& R = op.rotations()[t];
+        const Eigen::Matrix3d& B = rest.rest_shape_inverse;
+        const std::array<Eigen::Vector3d, 4> g = {-(B.row(0) + B.row(1) + B.row(2)).transpose(),
+                                                  B.row(0).transpose(), B.row(1).transpose(),
+                                                  B.row(2).transpose()};
+        for (size_t a = 0; a < 4; ++a) {
+          const size_t at = static_cast<size_t>(
+              std::lower_bound(patch, patch + size, element_nodes[4 * t + a]) - patch);
+          b[at] += (0.25 * rest.volume) * (R * g[a]);
+        }
+      }
+      const double scale = c * kappa / model.nodeVolumes()[static_cast<size_t>(node)];
+      const int* blocks =
+          m.patch_pair_blocks.data() + m.patch_pair_offsets[static_cast<size_t>(node)];
+      for (size_t a = 0, pair = 0; a < static_cast<size_t>(size); ++a) {
+        for (size_t bi = 0; bi <= a; ++bi, ++pair)
+          add_block(blocks[pair], scale * b[a] * b[bi].transpose());
       }
     }
   }

@@ -5,6 +5,7 @@
 #include <sstream>
 
 #include "torsion/fem/corotated_element.h"
+#include "torsion/fem/nodal_pressure.h"
 #include "torsion/fem/polar_rotation.h"
 #include "torsion/fem/quadratic_element.h"
 #include "torsion/solve/cholmod_solver.h"
@@ -50,7 +51,13 @@ double ImplicitStepper::computeElasticForces(FemState& state) {
   const double lambda = model_->material().lambda();
   const std::vector<int>& nodes = model_->elementNodes();
   std::vector<Eigen::Matrix3d>& rotations = system_.mutableRotations();
+  double nodal_energy = 0;
   if (model_->elementKind() == ElementKind::kTet4) {
+    // Nodal pressure (fem/nodal_pressure.h): the tets carry the deviatoric stress (lambda ->
+    // -2 mu / 3) and report their volumetric strain; the pressure comes from the node averages.
+    const bool nodal_pressure = model_->nodalPressure();
+    const double element_lambda = nodal_pressure ? -2.0 * mu / 3.0 : lambda;
+    tet_strain_.resize(nodal_pressure ? nodes.size() / 4 : 0);
     parallel_.forRange(model_->elementCount(), kTetGrain, [&](int begin, int end) {
       for (int t = begin; t < end; ++t) {
         const size_t ti = static_cast<size_t>(t);
@@ -60,11 +67,14 @@ double ImplicitStepper::computeElasticForces(FemState& state) {
           x[a] = state.positions.segment<3>(3 * nodes[4 * ti + a]);
         const Eigen::Matrix3d F = deformationGradient(x, rest.rest_shape_inverse);
         rotations[ti] = extractRotation(F, state.element_rotations[ti]);
-        const CorotatedResponse response = corotatedResponse(F, rotations[ti], rest, mu, lambda);
+        const CorotatedResponse response =
+            corotatedResponse(F, rotations[ti], rest, mu, element_lambda);
         std::copy(response.forces.begin(), response.forces.end(), element_forces_.begin() + 4 * t);
         element_energy_[ti] = response.energy;
+        if (nodal_pressure) tet_strain_[ti] = (rotations[ti].transpose() * F).trace() - 3.0;
       }
     });
+    if (nodal_pressure) nodal_energy = addNodalPressureForces();
   } else {
     // One rotation per element, from its mean deformation gradient (quadratic_element.h).
     parallel_.forRange(model_->elementCount(), kTetGrain / 4, [&](int begin, int end) {
@@ -83,10 +93,25 @@ double ImplicitStepper::computeElasticForces(FemState& state) {
     });
   }
   system_.gather(element_forces_, 1.0, elastic_forces_);
-  double energy = 0;
+  double energy = nodal_energy;
   for (double e : element_energy_)
     energy += e;
   return energy;
+}
+
+double ImplicitStepper::addNodalPressureForces() {
+  const int tets = model_->elementCount();
+  node_strain_.resize(static_cast<size_t>(model_->nodeCount()));
+  parallel_.forRange(model_->nodeCount(), kTetGrain, [&](int begin, int end) {
+    averageOverNodeTets(*model_, tet_strain_, begin, end, node_strain_);
+  });
+  parallel_.forRange(tets, kTetGrain, [&](int begin, int end) {
+    // tet_strain_ becomes the tet pressure pbar_e: each tet reads and writes only its own entry.
+    averageOverTetNodes(*model_, node_strain_, model_->material().bulkModulus(), begin, end,
+                        tet_strain_);
+    addPressureForces(*model_, tet_strain_, system_.rotations(), begin, end, element_forces_);
+  });
+  return nodalVolumetricEnergy(*model_, node_strain_);
 }
 
 StepReport ImplicitStepper::step(FemState& state, const NodeConstraints& constraints,

@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cassert>
 
+#include "torsion/fem/nodal_pressure.h"
+
 namespace torsion {
 
 namespace {
@@ -39,6 +41,7 @@ SystemOperator::SystemOperator(std::shared_ptr<const FemModel> model, const Para
     node_entries_[static_cast<size_t>(fill[static_cast<size_t>(element_nodes[entry])]++)] =
         static_cast<int>(entry);
   buildPattern();
+  if (model_->elementKind() == ElementKind::kTet4) buildPatches();
 }
 
 void SystemOperator::buildPattern() {
@@ -122,7 +125,9 @@ void SystemOperator::assemble() const {
 template <int N, int Q>
 void SystemOperator::assembleElements() const {
   const double mu = model_->material().mu();
-  const double lambda = model_->material().lambda();
+  // With nodal pressure the blocks hold the deviatoric part only (nodal_pressure.h): the same
+  // formula with lambda replaced by -2 mu / 3; the volumetric part is applied in factored form.
+  const double lambda = model_->nodalPressure() ? -2.0 * mu / 3.0 : model_->material().lambda();
   constexpr size_t kPerElement = static_cast<size_t>(N * Q);
   // Pass 1, per element: the rotated shape gradients R g_a at each quadrature point.
   parallel_.forRange(model_->elementCount(), kTetGrain, [&](int begin, int end) {
@@ -189,11 +194,39 @@ void SystemOperator::setCoefficients(double mass_coefficient, double stiffness_c
   stiffness_coefficient_ = stiffness_coefficient;
 }
 
+void SystemOperator::nodalPressureIncrements(const Eigen::VectorXd& y) const {
+  // dt_e = sum_a (R_e g_a) . y_a, dtheta_n (node average), then V_e kappa mean(dtheta) per tet.
+  const std::vector<int>& nodes = model_->elementNodes();
+  const int tets = model_->elementCount();
+  tet_scalars_.resize(static_cast<size_t>(tets));
+  node_scalars_.resize(static_cast<size_t>(model_->nodeCount()));
+  parallel_.forRange(tets, kTetGrain, [&](int begin, int end) {
+    for (int t = begin; t < end; ++t) {
+      const size_t i = 4 * static_cast<size_t>(t);
+      double trace = 0;
+      for (size_t a = 0; a < 4; ++a)
+        trace += rotated_gradients_[i + a].dot(y.segment<3>(3 * nodes[i + a]));
+      tet_scalars_[static_cast<size_t>(t)] = trace;
+    }
+  });
+  parallel_.forRange(model_->nodeCount(), kNodeGrain, [&](int begin, int end) {
+    averageOverNodeTets(*model_, tet_scalars_, begin, end, node_scalars_);
+  });
+  parallel_.forRange(tets, kTetGrain, [&](int begin, int end) {
+    averageOverTetNodes(*model_, node_scalars_, model_->material().bulkModulus(), begin, end,
+                        tet_scalars_);
+    for (int t = begin; t < end; ++t)
+      tet_scalars_[static_cast<size_t>(t)] *= model_->tetRestData()[static_cast<size_t>(t)].volume;
+  });
+}
+
 void SystemOperator::apply(const Eigen::VectorXd& y, Eigen::VectorXd& out, double mass_scale,
                            double stiffness_scale) const {
   assemble();
   const std::vector<double>& mass = model_->nodeMasses();
   out.resize(y.size());
+  const bool nodal_pressure = model_->nodalPressure();
+  if (nodal_pressure) nodalPressureIncrements(y);
   parallel_.forRange(model_->nodeCount(), kNodeGrain, [&](int begin, int end) {
     for (int row = begin; row < end; ++row) {
       const size_t r = static_cast<size_t>(row);
@@ -206,6 +239,13 @@ void SystemOperator::apply(const Eigen::VectorXd& y, Eigen::VectorXd& out, doubl
         sum.noalias() +=
             block_values_[static_cast<size_t>(lower_slots_[static_cast<size_t>(l)])].transpose() *
             y.segment<3>(3 * lower_columns_[static_cast<size_t>(l)]);
+      }
+      if (nodal_pressure) {  // K_vol y at this node: sum over its tets of V_e dpbar_e R_e g_a
+        for (int k = node_offsets_[r]; k < node_offsets_[r + 1]; ++k) {
+          const int entry = node_entries_[static_cast<size_t>(k)];
+          sum.noalias() += tet_scalars_[static_cast<size_t>(entry / 4)] *
+                           rotated_gradients_[static_cast<size_t>(entry)];
+        }
       }
       out.segment<3>(3 * row) =
           stiffness_scale * sum + (mass_scale * mass[r]) * y.segment<3>(3 * row);
@@ -244,6 +284,65 @@ void SystemOperator::diagonalBlocks(std::vector<Eigen::Matrix3d>& blocks) const 
     blocks[n] = mass_coefficient_ * mass[n] * Eigen::Matrix3d::Identity() +
                 stiffness_coefficient_ * block_values_[static_cast<size_t>(diagonal_slots_[n])];
   }
+  if (model_->nodalPressure()) addNodalPressureDiagonal(blocks);
+}
+
+void SystemOperator::buildPatches() {
+  // Row i's patch: the nodes of its tets, sorted; the patch slot of every (node entry, local node).
+  const std::vector<int>& nodes = model_->elementNodes();
+  const int n = model_->nodeCount();
+  patch_offsets_.assign(1, 0);
+  patch_nodes_.clear();
+  patch_slots_.assign(4 * node_entries_.size(), -1);
+  std::vector<int> patch;
+  for (int row = 0; row < n; ++row) {
+    const size_t r = static_cast<size_t>(row);
+    patch.clear();
+    for (int k = node_offsets_[r]; k < node_offsets_[r + 1]; ++k) {
+      const size_t t = static_cast<size_t>(node_entries_[static_cast<size_t>(k)] / 4);
+      patch.insert(patch.end(), nodes.begin() + static_cast<std::ptrdiff_t>(4 * t),
+                   nodes.begin() + static_cast<std::ptrdiff_t>(4 * t + 4));
+    }
+    std::sort(patch.begin(), patch.end());
+    patch.erase(std::unique(patch.begin(), patch.end()), patch.end());
+    for (int k = node_offsets_[r]; k < node_offsets_[r + 1]; ++k) {
+      const size_t t = static_cast<size_t>(node_entries_[static_cast<size_t>(k)] / 4);
+      for (size_t b = 0; b < 4; ++b) {
+        patch_slots_[4 * static_cast<size_t>(k) + b] = static_cast<int>(
+            std::lower_bound(patch.begin(), patch.end(), nodes[4 * t + b]) - patch.begin());
+      }
+    }
+    patch_nodes_.insert(patch_nodes_.end(), patch.begin(), patch.end());
+    patch_offsets_.push_back(static_cast<int>(patch_nodes_.size()));
+  }
+}
+
+void SystemOperator::addNodalPressureDiagonal(std::vector<Eigen::Matrix3d>& blocks) const {
+  // Block (i, i) of sum_n kappa V_n b_n b_n^T: for each node n sharing a tet with i,
+  // c_n = (b_n)_i = sum_{e ∋ n, i} (V_e / 4) R_e g_i / V_n, and the block gains kappa V_n c_n c_n^T.
+  const double scale = stiffness_coefficient_ * model_->material().bulkModulus();
+  const std::vector<double>& node_volume = model_->nodeVolumes();
+  parallel_.forRange(model_->nodeCount(), kNodeGrain, [&](int begin, int end) {
+    std::vector<Eigen::Vector3d> c;  // V_n c_n per patch slot
+    for (int row = begin; row < end; ++row) {
+      const size_t r = static_cast<size_t>(row);
+      const int first = patch_offsets_[r];
+      c.assign(static_cast<size_t>(patch_offsets_[r + 1] - first), Eigen::Vector3d::Zero());
+      for (int k = node_offsets_[r]; k < node_offsets_[r + 1]; ++k) {
+        const int entry = node_entries_[static_cast<size_t>(k)];
+        const Eigen::Vector3d g =
+            (0.25 * model_->tetRestData()[static_cast<size_t>(entry / 4)].volume) *
+            rotated_gradients_[static_cast<size_t>(entry)];
+        for (size_t b = 0; b < 4; ++b)
+          c[static_cast<size_t>(patch_slots_[4 * static_cast<size_t>(k) + b])] += g;
+      }
+      for (size_t j = 0; j < c.size(); ++j) {
+        const double weight =
+            scale / node_volume[static_cast<size_t>(patch_nodes_[static_cast<size_t>(first) + j])];
+        blocks[r].noalias() += weight * c[j] * c[j].transpose();
+      }
+    }
+  });
 }
 
 void SystemOperator::replaceModel(std::shared_ptr<const FemModel> model) {

@@ -30,12 +30,12 @@ struct TetRestData {
 class FemModel {
  public:
   /// Precomputes rest data of `mesh` (a linear mesh) discretised with `element`; fails if the
-  /// material is invalid.
+  /// material is invalid or asks for nodal-average volumetric strain on tet10.
   static Result<std::shared_ptr<const FemModel>> create(std::shared_ptr<const TetMesh> mesh,
                                                         const Material& material,
                                                         ElementKind element = ElementKind::kTet4);
   /// The same meshes, elements and rest data with another material (live edits); the masses
-  /// follow the density. Fails if the material is invalid.
+  /// follow the density. Fails as create() does.
   Result<std::shared_ptr<const FemModel>> withMaterial(const Material& material) const;
 
   /// All simulation nodes, their surface and incidence (see above).
@@ -59,6 +59,12 @@ class FemModel {
   const std::vector<TetRestData>& tetRestData() const { return rest_; }
   /// P2 rest data per element (tet10; empty for tet4).
   const std::vector<QuadraticRestData>& quadraticRestData() const { return quadratic_rest_; }
+  /// True when the tet4 volumetric strain is averaged over nodes (fem/nodal_pressure.h).
+  bool nodalPressure() const {
+    return material_.volumetric_strain == VolumetricStrain::kNodalAverage;
+  }
+  /// V_n = sum of V / 4 over the node's tets (tet4; empty for tet10), m^3.
+  const std::vector<double>& nodeVolumes() const { return node_volume_; }
   /// Lumped node masses, kg: rho V / 4 per corner for tet4; HRZ for tet10 (quadratic_element.h).
   const std::vector<double>& nodeMasses() const { return node_mass_; }
   double totalMass() const { return total_mass_; }
@@ -74,6 +80,7 @@ class FemModel {
   std::vector<int> element_nodes_;
   std::vector<TetRestData> rest_;
   std::vector<QuadraticRestData> quadratic_rest_;
+  std::vector<double> node_volume_;
   std::vector<double> node_mass_;
   double total_mass_ = 0;
 };

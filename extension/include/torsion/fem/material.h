@@ -1,9 +1,26 @@
 #pragma once
 // Linear elastic material of a corotational FEM body, SI units.
 
+#include <optional>
+#include <string>
+
 #include "torsion/result.h"
 
 namespace torsion {
+
+/// How a tet4 body measures the volume change its pressure responds to (fem/nodal_pressure.h).
+enum class VolumetricStrain {
+  /// Each tet its own (one-point tet4). Linear tets lock as nu -> 0.5: a body of N nodes has about
+  /// 5 N tets, each a volume constraint, against 3 N degrees of freedom.
+  kPerElement,
+  /// Averaged over the tets around each node (average nodal pressure, Bonet & Burton 1998): one
+  /// volume constraint per node, so nearly incompressible tet4 bodies do not lock. tet4 only
+  /// (quadratic tets do not lock; FemModel::create refuses the combination).
+  kNodalAverage,
+};
+/// "element" or "nodal_average" (the scene key's values).
+const char* toString(VolumetricStrain kind);
+std::optional<VolumetricStrain> parseVolumetricStrain(const std::string& name);
 
 struct Material {
   double youngs_modulus = 1e5;  ///< E, Pa
@@ -13,6 +30,9 @@ struct Material {
   /// too), beta in s (damps deformation rates only).
   double mass_damping = 0.0;
   double stiffness_damping = 0.01;
+  /// Per element (default) or averaged over nodes: set kNodalAverage for tet4 bodies with nu
+  /// above about 0.4 (docs/validation.md, "Nearly incompressible tet4").
+  VolumetricStrain volumetric_strain = VolumetricStrain::kPerElement;
 
   /// Lame's first parameter lambda = E nu / ((1 + nu)(1 - 2 nu)), Pa.
   double lambda() const {
@@ -20,6 +40,8 @@ struct Material {
   }
   /// Shear modulus mu = G = E / (2 (1 + nu)), Pa.
   double mu() const { return youngs_modulus / (2 * (1 + poisson_ratio)); }
+  /// Bulk modulus kappa = lambda + 2 mu / 3 = E / (3 (1 - 2 nu)), Pa.
+  double bulkModulus() const { return youngs_modulus / (3 * (1 - 2 * poisson_ratio)); }
 
   /// Error naming the field when a value is out of its physical range.
   Status validate() const;

@@ -113,6 +113,9 @@ class ImplicitStepper {
   double computeElasticForces(FemState& state);
 
  private:
+  // Stage 2's pressure pass for nodal pressure (adds to element_forces_); the volumetric energy.
+  double addNodalPressureForces();
+
   std::shared_ptr<const FemModel> model_;
   SolverSettings settings_;
   const Parallel& parallel_;
@@ -125,6 +128,9 @@ class ImplicitStepper {
   Eigen::VectorXd previous_velocities_;          // v of the step before, for the CG warm start
   std::vector<Eigen::Vector3d> element_forces_;  // N per element (SystemOperator::gather)
   std::vector<double> element_energy_;
+  // Nodal pressure (fem/nodal_pressure.h): per-tet volumetric strain, then pressure; per-node
+  // averaged strain.
+  std::vector<double> tet_strain_, node_strain_;
   bool internal_forces_valid_ = false;
   double last_dt_;  // s, dt of the last step (the internal forces' linearisation uses it)
 };

@@ -10,6 +10,11 @@
 // four products per step on (a step at E = 1e5 takes about six; stiffer materials take more).
 // Assembly runs per block row over the row node's tets in ascending order, so K and every
 // product are identical for any thread count.
+//
+// Nodal pressure (tet4 with VolumetricStrain::kNodalAverage, fem/nodal_pressure.h): the blocks
+// hold the deviatoric stiffness, and the volumetric part sum_n kappa V_n b_n b_n^T, which couples
+// nodes two tets apart, is applied in its factored form in every product (three more passes:
+// per tet, per node, per tet); diagonalBlocks() includes its diagonal.
 
 #include <Eigen/Core>
 #include <array>
@@ -61,6 +66,10 @@ class SystemOperator {
   void apply(const Eigen::VectorXd& y, Eigen::VectorXd& out, double mass_scale,
              double stiffness_scale) const;
   void buildPattern();
+  // tet_scalars_[e] = V_e dpbar_e(y), the volumetric stiffness's tet pressures for y.
+  void nodalPressureIncrements(const Eigen::VectorXd& y) const;
+  void addNodalPressureDiagonal(std::vector<Eigen::Matrix3d>& blocks) const;
+  void buildPatches();
   // Fills block_values_ from this step's rotations (if stale).
   void assemble() const;
   // The two passes of assemble() for N-node elements with Q quadrature points.
@@ -94,6 +103,12 @@ class SystemOperator {
   // R_e grad N_a at each quadrature point: index (Q e + q) N + a.
   mutable std::vector<Eigen::Vector3d> rotated_gradients_;
   mutable bool assembled_ = false;
+  // tet4 node patches (for the nodal-pressure diagonal): row n's patch, the nodes of its tets
+  // sorted, is patch_nodes_[patch_offsets_[n] ..]; patch_slots_[4 k + b] is where local node b of
+  // node entry k's tet sits in its row's patch.
+  std::vector<int> patch_offsets_, patch_nodes_, patch_slots_;
+  // Nodal pressure scratch: per tet and per node scalars of one product.
+  mutable std::vector<double> tet_scalars_, node_scalars_;
 };
 
 }  // namespace torsion
