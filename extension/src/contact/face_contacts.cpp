@@ -20,6 +20,8 @@ constexpr int kMaxStalls = 3;
 // interpolated distances to be a contact of its own (round-off on flat-on-flat is far below).
 constexpr double kDuplicateMargin = 1e-3;
 constexpr int kMaxSwitches = 1;
+// m: round-off between the nearest pair's and a supporting plane's predicted end gaps.
+constexpr double kPlaneChoiceMargin = 1e-9;
 
 Eigen::Matrix<double, 3, 6> pointJacobian(const Eigen::Vector3d& r) {
   Eigen::Matrix<double, 3, 6> J;
@@ -36,6 +38,41 @@ bool participates(const FaceContact& c) {
 Eigen::Matrix3d projector(const FaceContact& c) {
   return c.state == FaceContact::State::kStick ? Eigen::Matrix3d::Identity()
                                                : Eigen::Matrix3d(c.normal * c.normal.transpose());
+}
+
+// Whether the triangle is better held against the rigid shape's supporting plane that faces it
+// (normal minus the triangle's) than along the nearest pair (f), by the end gaps the predicted
+// motion leaves (the nodes' velocities, the rigid body's after Bullet's integration). A triangle
+// on a flat surface just ahead of a sliding box is nearest the box's front face, and the end gap
+// along that horizontal normal stops the box as at a wall; the box's bottom edge will pass over
+// the triangle, whose nodes hold it against the bottom plane themselves (node contacts take the
+// same plane, rigid_contact.cpp), so such a face contact is left out. At rest the nearest pair
+// is never farther than a supporting plane: nothing changes.
+bool supportPlaneLeavesMore(const btCollisionShape& shape, const btTransform& transform,
+                            const FemState& state, const Triangle& tri, const FacePoint& f,
+                            const RigidPartner& p, double dt) {
+  const Eigen::Vector3d a = state.position(tri[0]), b = state.position(tri[1]),
+                        c = state.position(tri[2]);
+  const Eigen::Vector3d outward = (b - a).cross(c - a);
+  if (outward.squaredNorm() == 0) return false;
+  const Eigen::Vector3d rigid = pointVelocity(p.entry_velocity, f.shape_point - p.com);
+  Eigen::Vector3d face_velocity = Eigen::Vector3d::Zero();
+  for (size_t j = 0; j < 3; ++j)
+    face_velocity += f.barycentric[static_cast<Eigen::Index>(j)] * state.velocity(tri[j]);
+  const Eigen::Vector3d into = -outward.normalized();
+  // Only the motion along the plane predicts which side the face ends on: across it, the rigid
+  // body's predicted velocity carries the step's gravity, which the contacts under it cancel.
+  Eigen::Vector3d slip = face_velocity - rigid;
+  slip -= into * into.dot(slip);
+  const double end_nearest = f.distance + dt * f.normal.dot(slip);
+  double end_plane = std::numeric_limits<double>::infinity();
+  for (size_t j = 0; j < 3; ++j) {
+    const std::optional<SurfacePoint> plane =
+        supportPlaneDistance(shape, transform, state.position(tri[j]), into);
+    if (!plane) return false;
+    end_plane = std::min(end_plane, plane->distance);
+  }
+  return end_plane > end_nearest + kPlaneChoiceMargin;
 }
 
 }  // namespace
@@ -82,7 +119,7 @@ double FaceContactSet::longestEdge(const FemState& state) const {
 void FaceContactSet::detect(const FemState& state, const NodeConstraints& held,
                             const std::vector<int>& nearby_nodes, const btCollisionShape& shape,
                             const btTransform& transform, const Eigen::Vector3d& lo,
-                            const Eigen::Vector3d& hi, double reach, int partner,
+                            const Eigen::Vector3d& hi, double reach, double dt, int partner,
                             const RigidPartner& p, double friction) {
   ++stamp_;
   const Eigen::Vector3d pad = Eigen::Vector3d::Constant(reach);
@@ -123,6 +160,7 @@ void FaceContactSet::detect(const FemState& state, const NodeConstraints& held,
                         (d ? d->distance : std::numeric_limits<double>::infinity());
       }
       if (f->distance >= interpolated - kDuplicateMargin * reach) continue;
+      if (supportPlaneLeavesMore(shape, transform, state, tri, *f, p, dt)) continue;
       FaceContact fc;
       fc.nodes = {tri[0], tri[1], tri[2]};
       fc.weights = f->barycentric;
@@ -271,7 +309,14 @@ bool FaceContactSet::update(const Eigen::VectorXd& v, const std::vector<RigidPar
       // micrometre, releasing it the next solve, and the nodes' friction following each time,
       // was most of the active-set iterations of rigid_mix.
       if (end_gap < -std::max(activation_tolerance, gap_tolerance)) {
-        c.state = c.friction > 0 ? FaceContact::State::kStick : FaceContact::State::kSlide;
+        // A face the rigid body slides over starts sliding: starting it stuck glued the body to
+        // the face through the penalty (a tangential impulse far above mu lambda), and the
+        // bounded stick/slide switches left such impulses in the step (docs/contact.md,
+        // "Sliding over nodes").
+        const Eigen::Vector3d slip = h - c.normal * c.normal.dot(h);
+        const bool slipping = dt * slip.norm() > gap_tolerance;
+        c.state = c.friction > 0 && !slipping ? FaceContact::State::kStick
+                                              : FaceContact::State::kSlide;
         c.multiplier.setZero();
         again = true;
       }
