@@ -156,6 +156,7 @@ void RigidContactSolver::chooseSupportPlane(const btCollisionShape& shape,
   c.normal = plane->normal;
   c.gap = plane->distance;
   c.lever = lever;
+  c.swept = true;
 }
 
 bool RigidContactSolver::detect(const FemState& state, const NodeConstraints& constraints,
@@ -454,12 +455,14 @@ bool RigidContactSolver::updateActiveSet(const Eigen::VectorXd& v, const Eigen::
       case NodeContact::State::kInactive: {
         const double gap_end = c.gap + dt * c.normal.dot(vi - rigid_v);
         if (gap_end < -settings_.activation_tolerance) {
-          // A node the rigid body slides over starts sliding (its friction follows from the
-          // next solve's normal impulse); starting it stuck stopped a sliding body at each new
-          // contact (docs/contact.md, "Sliding over nodes").
+          // A node the rigid body sweeps over (held by the supporting plane, chooseSupportPlane)
+          // starts sliding when it slips; its friction follows from the next solve's normal
+          // impulse. Starting it stuck stopped a sliding body at each node row (docs/contact.md,
+          // "Sliding over nodes"). Other contacts start stuck: a landing body's contacts slip
+          // too (Poisson), and starting those sliding kept a box on a tet10 slab from settling.
           Eigen::Vector3d slip = vi - rigid_v;
           slip -= c.normal * c.normal.dot(slip);
-          const bool slipping = dt * slip.norm() > settings_.activation_tolerance;
+          const bool slipping = c.swept && dt * slip.norm() > settings_.activation_tolerance;
           c.state = c.friction > 0 && !slipping ? NodeContact::State::kStick
                                                 : NodeContact::State::kSlide;
           c.friction_impulse.setZero();

@@ -78,6 +78,9 @@ struct NodeContact {
   Eigen::Vector3d lever;   ///< m, contact point minus centre of mass (start of step)
   double friction = 0;     ///< pair coefficient
   bool held = false;       ///< the node is prescribed (hand, node group)
+  /// Held by the supporting plane facing the soft surface, not the nearest feature: the rigid
+  /// body is sweeping over the node this step (a sliding box's leading edge).
+  bool swept = false;
   State state = State::kInactive;
   int releases = 0;              ///< times released this step (anti-cycling: never twice)
   int slips = 0;                 ///< stick-to-slide switches this step (anti-cycling: at most two)
