@@ -121,8 +121,7 @@ int RigidContactSolver::partnerIndex(const btCollisionObject* object) {
 }
 
 void RigidContactSolver::chooseSupportPlane(const btCollisionShape& shape,
-                                            const btTransform& transform,
-                                            const Eigen::Vector3d& x,
+                                            const btTransform& transform, const Eigen::Vector3d& x,
                                             const Eigen::Vector3d& node_velocity,
                                             const Eigen::Vector3d& into_surface, double dt,
                                             NodeContact& c) const {
@@ -143,8 +142,8 @@ void RigidContactSolver::chooseSupportPlane(const btCollisionShape& shape,
   // Where the node would touch the plane: its foot on the plane, moved onto the shape.
   const Eigen::Vector3d foot = x - plane->distance * plane->normal;
   const std::optional<SurfacePoint> onto = signedDistance(shape, transform, foot, 0);
-  const Eigen::Vector3d contact_point = onto ? Eigen::Vector3d(foot - onto->distance * onto->normal)
-                                             : foot;
+  const Eigen::Vector3d contact_point =
+      onto ? Eigen::Vector3d(foot - onto->distance * onto->normal) : foot;
   const Eigen::Vector3d lever = contact_point - k.com;
   // Only the motion along the plane predicts which side the node ends on: across it, the rigid
   // body's predicted velocity carries the step's gravity, which the contacts under it cancel.
@@ -463,8 +462,8 @@ bool RigidContactSolver::updateActiveSet(const Eigen::VectorXd& v, const Eigen::
           Eigen::Vector3d slip = vi - rigid_v;
           slip -= c.normal * c.normal.dot(slip);
           const bool slipping = c.swept && dt * slip.norm() > settings_.activation_tolerance;
-          c.state = c.friction > 0 && !slipping ? NodeContact::State::kStick
-                                                : NodeContact::State::kSlide;
+          c.state =
+              c.friction > 0 && !slipping ? NodeContact::State::kStick : NodeContact::State::kSlide;
           c.friction_impulse.setZero();
           changed = true;
         }

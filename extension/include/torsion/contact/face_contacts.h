@@ -53,9 +53,10 @@ struct FaceContact {
   /// on a parallel normal): the nodes decide, the contact sits out (an exact node constraint and
   /// a multiplier on the same motion would make the multiplier grow without bound).
   bool determined = false;
-  double last_violation = 0;  ///< m, |end gap| after the previous solve of this step
-  int stalls = 0;             ///< updates this step that did not reduce the violation
-  int switches = 0;           ///< stick/slide switches this step
+  double last_violation = 0;     ///< m, |end gap| after the previous solve of this step
+  int stalls = 0;                ///< updates this step that did not reduce the violation
+  int switches = 0;              ///< stick/slide switches this step
+  int friction_refinements = 0;  ///< solves this step reopened to bring the friction to mu lambda
 };
 
 class FaceContactSet {
