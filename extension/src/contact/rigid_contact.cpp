@@ -19,6 +19,9 @@ namespace {
 
 constexpr int kMaxSlipsPerStep = 2;
 constexpr int kMaxFrictionRefinements = 8;
+// m: a supporting plane replaces the nearest feature's only if it leaves a larger predicted end
+// gap by more than round-off (at rest the two agree).
+constexpr double kPlaneChoiceMargin = 1e-9;
 
 // Collects the soft body's nodes whose tree leaves overlap a volume.
 struct NodeCollector : btDbvt::ICollide {
@@ -117,6 +120,44 @@ int RigidContactSolver::partnerIndex(const btCollisionObject* object) {
   return static_cast<int>(partners_.size()) - 1;
 }
 
+void RigidContactSolver::chooseSupportPlane(const btCollisionShape& shape,
+                                            const btTransform& transform, const Eigen::Vector3d& x,
+                                            const Eigen::Vector3d& node_velocity,
+                                            const Eigen::Vector3d& into_surface, double dt,
+                                            NodeContact& c) const {
+  // The contact is linearised on one supporting plane of the (convex) rigid shape: the node must
+  // end the step outside it. The nearest feature's plane is exact at the start of the step but
+  // not over it: a node on a flat surface just ahead of a sliding box sees the box's front face
+  // (a horizontal normal), and the linearised end gap along it, d - v dt, stops the box at the
+  // node as at a wall, although the box's bottom edge would pass over it (docs/contact.md,
+  // "Sliding over nodes"). The supporting plane facing the soft surface (normal minus the node's
+  // surface normal: the bottom face's plane for a box on a slab) is as valid a bound. Of the two,
+  // the one the predicted motion (the node's velocity, the rigid body's velocity after Bullet's
+  // integration) leaves the larger end gap is taken. At rest they agree or the nearest wins: a
+  // supporting plane never measures more than the distance.
+  const RigidPartner& k = partners_[static_cast<size_t>(c.partner)];
+  if (into_surface.squaredNorm() == 0) return;
+  const std::optional<SurfacePoint> plane = supportPlaneDistance(shape, transform, x, into_surface);
+  if (!plane) return;
+  // Where the node would touch the plane: its foot on the plane, moved onto the shape.
+  const Eigen::Vector3d foot = x - plane->distance * plane->normal;
+  const std::optional<SurfacePoint> onto = signedDistance(shape, transform, foot, 0);
+  const Eigen::Vector3d contact_point =
+      onto ? Eigen::Vector3d(foot - onto->distance * onto->normal) : foot;
+  const Eigen::Vector3d lever = contact_point - k.com;
+  // Only the motion along the plane predicts which side the node ends on: across it, the rigid
+  // body's predicted velocity carries the step's gravity, which the contacts under it cancel.
+  Eigen::Vector3d slip = node_velocity - pointVelocity(k.entry_velocity, c.lever);
+  slip -= plane->normal * plane->normal.dot(slip);
+  const double end_nearest = c.gap + dt * c.normal.dot(slip);
+  const double end_plane = plane->distance;
+  if (end_plane <= end_nearest + kPlaneChoiceMargin) return;
+  c.normal = plane->normal;
+  c.gap = plane->distance;
+  c.lever = lever;
+  c.swept = true;
+}
+
 bool RigidContactSolver::detect(const FemState& state, const NodeConstraints& constraints,
                                 double dt) {
   // Remember last step's active contacts: they start this step active (warm active set).
@@ -183,14 +224,17 @@ bool RigidContactSolver::detect(const FemState& state, const NodeConstraints& co
       c.partner = partnerIndex(object);
       c.normal = sp->normal;
       c.gap = sp->distance;
+      c.distance = sp->distance;
       c.lever = x - sp->distance * sp->normal - partners_[static_cast<size_t>(c.partner)].com;
       c.friction = settings_.friction * object->getFriction();
       c.held = held;
+      chooseSupportPlane(*shape, transform, x, state.velocity(i), -toEigen(sb.m_nodes[i].m_n), dt,
+                         c);
       // One contact per free node: the deepest.
       if (!held) {
         int& slot = node_contact_[static_cast<size_t>(i)];
         if (slot >= 0) {
-          if (contacts_[static_cast<size_t>(slot)].gap <= c.gap) continue;
+          if (contacts_[static_cast<size_t>(slot)].distance <= c.distance) continue;
           contacts_[static_cast<size_t>(slot)] = c;
           continue;
         }
@@ -200,7 +244,7 @@ bool RigidContactSolver::detect(const FemState& state, const NodeConstraints& co
     }
     const int partner = partnerIndex(object);
     faces_.detect(state, constraints, collector.nodes, *shape, transform, toEigen(lo), toEigen(hi),
-                  reach, partner, partners_[static_cast<size_t>(partner)],
+                  reach, dt, partner, partners_[static_cast<size_t>(partner)],
                   settings_.friction * object->getFriction());
   }
   // A candidate object that nothing touches keeps Bullet's velocity untouched: not an unknown.
@@ -225,7 +269,7 @@ bool RigidContactSolver::detect(const FemState& state, const NodeConstraints& co
   stats_.candidates = static_cast<int>(contacts_.size());
   stats_.face_candidates = static_cast<int>(faces_.contacts().size());
   for (const NodeContact& c : contacts_)
-    stats_.max_penetration = std::max(stats_.max_penetration, -c.gap);
+    stats_.max_penetration = std::max(stats_.max_penetration, -c.distance);
   for (const FaceContact& c : faces_.contacts())
     stats_.max_penetration = std::max(stats_.max_penetration, -c.gap);
   return !contacts_.empty() || !faces_.empty();
@@ -387,7 +431,7 @@ LinearSolveReport RigidContactSolver::conjugateGradient(const SystemOperator& op
 }
 
 bool RigidContactSolver::updateActiveSet(const Eigen::VectorXd& v, const Eigen::VectorXd& p,
-                                         double dt) {
+                                         const Eigen::VectorXd& p_net, double dt) {
   bool changed = false;
   const std::vector<double>& mass = model_->nodeMasses();
   // Impulses below this are CG noise: a part in 1e4 of the largest one, or a micrometre per
@@ -402,13 +446,24 @@ bool RigidContactSolver::updateActiveSet(const Eigen::VectorXd& v, const Eigen::
     const RigidPartner& k = partners_[static_cast<size_t>(c.partner)];
     const Eigen::Vector3d vi = v.segment<3>(3 * c.node);
     const Eigen::Vector3d pi = p.segment<3>(3 * c.node);
+    const Eigen::Vector3d pi_net = p_net.segment<3>(3 * c.node);
+    const double lambda_net = c.normal.dot(pi_net);
     const double noise = std::max(1e-4 * largest, 1e-6 * mass[static_cast<size_t>(c.node)]);
     const Eigen::Vector3d rigid_v = pointVelocity(k.velocity, c.lever);
     switch (c.state) {
       case NodeContact::State::kInactive: {
         const double gap_end = c.gap + dt * c.normal.dot(vi - rigid_v);
         if (gap_end < -settings_.activation_tolerance) {
-          c.state = c.friction > 0 ? NodeContact::State::kStick : NodeContact::State::kSlide;
+          // A node the rigid body sweeps over (held by the supporting plane, chooseSupportPlane)
+          // starts sliding when it slips; its friction follows from the next solve's normal
+          // impulse. Starting it stuck stopped a sliding body at each node row (docs/contact.md,
+          // "Sliding over nodes"). Other contacts start stuck: a landing body's contacts slip
+          // too (Poisson), and starting those sliding kept a box on a tet10 slab from settling.
+          Eigen::Vector3d slip = vi - rigid_v;
+          slip -= c.normal * c.normal.dot(slip);
+          const bool slipping = c.swept && dt * slip.norm() > settings_.activation_tolerance;
+          c.state =
+              c.friction > 0 && !slipping ? NodeContact::State::kStick : NodeContact::State::kSlide;
           c.friction_impulse.setZero();
           changed = true;
         }
@@ -421,7 +476,8 @@ bool RigidContactSolver::updateActiveSet(const Eigen::VectorXd& v, const Eigen::
           c.state = NodeContact::State::kInactive;
           ++c.releases;
           changed = true;
-        } else if (pt.norm() > c.friction * std::max(lambda, 0.0) + noise &&
+        } else if ((pi_net - c.normal * lambda_net).norm() >
+                       c.friction * std::max(lambda_net, 0.0) + noise &&
                    c.slips < kMaxSlipsPerStep) {
           // Anti-cycling, as for releases: in a body pressed between two surfaces the nodes'
           // tangential and normal impulses are coupled through the body, and per-node stick/slide
@@ -430,7 +486,7 @@ bool RigidContactSolver::updateActiveSet(const Eigen::VectorXd& v, const Eigen::
           // re-examined from the next step on).
           ++c.slips;
           c.state = NodeContact::State::kSlide;
-          c.friction_impulse = c.friction * std::max(lambda, 0.0) * pt.normalized();
+          c.friction_impulse = c.friction * std::max(lambda_net, 0.0) * pt.normalized();
           changed = true;
         }
         break;
@@ -448,7 +504,7 @@ bool RigidContactSolver::updateActiveSet(const Eigen::VectorXd& v, const Eigen::
         Eigen::Vector3d slip = vi - rigid_v;
         slip -= c.normal * c.normal.dot(slip);
         const double speed = slip.norm();
-        const double bound = c.friction * std::max(lambda, 0.0);
+        const double bound = c.friction * std::max(lambda_net, 0.0);
         if (speed < 1e-9 || (c.friction_impulse.norm() > 0 && slip.dot(c.friction_impulse) > 0)) {
           // The slip stopped or turned along the friction: the friction was too strong. If it
           // exceeds mu lambda of this very solve it was stale (set from an earlier, larger
@@ -593,9 +649,16 @@ LinearSolveReport RigidContactSolver::solve(const SystemOperator& op,
     // impulses (neither is a node's constraint impulse).
     op.multiply(v, product_);
     product_ -= b_friction;
+    // What all contacts together give each node (node and face constraints, less the explicit
+    // friction): Coulomb's bound of a node's friction is set by this, not by its node
+    // constraint alone. A face contact on a node's triangle and the node's own constraint can
+    // hold the same motion; on a stiff body they split it as a large push and an equal pull,
+    // and a friction bounded by the push alone threw a sliding box back (docs/contact.md,
+    // "Sliding over nodes").
+    net_impulse_ = product_;
     faces_.takeImpulses(v, partners_, dt, product_);
     if (r.breakdown) break;
-    const bool nodes_changed = updateActiveSet(v, product_, dt);
+    const bool nodes_changed = updateActiveSet(v, product_, net_impulse_, dt);
     const bool faces_changed = faces_.update(v, partners_, dt, settings_.activation_tolerance,
                                              settings_.face_gap_tolerance);
     if (!nodes_changed && !faces_changed) {

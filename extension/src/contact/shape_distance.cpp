@@ -150,4 +150,16 @@ std::optional<SurfacePoint> signedDistance(const btCollisionShape& shape,
   return local;
 }
 
+std::optional<SurfacePoint> supportPlaneDistance(const btCollisionShape& shape,
+                                                 const btTransform& transform,
+                                                 const Eigen::Vector3d& x,
+                                                 const Eigen::Vector3d& direction) {
+  if (!shape.isConvex() || direction.squaredNorm() == 0) return std::nullopt;
+  const Eigen::Vector3d u = direction.normalized();
+  const btVector3 local_u = transform.getBasis().transpose() * toBt(u);
+  const btVector3 support =
+      transform(static_cast<const btConvexShape&>(shape).localGetSupportingVertex(local_u));
+  return SurfacePoint{u.dot(x - toEigen(support)), u};
+}
+
 }  // namespace torsion

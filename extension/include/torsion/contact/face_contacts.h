@@ -53,9 +53,10 @@ struct FaceContact {
   /// on a parallel normal): the nodes decide, the contact sits out (an exact node constraint and
   /// a multiplier on the same motion would make the multiplier grow without bound).
   bool determined = false;
-  double last_violation = 0;  ///< m, |end gap| after the previous solve of this step
-  int stalls = 0;             ///< updates this step that did not reduce the violation
-  int switches = 0;           ///< stick/slide switches this step
+  double last_violation = 0;     ///< m, |end gap| after the previous solve of this step
+  int stalls = 0;                ///< updates this step that did not reduce the violation
+  int switches = 0;              ///< stick/slide switches this step
+  int friction_refinements = 0;  ///< solves this step reopened to bring the friction to mu lambda
 };
 
 class FaceContactSet {
@@ -71,11 +72,13 @@ class FaceContactSet {
   /// triangles of `nearby_nodes` (every node within reach + longestEdge() of the bounds) whose
   /// bounds come within `reach` get the shape's distance (face_distance.h); a point at a
   /// triangle's corner is left to the node contact; a face all of whose nodes are held is left
-  /// out unless the partner is dynamic (held nodes push, never yield).
+  /// out unless the partner is dynamic (held nodes push, never yield); a face that the predicted
+  /// motion over `dt` (s) would rather hold against the shape's supporting plane facing it (a
+  /// triangle just ahead of a sliding box's edge) is left to its nodes.
   void detect(const FemState& state, const NodeConstraints& held,
               const std::vector<int>& nearby_nodes, const btCollisionShape& shape,
               const btTransform& transform, const Eigen::Vector3d& lo, const Eigen::Vector3d& hi,
-              double reach, int partner, const RigidPartner& p, double friction);
+              double reach, double dt, int partner, const RigidPartner& p, double friction);
   const std::vector<FaceContact>& contacts() const { return contacts_; }
   bool empty() const { return contacts_.empty(); }
 

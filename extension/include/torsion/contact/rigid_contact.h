@@ -72,11 +72,15 @@ struct NodeContact {
   enum class State { kInactive, kSlide, kStick };
   int node = -1;
   int partner = -1;        ///< index into partners()
-  Eigen::Vector3d normal;  ///< unit, world, out of the rigid body
-  double gap = 0;          ///< m, signed distance at the start of the step
+  Eigen::Vector3d normal;  ///< unit, world, out of the rigid body: the linearisation's plane
+  double gap = 0;          ///< m, signed distance to that plane at the start of the step
+  double distance = 0;     ///< m, signed distance to the shape at the start of the step
   Eigen::Vector3d lever;   ///< m, contact point minus centre of mass (start of step)
   double friction = 0;     ///< pair coefficient
   bool held = false;       ///< the node is prescribed (hand, node group)
+  /// Held by the supporting plane facing the soft surface, not the nearest feature: the rigid
+  /// body is sweeping over the node this step (a sliding box's leading edge).
+  bool swept = false;
   State state = State::kInactive;
   int releases = 0;              ///< times released this step (anti-cycling: never twice)
   int slips = 0;                 ///< stick-to-slide switches this step (anti-cycling: at most two)
@@ -131,6 +135,9 @@ class RigidContactSolver {
 
  private:
   int partnerIndex(const btCollisionObject* object);
+  void chooseSupportPlane(const btCollisionShape& shape, const btTransform& transform,
+                          const Eigen::Vector3d& x, const Eigen::Vector3d& node_velocity,
+                          const Eigen::Vector3d& into_surface, double dt, NodeContact& c) const;
   void expand(const Eigen::VectorXd& q, Eigen::VectorXd& v) const;
   void contract(const Eigen::VectorXd& y, const Eigen::VectorXd& rigid_part,
                 Eigen::VectorXd& q) const;
@@ -139,7 +146,10 @@ class RigidContactSolver {
   void precondition(const Eigen::VectorXd& r, Eigen::VectorXd& z) const;
   LinearSolveReport conjugateGradient(const SystemOperator& op, const Eigen::VectorXd& beta,
                                       const SolverSettings& settings, Eigen::VectorXd& q);
-  bool updateActiveSet(const Eigen::VectorXd& v, const Eigen::VectorXd& p, double dt);
+  /// `p`: the node constraints' impulses; `p_net`: with the face contacts' shares (friction
+  /// bounds).
+  bool updateActiveSet(const Eigen::VectorXd& v, const Eigen::VectorXd& p,
+                       const Eigen::VectorXd& p_net, double dt);
   void solveHeld(const Eigen::VectorXd& v, double dt);
 
   std::shared_ptr<const FemModel> model_;
@@ -161,7 +171,7 @@ class RigidContactSolver {
   // Solve workspace.
   std::vector<Eigen::Matrix3d> block_inverse_;
   std::vector<Eigen::Matrix<double, 6, 6>> rigid_inverse_;
-  Eigen::VectorXd v_c_, scratch_, product_, r_, beta_, q_, rigid_scratch_, b_solve_;
+  Eigen::VectorXd v_c_, scratch_, product_, r_, beta_, q_, rigid_scratch_, b_solve_, net_impulse_;
   PcgScratch cg_;
 };
 

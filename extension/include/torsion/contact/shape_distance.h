@@ -36,4 +36,15 @@ std::optional<SurfacePoint> signedDistance(
     const btCollisionShape& shape, const btTransform& transform, const Eigen::Vector3d& x,
     double search_radius, const Eigen::Vector3d& preferred = Eigen::Vector3d::Zero());
 
+/// Signed distance from `x` to the supporting plane of a convex shape whose outward normal is the
+/// unit vector `direction` (world): direction . x - h(direction), h the shape's support function
+/// (margin included, the surface the other queries measure). Every supporting plane bounds the
+/// shape, so this never exceeds signedDistance(x): keeping x outside it keeps x outside the
+/// shape. The normal returned is `direction`. nullopt for shapes that are not convex (planes,
+/// triangle meshes, compounds) or a zero direction.
+std::optional<SurfacePoint> supportPlaneDistance(const btCollisionShape& shape,
+                                                 const btTransform& transform,
+                                                 const Eigen::Vector3d& x,
+                                                 const Eigen::Vector3d& direction);
+
 }  // namespace torsion
