@@ -2,6 +2,7 @@
 
 #include <BulletSoftBody/btSoftBodyRigidBodyCollisionConfiguration.h>
 
+#include "torsion/bullet/bt_conversions.h"
 #include "torsion/bullet/fem_soft_body_solver.h"
 
 namespace torsion {
@@ -22,7 +23,7 @@ FemWorld::FemWorld(const WorldSettings& settings)
   world_ = std::make_unique<btSoftRigidDynamicsWorld>(
       dispatcher_.get(), broadphase_.get(), constraint_solver_.get(),
       collision_configuration_.get(), soft_solver_.get());
-  const btVector3 g(settings.gravity.x(), settings.gravity.y(), settings.gravity.z());
+  const btVector3 g = toBt(settings.gravity);
   world_->setGravity(g);
   btSoftBodyWorldInfo& info = world_->getWorldInfo();
   info.m_gravity = g;
@@ -61,9 +62,10 @@ Result<FemBody*> FemWorld::addBody(const std::string& name, const TetMesh& mesh,
 btRigidBody* FemWorld::addRigidBody(std::unique_ptr<btCollisionShape> shape, double mass,
                                     const btTransform& transform) {
   btVector3 inertia(0, 0, 0);
-  if (mass > 0) shape->calculateLocalInertia(mass, inertia);
+  if (mass > 0) shape->calculateLocalInertia(toBtScalar(mass), inertia);
   auto motion = std::make_unique<btDefaultMotionState>(transform);
-  btRigidBody::btRigidBodyConstructionInfo info(mass, motion.get(), shape.get(), inertia);
+  btRigidBody::btRigidBodyConstructionInfo info(toBtScalar(mass), motion.get(), shape.get(),
+                                                inertia);
   auto* rigid = new btRigidBody(info);
   world_->addRigidBody(rigid);
   shapes_.push_back(std::move(shape));
@@ -82,7 +84,7 @@ FemBody* FemWorld::body(const std::string& name) const {
 WorldStepReport FemWorld::step() {
   WorldStepReport report;
   soft_solver_->setTime(time_);
-  world_->stepSimulation(settings_.solver.time_step, 0);  // exactly one internal step of dt
+  world_->stepSimulation(toBtScalar(settings_.solver.time_step), 0);  // exactly one internal step of dt
   time_ += settings_.solver.time_step;
   report.step = ++steps_;
   for (const auto& body : bodies_) {
