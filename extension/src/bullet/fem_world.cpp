@@ -84,7 +84,8 @@ FemBody* FemWorld::body(const std::string& name) const {
 WorldStepReport FemWorld::step() {
   WorldStepReport report;
   soft_solver_->setTime(time_);
-  world_->stepSimulation(toBtScalar(settings_.solver.time_step), 0);  // exactly one internal step of dt
+  // Exactly one internal step of dt (maxSubSteps 0: Bullet steps by the time given).
+  world_->stepSimulation(toBtScalar(settings_.solver.time_step), 0);
   time_ += settings_.solver.time_step;
   report.step = ++steps_;
   for (const auto& body : bodies_) {

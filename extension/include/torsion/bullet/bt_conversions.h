@@ -70,8 +70,8 @@ inline Eigen::Matrix3d toEigen(const btMatrix3x3& m) {
 inline Eigen::Vector3d worldDirection(const btMatrix3x3& basis, const Eigen::Vector3d& v) {
   Eigen::Vector3d out;
   for (int r = 0; r < 3; ++r)
-    out[r] = toDouble(basis[r][0]) * v[0] + toDouble(basis[r][1]) * v[1] +
-             toDouble(basis[r][2]) * v[2];
+    out[r] =
+        toDouble(basis[r][0]) * v[0] + toDouble(basis[r][1]) * v[1] + toDouble(basis[r][2]) * v[2];
   return out;
 }
 
@@ -79,8 +79,8 @@ inline Eigen::Vector3d worldDirection(const btMatrix3x3& basis, const Eigen::Vec
 inline Eigen::Vector3d localDirection(const btMatrix3x3& basis, const Eigen::Vector3d& v) {
   Eigen::Vector3d out;
   for (int c = 0; c < 3; ++c)
-    out[c] = toDouble(basis[0][c]) * v[0] + toDouble(basis[1][c]) * v[1] +
-             toDouble(basis[2][c]) * v[2];
+    out[c] =
+        toDouble(basis[0][c]) * v[0] + toDouble(basis[1][c]) * v[1] + toDouble(basis[2][c]) * v[2];
   return out;
 }
 
