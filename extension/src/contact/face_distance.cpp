@@ -10,7 +10,6 @@
 #include <Eigen/Geometry>
 #include <array>
 #include <cmath>
-#include <limits>
 
 #include "torsion/bullet/bt_conversions.h"
 #include "torsion/contact/shape_distance.h"
@@ -129,10 +128,13 @@ std::optional<FacePoint> polish(const btCollisionShape& shape, const btTransform
     if ((next - on_face).norm() < 1e-13) break;
     on_face = next;
   }
-  // GJK runs in btScalar: on float Bullet its distance is only good to a few float roundings of
-  // the coordinates, and may come out below the exact one; within that it is not a better answer.
-  const double gjk_rounding = 16 * toDouble(std::numeric_limits<btScalar>::epsilon()) *
-                              (on_face.norm() + toEigen(transform.getOrigin()).norm());
+  // GJK runs in btScalar: on float Bullet its distance carries the float rounding of the
+  // coordinates and may come out below the exact one; within that it is not a better answer.
+  // Double Bullet keeps the strict comparison (the regression scenes' states depend on it).
+  const double gjk_rounding =
+      kBulletIsDouble
+          ? 0.0
+          : 16 * kBulletEpsilon * (on_face.norm() + toEigen(transform.getOrigin()).norm());
   if (!best || best->distance > f->distance + gjk_rounding) return f;
   f->barycentric = best_weights;
   on_face = best_weights[0] * t[0] + best_weights[1] * t[1] + best_weights[2] * t[2];
@@ -212,7 +214,7 @@ std::optional<FacePoint> shapeToTriangle(const btCollisionShape& shape,
     static_cast<const btConcaveShape&>(shape).processAllTriangles(&nearest, lo - pad, hi + pad);
     std::optional<FacePoint> f = nearest.best();
     if (f) {
-      f->normal = worldDirection(transform.getBasis(), f->normal).normalized();
+      f->normal = worldDirection(transform.getBasis(), f->normal);
       f->shape_point = worldPoint(transform, f->shape_point);
     }
     return f;

@@ -145,8 +145,7 @@ std::optional<SurfacePoint> signedDistance(const btCollisionShape& shape,
       break;
   }
   if (!local) return std::nullopt;
-  // Normalized again: a float Bullet's basis is orthonormal only to float precision.
-  local->normal = worldDirection(transform.getBasis(), local->normal).normalized();
+  local->normal = worldDirection(transform.getBasis(), local->normal);
   return local;
 }
 

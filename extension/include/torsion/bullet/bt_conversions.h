@@ -30,7 +30,8 @@ inline constexpr bool kBulletIsDouble = sizeof(btScalar) == sizeof(double);
 
 /// btScalar's machine epsilon: 2.2e-16 on double Bullet, 1.2e-7 on float Bullet. What Bullet keeps
 /// of a size L (a rigid body's position, a shape's half extent) is known to about L times this.
-inline constexpr double kBulletEpsilon = std::numeric_limits<btScalar>::epsilon();
+inline constexpr double kBulletEpsilon =
+    static_cast<double>(std::numeric_limits<btScalar>::epsilon());
 
 /// A Bullet scalar as the FEM's double (exact).
 inline double toDouble(btScalar s) {
