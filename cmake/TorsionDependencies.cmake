@@ -2,7 +2,7 @@
 # Each one is exposed as a namespaced imported target so the rest of the build never sees paths.
 
 find_package(Eigen3 3.3 REQUIRED NO_MODULE)
-include(TorsionBullet)   # Bullet::Bullet, double precision
+include(TorsionBullet)   # Bullet::Bullet, in TORSION_BULLET_PRECISION
 include(TorsionCholmod)  # SuiteSparse::CHOLMOD
 find_package(TBB REQUIRED)
 

@@ -1,9 +1,16 @@
 # Installed, relocatable package: find_package(Torsion) gives Torsion::extension and Torsion::device.
+#
+# Both Bullet precisions can live in one prefix. Everything a precision changes has its own name:
+# the targets file TorsionTargets-<precision>.cmake and the libraries and tools built on Bullet
+# (suffix TORSION_BULLET_NAME_SUFFIX, "-float" for float). The remaining files (TorsionConfig,
+# headers, Torsion::device, the haptic peer) do not depend on Bullet and are the same in both.
+# TorsionConfig.cmake picks the targets file the consumer asks for (docs/bullet-integration.md).
 include(CMakePackageConfigHelpers)
 
 set(TORSION_CMAKE_INSTALL_DIR "${CMAKE_INSTALL_LIBDIR}/cmake/Torsion")
 
 install(EXPORT TorsionTargets
+        FILE "TorsionTargets-${TORSION_BULLET_PRECISION}.cmake"
         NAMESPACE Torsion::
         DESTINATION "${TORSION_CMAKE_INSTALL_DIR}")
 

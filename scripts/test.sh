@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
-# The whole test suite, from a fresh machine: set-up, Release build, every CTest test, then a
-# clang build with ASan+UBSan that runs the unit tests again and fuzzes each mesh reader for a
-# bounded time. `.ci/run` calls exactly this.
+# The whole test suite, from a fresh machine: set-up, Release build, every CTest test, the fast
+# tests again on float Bullet, then a clang build with ASan+UBSan that runs the unit tests again
+# and fuzzes each mesh reader for a bounded time. `.ci/run` calls exactly this.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 jobs=$(nproc 2>/dev/null || echo 2)
@@ -21,6 +21,15 @@ cmake --build build-tsan -j"$jobs" --target torsion_device_tests torsion_bullet_
 TSAN_OPTIONS="halt_on_error=1 second_deadlock_stack=1" \
   ctest --test-dir build-tsan -j"$jobs" --output-on-failure --timeout 900 \
   -R "HapticLoop|TripleBuffer|NetworkDevice|UserWorldHaptics"
+
+echo "== Float-Bullet build (build-float/): Debian's default Bullet; fast tests and the package"
+# The same code on pkg-config `bullet` (btScalar = float), the Bullet most programs link. The
+# package test also installs build/ beside it and links each precision from the one prefix.
+cmake -S . -B build-float -G Ninja -DCMAKE_BUILD_TYPE=Release -DTORSION_WARNINGS_AS_ERRORS=ON \
+  -DTORSION_BULLET_PRECISION=float -DTORSION_BUILD_BENCHMARKS=OFF \
+  -DTORSION_CONSUMER_ALSO_INSTALL="$PWD/build"
+cmake --build build-float -j"$jobs"
+ctest --test-dir build-float -j"$jobs" --output-on-failure -L "unit|cli|package" --timeout 900
 
 echo "== Sanitizer + fuzz build (build-asan/, clang, ASan+UBSan)"
 cmake -S . -B build-asan -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_CXX_COMPILER=clang++ \

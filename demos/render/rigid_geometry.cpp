@@ -72,9 +72,7 @@ void convexHullTriangles(const std::vector<Eigen::Vector3d>& points,
 RigidDrawData rigidDrawData(const btRigidBody& body) {
   RigidDrawData d;
   const btTransform& t = body.getWorldTransform();
-  d.pose.linear() = Eigen::Quaterniond(t.getRotation().w(), t.getRotation().x(),
-                                       t.getRotation().y(), t.getRotation().z())
-                        .toRotationMatrix();
+  d.pose.linear() = toEigen(t.getRotation()).toRotationMatrix();
   d.pose.translation() = toEigen(t.getOrigin());
   d.is_static = body.getInvMass() == 0;
   const btCollisionShape* shape = body.getCollisionShape();
@@ -85,13 +83,13 @@ RigidDrawData rigidDrawData(const btRigidBody& body) {
       return d;
     case SPHERE_SHAPE_PROXYTYPE:
       d.shape = RigidDrawData::Shape::kSphere;
-      d.radius = static_cast<const btSphereShape*>(shape)->getRadius();
+      d.radius = toDouble(static_cast<const btSphereShape*>(shape)->getRadius());
       return d;
     case CAPSULE_SHAPE_PROXYTYPE: {
       const auto* capsule = static_cast<const btCapsuleShape*>(shape);
       d.shape = RigidDrawData::Shape::kCapsule;
-      d.radius = capsule->getRadius();
-      d.half_height = capsule->getHalfHeight();
+      d.radius = toDouble(capsule->getRadius());
+      d.half_height = toDouble(capsule->getHalfHeight());
       d.axis = capsule->getUpAxis();
       return d;
     }
@@ -110,7 +108,7 @@ RigidDrawData rigidDrawData(const btRigidBody& body) {
       const auto* plane = static_cast<const btStaticPlaneShape*>(shape);
       d.shape = RigidDrawData::Shape::kPlane;
       d.normal = d.pose.linear() * toEigen(plane->getPlaneNormal());
-      d.offset = plane->getPlaneConstant() + d.normal.dot(d.pose.translation());
+      d.offset = toDouble(plane->getPlaneConstant()) + d.normal.dot(d.pose.translation());
       return d;
     }
     default:

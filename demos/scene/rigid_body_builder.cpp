@@ -15,7 +15,7 @@ namespace {
 btTransform toTransform(const Frame& f) {
   btTransform t;
   t.setOrigin(toBt(f.origin));
-  t.setRotation(btQuaternion(f.rotation.x(), f.rotation.y(), f.rotation.z(), f.rotation.w()));
+  t.setRotation(toBt(f.rotation));
   return t;
 }
 
@@ -57,22 +57,24 @@ std::unique_ptr<btCollisionShape> makeRigidShape(const RigidBodySpec& r) {
     case RigidBodySpec::Shape::kBox:
       return std::make_unique<btBoxShape>(toBt(r.half_extents));
     case RigidBodySpec::Shape::kSphere:
-      return std::make_unique<btSphereShape>(r.radius);
-    case RigidBodySpec::Shape::kCapsule:
+      return std::make_unique<btSphereShape>(toBtScalar(r.radius));
+    case RigidBodySpec::Shape::kCapsule: {
       // Bullet's height is the distance between the cap centres.
-      if (r.axis == 0) return std::make_unique<btCapsuleShapeX>(r.radius, 2 * r.half_height);
-      if (r.axis == 1) return std::make_unique<btCapsuleShape>(r.radius, 2 * r.half_height);
-      return std::make_unique<btCapsuleShapeZ>(r.radius, 2 * r.half_height);
+      const btScalar radius = toBtScalar(r.radius), height = toBtScalar(2 * r.half_height);
+      if (r.axis == 0) return std::make_unique<btCapsuleShapeX>(radius, height);
+      if (r.axis == 1) return std::make_unique<btCapsuleShape>(radius, height);
+      return std::make_unique<btCapsuleShapeZ>(radius, height);
+    }
     case RigidBodySpec::Shape::kConvexHull: {
       auto hull = std::make_unique<btConvexHullShape>();
       for (const Eigen::Vector3d& p : r.points)
         hull->addPoint(toBt(p), false);
       hull->recalcLocalAabb();
-      hull->setMargin(r.margin);
+      hull->setMargin(toBtScalar(r.margin));
       return hull;
     }
     case RigidBodySpec::Shape::kPlane:
-      return std::make_unique<btStaticPlaneShape>(toBt(r.plane_normal), r.plane_offset);
+      return std::make_unique<btStaticPlaneShape>(toBt(r.plane_normal), toBtScalar(r.plane_offset));
     case RigidBodySpec::Shape::kTriangleMesh: {
       auto mesh = std::make_unique<btTriangleMesh>();
       for (const auto& t : r.triangles) {
@@ -91,8 +93,8 @@ SceneRigidBody addSceneRigidBody(FemWorld& world, const RigidBodySpec& spec) {
   added.name = spec.name;
   added.kinematic = spec.isKinematic();
   btRigidBody* body = world.addRigidBody(makeRigidShape(spec), spec.mass, toTransform(spec.pose));
-  body->setFriction(spec.friction);
-  body->setRestitution(spec.restitution);
+  body->setFriction(toBtScalar(spec.friction));
+  body->setRestitution(toBtScalar(spec.restitution));
   if (spec.mass > 0) {
     body->setLinearVelocity(toBt(spec.linear_velocity));
     body->setAngularVelocity(toBt(spec.angular_velocity));

@@ -4,6 +4,7 @@
 #include <btBulletDynamicsCommon.h>
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <memory>
 
 #include "torsion/bullet/bt_conversions.h"
@@ -12,6 +13,15 @@
 #include "torsion/mesh/box_mesh.h"
 
 namespace torsion::test {
+
+/// A tolerance `tol` that holds with double Bullet, widened to what float Bullet can resolve on
+/// coordinates of size `length` (m). Bullet keeps shapes and poses in btScalar and runs GJK in it:
+/// with float (7 significant digits) a contact measured there is good to about 1e-7 m per metre,
+/// twice that here for margin (docs/bullet-integration.md, "Bullet precision"). With double Bullet
+/// this is `tol`, unchanged.
+inline double atBulletPrecision(double tol, double length = 1.0) {
+  return std::max(tol, 2 * kBulletEpsilon * length);
+}
 
 inline WorldSettings contactSettings(double dt = 0.01) {
   WorldSettings s;

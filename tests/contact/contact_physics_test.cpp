@@ -97,7 +97,9 @@ TEST(ContactPhysics, MomentumExchangedWithFreeBox) {
   btRigidBody* box = world.addRigidBody(std::make_unique<btBoxShape>(btVector3(0.15, 0.15, 0.15)),
                                         box_mass, at({0.0, 0, 0.15}));
   box->setFriction(0.0);
-  auto px = [&] { return momentum(*block).x() + box_mass * box->getLinearVelocity().x(); };
+  auto px = [&] {
+    return momentum(*block).x() + box_mass * toDouble(box->getLinearVelocity().x());
+  };
   const double before = px();
   double box_speed = 0;
   for (int k = 0; k < 60; ++k) {  // contact at about 0.07 s, separated well before 0.6 s

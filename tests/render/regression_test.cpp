@@ -23,6 +23,7 @@
 #include "scene_builder.h"
 #include "scene_haptics.h"
 #include "scene_parser.h"
+#include "torsion/bullet/bt_conversions.h"
 
 namespace torsion::scene {
 namespace {
@@ -77,6 +78,7 @@ std::string toolchain() {
 #if defined(__SANITIZE_ADDRESS__)
   id += "-asan";
 #endif
+  if (!torsion::kBulletIsDouble) id += "-bullet-float";  // another build of Bullet: another state
   return id;
 }
 

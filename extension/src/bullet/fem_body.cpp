@@ -17,7 +17,7 @@ FemBody::FemBody(std::string name, std::shared_ptr<const FemModel> model,
   std::vector<btScalar> m(static_cast<size_t>(n));
   for (int i = 0; i < n; ++i) {
     x[static_cast<size_t>(i)] = toBt(state_.position(i));
-    m[static_cast<size_t>(i)] = model_->nodeMasses()[static_cast<size_t>(i)];
+    m[static_cast<size_t>(i)] = toBtScalar(model_->nodeMasses()[static_cast<size_t>(i)]);
   }
   // Nodes and surface faces only: our solver never uses Bullet's links, and soft-rigid contact
   // (SDF_RS) is node-based. No VF_SS/SDF_RD flags: without links their tree build would hang.
@@ -28,7 +28,7 @@ FemBody::FemBody(std::string name, std::shared_ptr<const FemModel> model,
   }
   soft_body_->m_cfg.collisions = btSoftBody::fCollision::SDF_RS;
   const Eigen::Vector3d extent = model_->mesh().boundsMax() - model_->mesh().boundsMin();
-  soft_body_->getCollisionShape()->setMargin(1e-3 * extent.norm());
+  soft_body_->getCollisionShape()->setMargin(toBtScalar(1e-3 * extent.norm()));
   soft_body_->setActivationState(DISABLE_DEACTIVATION);
   soft_body_->updateNodeTree(false, false);
   soft_body_->updateBounds();
@@ -95,22 +95,22 @@ Status FemBody::setMaterial(const Material& material) {
   stepper_.replaceModel(model_);
   contacts_->replaceModel(model_);  // gravity follows the new masses at the next step
   for (int i = 0; i < model_->nodeCount(); ++i)
-    soft_body_->m_nodes[i].m_im = 1 / model_->nodeMasses()[static_cast<size_t>(i)];
+    soft_body_->m_nodes[i].m_im = toBtScalar(1 / model_->nodeMasses()[static_cast<size_t>(i)]);
   return Ok{};
 }
 
 void FemBody::predict(double dt) {
   btSoftBody& sb = *soft_body_;
-  sb.m_sst.sdt = dt;
-  sb.m_sst.isdt = 1 / dt;
-  sb.m_sst.velmrg = 3 * dt;
+  sb.m_sst.sdt = toBtScalar(dt);
+  sb.m_sst.isdt = toBtScalar(1 / dt);
+  sb.m_sst.velmrg = toBtScalar(3 * dt);
   sb.m_sst.radmrg = sb.getCollisionShape()->getMargin();
   sb.m_sst.updmrg = sb.m_sst.radmrg / 4;
   for (int i = 0; i < model_->nodeCount(); ++i) {
     btSoftBody::Node& node = sb.m_nodes[i];
     node.m_q = toBt(state_.position(i));
     node.m_v = toBt(state_.velocity(i));
-    node.m_x = node.m_q + node.m_v * dt;
+    node.m_x = toBt(state_.position(i) + dt * state_.velocity(i));
   }
   sb.updateNodeTree(true, true);
   sb.updateBounds();

@@ -4,6 +4,8 @@
 
 #include <algorithm>
 
+#include "torsion/bullet/bt_conversions.h"
+
 namespace torsion {
 
 Status WorldSettings::validate() const {
@@ -21,7 +23,7 @@ FemWorld::FemWorld(const WorldSettings& settings)
   world_ = std::make_unique<btSoftRigidDynamicsWorld>(
       dispatcher_.get(), broadphase_.get(), constraint_solver_.get(),
       collision_configuration_.get(), soft_solver_.get());
-  const btVector3 g(settings.gravity.x(), settings.gravity.y(), settings.gravity.z());
+  const btVector3 g = toBt(settings.gravity);
   world_->setGravity(g);
   btSoftBodyWorldInfo& info = world_->getWorldInfo();
   info.m_gravity = g;
@@ -48,10 +50,10 @@ Result<FemBody*> FemWorld::addBody(const std::string& name, const TetMesh& mesh,
 btRigidBody* FemWorld::addRigidBody(std::unique_ptr<btCollisionShape> shape, double mass,
                                     const btTransform& transform) {
   btVector3 inertia(0, 0, 0);
-  if (mass > 0) shape->calculateLocalInertia(static_cast<btScalar>(mass), inertia);
+  if (mass > 0) shape->calculateLocalInertia(toBtScalar(mass), inertia);
   auto motion = std::make_unique<btDefaultMotionState>(transform);
-  btRigidBody::btRigidBodyConstructionInfo info(static_cast<btScalar>(mass), motion.get(),
-                                                shape.get(), inertia);
+  btRigidBody::btRigidBodyConstructionInfo info(toBtScalar(mass), motion.get(), shape.get(),
+                                                inertia);
   auto* rigid = new btRigidBody(info);
   world_->addRigidBody(rigid);
   shapes_.push_back(std::move(shape));

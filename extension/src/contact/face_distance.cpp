@@ -128,7 +128,14 @@ std::optional<FacePoint> polish(const btCollisionShape& shape, const btTransform
     if ((next - on_face).norm() < 1e-13) break;
     on_face = next;
   }
-  if (!best || best->distance > f->distance) return f;
+  // GJK runs in btScalar: on float Bullet its distance carries the float rounding of the
+  // coordinates and may come out below the exact one; within that it is not a better answer.
+  // Double Bullet keeps the strict comparison (the regression scenes' states depend on it).
+  const double gjk_rounding =
+      kBulletIsDouble
+          ? 0.0
+          : 16 * kBulletEpsilon * (on_face.norm() + toEigen(transform.getOrigin()).norm());
+  if (!best || best->distance > f->distance + gjk_rounding) return f;
   f->barycentric = best_weights;
   on_face = best_weights[0] * t[0] + best_weights[1] * t[1] + best_weights[2] * t[2];
   f->distance = best->distance;
@@ -197,18 +204,18 @@ std::optional<FacePoint> shapeToTriangle(const btCollisionShape& shape,
     Corners local;
     btVector3 lo(SIMD_INFINITY, SIMD_INFINITY, SIMD_INFINITY), hi = -lo;
     for (size_t k = 0; k < 3; ++k) {
-      const btVector3 p = inverse * toBt(t[k]);
-      local[k] = toEigen(p);
+      local[k] = worldPoint(inverse, t[k]);
+      const btVector3 p = toBt(local[k]);
       lo.setMin(p);
       hi.setMax(p);
     }
-    const btVector3 pad(search_radius, search_radius, search_radius);
+    const btVector3 pad = toBt(Eigen::Vector3d::Constant(search_radius));
     NearestFacingTriangle nearest(local, search_radius);
     static_cast<const btConcaveShape&>(shape).processAllTriangles(&nearest, lo - pad, hi + pad);
     std::optional<FacePoint> f = nearest.best();
     if (f) {
-      f->normal = toEigen(transform.getBasis() * toBt(f->normal));
-      f->shape_point = toEigen(transform * toBt(f->shape_point));
+      f->normal = worldDirection(transform.getBasis(), f->normal);
+      f->shape_point = worldPoint(transform, f->shape_point);
     }
     return f;
   }

@@ -46,7 +46,7 @@ btTransform startPose(const btCollisionObject& object, double dt) {
     return object.getWorldTransform();
   btTransform start;
   btTransformUtil::integrateTransform(object.getWorldTransform(), -body->getLinearVelocity(),
-                                      -body->getAngularVelocity(), dt, start);
+                                      -body->getAngularVelocity(), toBtScalar(dt), start);
   return start;
 }
 
@@ -104,7 +104,7 @@ int RigidContactSolver::partnerIndex(const btCollisionObject* object) {
   }
   p.com = toEigen(startPose(*object, dt_).getOrigin());
   if (p.dynamic) {
-    p.mass = 1.0 / p.body->getInvMass();
+    p.mass = 1.0 / toDouble(p.body->getInvMass());
     p.inverse_inertia = toEigen(p.body->getInvInertiaTensorWorld());
     // A zero inverse inertia component (locked rotation) has no inverse: keep it rigid.
     Eigen::Matrix3d regular = p.inverse_inertia;
@@ -196,14 +196,14 @@ bool RigidContactSolver::detect(const FemState& state, const NodeConstraints& co
     btVector3 lo, hi;
     shape->getAabb(transform, lo, hi);
     if (body != nullptr) {
-      const double radius = 0.5 * (hi - lo).length();
-      rigid_speed = body->getLinearVelocity().length() +
-                    body->getAngularVelocity().length() * std::min(radius, 1e6);
+      const double radius = 0.5 * toDouble((hi - lo).length());
+      rigid_speed = toDouble(body->getLinearVelocity().length()) +
+                    toDouble(body->getAngularVelocity().length()) * std::min(radius, 1e6);
     }
     // Anything that can close the gap within the step, twice over, plus the soft margin.
     const double reach = 2 * dt * (max_node_speed + rigid_speed) + 4 * margin;
-    const btVector3 pad(reach, reach, reach);
-    const btVector3 face_pad = pad + btVector3(longest_edge, longest_edge, longest_edge);
+    const btVector3 pad = toBt(Eigen::Vector3d::Constant(reach));
+    const btVector3 face_pad = pad + toBt(Eigen::Vector3d::Constant(longest_edge));
     NodeCollector collector(sb);
     sb.m_ndbvt.collideTV(sb.m_ndbvt.m_root, btDbvtVolume::FromMM(lo - face_pad, hi + face_pad),
                          collector);
@@ -226,7 +226,7 @@ bool RigidContactSolver::detect(const FemState& state, const NodeConstraints& co
       c.gap = sp->distance;
       c.distance = sp->distance;
       c.lever = x - sp->distance * sp->normal - partners_[static_cast<size_t>(c.partner)].com;
-      c.friction = settings_.friction * object->getFriction();
+      c.friction = settings_.friction * toDouble(object->getFriction());
       c.held = held;
       chooseSupportPlane(*shape, transform, x, state.velocity(i), -toEigen(sb.m_nodes[i].m_n), dt,
                          c);
@@ -245,7 +245,7 @@ bool RigidContactSolver::detect(const FemState& state, const NodeConstraints& co
     const int partner = partnerIndex(object);
     faces_.detect(state, constraints, collector.nodes, *shape, transform, toEigen(lo), toEigen(hi),
                   reach, dt, partner, partners_[static_cast<size_t>(partner)],
-                  settings_.friction * object->getFriction());
+                  settings_.friction * toDouble(object->getFriction()));
   }
   // A candidate object that nothing touches keeps Bullet's velocity untouched: not an unknown.
   std::vector<char> touched(partners_.size(), 0);
@@ -788,7 +788,7 @@ void RigidContactSolver::finish() {
     const Vector6d dV = k.velocity - k.entry_velocity;
     btTransform corrected;
     btTransformUtil::integrateTransform(k.body->getCenterOfMassTransform(), toBt(dV.head<3>()),
-                                        toBt(dV.tail<3>()), dt_, corrected);
+                                        toBt(dV.tail<3>()), toBtScalar(dt_), corrected);
     k.body->setLinearVelocity(toBt(k.velocity.head<3>()));
     k.body->setAngularVelocity(toBt(k.velocity.tail<3>()));
     k.body->setCenterOfMassTransform(corrected);

@@ -99,7 +99,7 @@ class ClosestTriangle : public btTriangleCallback {
 std::optional<SurfacePoint> signedDistance(const btCollisionShape& shape,
                                            const btTransform& transform, const Eigen::Vector3d& x,
                                            double search_radius, const Eigen::Vector3d& preferred) {
-  const Eigen::Vector3d p = toEigen(transform.invXform(toBt(x)));
+  const Eigen::Vector3d p = localPoint(transform, x);
   std::optional<SurfacePoint> local;
   switch (shape.getShapeType()) {
     case SPHERE_SHAPE_PROXYTYPE:
@@ -108,8 +108,7 @@ std::optional<SurfacePoint> signedDistance(const btCollisionShape& shape,
     case BOX_SHAPE_PROXYTYPE: {
       // Bullet's box collides at its half extents (the margin is inside them).
       const btVector3 h = static_cast<const btBoxShape&>(shape).getHalfExtentsWithMargin();
-      local =
-          boxDistance(toEigen(h), p, toEigen(transform.getBasis().transpose() * toBt(preferred)));
+      local = boxDistance(toEigen(h), p, localDirection(transform.getBasis(), preferred));
       break;
     }
     case CAPSULE_SHAPE_PROXYTYPE: {
@@ -120,7 +119,7 @@ std::optional<SurfacePoint> signedDistance(const btCollisionShape& shape,
     case STATIC_PLANE_PROXYTYPE: {
       const auto& plane = static_cast<const btStaticPlaneShape&>(shape);
       const Eigen::Vector3d n = toEigen(plane.getPlaneNormal()).normalized();
-      local = SurfacePoint{n.dot(p) - plane.getPlaneConstant(), n};
+      local = SurfacePoint{n.dot(p) - toDouble(plane.getPlaneConstant()), n};
       break;
     }
     default:
@@ -138,7 +137,7 @@ std::optional<SurfacePoint> signedDistance(const btCollisionShape& shape,
         }
       } else if (shape.isConcave()) {
         ClosestTriangle closest(p);
-        const btVector3 r(search_radius, search_radius, search_radius);
+        const btVector3 r = toBt(Eigen::Vector3d::Constant(search_radius));
         static_cast<const btConcaveShape&>(shape).processAllTriangles(&closest, toBt(p) - r,
                                                                       toBt(p) + r);
         local = closest.best();
@@ -146,7 +145,7 @@ std::optional<SurfacePoint> signedDistance(const btCollisionShape& shape,
       break;
   }
   if (!local) return std::nullopt;
-  local->normal = toEigen(transform.getBasis() * toBt(local->normal));
+  local->normal = worldDirection(transform.getBasis(), local->normal);
   return local;
 }
 
