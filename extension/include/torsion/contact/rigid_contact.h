@@ -39,6 +39,8 @@
 #include <vector>
 
 #include "torsion/contact/face_contacts.h"
+#include "torsion/contact/multibody_partner.h"
+#include "torsion/contact/node_anchors.h"
 #include "torsion/contact/rigid_partner.h"
 #include "torsion/fem/fem_model.h"
 #include "torsion/solve/fem_state.h"
@@ -77,6 +79,7 @@ struct NodeContact {
   Eigen::Vector3d lever;   ///< m, contact point minus centre of mass (start of step)
   double friction = 0;     ///< pair coefficient
   bool held = false;       ///< the node is prescribed (hand, node group)
+  bool anchored = false;   ///< an anchor (node_anchors.h): sticks for good, gap = -drift
   State state = State::kInactive;
   int releases = 0;              ///< times released this step (anti-cycling: never twice)
   int slips = 0;                 ///< stick-to-slide switches this step (anti-cycling: at most two)
@@ -121,8 +124,17 @@ class RigidContactSolver {
   LinearSolveReport solve(const SystemOperator& op, const NodeConstraints& constraints,
                           const Eigen::VectorXd& b, const SolverSettings& settings,
                           Eigen::VectorXd& v);
-  /// After the step: velocities and pose corrections onto dynamic rigid bodies.
+  /// After the step: velocities and pose corrections onto dynamic rigid bodies, impulses onto
+  /// multibodies.
   void finish();
+
+  /// Anchors `nodes` (at their positions in `state`) to `object` (node_anchors.h). Returns the
+  /// anchor's id.
+  int addAnchor(const btCollisionObject* object, std::vector<int> nodes, const FemState& state) {
+    return anchors_.add(object, std::move(nodes), state);
+  }
+  void removeAnchor(int anchor) { anchors_.remove(anchor); }
+  const NodeAnchors& anchors() const { return anchors_; }
 
   const std::vector<NodeContact>& contacts() const { return contacts_; }
   const std::vector<FaceContact>& faceContacts() const { return faces_.contacts(); }
@@ -131,6 +143,9 @@ class RigidContactSolver {
 
  private:
   int partnerIndex(const btCollisionObject* object);
+  btTransform startPoseOf(const btCollisionObject& object) const;
+  void recordAnchorStartPoses();  // node_anchors.cpp
+  void addAnchorContacts(const FemState& state, const NodeConstraints& constraints);
   void expand(const Eigen::VectorXd& q, Eigen::VectorXd& v) const;
   void contract(const Eigen::VectorXd& y, const Eigen::VectorXd& rigid_part,
                 Eigen::VectorXd& q) const;
@@ -148,6 +163,8 @@ class RigidContactSolver {
   std::vector<char> surface_;
   std::vector<const btCollisionObject*> candidates_;
   std::vector<RigidPartner> partners_;
+  MultibodyLinks links_;
+  NodeAnchors anchors_;
   std::vector<NodeContact> contacts_;
   FaceContactSet faces_;
   std::vector<int> node_contact_;  // per node: index into contacts_ (free nodes only) or -1

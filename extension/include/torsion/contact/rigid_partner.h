@@ -3,6 +3,7 @@
 // kinematics of a point on it. Touched only by the simulation thread.
 
 #include <BulletDynamics/Dynamics/btRigidBody.h>
+#include <BulletDynamics/Featherstone/btMultiBodyLinkCollider.h>
 
 #include <Eigen/Core>
 #include <Eigen/Geometry>
@@ -10,11 +11,15 @@
 namespace torsion {
 
 using Vector6d = Eigen::Matrix<double, 6, 1>;
+using Matrix6d = Eigen::Matrix<double, 6, 6>;
 
 /// A rigid object touched this step.
 struct RigidPartner {
   const btCollisionObject* object = nullptr;
-  btRigidBody* body = nullptr;  ///< null for a plain collision object
+  btRigidBody* body = nullptr;  ///< null for a plain collision object or a multibody link
+  /// A link (or base) of a Featherstone multibody: its velocities and response come from the
+  /// multibody (contact/multibody_partner.h); null otherwise.
+  btMultiBodyLinkCollider* link = nullptr;
   bool dynamic = false;         ///< velocities solved with the body's; else prescribed
   /// A dynamic body touching a static or kinematic one in Bullet (a box on the ground): solved
   /// as prescribed here, its contact impulse goes to Bullet's rigid solver (one step later), which
@@ -23,6 +28,10 @@ struct RigidPartner {
   double mass = 0;
   Eigen::Matrix3d inertia = Eigen::Matrix3d::Zero();          ///< world, kg m^2 (dynamic)
   Eigen::Matrix3d inverse_inertia = Eigen::Matrix3d::Zero();  ///< world (dynamic)
+  /// Effective mass of the body's motion (v, omega) at `com`, world (dynamic): diag(m, I) for a
+  /// rigid body, (J M^-1 J^T)^-1 for a multibody link (regularised in its locked directions).
+  Matrix6d mass_matrix = Matrix6d::Zero();
+  Matrix6d inverse_mass_matrix = Matrix6d::Zero();  ///< its inverse (velocity per impulse)
   Eigen::Vector3d com = Eigen::Vector3d::Zero();
   Vector6d entry_velocity = Vector6d::Zero();  ///< (v, omega) Bullet integrated with
   Vector6d velocity = Vector6d::Zero();        ///< (v, omega) current estimate / result
