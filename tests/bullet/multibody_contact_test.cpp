@@ -7,6 +7,7 @@
 
 #include "multibody_world.h"
 #include "torsion/contact/ball_mesh.h"
+#include "torsion/contact/multibody_partner.h"
 #include "torsion/mesh/box_mesh.h"
 
 namespace torsion {
@@ -30,6 +31,66 @@ Eigen::Vector3d femCentre(const FemBody& body) {
     mass += m;
   }
   return c / mass;
+}
+
+TEST(MultibodyPartner, AFreeMultibodyBoxHasTheMassAndInertiaOfARigidBox) {
+  MultibodyWorld user(btVector3(0, 0, 0));
+  auto box = std::make_unique<btBoxShape>(btVector3(0.2, 0.1, 0.05));
+  btVector3 inertia;
+  box->calculateLocalInertia(2.0, inertia);
+  btMultiBody* body = user.addMultibody(0, 2.0, inertia, false, btVector3(1, 2, 3));
+  std::vector<std::unique_ptr<btCollisionShape>> shapes;
+  shapes.push_back(std::move(box));
+  user.addColliders(body, std::move(shapes), 0.5);
+  body->setBaseOmega(btVector3(0, 0, 0.5));
+  body->setBaseVel(btVector3(0.1, 0, 0));
+  user.world.stepSimulation(1 / 240., 0);  // Bullet's forward dynamics caches M^-1
+
+  RigidPartner p;
+  p.com = toEigen(body->getBasePos());
+  MultibodyLinks links;
+  ASSERT_TRUE(links.describe(body->getBaseCollider(), p));
+  EXPECT_TRUE(p.dynamic);
+  const Eigen::Matrix3d R = toEigen(body->getBaseWorldTransform().getBasis());
+  Matrix6d expected = Matrix6d::Zero();
+  expected.topLeftCorner<3, 3>() = 2.0 * Eigen::Matrix3d::Identity();
+  expected.bottomRightCorner<3, 3>() =
+      R * Eigen::Vector3d(inertia.x(), inertia.y(), inertia.z()).asDiagonal() * R.transpose();
+  // To the regularisation (a millionth of the box's own mass) and one step's turn (2e-3 rad): M^-1
+  // is Bullet's, cached at the start of the step, R the end's.
+  EXPECT_LT((p.mass_matrix - expected).norm(), 1e-4 * expected.norm()) << p.mass_matrix;
+  Vector6d velocity;
+  velocity << toEigen(body->getBaseVel()), toEigen(body->getBaseOmega());
+  EXPECT_LT((p.entry_velocity - velocity).norm(), 1e-12);
+}
+
+TEST(MultibodyPartner, AFixedBasePrismaticLinkMovesOnlyAlongItsAxis) {
+  MultibodyWorld user(btVector3(0, 0, 0));
+  btMultiBody* body = user.addMultibody(1, 0, btVector3(0, 0, 0), true, btVector3(0, 0, 1));
+  const btVector3 half(0.05, 0.05, 0.05);
+  btVector3 inertia;
+  btBoxShape(half).calculateLocalInertia(0.3, inertia);
+  body->setupPrismatic(0, 0.3, inertia, -1, btQuaternion::getIdentity(), btVector3(0, 1, 0),
+                       btVector3(0, 0, -0.2), btVector3(0, 0, 0), true);
+  std::vector<std::unique_ptr<btCollisionShape>> shapes;
+  shapes.push_back(nullptr);
+  shapes.push_back(std::make_unique<btBoxShape>(half));
+  user.addColliders(body, std::move(shapes), 0.5);
+  body->setJointVel(0, 0.2);
+  user.world.stepSimulation(1 / 240., 0);
+
+  const btMultiBodyLinkCollider* collider = body->getLinkCollider(0);
+  RigidPartner p;
+  p.com = toEigen(collider->getWorldTransform().getOrigin());
+  MultibodyLinks links;
+  ASSERT_TRUE(links.describe(collider, p));
+  EXPECT_TRUE(p.dynamic);
+  // Velocity per unit impulse: 1/m along the joint's axis y, (almost) nothing elsewhere.
+  EXPECT_NEAR(p.inverse_mass_matrix(1, 1), 1 / 0.3, 1e-5 / 0.3);
+  EXPECT_LT(p.inverse_mass_matrix(0, 0), 1e-5 / 0.3);
+  EXPECT_LT(p.inverse_mass_matrix(2, 2), 1e-5 / 0.3);
+  EXPECT_NEAR(p.entry_velocity[1], 0.2, 1e-12);
+  EXPECT_LT(p.entry_velocity.norm() - 0.2, 1e-12);
 }
 
 TEST(MultibodyContact, BallHittingAFreeMultibodyBoxConservesLinearMomentum) {
@@ -134,9 +195,16 @@ TEST(MultibodyContact, MotorGripperLiftsASoftBlockAndHoldsItWithoutSlip) {
   const double weight = 0.06 * 0.06 * 0.06 * material.density * 9.81;
   const Eigen::Vector3d start = femCentre(*block);
 
+  // The lift is a servo: velocity target plus a position target along a ramp (Bullet's motor
+  // corrects a fraction kp of the position error per step), so the load it carries does not make
+  // it drift.
+  double lift_target = 0, lift_speed = 0;
   auto run = [&](double seconds) {
     const int steps = static_cast<int>(std::lround(seconds / kDt));
     for (int k = 0; k < steps; ++k) {
+      lift_target += lift_speed * kDt;
+      g.lift->setVelocityTarget(lift_speed);
+      g.lift->setPositionTarget(lift_target, 0.2);
       user.world.stepSimulation(kDt, 0);
       ASSERT_TRUE(user.fem.status().ok) << user.fem.status().message;
     }
@@ -161,9 +229,9 @@ TEST(MultibodyContact, MotorGripperLiftsASoftBlockAndHoldsItWithoutSlip) {
   EXPECT_LT(width, 0.06 - 0.0004);
   EXPECT_GT(width, 0.06 - 0.003);
   // Lift 5 cm.
-  g.lift->setVelocityTarget(0.05);
+  lift_speed = 0.05;
   run(1.0);
-  g.lift->setVelocityTarget(0);
+  lift_speed = 0;
   run(0.25);  // the lift stops; the block settles in the grip
   const Eigen::Vector3d held = femCentre(*block) - fingersMidpoint(g);
   EXPECT_GT(femCentre(*block).z() - start.z(), 0.04) << "the block went up with the gripper";

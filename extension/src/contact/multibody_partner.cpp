@@ -12,7 +12,7 @@ namespace {
 
 // A locked direction of a link (J M^-1 J^T singular there) yields within the solve as a body this
 // many times the link's own mass and inertia would.
-constexpr double kLockedMassFactor = 1e3;
+constexpr double kLockedMassFactor = 1e6;
 
 btMultiBody& multibodyOf(const btMultiBodyLinkCollider& link) {
   return *link.m_multiBody;
@@ -103,7 +103,7 @@ double MultibodyLinks::speedBound(const btCollisionObject& object, double radius
   return V.head<3>().norm() + V.tail<3>().norm() * std::min(radius, 1e6);
 }
 
-bool MultibodyLinks::describe(const btCollisionObject* object, RigidPartner& partner) {
+bool MultibodyLinks::describe(const btCollisionObject* object, RigidPartner& partner) const {
   btMultiBodyLinkCollider* link = asMultibodyLink(object);
   if (link == nullptr) return false;
   btMultiBody& body = multibodyOf(*link);
@@ -113,9 +113,19 @@ bool MultibodyLinks::describe(const btCollisionObject* object, RigidPartner& par
   for (int c = 0; c < J.cols(); ++c)
     qdot[c] = body.getVelocityVector()[c];
   partner.entry_velocity = J * qdot;
-  partner.velocity = partner.entry_velocity;
   partner.dynamic = canMove(*link);
+  partner.velocity = partner.entry_velocity;
   if (!partner.dynamic) return true;
+  // The other links' impulses of the last step, as this step's estimate of theirs.
+  Eigen::VectorXd others = Eigen::VectorXd::Zero(J.cols());
+  bool coupled = false;
+  for (const LinkImpulse& l : last_impulses_) {
+    if (l.link == link || l.link->m_multiBody != link->m_multiBody) continue;
+    others += linkJacobian(*l.link, l.point).transpose() * l.impulse;
+    coupled = true;
+  }
+  if (coupled) partner.entry_velocity += J * multibodyResponse(body, others);
+  partner.velocity = partner.entry_velocity;
 
   // W = J M^-1 J^T, column by column from the response to each row of J.
   Matrix6d W;
@@ -137,13 +147,21 @@ bool MultibodyLinks::describe(const btCollisionObject* object, RigidPartner& par
   return true;
 }
 
-void MultibodyLinks::applyImpulse(const RigidPartner& partner, double dt) {
-  if (partner.link == nullptr || !partner.dynamic) return;
-  if (partner.impulse.isZero(0)) return;
-  btMultiBody& body = multibodyOf(*partner.link);
+void MultibodyLinks::applyImpulses(const std::vector<RigidPartner>& partners, double dt) {
+  last_impulses_.clear();
+  for (const RigidPartner& partner : partners) {
+    if (partner.link == nullptr || !partner.dynamic || partner.impulse.isZero(0)) continue;
+    last_impulses_.push_back({partner.link, partner.com, partner.impulse});
+  }
+  for (const LinkImpulse& l : last_impulses_)
+    applyImpulse(l, dt);
+}
+
+void MultibodyLinks::applyImpulse(const LinkImpulse& l, double dt) {
+  btMultiBody& body = multibodyOf(*l.link);
   // F = (force, torque about com) x dt; its generalised impulse is J^T F (virtual power).
-  const Eigen::MatrixXd J = linkJacobian(*partner.link, partner.com);
-  const Eigen::VectorXd dv = multibodyResponse(body, J.transpose() * partner.impulse);
+  const Eigen::MatrixXd J = linkJacobian(*l.link, l.point);
+  const Eigen::VectorXd dv = multibodyResponse(body, J.transpose() * l.impulse);
   btAlignedObjectArray<btScalar> delta;
   delta.resize(static_cast<int>(dv.size()));
   for (int c = 0; c < dv.size(); ++c)

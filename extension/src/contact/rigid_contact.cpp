@@ -108,7 +108,7 @@ int RigidContactSolver::partnerIndex(const btCollisionObject* object) {
     p.dynamic = !p.body->isStaticOrKinematicObject() && p.body->getInvMass() > 0;
   }
   p.com = toEigen(startPoseOf(*object).getOrigin());
-  MultibodyLinks::describe(object, p);
+  links_.describe(object, p);
   if (p.dynamic && p.body != nullptr) {
     p.mass = 1.0 / p.body->getInvMass();
     p.inverse_inertia = toEigen(p.body->getInvInertiaTensorWorld());
@@ -722,11 +722,9 @@ void RigidContactSolver::solveHeld(const Eigen::VectorXd& v, double dt) {
 }
 
 void RigidContactSolver::finish() {
+  links_.applyImpulses(partners_, dt_);
   for (RigidPartner& k : partners_) {
-    if (k.link != nullptr) {
-      MultibodyLinks::applyImpulse(k, dt_);
-      continue;
-    }
+    if (k.link != nullptr) continue;
     if (k.supported && k.body != nullptr) {
       // Explicit: the impulse changes the velocity only; Bullet's rigid solver meets it next
       // step together with the body's other contacts (the ground), which alone it knows.

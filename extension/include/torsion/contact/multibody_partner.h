@@ -14,9 +14,11 @@
 // and inertia would (the impulse the multibody then receives moves it only where it can move);
 // J and M^-1 are taken at Bullet's configuration of the step (J after its integration, M^-1 as
 // cached by its forward dynamics); two links of one multibody touched in the same step are
-// independent partners within the solve (each sees the whole multibody's inertia behind it), the
-// multibody then receives both impulses exactly; joint motors and limits are Bullet's constraints,
-// solved before the FEM step: they answer the contact impulse one step later.
+// separate partners within the solve: each sees the multibody's inertia behind it, and the others'
+// impulses enter its entry velocity lagged by one step (J_a M^-1 sum_b J_b^T F_b of the last
+// step), exact when the impulses are steady (a held object); the multibody then receives every
+// impulse exactly. Joint motors and limits are Bullet's constraints, solved before the FEM step:
+// they answer the contact impulse one step later.
 // Touched only by the simulation thread.
 
 #include <BulletCollision/CollisionDispatch/btCollisionObject.h>
@@ -26,6 +28,7 @@
 #include <Eigen/Core>
 #include <map>
 #include <optional>
+#include <vector>
 
 #include "torsion/contact/rigid_partner.h"
 
@@ -57,14 +60,23 @@ class MultibodyLinks {
   static double speedBound(const btCollisionObject& object, double radius);
 
   /// Fills a partner for a link collider (its `com` set to the reference point): entry velocity
-  /// J qdot, dynamic unless the link and its ancestors are static or kinematic, effective mass.
+  /// J qdot plus the lagged response to last step's impulses on the multibody's other links,
+  /// dynamic unless the link and its ancestors are static or kinematic, effective mass.
   /// Returns false (partner untouched) when `object` is not a link.
-  static bool describe(const btCollisionObject* object, RigidPartner& partner);
-  /// After the step: the partner's impulse onto its multibody (velocities and joint positions).
-  static void applyImpulse(const RigidPartner& partner, double dt);
+  bool describe(const btCollisionObject* object, RigidPartner& partner) const;
+  /// After the step: each link partner's impulse onto its multibody (velocities and joint
+  /// positions), remembered for the next step's lagged coupling.
+  void applyImpulses(const std::vector<RigidPartner>& partners, double dt);
 
  private:
+  struct LinkImpulse {
+    const btMultiBodyLinkCollider* link;
+    Eigen::Vector3d point;  // m, where the wrench acts
+    Vector6d impulse;       // (force, torque about point) x dt
+  };
   std::map<const btCollisionObject*, btTransform> start_poses_;
+  static void applyImpulse(const LinkImpulse& l, double dt);
+  std::vector<LinkImpulse> last_impulses_;
 };
 
 }  // namespace torsion
