@@ -76,8 +76,9 @@ void solveTightly(FemSoftBodySolver& fem) {
 FemBody* addBar(FemSoftBodySolver& fem) {
   Material material;
   material.youngs_modulus = 1e5;
-  return fem.addBody("bar", makeBoxTetMesh({0, -0.025, -0.025}, {0.4, 0.025, 0.025}, 8, 1, 1).value(),
-                     material)
+  return fem
+      .addBody("bar", makeBoxTetMesh({0, -0.025, -0.025}, {0.4, 0.025, 0.025}, 8, 1, 1).value(),
+               material)
       .value();
 }
 
@@ -85,7 +86,7 @@ TEST(Anchors, ALightFreeBodyPulledByASoftBarConservesMomentumAndStaysStable) {
   MultibodyWorld user(btVector3(0, 0, 0));  // no external force
   solveTightly(user.fem);
   FemBody* bar = addBar(user.fem);  // 1 kg
-  const double mass = 0.01;                 // a hundred times lighter than the bar
+  const double mass = 0.01;         // a hundred times lighter than the bar
   btRigidBody* box = user.addRigid(std::make_unique<btBoxShape>(btVector3(0.025, 0.025, 0.025)),
                                    mass, btVector3(0.425, 0, 0));
   const std::vector<int> end =
@@ -119,12 +120,14 @@ TEST(Anchors, ASoftBlockOnARigidPendulumSwingsWithoutGainingEnergy) {
   Material material;
   material.youngs_modulus = 1e5;
   FemBody* block =
-      user.fem.addBody("block", makeBoxTetMesh({-0.05, -0.05, -0.6}, {0.05, 0.05, -0.5}, 3, 3, 3).value(),
-                       material)
+      user.fem
+          .addBody("block",
+                   makeBoxTetMesh({-0.05, -0.05, -0.6}, {0.05, 0.05, -0.5}, 3, 3, 3).value(),
+                   material)
           .value();  // 1 kg
   const double mass = 1.0;
-  btRigidBody* bob = user.addRigid(std::make_unique<btBoxShape>(btVector3(0.05, 0.05, 0.025)),
-                                   mass, btVector3(0, 0, -0.475));
+  btRigidBody* bob = user.addRigid(std::make_unique<btBoxShape>(btVector3(0.05, 0.05, 0.025)), mass,
+                                   btVector3(0, 0, -0.475));
   // A rod to a fixed pivot at the origin (Bullet's point-to-point constraint).
   btPoint2PointConstraint pivot(*bob, btVector3(0, 0, 0.475));
   user.world.addConstraint(&pivot);
@@ -145,8 +148,8 @@ TEST(Anchors, ASoftBlockOnARigidPendulumSwingsWithoutGainingEnergy) {
     peak = std::max(peak, e);
     highest = std::max(highest, static_cast<double>(bob->getCenterOfMassPosition().z()));
     worst_anchor = std::max(worst_anchor, anchorError(*block, *bob, top, local));
-    worst_rod = std::max(worst_rod,
-                         std::abs((bob->getCenterOfMassTransform() * btVector3(0, 0, 0.475)).length()));
+    worst_rod = std::max(
+        worst_rod, std::abs((bob->getCenterOfMassTransform() * btVector3(0, 0, 0.475)).length()));
   }
   // It swings round the pivot (a quarter turn at least) without blowing up.
   EXPECT_GT(highest, 0);
@@ -160,8 +163,10 @@ TEST(Anchors, ASoftBlockOnALightMultibodyPendulumSwingsWithoutGainingEnergy) {
   Material material;
   material.youngs_modulus = 1e5;
   FemBody* block =
-      user.fem.addBody("block", makeBoxTetMesh({-0.05, -0.05, -0.6}, {0.05, 0.05, -0.5}, 3, 3, 3).value(),
-                       material)
+      user.fem
+          .addBody("block",
+                   makeBoxTetMesh({-0.05, -0.05, -0.6}, {0.05, 0.05, -0.5}, 3, 3, 3).value(),
+                   material)
           .value();  // 1 kg
   // A revolute joint about y at the origin; the bob, twenty times lighter than the block, 0.475 m
   // below it.
@@ -208,8 +213,9 @@ TEST(Anchors, NodesAnchoredToAKinematicBodyFollowItExactly) {
   Material material;
   material.youngs_modulus = 1e5;
   FemBody* block =
-      user.fem.addBody("block", makeBoxTetMesh({-0.05, -0.05, -0.1}, {0.05, 0.05, 0}, 3, 3, 3).value(),
-                       material)
+      user.fem
+          .addBody("block", makeBoxTetMesh({-0.05, -0.05, -0.1}, {0.05, 0.05, 0}, 3, 3, 3).value(),
+                   material)
           .value();
   btRigidBody* plate = user.addRigid(std::make_unique<btBoxShape>(btVector3(0.08, 0.08, 0.01)), 0,
                                      btVector3(0, 0, 0.01));
@@ -274,8 +280,8 @@ TEST(Anchors, ASoftBarAnchoredToAFreeMultibodyConservesMomentum) {
 TEST(Anchors, BadAnchorRequestsAreErrorsNamingTheProblem) {
   MultibodyWorld user(btVector3(0, 0, 0));
   FemBody* bar = addBar(user.fem);
-  btRigidBody* box = user.addRigid(std::make_unique<btBoxShape>(btVector3(0.025, 0.025, 0.025)),
-                                   1, btVector3(0.425, 0, 0));
+  btRigidBody* box = user.addRigid(std::make_unique<btBoxShape>(btVector3(0.025, 0.025, 0.025)), 1,
+                                   btVector3(0.425, 0, 0));
   auto message = [](const Result<int>& r) { return r.ok() ? std::string() : r.error().message; };
   EXPECT_NE(message(bar->anchorNodes({0}, nullptr)).find("no object"), std::string::npos);
   EXPECT_NE(message(bar->anchorNodes({}, box)).find("no nodes"), std::string::npos);

@@ -129,8 +129,8 @@ TEST(MultibodyContact, BallHittingAFreeMultibodyBoxConservesLinearMomentum) {
   // The ball stays outside the box: its centre at least its radius above the box's top face
   // (to the contact's tolerance; the box has turned).
   const btVector3 local = body->getBaseWorldTransform().inverse() * toBt(femCentre(*ball));
-  EXPECT_GT(local.z(), 0.1 + 0.1 - 0.005) << "ball centre in the box's frame " << local.x() << " "
-                                          << local.y() << " " << local.z();
+  EXPECT_GT(local.z(), 0.1 + 0.1 - 0.005)
+      << "ball centre in the box's frame " << local.x() << " " << local.y() << " " << local.z();
 }
 
 // A fixed-base gripper: a lift (prismatic along z) carrying two fingers (prismatic along x), all
@@ -143,9 +143,9 @@ struct Gripper {
 };
 
 constexpr double kDt = 1 / 240.;
-constexpr double kFingerGap = 0.065;     // m, each finger's centre from the axis, open
-constexpr double kGripForce = 10;        // N, each finger motor's bound
-constexpr double kClosingSpeed = 0.05;   // m/s
+constexpr double kFingerGap = 0.065;    // m, each finger's centre from the axis, open
+constexpr double kGripForce = 10;       // N, each finger motor's bound
+constexpr double kClosingSpeed = 0.05;  // m/s
 
 Gripper buildGripper(MultibodyWorld& user) {
   Gripper g;
@@ -189,8 +189,9 @@ TEST(MultibodyContact, MotorGripperLiftsASoftBlockAndHoldsItWithoutSlip) {
   material.youngs_modulus = 2e5;
   material.poisson_ratio = 0.3;
   FemBody* block =
-      user.fem.addBody("block", makeBoxTetMesh({-0.03, -0.03, 0}, {0.03, 0.03, 0.06}, 4, 4, 4).value(),
-                       material)
+      user.fem
+          .addBody("block", makeBoxTetMesh({-0.03, -0.03, 0}, {0.03, 0.03, 0.06}, 4, 4, 4).value(),
+                   material)
           .value();
   const double weight = 0.06 * 0.06 * 0.06 * material.density * 9.81;
   const Eigen::Vector3d start = femCentre(*block);

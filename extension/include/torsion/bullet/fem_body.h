@@ -13,8 +13,8 @@
 #include "torsion/bullet/step_context.h"
 #include "torsion/constraints/carried_nodes.h"
 #include "torsion/contact/rigid_contact.h"
-#include "torsion/result.h"
 #include "torsion/fem/fem_model.h"
+#include "torsion/result.h"
 #include "torsion/solve/implicit_stepper.h"
 
 namespace torsion {

@@ -25,7 +25,11 @@
 //                                            Face contacts join the same solves as an augmented
 //                                            Lagrangian (face_contacts.h).
 //   after the step (finish)                  dynamic rigid bodies get their new velocities and
-//                                            the pose correction dt (v_new - v_bullet)
+//                                            the pose correction dt (v_new - v_bullet);
+//                                            multibodies their links' impulses
+//
+// Multibody links are partners like rigid bodies, with the multibody's effective mass at the link
+// (multibody_partner.h). Anchored nodes (node_anchors.h) are contacts that stick for good.
 //
 // A node held by a hand or a node group is never moved by a contact: it pushes a dynamic rigid
 // body away (a sequential-impulse pass on the rigid body alone) and ignores static or kinematic

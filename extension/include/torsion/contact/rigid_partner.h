@@ -20,7 +20,7 @@ struct RigidPartner {
   /// A link (or base) of a Featherstone multibody: its velocities and response come from the
   /// multibody (contact/multibody_partner.h); null otherwise.
   btMultiBodyLinkCollider* link = nullptr;
-  bool dynamic = false;         ///< velocities solved with the body's; else prescribed
+  bool dynamic = false;  ///< velocities solved with the body's; else prescribed
   /// A dynamic body touching a static or kinematic one in Bullet (a box on the ground): solved
   /// as prescribed here, its contact impulse goes to Bullet's rigid solver (one step later), which
   /// alone knows its other contacts.
