@@ -328,7 +328,7 @@ void RigidContactSolver::applyOperator(const SystemOperator& op, const Eigen::Ve
   for (const RigidPartner& k : partners_) {
     if (!k.dynamic) continue;
     const int o = k.unknown - 3 * model_->nodeCount();
-    rigid_scratch_.segment<6>(o) = k.mass_matrix * q.segment<6>(k.unknown);
+    rigid_scratch_.segment<6>(o) = partnerMomentum(k, q.segment<6>(k.unknown));
   }
   faces_.addProduct(scratch_, q, partners_, 3 * model_->nodeCount(), product_, rigid_scratch_);
   contract(product_, rigid_scratch_, out);
@@ -551,7 +551,7 @@ LinearSolveReport RigidContactSolver::solve(const SystemOperator& op,
     for (const RigidPartner& k : partners_) {
       if (!k.dynamic) continue;
       const int o = k.unknown - 3 * n;
-      rigid_rhs.segment<6>(o) = k.mass_matrix * k.entry_velocity;
+      rigid_rhs.segment<6>(o) = partnerMomentum(k, k.entry_velocity);
     }
     for (const NodeContact& c : contacts_) {
       if (c.held || c.state == NodeContact::State::kInactive) continue;
@@ -681,7 +681,7 @@ void RigidContactSolver::solveHeld(const Eigen::VectorXd& v, double dt) {
       const Eigen::Vector3d w = v.segment<3>(3 * c.node);
       auto response = [&](const Eigen::Vector3d& dir) {
         // dir . W dir: the rigid point's speed change along dir per unit impulse along dir.
-        return dir.dot(pointVelocity(k.inverse_mass_matrix * pointWrench(dir, c.lever), c.lever));
+        return dir.dot(pointVelocity(partnerResponse(k, pointWrench(dir, c.lever)), c.lever));
       };
       // Normal: n . J V <= n . w + gap/dt, i.e. the end gap >= 0.
       const double bound = c.normal.dot(w) + c.gap / dt;
@@ -691,7 +691,7 @@ void RigidContactSolver::solveHeld(const Eigen::VectorXd& v, double dt) {
       const double d_lambda = lambda_new - lambda;
       lambda = lambda_new;
       const Eigen::Vector3d impulse_on_rigid = -c.normal * d_lambda;
-      k.velocity += k.inverse_mass_matrix * pointWrench(impulse_on_rigid, c.lever);
+      k.velocity += partnerResponse(k, pointWrench(impulse_on_rigid, c.lever));
       k.impulse += pointWrench(impulse_on_rigid, c.lever);
       c.impulse -= impulse_on_rigid;
       // Friction: remove the tangential slip within mu lambda.
@@ -705,7 +705,7 @@ void RigidContactSolver::solveHeld(const Eigen::VectorXd& v, double dt) {
         const double cap = c.friction * lambda;
         if (target.norm() > cap) target *= cap / target.norm();
         const Eigen::Vector3d change_on_rigid = -(target - tangential);
-        k.velocity += k.inverse_mass_matrix * pointWrench(change_on_rigid, c.lever);
+        k.velocity += partnerResponse(k, pointWrench(change_on_rigid, c.lever));
         k.impulse += pointWrench(change_on_rigid, c.lever);
         c.impulse -= change_on_rigid;
       }

@@ -39,6 +39,24 @@ struct RigidPartner {
   int unknown = -1;                            ///< offset of its 6 unknowns in the CG vector
 };
 
+/// M V: the partner's momentum (linear, angular about com) at velocity V (dynamic partners). A
+/// rigid body's from m and I directly (the same arithmetic as before multibody partners, so rigid
+/// scenes are unchanged to the bit); a link's from its 6x6 effective mass.
+inline Vector6d partnerMomentum(const RigidPartner& k, const Vector6d& V) {
+  if (k.link != nullptr) return k.mass_matrix * V;
+  Vector6d p;
+  p << k.mass * V.head<3>(), k.inertia * V.tail<3>();
+  return p;
+}
+
+/// M^-1 w: the partner's velocity change for an impulse wrench w (dynamic or supported partners).
+inline Vector6d partnerResponse(const RigidPartner& k, const Vector6d& w) {
+  if (k.link != nullptr) return k.inverse_mass_matrix * w;
+  Vector6d dv;
+  dv << w.head<3>() / k.mass, k.inverse_inertia * w.tail<3>();
+  return dv;
+}
+
 /// Velocity of the rigid point at lever r (from the centre of mass): J V = v + omega x r.
 inline Eigen::Vector3d pointVelocity(const Vector6d& V, const Eigen::Vector3d& r) {
   return V.head<3>() + V.tail<3>().cross(r);
