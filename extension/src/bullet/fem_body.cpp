@@ -55,6 +55,34 @@ Wrench FemBody::groupWrench(int group, const Eigen::Vector3d& point) {
   return groups_[static_cast<size_t>(group)]->wrenchOn(stepper_.internalForces(), state_, point);
 }
 
+Result<int> FemBody::anchorNodes(std::vector<int> nodes, btCollisionObject* object) {
+  const std::string where = "body '" + name_ + "': anchor: ";
+  if (object == nullptr) return Error{where + "no object to anchor to"};
+  if (nodes.empty()) return Error{where + "no nodes"};
+  std::vector<char> listed(static_cast<size_t>(model_->nodeCount()), 0);
+  for (int node : nodes) {
+    if (node < 0 || node >= model_->nodeCount()) {
+      return Error{where + "node " + std::to_string(node) + " out of range [0, " +
+                   std::to_string(model_->nodeCount()) + ")"};
+    }
+    if (listed[static_cast<size_t>(node)]++)
+      return Error{where + "node " + std::to_string(node) + " listed twice"};
+    if (contacts_->anchors().anchored(node))
+      return Error{where + "node " + std::to_string(node) + " is anchored already"};
+  }
+  return contacts_->addAnchor(object, std::move(nodes), state_);
+}
+
+Status FemBody::removeAnchor(int anchor) {
+  const auto& anchors = contacts_->anchors().anchors();
+  if (anchor < 0 || anchor >= static_cast<int>(anchors.size()) ||
+      anchors[static_cast<size_t>(anchor)].object == nullptr) {
+    return Error{"body '" + name_ + "': no anchor " + std::to_string(anchor)};
+  }
+  contacts_->removeAnchor(anchor);
+  return Ok{};
+}
+
 void FemBody::setVelocity(const Eigen::Vector3d& velocity) {
   for (int i = 0; i < model_->nodeCount(); ++i)
     state_.velocities.segment<3>(3 * i) = velocity;

@@ -70,6 +70,11 @@ bool touchesStaticOrKinematic(const btRigidBody& body, btSoftBody& soft) {
 
 }  // namespace
 
+btTransform RigidContactSolver::startPoseOf(const btCollisionObject& object) const {
+  if (std::optional<btTransform> pose = links_.startPose(object)) return *pose;
+  return startPose(object, dt_);
+}
+
 RigidContactSolver::RigidContactSolver(std::shared_ptr<const FemModel> model, btSoftBody* soft_body)
     : model_(std::move(model)), soft_body_(soft_body), faces_(model_->mesh()) {
   const int n = model_->nodeCount();
@@ -83,12 +88,15 @@ RigidContactSolver::RigidContactSolver(std::shared_ptr<const FemModel> model, bt
 
 void RigidContactSolver::beginStep(double /*dt*/) {
   candidates_.clear();
+  links_.beginStep();
+  recordAnchorStartPoses();
 }
 
 void RigidContactSolver::addCandidate(const btCollisionObject* object) {
   // A concave object reaches us once per overlapping triangle: keep it once.
   if (std::find(candidates_.begin(), candidates_.end(), object) == candidates_.end())
     candidates_.push_back(object);
+  links_.recordStartPose(object);
 }
 
 int RigidContactSolver::partnerIndex(const btCollisionObject* object) {
@@ -102,14 +110,21 @@ int RigidContactSolver::partnerIndex(const btCollisionObject* object) {
     p.entry_velocity << toEigen(p.body->getLinearVelocity()), toEigen(p.body->getAngularVelocity());
     p.dynamic = !p.body->isStaticOrKinematicObject() && p.body->getInvMass() > 0;
   }
-  p.com = toEigen(startPose(*object, dt_).getOrigin());
-  if (p.dynamic) {
+  p.com = toEigen(startPoseOf(*object).getOrigin());
+  links_.describe(object, p);
+  if (p.dynamic && p.body != nullptr) {
     p.mass = 1.0 / toDouble(p.body->getInvMass());
     p.inverse_inertia = toEigen(p.body->getInvInertiaTensorWorld());
     // A zero inverse inertia component (locked rotation) has no inverse: keep it rigid.
     Eigen::Matrix3d regular = p.inverse_inertia;
     regular.diagonal().array() += 1e-12 * std::max(1.0, regular.norm());
     p.inertia = regular.inverse();
+    p.mass_matrix.setZero();
+    p.mass_matrix.topLeftCorner<3, 3>() = p.mass * Eigen::Matrix3d::Identity();
+    p.mass_matrix.bottomRightCorner<3, 3>() = p.inertia;
+    p.inverse_mass_matrix.setZero();
+    p.inverse_mass_matrix.topLeftCorner<3, 3>() = Eigen::Matrix3d::Identity() / p.mass;
+    p.inverse_mass_matrix.bottomRightCorner<3, 3>() = p.inverse_inertia;
     if (touchesStaticOrKinematic(*p.body, *soft_body_)) {
       p.dynamic = false;
       p.supported = true;
@@ -178,7 +193,7 @@ bool RigidContactSolver::detect(const FemState& state, const NodeConstraints& co
   stats_ = ContactStepStats{};
   dt_ = dt;
   dynamic_count_ = 0;
-  if (candidates_.empty()) return false;
+  if (candidates_.empty() && anchors_.empty()) return false;
 
   const btSoftBody& sb = *soft_body_;
   const double margin = sb.getCollisionShape()->getMargin();
@@ -190,7 +205,7 @@ bool RigidContactSolver::detect(const FemState& state, const NodeConstraints& co
   const double longest_edge = faces_.longestEdge(state);
   for (const btCollisionObject* object : candidates_) {
     const btCollisionShape* shape = object->getCollisionShape();
-    const btTransform transform = startPose(*object, dt);
+    const btTransform transform = startPoseOf(*object);
     const btRigidBody* body = btRigidBody::upcast(object);
     double rigid_speed = 0;
     btVector3 lo, hi;
@@ -199,6 +214,8 @@ bool RigidContactSolver::detect(const FemState& state, const NodeConstraints& co
       const double radius = 0.5 * toDouble((hi - lo).length());
       rigid_speed = toDouble(body->getLinearVelocity().length()) +
                     toDouble(body->getAngularVelocity().length()) * std::min(radius, 1e6);
+    } else {
+      rigid_speed = MultibodyLinks::speedBound(*object, 0.5 * toDouble((hi - lo).length()));
     }
     // Anything that can close the gap within the step, twice over, plus the soft margin.
     const double reach = 2 * dt * (max_node_speed + rigid_speed) + 4 * margin;
@@ -210,6 +227,7 @@ bool RigidContactSolver::detect(const FemState& state, const NodeConstraints& co
     const Eigen::Vector3d node_lo = toEigen(lo - pad), node_hi = toEigen(hi + pad);
     for (int i : collector.nodes) {
       if (!surface_[static_cast<size_t>(i)]) continue;
+      if (anchors_.anchored(i) && constraints.kind(i) != NodeConstraints::Kind::kFull) continue;
       const Eigen::Vector3d x = state.position(i);
       if ((x.array() < node_lo.array()).any() || (x.array() > node_hi.array()).any()) continue;
       std::optional<SurfacePoint> sp =
@@ -247,6 +265,7 @@ bool RigidContactSolver::detect(const FemState& state, const NodeConstraints& co
                   reach, dt, partner, partners_[static_cast<size_t>(partner)],
                   settings_.friction * toDouble(object->getFriction()));
   }
+  addAnchorContacts(state, constraints);
   // A candidate object that nothing touches keeps Bullet's velocity untouched: not an unknown.
   std::vector<char> touched(partners_.size(), 0);
   for (const NodeContact& c : contacts_)
@@ -258,7 +277,7 @@ bool RigidContactSolver::detect(const FemState& state, const NodeConstraints& co
   }
   // Warm active set.
   for (NodeContact& c : contacts_) {
-    if (c.held) continue;
+    if (c.held || c.anchored) continue;
     for (size_t k = 0; k < previous_active_.size(); ++k) {
       if (previous_active_[k].first == c.node &&
           previous_active_[k].second == partners_[static_cast<size_t>(c.partner)].object) {
@@ -268,8 +287,9 @@ bool RigidContactSolver::detect(const FemState& state, const NodeConstraints& co
   }
   stats_.candidates = static_cast<int>(contacts_.size());
   stats_.face_candidates = static_cast<int>(faces_.contacts().size());
-  for (const NodeContact& c : contacts_)
-    stats_.max_penetration = std::max(stats_.max_penetration, -c.distance);
+  for (const NodeContact& c : contacts_) {
+    if (!c.anchored) stats_.max_penetration = std::max(stats_.max_penetration, -c.distance);
+  }
   for (const FaceContact& c : faces_.contacts())
     stats_.max_penetration = std::max(stats_.max_penetration, -c.gap);
   return !contacts_.empty() || !faces_.empty();
@@ -352,8 +372,7 @@ void RigidContactSolver::applyOperator(const SystemOperator& op, const Eigen::Ve
   for (const RigidPartner& k : partners_) {
     if (!k.dynamic) continue;
     const int o = k.unknown - 3 * model_->nodeCount();
-    rigid_scratch_.segment<3>(o) = k.mass * q.segment<3>(k.unknown);
-    rigid_scratch_.segment<3>(o + 3) = k.inertia * q.segment<3>(k.unknown + 3);
+    rigid_scratch_.segment<6>(o) = partnerMomentum(k, q.segment<6>(k.unknown));
   }
   faces_.addProduct(scratch_, q, partners_, 3 * model_->nodeCount(), product_, rigid_scratch_);
   contract(product_, rigid_scratch_, out);
@@ -365,8 +384,7 @@ void RigidContactSolver::buildPreconditioner(const SystemOperator& op) {
   rigid_inverse_.assign(partners_.size(), Eigen::Matrix<double, 6, 6>::Zero());
   for (size_t k = 0; k < partners_.size(); ++k) {
     if (!partners_[k].dynamic) continue;
-    rigid_inverse_[k].topLeftCorner<3, 3>() = partners_[k].mass * Eigen::Matrix3d::Identity();
-    rigid_inverse_[k].bottomRightCorner<3, 3>() = partners_[k].inertia;
+    rigid_inverse_[k] = partners_[k].mass_matrix;
   }
   faces_.addPreconditioner(block_inverse_, rigid_inverse_, partners_);
   for (int i = 0; i < n; ++i) {
@@ -442,7 +460,7 @@ bool RigidContactSolver::updateActiveSet(const Eigen::VectorXd& v, const Eigen::
       largest = std::max(largest, std::abs(c.normal.dot(p.segment<3>(3 * c.node))));
   }
   for (NodeContact& c : contacts_) {
-    if (c.held) continue;
+    if (c.held || c.anchored) continue;  // an anchor sticks for good
     const RigidPartner& k = partners_[static_cast<size_t>(c.partner)];
     const Eigen::Vector3d vi = v.segment<3>(3 * c.node);
     const Eigen::Vector3d pi = p.segment<3>(3 * c.node);
@@ -589,8 +607,7 @@ LinearSolveReport RigidContactSolver::solve(const SystemOperator& op,
     for (const RigidPartner& k : partners_) {
       if (!k.dynamic) continue;
       const int o = k.unknown - 3 * n;
-      rigid_rhs.segment<3>(o) = k.mass * k.entry_velocity.head<3>();
-      rigid_rhs.segment<3>(o + 3) = k.inertia * k.entry_velocity.tail<3>();
+      rigid_rhs.segment<6>(o) = partnerMomentum(k, k.entry_velocity);
     }
     for (const NodeContact& c : contacts_) {
       if (c.held || c.state == NodeContact::State::kInactive) continue;
@@ -727,7 +744,7 @@ void RigidContactSolver::solveHeld(const Eigen::VectorXd& v, double dt) {
       const Eigen::Vector3d w = v.segment<3>(3 * c.node);
       auto response = [&](const Eigen::Vector3d& dir) {
         // dir . W dir: the rigid point's speed change along dir per unit impulse along dir.
-        return dir.dot(dir / k.mass + (k.inverse_inertia * c.lever.cross(dir)).cross(c.lever));
+        return dir.dot(pointVelocity(partnerResponse(k, pointWrench(dir, c.lever)), c.lever));
       };
       // Normal: n . J V <= n . w + gap/dt, i.e. the end gap >= 0.
       const double bound = c.normal.dot(w) + c.gap / dt;
@@ -736,10 +753,8 @@ void RigidContactSolver::solveHeld(const Eigen::VectorXd& v, double dt) {
       const double lambda_new = std::max(0.0, lambda + violation / response(c.normal));
       const double d_lambda = lambda_new - lambda;
       lambda = lambda_new;
-      Vector6d dV;
       const Eigen::Vector3d impulse_on_rigid = -c.normal * d_lambda;
-      dV << impulse_on_rigid / k.mass, k.inverse_inertia * c.lever.cross(impulse_on_rigid);
-      k.velocity += dV;
+      k.velocity += partnerResponse(k, pointWrench(impulse_on_rigid, c.lever));
       k.impulse += pointWrench(impulse_on_rigid, c.lever);
       c.impulse -= impulse_on_rigid;
       // Friction: remove the tangential slip within mu lambda.
@@ -753,9 +768,7 @@ void RigidContactSolver::solveHeld(const Eigen::VectorXd& v, double dt) {
         const double cap = c.friction * lambda;
         if (target.norm() > cap) target *= cap / target.norm();
         const Eigen::Vector3d change_on_rigid = -(target - tangential);
-        Vector6d dVt;
-        dVt << change_on_rigid / k.mass, k.inverse_inertia * c.lever.cross(change_on_rigid);
-        k.velocity += dVt;
+        k.velocity += partnerResponse(k, pointWrench(change_on_rigid, c.lever));
         k.impulse += pointWrench(change_on_rigid, c.lever);
         c.impulse -= change_on_rigid;
       }
@@ -772,7 +785,9 @@ void RigidContactSolver::solveHeld(const Eigen::VectorXd& v, double dt) {
 }
 
 void RigidContactSolver::finish() {
+  links_.applyImpulses(partners_, dt_);
   for (RigidPartner& k : partners_) {
+    if (k.link != nullptr) continue;
     if (k.supported && k.body != nullptr) {
       // Explicit: the impulse changes the velocity only; Bullet's rigid solver meets it next
       // step together with the body's other contacts (the ground), which alone it knows.

@@ -14,6 +14,7 @@
 #include "torsion/constraints/carried_nodes.h"
 #include "torsion/contact/rigid_contact.h"
 #include "torsion/fem/fem_model.h"
+#include "torsion/result.h"
 #include "torsion/solve/implicit_stepper.h"
 
 namespace torsion {
@@ -51,6 +52,16 @@ class FemBody {
 
   /// The wrench the body exerts on group `group` at the end of the last step, about `point`.
   Wrench groupWrench(int group, const Eigen::Vector3d& point);
+
+  /// Anchors `nodes` to `object` for good, two ways (docs/contact.md, "Anchors"): each node keeps
+  /// the offset it has now in the object's frame, moves with it and pulls on it inside the same
+  /// implicit solve. `object` is a btRigidBody (dynamic, kinematic or static) or a multibody link
+  /// collider (btMultiBodyLinkCollider); it must stay in the world while anchored. A node held by
+  /// a hand or a node group follows that instead. Returns the anchor's id for removeAnchor().
+  /// Errors: a null object, an empty list, a node out of range, anchored already, or listed twice.
+  Result<int> anchorNodes(std::vector<int> nodes, btCollisionObject* object);
+  /// Frees an anchor's nodes (its id stays reserved). Errors: an unknown or removed anchor.
+  Status removeAnchor(int anchor);
 
   /// Sets every node's velocity (m/s), e.g. an initial velocity before the first step.
   void setVelocity(const Eigen::Vector3d& velocity);

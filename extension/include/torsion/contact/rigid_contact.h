@@ -25,7 +25,11 @@
 //                                            Face contacts join the same solves as an augmented
 //                                            Lagrangian (face_contacts.h).
 //   after the step (finish)                  dynamic rigid bodies get their new velocities and
-//                                            the pose correction dt (v_new - v_bullet)
+//                                            the pose correction dt (v_new - v_bullet);
+//                                            multibodies their links' impulses
+//
+// Multibody links are partners like rigid bodies, with the multibody's effective mass at the link
+// (multibody_partner.h). Anchored nodes (node_anchors.h) are contacts that stick for good.
 //
 // A node held by a hand or a node group is never moved by a contact: it pushes a dynamic rigid
 // body away (a sequential-impulse pass on the rigid body alone) and ignores static or kinematic
@@ -39,6 +43,8 @@
 #include <vector>
 
 #include "torsion/contact/face_contacts.h"
+#include "torsion/contact/multibody_partner.h"
+#include "torsion/contact/node_anchors.h"
 #include "torsion/contact/rigid_partner.h"
 #include "torsion/fem/fem_model.h"
 #include "torsion/solve/fem_state.h"
@@ -81,6 +87,7 @@ struct NodeContact {
   /// Held by the supporting plane facing the soft surface, not the nearest feature: the rigid
   /// body is sweeping over the node this step (a sliding box's leading edge).
   bool swept = false;
+  bool anchored = false;   ///< an anchor (node_anchors.h): sticks for good, gap = -drift
   State state = State::kInactive;
   int releases = 0;              ///< times released this step (anti-cycling: never twice)
   int slips = 0;                 ///< stick-to-slide switches this step (anti-cycling: at most two)
@@ -125,8 +132,17 @@ class RigidContactSolver {
   LinearSolveReport solve(const SystemOperator& op, const NodeConstraints& constraints,
                           const Eigen::VectorXd& b, const SolverSettings& settings,
                           Eigen::VectorXd& v);
-  /// After the step: velocities and pose corrections onto dynamic rigid bodies.
+  /// After the step: velocities and pose corrections onto dynamic rigid bodies, impulses onto
+  /// multibodies.
   void finish();
+
+  /// Anchors `nodes` (at their positions in `state`) to `object` (node_anchors.h). Returns the
+  /// anchor's id.
+  int addAnchor(const btCollisionObject* object, std::vector<int> nodes, const FemState& state) {
+    return anchors_.add(object, std::move(nodes), state);
+  }
+  void removeAnchor(int anchor) { anchors_.remove(anchor); }
+  const NodeAnchors& anchors() const { return anchors_; }
 
   const std::vector<NodeContact>& contacts() const { return contacts_; }
   const std::vector<FaceContact>& faceContacts() const { return faces_.contacts(); }
@@ -138,6 +154,9 @@ class RigidContactSolver {
   void chooseSupportPlane(const btCollisionShape& shape, const btTransform& transform,
                           const Eigen::Vector3d& x, const Eigen::Vector3d& node_velocity,
                           const Eigen::Vector3d& into_surface, double dt, NodeContact& c) const;
+  btTransform startPoseOf(const btCollisionObject& object) const;
+  void recordAnchorStartPoses();  // node_anchors.cpp
+  void addAnchorContacts(const FemState& state, const NodeConstraints& constraints);
   void expand(const Eigen::VectorXd& q, Eigen::VectorXd& v) const;
   void contract(const Eigen::VectorXd& y, const Eigen::VectorXd& rigid_part,
                 Eigen::VectorXd& q) const;
@@ -158,6 +177,8 @@ class RigidContactSolver {
   std::vector<char> surface_;
   std::vector<const btCollisionObject*> candidates_;
   std::vector<RigidPartner> partners_;
+  MultibodyLinks links_;
+  NodeAnchors anchors_;
   std::vector<NodeContact> contacts_;
   FaceContactSet faces_;
   std::vector<int> node_contact_;  // per node: index into contacts_ (free nodes only) or -1

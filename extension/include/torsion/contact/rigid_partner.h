@@ -3,6 +3,7 @@
 // kinematics of a point on it. Touched only by the simulation thread.
 
 #include <BulletDynamics/Dynamics/btRigidBody.h>
+#include <BulletDynamics/Featherstone/btMultiBodyLinkCollider.h>
 
 #include <Eigen/Core>
 #include <Eigen/Geometry>
@@ -10,12 +11,16 @@
 namespace torsion {
 
 using Vector6d = Eigen::Matrix<double, 6, 1>;
+using Matrix6d = Eigen::Matrix<double, 6, 6>;
 
 /// A rigid object touched this step.
 struct RigidPartner {
   const btCollisionObject* object = nullptr;
-  btRigidBody* body = nullptr;  ///< null for a plain collision object
-  bool dynamic = false;         ///< velocities solved with the body's; else prescribed
+  btRigidBody* body = nullptr;  ///< null for a plain collision object or a multibody link
+  /// A link (or base) of a Featherstone multibody: its velocities and response come from the
+  /// multibody (contact/multibody_partner.h); null otherwise.
+  btMultiBodyLinkCollider* link = nullptr;
+  bool dynamic = false;  ///< velocities solved with the body's; else prescribed
   /// A dynamic body touching a static or kinematic one in Bullet (a box on the ground): solved
   /// as prescribed here, its contact impulse goes to Bullet's rigid solver (one step later), which
   /// alone knows its other contacts.
@@ -23,12 +28,34 @@ struct RigidPartner {
   double mass = 0;
   Eigen::Matrix3d inertia = Eigen::Matrix3d::Zero();          ///< world, kg m^2 (dynamic)
   Eigen::Matrix3d inverse_inertia = Eigen::Matrix3d::Zero();  ///< world (dynamic)
+  /// Effective mass of the body's motion (v, omega) at `com`, world (dynamic): diag(m, I) for a
+  /// rigid body, (J M^-1 J^T)^-1 for a multibody link (regularised in its locked directions).
+  Matrix6d mass_matrix = Matrix6d::Zero();
+  Matrix6d inverse_mass_matrix = Matrix6d::Zero();  ///< its inverse (velocity per impulse)
   Eigen::Vector3d com = Eigen::Vector3d::Zero();
   Vector6d entry_velocity = Vector6d::Zero();  ///< (v, omega) Bullet integrated with
   Vector6d velocity = Vector6d::Zero();        ///< (v, omega) current estimate / result
   Vector6d impulse = Vector6d::Zero();         ///< (force, torque about com) x dt from this body
   int unknown = -1;                            ///< offset of its 6 unknowns in the CG vector
 };
+
+/// M V: the partner's momentum (linear, angular about com) at velocity V (dynamic partners). A
+/// rigid body's from m and I directly (the same arithmetic as before multibody partners, so rigid
+/// scenes are unchanged to the bit); a link's from its 6x6 effective mass.
+inline Vector6d partnerMomentum(const RigidPartner& k, const Vector6d& V) {
+  if (k.link != nullptr) return k.mass_matrix * V;
+  Vector6d p;
+  p << k.mass * V.head<3>(), k.inertia * V.tail<3>();
+  return p;
+}
+
+/// M^-1 w: the partner's velocity change for an impulse wrench w (dynamic or supported partners).
+inline Vector6d partnerResponse(const RigidPartner& k, const Vector6d& w) {
+  if (k.link != nullptr) return k.inverse_mass_matrix * w;
+  Vector6d dv;
+  dv << w.head<3>() / k.mass, k.inverse_inertia * w.tail<3>();
+  return dv;
+}
 
 /// Velocity of the rigid point at lever r (from the centre of mass): J V = v + omega x r.
 inline Eigen::Vector3d pointVelocity(const Vector6d& V, const Eigen::Vector3d& r) {
