@@ -116,9 +116,9 @@ Verdict judge(const scene::SceneSpec& spec, const std::vector<TetMesh>& rest, co
   d << "deepest node in a box " << deepest << " m; ";
 
   // The defining outcome of each re-created demo (docs/performance.md).
-  const std::vector<Eigen::Vector3d>& cube = end.nodes.front();
+  const std::vector<Eigen::Vector3d>& cube = end.nodes.front();  // the demo's one soft body
   const Eigen::Vector3d c = centroid(cube);
-  d << "cube centroid (" << c.x() << ", " << c.y() << ", " << c.z() << "), z " << lowestZ(cube)
+  d << "soft body centroid (" << c.x() << ", " << c.y() << ", " << c.z() << "), z " << lowestZ(cube)
     << " to " << highestZ(cube);
   bool ok = true;
   if (spec.name == "bullet_pinch") {
@@ -151,6 +151,17 @@ Verdict judge(const scene::SceneSpec& spec, const std::vector<TetMesh>& rest, co
     const double error = shapeError(rest.front(), cube);
     ok = error < 0.2 && inverted == 0 && std::abs(c.z() - 8) < 1;
     d << "; off its rest shape by " << error << " m RMS";
+  } else if (spec.name == "bullet_deformable_rigid") {
+    // The five boxes (2 m) stay stacked on the sheet held at its corners: four on the sheet
+    // (top at 0.1 m; centres at 1.1 m less its sag), the fifth on them.
+    const std::vector<Eigen::Vector3d>& sheet = end.nodes.front();
+    ok = inverted == 0;
+    for (size_t r = 0; r < end.rigid.size(); ++r) {
+      const double z = end.rigid[r].origin.z();
+      ok = ok && (r < 4 ? z > 0.8 && z < 1.3 : z > 2.8 && z < 3.4);
+      d << "; " << spec.rigid_bodies[r].name << " z " << z;
+    }
+    d << "; sheet z " << lowestZ(sheet) << " to " << highestZ(sheet);
   } else {
     v.detail = d.str();
     return v;
