@@ -1,6 +1,7 @@
 #pragma once
 // Bullet's own deformable world (btDeformableMultiBodyDynamicsWorld) on a scene file: the same
-// meshes, node sets, rigid bodies, gravity and dt as Torsion's run (bench_rigid_mix.cpp).
+// meshes, node sets, rigid bodies (static, dynamic and kinematic on their scripts), gravity and dt
+// as Torsion's run (bench_rigid_mix.cpp, bench_bullet_demos.cpp). Hands are not mapped.
 
 #include <Eigen/Core>
 #include <string>
