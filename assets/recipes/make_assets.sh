@@ -86,11 +86,17 @@ echo "== rod_1200, slab_768, block_162, paddle_108, ball_384"
   -o "$meshes/paddle_108.node"
 "$torsion" mesh ball --radius 0.25 --cells 4 -o "$meshes/ball_384.node"
 
+# ---- Bullet's deformable demos re-created (demos/scenes/bullet_*.json): soft cube, sheet ----
+echo "== cube_384, sheet_1536"
+"$torsion" mesh box --min -2 -2 -2 --max 2 2 2 --cells 4 4 4 -o "$meshes/cube_384.node"
+"$torsion" mesh box --min -4 -4 -0.1 --max 4 4 0.1 --cells 16 16 1 -o "$meshes/sheet_1536.node"
+
 echo "== torsion mesh info"
 for f in "$meshes"/cylinder_2430.node "$meshes"/cylinder_4323.node "$meshes"/cylinder_8332.node \
   "$meshes"/cylinder_31558.node "$meshes"/dragon_4300.node "$meshes"/rod_1200.node \
   "$meshes"/slab_768.node "$meshes"/block_162.node "$meshes"/paddle_108.node \
-  "$meshes"/ball_384.node; do
+  "$meshes"/ball_384.node "$meshes"/cube_384.node \
+  "$meshes"/sheet_1536.node; do
   (cd "$meshes" && "$torsion" mesh info "$(basename "$f")")
   echo
 done

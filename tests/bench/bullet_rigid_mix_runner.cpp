@@ -32,6 +32,26 @@ btVector3 toBtV(const Eigen::Vector3d& v) {
   return {v.x(), v.y(), v.z()};
 }
 
+// A kinematic scene body's script, as Torsion's scene builder runs it: Bullet asks the motion state
+// once per step (saveKinematicState, before the step) and takes (that pose - the last) / dt as the
+// body's velocity, so it answers with the pose at the end of the coming step.
+class ScriptedMotionState : public btMotionState {
+ public:
+  ScriptedMotionState(const scene::RigidBodySpec& spec, const double& next_time)
+      : spec_(spec), next_time_(next_time) {}
+  void getWorldTransform(btTransform& transform) const override {
+    const Frame f = spec_.poseAt(next_time_);
+    transform.setOrigin(toBtV(f.origin));
+    transform.setRotation(
+        btQuaternion(f.rotation.x(), f.rotation.y(), f.rotation.z(), f.rotation.w()));
+  }
+  void setWorldTransform(const btTransform& /*transform*/) override {}
+
+ private:
+  const scene::RigidBodySpec& spec_;
+  const double& next_time_;
+};
+
 struct DrivenNode {
   btSoftBody* body;
   int node;
@@ -140,6 +160,7 @@ MixRun runBulletMix(const scene::SceneSpec& spec, int steps) {
   std::vector<std::unique_ptr<btCollisionShape>> shapes;
   std::vector<std::unique_ptr<btMotionState>> states;
   std::vector<std::unique_ptr<btRigidBody>> rigids;
+  double next_time = 0;  // the kinematic scripts' clock: the end time of the coming step
   auto add_rigid = [&](const scene::RigidBodySpec& r) {
     shapes.push_back(scene::makeRigidShape(r));
     btVector3 inertia(0, 0, 0);
@@ -151,7 +172,14 @@ MixRun runBulletMix(const scene::SceneSpec& spec, int steps) {
     states.push_back(std::make_unique<btDefaultMotionState>(t));
     btRigidBody::btRigidBodyConstructionInfo info(r.mass, states.back().get(), shapes.back().get(),
                                                   inertia);
+    if (r.isKinematic()) states.back() = std::make_unique<ScriptedMotionState>(r, next_time);
+    info.m_motionState = states.back().get();
     rigids.push_back(std::make_unique<btRigidBody>(info));
+    if (r.isKinematic()) {
+      rigids.back()->setCollisionFlags(rigids.back()->getCollisionFlags() |
+                                       btCollisionObject::CF_KINEMATIC_OBJECT);
+      rigids.back()->setActivationState(DISABLE_DEACTIVATION);
+    }
     rigids.back()->setFriction(r.friction);
     rigids.back()->setRestitution(r.restitution);
     rigids.back()->setLinearVelocity(toBtV(r.linear_velocity));
@@ -159,7 +187,6 @@ MixRun runBulletMix(const scene::SceneSpec& spec, int steps) {
     world->addRigidBody(rigids.back().get());
   };
   for (const scene::RigidBodySpec& r : spec.rigid_bodies) {
-    if (r.isKinematic()) return failed("kinematic rigid bodies are not driven by this runner");
     add_rigid(r);
   }
   if (spec.ground) add_rigid(*spec.ground);
@@ -171,6 +198,7 @@ MixRun runBulletMix(const scene::SceneSpec& spec, int steps) {
   using Clock = std::chrono::steady_clock;
   for (int k = 0; k < steps; ++k) {
     const double t_next = (k + 1) * dt;
+    next_time = t_next;
     const Clock::time_point t0 = Clock::now();
     for (const DrivenNode& d : driven) {
       btSoftBody::Node& node = d.body->m_nodes[d.node];
@@ -192,8 +220,23 @@ MixRun runBulletMix(const scene::SceneSpec& spec, int steps) {
     }
     if (!run.ok) break;
   }
-  for (size_t r = 0; r < spec.rigid_bodies.size(); ++r)
-    run.rigid_final_z.push_back(rigids[r]->getCenterOfMassPosition().z());
+  for (size_t r = 0; r < spec.rigid_bodies.size(); ++r) {
+    const btTransform& t = rigids[r]->getWorldTransform();
+    run.rigid_final_z.push_back(t.getOrigin().z());
+    Frame pose;
+    pose.origin = {t.getOrigin().x(), t.getOrigin().y(), t.getOrigin().z()};
+    const btQuaternion q = t.getRotation();
+    pose.rotation = Eigen::Quaterniond(q.w(), q.x(), q.y(), q.z());
+    run.rigid_final_pose.push_back(pose);
+  }
+  for (const auto& body : bodies) {
+    std::vector<Eigen::Vector3d> nodes;
+    for (int i = 0; i < body->m_nodes.size(); ++i) {
+      const btVector3& x = body->m_nodes[i].m_x;
+      nodes.emplace_back(x.x(), x.y(), x.z());
+    }
+    run.final_nodes.push_back(std::move(nodes));
+  }
   for (const auto& body : bodies)
     world->removeSoftBody(body.get());
   for (const auto& rigid : rigids)
