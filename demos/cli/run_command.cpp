@@ -116,8 +116,8 @@ int run(const RunArguments& args) {
     return 3;
   }
   if (!outcome.value().stopped_on_anomaly.empty()) {
-    std::cerr << "error: stopped at an anomaly after step " << outcome.value().steps_done << ": "
-              << outcome.value().stopped_on_anomaly << "\n";
+    std::cerr << "error: stopped at the first anomaly: " << outcome.value().stopped_on_anomaly
+              << "\nresults up to that step are in " << args.out << "/\n";
     return 4;
   }
   std::cerr << "done: " << outcome.value().steps_done << " steps; results in " << args.out

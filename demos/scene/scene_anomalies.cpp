@@ -20,8 +20,9 @@ std::string describe(AnomalyKind kind, const Anomaly& a, const StepObservation& 
                     o.kinetic_energy, 100 * a.peak);
       break;
     case AnomalyKind::kSpeedBurst:
-      std::snprintf(text, sizeof text, "max node speed %.4g m/s, %.0fx its recent median",
-                    o.max_speed, a.peak);
+      std::snprintf(text, sizeof text,
+                    "max node speed %.4g m/s, %.0fx its median before the last steps", o.max_speed,
+                    a.peak);
       break;
   }
   return text;

@@ -90,6 +90,19 @@ TEST(StepAnomalies, NoAlarmWhenARebounceGivesBackWhatTheImpactTook) {
   EXPECT_TRUE(monitor.anomalies().empty());
 }
 
+TEST(StepAnomalies, NoReleaseWhenAnImpactStoresEnergyAndGivesItBackWithinAFewSteps) {
+  // A body at rest struck by a rigid one: the blow is stored as elastic energy over 5 steps and
+  // comes back out as the body's motion over the next 5, more kinetic energy than it ever had.
+  StepAnomalyMonitor monitor;
+  int step = 0;
+  for (; step < 100; ++step)
+    EXPECT_TRUE(monitor.observe(step, observation(0, 0, 0)).empty());
+  for (int k = 1; k <= 5; ++k, ++step)
+    EXPECT_TRUE(monitor.observe(step, observation(0, 20.0 * k, 0)).empty());
+  for (int k = 1; k <= 5; ++k, ++step)
+    EXPECT_TRUE(monitor.observe(step, observation(15.0 * k, 100 - 20.0 * k, 0.1)).empty()) << k;
+}
+
 TEST(StepAnomalies, NoReleaseWhenMotionIsNotPaidByElasticEnergy) {
   // Kinetic energy rising while the elastic store grows too (work done on the body by a hand).
   StepAnomalyMonitor monitor;
@@ -97,10 +110,10 @@ TEST(StepAnomalies, NoReleaseWhenMotionIsNotPaidByElasticEnergy) {
     EXPECT_TRUE(monitor.observe(step, observation(2.0 * step, 100.0 + step)).empty());
 }
 
-TEST(StepAnomalies, FlagsASpeedBurstOverTheRecentMedianOnly) {
+TEST(StepAnomalies, FlagsASpeedBurstOverTheEarlierMedianOnly) {
   StepAnomalyMonitor monitor;
   int step = 0;
-  for (; step < 60; ++step)
+  for (; step < 160; ++step)
     monitor.observe(step, observation(0, 0, 0.5 + 0.01 * (step % 7)));
   // Four times the median: fast, but no burst.
   EXPECT_TRUE(monitor.observe(step++, observation(0, 0, 2.0)).empty());
@@ -110,13 +123,30 @@ TEST(StepAnomalies, FlagsASpeedBurstOverTheRecentMedianOnly) {
   EXPECT_GT(monitor.anomalies().back().peak, 10);
 }
 
+TEST(StepAnomalies, FlagsASpeedRampOfTensOfStepsAgainstTheSpeedBeforeIt) {
+  // Steady at 0.5 m/s, then speeding up 20 % per step: the median of the last 50 steps would
+  // follow the ramp, the median before them does not.
+  StepAnomalyMonitor monitor;
+  int step = 0;
+  for (; step < 200; ++step)
+    EXPECT_TRUE(monitor.observe(step, observation(0, 0, 0.5)).empty());
+  double speed = 0.5;
+  int burst_step = -1;
+  for (int k = 1; k <= 30 && burst_step < 0; ++k, ++step) {
+    speed *= 1.2;
+    if (!monitor.observe(step, observation(0, 0, speed)).empty()) burst_step = k;
+  }
+  // 1.2^k > 10 first at k = 13.
+  EXPECT_EQ(burst_step, 13);
+}
+
 TEST(StepAnomalies, NoSpeedBurstWhenABodyStartsFromRest) {
   // At rest for the whole history, then the slow speeds a hand gives: below the speed floor.
   StepAnomalyMonitor monitor;
   int step = 0;
-  for (; step < 60; ++step)
+  for (; step < 160; ++step)
     monitor.observe(step, observation(0, 0, 0));
-  for (; step < 100; ++step)
+  for (; step < 300; ++step)
     EXPECT_TRUE(monitor.observe(step, observation(0, 0, 0.5)).empty());
 }
 

@@ -46,8 +46,8 @@ std::vector<AnomalyKind> StepAnomalyMonitor::observe(int step, const StepObserva
 
   history_.push_back(now);
   const size_t keep = static_cast<size_t>(
-      std::max(thresholds_.energy_window_steps + thresholds_.kinetic_history_steps,
-               thresholds_.speed_history_steps));
+      std::max(2 * thresholds_.energy_window_steps + thresholds_.kinetic_history_steps,
+               thresholds_.speed_history_steps + thresholds_.speed_window_steps));
   while (history_.size() > keep)
     history_.pop_front();
   return started;
@@ -57,33 +57,43 @@ double StepAnomalyMonitor::energyReleaseRatio(const StepObservation& now) const 
   const int size = static_cast<int>(history_.size());
   const int window = std::min(thresholds_.energy_window_steps, size);
   if (window == 0) return 0;
-  // Largest kinetic energy from the start of the kept history up to each window start j.
+  const auto at = [this](int i) -> const StepObservation& {
+    return history_[static_cast<size_t>(i)];
+  };
+  // Largest kinetic energy over kinetic_history_steps before the window, then up to each window
+  // start j.
   const int first_j = size - window;
   double kinetic_before = 0;
-  for (int i = 0; i < first_j; ++i)
-    kinetic_before = std::max(kinetic_before, history_[static_cast<size_t>(i)].kinetic_energy);
+  for (int i = std::max(0, first_j - thresholds_.kinetic_history_steps); i < first_j; ++i)
+    kinetic_before = std::max(kinetic_before, at(i).kinetic_energy);
   double best = 0;
   for (int j = first_j; j < size; ++j) {
-    const StepObservation& start = history_[static_cast<size_t>(j)];
-    kinetic_before = std::max(kinetic_before, start.kinetic_energy);
+    kinetic_before = std::max(kinetic_before, at(j).kinetic_energy);
+    // The elastic energy held through the window's length before j: what an impact stores and
+    // gives back within a few steps is not in it.
+    double held = at(j).elastic_energy;
+    for (int i = std::max(0, j - thresholds_.energy_window_steps); i < j; ++i)
+      held = std::min(held, at(i).elastic_energy);
     const double gain = now.kinetic_energy - kinetic_before;
-    const double drop = start.elastic_energy - now.elastic_energy;
-    if (gain > thresholds_.energy_floor &&
-        gain > thresholds_.energy_release_fraction * start.elastic_energy && drop >= 0.5 * gain)
-      best = std::max(best, gain / start.elastic_energy);
+    const double drop = held - now.elastic_energy;
+    if (gain > thresholds_.energy_floor && gain > thresholds_.energy_release_fraction * held &&
+        drop >= 0.5 * gain)
+      best = std::max(best, gain / held);
   }
   return best;
 }
 
 double StepAnomalyMonitor::speedBurstRatio(double max_speed) const {
   const size_t n = static_cast<size_t>(thresholds_.speed_history_steps);
-  if (n == 0 || history_.size() < n) return 0;
-  std::vector<double> recent;
-  recent.reserve(n);
-  for (size_t i = history_.size() - n; i < history_.size(); ++i)
-    recent.push_back(history_[i].max_speed);
-  std::nth_element(recent.begin(), recent.begin() + static_cast<long>(n / 2), recent.end());
-  const double reference = std::max(recent[n / 2], thresholds_.speed_floor);
+  const size_t lag = static_cast<size_t>(thresholds_.speed_window_steps);
+  if (n == 0 || history_.size() < n + lag) return 0;
+  std::vector<double> earlier;
+  earlier.reserve(n);
+  const size_t end = history_.size() - lag;
+  for (size_t i = end - n; i < end; ++i)
+    earlier.push_back(history_[i].max_speed);
+  std::nth_element(earlier.begin(), earlier.begin() + static_cast<long>(n / 2), earlier.end());
+  const double reference = std::max(earlier[n / 2], thresholds_.speed_floor);
   const double ratio = max_speed / reference;
   // A non-finite speed is a burst too (the stepper reports it fatally anyway).
   return (ratio > thresholds_.speed_burst_factor || !std::isfinite(ratio)) ? ratio : 0;

@@ -39,20 +39,24 @@ const char* toString(AnomalyKind kind);
 /// Defaults and why they are what they are: docs/validation.md, "Twisting past the kink".
 struct AnomalyThresholds {
   /// Energy release: within the last `energy_window_steps` steps the kinetic energy rose by more
-  /// than `energy_release_fraction` of the elastic energy the body had at the window's start, to
-  /// above anything it had in the preceding `kinetic_history_steps` (a rebound only gives back
-  /// what an impact took), while the elastic energy fell by at least half that gain (the motion
-  /// comes out of the body's own store, not from work done on it) and the gain exceeds
-  /// `energy_floor` (round-off on a body at rest).
+  /// than `energy_release_fraction` of the elastic energy the body had held through the
+  /// `energy_window_steps` steps before the window started (its minimum there: energy an impact
+  /// stores and gives back within a few steps is not held), to above anything it had in the
+  /// preceding `kinetic_history_steps` (a rebound only gives back what an impact took), while
+  /// the elastic energy fell below that held energy by at least half the gain (the motion comes
+  /// out of the body's own store, not from work done on it) and the gain exceeds `energy_floor`
+  /// (round-off on a body at rest).
   int energy_window_steps = 50;
   double energy_release_fraction = 0.1;
   int kinetic_history_steps = 200;
   double energy_floor = 1e-6;  ///< J
-  /// Speed burst: the maximum node speed above `speed_burst_factor` times the median of that
-  /// maximum over the previous `speed_history_steps` steps (and above factor times
-  /// `speed_floor`, so that a body starting from rest is no burst); checked once that history
-  /// is full.
-  int speed_history_steps = 50;
+  /// Speed burst: the maximum node speed above `speed_burst_factor` times its median over
+  /// `speed_history_steps` steps that ended `speed_window_steps` steps ago (a release takes tens
+  /// of steps to speed up; a median that includes them would rise with it), that median floored
+  /// at `speed_floor` (a body starting from rest is no burst); checked once that much history is
+  /// kept.
+  int speed_history_steps = 100;
+  int speed_window_steps = 50;
   double speed_burst_factor = 10;
   double speed_floor = 0.1;  ///< m/s
   /// A condition back within this many steps of a range's last step extends that range.
@@ -77,7 +81,7 @@ struct Anomaly {
   int first_step = 0;
   int last_step = 0;
   /// The worst value in the range: inverted elements (count); energy release (kinetic gain over
-  /// the window-start elastic energy); speed burst (max speed over its recent median, floored).
+  /// the held elastic energy); speed burst (max speed over its earlier median, floored).
   double peak = 0;
 };
 
@@ -95,7 +99,7 @@ class StepAnomalyMonitor {
  private:
   /// The gain/elastic ratio of an energy release ending at this step, or 0 when there is none.
   double energyReleaseRatio(const StepObservation& now) const;
-  /// max speed over its floored recent median when that is a burst, else 0.
+  /// max speed over its floored earlier median when that is a burst, else 0.
   double speedBurstRatio(double max_speed) const;
   /// Extends the open range of `kind` or opens a new one; true when it opens one.
   bool record(AnomalyKind kind, int step, double value);
