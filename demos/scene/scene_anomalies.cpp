@@ -14,10 +14,11 @@ std::string describe(AnomalyKind kind, const Anomaly& a, const StepObservation& 
       std::snprintf(text, sizeof text, "%d inverted tets (det F <= 0)", o.inverted_elements);
       break;
     case AnomalyKind::kEnergyRelease:
-      std::snprintf(text, sizeof text,
-                    "kinetic energy (%.4g J) rose by %.0f%% of the elastic energy while that fell: "
-                    "stored energy released (a kink passing through itself?)",
-                    o.kinetic_energy, 100 * a.peak);
+      std::snprintf(
+          text, sizeof text,
+          "kinetic energy (%.4g J) rose by %.0f%% of the elastic energy held while that fell: "
+          "stored energy released (a kink passing through itself?)",
+          o.kinetic_energy, 100 * a.peak);
       break;
     case AnomalyKind::kSpeedBurst:
       std::snprintf(text, sizeof text,
