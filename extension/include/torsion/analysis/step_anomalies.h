@@ -31,7 +31,7 @@ namespace torsion {
 enum class AnomalyKind {
   kInvertedElements,  ///< tets of the body's mesh with det F <= 0 (for tet10: its linear sub-tets)
   kEnergyRelease,     ///< stored elastic energy turned into kinetic energy within a short window
-  kSpeedBurst,        ///< the fastest node far faster than the recent median of that maximum
+  kSpeedBurst,        ///< the fastest node far faster than that maximum was shortly before
 };
 /// "inverted_elements", "energy_release", "speed_burst".
 const char* toString(AnomalyKind kind);
@@ -101,7 +101,8 @@ class StepAnomalyMonitor {
   double energyReleaseRatio(const StepObservation& now) const;
   /// max speed over its floored earlier median when that is a burst, else 0.
   double speedBurstRatio(double max_speed) const;
-  /// Extends the open range of `kind` or opens a new one; true when it opens one.
+  /// Extends the latest range of `kind` when `step` is within merge_gap_steps of its end, else
+  /// opens a new one; true when it opens one.
   bool record(AnomalyKind kind, int step, double value);
 
   AnomalyThresholds thresholds_;
