@@ -24,10 +24,12 @@ struct RunArguments {
   std::string render;  // --render DIR: PNG pictures (and an MP4 with ffmpeg)
   std::string render_size = "800x600";
   int render_every = 10;
+  bool stop_on_anomaly = false;
   scene::DeviceOverrides devices;  // --device HAND=TYPE[:ARG] (repeatable), --haptics MODE
 };
 
-// Exit codes: 0 done and stable, 1 bad input or output error, 3 the simulation went unstable.
+// Exit codes: 0 done and stable, 1 bad input or output error, 3 the simulation went unstable,
+// 4 stopped at an anomaly (--stop-on-anomaly).
 int run(const RunArguments& args) {
   Result<scene::SceneSpec> spec = scene::loadScene(args.scene);
   if (!spec) {
@@ -84,6 +86,7 @@ int run(const RunArguments& args) {
   scene::RunOptions options;
   options.output_directory = args.out;
   options.steps = args.steps;
+  options.stop_on_anomaly = args.stop_on_anomaly;
   std::string render_error;
   options.progress = [&](int done, int total, double rate) {
     bar.update(done, total, rate);
@@ -111,6 +114,11 @@ int run(const RunArguments& args) {
     std::cerr << "error: simulation unstable: " << outcome.value().failure << "\n"
               << "results up to the last good step are in " << args.out << "/\n";
     return 3;
+  }
+  if (!outcome.value().stopped_on_anomaly.empty()) {
+    std::cerr << "error: stopped at the first anomaly: " << outcome.value().stopped_on_anomaly
+              << "\nresults up to that step are in " << args.out << "/\n";
+    return 4;
   }
   std::cerr << "done: " << outcome.value().steps_done << " steps; results in " << args.out
             << "/ (summary.json, wrench.csv, energy.csv, "
@@ -141,6 +149,9 @@ void addRunCommand(CLI::App& app) {
   cmd->add_option("--render-every", args->render_every, "Steps between pictures")
       ->check(CLI::PositiveNumber)
       ->capture_default_str();
+  cmd->add_flag("--stop-on-anomaly", args->stop_on_anomaly,
+                "Stop at the first anomaly (inverted tets, released elastic energy, node speed "
+                "burst) with exit code 4");
   addDeviceOptions(*cmd, args->devices);
   cmd->callback([args] { setExitCode(run(*args)); });
 }

@@ -6,6 +6,7 @@
 #include <fstream>
 #include <nlohmann/json.hpp>
 
+#include "scene_anomalies.h"
 #include "scene_haptics.h"
 #include "torsion/mesh/mesh_io.h"
 #include "torsion/mesh/vtk_format.h"
@@ -135,6 +136,7 @@ Result<RunOutcome> runScene(BuiltScene& scene, const RunOptions& options) {
     rigid_csv.precision(10);
   }
   ContactTotals contact_totals;
+  SceneAnomalies anomalies(world);  // inverted tets, energy release, speed bursts
 
   std::vector<Eigen::VectorXd> last_good;
   for (const auto& body : world.bodies())
@@ -193,6 +195,10 @@ Result<RunOutcome> runScene(BuiltScene& scene, const RunOptions& options) {
     energy_csv << "," << iterations << "," << residual << "\n";
     if (rigid_csv.is_open()) writeRigidRow(rigid_csv, scene, report.step, world.time());
     contact_totals.add(world);
+    if (anomalies.observe(world, report.step) && options.stop_on_anomaly) {
+      outcome.stopped_on_anomaly = anomalies.firstWarning();
+      break;
+    }
     if (options.progress) {
       const double elapsed =
           std::chrono::duration<double>(std::chrono::steady_clock::now() - run_start).count();
@@ -250,6 +256,8 @@ Result<RunOutcome> runScene(BuiltScene& scene, const RunOptions& options) {
     summary["haptic_warnings"] = scene.haptics->warnings();
   }
   if (!scene.rigid_bodies.empty() || scene.spec.ground) summary["contacts"] = contact_totals.json();
+  summary["anomalies"] = anomalies.json();
+  if (options.stop_on_anomaly) summary["stopped_on_anomaly"] = !outcome.stopped_on_anomaly.empty();
   summary["stable"] = outcome.stable;
   if (!outcome.stable) summary["failure"] = outcome.failure;
   std::ofstream(out / "summary.json") << summary.dump(2) << "\n";

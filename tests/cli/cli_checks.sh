@@ -458,6 +458,26 @@ EOF
     ! grep -qi nan out/cylinder.vtk || fail "NaN written to the final mesh"
     ;;
 
+  run_twist_past_kink)
+    # The small cylinder twisted at 1 rad/s to 4.8 pi: it kinks near 4 pi and, without
+    # self-contact, passes through itself. The run is still "stable" but warns and lists the
+    # anomalies; with --stop-on-anomaly it stops at the first one with exit code 4.
+    sed "s|../../assets/meshes|$assets|; s|\"angular_velocity\": \\[0, 0, 0.1\\]|\"angular_velocity\": [0, 0, 1]|; s|\"duration\": 62.83185307179586|\"duration\": 15|" \
+      "$scenes/twist_cylinder_2430.json" > kink.json
+    run "$torsion" run kink.json --out out --steps 1500 --threads 1
+    expect_rc 0
+    expect_out "warning: body 'cylinder', step [0-9]+: [0-9]+ inverted tets \\(det F <= 0\\)"
+    expect_out "warning: body 'cylinder', step [0-9]+: kinetic energy .* stored energy released"
+    grep -q '"kind": "inverted_elements"' out/summary.json || fail "summary lacks inverted_elements"
+    grep -q '"kind": "energy_release"' out/summary.json || fail "summary lacks energy_release"
+    grep -q '"stable": true' out/summary.json || fail "summary does not say stable"
+    run "$torsion" run kink.json --out stop --steps 1500 --threads 1 --stop-on-anomaly
+    [[ $rc -eq 4 ]] || fail "exit code $rc, expected 4"
+    expect_out "^error: stopped at the first anomaly: body 'cylinder', step [0-9]+: "
+    grep -q '"stopped_on_anomaly": true' stop/summary.json || fail "summary does not say stopped"
+    ! grep -q '"steps": 1500,' stop/summary.json || fail "the stopped run did all its steps"
+    ;;
+
   run_haptic_scripted_replay)
     # A scripted device drives the cylinder's hand from the CLI (lockstep haptics); its loop log
     # is then replayed as a device and must reproduce the run.

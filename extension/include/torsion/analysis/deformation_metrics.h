@@ -23,6 +23,11 @@ struct DeformationMetrics {
 /// Metrics of the configuration `positions` (3n) of `model`'s body.
 DeformationMetrics measureDeformation(const FemModel& model, const Eigen::VectorXd& positions);
 
+/// Tets of `model`'s mesh with det F <= 0 (or non-finite) at `positions` (3n): the count of
+/// measureDeformation() without its singular values, cheap enough to run after every step. For
+/// tet10 these are the linear sub-tets of FemModel::mesh().
+int countInvertedTets(const FemModel& model, const Eigen::VectorXd& positions);
+
 /// max_i |s_i - 1| of one deformation gradient (signed singular values).
 double elementStrain(const Eigen::Matrix3d& deformation_gradient);
 
