@@ -1,5 +1,6 @@
 #include "run_command.h"
 
+#include <csignal>
 #include <cstdio>
 #include <iostream>
 #include <memory>
@@ -27,7 +28,38 @@ struct RunArguments {
   scene::DeviceOverrides devices;  // --device HAND=TYPE[:ARG] (repeatable), --haptics MODE
 };
 
-// Exit codes: 0 done and stable, 1 bad input or output error, 3 the simulation went unstable.
+// The signal that asked the run to stop, 0 while none has. Written by the handler only.
+volatile std::sig_atomic_t g_stop_signal = 0;
+
+extern "C" void requestStop(int signal) {
+  g_stop_signal = signal;
+}
+
+// SIGINT and SIGTERM stop the run at the end of the current step (scene_runner.h) while this
+// object lives; the previous handlers come back afterwards.
+class StopOnSignals {
+ public:
+  StopOnSignals() {
+    struct sigaction action {};
+    action.sa_handler = requestStop;
+    sigemptyset(&action.sa_mask);
+    sigaction(SIGINT, &action, &previous_int_);
+    sigaction(SIGTERM, &action, &previous_term_);
+  }
+  ~StopOnSignals() {
+    sigaction(SIGINT, &previous_int_, nullptr);
+    sigaction(SIGTERM, &previous_term_, nullptr);
+  }
+  StopOnSignals(const StopOnSignals&) = delete;
+  StopOnSignals& operator=(const StopOnSignals&) = delete;
+
+ private:
+  struct sigaction previous_int_ {};
+  struct sigaction previous_term_ {};
+};
+
+// Exit codes: 0 done and stable, 1 bad input or output error, 3 the simulation went unstable,
+// 128 + signal when SIGINT (130) or SIGTERM (143) stopped the run.
 int run(const RunArguments& args) {
   Result<scene::SceneSpec> spec = scene::loadScene(args.scene);
   if (!spec) {
@@ -92,7 +124,12 @@ int run(const RunArguments& args) {
       if (!drawn) render_error = drawn.error().message;
     }
   };
-  Result<scene::RunOutcome> outcome = scene::runScene(s, options);
+  options.stop_requested = [] { return static_cast<int>(g_stop_signal); };
+  Result<scene::RunOutcome> outcome = Error{};
+  {
+    StopOnSignals stop_on_signals;
+    outcome = scene::runScene(s, options);
+  }
   bar.finish();
   if (!outcome) {
     std::cerr << "error: " << outcome.error().message << "\n";
@@ -107,6 +144,12 @@ int run(const RunArguments& args) {
       std::cerr << "warning: haptics: " << w << "\n";
   }
   if (recorder) std::cerr << "pictures: " << recorder->finish(s.spec.name) << "\n";
+  if (const int signal = outcome.value().stopped_by; signal != 0) {
+    std::cerr << "stopped by " << (signal == SIGINT ? "SIGINT" : "SIGTERM") << " after "
+              << outcome.value().steps_done << " steps; results so far in " << args.out
+              << "/ (summary.json says \"completed\": false)\n";
+    return 128 + signal;
+  }
   if (!outcome.value().stable) {
     std::cerr << "error: simulation unstable: " << outcome.value().failure << "\n"
               << "results up to the last good step are in " << args.out << "/\n";

@@ -175,10 +175,17 @@ Result<nlohmann::json> SceneHaptics::finish(const std::string& directory) {
   for (const Channel& c : channels_) {
     const std::filesystem::path path =
         std::filesystem::path(directory) / ("haptic_" + fileSafe(c.hand) + ".csv");
-    if (!c.loop->writeLog(path.string())) return Error{path.string() + ": cannot write"};
+    if (std::string error; !c.loop->writeLog(path.string(), &error)) return Error{error};
     hands.push_back(statistics(c));
   }
   return hands;
+}
+
+std::vector<std::string> SceneHaptics::logFileNames() const {
+  std::vector<std::string> names;
+  for (const Channel& c : channels_)
+    names.push_back("haptic_" + fileSafe(c.hand) + ".csv");
+  return names;
 }
 
 std::vector<std::string> SceneHaptics::describe() const {

@@ -7,6 +7,7 @@
 #include "json_reader.h"
 #include "rigid_body_parser.h"
 #include "scene_catalog.h"
+#include "torsion/device/json_check.h"
 #include "torsion/mesh/mesh_io.h"
 
 namespace torsion::scene {
@@ -179,19 +180,6 @@ HandSpec readHand(const JsonObject& h, const std::string& base_directory) {
   return hand;
 }
 
-std::string lineAndColumn(std::string_view text, size_t byte) {
-  int line = 1, column = 1;
-  for (size_t i = 0; i < byte && i < text.size(); ++i) {
-    if (text[i] == '\n') {
-      ++line;
-      column = 1;
-    } else {
-      ++column;
-    }
-  }
-  return std::to_string(line) + ":" + std::to_string(column);
-}
-
 }  // namespace
 
 Frame parsePose(const JsonObject& parent, const std::string& key) {
@@ -236,17 +224,14 @@ Frame HandSpec::frameAt(double t) const {
 
 Result<SceneSpec> parseScene(std::string_view text, const std::string& file_name,
                              const std::string& base_directory) {
-  nlohmann::json json;
-  try {
-    json = nlohmann::json::parse(text.begin(), text.end());
-  } catch (const nlohmann::json::parse_error& e) {
-    // nlohmann's text repeats the position; keep only what went wrong.
-    std::string what = e.what();
-    const size_t column = what.find("column ");
-    const size_t colon = column == std::string::npos ? std::string::npos : what.find(": ", column);
-    return Error{file_name + ":" + lineAndColumn(text, e.byte == 0 ? 0 : e.byte - 1) +
-                 ": invalid JSON: " + (colon != std::string::npos ? what.substr(colon + 2) : what)};
+  // A strict pass first: duplicate keys, numbers beyond a double and syntax, with a position.
+  if (const auto fault = device::findJsonTextFault(text)) {
+    const std::string where = fault->line > 0 ? ":" + std::to_string(fault->line) + ":" +
+                                                    std::to_string(fault->column)
+                                              : std::string();
+    return Error{file_name + where + ": invalid JSON: " + fault->what};
   }
+  const nlohmann::json json = nlohmann::json::parse(text.begin(), text.end());
   try {
     SceneSpec scene;
     scene.file = file_name;

@@ -6,6 +6,10 @@
 //                 set's wrench_about point
 //   energy.csv    per step, per body: kinetic and elastic energy
 //   <body>.vtk    final mesh of each body with its displacement (last good state on failure)
+//   rigid.csv     per step, per rigid body: pose and velocity (scenes with rigid bodies)
+//   haptic_<hand>.csv  the haptic loop's log per device hand
+// How the directory is kept consistent across runs and stops (completed, error, signal, kill):
+// run_directory.h and docs/outputs.md.
 
 #include <functional>
 #include <string>
@@ -19,15 +23,21 @@ struct RunOptions {
   int steps = -1;  ///< < 0: the scene's own
   /// Called after every step with (step, total, steps per second so far).
   std::function<void(int, int, double)> progress;
+  /// Polled after every step: a signal number (SIGINT, SIGTERM) stops the run there, with every
+  /// output written for the steps done; 0 goes on.
+  std::function<int()> stop_requested;
 };
 
 struct RunOutcome {
   bool stable = true;
   std::string failure;  ///< the first fatal report, when not stable
   int steps_done = 0;
+  int stopped_by = 0;      ///< the signal that stopped the run, 0 if none
+  bool completed = false;  ///< every requested step ran and every output was written
 };
 
-/// Errors are for output that cannot be written; an unstable simulation is a RunOutcome.
+/// Errors are for output that cannot be written (summary.json then says "completed": false and
+/// the error, when it can still be written); an unstable simulation is a RunOutcome.
 Result<RunOutcome> runScene(BuiltScene& scene, const RunOptions& options);
 
 }  // namespace torsion::scene

@@ -26,6 +26,10 @@ NetworkDevice::NetworkDevice(const NetworkDeviceSettings& settings,
                              std::shared_ptr<UdpSocket> socket)
     : settings_(settings), socket_(std::move(socket)) {}
 
+NetworkDevice::~NetworkDevice() {
+  write(Wrench{});
+}
+
 std::string NetworkDevice::name() const {
   return "network(udp port " + std::to_string(socket_->local().port) + ")";
 }

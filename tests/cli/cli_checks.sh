@@ -514,7 +514,7 @@ EOF
     expect_out "^error: twist.json: hands\[0\] 'hand': device: a network device lives in wall-clock time and cannot tick in lockstep: use --haptics threaded$"
     run "$torsion" run twist.json --device hand=scripted:missing.json --out out --steps 5
     expect_rc nonzero
-    expect_out "^error: twist.json: hands\[0\] 'hand': device: missing.json: cannot open the trajectory file$"
+    expect_out "^error: twist.json: hands\[0\] 'hand': device: missing.json: cannot open: No such file or directory$"
     run "$torsion" run twist.json --device foot=spacemouse --out out --steps 5
     expect_rc nonzero
     expect_out "^error: --device 'foot=spacemouse': the scene has no hand named 'foot' \(hands: 'hand'\)$"

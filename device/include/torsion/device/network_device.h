@@ -23,6 +23,8 @@ struct NetworkDeviceSettings {
 class NetworkDevice : public HapticDevice {
  public:
   static Loaded<std::unique_ptr<NetworkDevice>> open(const NetworkDeviceSettings& settings);
+  /// Sends a zero wrench to the peer before the socket closes, whatever ended the session.
+  ~NetworkDevice() override;
 
   std::string name() const override;
   DeviceLimits limits() const override { return settings_.limits; }
