@@ -149,6 +149,11 @@ std::string writeFilesTogether(const std::vector<std::pair<std::string, std::str
   for (; replaced < files.size(); ++replaced) {
     const std::string& path = files[replaced].first;
     const std::string backup = path + ".old-" + std::to_string(::getpid());
+    struct stat st {};
+    if (::lstat(path.c_str(), &st) == 0 && S_ISDIR(st.st_mode)) {
+      failure = path + ": cannot write: " + reason(EISDIR);  // link() would say EPERM
+      break;
+    }
     if (::link(path.c_str(), backup.c_str()) == 0) {
       backups[replaced] = backup;
     } else if (errno != ENOENT) {
