@@ -85,7 +85,10 @@ class StrictChecker {
       what = printableExcerpt(what, 200);
     }
     fault_ = JsonTextFault{};
-    locate(text_, position == 0 ? 0 : position - 1, *fault_);
+    // A number is located at its first character; a syntax error where the parser stopped.
+    const size_t at = e.id == 406 && position >= token.size() ? position - token.size()
+                                                                : (position == 0 ? 0 : position - 1);
+    locate(text_, at, *fault_);
     fault_->what = what;
     return false;
   }
