@@ -1,5 +1,7 @@
 #include "scene_builder.h"
 
+#include "arithmetic_bounds.h"
+
 #include "scene_haptics.h"
 #include "torsion/mesh/mesh_io.h"
 
@@ -64,6 +66,10 @@ Result<std::unique_ptr<BuiltScene>> buildScene(SceneSpec spec, int threads_overr
     if (!mesh) return Error{entry + ": " + mesh.error().message};
     for (const std::string& w : mesh.value().warnings)
       built->warnings.push_back(w);
+    if (Status carried = checkStiffnessRatio(body.material, mesh.value().mesh,
+                                             spec.world.solver.time_step);
+        !carried)
+      return Error{entry + ": " + carried.error().message};
     Result<FemBody*> added =
         world.addBody(body.name, mesh.value().mesh, body.material, body.pose, body.element);
     if (!added) return Error{entry + ": " + added.error().message};

@@ -2,6 +2,7 @@
 
 #include <filesystem>
 
+#include "arithmetic_bounds.h"
 #include "camera_spec.h"
 #include "device_parser.h"
 #include "json_reader.h"
@@ -238,6 +239,8 @@ Result<SceneSpec> parseScene(std::string_view text, const std::string& file_name
     const JsonObject root(json, "", file_name);
     scene.name = root.string("name", std::filesystem::path(file_name).stem().string());
     scene.world.gravity = root.vector3("gravity", Eigen::Vector3d(0, 0, -9.81));
+    if (Status carried = checkGravity(scene.world.gravity); !carried)
+      root.fail("gravity", carried.error().message.substr(std::string("gravity: ").size()));
     if (root.has("solver")) scene.world.solver = readSolver(root.object("solver"));
     scene.steps = root.integer("steps", scene.steps);
     if (scene.steps < 1) root.fail("steps", "must be >= 1");

@@ -10,6 +10,7 @@
 
 #include "run_directory.h"
 #include "scene_haptics.h"
+#include "torsion/bullet/rigid_health.h"
 #include "torsion/mesh/mesh_io.h"
 #include "torsion/mesh/vtk_format.h"
 
@@ -113,7 +114,10 @@ class Run {
       : scene_(scene),
         world_(*scene.world),
         options_(options),
-        steps_(options.steps > 0 ? options.steps : scene.spec.steps) {}
+        steps_(options.steps > 0 ? options.steps : scene.spec.steps) {
+    for (const SceneRigidBody& r : scene.rigid_bodies)
+      rigid_bodies_.push_back({r.name, r.body});
+  }
 
   Result<RunOutcome> execute() {
     Result<RunDirectory> dir = RunDirectory::prepare(options_.output_directory, outputNames(),
@@ -138,6 +142,12 @@ class Run {
       if (!report.ok) {
         outcome_.stable = false;
         outcome_.failure = report.message;
+        break;
+      }
+      // Bullet lets a rigid body become NaN silently; such a step is no good step.
+      if (auto fault = findUnhealthyRigidBody(rigid_bodies_)) {
+        outcome_.stable = false;
+        outcome_.failure = "step " + std::to_string(report.step) + ": " + fault->message;
         break;
       }
       outcome_.steps_done = k + 1;
@@ -327,6 +337,7 @@ class Run {
   FemWorld& world_;
   const RunOptions& options_;
   const int steps_;
+  std::vector<NamedRigidBody> rigid_bodies_;
   std::optional<RunDirectory> dir_;
   CsvOutput wrench_csv_, energy_csv_, rigid_csv_;
   std::vector<Eigen::VectorXd> last_good_;

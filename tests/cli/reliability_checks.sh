@@ -238,6 +238,30 @@ case "$case_name" in
     csv_rows_whole out/energy.csv
     [[ ! -e out/cylinder.vtk ]] || fail "a final mesh exists for a run that never finished"
     ;;
+  refuse_overflowing_values)
+    # Values the arithmetic cannot carry used to run as "stable" with CG at 0 iterations and
+    # residual 0, or fill rigid.csv with nan: now refused at load, naming the bound.
+    drop_scene -e 's/"steps": 150,/"steps": 20, "gravity": [0, 0, -1e160],/' > gravity.json
+    run "$torsion" run gravity.json --out out
+    expect_rc 1
+    expect_out "^error: gravity.json: gravity: magnitude 1e\+160 m/s\^2 is above the bound 1e\+06 m/s\^2"
+    twist_scene -e 's/"youngs_modulus": [0-9.e+]*/"youngs_modulus": 1e300/' > stiff.json
+    run "$torsion" run stiff.json --out out --steps 5
+    expect_rc 1
+    expect_out "^error: stiff.json: bodies\[0\] 'cylinder': material: E dt\^2 / \(rho h\^2\) = .* is above the bound 1e\+100"
+    sed -e "s|../../assets/meshes|$assets|" -e 's/"radius": 0.15/"radius": 1e300/' \
+      "$scenes/rigid_mix.json" > sphere.json
+    run "$torsion" run sphere.json --out out --steps 5
+    expect_rc 1
+    expect_out "^error: sphere.json: rigid_bodies\[1\].shape.sphere.radius: must be at most 1e6 m"
+    sed -e "s|../../assets/meshes|$assets|" \
+      -e 's/"convex_hull": {"points"/"convex_hull": {"margin": 1e300, "points"/' \
+      "$scenes/rigid_mix.json" > hull.json
+    run "$torsion" run hull.json --out out --steps 5
+    expect_rc 1
+    expect_out "shape.convex_hull.margin: must be at most 1e6 m"
+    [[ ! -e out ]] || fail "nothing may be written for a refused scene"
+    ;;
   *)
     fail "unknown case '$case_name'"
     ;;
