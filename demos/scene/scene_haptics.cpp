@@ -146,6 +146,7 @@ nlohmann::json SceneHaptics::statistics(const Channel& c) const {
       {"overruns", st.overruns.load()},
       {"nonfinite", st.nonfinite.load()},
       {"log_dropped", st.log_dropped.load()},
+      {"poses_rejected", c.coupling->rejectedPoses()},
       {"max_output", {{"force", max_force}, {"torque", max_torque}}},
       {"limits",
        {{"max_force", c.device->limits().max_force},
