@@ -172,17 +172,18 @@ void addRunCommand(CLI::App& app) {
                   "twist_cylinder_2430, ...)")
       ->required();
   cmd->add_option("--out", args->out, "Output directory")->capture_default_str();
+  // Ranges with readable bounds (CLI::PositiveNumber prints the double range in 300 digits).
   cmd->add_option("--steps", args->steps, "Number of steps (default: the scene's)")
-      ->check(CLI::PositiveNumber);
+      ->check(CLI::Range(1, 2000000000).description("an integer from 1 to 2000000000"));
   cmd->add_option("--threads", args->threads,
                   "Worker threads (default: the scene's; 0 = all cores)")
-      ->check(CLI::NonNegativeNumber);
+      ->check(CLI::Range(0, 4096).description("an integer from 0 to 4096"));
   cmd->add_option("--render", args->render,
                   "Also draw the scene (OSMesa) into PNG pictures in this directory, and an MP4 "
                   "when ffmpeg is on PATH");
   cmd->add_option("--render-size", args->render_size, "Picture size WxH")->capture_default_str();
   cmd->add_option("--render-every", args->render_every, "Steps between pictures")
-      ->check(CLI::PositiveNumber)
+      ->check(CLI::Range(1, 1000000000).description("an integer from 1 to 1000000000"))
       ->capture_default_str();
   addDeviceOptions(*cmd, args->devices);
   cmd->callback([args] { setExitCode(run(*args)); });

@@ -1,6 +1,9 @@
 #include "json_reader.h"
 
+#include <cctype>
 #include <cmath>
+#include <cstdio>
+#include <cstring>
 
 namespace torsion::scene {
 
@@ -81,6 +84,30 @@ std::string JsonObject::string(const std::string& key) const {
 
 std::string JsonObject::string(const std::string& key, const std::string& fallback) const {
   return has(key) ? string(key) : fallback;
+}
+
+std::string JsonObject::name(const std::string& key) const {
+  const std::string value = string(key);
+  if (value.empty()) fail(key, "must not be empty");
+  if (value.size() > 64) fail(key, "must be at most 64 characters (it names files and columns)");
+  if (value == "." || value == "..") fail(key, "'" + value + "' cannot name a file");
+  for (const char c : value) {
+    const auto byte = static_cast<unsigned char>(c);
+    const bool allowed =
+        std::isalnum(byte) || (c != '\0' && std::strchr(" -_.+()", c) != nullptr);
+    if (!allowed || byte >= 0x80) {
+      char shown[8];
+      if (byte >= 0x21 && byte < 0x7f) {
+        std::snprintf(shown, sizeof shown, "'%c'", c);
+      } else {
+        std::snprintf(shown, sizeof shown, "\\x%02X", static_cast<unsigned>(byte));
+      }
+      fail(key, std::string("character ") + shown +
+                    " not allowed: names become file names and CSV columns (use letters, digits "
+                    "and \" -_.+()\")");
+    }
+  }
+  return value;
 }
 
 bool JsonObject::boolean(const std::string& key, bool fallback) const {

@@ -107,7 +107,7 @@ double readCoefficient(const JsonObject& r, const std::string& key, double fallb
 
 RigidBodySpec readRigidBody(const JsonObject& r, const std::vector<RigidBodySpec>& earlier) {
   RigidBodySpec spec;
-  spec.name = r.string("name");
+  spec.name = r.name("name");
   for (const RigidBodySpec& other : earlier) {
     if (other.name == spec.name) r.fail("name", "duplicate rigid body name '" + spec.name + "'");
   }

@@ -147,7 +147,7 @@ MotionSpec readMotion(const JsonObject& m) {
 
 HandSpec readHand(const JsonObject& h, const std::string& base_directory) {
   HandSpec hand;
-  hand.name = h.string("name");
+  hand.name = h.name("name");
   hand.body = h.string("body");
   if (h.has("device")) hand.device = readDevice(h, base_directory);  // device_parser.cpp
   if (h.has("keyframes")) {
@@ -247,7 +247,7 @@ Result<SceneSpec> parseScene(std::string_view text, const std::string& file_name
 
     for (const JsonObject& b : root.objects("bodies")) {
       BodySpec body;
-      body.name = b.string("name");
+      body.name = b.name("name");
       for (const BodySpec& other : scene.bodies) {
         if (other.name == body.name) b.fail("name", "duplicate body name '" + body.name + "'");
       }
@@ -271,7 +271,7 @@ Result<SceneSpec> parseScene(std::string_view text, const std::string& file_name
 
     for (const JsonObject& s : root.objects("node_sets")) {
       NodeSetSpec set;
-      set.name = s.string("name");
+      set.name = s.name("name");
       for (const NodeSetSpec& other : scene.node_sets) {
         if (other.name == set.name) s.fail("name", "duplicate node set name '" + set.name + "'");
       }
@@ -295,6 +295,12 @@ Result<SceneSpec> parseScene(std::string_view text, const std::string& file_name
       if (!known) h.fail("body", "no body named '" + hand.body + "'");
       for (const HandSpec& other : scene.hands) {
         if (other.name == hand.name) h.fail("name", "duplicate hand name '" + hand.name + "'");
+      }
+      // Node sets and hands share wrench.csv's columns ("<name>.fx").
+      for (const NodeSetSpec& set : scene.node_sets) {
+        if (set.name == hand.name)
+          h.fail("name", "'" + hand.name +
+                             "' is also a node set's name: both would be columns of wrench.csv");
       }
       scene.hands.push_back(std::move(hand));
     }

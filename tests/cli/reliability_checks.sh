@@ -262,6 +262,43 @@ case "$case_name" in
     expect_out "shape.convex_hull.margin: must be at most 1e6 m"
     [[ ! -e out ]] || fail "nothing may be written for a refused scene"
     ;;
+  names_checked_at_load)
+    # Names become file names (<body>.vtk) and CSV columns: nothing may leave --out or clash.
+    drop_scene -e 's|"name": "ball"|"name": "../escape"|' > slash.json
+    run "$torsion" run slash.json --out out
+    expect_rc 1
+    expect_out "^error: slash.json: bodies\[0\].name: character '/' not allowed"
+    [[ ! -e escape.vtk ]] || fail "a file was written outside --out"
+    drop_scene -e 's|"name": "ball"|"name": ""|' > empty.json
+    run "$torsion" run empty.json --out out
+    expect_rc 1
+    expect_out "^error: empty.json: bodies\[0\].name: must not be empty$"
+    drop_scene -e 's|"name": "ball"|"name": "a,b"|' > comma.json
+    run "$torsion" run comma.json --out out
+    expect_rc 1
+    expect_out "character ',' not allowed"
+    twist_scene -e 's|"name": "base", "body"|"name": "hand", "body"|' > clash.json
+    grep -q '"name": "hand", "body"' clash.json || fail "test setup: no node set renamed"
+    run "$torsion" run clash.json --out out
+    expect_rc 1
+    expect_out "^error: clash.json: hands\[0\].name: 'hand' is also a node set's name: both would be columns of wrench.csv$"
+    [[ ! -e out ]] || fail "nothing may be written for a refused scene"
+    ;;
+  only_regular_files_read)
+    # A FIFO used to block forever and /dev/zero to be read until memory ran out.
+    mkfifo mesh.vtk
+    run timeout 10 "$torsion" mesh info mesh.vtk
+    expect_rc 1
+    expect_out "^error: mesh.vtk: cannot open: is a FIFO, not a regular file$"
+    ln -s /dev/zero zero.vtk
+    run timeout 10 "$torsion" mesh info zero.vtk
+    expect_rc 1
+    expect_out "^error: zero.vtk: cannot open: is a character device, not a regular file$"
+    printf 'x%.0s' $(seq 3000) > big.vtk
+    run "$torsion" mesh info big.vtk --max-input-mb 0.001
+    expect_rc 1
+    expect_out "^error: big.vtk: 3000 bytes, above the input size cap of 1000 bytes \(raise it with --max-input-mb\)$"
+    ;;
   *)
     fail "unknown case '$case_name'"
     ;;
