@@ -414,7 +414,7 @@ EOF
     printf '{\n  "steps": 10,\n  "bodies": [{"name": "b", "mesh": "x.node", "material": {"youngs_modulus": 1e5, "poisson_ratio": 0.3, "densty": 1000}}]\n}\n' > bad.json
     run "$torsion" run bad.json --out out
     expect_rc nonzero
-    expect_out "^error: bad.json: bodies\\[0\\].material.density: missing \\(required\\); also found unknown key\\(s\\) 'densty'$"
+    expect_out "^error: bad.json: bodies\\[0\\].material.density: missing \\(required\\); did you mean 'densty'\\?$"
     [[ ! -e out/summary.json ]] || fail "no output may be written for a bad scene"
     ;;
 
