@@ -6,11 +6,12 @@
 
 #include "mesh_command.h"
 #include "run_command.h"
+#include "text_only_stderr.h"
 #include "torsion/device/file_io.h"
-#include "torsion/device/json_check.h"
 #include "view_command.h"
 
 int main(int argc, char** argv) {
+  const torsion::cli::TextOnlyStderr text_only_stderr;  // no raw bytes from user input on stderr
   CLI::App app{"torsion: corotational FEM soft bodies with hand-plane torsion, inside Bullet"};
   app.require_subcommand(1);
   app.fallthrough();  // options of the tool (--max-input-mb) may follow a subcommand
@@ -35,7 +36,7 @@ int main(int argc, char** argv) {
     return app.exit(e);
   } catch (const CLI::ParseError& e) {
     // Usage errors exit 1 like every other error, on one "error:" line (CLI11 uses 104-114).
-    std::cerr << "error: " << torsion::device::printableExcerpt(e.what(), 300)
+    std::cerr << "error: " << e.what()
               << "\nrun '" << argv[0] << " --help' (or '<command> --help') for usage\n";
     return 1;
   }

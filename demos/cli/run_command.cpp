@@ -12,6 +12,7 @@
 #include "frame_recorder.h"
 #include "mesh_command.h"
 #include "progress_bar.h"
+#include "torsion/device/json_check.h"
 
 namespace torsion::cli {
 
@@ -112,7 +113,7 @@ int run(const RunArguments& args) {
     }
   }
 
-  ProgressBar bar(s.spec.name);
+  ProgressBar bar(device::printableExcerpt(s.spec.name));  // the label goes out through stdio
   scene::RunOptions options;
   options.output_directory = args.out;
   options.steps = args.steps;

@@ -299,6 +299,17 @@ case "$case_name" in
     expect_rc 1
     expect_out "^error: big.vtk: 3000 bytes, above the input size cap of 1000 bytes \(raise it with --max-input-mb\)$"
     ;;
+  errors_show_no_raw_bytes)
+    # A file name with a byte that is not UTF-8 is shown escaped, not sent raw to the terminal.
+    run "$torsion" run $'nope\xff\x1b[2J.json' --out out
+    expect_rc 1
+    expect_out '^error: nope\\xFF\\x1B\[2J.json: no such scene file'
+    LC_ALL=C grep -q $'\xff' <<<"$out" && fail "a raw 0xFF byte reached stderr"
+    [[ $out == *$'\x1b'* ]] && fail "a raw escape character reached stderr"
+    # Valid UTF-8 stays as it is.
+    run "$torsion" run 'nöpe.json' --out out
+    expect_out "^error: nöpe.json: no such scene file"
+    ;;
   *)
     fail "unknown case '$case_name'"
     ;;
