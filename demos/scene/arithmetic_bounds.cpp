@@ -2,16 +2,15 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdio>
 #include <limits>
+
+#include "torsion/format_number.h"
 
 namespace torsion::scene {
 
 namespace {
 std::string g(double value) {
-  char text[32];
-  std::snprintf(text, sizeof text, "%g", value);
-  return text;
+  return formatNumber(value);
 }
 }  // namespace
 

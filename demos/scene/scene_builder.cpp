@@ -1,6 +1,7 @@
 #include "scene_builder.h"
 
 #include "arithmetic_bounds.h"
+#include "torsion/format_number.h"
 
 #include "scene_haptics.h"
 #include "torsion/mesh/mesh_io.h"
@@ -45,7 +46,7 @@ Status driveHands(BuiltScene& scene) {
       Result<int> grabbed = s.hand->grab(s.spec.frameAt(now), now);
       if (!grabbed) {
         return Error{"hands[" + std::to_string(h) + "] '" + s.spec.name +
-                     "': grab at t = " + std::to_string(now) + " s: " + grabbed.error().message};
+                     "': grab at t = " + formatNumber(now) + " s: " + grabbed.error().message};
       }
     }
     if (s.hand->grabbed()) s.hand->moveTo(s.spec.frameAt(now + dt));

@@ -9,6 +9,7 @@
 #include "rigid_body_parser.h"
 #include "scene_catalog.h"
 #include "torsion/device/json_check.h"
+#include "torsion/format_number.h"
 #include "torsion/mesh/mesh_io.h"
 
 namespace torsion::scene {
@@ -158,8 +159,8 @@ HandSpec readHand(const JsonObject& h, const std::string& base_directory) {
     for (size_t k = 0; k < keys.size(); ++k) {
       const double time = keys[k].number("time");
       if (k > 0 && !(time > hand.keyframes.back().first)) {
-        keys[k].fail("time", std::to_string(time) + " is not after the previous keyframe's " +
-                                 std::to_string(hand.keyframes.back().first) +
+        keys[k].fail("time", formatNumber(time) + " is not after the previous keyframe's " +
+                                 formatNumber(hand.keyframes.back().first) +
                                  ": keyframes must be in time order");
       }
       hand.keyframes.emplace_back(time, readHandFrame(keys[k]));

@@ -442,7 +442,7 @@ EOF
       "$scenes/twist_cylinder_2430.json" > miss.json
     run "$torsion" run miss.json --out out --steps 5
     expect_rc nonzero
-    expect_out "^error: miss.json: hands\\[0\\] 'hand': grab at t = 0.000000 s: .*"
+    expect_out "^error: miss.json: hands\\[0\\] 'hand': grab at t = 0 s: .*"
     [[ ! -e out/summary.json ]] || fail "no output may be written when a hand misses"
     ;;
 

@@ -96,6 +96,12 @@ TEST(SceneParserFaults, AMissingKeyDoesNotCallValidKeysNotYetReadUnknown) {
   EXPECT_EQ(spec.error().message, "s.json: bodies[0].name: missing (required)");
 }
 
+TEST(SceneParserFaults, BadValuesAreShownInShortestForm) {
+  // std::to_string showed -1e-9 as "-0.000000", hiding the value that was wrong.
+  EXPECT_TRUE(failsWith(parse(replaced(kValid, "\"youngs_modulus\": 1e5", "\"youngs_modulus\": -1e-9")),
+                        {"youngs_modulus = -1e-09: must be > 0 Pa"}));
+}
+
 TEST(SceneParserFaults, DuplicateKeysAndHugeNumbersAreNamed) {
   EXPECT_TRUE(failsWith(parse(replaced(kValid, "\"steps\": 50", "\"steps\": 50, \"steps\": 5")),
                         {"s.json: invalid JSON: duplicate key 'steps' in the top-level object"}));
