@@ -13,6 +13,7 @@
 #include "mesh_command.h"
 #include "progress_bar.h"
 #include "torsion/device/json_check.h"
+#include "torsion/solve/parallel.h"
 
 namespace torsion::cli {
 
@@ -80,6 +81,12 @@ int run(const RunArguments& args) {
   scene::BuiltScene& s = *built.value();
   for (const std::string& w : s.warnings)
     std::cerr << "warning: " << w << "\n";
+  if (const int asked = s.world->settings().solver.threads;
+      asked > 0 && Parallel::usableThreads(asked) < asked) {
+    std::cerr << "warning: " << asked << " threads asked for, the machine has "
+              << Parallel::usableThreads(asked) << " cores: using " << Parallel::usableThreads(asked)
+              << "\n";
+  }
   for (const auto& body : s.world->bodies()) {
     std::cerr << "body '" << body->name() << "': " << body->model().nodeCount() << " nodes, "
               << body->model().elementCount()

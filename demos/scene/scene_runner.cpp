@@ -294,7 +294,7 @@ class Run {
     summary["linear_solver"] = toString(world_.settings().solver.linear_solver);
     summary["preconditioner"] = toString(world_.settings().solver.preconditioner);
     summary["tolerance"] = world_.settings().solver.tolerance;
-    summary["threads"] = world_.settings().solver.threads;
+    summary["threads"] = Parallel::usableThreads(world_.settings().solver.threads);  // used
     summary["ms_per_step"] = {{"median", percentile(step_ms_, 0.5)},
                               {"p95", percentile(step_ms_, 0.95)}};
     summary["solver_iterations"] = {

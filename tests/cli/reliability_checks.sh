@@ -310,6 +310,21 @@ case "$case_name" in
     run "$torsion" run 'nöpe.json' --out out
     expect_out "^error: nöpe.json: no such scene file"
     ;;
+  threads_reported_as_used)
+    # More threads than cores run on the cores: the summary reports the count used (TBB's core
+    # count, which honours the affinity mask like nproc; a CPU quota may lower it further).
+    cores=$(nproc)
+    asked=$((cores + 7))
+    drop_scene > drop.json
+    run "$torsion" run drop.json --out out --steps 2 --threads $asked
+    expect_rc 0
+    expect_out "^warning: $asked threads asked for, the machine has [0-9]+ cores: using [0-9]+$"
+    used=$(sed -n 's/^warning: .* using \([0-9]*\)$/\1/p' <<<"$out")
+    [[ $used -ge 1 && $used -le $cores ]] || fail "using $used threads on $cores cores"
+    [[ $(json_field out/summary.json threads) == "$used" ]] || fail "summary does not report $used threads"
+    run "$torsion" run drop.json --out out --steps 2 --threads 0
+    [[ $(json_field out/summary.json threads) == "$used" ]] || fail "--threads 0 is not all $used cores"
+    ;;
   *)
     fail "unknown case '$case_name'"
     ;;
