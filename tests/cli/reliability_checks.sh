@@ -325,6 +325,21 @@ case "$case_name" in
     run "$torsion" run drop.json --out out --steps 2 --threads 0
     [[ $(json_field out/summary.json threads) == "$used" ]] || fail "--threads 0 is not all $used cores"
     ;;
+  huge_step_count_reserves_nothing)
+    # --steps 2e9 used to reserve 16 GB of step timings up front; memory now grows with the steps
+    # done. Peak virtual size after a few steps stays far below (1 GB; a run of the drop scene
+    # needs ~50 MB).
+    drop_scene > drop.json
+    start_run out drop.json --steps 2000000000
+    wait_rows out/wrench.csv 5
+    peak_kb=$(sed -n 's/^VmPeak:[[:space:]]*\([0-9]*\) kB/\1/p' "/proc/$sim/status")
+    kill -INT "$sim"
+    wait "$sim"
+    rc=$?
+    expect_rc 130
+    [[ -n $peak_kb && $peak_kb -lt 1000000 ]] || fail "peak virtual size ${peak_kb} kB"
+    [[ $(json_field out/summary.json steps_requested) == 2000000000 ]] || fail "steps_requested"
+    ;;
   *)
     fail "unknown case '$case_name'"
     ;;
