@@ -38,15 +38,14 @@ extern "C" void requestStop(int signal) {
 }
 
 // SIGINT and SIGTERM stop the run at the end of the current step (scene_runner.h) while this
-// object lives; the previous handlers come back afterwards.
+// object lives; the previous handlers come back afterwards. A signal the process was started
+// ignoring (a background job of a non-interactive shell ignores SIGINT, nohup SIGHUP) stays
+// ignored, as is the convention.
 class StopOnSignals {
  public:
   StopOnSignals() {
-    struct sigaction action {};
-    action.sa_handler = requestStop;
-    sigemptyset(&action.sa_mask);
-    sigaction(SIGINT, &action, &previous_int_);
-    sigaction(SIGTERM, &action, &previous_term_);
+    catchUnlessIgnored(SIGINT, previous_int_);
+    catchUnlessIgnored(SIGTERM, previous_term_);
   }
   ~StopOnSignals() {
     sigaction(SIGINT, &previous_int_, nullptr);
@@ -56,6 +55,15 @@ class StopOnSignals {
   StopOnSignals& operator=(const StopOnSignals&) = delete;
 
  private:
+  static void catchUnlessIgnored(int signal, struct sigaction& previous) {
+    sigaction(signal, nullptr, &previous);
+    if (previous.sa_handler == SIG_IGN) return;
+    struct sigaction action {};
+    action.sa_handler = requestStop;
+    sigemptyset(&action.sa_mask);
+    sigaction(signal, &action, nullptr);
+  }
+
   struct sigaction previous_int_ {};
   struct sigaction previous_term_ {};
 };

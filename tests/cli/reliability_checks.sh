@@ -58,11 +58,13 @@ twist_scene() {
   sed -e "s|../../assets/meshes|$assets|" "$@" "$scenes/twist_cylinder_2430.json"
 }
 
-# start_run OUT ARGS...: torsion run in the background (pid in $sim), log in run.log.
+# start_run OUT ARGS...: torsion run in the background (pid in $sim), log in run.log. SIGINT is
+# given back its default first: a non-interactive shell starts background jobs ignoring it, and
+# torsion keeps a signal ignored that it was started ignoring.
 start_run() {
   local dir=$1
   shift
-  "$torsion" run "$@" --out "$dir" >run.log 2>&1 &
+  env --default-signal=INT "$torsion" run "$@" --out "$dir" >run.log 2>&1 &
   sim=$!
 }
 # wait_rows FILE N: waits (up to 20 s) until FILE has at least N lines.
