@@ -159,6 +159,7 @@ nlohmann::json SceneHaptics::statistics(const Channel& c) const {
                     {"out_of_order", p.out_of_order.load()},
                     {"duplicate", p.duplicate.load()},
                     {"lost", p.lost.load()},
+                    {"foreign", p.foreign.load()},
                     {"sent", p.sent.load()}};
   }
   return j;
