@@ -36,8 +36,8 @@ int main(int argc, char** argv) {
     return app.exit(e);
   } catch (const CLI::ParseError& e) {
     // Usage errors exit 1 like every other error, on one "error:" line (CLI11 uses 104-114).
-    std::cerr << "error: " << e.what()
-              << "\nrun '" << argv[0] << " --help' (or '<command> --help') for usage\n";
+    std::cerr << "error: " << e.what() << "\nrun '" << argv[0]
+              << " --help' (or '<command> --help') for usage\n";
     return 1;
   }
   return torsion::cli::exitCode();

@@ -92,8 +92,8 @@ int run(const RunArguments& args) {
   if (const int asked = s.world->settings().solver.threads;
       asked > 0 && Parallel::usableThreads(asked) < asked) {
     std::cerr << "warning: " << asked << " threads asked for, the machine has "
-              << Parallel::usableThreads(asked) << " cores: using " << Parallel::usableThreads(asked)
-              << "\n";
+              << Parallel::usableThreads(asked) << " cores: using "
+              << Parallel::usableThreads(asked) << "\n";
   }
   for (const auto& body : s.world->bodies()) {
     std::cerr << "body '" << body->name() << "': " << body->model().nodeCount() << " nodes, "

@@ -35,10 +35,9 @@ Status checkStiffnessRatio(const Material& material, const TetMesh& mesh, double
   }
   const double ratio = material.youngs_modulus * dt * dt / (material.density * shortest_sq);
   if (ratio <= kMaxStiffnessRatio) return Ok{};
-  return Error{"material: E dt^2 / (rho h^2) = " + g(ratio) + " (E " +
-               g(material.youngs_modulus) + " Pa, dt " + g(dt) + " s, rho " +
-               g(material.density) + " kg/m^3, shortest edge h " + g(std::sqrt(shortest_sq)) +
-               " m) is above the bound " + g(kMaxStiffnessRatio) +
+  return Error{"material: E dt^2 / (rho h^2) = " + g(ratio) + " (E " + g(material.youngs_modulus) +
+               " Pa, dt " + g(dt) + " s, rho " + g(material.density) + " kg/m^3, shortest edge h " +
+               g(std::sqrt(shortest_sq)) + " m) is above the bound " + g(kMaxStiffnessRatio) +
                ": the step's arithmetic would overflow"};
 }
 

@@ -29,7 +29,8 @@ bool spelledAlike(const std::string& a, const std::string& b) {
     for (size_t j = 1; j <= m; ++j) {
       const bool same = std::tolower(static_cast<unsigned char>(a[i - 1])) ==
                         std::tolower(static_cast<unsigned char>(b[j - 1]));
-      current[j] = std::min({previous[j] + 1, current[j - 1] + 1, previous[j - 1] + (same ? 0 : 1)});
+      current[j] =
+          std::min({previous[j] + 1, current[j - 1] + 1, previous[j - 1] + (same ? 0 : 1)});
     }
     std::swap(previous, current);
   }
@@ -114,8 +115,7 @@ std::string JsonObject::name(const std::string& key) const {
   if (value == "." || value == "..") fail(key, "'" + value + "' cannot name a file");
   for (const char c : value) {
     const auto byte = static_cast<unsigned char>(c);
-    const bool allowed =
-        std::isalnum(byte) || (c != '\0' && std::strchr(" -_.+()", c) != nullptr);
+    const bool allowed = std::isalnum(byte) || (c != '\0' && std::strchr(" -_.+()", c) != nullptr);
     if (!allowed || byte >= 0x80) {
       char shown[8];
       if (byte >= 0x21 && byte < 0x7f) {

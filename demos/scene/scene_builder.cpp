@@ -1,9 +1,8 @@
 #include "scene_builder.h"
 
 #include "arithmetic_bounds.h"
-#include "torsion/format_number.h"
-
 #include "scene_haptics.h"
+#include "torsion/format_number.h"
 #include "torsion/mesh/mesh_io.h"
 
 namespace torsion::scene {
@@ -67,8 +66,8 @@ Result<std::unique_ptr<BuiltScene>> buildScene(SceneSpec spec, int threads_overr
     if (!mesh) return Error{entry + ": " + mesh.error().message};
     for (const std::string& w : mesh.value().warnings)
       built->warnings.push_back(w);
-    if (Status carried = checkStiffnessRatio(body.material, mesh.value().mesh,
-                                             spec.world.solver.time_step);
+    if (Status carried =
+            checkStiffnessRatio(body.material, mesh.value().mesh, spec.world.solver.time_step);
         !carried)
       return Error{entry + ": " + carried.error().message};
     Result<FemBody*> added =

@@ -228,9 +228,9 @@ Result<SceneSpec> parseScene(std::string_view text, const std::string& file_name
                              const std::string& base_directory) {
   // A strict pass first: duplicate keys, numbers beyond a double and syntax, with a position.
   if (const auto fault = device::findJsonTextFault(text)) {
-    const std::string where = fault->line > 0 ? ":" + std::to_string(fault->line) + ":" +
-                                                    std::to_string(fault->column)
-                                              : std::string();
+    const std::string where =
+        fault->line > 0 ? ":" + std::to_string(fault->line) + ":" + std::to_string(fault->column)
+                        : std::string();
     return Error{file_name + where + ": invalid JSON: " + fault->what};
   }
   const nlohmann::json json = nlohmann::json::parse(text.begin(), text.end());

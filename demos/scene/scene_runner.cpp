@@ -100,10 +100,14 @@ struct ContactTotals {
 
 const char* signalName(int signal) {
   switch (signal) {
-    case SIGINT: return "SIGINT";
-    case SIGTERM: return "SIGTERM";
-    case SIGHUP: return "SIGHUP";
-    default: return "signal";
+    case SIGINT:
+      return "SIGINT";
+    case SIGTERM:
+      return "SIGTERM";
+    case SIGHUP:
+      return "SIGHUP";
+    default:
+      return "signal";
   }
 }
 
@@ -120,8 +124,8 @@ class Run {
   }
 
   Result<RunOutcome> execute() {
-    Result<RunDirectory> dir = RunDirectory::prepare(options_.output_directory, outputNames(),
-                                                     summary());
+    Result<RunDirectory> dir =
+        RunDirectory::prepare(options_.output_directory, outputNames(), summary());
     if (!dir) return dir.error();
     dir_.emplace(std::move(dir).value());
     if (Status opened = openCsvs(); !opened) return fail(opened.error());
@@ -137,8 +141,7 @@ class Run {
       if (!stepped) return fail(Error{scene_.spec.file + ": " + stepped.error().message});
       const WorldStepReport& report = stepped.value();
       step_ms_.push_back(
-          std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0)
-              .count());
+          std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
       if (!report.ok) {
         outcome_.stable = false;
         outcome_.failure = report.message;
@@ -163,7 +166,8 @@ class Run {
       }
     }
     if (Status finished = writeFinalOutputs(); !finished) return fail(finished.error());
-    outcome_.completed = outcome_.stable && outcome_.stopped_by == 0 && outcome_.steps_done == steps_;
+    outcome_.completed =
+        outcome_.stable && outcome_.stopped_by == 0 && outcome_.steps_done == steps_;
     if (Status written = dir_->writeSummary(summary()); !written) return written.error();
     return outcome_;
   }
@@ -195,7 +199,8 @@ class Run {
     std::string energy = "step,time";
     for (const auto& body : world_.bodies())
       energy += "," + body->name() + ".kinetic," + body->name() + ".elastic";
-    if (Status s = energy_csv_.open(dir_->path("energy.csv"), energy + ",iterations,relative_residual\n");
+    if (Status s =
+            energy_csv_.open(dir_->path("energy.csv"), energy + ",iterations,relative_residual\n");
         !s)
       return s;
     if (scene_.rigid_bodies.empty()) return Ok{};

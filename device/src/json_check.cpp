@@ -80,14 +80,15 @@ class StrictChecker {
       // nlohmann's text repeats the position ("... at line 2, column 3: "); keep the fault only.
       what = e.what();
       const size_t column = what.find("column ");
-      const size_t colon = column == std::string::npos ? std::string::npos : what.find(": ", column);
+      const size_t colon =
+          column == std::string::npos ? std::string::npos : what.find(": ", column);
       if (colon != std::string::npos) what = what.substr(colon + 2);
       what = printableExcerpt(what, 200);
     }
     fault_ = JsonTextFault{};
     // A number is located at its first character; a syntax error where the parser stopped.
     const size_t at = e.id == 406 && position >= token.size() ? position - token.size()
-                                                                : (position == 0 ? 0 : position - 1);
+                                                              : (position == 0 ? 0 : position - 1);
     locate(text_, at, *fault_);
     fault_->what = what;
     return false;
@@ -97,8 +98,8 @@ class StrictChecker {
   struct Level {
     bool is_object = false;
     std::set<std::string> keys;
-    std::string key;  // the last key of an object
-    size_t index = 0; // the next element of an array
+    std::string key;   // the last key of an object
+    size_t index = 0;  // the next element of an array
   };
 
   // Counts a value in its enclosing array.

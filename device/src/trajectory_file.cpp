@@ -115,9 +115,9 @@ std::vector<ButtonEvent> buttons(const json& list) {
 Loaded<Trajectory> parseTrajectory(const std::string& json_text, const std::string& source) {
   // A strict pass first: duplicate keys, numbers beyond a double and syntax, with a position.
   if (const auto fault = findJsonTextFault(json_text)) {
-    const std::string where = fault->line > 0 ? ":" + std::to_string(fault->line) + ":" +
-                                                    std::to_string(fault->column)
-                                              : std::string();
+    const std::string where =
+        fault->line > 0 ? ":" + std::to_string(fault->line) + ":" + std::to_string(fault->column)
+                        : std::string();
     return Loaded<Trajectory>::fail(source + where + ": not valid JSON: " + fault->what);
   }
   const json root = json::parse(json_text);

@@ -3,14 +3,13 @@
 // $TORSION_FAIL_WRITES_AFTER bytes (default 0) have gone to such files, as on a full disk.
 // It proves it was loaded by creating $TORSION_FAIL_WRITES_MARK, so a test can tell "the
 // program ignored the failure" from "the shim could not be preloaded".
-#include <cstddef>  // before dlfcn.h, which needs size_t
-
 #include <dlfcn.h>
 #include <fcntl.h>
 #include <sys/types.h>
 #include <unistd.h>
 
 #include <cerrno>
+#include <cstddef>  // before dlfcn.h, which needs size_t
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>

@@ -98,8 +98,9 @@ TEST(SceneParserFaults, AMissingKeyDoesNotCallValidKeysNotYetReadUnknown) {
 
 TEST(SceneParserFaults, BadValuesAreShownInShortestForm) {
   // std::to_string showed -1e-9 as "-0.000000", hiding the value that was wrong.
-  EXPECT_TRUE(failsWith(parse(replaced(kValid, "\"youngs_modulus\": 1e5", "\"youngs_modulus\": -1e-9")),
-                        {"youngs_modulus = -1e-09: must be > 0 Pa"}));
+  EXPECT_TRUE(
+      failsWith(parse(replaced(kValid, "\"youngs_modulus\": 1e5", "\"youngs_modulus\": -1e-9")),
+                {"youngs_modulus = -1e-09: must be > 0 Pa"}));
 }
 
 TEST(SceneParserFaults, DuplicateKeysAndHugeNumbersAreNamed) {

@@ -56,8 +56,8 @@ TEST(OverflowHealth, ConjugateGradientCallsAnOverflowingNormABreakdown) {
 struct OneSphere {
   btSphereShape shape{0.5};
   btDefaultMotionState motion;
-  btRigidBody body{btRigidBody::btRigidBodyConstructionInfo(1.0, &motion, &shape,
-                                                            btVector3(0.1, 0.1, 0.1))};
+  btRigidBody body{
+      btRigidBody::btRigidBodyConstructionInfo(1.0, &motion, &shape, btVector3(0.1, 0.1, 0.1))};
 };
 
 TEST(OverflowHealth, HealthyRigidBodiesPass) {

@@ -1,6 +1,5 @@
 #include "torsion/mesh/mesh_io.h"
 
-
 #include "torsion/device/file_io.h"
 #include "torsion/mesh/gmsh_format.h"
 #include "torsion/mesh/tetgen_format.h"

@@ -29,8 +29,8 @@ std::size_t maxInputFileBytes();
 void setMaxInputFileBytes(std::size_t bytes);
 
 /// Reads a whole regular file into `text`. Errors: "<path>: cannot open: <reason>",
-/// "<path>: cannot open: is a FIFO, not a regular file", "<path>: 2147483648 bytes, above the input size cap of
-/// 1073741824 bytes (raise it with --max-input-mb)", "<path>: read failed: <reason>".
+/// "<path>: cannot open: is a FIFO, not a regular file", "<path>: 2147483648 bytes, above the input
+/// size cap of 1073741824 bytes (raise it with --max-input-mb)", "<path>: read failed: <reason>".
 std::string readRegularFile(const std::string& path, std::string& text);
 
 /// Replaces `path` by `text` (temporary, fsync, rename). Errors: "<path>: cannot write: <reason>".

@@ -21,7 +21,7 @@ namespace torsion::device {
 struct NetworkDeviceSettings {
   UdpEndpoint local{0x7f000001, 5750};  ///< where poses arrive; port 0: any free port
   double timeout = 0.05;                ///< s without an accepted pose before the device is dead
-  double session_timeout = 1.0;  ///< s without an accepted pose before another peer may bind
+  double session_timeout = 1.0;         ///< s without an accepted pose before another peer may bind
   DeviceLimits limits;                  ///< of the device behind the peer
 };
 

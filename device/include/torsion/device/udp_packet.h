@@ -35,7 +35,7 @@ enum class PacketKind : std::uint16_t { kPose = 1, kWrench = 2 };
 struct Packet {
   PacketKind kind = PacketKind::kPose;
   std::uint32_t sequence = 0;
-  bool flag = false;  ///< pose: device alive; wrench: force enabled
+  bool flag = false;     ///< pose: device alive; wrench: force enabled
   bool goodbye = false;  ///< pose: the peer ends its session with this packet (flags bit 1)
   std::uint64_t timestamp_ns = 0;
   Pose pose;                        ///< kind pose

@@ -28,7 +28,8 @@ Result<MeshFormat> meshFormatOf(const std::filesystem::path& path);
 Result<LoadedMesh> readMesh(const std::filesystem::path& path, const MeshLoadOptions& options = {});
 
 /// Writes the mesh in the format of the path's extension (for TetGen, both .node and .ele beside
-/// each other, replaced together or not at all). Fields are written only to VTK; other formats ignore them.
+/// each other, replaced together or not at all). Fields are written only to VTK; other formats
+/// ignore them.
 Status writeMesh(const std::filesystem::path& path, const TetMesh& mesh,
                  const MeshFields& fields = {});
 
