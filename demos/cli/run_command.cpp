@@ -80,6 +80,8 @@ int run(const RunArguments& args) {
     std::cerr << "error: " << applied.error().message << "\n";
     return 1;
   }
+  for (const std::string& w : scene::remoteDeviceWarnings(spec.value()))
+    std::cerr << "warning: " << w << "\n";
   Result<std::unique_ptr<scene::BuiltScene>> built =
       scene::buildScene(std::move(spec).value(), args.threads);
   if (!built) {

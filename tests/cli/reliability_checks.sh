@@ -342,6 +342,18 @@ case "$case_name" in
     [[ -n $peak_kb && $peak_kb -lt 1000000 ]] || fail "peak virtual size ${peak_kb} kB"
     [[ $(json_field out/summary.json steps_requested) == 2000000000 ]] || fail "steps_requested"
     ;;
+  remote_device_needs_a_flag)
+    # Listening outside loopback lets any host drive the hand: an explicit flag, and a warning.
+    twist_scene > twist.json
+    run "$torsion" run twist.json --device hand=network:0.0.0.0:0 --out out --steps 1
+    expect_rc 1
+    expect_out "^error: twist.json: hands\[0\] 'hand': device host 0.0.0.0 is not loopback: .* pass --allow-remote-device"
+    [[ ! -e out ]] || fail "nothing may be written for a refused device"
+    run "$torsion" run twist.json --device hand=network:0.0.0.0:0 --allow-remote-device \
+      --out out --steps 1 --threads 1
+    expect_rc 0
+    expect_out "^warning: hand 'hand': the network device listens on 0.0.0.0, outside loopback"
+    ;;
   *)
     fail "unknown case '$case_name'"
     ;;
