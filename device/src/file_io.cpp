@@ -157,12 +157,23 @@ std::string writeFilesTogether(const std::vector<std::pair<std::string, std::str
     if (::link(path.c_str(), backup.c_str()) == 0) {
       backups[replaced] = backup;
     } else if (errno != ENOENT) {
-      failure = path + ": cannot write: " + reason(errno);
-      break;
+      // No hard links here (some file systems): move the old file aside instead.
+      if (::rename(path.c_str(), backup.c_str()) != 0) {
+        failure = path + ": cannot write: " + reason(errno);
+        break;
+      }
+      backups[replaced] = backup;
     }
     if (::rename(temps[replaced].c_str(), path.c_str()) != 0) {
       failure = path + ": cannot write: " + reason(errno);
-      if (!backups[replaced].empty()) ::unlink(backups[replaced].c_str());
+      if (!backups[replaced].empty()) {
+        // Put the old file back if it was moved aside; drop the link if it was linked.
+        if (::access(path.c_str(), F_OK) != 0) {
+          ::rename(backups[replaced].c_str(), path.c_str());
+        } else {
+          ::unlink(backups[replaced].c_str());
+        }
+      }
       break;
     }
   }
