@@ -1,22 +1,44 @@
 // torsion: the command-line tool. Each subcommand lives in its own file and registers itself here.
 
 #include <CLI/CLI.hpp>
+#include <cmath>
 #include <iostream>
 
 #include "mesh_command.h"
 #include "run_command.h"
+#include "text_only_stderr.h"
+#include "torsion/device/file_io.h"
 #include "view_command.h"
 
 int main(int argc, char** argv) {
+  const torsion::cli::TextOnlyStderr text_only_stderr;  // no raw bytes from user input on stderr
   CLI::App app{"torsion: corotational FEM soft bodies with hand-plane torsion, inside Bullet"};
   app.require_subcommand(1);
+  app.fallthrough();  // options of the tool (--max-input-mb) may follow a subcommand
+  app.add_option_function<double>(
+         "--max-input-mb",
+         [](double mb) {
+           torsion::device::setMaxInputFileBytes(static_cast<std::size_t>(std::llround(mb * 1e6)));
+         },
+         "Largest scene, mesh or trajectory file read, in MB (default 1073.741824, i.e. 1 GiB)")
+      ->check(CLI::Range(1e-6, 1e9))
+      ->trigger_on_parse();  // before the subcommand's callback reads anything
   torsion::cli::addMeshCommand(app);
   torsion::cli::addRunCommand(app);
   torsion::cli::addViewCommand(app);
   try {
     app.parse(argc, argv);
-  } catch (const CLI::ParseError& e) {
+  } catch (const CLI::CallForHelp& e) {
     return app.exit(e);
+  } catch (const CLI::CallForAllHelp& e) {
+    return app.exit(e);
+  } catch (const CLI::CallForVersion& e) {
+    return app.exit(e);
+  } catch (const CLI::ParseError& e) {
+    // Usage errors exit 1 like every other error, on one "error:" line (CLI11 uses 104-114).
+    std::cerr << "error: " << e.what() << "\nrun '" << argv[0]
+              << " --help' (or '<command> --help') for usage\n";
+    return 1;
   }
   return torsion::cli::exitCode();
 }

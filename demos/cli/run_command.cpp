@@ -1,5 +1,6 @@
 #include "run_command.h"
 
+#include <csignal>
 #include <cstdio>
 #include <iostream>
 #include <memory>
@@ -11,6 +12,8 @@
 #include "frame_recorder.h"
 #include "mesh_command.h"
 #include "progress_bar.h"
+#include "torsion/device/json_check.h"
+#include "torsion/solve/parallel.h"
 
 namespace torsion::cli {
 
@@ -28,8 +31,47 @@ struct RunArguments {
   scene::DeviceOverrides devices;  // --device HAND=TYPE[:ARG] (repeatable), --haptics MODE
 };
 
+// The signal that asked the run to stop, 0 while none has. Written by the handler only.
+volatile std::sig_atomic_t g_stop_signal = 0;
+
+extern "C" void requestStop(int signal) {
+  g_stop_signal = signal;
+}
+
+// SIGINT and SIGTERM stop the run at the end of the current step (scene_runner.h) while this
+// object lives; the previous handlers come back afterwards. A signal the process was started
+// ignoring (a background job of a non-interactive shell ignores SIGINT, nohup SIGHUP) stays
+// ignored, as is the convention.
+class StopOnSignals {
+ public:
+  StopOnSignals() {
+    catchUnlessIgnored(SIGINT, previous_int_);
+    catchUnlessIgnored(SIGTERM, previous_term_);
+  }
+  ~StopOnSignals() {
+    sigaction(SIGINT, &previous_int_, nullptr);
+    sigaction(SIGTERM, &previous_term_, nullptr);
+  }
+  StopOnSignals(const StopOnSignals&) = delete;
+  StopOnSignals& operator=(const StopOnSignals&) = delete;
+
+ private:
+  static void catchUnlessIgnored(int signal, struct sigaction& previous) {
+    sigaction(signal, nullptr, &previous);
+    if (previous.sa_handler == SIG_IGN) return;
+    struct sigaction action {};
+    action.sa_handler = requestStop;
+    sigemptyset(&action.sa_mask);
+    sigaction(signal, &action, nullptr);
+  }
+
+  struct sigaction previous_int_ {};
+  struct sigaction previous_term_ {};
+};
+
 // Exit codes: 0 done and stable, 1 bad input or output error, 3 the simulation went unstable,
-// 4 stopped at an anomaly (--stop-on-anomaly).
+// 4 stopped at an anomaly (--stop-on-anomaly), 128 + signal when SIGINT (130) or SIGTERM (143)
+// stopped the run.
 int run(const RunArguments& args) {
   Result<scene::SceneSpec> spec = scene::loadScene(args.scene);
   if (!spec) {
@@ -40,6 +82,8 @@ int run(const RunArguments& args) {
     std::cerr << "error: " << applied.error().message << "\n";
     return 1;
   }
+  for (const std::string& w : scene::remoteDeviceWarnings(spec.value()))
+    std::cerr << "warning: " << w << "\n";
   Result<std::unique_ptr<scene::BuiltScene>> built =
       scene::buildScene(std::move(spec).value(), args.threads);
   if (!built) {
@@ -49,6 +93,12 @@ int run(const RunArguments& args) {
   scene::BuiltScene& s = *built.value();
   for (const std::string& w : s.warnings)
     std::cerr << "warning: " << w << "\n";
+  if (const int asked = s.world->settings().solver.threads;
+      asked > 0 && Parallel::usableThreads(asked) < asked) {
+    std::cerr << "warning: " << asked << " threads asked for, the machine has "
+              << Parallel::usableThreads(asked) << " cores: using "
+              << Parallel::usableThreads(asked) << "\n";
+  }
   for (const auto& body : s.world->bodies()) {
     std::cerr << "body '" << body->name() << "': " << body->model().nodeCount() << " nodes, "
               << body->model().elementCount()
@@ -82,7 +132,7 @@ int run(const RunArguments& args) {
     }
   }
 
-  ProgressBar bar(s.spec.name);
+  ProgressBar bar(device::printableExcerpt(s.spec.name));  // the label goes out through stdio
   scene::RunOptions options;
   options.output_directory = args.out;
   options.steps = args.steps;
@@ -95,7 +145,12 @@ int run(const RunArguments& args) {
       if (!drawn) render_error = drawn.error().message;
     }
   };
-  Result<scene::RunOutcome> outcome = scene::runScene(s, options);
+  options.stop_requested = [] { return static_cast<int>(g_stop_signal); };
+  Result<scene::RunOutcome> outcome = Error{};
+  {
+    StopOnSignals stop_on_signals;
+    outcome = scene::runScene(s, options);
+  }
   bar.finish();
   if (!outcome) {
     std::cerr << "error: " << outcome.error().message << "\n";
@@ -110,6 +165,12 @@ int run(const RunArguments& args) {
       std::cerr << "warning: haptics: " << w << "\n";
   }
   if (recorder) std::cerr << "pictures: " << recorder->finish(s.spec.name) << "\n";
+  if (const int signal = outcome.value().stopped_by; signal != 0) {
+    std::cerr << "stopped by " << (signal == SIGINT ? "SIGINT" : "SIGTERM") << " after "
+              << outcome.value().steps_done << " steps; results so far in " << args.out
+              << "/ (summary.json says \"completed\": false)\n";
+    return 128 + signal;
+  }
   if (!outcome.value().stable) {
     std::cerr << "error: simulation unstable: " << outcome.value().failure << "\n"
               << "results up to the last good step are in " << args.out << "/\n";
@@ -137,17 +198,18 @@ void addRunCommand(CLI::App& app) {
                   "twist_cylinder_2430, ...)")
       ->required();
   cmd->add_option("--out", args->out, "Output directory")->capture_default_str();
+  // Ranges with readable bounds (CLI::PositiveNumber prints the double range in 300 digits).
   cmd->add_option("--steps", args->steps, "Number of steps (default: the scene's)")
-      ->check(CLI::PositiveNumber);
+      ->check(CLI::Range(1, 2000000000).description("an integer from 1 to 2000000000"));
   cmd->add_option("--threads", args->threads,
                   "Worker threads (default: the scene's; 0 = all cores)")
-      ->check(CLI::NonNegativeNumber);
+      ->check(CLI::Range(0, 4096).description("an integer from 0 to 4096"));
   cmd->add_option("--render", args->render,
                   "Also draw the scene (OSMesa) into PNG pictures in this directory, and an MP4 "
                   "when ffmpeg is on PATH");
   cmd->add_option("--render-size", args->render_size, "Picture size WxH")->capture_default_str();
   cmd->add_option("--render-every", args->render_every, "Steps between pictures")
-      ->check(CLI::PositiveNumber)
+      ->check(CLI::Range(1, 1000000000).description("an integer from 1 to 1000000000"))
       ->capture_default_str();
   cmd->add_flag("--stop-on-anomaly", args->stop_on_anomaly,
                 "Stop at the first anomaly (inverted tets, released elastic energy, node speed "

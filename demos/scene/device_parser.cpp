@@ -27,6 +27,12 @@ double nonNegative(const JsonObject& o, const std::string& key, double fallback,
   return v;
 }
 
+// 127.0.0.0/8: only this machine can send there.
+bool isLoopback(const std::string& host) {
+  std::uint32_t address = 0;
+  return device::parseIpv4(host, address) && (address >> 24) == 127;
+}
+
 void readNetwork(const JsonObject& d, DeviceSpec& spec) {
   spec.host = d.string("host", spec.host);
   std::uint32_t address = 0;
@@ -254,7 +260,33 @@ Status applyDeviceOverrides(SceneSpec& scene, const DeviceOverrides& overrides) 
     if (!mode) return mode.error();
     scene.haptics_mode = mode.value();
   }
+  if (!overrides.allow_remote_devices) {
+    for (size_t h = 0; h < scene.hands.size(); ++h) {
+      const HandSpec& hand = scene.hands[h];
+      if (!hand.device || hand.device->kind != DeviceSpec::Kind::kNetwork ||
+          isLoopback(hand.device->host))
+        continue;
+      return Error{scene.file + ": hands[" + std::to_string(h) + "] '" + hand.name +
+                   "': device host " + hand.device->host +
+                   " is not loopback: anyone who can reach that port could drive the hand (the "
+                   "packets are not authenticated); pass --allow-remote-device to listen there"};
+    }
+  }
   return Ok{};
+}
+
+std::vector<std::string> remoteDeviceWarnings(const SceneSpec& scene) {
+  std::vector<std::string> warnings;
+  for (const HandSpec& hand : scene.hands) {
+    if (hand.device && hand.device->kind == DeviceSpec::Kind::kNetwork &&
+        !isLoopback(hand.device->host)) {
+      warnings.push_back("hand '" + hand.name + "': the network device listens on " +
+                         hand.device->host +
+                         ", outside loopback: its first peer is bound, "
+                         "unauthenticated (docs/haptics.md)");
+    }
+  }
+  return warnings;
 }
 
 }  // namespace torsion::scene

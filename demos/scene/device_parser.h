@@ -27,10 +27,16 @@ Result<HapticsMode> parseHapticsMode(const std::string& text);
 struct DeviceOverrides {
   std::vector<std::string> devices;  ///< `--device HAND=TYPE[:ARG]`, repeatable
   std::string haptics;               ///< `--haptics lockstep|threaded`; empty: the default
+  /// `--allow-remote-device`: a network device may listen on an address other than loopback.
+  bool allow_remote_devices = false;
 };
 
 /// Applies every --device (applyDeviceOverride), then --haptics, to `scene`; the first fault
-/// is the error.
+/// is the error. A network device on a host outside 127.0.0.0/8 is an error unless
+/// `allow_remote_devices` (the packets carry no authentication: docs/haptics.md).
 Status applyDeviceOverrides(SceneSpec& scene, const DeviceOverrides& overrides);
+
+/// One warning per network device listening outside loopback (after applyDeviceOverrides).
+std::vector<std::string> remoteDeviceWarnings(const SceneSpec& scene);
 
 }  // namespace torsion::scene

@@ -1,6 +1,10 @@
 #include "json_reader.h"
 
+#include <algorithm>
+#include <cctype>
 #include <cmath>
+#include <cstdio>
+#include <cstring>
 
 namespace torsion::scene {
 
@@ -13,6 +17,26 @@ std::string typeName(const nlohmann::json& j) {
   if (j.is_object()) return "an object";
   return "null";
 }
+// Within two single-character edits (insert, delete, substitute), or equal but for case.
+bool spelledAlike(const std::string& a, const std::string& b) {
+  const size_t n = a.size(), m = b.size();
+  if ((n > m ? n - m : m - n) > 2) return false;
+  std::vector<size_t> previous(m + 1), current(m + 1);
+  for (size_t j = 0; j <= m; ++j)
+    previous[j] = j;
+  for (size_t i = 1; i <= n; ++i) {
+    current[0] = i;
+    for (size_t j = 1; j <= m; ++j) {
+      const bool same = std::tolower(static_cast<unsigned char>(a[i - 1])) ==
+                        std::tolower(static_cast<unsigned char>(b[j - 1]));
+      current[j] =
+          std::min({previous[j] + 1, current[j - 1] + 1, previous[j - 1] + (same ? 0 : 1)});
+    }
+    std::swap(previous, current);
+  }
+  return previous[m] <= 2;
+}
+
 }  // namespace
 
 JsonObject::JsonObject(const nlohmann::json& json, std::string path, const std::string& file)
@@ -40,14 +64,15 @@ bool JsonObject::has(const std::string& key) const {
 const nlohmann::json& JsonObject::at(const std::string& key) const {
   read_.insert(key);
   if (!json_.contains(key)) {
-    // A misspelt key shows up here first: name the keys this object has that nobody asked for.
-    std::string unread;
+    // A misspelt key shows up here first. Keys not read yet may well be valid ones read later,
+    // so only those spelt like the missing key are offered, as a guess.
+    std::string similar;
     for (auto it = json_.begin(); it != json_.end(); ++it) {
-      if (read_.count(it.key()) == 0)
-        unread += (unread.empty() ? "" : ", ") + ("'" + it.key() + "'");
+      if (read_.count(it.key()) == 0 && spelledAlike(it.key(), key))
+        similar += (similar.empty() ? "" : ", ") + ("'" + it.key() + "'");
     }
     fail(key, "missing (required)" +
-                  (unread.empty() ? std::string() : "; also found unknown key(s) " + unread));
+                  (similar.empty() ? std::string() : "; did you mean " + similar + "?"));
   }
   return json_.at(key);
 }
@@ -81,6 +106,29 @@ std::string JsonObject::string(const std::string& key) const {
 
 std::string JsonObject::string(const std::string& key, const std::string& fallback) const {
   return has(key) ? string(key) : fallback;
+}
+
+std::string JsonObject::name(const std::string& key) const {
+  const std::string value = string(key);
+  if (value.empty()) fail(key, "must not be empty");
+  if (value.size() > 64) fail(key, "must be at most 64 characters (it names files and columns)");
+  if (value == "." || value == "..") fail(key, "'" + value + "' cannot name a file");
+  for (const char c : value) {
+    const auto byte = static_cast<unsigned char>(c);
+    const bool allowed = std::isalnum(byte) || (c != '\0' && std::strchr(" -_.+()", c) != nullptr);
+    if (!allowed || byte >= 0x80) {
+      char shown[8];
+      if (byte >= 0x21 && byte < 0x7f) {
+        std::snprintf(shown, sizeof shown, "'%c'", c);
+      } else {
+        std::snprintf(shown, sizeof shown, "\\x%02X", static_cast<unsigned>(byte));
+      }
+      fail(key, std::string("character ") + shown +
+                    " not allowed: names become file names and CSV columns (use letters, digits "
+                    "and \" -_.+()\")");
+    }
+  }
+  return value;
 }
 
 bool JsonObject::boolean(const std::string& key, bool fallback) const {

@@ -27,6 +27,10 @@ class JsonObject {
   int integer(const std::string& key, int fallback) const;
   std::string string(const std::string& key) const;
   std::string string(const std::string& key, const std::string& fallback) const;
+  /// A name that becomes part of a file name or a CSV column (<body>.vtk, "<set>.fx"): not
+  /// empty, at most 64 bytes, printable ASCII letters, digits and " -_.+()" only, not "." or
+  /// "..", so it can neither leave --out nor break a CSV header.
+  std::string name(const std::string& key) const;
   bool boolean(const std::string& key, bool fallback) const;
   Eigen::Vector3d vector3(const std::string& key) const;
   Eigen::Vector3d vector3(const std::string& key, const Eigen::Vector3d& fallback) const;

@@ -2,9 +2,28 @@
 
 #include <algorithm>
 
+#include "arithmetic_bounds.h"
+
 namespace torsion::scene {
 
 namespace {
+
+// A rigid length the arithmetic can carry (arithmetic_bounds.h).
+double readLength(const JsonObject& s, const std::string& key) {
+  const double value = s.number(key);
+  if (!(value > 0)) s.fail(key, "must be > 0");
+  if (value > kMaxRigidLength)
+    s.fail(key, "must be at most 1e6 m (Bullet's inertias grow as size^2 and must stay finite)");
+  return value;
+}
+
+void checkPoints(const JsonObject& s, const std::string& key,
+                 const std::vector<Eigen::Vector3d>& points) {
+  for (size_t i = 0; i < points.size(); ++i) {
+    if (points[i].cwiseAbs().maxCoeff() > kMaxRigidLength)
+      s.fail(key, "element " + std::to_string(i) + ": coordinates must be within 1e6 m");
+  }
+}
 
 void readShape(const JsonObject& shape, RigidBodySpec& spec) {
   const std::string kind =
@@ -14,16 +33,15 @@ void readShape(const JsonObject& shape, RigidBodySpec& spec) {
     spec.shape = RigidBodySpec::Shape::kBox;
     spec.half_extents = s.vector3("half_extents");
     if (!(spec.half_extents.minCoeff() > 0)) s.fail("half_extents", "must be > 0");
+    if (spec.half_extents.maxCoeff() > kMaxRigidLength)
+      s.fail("half_extents", "must be at most 1e6 m (Bullet's inertias must stay finite)");
   } else if (kind == "sphere") {
     spec.shape = RigidBodySpec::Shape::kSphere;
-    spec.radius = s.number("radius");
-    if (!(spec.radius > 0)) s.fail("radius", "must be > 0");
+    spec.radius = readLength(s, "radius");
   } else if (kind == "capsule") {
     spec.shape = RigidBodySpec::Shape::kCapsule;
-    spec.radius = s.number("radius");
-    if (!(spec.radius > 0)) s.fail("radius", "must be > 0");
-    spec.half_height = s.number("half_height");
-    if (!(spec.half_height > 0)) s.fail("half_height", "must be > 0");
+    spec.radius = readLength(s, "radius");
+    spec.half_height = readLength(s, "half_height");
     const std::string axis = s.string("axis", "z");
     if (axis != "x" && axis != "y" && axis != "z")
       s.fail("axis", "'" + axis + "' is not one of: x, y, z");
@@ -32,6 +50,7 @@ void readShape(const JsonObject& shape, RigidBodySpec& spec) {
     spec.shape = RigidBodySpec::Shape::kConvexHull;
     spec.points = s.vector3List("points");
     if (spec.points.size() < 4) s.fail("points", "a convex hull needs at least 4 points");
+    checkPoints(s, "points", spec.points);
     // Not flat: some point off the plane of the first three (or of any line, if collinear).
     Eigen::Vector3d extent = Eigen::Vector3d::Zero();
     for (const Eigen::Vector3d& p : spec.points)
@@ -50,6 +69,8 @@ void readShape(const JsonObject& shape, RigidBodySpec& spec) {
       s.fail("points", "the points are flat (coplanar): a convex hull needs volume");
     spec.margin = s.number("margin", spec.margin);
     if (!(spec.margin >= 0)) s.fail("margin", "must be >= 0 m");
+    if (spec.margin > kMaxRigidLength)
+      s.fail("margin", "must be at most 1e6 m (Bullet's inertias must stay finite)");
   } else if (kind == "plane") {
     spec.shape = RigidBodySpec::Shape::kPlane;
     const Eigen::Vector3d n = s.vector3("normal");
@@ -59,6 +80,7 @@ void readShape(const JsonObject& shape, RigidBodySpec& spec) {
   } else {
     spec.shape = RigidBodySpec::Shape::kTriangleMesh;
     spec.points = s.vector3List("vertices");
+    checkPoints(s, "vertices", spec.points);
     spec.triangles = s.integerTriples("triangles");
     if (spec.triangles.empty()) s.fail("triangles", "a triangle mesh needs triangles");
     for (size_t t = 0; t < spec.triangles.size(); ++t) {
@@ -85,7 +107,7 @@ double readCoefficient(const JsonObject& r, const std::string& key, double fallb
 
 RigidBodySpec readRigidBody(const JsonObject& r, const std::vector<RigidBodySpec>& earlier) {
   RigidBodySpec spec;
-  spec.name = r.string("name");
+  spec.name = r.name("name");
   for (const RigidBodySpec& other : earlier) {
     if (other.name == spec.name) r.fail("name", "duplicate rigid body name '" + spec.name + "'");
   }

@@ -1,7 +1,9 @@
 #include "scene_builder.h"
 
+#include "arithmetic_bounds.h"
 #include "bullet_file_import.h"
 #include "scene_haptics.h"
+#include "torsion/format_number.h"
 #include "torsion/mesh/mesh_io.h"
 
 namespace torsion::scene {
@@ -44,7 +46,7 @@ Status driveHands(BuiltScene& scene) {
       Result<int> grabbed = s.hand->grab(s.spec.frameAt(now), now);
       if (!grabbed) {
         return Error{"hands[" + std::to_string(h) + "] '" + s.spec.name +
-                     "': grab at t = " + std::to_string(now) + " s: " + grabbed.error().message};
+                     "': grab at t = " + formatNumber(now) + " s: " + grabbed.error().message};
       }
     }
     if (s.hand->grabbed()) s.hand->moveTo(s.spec.frameAt(now + dt));
@@ -65,6 +67,10 @@ Result<std::unique_ptr<BuiltScene>> buildScene(SceneSpec spec, int threads_overr
     if (!mesh) return Error{entry + ": " + mesh.error().message};
     for (const std::string& w : mesh.value().warnings)
       built->warnings.push_back(w);
+    if (Status carried =
+            checkStiffnessRatio(body.material, mesh.value().mesh, spec.world.solver.time_step);
+        !carried)
+      return Error{entry + ": " + carried.error().message};
     Result<FemBody*> added =
         world.addBody(body.name, mesh.value().mesh, body.material, body.pose, body.element);
     if (!added) return Error{entry + ": " + added.error().message};

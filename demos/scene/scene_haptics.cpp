@@ -146,19 +146,17 @@ nlohmann::json SceneHaptics::statistics(const Channel& c) const {
       {"overruns", st.overruns.load()},
       {"nonfinite", st.nonfinite.load()},
       {"log_dropped", st.log_dropped.load()},
+      {"poses_rejected", c.coupling->rejectedPoses()},
       {"max_output", {{"force", max_force}, {"torque", max_torque}}},
       {"limits",
        {{"max_force", c.device->limits().max_force},
         {"max_torque", c.device->limits().max_torque}}}};
   if (const auto* net = dynamic_cast<const device::NetworkDevice*>(c.device.get())) {
     const device::PacketStats& p = net->stats();
-    j["packets"] = {{"accepted", p.accepted.load()},
-                    {"truncated", p.truncated.load()},
-                    {"malformed", p.malformed.load()},
-                    {"out_of_order", p.out_of_order.load()},
-                    {"duplicate", p.duplicate.load()},
-                    {"lost", p.lost.load()},
-                    {"sent", p.sent.load()}};
+    j["packets"] = {{"accepted", p.accepted.load()},   {"truncated", p.truncated.load()},
+                    {"malformed", p.malformed.load()}, {"out_of_order", p.out_of_order.load()},
+                    {"duplicate", p.duplicate.load()}, {"lost", p.lost.load()},
+                    {"foreign", p.foreign.load()},     {"sent", p.sent.load()}};
   }
   return j;
 }
@@ -175,10 +173,17 @@ Result<nlohmann::json> SceneHaptics::finish(const std::string& directory) {
   for (const Channel& c : channels_) {
     const std::filesystem::path path =
         std::filesystem::path(directory) / ("haptic_" + fileSafe(c.hand) + ".csv");
-    if (!c.loop->writeLog(path.string())) return Error{path.string() + ": cannot write"};
+    if (std::string error; !c.loop->writeLog(path.string(), &error)) return Error{error};
     hands.push_back(statistics(c));
   }
   return hands;
+}
+
+std::vector<std::string> SceneHaptics::logFileNames() const {
+  std::vector<std::string> names;
+  for (const Channel& c : channels_)
+    names.push_back("haptic_" + fileSafe(c.hand) + ".csv");
+  return names;
 }
 
 std::vector<std::string> SceneHaptics::describe() const {

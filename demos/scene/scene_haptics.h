@@ -41,6 +41,9 @@ class SceneHaptics {
   /// into `directory` and returns per-hand statistics for summary.json.
   Result<nlohmann::json> finish(const std::string& directory);
 
+  /// The names of the logs finish() writes, "haptic_<hand>.csv" per device hand.
+  std::vector<std::string> logFileNames() const;
+
   /// One line per device hand: "hand 'h': device scripted(f.json), lockstep at 1000 Hz".
   std::vector<std::string> describe() const;
   const std::vector<std::string>& warnings() const { return runtime_->warnings(); }

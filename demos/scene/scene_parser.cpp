@@ -2,11 +2,14 @@
 
 #include <filesystem>
 
+#include "arithmetic_bounds.h"
 #include "camera_spec.h"
 #include "device_parser.h"
 #include "json_reader.h"
 #include "rigid_body_parser.h"
 #include "scene_catalog.h"
+#include "torsion/device/json_check.h"
+#include "torsion/format_number.h"
 #include "torsion/mesh/mesh_io.h"
 
 namespace torsion::scene {
@@ -153,7 +156,7 @@ MotionSpec readMotion(const JsonObject& m) {
 
 HandSpec readHand(const JsonObject& h, const std::string& base_directory) {
   HandSpec hand;
-  hand.name = h.string("name");
+  hand.name = h.name("name");
   hand.body = h.string("body");
   if (h.has("device")) hand.device = readDevice(h, base_directory);  // device_parser.cpp
   if (h.has("keyframes")) {
@@ -164,8 +167,8 @@ HandSpec readHand(const JsonObject& h, const std::string& base_directory) {
     for (size_t k = 0; k < keys.size(); ++k) {
       const double time = keys[k].number("time");
       if (k > 0 && !(time > hand.keyframes.back().first)) {
-        keys[k].fail("time", std::to_string(time) + " is not after the previous keyframe's " +
-                                 std::to_string(hand.keyframes.back().first) +
+        keys[k].fail("time", formatNumber(time) + " is not after the previous keyframe's " +
+                                 formatNumber(hand.keyframes.back().first) +
                                  ": keyframes must be in time order");
       }
       hand.keyframes.emplace_back(time, readHandFrame(keys[k]));
@@ -185,19 +188,6 @@ HandSpec readHand(const JsonObject& h, const std::string& base_directory) {
     h.fail("max_drag_strain", "must be >= 0 (0 turns the hand's speed limit off)");
   h.finish();
   return hand;
-}
-
-std::string lineAndColumn(std::string_view text, size_t byte) {
-  int line = 1, column = 1;
-  for (size_t i = 0; i < byte && i < text.size(); ++i) {
-    if (text[i] == '\n') {
-      ++line;
-      column = 1;
-    } else {
-      ++column;
-    }
-  }
-  return std::to_string(line) + ":" + std::to_string(column);
 }
 
 }  // namespace
@@ -244,30 +234,29 @@ Frame HandSpec::frameAt(double t) const {
 
 Result<SceneSpec> parseScene(std::string_view text, const std::string& file_name,
                              const std::string& base_directory) {
-  nlohmann::json json;
-  try {
-    json = nlohmann::json::parse(text.begin(), text.end());
-  } catch (const nlohmann::json::parse_error& e) {
-    // nlohmann's text repeats the position; keep only what went wrong.
-    std::string what = e.what();
-    const size_t column = what.find("column ");
-    const size_t colon = column == std::string::npos ? std::string::npos : what.find(": ", column);
-    return Error{file_name + ":" + lineAndColumn(text, e.byte == 0 ? 0 : e.byte - 1) +
-                 ": invalid JSON: " + (colon != std::string::npos ? what.substr(colon + 2) : what)};
+  // A strict pass first: duplicate keys, numbers beyond a double and syntax, with a position.
+  if (const auto fault = device::findJsonTextFault(text)) {
+    const std::string where =
+        fault->line > 0 ? ":" + std::to_string(fault->line) + ":" + std::to_string(fault->column)
+                        : std::string();
+    return Error{file_name + where + ": invalid JSON: " + fault->what};
   }
+  const nlohmann::json json = nlohmann::json::parse(text.begin(), text.end());
   try {
     SceneSpec scene;
     scene.file = file_name;
     const JsonObject root(json, "", file_name);
     scene.name = root.string("name", std::filesystem::path(file_name).stem().string());
     scene.world.gravity = root.vector3("gravity", Eigen::Vector3d(0, 0, -9.81));
+    if (Status carried = checkGravity(scene.world.gravity); !carried)
+      root.fail("gravity", carried.error().message.substr(std::string("gravity: ").size()));
     if (root.has("solver")) scene.world.solver = readSolver(root.object("solver"));
     scene.steps = root.integer("steps", scene.steps);
     if (scene.steps < 1) root.fail("steps", "must be >= 1");
 
     for (const JsonObject& b : root.objects("bodies")) {
       BodySpec body;
-      body.name = b.string("name");
+      body.name = b.name("name");
       for (const BodySpec& other : scene.bodies) {
         if (other.name == body.name) b.fail("name", "duplicate body name '" + body.name + "'");
       }
@@ -296,7 +285,7 @@ Result<SceneSpec> parseScene(std::string_view text, const std::string& file_name
 
     for (const JsonObject& s : root.objects("node_sets")) {
       NodeSetSpec set;
-      set.name = s.string("name");
+      set.name = s.name("name");
       for (const NodeSetSpec& other : scene.node_sets) {
         if (other.name == set.name) s.fail("name", "duplicate node set name '" + set.name + "'");
       }
@@ -320,6 +309,12 @@ Result<SceneSpec> parseScene(std::string_view text, const std::string& file_name
       if (!known) h.fail("body", "no body named '" + hand.body + "'");
       for (const HandSpec& other : scene.hands) {
         if (other.name == hand.name) h.fail("name", "duplicate hand name '" + hand.name + "'");
+      }
+      // Node sets and hands share wrench.csv's columns ("<name>.fx").
+      for (const NodeSetSpec& set : scene.node_sets) {
+        if (set.name == hand.name)
+          h.fail("name", "'" + hand.name +
+                             "' is also a node set's name: both would be columns of wrench.csv");
       }
       scene.hands.push_back(std::move(hand));
     }

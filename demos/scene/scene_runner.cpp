@@ -2,12 +2,16 @@
 
 #include <algorithm>
 #include <chrono>
+#include <csignal>
 #include <filesystem>
-#include <fstream>
 #include <nlohmann/json.hpp>
+#include <optional>
+#include <sstream>
 
+#include "run_directory.h"
 #include "scene_anomalies.h"
 #include "scene_haptics.h"
+#include "torsion/bullet/rigid_health.h"
 #include "torsion/mesh/mesh_io.h"
 #include "torsion/mesh/vtk_format.h"
 
@@ -43,7 +47,9 @@ Status writeFinalMesh(const FemBody& body, const Eigen::VectorXd& positions, con
 }
 
 // Per step: each rigid body's centre of mass, orientation quaternion and linear velocity.
-void writeRigidRow(std::ofstream& csv, const BuiltScene& scene, int step, double time) {
+std::string rigidRow(const BuiltScene& scene, int step, double time) {
+  std::ostringstream csv;
+  csv.precision(10);
   csv << step << "," << time;
   for (const SceneRigidBody& r : scene.rigid_bodies) {
     const btTransform& t = r.body->getCenterOfMassTransform();
@@ -54,6 +60,7 @@ void writeRigidRow(std::ofstream& csv, const BuiltScene& scene, int step, double
         << "," << v.z();
   }
   csv << "\n";
+  return csv.str();
 }
 
 // FEM-rigid contact figures over the run (docs/contact.md), summed over the FEM bodies per step.
@@ -92,176 +99,277 @@ struct ContactTotals {
   }
 };
 
-}  // namespace
-
-Result<RunOutcome> runScene(BuiltScene& scene, const RunOptions& options) {
-  const fs::path out(options.output_directory);
-  std::error_code ec;
-  fs::create_directories(out, ec);
-  if (ec) return Error{out.string() + ": cannot create the output directory: " + ec.message()};
-
-  FemWorld& world = *scene.world;
-  const int steps = options.steps > 0 ? options.steps : scene.spec.steps;
-
-  std::ofstream wrench_csv(out / "wrench.csv"), energy_csv(out / "energy.csv");
-  if (!wrench_csv || !energy_csv) return Error{out.string() + ": cannot write the CSV files"};
-  wrench_csv << "step,time";
-  for (const NodeSetHandle& s : scene.node_sets) {
-    for (const char* c : {"fx", "fy", "fz", "tx", "ty", "tz"})
-      wrench_csv << "," << s.name << "." << c;
+const char* signalName(int signal) {
+  switch (signal) {
+    case SIGINT:
+      return "SIGINT";
+    case SIGTERM:
+      return "SIGTERM";
+    case SIGHUP:
+      return "SIGHUP";
+    default:
+      return "signal";
   }
-  for (const SceneHand& h : scene.hands) {
-    for (const char* c : {"fx", "fy", "fz", "tx", "ty", "tz"})
-      wrench_csv << "," << h.spec.name << "." << c;
-  }
-  wrench_csv << "\n";
-  energy_csv << "step,time";
-  for (const auto& body : world.bodies())
-    energy_csv << "," << body->name() << ".kinetic," << body->name() << ".elastic";
-  energy_csv << ",iterations,relative_residual\n";
-  wrench_csv.precision(10);
-  energy_csv.precision(10);
+}
 
-  // Rigid bodies' poses per step (only when the scene has some).
-  std::ofstream rigid_csv;
-  if (!scene.rigid_bodies.empty()) {
-    rigid_csv.open(out / "rigid.csv");
-    if (!rigid_csv) return Error{out.string() + ": cannot write rigid.csv"};
-    rigid_csv << "step,time";
-    for (const SceneRigidBody& r : scene.rigid_bodies) {
+// One run: its outputs, its statistics so far and the summary built from them.
+class Run {
+ public:
+  Run(BuiltScene& scene, const RunOptions& options)
+      : scene_(scene),
+        world_(*scene.world),
+        options_(options),
+        steps_(options.steps > 0 ? options.steps : scene.spec.steps),
+        anomalies_(world_) {
+    for (const SceneRigidBody& r : scene.rigid_bodies)
+      rigid_bodies_.push_back({r.name, r.body});
+  }
+
+  Result<RunOutcome> execute() {
+    Result<RunDirectory> dir =
+        RunDirectory::prepare(options_.output_directory, outputNames(), summary());
+    if (!dir) return dir.error();
+    dir_.emplace(std::move(dir).value());
+    if (Status opened = openCsvs(); !opened) return fail(opened.error());
+
+    for (const auto& body : world_.bodies())
+      last_good_.push_back(body->state().positions);
+    const auto run_start = std::chrono::steady_clock::now();
+    if (scene_.haptics) scene_.haptics->prepareRun(steps_);
+    for (int k = 0; k < steps_; ++k) {
+      if (scene_.haptics) scene_.haptics->pace();  // threaded: wall-clock pacing, not step time
+      const auto t0 = std::chrono::steady_clock::now();
+      Result<WorldStepReport> stepped = stepScene(scene_);
+      if (!stepped) return fail(Error{scene_.spec.file + ": " + stepped.error().message});
+      const WorldStepReport& report = stepped.value();
+      step_ms_.push_back(
+          std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
+      if (!report.ok) {
+        outcome_.stable = false;
+        outcome_.failure = report.message;
+        break;
+      }
+      // Bullet lets a rigid body become NaN silently; such a step is no good step.
+      if (auto fault = findUnhealthyRigidBody(rigid_bodies_)) {
+        outcome_.stable = false;
+        outcome_.failure = "step " + std::to_string(report.step) + ": " + fault->message;
+        break;
+      }
+      outcome_.steps_done = k + 1;
+      if (Status recorded = recordStep(report); !recorded) return fail(recorded.error());
+      // Inverted tets, energy release, speed bursts (scene_anomalies.h): warned, optionally fatal.
+      if (anomalies_.observe(world_, report.step) && options_.stop_on_anomaly) {
+        outcome_.stopped_on_anomaly = anomalies_.firstWarning();
+        break;
+      }
+      if (options_.progress) {
+        const double elapsed =
+            std::chrono::duration<double>(std::chrono::steady_clock::now() - run_start).count();
+        options_.progress(k + 1, steps_, elapsed > 0 ? (k + 1) / elapsed : 0.0);
+      }
+      if (options_.stop_requested) {
+        outcome_.stopped_by = options_.stop_requested();
+        if (outcome_.stopped_by != 0) break;
+      }
+    }
+    if (Status finished = writeFinalOutputs(); !finished) return fail(finished.error());
+    outcome_.completed = outcome_.stable && outcome_.stopped_by == 0 &&
+                         outcome_.stopped_on_anomaly.empty() && outcome_.steps_done == steps_;
+    if (Status written = dir_->writeSummary(summary()); !written) return written.error();
+    return outcome_;
+  }
+
+ private:
+  std::vector<std::string> outputNames() const {
+    std::vector<std::string> names = {"wrench.csv", "energy.csv"};
+    if (!scene_.rigid_bodies.empty()) names.push_back("rigid.csv");
+    for (const auto& body : world_.bodies())
+      names.push_back(body->name() + ".vtk");
+    if (scene_.haptics) {
+      for (const std::string& log : scene_.haptics->logFileNames())
+        names.push_back(log);
+    }
+    return names;
+  }
+
+  Status openCsvs() {
+    std::string wrench = "step,time";
+    for (const NodeSetHandle& s : scene_.node_sets) {
+      for (const char* c : {"fx", "fy", "fz", "tx", "ty", "tz"})
+        wrench += "," + s.name + "." + c;
+    }
+    for (const SceneHand& h : scene_.hands) {
+      for (const char* c : {"fx", "fy", "fz", "tx", "ty", "tz"})
+        wrench += "," + h.spec.name + "." + c;
+    }
+    if (Status s = wrench_csv_.open(dir_->path("wrench.csv"), wrench + "\n"); !s) return s;
+    std::string energy = "step,time";
+    for (const auto& body : world_.bodies())
+      energy += "," + body->name() + ".kinetic," + body->name() + ".elastic";
+    if (Status s =
+            energy_csv_.open(dir_->path("energy.csv"), energy + ",iterations,relative_residual\n");
+        !s)
+      return s;
+    if (scene_.rigid_bodies.empty()) return Ok{};
+    std::string rigid = "step,time";
+    for (const SceneRigidBody& r : scene_.rigid_bodies) {
       for (const char* c : {"x", "y", "z", "qx", "qy", "qz", "qw", "vx", "vy", "vz"})
-        rigid_csv << "," << r.name << "." << c;
+        rigid += "," + r.name + "." + c;
     }
-    rigid_csv << "\n";
-    rigid_csv.precision(10);
+    return rigid_csv_.open(dir_->path("rigid.csv"), rigid + "\n");
   }
-  ContactTotals contact_totals;
-  SceneAnomalies anomalies(world);  // inverted tets, energy release, speed bursts
 
-  std::vector<Eigen::VectorXd> last_good;
-  for (const auto& body : world.bodies())
-    last_good.push_back(body->state().positions);
-
-  RunOutcome outcome;
-  std::vector<double> step_ms;
-  step_ms.reserve(static_cast<size_t>(steps));
-  long iteration_sum = 0;
-  int iteration_max = 0;
-  const auto run_start = std::chrono::steady_clock::now();
-  if (scene.haptics) scene.haptics->prepareRun(steps);
-  for (int k = 0; k < steps; ++k) {
-    if (scene.haptics) scene.haptics->pace();  // threaded: wall-clock pacing, not step time
-    const auto t0 = std::chrono::steady_clock::now();
-    Result<WorldStepReport> stepped = stepScene(scene);
-    if (!stepped) return Error{scene.spec.file + ": " + stepped.error().message};
-    const WorldStepReport& report = stepped.value();
-    step_ms.push_back(
-        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
-    if (!report.ok) {
-      outcome.stable = false;
-      outcome.failure = report.message;
-      break;
-    }
-    outcome.steps_done = k + 1;
+  // The rows of one good step, each written whole.
+  Status recordStep(const WorldStepReport& report) {
     int iterations = 0;
     double residual = 0;
-    for (size_t b = 0; b < world.bodies().size(); ++b) {
-      last_good[b] = world.bodies()[b]->state().positions;
-      const StepReport& r = world.bodies()[b]->lastReport();
+    for (size_t b = 0; b < world_.bodies().size(); ++b) {
+      last_good_[b] = world_.bodies()[b]->state().positions;
+      const StepReport& r = world_.bodies()[b]->lastReport();
       iterations += r.solve.iterations;
       residual = std::max(residual, r.solve.relative_residual);
     }
-    iteration_sum += iterations;
-    iteration_max = std::max(iteration_max, iterations);
+    iteration_sum_ += iterations;
+    iteration_max_ = std::max(iteration_max_, iterations);
 
-    wrench_csv << report.step << "," << world.time();
-    for (const NodeSetHandle& s : scene.node_sets) {
+    std::ostringstream wrench;
+    wrench.precision(10);
+    wrench << report.step << "," << world_.time();
+    for (const NodeSetHandle& s : scene_.node_sets) {
       const Wrench w = s.body->groupWrench(s.group, s.wrench_about);
-      wrench_csv << "," << w.force.x() << "," << w.force.y() << "," << w.force.z() << ","
-                 << w.torque.x() << "," << w.torque.y() << "," << w.torque.z();
+      wrench << "," << w.force.x() << "," << w.force.y() << "," << w.force.z() << ","
+             << w.torque.x() << "," << w.torque.y() << "," << w.torque.z();
     }
-    for (const SceneHand& h : scene.hands) {  // about the hand's origin O; zero when not holding
+    for (const SceneHand& h : scene_.hands) {  // about the hand's origin O; zero when not holding
       const Wrench w = h.hand->wrench();
-      wrench_csv << "," << w.force.x() << "," << w.force.y() << "," << w.force.z() << ","
-                 << w.torque.x() << "," << w.torque.y() << "," << w.torque.z();
+      wrench << "," << w.force.x() << "," << w.force.y() << "," << w.force.z() << ","
+             << w.torque.x() << "," << w.torque.y() << "," << w.torque.z();
     }
-    wrench_csv << "\n";
-    energy_csv << report.step << "," << world.time();
-    for (const auto& body : world.bodies()) {
+    wrench << "\n";
+    if (Status s = wrench_csv_.row(wrench.str()); !s) return s;
+
+    std::ostringstream energy;
+    energy.precision(10);
+    energy << report.step << "," << world_.time();
+    for (const auto& body : world_.bodies()) {
       // kinetic at the end of the step; elastic at its start (the stepper's by-product)
-      energy_csv << "," << body->lastReport().kinetic_energy << ","
-                 << body->lastReport().elastic_energy;
+      energy << "," << body->lastReport().kinetic_energy << ","
+             << body->lastReport().elastic_energy;
     }
-    energy_csv << "," << iterations << "," << residual << "\n";
-    if (rigid_csv.is_open()) writeRigidRow(rigid_csv, scene, report.step, world.time());
-    contact_totals.add(world);
-    if (anomalies.observe(world, report.step) && options.stop_on_anomaly) {
-      outcome.stopped_on_anomaly = anomalies.firstWarning();
-      break;
+    energy << "," << iterations << "," << residual << "\n";
+    if (Status s = energy_csv_.row(energy.str()); !s) return s;
+    if (rigid_csv_.isOpen()) {
+      if (Status s = rigid_csv_.row(rigidRow(scene_, report.step, world_.time())); !s) return s;
     }
-    if (options.progress) {
-      const double elapsed =
-          std::chrono::duration<double>(std::chrono::steady_clock::now() - run_start).count();
-      options.progress(k + 1, steps, elapsed > 0 ? (k + 1) / elapsed : 0.0);
-    }
+    contact_totals_.add(world_);
+    return Ok{};
   }
 
-  for (size_t b = 0; b < world.bodies().size(); ++b) {
-    const FemBody& body = *world.bodies()[b];
-    Status written = writeFinalMesh(body, last_good[b], out / (body.name() + ".vtk"));
-    if (!written) return written.error();
+  Status writeFinalOutputs() {
+    for (CsvOutput* csv : {&wrench_csv_, &energy_csv_, &rigid_csv_}) {
+      if (Status closed = csv->close(); !closed) return closed;
+    }
+    for (size_t b = 0; b < world_.bodies().size(); ++b) {
+      const FemBody& body = *world_.bodies()[b];
+      Status written = writeFinalMesh(body, last_good_[b], dir_->path(body.name() + ".vtk"));
+      if (!written) return written;
+    }
+    if (scene_.haptics) {  // stops the haptic threads (zero wrench), writes haptic_<hand>.csv
+      Result<nlohmann::json> haptics = scene_.haptics->finish(dir_->directory());
+      if (!haptics) return haptics.error();
+      haptics_ = std::move(haptics).value();
+    }
+    return Ok{};
   }
 
-  nlohmann::json summary;
-  summary["scene"] = scene.spec.name;
-  summary["scene_file"] = scene.spec.file;
-  summary["steps_requested"] = steps;
-  summary["steps"] = outcome.steps_done;
-  summary["dt"] = world.settings().solver.time_step;
-  summary["simulated_time"] = world.time();
-  summary["linear_solver"] = toString(world.settings().solver.linear_solver);
-  summary["preconditioner"] = toString(world.settings().solver.preconditioner);
-  summary["tolerance"] = world.settings().solver.tolerance;
-  summary["threads"] = world.settings().solver.threads;
-  summary["ms_per_step"] = {{"median", percentile(step_ms, 0.5)},
-                            {"p95", percentile(step_ms, 0.95)}};
-  summary["solver_iterations"] = {
-      {"mean", outcome.steps_done > 0 ? double(iteration_sum) / outcome.steps_done : 0.0},
-      {"max", iteration_max}};
-  summary["bodies"] = nlohmann::json::array();
-  for (const auto& body : world.bodies()) {
-    summary["bodies"].push_back({{"name", body->name()},
-                                 {"nodes", body->model().nodeCount()},
-                                 {"element", toString(body->model().elementKind())},
-                                 {"tets", body->model().elementCount()},
-                                 {"mass_kg", body->model().totalMass()}});
+  // Records the error in summary.json when it can still be written, and returns it.
+  Error fail(Error error) {
+    error_ = error.message;
+    if (dir_) {
+      if (scene_.haptics) (void)scene_.haptics->finish(dir_->directory());
+      (void)dir_->writeSummary(summary());
+    }
+    return error;
   }
-  summary["node_sets"] = nlohmann::json::array();
-  for (const NodeSetHandle& s : scene.node_sets) {
-    summary["node_sets"].push_back(
-        {{"name", s.name}, {"body", s.body->name()}, {"nodes", s.node_count}});
+
+  nlohmann::json summary() const {
+    nlohmann::json summary;
+    summary["completed"] = outcome_.completed;
+    if (outcome_.stopped_by != 0) summary["stopped_by"] = signalName(outcome_.stopped_by);
+    if (!error_.empty()) summary["error"] = error_;
+    summary["scene"] = scene_.spec.name;
+    summary["scene_file"] = scene_.spec.file;
+    summary["steps_requested"] = steps_;
+    summary["steps"] = outcome_.steps_done;
+    summary["dt"] = world_.settings().solver.time_step;
+    summary["simulated_time"] = world_.time();
+    summary["linear_solver"] = toString(world_.settings().solver.linear_solver);
+    summary["preconditioner"] = toString(world_.settings().solver.preconditioner);
+    summary["tolerance"] = world_.settings().solver.tolerance;
+    summary["threads"] = Parallel::usableThreads(world_.settings().solver.threads);  // used
+    summary["ms_per_step"] = {{"median", percentile(step_ms_, 0.5)},
+                              {"p95", percentile(step_ms_, 0.95)}};
+    summary["solver_iterations"] = {
+        {"mean", outcome_.steps_done > 0 ? double(iteration_sum_) / outcome_.steps_done : 0.0},
+        {"max", iteration_max_}};
+    summary["bodies"] = nlohmann::json::array();
+    for (const auto& body : world_.bodies()) {
+      summary["bodies"].push_back({{"name", body->name()},
+                                   {"nodes", body->model().nodeCount()},
+                                   {"element", toString(body->model().elementKind())},
+                                   {"tets", body->model().elementCount()},
+                                   {"mass_kg", body->model().totalMass()}});
+    }
+    summary["node_sets"] = nlohmann::json::array();
+    for (const NodeSetHandle& s : scene_.node_sets) {
+      summary["node_sets"].push_back(
+          {{"name", s.name}, {"body", s.body->name()}, {"nodes", s.node_count}});
+    }
+    summary["hands"] = nlohmann::json::array();
+    for (const SceneHand& h : scene_.hands) {
+      summary["hands"].push_back(
+          {{"name", h.spec.name},
+           {"body", h.spec.body},
+           {"grabbed_nodes", static_cast<int>(h.hand->selection().nodes.size())},
+           {"holding_at_end", h.hand->grabbed()}});
+    }
+    if (scene_.haptics) {
+      summary["haptics"] = haptics_.is_null() ? nlohmann::json::array() : haptics_;
+      summary["haptic_warnings"] = scene_.haptics->warnings();
+    }
+    if (!scene_.rigid_bodies.empty() || scene_.spec.ground)
+      summary["contacts"] = contact_totals_.json();
+    summary["anomalies"] = anomalies_.json();
+    if (options_.stop_on_anomaly)
+      summary["stopped_on_anomaly"] = !outcome_.stopped_on_anomaly.empty();
+    summary["stable"] = outcome_.stable;
+    if (!outcome_.stable) summary["failure"] = outcome_.failure;
+    summary["outputs"] = outputNames();
+    return summary;
   }
-  summary["hands"] = nlohmann::json::array();
-  for (const SceneHand& h : scene.hands) {
-    summary["hands"].push_back(
-        {{"name", h.spec.name},
-         {"body", h.spec.body},
-         {"grabbed_nodes", static_cast<int>(h.hand->selection().nodes.size())},
-         {"holding_at_end", h.hand->grabbed()}});
-  }
-  if (scene.haptics) {  // stops the haptic threads, writes haptic_<hand>.csv
-    Result<nlohmann::json> haptics = scene.haptics->finish(out.string());
-    if (!haptics) return haptics.error();
-    summary["haptics"] = std::move(haptics).value();
-    summary["haptic_warnings"] = scene.haptics->warnings();
-  }
-  if (!scene.rigid_bodies.empty() || scene.spec.ground) summary["contacts"] = contact_totals.json();
-  summary["anomalies"] = anomalies.json();
-  if (options.stop_on_anomaly) summary["stopped_on_anomaly"] = !outcome.stopped_on_anomaly.empty();
-  summary["stable"] = outcome.stable;
-  if (!outcome.stable) summary["failure"] = outcome.failure;
-  std::ofstream(out / "summary.json") << summary.dump(2) << "\n";
-  return outcome;
+
+  BuiltScene& scene_;
+  FemWorld& world_;
+  const RunOptions& options_;
+  const int steps_;
+  std::vector<NamedRigidBody> rigid_bodies_;
+  std::optional<RunDirectory> dir_;
+  CsvOutput wrench_csv_, energy_csv_, rigid_csv_;
+  std::vector<Eigen::VectorXd> last_good_;
+  RunOutcome outcome_;
+  std::vector<double> step_ms_;  // grows with the steps done, never reserved for the requested
+  long iteration_sum_ = 0;
+  int iteration_max_ = 0;
+  ContactTotals contact_totals_;
+  SceneAnomalies anomalies_;  // after world_: built from it
+  nlohmann::json haptics_;
+  std::string error_;
+};
+
+}  // namespace
+
+Result<RunOutcome> runScene(BuiltScene& scene, const RunOptions& options) {
+  return Run(scene, options).execute();
 }
 
 }  // namespace torsion::scene

@@ -7,6 +7,10 @@
 //                 set's wrench_about point
 //   energy.csv    per step, per body: kinetic and elastic energy
 //   <body>.vtk    final mesh of each body with its displacement (last good state on failure)
+//   rigid.csv     per step, per rigid body: pose and velocity (scenes with rigid bodies)
+//   haptic_<hand>.csv  the haptic loop's log per device hand
+// How the directory is kept consistent across runs and stops (completed, error, signal, kill):
+// run_directory.h and docs/outputs.md.
 
 #include <functional>
 #include <string>
@@ -22,6 +26,9 @@ struct RunOptions {
   std::function<void(int, int, double)> progress;
   /// Stop after the step in which the first anomaly (scene_anomalies.h) starts.
   bool stop_on_anomaly = false;
+  /// Polled after every step: a signal number (SIGINT, SIGTERM) stops the run there, with every
+  /// output written for the steps done; 0 goes on.
+  std::function<int()> stop_requested;
 };
 
 struct RunOutcome {
@@ -30,9 +37,12 @@ struct RunOutcome {
   int steps_done = 0;
   /// With RunOptions::stop_on_anomaly: the anomaly the run stopped at ("" when it did not).
   std::string stopped_on_anomaly;
+  int stopped_by = 0;      ///< the signal that stopped the run, 0 if none
+  bool completed = false;  ///< every requested step ran and every output was written
 };
 
-/// Errors are for output that cannot be written; an unstable simulation is a RunOutcome.
+/// Errors are for output that cannot be written (summary.json then says "completed": false and
+/// the error, when it can still be written); an unstable simulation is a RunOutcome.
 Result<RunOutcome> runScene(BuiltScene& scene, const RunOptions& options);
 
 }  // namespace torsion::scene

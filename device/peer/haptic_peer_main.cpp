@@ -95,6 +95,7 @@ int main(int argc, char** argv) {
           << ',' << w.torque.y << ',' << w.torque.z << ',' << p.newestEcho() << '\n';
     }
   }
+  p.sayGoodbye(monotonicSeconds() - origin);  // frees the simulation's device for another peer
   const PacketStats& s = p.stats();
   std::fprintf(stderr, "peer: sent %llu poses, accepted %llu wrenches, rejected %llu\n",
                static_cast<unsigned long long>(s.sent.load()),

@@ -5,8 +5,9 @@
 #include <time.h>
 
 #include <cmath>
-#include <fstream>
+#include <sstream>
 
+#include "torsion/device/file_io.h"
 #include "torsion/device/pose_math.h"
 
 namespace torsion::device {
@@ -185,9 +186,8 @@ void HapticLoop::setLogCapacity(std::size_t rows) {
   log_.reserve(rows);
 }
 
-bool HapticLoop::writeLog(const std::string& path) const {
-  std::ofstream out(path);
-  if (!out) return false;
+bool HapticLoop::writeLog(const std::string& path, std::string* error) const {
+  std::ostringstream out;
   out.precision(10);
   out << "tick,time,period_ms,lateness_ms,px,py,pz,qw,qx,qy,qz,buttons,alive,"
          "fx,fy,fz,tx,ty,tz,sim_fx,sim_fy,sim_fz,sim_tx,sim_ty,sim_tz,"
@@ -205,7 +205,9 @@ bool HapticLoop::writeLog(const std::string& path) const {
         << s.torque.z << ',' << r.sim_step << ',' << 1e3 * r.wrench_age << ',' << r.pose_lag_ticks
         << ',' << r.grabbed << ',' << r.fresh << '\n';
   }
-  return static_cast<bool>(out);
+  const std::string failure = writeFileAtomically(path, out.str());
+  if (error != nullptr) *error = failure;
+  return failure.empty();
 }
 
 }  // namespace torsion::device

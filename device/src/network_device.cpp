@@ -26,6 +26,10 @@ NetworkDevice::NetworkDevice(const NetworkDeviceSettings& settings,
                              std::shared_ptr<UdpSocket> socket)
     : settings_(settings), socket_(std::move(socket)) {}
 
+NetworkDevice::~NetworkDevice() {
+  write(Wrench{});
+}
+
 std::string NetworkDevice::name() const {
   return "network(udp port " + std::to_string(socket_->local().port) + ")";
 }
@@ -41,11 +45,22 @@ DeviceSample NetworkDevice::read(double time) {
       ++stats_.truncated;  // longer than any packet
       continue;
     }
+    if (have_peer_ && !(from == peer_)) {
+      if (time - last_accepted_time_ <= settings_.session_timeout) {
+        ++stats_.foreign;  // the session belongs to its first peer
+        continue;
+      }
+      endSession();  // the bound peer went silent: the session is over
+    }
     if (!filter_.accept(buffer, kept, packet, stats_)) continue;
     newest_ = packet;
     peer_ = from;
     have_peer_ = true;
     last_accepted_time_ = time;
+    if (packet.goodbye) {
+      endSession();
+      break;  // the goodbye is the session's last word: later datagrams wait for the next read
+    }
   }
   DeviceSample sample;
   sample.time = time;
@@ -53,6 +68,14 @@ DeviceSample NetworkDevice::read(double time) {
   sample.buttons = newest_.buttons;
   sample.alive = have_peer_ && newest_.flag && time - last_accepted_time_ <= settings_.timeout;
   return sample;
+}
+
+void NetworkDevice::endSession() {
+  write(Wrench{});  // the departing peer's device must not keep the last force
+  have_peer_ = false;
+  newest_ = Packet{};
+  filter_ = PacketFilter(PacketKind::kPose);  // the next peer's sequence starts afresh
+  last_accepted_time_ = -1e300;
 }
 
 void NetworkDevice::write(const Wrench& wrench) {

@@ -23,12 +23,17 @@ void NetworkPeer::tick(double time) {
   drain();
 }
 
+void NetworkPeer::sayGoodbye(double time) {
+  sendPose(++sequence_, trajectory_.poseAt(time), trajectory_.buttonsAt(time), false, true);
+}
+
 void NetworkPeer::sendPose(std::uint32_t sequence, const Pose& pose, std::uint32_t buttons,
-                           bool alive) {
+                           bool alive, bool goodbye) {
   Packet packet;
   packet.kind = PacketKind::kPose;
   packet.sequence = sequence;
   packet.flag = alive;
+  packet.goodbye = goodbye;
   packet.timestamp_ns =
       static_cast<std::uint64_t>(std::chrono::duration_cast<std::chrono::nanoseconds>(
                                      std::chrono::steady_clock::now().time_since_epoch())

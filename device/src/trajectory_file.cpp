@@ -5,10 +5,10 @@
 //    "buttons": [{"time": s, "held": [1]}, ...]}                        optional
 // Rotations are rotation vectors (axis * angle, rad) in the device frame.
 #include <cmath>
-#include <fstream>
 #include <nlohmann/json.hpp>
-#include <sstream>
 
+#include "torsion/device/file_io.h"
+#include "torsion/device/json_check.h"
 #include "torsion/device/pose_math.h"
 #include "torsion/device/trajectory.h"
 
@@ -113,12 +113,14 @@ std::vector<ButtonEvent> buttons(const json& list) {
 }  // namespace
 
 Loaded<Trajectory> parseTrajectory(const std::string& json_text, const std::string& source) {
-  json root;
-  try {
-    root = json::parse(json_text);
-  } catch (const json::parse_error& e) {
-    return Loaded<Trajectory>::fail(source + ": not valid JSON: " + e.what());
+  // A strict pass first: duplicate keys, numbers beyond a double and syntax, with a position.
+  if (const auto fault = findJsonTextFault(json_text)) {
+    const std::string where =
+        fault->line > 0 ? ":" + std::to_string(fault->line) + ":" + std::to_string(fault->column)
+                        : std::string();
+    return Loaded<Trajectory>::fail(source + where + ": not valid JSON: " + fault->what);
   }
+  const json root = json::parse(json_text);
   try {
     if (!root.is_object()) throw BadKey{"top level: expected an object"};
     if (root.contains("segments") == root.contains("keyframes")) {
@@ -140,11 +142,10 @@ Loaded<Trajectory> parseTrajectory(const std::string& json_text, const std::stri
 }
 
 Loaded<Trajectory> loadTrajectory(const std::string& path) {
-  std::ifstream in(path);
-  if (!in) return Loaded<Trajectory>::fail(path + ": cannot open the trajectory file");
-  std::stringstream text;
-  text << in.rdbuf();
-  return parseTrajectory(text.str(), path);
+  std::string text;
+  if (std::string error = readRegularFile(path, text); !error.empty())
+    return Loaded<Trajectory>::fail(error);
+  return parseTrajectory(text, path);
 }
 
 }  // namespace torsion::device

@@ -49,7 +49,7 @@ PacketBytes encodePacket(const Packet& packet) {
   put(&b[4], kPacketVersion);
   put(&b[6], static_cast<std::uint16_t>(packet.kind));
   put(&b[8], packet.sequence);
-  put(&b[12], static_cast<std::uint32_t>(packet.flag ? 1 : 0));
+  put(&b[12], static_cast<std::uint32_t>((packet.flag ? 1u : 0u) | (packet.goodbye ? 2u : 0u)));
   put(&b[16], packet.timestamp_ns);
   double values[7] = {};
   if (packet.kind == PacketKind::kPose) {
@@ -81,6 +81,7 @@ PacketError decodePacket(const unsigned char* bytes, std::size_t size, Packet& o
   out.kind = static_cast<PacketKind>(kind);
   out.sequence = get<std::uint32_t>(bytes + 8);
   out.flag = (get<std::uint32_t>(bytes + 12) & 1u) != 0;
+  out.goodbye = (get<std::uint32_t>(bytes + 12) & 2u) != 0;
   out.timestamp_ns = get<std::uint64_t>(bytes + 16);
   double v[7];
   for (int k = 0; k < 7; ++k) {

@@ -38,6 +38,25 @@ TEST(HandCoupling, ZeroAtRestAndAfterRelease) {
   EXPECT_EQ(rig.published.stiffness[0], 0.0);
 }
 
+TEST(HandCoupling, AnEnormousPoseIsDroppedAndCountedNotFollowed) {
+  // 1.7e308 m is a finite double and passes the packet check; scaled by the mapping it would
+  // overflow, and unscaled it would drag the hand out of the arithmetic's range.
+  CouplingRig rig(2430, quasiStatic());
+  rig.step(device::Pose{});
+  ASSERT_TRUE(rig.published.grabbed);
+  const Eigen::Vector3d held = rig.coupling->goal().origin;
+  device::Pose wild;
+  wild.position.x = 1.7e308;
+  rig.step(wild);
+  EXPECT_EQ(rig.coupling->rejectedPoses(), 1u);
+  EXPECT_EQ(rig.coupling->goal().origin, held);  // the last good goal is held
+  EXPECT_TRUE(rig.hand->grabbed());
+  EXPECT_TRUE(std::isfinite(rig.coupling->worldWrench().force.norm()));
+  rig.step(displaced(0, 0.01));  // good poses are followed again
+  EXPECT_EQ(rig.coupling->rejectedPoses(), 1u);
+  EXPECT_NEAR(rig.coupling->goal().origin.x(), held.x() + 0.01, 1e-12);
+}
+
 TEST(HandCoupling, WrenchOpposesTheDisplacementOnEveryAxis) {
   for (Rendering rendering : {Rendering::kInternalForce, Rendering::kFrameDifference}) {
     for (int axis = 0; axis < 6; ++axis) {

@@ -43,6 +43,62 @@ TEST(NetworkDevice, PoseInWrenchOutRoundTrip) {
   EXPECT_EQ(l.device->stats().rejected(), 0u);
 }
 
+TEST(NetworkDevice, ASessionBelongsToItsFirstPeerUntilGoodbye) {
+  Loopback l = open();
+  auto intruder = NetworkPeer::open(l.device->local(), Trajectory({{0, Pose{{5, 5, 5}, {}}}}, {}));
+  ASSERT_TRUE(intruder) << intruder.error;
+  l.peer->tick(0.0);  // the first peer binds the session
+  (*intruder.value)->tick(0.0);
+  DeviceSample s = l.device->read(0.001);
+  EXPECT_DOUBLE_EQ(s.pose.position.z, 0.03);  // the intruder's pose was not taken
+  EXPECT_EQ(l.device->stats().foreign, 1u);
+  l.device->write({{1, 0, 0}, {0, 0, 0}});
+  (*intruder.value)->tick(0.002);
+  EXPECT_EQ((*intruder.value)->stats().accepted, 0u);  // no wrench went to the intruder
+
+  // Goodbye: the first peer gets a zero wrench and the device is free for the next peer.
+  l.peer->sayGoodbye(0.003);
+  s = l.device->read(0.004);
+  EXPECT_FALSE(s.alive);
+  (*intruder.value)->tick(0.005);
+  s = l.device->read(0.006);
+  EXPECT_TRUE(s.alive);
+  EXPECT_DOUBLE_EQ(s.pose.position.x, 5.0);
+  l.peer->tick(0.007);  // now the first peer is the stranger; its tick also drains its inbox
+  EXPECT_EQ(l.peer->newestWrench().force.x, 0.0);
+  (void)l.device->read(0.008);
+  // Foreign: the intruder's poses at 0 and 0.002 (before the goodbye), the first peer's at 0.007.
+  EXPECT_EQ(l.device->stats().foreign, 3u);
+}
+
+TEST(NetworkDevice, ASilentPeerLosesItsSessionAfterTheSessionTimeout) {
+  Loopback l = open();
+  auto next = NetworkPeer::open(l.device->local(), Trajectory({{0, Pose{{5, 5, 5}, {}}}}, {}));
+  ASSERT_TRUE(next) << next.error;
+  l.peer->tick(0.0);
+  (void)l.device->read(0.0);
+  (*next.value)->tick(0.5);
+  EXPECT_DOUBLE_EQ(l.device->read(0.5).pose.position.x, 0.01);  // within the 1 s session
+  (*next.value)->tick(1.2);
+  const DeviceSample s = l.device->read(1.2);  // the first peer silent for 1.2 s
+  EXPECT_TRUE(s.alive);
+  EXPECT_DOUBLE_EQ(s.pose.position.x, 5.0);
+  EXPECT_EQ(l.device->stats().foreign, 1u);
+}
+
+TEST(NetworkDevice, ClosingSendsTheBoundPeerAZeroWrench) {
+  Loopback l = open();
+  l.peer->tick(0.0);
+  (void)l.device->read(0.001);
+  l.device->write({{3, 0, 0}, {0, 0, 0.5}});
+  l.peer->tick(0.002);
+  ASSERT_EQ(l.peer->newestWrench().force.x, 3.0);
+  l.device.reset();  // whatever ends the run (signal, error) destroys the device
+  l.peer->tick(0.003);
+  EXPECT_EQ(l.peer->newestWrench().force.x, 0.0);
+  EXPECT_EQ(l.peer->newestWrench().torque.z, 0.0);
+}
+
 TEST(NetworkDevice, BadPacketsAreDroppedAndCounted) {
   Loopback l = open();
   const Pose good{{0.05, 0, 0}, {}};

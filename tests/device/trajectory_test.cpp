@@ -72,5 +72,25 @@ TEST(Trajectory, BadFilesNameTheKey) {
               "buttons[0].held");
 }
 
+TEST(Trajectory, NumbersBeyondADoubleAndDuplicateKeysAreErrorsNotAbortsOrSilentChoices) {
+  // nlohmann throws out_of_range (not parse_error) on 1e400, and keeps the last of two equal
+  // keys: both must come back as errors naming the place.
+  Loaded<Trajectory> big = parseTrajectory(R"({"segments": [{"duration": 1e400}]})", "big.json");
+  ASSERT_FALSE(big);
+  EXPECT_EQ(big.error, "big.json:1:28: not valid JSON: number out of range of a double: 1e400");
+  Loaded<Trajectory> twice =
+      parseTrajectory(R"({"segments": [{"duration": 1, "duration": 2}]})", "twice.json");
+  ASSERT_FALSE(twice);
+  EXPECT_EQ(twice.error,
+            "twice.json: not valid JSON: duplicate key 'duration' in object 'segments[0]'");
+}
+
+TEST(Trajectory, OnlyRegularFilesAreRead) {
+  // A FIFO would block the reader forever and /dev/zero never ends: both refused at once.
+  Loaded<Trajectory> zero = loadTrajectory("/dev/zero");
+  ASSERT_FALSE(zero);
+  EXPECT_EQ(zero.error, "/dev/zero: cannot open: is a character device, not a regular file");
+}
+
 }  // namespace
 }  // namespace torsion::device

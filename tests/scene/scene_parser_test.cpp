@@ -84,9 +84,30 @@ TEST(SceneParserFaults, UnknownKeyIsNamedWithItsPath) {
   // A misspelt optional key is an unknown key; a misspelt required one is named as both.
   EXPECT_TRUE(failsWith(parse(replaced(kValid, "\"linear_solver\"", "\"linearsolver\"")),
                         {"s.json: solver.linearsolver: unknown key", "linear_solver"}));
+  EXPECT_TRUE(failsWith(parse(replaced(kValid, "\"density\"", "\"densty\"")),
+                        {"s.json: bodies[0].material.density: missing (required); did you mean "
+                         "'densty'?"}));
+}
+
+TEST(SceneParserFaults, AMissingKeyDoesNotCallValidKeysNotYetReadUnknown) {
+  // "name" is read first: "mesh", "material" and "pose" are valid keys read after it.
+  const Result<SceneSpec> spec = parse(replaced(kValid, "\"name\": \"cyl\", ", ""));
+  ASSERT_FALSE(spec.ok());
+  EXPECT_EQ(spec.error().message, "s.json: bodies[0].name: missing (required)");
+}
+
+TEST(SceneParserFaults, BadValuesAreShownInShortestForm) {
+  // std::to_string showed -1e-9 as "-0.000000", hiding the value that was wrong.
   EXPECT_TRUE(
-      failsWith(parse(replaced(kValid, "\"density\"", "\"densty\"")),
-                {"s.json: bodies[0].material.density: missing", "unknown key(s) 'densty'"}));
+      failsWith(parse(replaced(kValid, "\"youngs_modulus\": 1e5", "\"youngs_modulus\": -1e-9")),
+                {"youngs_modulus = -1e-09: must be > 0 Pa"}));
+}
+
+TEST(SceneParserFaults, DuplicateKeysAndHugeNumbersAreNamed) {
+  EXPECT_TRUE(failsWith(parse(replaced(kValid, "\"steps\": 50", "\"steps\": 50, \"steps\": 5")),
+                        {"s.json: invalid JSON: duplicate key 'steps' in the top-level object"}));
+  EXPECT_TRUE(failsWith(parse(replaced(kValid, "\"steps\": 50", "\"steps\": 5e999")),
+                        {"s.json:4:12: invalid JSON: number out of range of a double: 5e999"}));
 }
 
 TEST(SceneParserFaults, WrongTypeIsNamed) {

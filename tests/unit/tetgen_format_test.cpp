@@ -44,6 +44,21 @@ TEST(TetGen, ReadsOneBasedWithAttributesMarkersAndComments) {
   EXPECT_EQ(raw.value().origins[0].id, 1);
 }
 
+TEST(TetGen, ReadsAByteOrderMarkAndWindowsLineEndings) {
+  // Editors on Windows save "\xEF\xBB\xBF" first and end lines in CR LF.
+  auto windows = [](const std::string& text) {
+    std::string out = "\xEF\xBB\xBF";
+    for (char c : text)
+      out += c == '\n' ? std::string("\r\n") : std::string(1, c);
+    return out;
+  };
+  Result<RawTetMesh> raw = parse(windows(test::kCubeNode), windows(test::kCubeEle));
+  ASSERT_TRUE(raw.ok()) << raw.error().message;
+  EXPECT_EQ(raw.value().positions.size(), 8u);
+  EXPECT_EQ(raw.value().tets.size(), 5u);
+  EXPECT_EQ(raw.value().positions[7], Eigen::Vector3d(1, 1, 1));
+}
+
 TEST(TetGen, RoundTripsThroughItsWriter) {
   Result<LoadedMesh> first = buildTetMesh(parse(test::kCubeNode, test::kCubeEle).value());
   ASSERT_TRUE(first.ok());

@@ -655,6 +655,7 @@ LinearSolveReport RigidContactSolver::solve(const SystemOperator& op,
     total.relative_residual = r.relative_residual;
     total.converged = r.converged;
     total.breakdown = total.breakdown || r.breakdown;
+    if (r.breakdown_reason != nullptr) total.breakdown_reason = r.breakdown_reason;
     ++stats_.active_set_iterations;
 
     expand(q_, v);

@@ -3,6 +3,8 @@
 #include <cmath>
 #include <string>
 
+#include "torsion/format_number.h"
+
 namespace torsion {
 
 const char* toString(VolumetricStrain kind) {
@@ -17,7 +19,7 @@ std::optional<VolumetricStrain> parseVolumetricStrain(const std::string& name) {
 
 Status Material::validate() const {
   auto bad = [](const char* field, double value, const char* rule) {
-    return Error{std::string("material: ") + field + " = " + std::to_string(value) + ": " + rule};
+    return Error{std::string("material: ") + field + " = " + formatNumber(value) + ": " + rule};
   };
   if (!(std::isfinite(youngs_modulus) && youngs_modulus > 0))
     return bad("youngs_modulus", youngs_modulus, "must be > 0 Pa");

@@ -38,8 +38,15 @@ HandCoupling::HandCoupling(Hand& hand, const DeviceMapping& mapping,
 Status HandCoupling::apply(const device::HandCommand& command, double now) {
   command_tick_ = command.tick;
   if (command.alive) {  // a dead device's pose is stale: hold the last goal
-    goal_pose_ = command.pose;
-    goal_ = mapping_.toWorld(command.pose);
+    // Validated after the mapping: a finite but enormous packet position overflows once scaled.
+    const Frame mapped = mapping_.toWorld(command.pose);
+    if (mapped.origin.allFinite() && mapped.origin.cwiseAbs().maxCoeff() <= kMaxHandReach &&
+        mapped.rotation.coeffs().allFinite()) {
+      goal_pose_ = command.pose;
+      goal_ = mapped;
+    } else {
+      ++rejected_poses_;
+    }
   }
   // Counters, not edges: several presses between two steps still count once each, in order.
   const bool release = command.release_requests != releases_seen_;

@@ -1,10 +1,6 @@
 #include "torsion/mesh/mesh_io.h"
 
-#include <cerrno>
-#include <cstring>
-#include <fstream>
-#include <sstream>
-
+#include "torsion/device/file_io.h"
 #include "torsion/mesh/gmsh_format.h"
 #include "torsion/mesh/tetgen_format.h"
 #include "torsion/mesh/vtk_format.h"
@@ -42,21 +38,19 @@ Result<MeshFormat> meshFormatOf(const fs::path& path) {
   if (ext.empty()) {
     fs::path node = path;
     node += ".node";
-    if (fs::exists(node)) return MeshFormat::kTetGen;
+    // error_code form: a name too long or a directory we may not search is "not found" here,
+    // and the reader then reports the real reason instead of an exception aborting the program.
+    std::error_code ec;
+    if (fs::exists(node, ec)) return MeshFormat::kTetGen;
   }
   return Error{path.string() + ": unknown mesh format '" + ext +
                "' (known: .node/.ele for TetGen, .msh for Gmsh 2.2/4.1, .vtk for legacy VTK)"};
 }
 
 Result<std::string> readTextFile(const fs::path& path) {
-  std::error_code ec;
-  if (fs::is_directory(path, ec)) return Error{path.string() + ": cannot open: is a directory"};
-  std::ifstream in(path, std::ios::binary);
-  if (!in) return Error{path.string() + ": cannot open: " + std::strerror(errno)};
-  std::ostringstream text;
-  text << in.rdbuf();
-  if (in.bad()) return Error{path.string() + ": read error: " + std::strerror(errno)};
-  std::string content = std::move(text).str();
+  std::string content;
+  if (std::string error = device::readRegularFile(path.string(), content); !error.empty())
+    return Error{error};
   if (content.find_first_not_of(" \t\r\n") == std::string::npos) {
     return Error{path.string() + ": file is empty"};
   }
@@ -64,18 +58,8 @@ Result<std::string> readTextFile(const fs::path& path) {
 }
 
 Status writeTextFile(const fs::path& path, const std::string& text) {
-  fs::path temp = path;
-  temp += ".partial";
-  {
-    std::ofstream out(temp, std::ios::binary | std::ios::trunc);
-    if (!out) return Error{path.string() + ": cannot write: " + std::strerror(errno)};
-    out << text;
-    out.flush();
-    if (!out) return Error{path.string() + ": write failed: " + std::strerror(errno)};
-  }
-  std::error_code ec;
-  fs::rename(temp, path, ec);
-  if (ec) return Error{path.string() + ": cannot write: " + ec.message()};
+  if (std::string error = device::writeFileAtomically(path.string(), text); !error.empty())
+    return Error{error};
   return Ok{};
 }
 
@@ -119,10 +103,12 @@ Status writeMesh(const fs::path& path, const TetMesh& mesh, const MeshFields& fi
       fs::path node_path = base, ele_path = base;
       node_path += ".node";
       ele_path += ".ele";
-      const TetGenText text = formatTetGen(mesh);
-      Status node_written = writeTextFile(node_path, text.node);
-      if (!node_written) return node_written;
-      return writeTextFile(ele_path, text.ele);
+      // Both files or neither: a .node beside a stale .ele would be a different mesh.
+      TetGenText text = formatTetGen(mesh);
+      const std::string error = device::writeFilesTogether(
+          {{node_path.string(), std::move(text.node)}, {ele_path.string(), std::move(text.ele)}});
+      if (!error.empty()) return Error{error};
+      return Ok{};
     }
     case MeshFormat::kGmsh:
       return writeTextFile(path, formatGmsh41(mesh));

@@ -13,7 +13,10 @@ bool isSpace(char c) {
 }  // namespace
 
 TextScanner::TextScanner(std::string_view text, std::string file_name, char comment)
-    : text_(text), file_name_(std::move(file_name)), comment_(comment) {}
+    : text_(text), file_name_(std::move(file_name)), comment_(comment) {
+  // A UTF-8 byte order mark, as some editors save it, is not part of the first line.
+  if (text_.substr(0, 3) == "\xEF\xBB\xBF") pos_ = 3;
+}
 
 bool TextScanner::readRawLine() {
   if (pos_ >= text_.size()) return false;

@@ -290,19 +290,20 @@ LinearSolveReport CholmodSolver::solve(const SystemOperator& op, const NodeConst
   m.rhs = b - m.q;
   constraints.filter(m.rhs);
   const double reference = m.rhs.norm();
+  report.relative_residual = std::numeric_limits<double>::infinity();
+  if (!std::isfinite(reference))  // an overflowed system must not pass as solved
+    return brokenDown(report, "the right-hand side or the matrix is not finite (overflow)");
 
   const Eigen::SparseMatrix<double>& A = assemble(op, constraints);
+  if (!Eigen::Map<const Eigen::VectorXd>(A.valuePtr(), A.nonZeros()).allFinite())
+    return brokenDown(report, "the matrix is not finite (overflow)");
   if (!m.analysed) {
     m.factor.analyzePattern(A);
     m.analysed = true;
   }
   m.factor.factorize(A);
-  if (m.factor.info() != Eigen::Success) {
-    report.converged = false;
-    report.breakdown = true;
-    report.relative_residual = std::numeric_limits<double>::infinity();
-    return report;
-  }
+  if (m.factor.info() != Eigen::Success)
+    return brokenDown(report, "the Cholesky factorisation failed (matrix not positive definite)");
   m.solution = m.factor.solve(m.rhs);
   constraints.filter(m.solution);
   v = m.prescribed + m.solution;
@@ -312,7 +313,9 @@ LinearSolveReport CholmodSolver::solve(const SystemOperator& op, const NodeConst
   m.rhs = b - m.q;
   constraints.filter(m.rhs);
   report.relative_residual = reference > 0 ? m.rhs.norm() / reference : 0.0;
-  report.converged = std::isfinite(report.relative_residual) && report.relative_residual < 1e-6;
+  if (!std::isfinite(report.relative_residual) || !v.allFinite())
+    return brokenDown(report, "the residual or the solution became non-finite");
+  report.converged = report.relative_residual < 1e-6;
   return report;
 }
 

@@ -192,8 +192,9 @@ StepReport ImplicitStepper::step(FemState& state, const NodeConstraints& constra
     std::ostringstream s;
     s << "linear solver " << (report.solve.breakdown ? "broke down" : "did not converge")
       << " after " << report.solve.iterations << " iterations at relative residual "
-      << report.solve.relative_residual << " (tolerance " << settings_.tolerance
-      << ", max_iterations " << settings_.max_iterations
+      << report.solve.relative_residual
+      << (report.solve.breakdown_reason ? std::string(": ") + report.solve.breakdown_reason : "")
+      << " (tolerance " << settings_.tolerance << ", max_iterations " << settings_.max_iterations
       << "): the system is indefinite or badly conditioned; raise max_iterations, reduce dt, or "
          "use cholmod";
     report.message = s.str();

@@ -2,13 +2,15 @@
 
 #include <cmath>
 
+#include "torsion/format_number.h"
+
 namespace torsion {
 
 Status SolverSettings::validate() const {
   if (!(std::isfinite(time_step) && time_step > 0 && time_step <= 1))
-    return Error{"solver: time_step = " + std::to_string(time_step) + ": must be in (0, 1] s"};
+    return Error{"solver: time_step = " + formatNumber(time_step) + ": must be in (0, 1] s"};
   if (!(std::isfinite(tolerance) && tolerance > 0 && tolerance < 1))
-    return Error{"solver: tolerance = " + std::to_string(tolerance) + ": must be in (0, 1)"};
+    return Error{"solver: tolerance = " + formatNumber(tolerance) + ": must be in (0, 1)"};
   if (max_iterations < 1)
     return Error{"solver: max_iterations = " + std::to_string(max_iterations) + ": must be >= 1"};
   if (threads < 0) return Error{"solver: threads = " + std::to_string(threads) + ": must be >= 0"};

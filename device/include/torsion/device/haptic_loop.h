@@ -95,8 +95,9 @@ class HapticLoop {
   const std::vector<LoopLogRow>& log() const { return log_; }
   /// Keeps at most `rows` log rows (reserved now); only while the loop is not running.
   void setLogCapacity(std::size_t rows);
-  /// Writes the log as CSV; false when the file cannot be written.
-  bool writeLog(const std::string& path) const;
+  /// Writes the log as CSV, whole or not at all (file_io.h); false when the file cannot be
+  /// written, with the reason ("<path>: cannot write: <strerror>") in *error when given.
+  bool writeLog(const std::string& path, std::string* error = nullptr) const;
   const Wrench& lastOutput() const { return safety_.output(); }
   bool forceEnabled() const { return force_enabled_; }
 

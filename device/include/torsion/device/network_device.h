@@ -2,8 +2,12 @@
 // A device in another process, over UDP (loopback by default): pose packets in, wrench packets
 // out, in the format of udp_packet.h. A vendor's force-feedback driver (their SDKs are
 // proprietary) runs as its own process and speaks this format; network_peer.h is the reference
-// peer. The device answers to whoever sent the newest accepted pose. It is alive while accepted
-// packets flagged alive keep arriving within `timeout`.
+// peer. It is alive while accepted packets flagged alive keep arriving within `timeout`.
+//
+// Session: the first peer (address and port) whose valid pose arrives is bound; datagrams from
+// any other address are dropped and counted (PacketStats::foreign) until the session ends, either
+// by the peer's goodbye (a pose packet with flags bit 1; the device answers with a zero wrench) or
+// after `session_timeout` without an accepted pose from it. Then the next peer may bind.
 
 #include <memory>
 #include <string>
@@ -17,18 +21,21 @@ namespace torsion::device {
 struct NetworkDeviceSettings {
   UdpEndpoint local{0x7f000001, 5750};  ///< where poses arrive; port 0: any free port
   double timeout = 0.05;                ///< s without an accepted pose before the device is dead
+  double session_timeout = 1.0;         ///< s without an accepted pose before another peer may bind
   DeviceLimits limits;                  ///< of the device behind the peer
 };
 
 class NetworkDevice : public HapticDevice {
  public:
   static Loaded<std::unique_ptr<NetworkDevice>> open(const NetworkDeviceSettings& settings);
+  /// Sends a zero wrench to the peer before the socket closes, whatever ended the session.
+  ~NetworkDevice() override;
 
   std::string name() const override;
   DeviceLimits limits() const override { return settings_.limits; }
-  /// Drains every queued datagram, keeps the newest valid pose.
+  /// Drains every queued datagram, keeps the newest valid pose of the session's peer.
   DeviceSample read(double time) override;
-  /// Sends the wrench to the peer of the newest accepted pose (nothing before one arrived).
+  /// Sends the wrench to the session's peer (nothing while no peer is bound).
   void write(const Wrench& wrench) override;
 
   UdpEndpoint local() const { return socket_->local(); }
@@ -36,6 +43,7 @@ class NetworkDevice : public HapticDevice {
 
  private:
   NetworkDevice(const NetworkDeviceSettings& settings, std::shared_ptr<UdpSocket> socket);
+  void endSession();
 
   NetworkDeviceSettings settings_;
   std::shared_ptr<UdpSocket> socket_;

@@ -23,8 +23,11 @@ class NetworkPeer {
   void tick(double time);
   /// Sends raw bytes to the simulation (tests use it to inject bad packets).
   void sendRaw(const void* bytes, std::size_t size);
+  /// Ends the session: a last pose packet, not alive, with the goodbye flag (network_device.h).
+  void sayGoodbye(double time);
   /// Sends a pose packet with an explicit sequence number (tests: duplicates, reordering).
-  void sendPose(std::uint32_t sequence, const Pose& pose, std::uint32_t buttons, bool alive);
+  void sendPose(std::uint32_t sequence, const Pose& pose, std::uint32_t buttons, bool alive,
+                bool goodbye = false);
 
   const Wrench& newestWrench() const { return newest_.wrench; }
   std::uint32_t newestEcho() const { return newest_.echo_sequence; }

@@ -16,11 +16,13 @@ struct PacketStats {
   std::atomic<std::uint64_t> out_of_order{0};  ///< older than the newest accepted
   std::atomic<std::uint64_t> duplicate{0};     ///< same sequence as the newest accepted
   std::atomic<std::uint64_t> lost{0};          ///< gaps in the sequence (sent but never seen)
+  std::atomic<std::uint64_t> foreign{0};       ///< from another address than the session's peer
   std::atomic<std::uint64_t> sent{0};
   std::atomic<std::uint64_t> send_failed{0};
 
   std::uint64_t rejected() const {
-    return truncated.load() + malformed.load() + out_of_order.load() + duplicate.load();
+    return truncated.load() + malformed.load() + out_of_order.load() + duplicate.load() +
+           foreign.load();
   }
 };
 

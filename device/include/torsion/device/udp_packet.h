@@ -7,7 +7,8 @@
 //   4      2     version = 1
 //   6      2     kind: 1 = pose (peer -> simulation), 2 = wrench (simulation -> peer)
 //   8      4     sequence number, +1 per packet sent by that side (wraps modulo 2^32)
-//   12     4     flags: bit 0 alive (pose) / force enabled (wrench)
+//   12     4     flags: bit 0 alive (pose) / force enabled (wrench);
+//                bit 1 goodbye (pose): the peer's last packet, it ends the session
 //   16     8     timestamp, ns, sender's monotonic clock
 //   24     56    pose:   7 float64 px py pz (m) qw qx qy qz (unit quaternion)
 //                wrench: 6 float64 fx fy fz (N) tx ty tz (N m), then 8 bytes zero
@@ -34,7 +35,8 @@ enum class PacketKind : std::uint16_t { kPose = 1, kWrench = 2 };
 struct Packet {
   PacketKind kind = PacketKind::kPose;
   std::uint32_t sequence = 0;
-  bool flag = false;  ///< pose: device alive; wrench: force enabled
+  bool flag = false;     ///< pose: device alive; wrench: force enabled
+  bool goodbye = false;  ///< pose: the peer ends its session with this packet (flags bit 1)
   std::uint64_t timestamp_ns = 0;
   Pose pose;                        ///< kind pose
   Wrench wrench;                    ///< kind wrench

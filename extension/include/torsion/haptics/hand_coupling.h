@@ -54,7 +54,14 @@ class HandCoupling {
 
   /// Before FemWorld::step(): acts on `command` (grab, release, move). `now` is the world time.
   /// Returns an error when a requested grab found nothing to hold (the hand stays empty).
+  /// A pose whose world frame (after the mapping's scale) is not finite or farther than
+  /// kMaxHandReach from the origin is dropped and counted: the last goal is held.
   Status apply(const device::HandCommand& command, double now);
+  /// Poses dropped by apply() because their mapped frame was out of reach or not finite.
+  std::uint64_t rejectedPoses() const { return rejected_poses_; }
+
+  /// m: a device pose mapped beyond this is refused (a packet may carry 1.7e308).
+  static constexpr double kMaxHandReach = 1e6;
   /// After the step: the wrench for the loop, in device units. `step` is the world's step count.
   device::SimulationWrench publish(std::uint64_t step);
 
@@ -76,6 +83,7 @@ class HandCoupling {
   std::uint32_t grabs_seen_ = 0, releases_seen_ = 0;
   std::uint64_t command_tick_ = 0;
   device::Pose goal_pose_;
+  std::uint64_t rejected_poses_ = 0;
   Frame goal_;
   // BeginInteraction (Algorithm 3)
   Eigen::Vector3d rest_center_ = Eigen::Vector3d::Zero();

@@ -28,13 +28,16 @@ Result<MeshFormat> meshFormatOf(const std::filesystem::path& path);
 Result<LoadedMesh> readMesh(const std::filesystem::path& path, const MeshLoadOptions& options = {});
 
 /// Writes the mesh in the format of the path's extension (for TetGen, both .node and .ele beside
-/// each other). Fields are written only to VTK; other formats ignore them.
+/// each other, replaced together or not at all). Fields are written only to VTK; other formats
+/// ignore them.
 Status writeMesh(const std::filesystem::path& path, const TetMesh& mesh,
                  const MeshFields& fields = {});
 
 /// Whole file as text, or an Error: "<path>: cannot open: <reason>" / "<path>: file is empty".
+/// Only regular files are read, up to device::maxInputFileBytes() (torsion/device/file_io.h).
 Result<std::string> readTextFile(const std::filesystem::path& path);
-/// Writes text atomically enough for our use (temp + rename), or an Error naming the path.
+/// Replaces the file by the text or leaves it as it was (temporary beside it, flushed, renamed),
+/// or an Error naming the path and the reason.
 Status writeTextFile(const std::filesystem::path& path, const std::string& text);
 
 }  // namespace torsion

@@ -16,8 +16,10 @@ namespace torsion {
 
 class Parallel {
  public:
-  /// threads <= 0: as many as the machine has.
+  /// threads <= 0: as many as the machine has; more than it has: as many as it has.
   explicit Parallel(int threads = 0);
+  /// The threads a request gets: min(requested, cores), all cores for requested <= 0.
+  static int usableThreads(int requested);
 
   int threads() const { return threads_; }
 

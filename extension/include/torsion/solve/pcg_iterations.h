@@ -7,6 +7,7 @@
 
 #include <Eigen/Core>
 #include <cmath>
+#include <limits>
 
 #include "torsion/solve/projected_cg.h"
 
@@ -23,6 +24,13 @@ LinearSolveReport pcgIterations(const Apply& apply, const Precondition& precondi
                                 Eigen::VectorXd& x, Eigen::VectorXd& r, PcgScratch& s) {
   LinearSolveReport report;
   double residual = r.norm();
+  // Before the convergence test: inf <= tolerance * inf would pass an overflowed system as
+  // solved in 0 iterations. A norm overflows once entries pass ~1e154: the arithmetic cannot
+  // carry such a system either.
+  if (!std::isfinite(reference) || !std::isfinite(residual)) {
+    report.relative_residual = std::numeric_limits<double>::infinity();
+    return brokenDown(report, "the right-hand side or the matrix is not finite (overflow)");
+  }
   if (reference == 0.0 || residual <= settings.tolerance * reference) {
     report.relative_residual = reference > 0 ? residual / reference : 0.0;
     report.converged = true;
@@ -53,7 +61,8 @@ LinearSolveReport pcgIterations(const Apply& apply, const Precondition& precondi
     rz = rz_next;
   }
   report.relative_residual = residual / reference;
-  if (!std::isfinite(report.relative_residual)) report.breakdown = true;
+  if (!std::isfinite(report.relative_residual) || !x.allFinite())
+    return brokenDown(report, "the residual or the solution became non-finite");
   return report;
 }
 

@@ -22,7 +22,17 @@ struct LinearSolveReport {
   /// The solver could not proceed (non-positive curvature, non-finite numbers, failed
   /// factorisation): the result is meaningless, unlike a merely unconverged one.
   bool breakdown = false;
+  /// Why it broke down, when known: e.g. "the right-hand side is not finite". A static string.
+  const char* breakdown_reason = nullptr;
 };
+
+/// Marks a report as broken down for a reason (a static string) and returns it.
+inline LinearSolveReport brokenDown(LinearSolveReport report, const char* reason) {
+  report.converged = false;
+  report.breakdown = true;
+  report.breakdown_reason = reason;
+  return report;
+}
 
 /// Solves A v = b for the free components of v. On entry v holds the warm start; prescribed
 /// components are imposed from `constraints` first. Workspace vectors are reused across calls.

@@ -1,0 +1,26 @@
+#pragma once
+// Values a scene may state but the arithmetic cannot carry: refused at load, naming the bound,
+// instead of running into inf or NaN that a step would then report as converged or stable.
+
+#include "torsion/fem/material.h"
+#include "torsion/mesh/tet_mesh.h"
+#include "torsion/result.h"
+
+namespace torsion::scene {
+
+/// |gravity| above this (m/s^2, 10^5 g) is refused.
+inline constexpr double kMaxGravity = 1e6;
+/// The stiffness-to-inertia ratio E dt^2 / (rho h^2) (h: the shortest edge) above this is
+/// refused: the step's matrix entries and their squares in the solver's norms must stay finite.
+inline constexpr double kMaxStiffnessRatio = 1e100;
+/// Rigid-body lengths (sizes, margins, hull points) above this (m) are refused: Bullet forms
+/// inertias ~ mass * size^2 and products of them.
+inline constexpr double kMaxRigidLength = 1e6;
+
+/// "gravity: magnitude 1e+160 m/s^2 is above the bound 1e+06 m/s^2 ..." or Ok.
+Status checkGravity(const Eigen::Vector3d& gravity);
+
+/// Checks E dt^2 / (rho h^2) for a body's material on its mesh.
+Status checkStiffnessRatio(const Material& material, const TetMesh& mesh, double dt);
+
+}  // namespace torsion::scene
