@@ -5,6 +5,7 @@
 #include <algorithm>
 
 #include "torsion/bullet/bt_conversions.h"
+#include "torsion/bullet/rigid_health.h"
 
 namespace torsion {
 
@@ -126,6 +127,10 @@ WorldStepReport FemWorld::step() {
     report.ok = false;
     report.step = static_cast<int>(status.failed_step);
     report.message = status.message;
+  } else if (auto fault = findUnhealthyRigidBody(*world_)) {
+    // Bullet integrates an overflowing rigid body into NaN without complaint: not a good step.
+    report.ok = false;
+    report.message = "step " + std::to_string(report.step) + ": " + fault->message;
   }
   return report;
 }

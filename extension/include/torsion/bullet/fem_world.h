@@ -75,8 +75,9 @@ class FemWorld {
   /// removed from the world nor deleted by this FemWorld; its owner must keep it alive as long.
   void trackRigidBody(btRigidBody* body);
 
-  /// One step of settings().solver.time_step. After a failed step (ok false) the FEM bodies stay
-  /// where they were and every later step reports the same failure.
+  /// One step of settings().solver.time_step. Not ok when an FEM step failed (the FEM bodies then
+  /// stay where they were and every later step reports the same failure) or a rigid body became
+  /// non-finite or overflowed (bullet/rigid_health.h).
   WorldStepReport step();
 
   /// Live edit between steps (the viewer's dt and solver keys): the next steps use `solver`
