@@ -143,13 +143,16 @@ TEST(Anchors, ASoftBlockOnARigidPendulumSwingsWithoutGainingEnergy) {
   for (int k = 0; k < 3000; ++k) {
     user.world.stepSimulation(kDt, 0);
     ASSERT_TRUE(user.fem.status().ok) << user.fem.status().message;
-    const double e = femKineticEnergy(*block) +
-                     0.5 * mass * bob->getLinearVelocity().length2();  // + the bob's spin, small
+    const double e =
+        femKineticEnergy(*block) +
+        0.5 * mass *
+            static_cast<double>(bob->getLinearVelocity().length2());  // + the bob's spin, small
     peak = std::max(peak, e);
     highest = std::max(highest, static_cast<double>(bob->getCenterOfMassPosition().z()));
     worst_anchor = std::max(worst_anchor, anchorError(*block, *bob, top, local));
-    worst_rod = std::max(
-        worst_rod, std::abs((bob->getCenterOfMassTransform() * btVector3(0, 0, 0.475)).length()));
+    worst_rod = std::max(worst_rod,
+                         std::abs(static_cast<double>(
+                             (bob->getCenterOfMassTransform() * btVector3(0, 0, 0.475)).length())));
   }
   // It swings round the pivot (a quarter turn at least) without blowing up.
   EXPECT_GT(highest, 0);
@@ -189,7 +192,7 @@ TEST(Anchors, ASoftBlockOnALightMultibodyPendulumSwingsWithoutGainingEnergy) {
   // Bullet's revolute joint turns about -y for +x at the bottom: qdot = -v / r.
   block->setVelocity({1, 0, 0});
   pendulum->setJointVel(0, -1 / 0.475);
-  const double link_inertia = mass * 0.475 * 0.475 + inertia.y();
+  const double link_inertia = mass * 0.475 * 0.475 + static_cast<double>(inertia.y());
   auto energy = [&] {
     const double qdot = pendulum->getJointVel(0);
     return femKineticEnergy(*block) + 0.5 * link_inertia * qdot * qdot;
@@ -242,7 +245,8 @@ TEST(Anchors, NodesAnchoredToAKinematicBodyFollowItExactly) {
   // the next step.
   EXPECT_LT(worst, 1e-5);
   // The block hangs from the plate: it sags under its weight, it does not fall.
-  EXPECT_GT(block->state().position(0).z(), plate->getWorldTransform().getOrigin().z() - 0.2);
+  EXPECT_GT(block->state().position(0).z(),
+            static_cast<double>(plate->getWorldTransform().getOrigin().z()) - 0.2);
 }
 
 TEST(Anchors, ASoftBarAnchoredToAFreeMultibodyConservesMomentum) {

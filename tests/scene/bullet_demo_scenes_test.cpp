@@ -144,7 +144,7 @@ TEST(BulletDemoScenes, CollideKnocksTheCubeAwayAndKeepsTheMomentum) {
   for (int i = 0; i < cube.model().nodeCount(); ++i)
     p += cube.model().nodeMasses()[static_cast<size_t>(i)] * cube.state().velocity(i);
   const btRigidBody& box = *s->rigid_bodies.front().body;
-  p.z() += 0.5 * box.getLinearVelocity().z();
+  p.z() += 0.5 * static_cast<double>(box.getLinearVelocity().z());
   EXPECT_NEAR(p.z(), 15.0, 0.15);
   // The box stays below the cube: it hit it, did not pass through.
   EXPECT_LT(rigidPosition(*s, "box").z() + 2, lowestZ(cube) + 0.01);

@@ -10,7 +10,8 @@ namespace torsion {
 namespace {
 
 bool carried(btScalar v) {
-  return std::isfinite(v) && std::abs(v) <= kRigidMagnitudeLimit;
+  const double x = static_cast<double>(v);  // float Bullet: widened exactly
+  return std::isfinite(x) && std::abs(x) <= kRigidMagnitudeLimit;
 }
 
 bool carried(const btVector3& v) {
@@ -20,7 +21,8 @@ bool carried(const btVector3& v) {
 std::string describe(const btVector3& v) {
   std::ostringstream s;
   s.precision(6);
-  s << "(" << v.x() << ", " << v.y() << ", " << v.z() << ")";
+  s << "(" << static_cast<double>(v.x()) << ", " << static_cast<double>(v.y()) << ", "
+    << static_cast<double>(v.z()) << ")";
   return s.str();
 }
 
