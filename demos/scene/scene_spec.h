@@ -122,7 +122,7 @@ struct SceneSpec {
   /// Rigid bodies (and their constraints) from a Bullet .bullet file, resolved against the scene
   /// file's directory; empty: none.
   std::string bullet_file;
-  CameraSpec camera;                    ///< how pictures look at the scene (camera_spec.h)
+  CameraSpec camera;  ///< how pictures look at the scene (camera_spec.h)
   HapticsMode haptics_mode = HapticsMode::kAuto;  ///< not in the file: the CLI's --haptics
 };
 

@@ -235,12 +235,12 @@ FemState twistedRun(int threads, LinearSolverKind kind, int steps = 15,
 
 TEST(ImplicitStepper, SameResultForAnyThreadCount) {
   // 5184 tets and 1225 nodes: above every kernel's grain, so the 2-thread run really splits.
-  auto model = FemModel::create(std::make_shared<TetMesh>(
-                                    makeBoxTetMesh(Eigen::Vector3d(0, 0, 0),
-                                                   Eigen::Vector3d(4, 1, 1), 24, 6, 6)
-                                        .value()),
-                                Material{})
-                   .value();
+  auto model =
+      FemModel::create(
+          std::make_shared<TetMesh>(
+              makeBoxTetMesh(Eigen::Vector3d(0, 0, 0), Eigen::Vector3d(4, 1, 1), 24, 6, 6).value()),
+          Material{})
+          .value();
   std::int64_t serial_splits = -1, parallel_splits = -1;
   const FemState one = twistedRun(1, LinearSolverKind::kConjugateGradient, 5,
                                   PreconditionerKind::kBlockJacobi, model, &serial_splits);

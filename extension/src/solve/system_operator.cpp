@@ -319,7 +319,8 @@ void SystemOperator::buildPatches() {
 
 void SystemOperator::addNodalPressureDiagonal(std::vector<Eigen::Matrix3d>& blocks) const {
   // Block (i, i) of sum_n kappa V_n b_n b_n^T: for each node n sharing a tet with i,
-  // c_n = (b_n)_i = sum_{e ∋ n, i} (V_e / 4) R_e g_i / V_n, and the block gains kappa V_n c_n c_n^T.
+  // c_n = (b_n)_i = sum_{e ∋ n, i} (V_e / 4) R_e g_i / V_n, and the block gains kappa V_n c_n
+  // c_n^T.
   const double scale = stiffness_coefficient_ * model_->material().bulkModulus();
   const std::vector<double>& node_volume = model_->nodeVolumes();
   parallel_.forRange(model_->nodeCount(), kNodeGrain, [&](int begin, int end) {

@@ -87,7 +87,7 @@ struct NodeContact {
   /// Held by the supporting plane facing the soft surface, not the nearest feature: the rigid
   /// body is sweeping over the node this step (a sliding box's leading edge).
   bool swept = false;
-  bool anchored = false;   ///< an anchor (node_anchors.h): sticks for good, gap = -drift
+  bool anchored = false;  ///< an anchor (node_anchors.h): sticks for good, gap = -drift
   State state = State::kInactive;
   int releases = 0;              ///< times released this step (anti-cycling: never twice)
   int slips = 0;                 ///< stick-to-slide switches this step (anti-cycling: at most two)
