@@ -4,7 +4,7 @@
 
 #include <CLI/CLI.hpp>
 
-#include "../scene/device_parser.h"
+#include "device_parser.h"
 
 namespace torsion::cli {
 

@@ -22,10 +22,11 @@ int main(int argc, char** argv) {
          },
          "Largest scene, mesh or trajectory file read, in MB (default 1073.741824, i.e. 1 GiB)")
       ->check(CLI::Range(1e-6, 1e9))
-      ->trigger_on_parse();  // before the subcommand's callback reads anything
-  torsion::cli::addMeshCommand(app);
-  torsion::cli::addRunCommand(app);
-  torsion::cli::addViewCommand(app);
+      ->trigger_on_parse();            // before the subcommand's callback reads anything
+  torsion::cli::CommandAction chosen;  // set by the subcommand the command line names
+  torsion::cli::addMeshCommand(app, chosen);
+  torsion::cli::addRunCommand(app, chosen);
+  torsion::cli::addViewCommand(app, chosen);
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {
@@ -40,5 +41,5 @@ int main(int argc, char** argv) {
               << " --help' (or '<command> --help') for usage\n";
     return 1;
   }
-  return torsion::cli::exitCode();
+  return chosen ? chosen() : 0;
 }

@@ -4,16 +4,14 @@
 #include <iostream>
 #include <memory>
 
-#include "../meshgen/mesh_generate_command.h"
-#include "../meshgen/structured_mesh_command.h"
+#include "mesh_generate_command.h"
+#include "structured_mesh_command.h"
 #include "torsion/mesh/mesh_io.h"
 #include "torsion/mesh/mesh_quality.h"
 
 namespace torsion::cli {
 
 namespace {
-
-int g_exit_code = 0;
 
 struct InfoOptions {
   std::string file;
@@ -74,14 +72,7 @@ int runConvert(const ConvertOptions& options) {
 
 }  // namespace
 
-int exitCode() {
-  return g_exit_code;
-}
-void setExitCode(int code) {
-  g_exit_code = code;
-}
-
-void addMeshCommand(CLI::App& app) {
+void addMeshCommand(CLI::App& app, CommandAction& chosen) {
   CLI::App* mesh = app.add_subcommand("mesh", "Inspect, convert and generate tetrahedral meshes");
   mesh->require_subcommand(1);
 
@@ -91,7 +82,7 @@ void addMeshCommand(CLI::App& app) {
   info_cmd->add_option("file", info->file, "Mesh file (.node/.ele, .msh, .vtk)")->required();
   info_cmd->add_flag("--refuse-inverted", info->refuse_inverted,
                      "Fail on inverted tets instead of reorienting them");
-  info_cmd->callback([info] { setExitCode(runInfo(*info)); });
+  info_cmd->callback([&chosen, info] { chosen = [info] { return runInfo(*info); }; });
 
   auto convert = std::make_shared<ConvertOptions>();
   CLI::App* convert_cmd = mesh->add_subcommand(
@@ -100,10 +91,11 @@ void addMeshCommand(CLI::App& app) {
   convert_cmd->add_option("output", convert->output, "Mesh to write")->required();
   convert_cmd->add_flag("--refuse-inverted", convert->refuse_inverted,
                         "Fail on inverted tets instead of reorienting them");
-  convert_cmd->callback([convert] { setExitCode(runConvert(*convert)); });
+  convert_cmd->callback(
+      [&chosen, convert] { chosen = [convert] { return runConvert(*convert); }; });
 
-  addMeshGenerateCommands(*mesh);
-  addStructuredMeshCommands(*mesh);
+  addMeshGenerateCommands(*mesh, chosen);
+  addStructuredMeshCommands(*mesh, chosen);
 }
 
 }  // namespace torsion::cli

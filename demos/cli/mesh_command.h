@@ -3,14 +3,12 @@
 
 #include <CLI/CLI.hpp>
 
+#include "command_action.h"
+
 namespace torsion::cli {
 
-/// Registers `mesh` and its subcommands (info, convert, cylinder, tetrahedralize).
-void addMeshCommand(CLI::App& app);
-
-/// The exit code of the subcommand that ran (0 success, 1 bad input or failure).
-int exitCode();
-/// Records the exit code of the subcommand that ran.
-void setExitCode(int code);
+/// Registers `mesh` and its subcommands (info, convert, box, ball, cylinder, tetrahedralize); the
+/// one the command line names is put into `chosen`.
+void addMeshCommand(CLI::App& app, CommandAction& chosen);
 
 }  // namespace torsion::cli

@@ -5,13 +5,12 @@
 #include <iostream>
 #include <memory>
 
-#include "../scene/scene_haptics.h"
-#include "../scene/scene_parser.h"
-#include "../scene/scene_runner.h"
 #include "device_options.h"
 #include "frame_recorder.h"
-#include "mesh_command.h"
 #include "progress_bar.h"
+#include "scene_haptics.h"
+#include "scene_parser.h"
+#include "scene_runner.h"
 #include "torsion/device/json_check.h"
 #include "torsion/solve/parallel.h"
 
@@ -190,7 +189,7 @@ int run(const RunArguments& args) {
 
 }  // namespace
 
-void addRunCommand(CLI::App& app) {
+void addRunCommand(CLI::App& app, CommandAction& chosen) {
   auto args = std::make_shared<RunArguments>();
   CLI::App* cmd = app.add_subcommand("run", "Run a scene headless and write its results");
   cmd->add_option("scene", args->scene,
@@ -215,7 +214,7 @@ void addRunCommand(CLI::App& app) {
                 "Stop at the first anomaly (inverted tets, released elastic energy, node speed "
                 "burst) with exit code 4");
   addDeviceOptions(*cmd, args->devices);
-  cmd->callback([args] { setExitCode(run(*args)); });
+  cmd->callback([&chosen, args] { chosen = [args] { return run(*args); }; });
 }
 
 }  // namespace torsion::cli

@@ -3,8 +3,10 @@
 
 #include <CLI/CLI.hpp>
 
+#include "command_action.h"
+
 namespace torsion::cli {
 
-void addRunCommand(CLI::App& app);
+void addRunCommand(CLI::App& app, CommandAction& chosen);
 
 }  // namespace torsion::cli

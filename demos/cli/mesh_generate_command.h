@@ -4,8 +4,10 @@
 
 #include <CLI/CLI.hpp>
 
+#include "command_action.h"
+
 namespace torsion::cli {
 
-void addMeshGenerateCommands(CLI::App& mesh);
+void addMeshGenerateCommands(CLI::App& mesh, CommandAction& chosen);
 
 }  // namespace torsion::cli

@@ -6,7 +6,6 @@
 #include <string>
 #include <vector>
 
-#include "../cli/mesh_command.h"
 #include "torsion/contact/ball_mesh.h"
 #include "torsion/mesh/box_mesh.h"
 #include "torsion/mesh/mesh_io.h"
@@ -72,7 +71,7 @@ int runBall(const BallOptions& o) {
 
 }  // namespace
 
-void addStructuredMeshCommands(CLI::App& mesh) {
+void addStructuredMeshCommands(CLI::App& mesh, CommandAction& chosen) {
   auto box = std::make_shared<BoxOptions>();
   CLI::App* box_cmd = mesh.add_subcommand(
       "box", "Mesh an axis-aligned box with a structured grid (each cell split into 6 tets)");
@@ -81,7 +80,7 @@ void addStructuredMeshCommands(CLI::App& mesh) {
   box_cmd->add_option("--cells", box->cells, "Cells along x y z")->required()->expected(3);
   box_cmd->add_option("-o,--output", box->output, "Mesh to write (.node/.ele, .msh, .vtk)")
       ->required();
-  box_cmd->callback([box] { setExitCode(runBox(*box)); });
+  box_cmd->callback([&chosen, box] { chosen = [box] { return runBox(*box); }; });
 
   auto ball = std::make_shared<BallOptions>();
   CLI::App* ball_cmd = mesh.add_subcommand(
@@ -92,7 +91,7 @@ void addStructuredMeshCommands(CLI::App& mesh) {
   ball_cmd->add_option("--center", ball->center, "Centre x y z (m), default 0 0 0")->expected(3);
   ball_cmd->add_option("-o,--output", ball->output, "Mesh to write (.node/.ele, .msh, .vtk)")
       ->required();
-  ball_cmd->callback([ball] { setExitCode(runBall(*ball)); });
+  ball_cmd->callback([&chosen, ball] { chosen = [ball] { return runBall(*ball); }; });
 }
 
 }  // namespace torsion::cli

@@ -6,7 +6,7 @@
 //
 // Scenes are found when the tests run, so a new scene needs only its entry. To write or refresh
 // entries (one process, so the file is not written concurrently), then review the diff:
-//   TORSION_UPDATE_REGRESSION=1 build/tests/render/torsion_regression_tests
+//   TORSION_UPDATE_REGRESSION=1 build/tests/regression/torsion_regression_tests
 
 #include <gtest/gtest.h>
 

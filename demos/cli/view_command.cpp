@@ -4,13 +4,12 @@
 #include <iostream>
 #include <memory>
 
-#include "../cli/device_options.h"
-#include "../cli/mesh_command.h"
+#include "device_options.h"
 #include "viewer.h"
 
 namespace torsion::cli {
 
-void addViewCommand(CLI::App& app) {
+void addViewCommand(CLI::App& app, CommandAction& chosen) {
   auto options = std::make_shared<viewer::ViewerOptions>();
   auto size = std::make_shared<std::string>("1024x720");
   CLI::App* cmd = app.add_subcommand("view", "Open a scene in a window and drive it live");
@@ -27,14 +26,15 @@ void addViewCommand(CLI::App& app) {
                   "left|right|middle DX DY [ctrl]', '<frame> scroll DY'");
   cmd->add_option("--screenshot", options->screenshot, "Write the last frame to this PNG");
   addDeviceOptions(*cmd, options->devices);
-  cmd->callback([options, size] {
-    if (std::sscanf(size->c_str(), "%dx%d", &options->width, &options->height) != 2 ||
-        options->width < 64 || options->height < 64) {
-      std::cerr << "error: --size '" << *size << "': expected WxH, at least 64x64\n";
-      setExitCode(1);
-      return;
-    }
-    setExitCode(viewer::runViewer(*options));
+  cmd->callback([&chosen, options, size] {
+    chosen = [options, size] {
+      if (std::sscanf(size->c_str(), "%dx%d", &options->width, &options->height) != 2 ||
+          options->width < 64 || options->height < 64) {
+        std::cerr << "error: --size '" << *size << "': expected WxH, at least 64x64\n";
+        return 1;
+      }
+      return viewer::runViewer(*options);
+    };
   });
 }
 

@@ -6,7 +6,6 @@
 #include <memory>
 #include <string>
 
-#include "../cli/mesh_command.h"
 #include "cylinder_mesher.h"
 #include "surface_mesh.h"
 #include "tetgen_runner.h"
@@ -202,7 +201,7 @@ int runTetrahedralize(const TetrahedralizeOptions& o) {
 
 }  // namespace
 
-void addMeshGenerateCommands(CLI::App& mesh) {
+void addMeshGenerateCommands(CLI::App& mesh, CommandAction& chosen) {
   auto cyl = std::make_shared<CylinderOptions>();
   CLI::App* cyl_cmd = mesh.add_subcommand(
       "cylinder",
@@ -217,7 +216,7 @@ void addMeshGenerateCommands(CLI::App& mesh) {
   cyl_cmd->add_option("--mesher", cyl->mesher, "Mesh generator (only 'tetgen')")
       ->capture_default_str();
   cyl_cmd->add_flag("-v,--verbose", cyl->verbose, "Print every tetgen run of the search");
-  cyl_cmd->callback([cyl] { setExitCode(runCylinder(*cyl)); });
+  cyl_cmd->callback([&chosen, cyl] { chosen = [cyl] { return runCylinder(*cyl); }; });
 
   auto tet = std::make_shared<TetrahedralizeOptions>();
   CLI::App* tet_cmd = mesh.add_subcommand(
@@ -238,7 +237,7 @@ void addMeshGenerateCommands(CLI::App& mesh) {
   tet_cmd->add_flag("--keep-surface", tet->keep_surface,
                     "Do not add points on the surface (tetgen -Y)");
   tet_cmd->add_flag("-v,--verbose", tet->verbose, "Print the tetgen command line");
-  tet_cmd->callback([tet] { setExitCode(runTetrahedralize(*tet)); });
+  tet_cmd->callback([&chosen, tet] { chosen = [tet] { return runTetrahedralize(*tet); }; });
 }
 
 }  // namespace torsion::cli
