@@ -17,8 +17,8 @@ std::string g(double value) {
 Status checkGravity(const Eigen::Vector3d& gravity) {
   const double magnitude = gravity.stableNorm();  // norm() would overflow to inf past 1e154
   if (magnitude <= kMaxGravity) return Ok{};
-  return Error{"gravity: magnitude " + g(magnitude) + " m/s^2 is above the bound " +
-               g(kMaxGravity) + " m/s^2 (forces and their squares must stay finite)"};
+  return Error{"magnitude " + g(magnitude) + " m/s^2 is above the bound " + g(kMaxGravity) +
+               " m/s^2 (forces and their squares must stay finite)"};
 }
 
 Status checkStiffnessRatio(const Material& material, const TetMesh& mesh, double dt) {

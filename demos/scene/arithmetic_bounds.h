@@ -17,7 +17,8 @@ inline constexpr double kMaxStiffnessRatio = 1e100;
 /// inertias ~ mass * size^2 and products of them.
 inline constexpr double kMaxRigidLength = 1e6;
 
-/// "gravity: magnitude 1e+160 m/s^2 is above the bound 1e+06 m/s^2 ..." or Ok.
+/// "magnitude 1e+160 m/s^2 is above the bound 1e+06 m/s^2 ..." or Ok; the caller names where
+/// the gravity came from (the scene parser: its key path).
 Status checkGravity(const Eigen::Vector3d& gravity);
 
 /// Checks E dt^2 / (rho h^2) for a body's material on its mesh.

@@ -39,11 +39,15 @@ bool spelledAlike(const std::string& a, const std::string& b) {
 
 }  // namespace
 
+std::string SceneFault::text() const {
+  return file + ": " + (key_path.empty() ? "" : key_path + ": ") + message;
+}
+
 JsonObject::JsonObject(const nlohmann::json& json, std::string path, const std::string& file)
     : json_(json), path_(std::move(path)), file_(file) {
   if (!json_.is_object()) {
-    throw JsonFault(file_ + ": " + (path_.empty() ? "the scene" : path_) +
-                    ": expected an object, found " + typeName(json_));
+    throw JsonFault({file_, path_.empty() ? "the scene" : path_,
+                     "expected an object, found " + typeName(json_)});
   }
 }
 
@@ -53,7 +57,7 @@ std::string JsonObject::keyPath(const std::string& key) const {
 }
 
 void JsonObject::fail(const std::string& key, const std::string& fault) const {
-  throw JsonFault(file_ + ": " + keyPath(key) + ": " + fault);
+  throw JsonFault({file_, keyPath(key), fault});
 }
 
 bool JsonObject::has(const std::string& key) const {
@@ -169,7 +173,7 @@ std::vector<JsonObject> JsonObject::objects(const std::string& key) const {
   for (size_t i = 0; i < j.size(); ++i) {
     const std::string item = keyPath(key) + "[" + std::to_string(i) + "]";
     if (!j[i].is_object())
-      throw JsonFault(file_ + ": " + item + ": expected an object, found " + typeName(j[i]));
+      throw JsonFault({file_, item, "expected an object, found " + typeName(j[i])});
     out.emplace_back(j[i], item, file_);
   }
   return out;
@@ -221,12 +225,11 @@ std::string JsonObject::oneOf(const std::vector<std::string>& choices) const {
   for (const std::string& c : choices) {
     list += (list.empty() ? "" : ", ") + c;
     if (has(c)) {
-      if (!found.empty())
-        throw JsonFault(file_ + ": " + path_ + ": give only one of " + list + "...");
+      if (!found.empty()) throw JsonFault({file_, path_, "give only one of " + list + "..."});
       found = c;
     }
   }
-  if (found.empty()) throw JsonFault(file_ + ": " + path_ + ": needs one of: " + list);
+  if (found.empty()) throw JsonFault({file_, path_, "needs one of: " + list});
   return found;
 }
 

@@ -1,7 +1,7 @@
 #pragma once
-// Typed, path-tracking access to a JSON object for scene files. Each accessor fails with
-// "<file>: <path>: <fault>" (thrown as JsonFault, caught by parseScene), and finish() rejects any
-// key that was never asked for, so a misspelt key never passes silently.
+// Typed, path-tracking access to a JSON object for scene files. Each accessor fails with a
+// SceneFault (thrown as JsonFault, caught by parseScene), and finish() rejects any key that was
+// never asked for, so a misspelt key never passes silently.
 
 #include <Eigen/Core>
 #include <array>
@@ -13,8 +13,21 @@
 
 namespace torsion::scene {
 
+/// A fault in a scene file: the file, where in it (the key path, "bodies[0].material.density";
+/// empty for the scene as a whole) and what is wrong. Formatted once, by text():
+/// "<file>: <key path>: <message>" ("<file>: <message>" without a key path).
+struct SceneFault {
+  std::string file;
+  std::string key_path;
+  std::string message;
+
+  std::string text() const;
+};
+
+/// Thrown by JsonObject and the readers built on it; parseScene returns fault.text() as its Error.
 struct JsonFault : std::runtime_error {
-  using std::runtime_error::runtime_error;
+  explicit JsonFault(SceneFault f) : std::runtime_error(f.text()), fault(std::move(f)) {}
+  SceneFault fault;
 };
 
 class JsonObject {
@@ -47,6 +60,7 @@ class JsonObject {
   /// Fails on keys never read through this object.
   void finish() const;
 
+  /// Throws the fault at this object's key (an empty key: at the object itself).
   [[noreturn]] void fail(const std::string& key, const std::string& fault) const;
   const std::string& path() const { return path_; }
 

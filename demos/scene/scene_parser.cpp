@@ -16,6 +16,17 @@ namespace torsion::scene {
 
 namespace {
 
+// Material::validate and SolverSettings::validate word a fault "<subject>: <detail>", the subject
+// being the object this parser reads there ("material", "solver"). The fault goes to that
+// object's key path with the detail; a message not worded so is kept whole.
+[[noreturn]] void failValidation(const JsonObject& object, const std::string& subject,
+                                 const Error& error) {
+  const std::string prefix = subject + ": ";
+  const std::string& message = error.message;
+  const bool worded = message.compare(0, prefix.size(), prefix) == 0;
+  object.fail("", worded ? message.substr(prefix.size()) : message);
+}
+
 // {"axis": [3], "angle": rad} -> a rotation; the axis need not be unit, but not zero.
 Eigen::Quaterniond readAxisAngle(const JsonObject& aa) {
   const Eigen::Vector3d axis = aa.vector3("axis");
@@ -52,7 +63,7 @@ Material readMaterial(const JsonObject& m) {
   }
   m.finish();
   Status valid = material.validate();
-  if (!valid) m.fail("", valid.error().message.substr(valid.error().message.find(':') + 2));
+  if (!valid) failValidation(m, "material", valid.error());
   return material;
 }
 
@@ -81,7 +92,7 @@ SolverSettings readSolver(const JsonObject& s) {
   settings.max_speed = s.number("max_speed", settings.max_speed);
   s.finish();
   Status valid = settings.validate();
-  if (!valid) s.fail("", valid.error().message.substr(valid.error().message.find(':') + 2));
+  if (!valid) failValidation(s, "solver", valid.error());
   return settings;
 }
 
@@ -249,7 +260,7 @@ Result<SceneSpec> parseScene(std::string_view text, const std::string& file_name
     scene.name = root.string("name", std::filesystem::path(file_name).stem().string());
     scene.world.gravity = root.vector3("gravity", Eigen::Vector3d(0, 0, -9.81));
     if (Status carried = checkGravity(scene.world.gravity); !carried)
-      root.fail("gravity", carried.error().message.substr(std::string("gravity: ").size()));
+      root.fail("gravity", carried.error().message);
     if (root.has("solver")) scene.world.solver = readSolver(root.object("solver"));
     scene.steps = root.integer("steps", scene.steps);
     if (scene.steps < 1) root.fail("steps", "must be >= 1");
@@ -330,10 +341,10 @@ Result<SceneSpec> parseScene(std::string_view text, const std::string& file_name
     scene.camera = readCameraSpec(root);
     root.finish();
     Status world_ok = scene.world.validate();
-    if (!world_ok) return Error{file_name + ": " + world_ok.error().message};
+    if (!world_ok) return Error{SceneFault{file_name, "", world_ok.error().message}.text()};
     return scene;
   } catch (const JsonFault& fault) {
-    return Error{fault.what()};
+    return Error{fault.fault.text()};
   }
 }
 

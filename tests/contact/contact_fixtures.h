@@ -59,9 +59,15 @@ inline btRigidBody* addGround(FemWorld& world, double mu) {
 inline FemBody* addBox(FemWorld& world, const std::string& name, const Eigen::Vector3d& lo,
                        const Eigen::Vector3d& hi, int nx, int ny, int nz, const Material& m) {
   Result<TetMesh> mesh = makeBoxTetMesh(lo, hi, nx, ny, nz);
-  EXPECT_TRUE(mesh.ok());
+  if (!mesh.ok()) {
+    ADD_FAILURE() << mesh.error().message;
+    return nullptr;
+  }
   Result<FemBody*> body = world.addBody(name, mesh.value(), m);
-  EXPECT_TRUE(body.ok()) << (body.ok() ? "" : body.error().message);
+  if (!body.ok()) {
+    ADD_FAILURE() << body.error().message;
+    return nullptr;
+  }
   return body.value();
 }
 

@@ -92,6 +92,7 @@ TEST(ContactPhysics, MomentumExchangedWithFreeBox) {
   addGround(world, 0.0);
   const Material m = softMaterial(5e4, 200);
   FemBody* block = addBox(world, "block", {-0.6, -0.15, 0.0}, {-0.3, 0.15, 0.3}, 3, 3, 3, m);
+  ASSERT_NE(block, nullptr);
   block->setVelocity({2.0, 0, 0});
   const double box_mass = 4;
   btRigidBody* box = world.addRigidBody(std::make_unique<btBoxShape>(btVector3(0.15, 0.15, 0.15)),
@@ -123,6 +124,7 @@ double slideDistance(double theta, double mu, double seconds) {
   addGround(world, mu);
   const Material m = softMaterial(1e5, 500);
   FemBody* block = addBox(world, "block", {-0.1, -0.1, 0}, {0.1, 0.1, 0.2}, 2, 2, 2, m);
+  ASSERT_NE(block, nullptr);
   // Settle without tilt first would change the set-up; start in contact, at rest.
   const double x0 = centreOfMass(*block).x();
   const int steps = static_cast<int>(std::lround(seconds / s.solver.time_step));
@@ -157,6 +159,7 @@ TEST(ContactPhysics, PressedCubeStaysPut) {
   addGround(world, 0.8);
   const Material m = softMaterial(5e4, 300);
   FemBody* cube = addBox(world, "cube", {-0.1, -0.1, 0}, {0.1, 0.1, 0.2}, 3, 3, 3, m);
+  ASSERT_NE(cube, nullptr);
   const double plate_half = 0.05;
   btRigidBody* plate =
       world.addRigidBody(std::make_unique<btBoxShape>(btVector3(0.3, 0.3, plate_half)), 0,
@@ -216,6 +219,7 @@ TEST(ContactPhysics, SqueezedBoxUnderHeldBlockIsStable) {
   box->setFriction(0.8);
   const Material m = softMaterial(5e4, 300);
   FemBody* block = addBox(world, "block", {-0.15, -0.15, 0.11}, {0.15, 0.15, 0.31}, 3, 3, 2, m);
+  ASSERT_NE(block, nullptr);
   std::vector<int> top;
   for (int i = 0; i < block->model().nodeCount(); ++i) {
     if (block->state().position(i).z() > 0.31 - 1e-9) top.push_back(i);

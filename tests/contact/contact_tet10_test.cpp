@@ -82,9 +82,15 @@ TEST(ContactTet10, DroppedBallRestsOnGround) {
 FemBody* addTet10Box(FemWorld& world, const std::string& name, const Eigen::Vector3d& lo,
                      const Eigen::Vector3d& hi, int nx, int ny, int nz, const Material& m) {
   Result<TetMesh> mesh = makeBoxTetMesh(lo, hi, nx, ny, nz);
-  EXPECT_TRUE(mesh.ok());
+  if (!mesh.ok()) {
+    ADD_FAILURE() << mesh.error().message;
+    return nullptr;
+  }
   Result<FemBody*> body = world.addBody(name, mesh.value(), m, Frame{}, ElementKind::kTet10);
-  EXPECT_TRUE(body.ok()) << (body.ok() ? "" : body.error().message);
+  if (!body.ok()) {
+    ADD_FAILURE() << body.error().message;
+    return nullptr;
+  }
   return body.value();
 }
 
@@ -96,6 +102,7 @@ TEST(ContactTet10, MomentumExchangedWithFreeBox) {
   addGround(world, 0.0);
   FemBody* block = addTet10Box(world, "block", {-0.6, -0.15, 0.0}, {-0.3, 0.15, 0.3}, 2, 2, 2,
                                softMaterial(5e4, 200));
+  ASSERT_NE(block, nullptr);
   block->setVelocity({2.0, 0, 0});
   const double box_mass = 4;
   btRigidBody* box = world.addRigidBody(std::make_unique<btBoxShape>(btVector3(0.15, 0.15, 0.15)),
@@ -128,6 +135,7 @@ double tet10SlideDistance(double theta, double mu, double seconds) {
   addGround(world, mu);
   FemBody* block = addTet10Box(world, "block", {-0.1, -0.1, 0}, {0.1, 0.1, 0.2}, 2, 2, 2,
                                softMaterial(1e5, 500));
+  ASSERT_NE(block, nullptr);
   const double x0 = centreOfMass(*block).x();
   const int steps = static_cast<int>(std::lround(seconds / s.solver.time_step));
   for (int k = 0; k < steps; ++k)

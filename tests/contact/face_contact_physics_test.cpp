@@ -30,6 +30,7 @@ double surfacePenetration(const FemBody& body, const btRigidBody& rigid) {
 FemBody* coarseSlab(FemWorld& world) {
   Material m = softMaterial(2e5, 100);
   FemBody* slab = addBox(world, "slab", {-0.5, -0.5, 0}, {0.5, 0.5, 0.2}, 4, 4, 1, m);
+  if (!slab) return nullptr;  // addBox reported why
   std::vector<int> base;
   for (int i = 0; i < slab->model().nodeCount(); ++i) {
     if (slab->state().position(i).z() < 1e-9) base.push_back(i);
@@ -44,6 +45,7 @@ FemBody* coarseSlab(FemWorld& world) {
 TEST(FaceContact, SmallBallRestsOnCoarseSlab) {
   FemWorld world(contactSettings(0.01));
   FemBody* slab = coarseSlab(world);
+  ASSERT_NE(slab, nullptr);
   const double r = 0.1;
   btRigidBody* ball = world.addRigidBody(std::make_unique<btSphereShape>(r), 1.0,
                                          at({0.125, 0.125, 0.2 + r + 0.05}));
@@ -71,6 +73,7 @@ TEST(FaceContact, SmallBallRestsOnCoarseSlab) {
 TEST(FaceContact, CapsuleRestsAcrossFacesBetweenNodeRows) {
   FemWorld world(contactSettings(0.01));
   FemBody* slab = coarseSlab(world);
+  ASSERT_NE(slab, nullptr);
   const double r = 0.05;
   btRigidBody* pin = world.addRigidBody(std::make_unique<btCapsuleShape>(r, 0.4), 0.5,
                                         at({0.125, 0.0, 0.2 + r + 0.02}));
@@ -96,6 +99,7 @@ TEST(FaceContact, MomentumExchangedThroughAFace) {
   FemWorld world(s);
   FemBody* block =
       addBox(world, "block", {0, -0.25, -0.25}, {0.2, 0.25, 0.25}, 1, 2, 2, softMaterial(1e5, 200));
+  ASSERT_NE(block, nullptr);
   const double ball_mass = 2, r = 0.05;
   // Aimed at (0, 0.125, 0.125): the middle of a face of the block's -x side, 0.177 m from nodes.
   btRigidBody* ball =

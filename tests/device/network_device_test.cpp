@@ -21,14 +21,21 @@ Loopback open(Trajectory trajectory = Trajectory({{0, Pose{{0.01, 0.02, 0.03}, {
   settings.local.port = 0;  // any free port: tests may run in parallel
   settings.limits = defaultDeviceLimits();
   auto device = NetworkDevice::open(settings);
-  EXPECT_TRUE(device) << device.error;
+  if (!device) {
+    ADD_FAILURE() << device.error;
+    return {};
+  }
   auto peer = NetworkPeer::open((*device.value)->local(), std::move(trajectory));
-  EXPECT_TRUE(peer) << peer.error;
+  if (!peer) {
+    ADD_FAILURE() << peer.error;
+    return {};
+  }
   return {std::move(*device.value), std::move(*peer.value)};
 }
 
 TEST(NetworkDevice, PoseInWrenchOutRoundTrip) {
   Loopback l = open();
+  ASSERT_TRUE(l.device && l.peer);          // open() reported why
   EXPECT_FALSE(l.device->read(0.0).alive);  // nothing heard yet
   l.peer->tick(0.0);
   const DeviceSample s = l.device->read(0.001);
@@ -45,6 +52,7 @@ TEST(NetworkDevice, PoseInWrenchOutRoundTrip) {
 
 TEST(NetworkDevice, ASessionBelongsToItsFirstPeerUntilGoodbye) {
   Loopback l = open();
+  ASSERT_TRUE(l.device && l.peer);  // open() reported why
   auto intruder = NetworkPeer::open(l.device->local(), Trajectory({{0, Pose{{5, 5, 5}, {}}}}, {}));
   ASSERT_TRUE(intruder) << intruder.error;
   l.peer->tick(0.0);  // the first peer binds the session
@@ -73,6 +81,7 @@ TEST(NetworkDevice, ASessionBelongsToItsFirstPeerUntilGoodbye) {
 
 TEST(NetworkDevice, ASilentPeerLosesItsSessionAfterTheSessionTimeout) {
   Loopback l = open();
+  ASSERT_TRUE(l.device && l.peer);  // open() reported why
   auto next = NetworkPeer::open(l.device->local(), Trajectory({{0, Pose{{5, 5, 5}, {}}}}, {}));
   ASSERT_TRUE(next) << next.error;
   l.peer->tick(0.0);
@@ -88,6 +97,7 @@ TEST(NetworkDevice, ASilentPeerLosesItsSessionAfterTheSessionTimeout) {
 
 TEST(NetworkDevice, ClosingSendsTheBoundPeerAZeroWrench) {
   Loopback l = open();
+  ASSERT_TRUE(l.device && l.peer);  // open() reported why
   l.peer->tick(0.0);
   (void)l.device->read(0.001);
   l.device->write({{3, 0, 0}, {0, 0, 0.5}});
@@ -101,6 +111,7 @@ TEST(NetworkDevice, ClosingSendsTheBoundPeerAZeroWrench) {
 
 TEST(NetworkDevice, BadPacketsAreDroppedAndCounted) {
   Loopback l = open();
+  ASSERT_TRUE(l.device && l.peer);  // open() reported why
   const Pose good{{0.05, 0, 0}, {}};
   l.peer->sendPose(10, good, 1, true);
   const unsigned char junk[10] = {1, 2, 3};
@@ -136,6 +147,7 @@ TEST(NetworkDevice, BadPacketsAreDroppedAndCounted) {
 
 TEST(NetworkDevice, SilentPeerMeansDeadDevice) {
   Loopback l = open();
+  ASSERT_TRUE(l.device && l.peer);  // open() reported why
   l.peer->tick(0.0);
   EXPECT_TRUE(l.device->read(0.0).alive);
   EXPECT_TRUE(l.device->read(0.04).alive);   // within the 50 ms timeout
@@ -148,6 +160,7 @@ TEST(NetworkDevice, LoopRoundTripWithTheReferencePeer) {
   // The peer plays a trajectory; the loop reads it, the "simulation" answers with a spring
   // wrench; the peer receives the loop's safe output.
   Loopback l = open(Trajectory({{0, Pose{}}, {1, Pose{{0.1, 0, 0}, {}}}}, {{0, 1u}}));
+  ASSERT_TRUE(l.device && l.peer);  // open() reported why
   HapticLoopSettings settings;
   HapticLoop loop(*l.device, settings);
   HandCommand command;

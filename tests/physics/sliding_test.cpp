@@ -54,9 +54,15 @@ double slideDistance(const Slope& s, double seconds) {
   const double length = 2, width = 0.6, thickness = 0.1;
   Result<TetMesh> mesh = makeBoxTetMesh({-length / 2, -width / 2, 0},
                                         {length / 2, width / 2, thickness}, s.cells_along, 6, 2);
-  EXPECT_TRUE(mesh.ok());
+  if (!mesh.ok()) {
+    ADD_FAILURE() << mesh.error().message;
+    return std::nan("");
+  }
   Result<FemBody*> added = world.addBody("slab", mesh.value(), m, Frame{}, s.element);
-  EXPECT_TRUE(added.ok()) << (added.ok() ? "" : added.error().message);
+  if (!added.ok()) {
+    ADD_FAILURE() << added.error().message;
+    return std::nan("");
+  }
   FemBody* slab = added.value();
   std::vector<int> base;
   for (int i = 0; i < slab->model().nodeCount(); ++i) {

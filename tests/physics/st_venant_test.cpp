@@ -24,8 +24,11 @@ TetMesh cylinder(int tets) {
   const std::string path =
       std::string(TORSION_ASSETS_DIR) + "/cylinder_" + std::to_string(tets) + ".node";
   Result<LoadedMesh> loaded = readMesh(path);
-  EXPECT_TRUE(loaded.ok()) << loaded.error().message;
-  return loaded.ok() ? std::move(loaded).value().mesh : TetMesh();
+  if (!loaded.ok()) {
+    ADD_FAILURE() << loaded.error().message;
+    return TetMesh();
+  }
+  return std::move(loaded).value().mesh;
 }
 
 std::vector<int> nodesAtZ(const TetMesh& mesh, double z) {

@@ -40,9 +40,15 @@ RenderOptions compareOptions() {
 Rendered loadAndCapture(const std::string& name, int steps) {
   Result<scene::SceneSpec> spec =
       scene::loadScene(std::string(TORSION_TEST_DATA) + "/render/" + name + ".json");
-  EXPECT_TRUE(spec.ok()) << (spec.ok() ? "" : spec.error().message);
+  if (!spec.ok()) {
+    ADD_FAILURE() << spec.error().message;
+    return {};
+  }
   auto built = scene::buildScene(std::move(spec).value(), 1);
-  EXPECT_TRUE(built.ok()) << (built.ok() ? "" : built.error().message);
+  if (!built.ok()) {
+    ADD_FAILURE() << built.error().message;
+    return {};
+  }
   scene::BuiltScene& s = *built.value();
   for (int k = 0; k < steps; ++k) {
     EXPECT_TRUE(scene::driveHands(s).ok());

@@ -17,9 +17,15 @@ namespace {
 
 nlohmann::json runAndReadSummary(const std::string& name, int steps) {
   Result<SceneSpec> spec = loadScene(std::string(TORSION_SCENES_DIR) + "/" + name + ".json");
-  EXPECT_TRUE(spec.ok()) << spec.error().message;
+  if (!spec.ok()) {
+    ADD_FAILURE() << spec.error().message;
+    return {};
+  }
   auto built = buildScene(std::move(spec).value(), 1);
-  EXPECT_TRUE(built.ok()) << built.error().message;
+  if (!built.ok()) {
+    ADD_FAILURE() << built.error().message;
+    return {};
+  }
   const std::filesystem::path out =
       std::filesystem::temp_directory_path() /
       ("torsion_scene_anomalies_test_" + name + "_" + std::to_string(::getpid()));
@@ -28,7 +34,10 @@ nlohmann::json runAndReadSummary(const std::string& name, int steps) {
   options.steps = steps;
   options.stop_on_anomaly = true;
   Result<RunOutcome> outcome = runScene(*built.value(), options);
-  EXPECT_TRUE(outcome.ok()) << outcome.error().message;
+  if (!outcome.ok()) {
+    ADD_FAILURE() << outcome.error().message;
+    return {};
+  }
   EXPECT_TRUE(outcome.value().stable) << outcome.value().failure;
   EXPECT_EQ(outcome.value().stopped_on_anomaly, "");
   EXPECT_EQ(outcome.value().steps_done, steps);

@@ -14,9 +14,15 @@ namespace {
 
 TetMesh cube() {
   Result<RawTetMesh> raw = parseTetGen(test::kCubeNode, "cube.node", test::kCubeEle, "cube.ele");
-  EXPECT_TRUE(raw.ok()) << raw.error().message;
+  if (!raw.ok()) {
+    ADD_FAILURE() << raw.error().message;
+    return TetMesh();
+  }
   Result<LoadedMesh> loaded = buildTetMesh(std::move(raw).value());
-  EXPECT_TRUE(loaded.ok()) << loaded.error().message;
+  if (!loaded.ok()) {
+    ADD_FAILURE() << loaded.error().message;
+    return TetMesh();
+  }
   return std::move(loaded).value().mesh;
 }
 

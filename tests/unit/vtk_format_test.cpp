@@ -64,8 +64,15 @@ CELL_TYPES 1
 
 TetMesh cube() {
   Result<RawTetMesh> raw = parseTetGen(test::kCubeNode, "cube.node", test::kCubeEle, "cube.ele");
+  if (!raw.ok()) {
+    ADD_FAILURE() << raw.error().message;
+    return TetMesh();
+  }
   Result<LoadedMesh> loaded = buildTetMesh(raw.value());
-  EXPECT_TRUE(loaded.ok()) << loaded.error().message;
+  if (!loaded.ok()) {
+    ADD_FAILURE() << loaded.error().message;
+    return TetMesh();
+  }
   return loaded.value().mesh;
 }
 
