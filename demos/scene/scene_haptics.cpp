@@ -156,7 +156,9 @@ nlohmann::json SceneHaptics::statistics(const Channel& c) const {
     j["packets"] = {{"accepted", p.accepted.load()},   {"truncated", p.truncated.load()},
                     {"malformed", p.malformed.load()}, {"out_of_order", p.out_of_order.load()},
                     {"duplicate", p.duplicate.load()}, {"lost", p.lost.load()},
-                    {"foreign", p.foreign.load()},     {"sent", p.sent.load()}};
+                    {"foreign", p.foreign.load()},     {"sent", p.sent.load()},
+                    {"unauthenticated", p.unauthenticated.load()},
+                    {"replayed", p.replayed.load()},   {"authenticated", net->authenticated()}};
   }
   return j;
 }
