@@ -52,8 +52,7 @@ Result<std::unique_ptr<device::HapticDevice>> openDevice(const DeviceSpec& spec)
         if (!key) return Error{key.error};
         settings.key = std::move(*key.value);
       } else {
-        device::Loaded<std::optional<device::PacketKey>> key =
-            device::PacketKey::fromEnvironment();
+        device::Loaded<std::optional<device::PacketKey>> key = device::PacketKey::fromEnvironment();
         if (!key) return Error{key.error};
         settings.key = std::move(*key.value);
       }

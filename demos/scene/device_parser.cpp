@@ -281,7 +281,8 @@ Status applyDeviceOverrides(SceneSpec& scene, const DeviceOverrides& overrides) 
                    "': device host " + hand.device->host +
                    " is not loopback: anyone who can reach that port could drive the hand (the "
                    "packets are not authenticated); give the device a key_file (or set " +
-                   device::kKeyFileVariable + ", docs/haptics.md), or pass "
+                   device::kKeyFileVariable +
+                   ", docs/haptics.md), or pass "
                    "--allow-remote-device to listen there unauthenticated"};
     }
   }

@@ -11,8 +11,8 @@
 
 #include <cmath>
 #include <cstdio>
-#include <cstring>
 #include <cstdlib>
+#include <cstring>
 #include <fstream>
 #include <optional>
 #include <string>
@@ -75,8 +75,9 @@ int main(int argc, char** argv) {
     } else if (a == "--key-file" && has_value) {
       key_path = argv[++k];
     } else if (a == "--key") {
-      return usage("--key: a key on the command line is visible to every local user; put it in "
-                   "a file (--key-file) or in TORSION_HAPTIC_KEY");
+      return usage(
+          "--key: a key on the command line is visible to every local user; put it in "
+          "a file (--key-file) or in TORSION_HAPTIC_KEY");
     } else {
       return usage(has_value || a.rfind("--", 0) != 0 ? "unexpected argument '" + a + "'"
                                                       : a + " needs a value");

@@ -11,8 +11,8 @@ Loaded<std::unique_ptr<NetworkPeer>> NetworkPeer::open(const UdpEndpoint& simula
   using Out = Loaded<std::unique_ptr<NetworkPeer>>;
   auto socket = UdpSocket::open(UdpEndpoint{simulation.address, 0});
   if (!socket) return Out::fail("network peer: " + socket.error);
-  return Out{std::unique_ptr<NetworkPeer>(new NetworkPeer(*socket.value, simulation,
-                                                          std::move(trajectory), std::move(key))),
+  return Out{std::unique_ptr<NetworkPeer>(
+                 new NetworkPeer(*socket.value, simulation, std::move(trajectory), std::move(key))),
              {}};
 }
 

@@ -19,8 +19,8 @@ bool sodiumReady() {
 }
 
 std::string trimmedRight(std::string text) {
-  while (!text.empty() && (text.back() == '\n' || text.back() == '\r' || text.back() == ' ' ||
-                           text.back() == '\t'))
+  while (!text.empty() &&
+         (text.back() == '\n' || text.back() == '\r' || text.back() == ' ' || text.back() == '\t'))
     text.pop_back();
   return text;
 }
@@ -30,9 +30,9 @@ std::string trimmedRight(std::string text) {
 Loaded<PacketKey> PacketKey::fromSecret(const std::string& secret, const std::string& origin) {
   const std::string trimmed = trimmedRight(secret);
   if (trimmed.size() < kMinKeyBytes) {
-    return Loaded<PacketKey>::fail(
-        origin + ": the key has " + std::to_string(trimmed.size()) + " bytes, fewer than the " +
-        std::to_string(kMinKeyBytes) + " required (make one with: openssl rand -hex 32)");
+    return Loaded<PacketKey>::fail(origin + ": the key has " + std::to_string(trimmed.size()) +
+                                   " bytes, fewer than the " + std::to_string(kMinKeyBytes) +
+                                   " required (make one with: openssl rand -hex 32)");
   }
   if (!sodiumReady()) return Loaded<PacketKey>::fail(origin + ": libsodium failed to initialise");
   return Loaded<PacketKey>{PacketKey(std::vector<unsigned char>(trimmed.begin(), trimmed.end())),
@@ -95,7 +95,8 @@ bool PacketKey::verify(const unsigned char* mac_bytes, const unsigned char* byte
 std::uint64_t randomSessionId() {
   sodiumReady();
   std::uint64_t id = 0;
-  while (id == 0) randombytes_buf(&id, sizeof id);  // 0 means "no session"
+  while (id == 0)
+    randombytes_buf(&id, sizeof id);  // 0 means "no session"
   return id;
 }
 

@@ -33,8 +33,7 @@ bool PacketFilter::inOrder(const Packet& packet, PacketStats& stats) {
     }
     // A signed sequence never wraps: serial-number order would let a packet recorded 2^31
     // packets ago count as new.
-    const bool after =
-        key_ ? packet.sequence > newest_ : sequenceAfter(packet.sequence, newest_);
+    const bool after = key_ ? packet.sequence > newest_ : sequenceAfter(packet.sequence, newest_);
     if (!after) {
       ++stats.out_of_order;
       return false;

@@ -285,8 +285,9 @@ TEST_F(KeyFile, TheEnvironmentGivesAKeyFileOrAKeyOrNothing) {
   ::setenv(kKeyFileVariable, missing.c_str(), 1);
   key = PacketKey::fromEnvironment();
   ASSERT_FALSE(key);
-  EXPECT_EQ(key.error, "key file " + missing +
-                           ": cannot open: No such file or directory (from TORSION_HAPTIC_KEY_FILE)");
+  EXPECT_EQ(key.error,
+            "key file " + missing +
+                ": cannot open: No such file or directory (from TORSION_HAPTIC_KEY_FILE)");
   ::unsetenv(kKeyFileVariable);
   ::unsetenv(kKeyVariable);
 }

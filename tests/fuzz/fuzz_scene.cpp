@@ -19,12 +19,11 @@
 #include <cstddef>
 #include <cstdint>
 #include <cstdio>
+#include <nlohmann/json.hpp>
 #include <random>
 #include <string>
 #include <string_view>
 #include <vector>
-
-#include <nlohmann/json.hpp>
 
 #include "fuzz_checks.h"
 #include "scene_builder.h"
@@ -144,33 +143,50 @@ bool collect(Json& root, std::vector<Json*>& into, int max_depth) {
     if (depth > max_depth) return false;
     into.push_back(node);
     if (node->is_object() || node->is_array()) {
-      for (Json& child : *node) stack.push_back({&child, depth + 1});
+      for (Json& child : *node)
+        stack.push_back({&child, depth + 1});
     }
   }
   return true;
 }
 
 // Placeholders replaced in the dumped text by tokens a JSON value cannot hold.
-const char* const kRawTokens[] = {"1e400", "-1e400", "NaN", "Infinity", "-0", "1e-400",
-                                  "18446744073709551616", "-9223372036854775809"};
+const char* const kRawTokens[] = {"1e400",
+                                  "-1e400",
+                                  "NaN",
+                                  "Infinity",
+                                  "-0",
+                                  "1e-400",
+                                  "18446744073709551616",
+                                  "-9223372036854775809"};
 
 Json extremeNumber(std::mt19937& random) {
-  const Json values[] = {0,       -0.0,        1e308,       -1e308,      5e-324,
-                         1e-300,  2147483647,  2147483648,  -2147483649, 4294967296,
-                         1e18,    9.3e18,      -1,          1e6,         1e15,
-                         0.5,     -1e-12,      65536,       1e100,       -1e100};
+  const Json values[] = {0,          -0.0,        1e308,      -1e308, 5e-324, 1e-300, 2147483647,
+                         2147483648, -2147483649, 4294967296, 1e18,   9.3e18, -1,     1e6,
+                         1e15,       0.5,         -1e-12,     65536,  1e100,  -1e100};
   return values[random() % (sizeof values / sizeof values[0])];
 }
 
 Json nanLikeString(std::mt19937& random) {
-  const char* const strings[] = {"NaN", "nan", "inf", "-Infinity", "1e999", "0x10", "",
-                                 "\u00e9\u00e8", "\u0001\u0002", "../../../../dev/zero",
-                                 "/dev/zero", "/proc/self/fd/0", "tet10", "tet4", "network"};
+  const char* const strings[] = {"NaN",
+                                 "nan",
+                                 "inf",
+                                 "-Infinity",
+                                 "1e999",
+                                 "0x10",
+                                 "",
+                                 "\u00e9\u00e8",
+                                 "\u0001\u0002",
+                                 "../../../../dev/zero",
+                                 "/dev/zero",
+                                 "/proc/self/fd/0",
+                                 "tet10",
+                                 "tet4",
+                                 "network"};
   return strings[random() % (sizeof strings / sizeof strings[0])];
 }
 
-bool mutateNode(Json& root, std::mt19937& random, std::vector<std::string>& raw,
-                size_t max_size) {
+bool mutateNode(Json& root, std::mt19937& random, std::vector<std::string>& raw, size_t max_size) {
   std::vector<Json*> nodes;
   if (!collect(root, nodes, 4000)) return false;
   Json& node = *nodes[random() % nodes.size()];
@@ -207,14 +223,16 @@ bool mutateNode(Json& root, std::mt19937& random, std::vector<std::string>& raw,
       if (element.dump().size() * n > max_size) element = 0;
       if (2 * n > max_size) break;
       node = Json::array();
-      for (size_t k = 0; k < n; ++k) node.push_back(element);
+      for (size_t k = 0; k < n; ++k)
+        node.push_back(element);
       break;
     }
-    case 6: {  // deep nesting
+    case 6: {                                      // deep nesting
       const int depth = 1 << (2 + random() % 11);  // 4 .. 4096
       if (node.dump().size() + 2 * static_cast<size_t>(depth) > max_size) break;
       Json inner = node;
-      for (int k = 0; k < depth; ++k) inner = Json::array({std::move(inner)});
+      for (int k = 0; k < depth; ++k)
+        inner = Json::array({std::move(inner)});
       node = std::move(inner);
       break;
     }

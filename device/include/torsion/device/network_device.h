@@ -31,7 +31,7 @@ struct NetworkDeviceSettings {
   double timeout = 0.05;                ///< s without an accepted pose before the device is dead
   double session_timeout = 1.0;         ///< s without an accepted pose before another peer may bind
   DeviceLimits limits;                  ///< of the device behind the peer
-  std::optional<PacketKey> key;  ///< shared with the peer; empty: unauthenticated packets
+  std::optional<PacketKey> key;         ///< shared with the peer; empty: unauthenticated packets
 };
 
 class NetworkDevice : public HapticDevice {
@@ -66,9 +66,9 @@ class NetworkDevice : public HapticDevice {
   Packet newest_;
   bool have_peer_ = false;
   UdpEndpoint peer_;
-  std::uint64_t session_ = 0;                 // signed: the bound session's id
+  std::uint64_t session_ = 0;                  // signed: the bound session's id
   std::vector<std::uint64_t> ended_sessions_;  // signed: ids never to be accepted again
-  double last_accepted_time_ = -1e300;  // loop clock, s
+  double last_accepted_time_ = -1e300;         // loop clock, s
   std::uint32_t sent_sequence_ = 0;
 };
 
