@@ -7,6 +7,7 @@
 //
 // With --key-file (or TORSION_HAPTIC_KEY_FILE / TORSION_HAPTIC_KEY in the environment) it signs
 // its packets with the shared key (packet_key.h); the key itself is never an argument.
+#include <signal.h>
 #include <time.h>
 
 #include <cmath>
@@ -22,6 +23,12 @@
 #include "torsion/device/trajectory.h"
 
 namespace {
+
+// SIGINT/SIGTERM end the loop; the peer then says goodbye and closes its log whole.
+volatile sig_atomic_t g_stop = 0;
+void requestStop(int) {
+  g_stop = 1;
+}
 
 double monotonicSeconds() {
   timespec ts{};
@@ -128,8 +135,13 @@ int main(int argc, char** argv) {
   std::fprintf(stderr, "peer: sending %s to %s:%d at %g Hz for %.1f s, %s\n",
                trajectory_path.c_str(), host.c_str(), port, rate, duration,
                signing ? "signed with the shared key" : "unauthenticated");
+  struct sigaction action {};
+  action.sa_handler = requestStop;
+  sigemptyset(&action.sa_mask);
+  sigaction(SIGINT, &action, nullptr);
+  sigaction(SIGTERM, &action, nullptr);
   const double origin = monotonicSeconds();
-  for (long k = 0;; ++k) {
+  for (long k = 0; !g_stop; ++k) {
     const double deadline = origin + static_cast<double>(k) * period;
     timespec ts{static_cast<time_t>(deadline), static_cast<long>(std::fmod(deadline, 1.0) * 1e9)};
     clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &ts, nullptr);

@@ -364,6 +364,44 @@ case "$case_name" in
     expect_out "^warning: hand 'hand': the network device listens on 0.0.0.0, outside loopback"
     ;;
 
+  sigint_zeroes_the_network_device)
+    # Ctrl-C while a peer is holding the hand: the run stops marked, and the last wrench the peer
+    # receives is zero (the loop's stop and the device's close each send one).
+    [[ -x $peer ]] || fail "no torsion_haptic_peer given"
+    twist_scene > twist.json
+    cat > hold.json <<'JSON'
+{"segments": [{"duration": 0.6, "angular_velocity": [0, 0, 0.5]}, {"duration": 5}],
+ "buttons": [{"time": 0, "held": [1]}]}
+JSON
+    port=$((20000 + RANDOM % 20000))
+    start_run out twist.json --device "hand=network:$port" --steps 100000 --threads 1
+    for _ in $(seq 100); do
+      grep -q "device network" run.log && break
+      sleep 0.1
+    done
+    "$peer" --trajectory hold.json --port "$port" --log peer.csv >peer.log 2>&1 &
+    peer_pid=$!
+    # Wait until the peer holds a non-zero torque, then interrupt the simulation.
+    for _ in $(seq 100); do
+      awk -F, 'NR > 1 && ($7 > 0.1 || $7 < -0.1) { found = 1 } END { exit !found }' peer.csv \
+        2>/dev/null && break
+      sleep 0.1
+    done
+    kill -INT "$sim"
+    wait "$sim"
+    rc=$?
+    sleep 0.3  # the peer goes on ticking: its log's last rows come after the close
+    kill -TERM "$peer_pid" 2>/dev/null  # the peer stops cleanly: its log ends with a whole row
+    wait "$peer_pid"
+    cat run.log peer.log
+    expect_rc 130
+    [[ $(json_field out/summary.json stopped_by) == SIGINT ]] || fail "summary lacks stopped_by"
+    awk -F, 'NR > 1 && ($7 > 0.1 || $7 < -0.1) { found = 1 } END { exit !found }' peer.csv ||
+      fail "the peer never held a torque"
+    tail -1 peer.csv | awk -F, '{ for (i = 2; i <= 7; i++) if ($i != 0) exit 1 }' ||
+      fail "the peer's last wrench is not zero: $(tail -1 peer.csv)"
+    ;;
+
   network_device_key)
     # A shared key (docs/haptics.md, "Authentication"): the signed peer drives the hand while an
     # unsigned one, sending to the same port at the same time, is refused and counted.
