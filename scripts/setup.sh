@@ -15,6 +15,8 @@ packages=(
   libosmesa6-dev libglfw3-dev
   # the SpaceMouse device (optional in CMake; the spacenavd daemon is the user's to install)
   libspnav-dev
+  # the network device's packet authentication (HMAC-SHA256, random session ids)
+  libsodium-dev
   # the viewer's test: a virtual X server and Mesa's software GLX
   xvfb xauth libgl1-mesa-dri libglx-mesa0
   # tests and benchmarks; clang + its runtime for the libFuzzer targets

@@ -12,8 +12,9 @@ void addDeviceOptions(CLI::App& command, scene::DeviceOverrides& into) {
                      "scripted and replay devices) or threaded (1 kHz threads, simulation paced "
                      "to wall-clock time; default for network and SpaceMouse)");
   command.add_flag("--allow-remote-device", into.allow_remote_devices,
-                   "Let a network device listen on an address other than loopback (its packets "
-                   "are not authenticated: anyone who can reach the port first drives the hand)");
+                   "Let a network device without a key listen on an address other than loopback "
+                   "(its packets are not authenticated: anyone who can reach the port first "
+                   "drives the hand; docs/haptics.md tells how to give it a key)");
 }
 
 }  // namespace torsion::cli

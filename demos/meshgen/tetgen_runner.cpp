@@ -214,7 +214,7 @@ Result<TetgenRun> runTetgen(const fs::path& tetgen, const std::string& switches,
   if (!run) return run.error();
   const ProcessResult& r = run.value();
   const bool ended_well = r.exited && r.exit_code == 0;
-  const bool have_files = fs::exists(out.node) && fs::exists(out.ele);
+  const bool have_files = fs::exists(out.node, ec) && fs::exists(out.ele, ec);
   if (!ended_well || !have_files) {
     std::string message = "tetgen " + switches + " failed (" + howItEnded(r) +
                           (ended_well ? ", but it wrote no tetrahedra" : "") + ")";

@@ -47,6 +47,15 @@ Result<std::unique_ptr<device::HapticDevice>> openDevice(const DeviceSpec& spec)
       settings.local.port = static_cast<std::uint16_t>(spec.port);
       settings.timeout = spec.timeout;
       settings.limits = limitsOf(spec);
+      if (!spec.key_file.empty()) {
+        device::Loaded<device::PacketKey> key = device::PacketKey::fromFile(spec.key_file);
+        if (!key) return Error{key.error};
+        settings.key = std::move(*key.value);
+      } else {
+        device::Loaded<std::optional<device::PacketKey>> key = device::PacketKey::fromEnvironment();
+        if (!key) return Error{key.error};
+        settings.key = std::move(*key.value);
+      }
       auto opened = device::NetworkDevice::open(settings);
       if (!opened) return Error{opened.error};
       return std::unique_ptr<device::HapticDevice>(std::move(*opened.value));

@@ -1,7 +1,9 @@
 #include "device_parser.h"
 
+#include <cstdlib>
 #include <filesystem>
 
+#include "torsion/device/packet_key.h"
 #include "torsion/device/udp_socket.h"
 
 namespace torsion::scene {
@@ -33,7 +35,7 @@ bool isLoopback(const std::string& host) {
   return device::parseIpv4(host, address) && (address >> 24) == 127;
 }
 
-void readNetwork(const JsonObject& d, DeviceSpec& spec) {
+void readNetwork(const JsonObject& d, DeviceSpec& spec, const std::string& base_directory) {
   spec.host = d.string("host", spec.host);
   std::uint32_t address = 0;
   if (!device::parseIpv4(spec.host, address))
@@ -42,6 +44,7 @@ void readNetwork(const JsonObject& d, DeviceSpec& spec) {
   if (spec.port < 0 || spec.port > 65535)
     d.fail("port", "must be in [0, 65535] (0: any free port)");
   spec.timeout = positive(d, "timeout", spec.timeout, " s");
+  if (d.has("key_file")) spec.key_file = resolve(d.string("key_file"), base_directory);
 }
 
 void readSpaceMouse(const JsonObject& d, DeviceSpec& spec) {
@@ -99,6 +102,14 @@ void readLoop(const JsonObject& d, DeviceSpec& spec) {
   }
 }
 
+// A key file in the scene, or a key in the environment (device_factory.cpp loads it; a key that
+// fails to load stops the run there).
+bool authenticated(const DeviceSpec& spec) {
+  const char* file = std::getenv(device::kKeyFileVariable);
+  const char* secret = std::getenv(device::kKeyVariable);
+  return !spec.key_file.empty() || (file && *file) || (secret && *secret);
+}
+
 }  // namespace
 
 const char* toString(DeviceSpec::Kind kind) {
@@ -147,7 +158,7 @@ DeviceSpec readDevice(const JsonObject& hand, const std::string& base_directory)
     spec.file = resolve(d.string("log"), base_directory);
   } else if (type == "network") {
     spec.kind = DeviceSpec::Kind::kNetwork;
-    readNetwork(d, spec);
+    readNetwork(d, spec, base_directory);
   } else if (type == "spacemouse") {
     spec.kind = DeviceSpec::Kind::kSpaceMouse;
     readSpaceMouse(d, spec);
@@ -264,12 +275,15 @@ Status applyDeviceOverrides(SceneSpec& scene, const DeviceOverrides& overrides) 
     for (size_t h = 0; h < scene.hands.size(); ++h) {
       const HandSpec& hand = scene.hands[h];
       if (!hand.device || hand.device->kind != DeviceSpec::Kind::kNetwork ||
-          isLoopback(hand.device->host))
+          isLoopback(hand.device->host) || authenticated(*hand.device))
         continue;
       return Error{scene.file + ": hands[" + std::to_string(h) + "] '" + hand.name +
                    "': device host " + hand.device->host +
                    " is not loopback: anyone who can reach that port could drive the hand (the "
-                   "packets are not authenticated); pass --allow-remote-device to listen there"};
+                   "packets are not authenticated); give the device a key_file (or set " +
+                   device::kKeyFileVariable +
+                   ", docs/haptics.md), or pass "
+                   "--allow-remote-device to listen there unauthenticated"};
     }
   }
   return Ok{};
@@ -280,10 +294,12 @@ std::vector<std::string> remoteDeviceWarnings(const SceneSpec& scene) {
   for (const HandSpec& hand : scene.hands) {
     if (hand.device && hand.device->kind == DeviceSpec::Kind::kNetwork &&
         !isLoopback(hand.device->host)) {
-      warnings.push_back("hand '" + hand.name + "': the network device listens on " +
-                         hand.device->host +
-                         ", outside loopback: its first peer is bound, "
-                         "unauthenticated (docs/haptics.md)");
+      warnings.push_back(
+          "hand '" + hand.name + "': the network device listens on " + hand.device->host +
+          (authenticated(*hand.device)
+               ? ", outside loopback: only peers holding the shared key are heard; the packets "
+                 "are signed, not encrypted (docs/haptics.md)"
+               : ", outside loopback: its first peer is bound, unauthenticated (docs/haptics.md)"));
     }
   }
   return warnings;

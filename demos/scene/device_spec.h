@@ -19,6 +19,9 @@ struct DeviceSpec {
   std::string host = "127.0.0.1";  ///< network: IPv4 address the poses arrive on
   int port = 5750;                 ///< network: UDP port
   double timeout = 0.05;           ///< network: s without a pose before the device is dead
+  /// network: file of the shared packet key (resolved; empty: TORSION_HAPTIC_KEY_FILE or
+  /// TORSION_HAPTIC_KEY from the environment, else unauthenticated packets)
+  std::string key_file;
   device::SpaceMouseSettings spacemouse;
   double max_force = 30;      ///< N, the device's limit (scripted, replay, network)
   double max_torque = 3;      ///< N m

@@ -153,10 +153,17 @@ nlohmann::json SceneHaptics::statistics(const Channel& c) const {
         {"max_torque", c.device->limits().max_torque}}}};
   if (const auto* net = dynamic_cast<const device::NetworkDevice*>(c.device.get())) {
     const device::PacketStats& p = net->stats();
-    j["packets"] = {{"accepted", p.accepted.load()},   {"truncated", p.truncated.load()},
-                    {"malformed", p.malformed.load()}, {"out_of_order", p.out_of_order.load()},
-                    {"duplicate", p.duplicate.load()}, {"lost", p.lost.load()},
-                    {"foreign", p.foreign.load()},     {"sent", p.sent.load()}};
+    j["packets"] = {{"accepted", p.accepted.load()},
+                    {"truncated", p.truncated.load()},
+                    {"malformed", p.malformed.load()},
+                    {"out_of_order", p.out_of_order.load()},
+                    {"duplicate", p.duplicate.load()},
+                    {"lost", p.lost.load()},
+                    {"foreign", p.foreign.load()},
+                    {"sent", p.sent.load()},
+                    {"unauthenticated", p.unauthenticated.load()},
+                    {"replayed", p.replayed.load()},
+                    {"authenticated", net->authenticated()}};
   }
   return j;
 }

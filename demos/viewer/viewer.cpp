@@ -494,6 +494,8 @@ int runViewer(const ViewerOptions& options) {
     std::cerr << "error: " << applied.error().message << "\n";
     return 1;
   }
+  for (const std::string& w : scene::remoteDeviceWarnings(spec.value()))
+    std::cerr << "warning: " << w << "\n";  // as `torsion run` says it
   Viewer viewer(options, std::move(spec).value());
   // Opens the devices too: a SpaceMouse without its daemon stops here, before any window.
   if (Status built = viewer.rebuild(); !built) {

@@ -35,16 +35,18 @@ std::string NetworkDevice::name() const {
 }
 
 DeviceSample NetworkDevice::read(double time) {
-  unsigned char buffer[kPacketSize + 1];  // one spare byte: longer datagrams are seen as such
+  unsigned char buffer[kMaxPacketSize + 1];  // one spare byte: longer datagrams are seen as such
   UdpEndpoint from;
   long size;
   while ((size = socket_->receive(buffer, sizeof buffer, from)) >= 0) {
     Packet packet;
     const std::size_t kept = std::min(static_cast<std::size_t>(size), sizeof buffer);
-    if (static_cast<std::size_t>(size) != kept) {
+    if (static_cast<std::size_t>(size) != kept || kept > kMaxPacketSize) {
       ++stats_.truncated;  // longer than any packet
       continue;
     }
+    // Validate (and, with a key, authenticate) first: a bad datagram must not end a session.
+    if (!filter_.decode(buffer, kept, packet, stats_)) continue;
     if (have_peer_ && !(from == peer_)) {
       if (time - last_accepted_time_ <= settings_.session_timeout) {
         ++stats_.foreign;  // the session belongs to its first peer
@@ -52,9 +54,10 @@ DeviceSample NetworkDevice::read(double time) {
       }
       endSession();  // the bound peer went silent: the session is over
     }
-    if (!filter_.accept(buffer, kept, packet, stats_)) continue;
+    if (!freshSession(packet) || !filter_.inOrder(packet, stats_)) continue;
     newest_ = packet;
     peer_ = from;
+    session_ = packet.session;
     have_peer_ = true;
     last_accepted_time_ = time;
     if (packet.goodbye) {
@@ -70,11 +73,26 @@ DeviceSample NetworkDevice::read(double time) {
   return sample;
 }
 
+bool NetworkDevice::freshSession(const Packet& packet) {
+  if (!key()) return true;
+  for (const std::uint64_t ended : ended_sessions_) {
+    if (packet.session == ended) {
+      ++stats_.replayed;
+      return false;
+    }
+  }
+  // The bound peer's address with a new session id: the peer restarted; its old session ends.
+  if (have_peer_ && packet.session != session_) endSession();
+  return true;
+}
+
 void NetworkDevice::endSession() {
   write(Wrench{});  // the departing peer's device must not keep the last force
+  if (key()) ended_sessions_.push_back(session_);  // grows only with authenticated sessions
   have_peer_ = false;
   newest_ = Packet{};
-  filter_ = PacketFilter(PacketKind::kPose);  // the next peer's sequence starts afresh
+  session_ = 0;
+  filter_ = PacketFilter(PacketKind::kPose, key());  // the next peer's sequence starts afresh
   last_accepted_time_ = -1e300;
 }
 
@@ -87,8 +105,16 @@ void NetworkDevice::write(const Wrench& wrench) {
   packet.wrench = wrench;
   packet.flag = true;  // the loop only writes wrenches that passed its safety filter
   packet.echo_sequence = newest_.sequence;
-  const PacketBytes bytes = encodePacket(packet);
-  if (socket_->send(peer_, bytes.data(), bytes.size())) {
+  packet.session = session_;
+  bool sent;
+  if (key()) {
+    const SignedPacketBytes bytes = encodeSignedPacket(packet, *key());
+    sent = socket_->send(peer_, bytes.data(), bytes.size());
+  } else {
+    const PacketBytes bytes = encodePacket(packet);
+    sent = socket_->send(peer_, bytes.data(), bytes.size());
+  }
+  if (sent) {
     ++stats_.sent;
   } else {
     ++stats_.send_failed;

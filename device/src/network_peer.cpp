@@ -1,30 +1,45 @@
 #include "torsion/device/network_peer.h"
 
 #include <chrono>
+#include <cstdint>
 
 namespace torsion::device {
 
 Loaded<std::unique_ptr<NetworkPeer>> NetworkPeer::open(const UdpEndpoint& simulation,
-                                                       Trajectory trajectory) {
+                                                       Trajectory trajectory,
+                                                       std::optional<PacketKey> key) {
   using Out = Loaded<std::unique_ptr<NetworkPeer>>;
   auto socket = UdpSocket::open(UdpEndpoint{simulation.address, 0});
   if (!socket) return Out::fail("network peer: " + socket.error);
   return Out{std::unique_ptr<NetworkPeer>(
-                 new NetworkPeer(*socket.value, simulation, std::move(trajectory))),
+                 new NetworkPeer(*socket.value, simulation, std::move(trajectory), std::move(key))),
              {}};
 }
 
 NetworkPeer::NetworkPeer(std::shared_ptr<UdpSocket> socket, UdpEndpoint simulation,
-                         Trajectory trajectory)
-    : socket_(std::move(socket)), simulation_(simulation), trajectory_(std::move(trajectory)) {}
+                         Trajectory trajectory, std::optional<PacketKey> key)
+    : socket_(std::move(socket)),
+      simulation_(simulation),
+      trajectory_(std::move(trajectory)),
+      key_(std::move(key)),
+      session_(key_ ? randomSessionId() : 0) {}
+
+std::uint32_t NetworkPeer::nextSequence() {
+  if (key() && sequence_ == UINT32_MAX) {
+    // Signed sequences never wrap (packet_stats.h): a new session starts instead.
+    session_ = randomSessionId();
+    sequence_ = 0;
+  }
+  return ++sequence_;
+}
 
 void NetworkPeer::tick(double time) {
-  sendPose(++sequence_, trajectory_.poseAt(time), trajectory_.buttonsAt(time), true);
+  sendPose(nextSequence(), trajectory_.poseAt(time), trajectory_.buttonsAt(time), true);
   drain();
 }
 
 void NetworkPeer::sayGoodbye(double time) {
-  sendPose(++sequence_, trajectory_.poseAt(time), trajectory_.buttonsAt(time), false, true);
+  sendPose(nextSequence(), trajectory_.poseAt(time), trajectory_.buttonsAt(time), false, true);
 }
 
 void NetworkPeer::sendPose(std::uint32_t sequence, const Pose& pose, std::uint32_t buttons,
@@ -40,8 +55,14 @@ void NetworkPeer::sendPose(std::uint32_t sequence, const Pose& pose, std::uint32
                                      .count());
   packet.pose = pose;
   packet.buttons = buttons;
-  const PacketBytes bytes = encodePacket(packet);
-  sendRaw(bytes.data(), bytes.size());
+  if (key()) {
+    packet.session = session_;
+    const SignedPacketBytes bytes = encodeSignedPacket(packet, *key());
+    sendRaw(bytes.data(), bytes.size());
+  } else {
+    const PacketBytes bytes = encodePacket(packet);
+    sendRaw(bytes.data(), bytes.size());
+  }
 }
 
 void NetworkPeer::sendRaw(const void* bytes, std::size_t size) {
@@ -53,16 +74,21 @@ void NetworkPeer::sendRaw(const void* bytes, std::size_t size) {
 }
 
 void NetworkPeer::drain() {
-  unsigned char buffer[kPacketSize + 1];
+  unsigned char buffer[kMaxPacketSize + 1];
   UdpEndpoint from;
   long size;
   while ((size = socket_->receive(buffer, sizeof buffer, from)) >= 0) {
-    if (static_cast<std::size_t>(size) > kPacketSize) {
+    if (static_cast<std::size_t>(size) > kMaxPacketSize) {
       ++stats_.truncated;
       continue;
     }
     Packet packet;
-    if (filter_.accept(buffer, static_cast<std::size_t>(size), packet, stats_)) newest_ = packet;
+    if (!filter_.decode(buffer, static_cast<std::size_t>(size), packet, stats_)) continue;
+    if (key() && packet.session != session_) {
+      ++stats_.replayed;  // signed, but for another session of this key
+      continue;
+    }
+    if (filter_.inOrder(packet, stats_)) newest_ = packet;
   }
 }
 

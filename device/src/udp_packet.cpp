@@ -41,12 +41,10 @@ double getDouble(const unsigned char* at) {
   return value;
 }
 
-}  // namespace
-
-PacketBytes encodePacket(const Packet& packet) {
-  PacketBytes b{};
+// Bytes 0..87, shared by both versions.
+void encodeBody(const Packet& packet, std::uint16_t version, unsigned char* b) {
   put(&b[0], kPacketMagic);
-  put(&b[4], kPacketVersion);
+  put(&b[4], version);
   put(&b[6], static_cast<std::uint16_t>(packet.kind));
   put(&b[8], packet.sequence);
   put(&b[12], static_cast<std::uint32_t>((packet.flag ? 1u : 0u) | (packet.goodbye ? 2u : 0u)));
@@ -66,15 +64,9 @@ PacketBytes encodePacket(const Packet& packet) {
   }
   for (int k = 0; k < 7; ++k)
     putDouble(&b[24 + 8 * k], values[k]);
-  put(&b[88], fnv1a(b.data(), 88));
-  return b;
 }
 
-PacketError decodePacket(const unsigned char* bytes, std::size_t size, Packet& out) {
-  if (size != kPacketSize) return PacketError::kTruncated;
-  if (get<std::uint32_t>(bytes) != kPacketMagic) return PacketError::kMalformed;
-  if (get<std::uint16_t>(bytes + 4) != kPacketVersion) return PacketError::kMalformed;
-  if (get<std::uint32_t>(bytes + 88) != fnv1a(bytes, 88)) return PacketError::kMalformed;
+PacketError decodeBody(const unsigned char* bytes, Packet& out) {
   const auto kind = get<std::uint16_t>(bytes + 6);
   if (kind != 1 && kind != 2) return PacketError::kMalformed;
   out = Packet{};
@@ -98,6 +90,44 @@ PacketError decodePacket(const unsigned char* bytes, std::size_t size, Packet& o
     out.echo_sequence = get<std::uint32_t>(bytes + 80);
   }
   return PacketError::kNone;
+}
+
+}  // namespace
+
+PacketBytes encodePacket(const Packet& packet) {
+  PacketBytes b{};
+  encodeBody(packet, kPacketVersion, b.data());
+  put(&b[88], fnv1a(b.data(), 88));
+  return b;
+}
+
+SignedPacketBytes encodeSignedPacket(const Packet& packet, const PacketKey& key) {
+  SignedPacketBytes b{};
+  encodeBody(packet, kSignedPacketVersion, b.data());
+  put(&b[88], packet.session);
+  const Mac mac = key.mac(b.data(), 96);
+  std::memcpy(&b[96], mac.data(), mac.size());
+  return b;
+}
+
+PacketError decodePacket(const unsigned char* bytes, std::size_t size, Packet& out,
+                         const PacketKey* key) {
+  if (size != kPacketSize && size != kSignedPacketSize) return PacketError::kTruncated;
+  if (get<std::uint32_t>(bytes) != kPacketMagic) return PacketError::kMalformed;
+  const auto version = get<std::uint16_t>(bytes + 4);
+  if (version == kPacketVersion && size == kPacketSize) {
+    if (get<std::uint32_t>(bytes + 88) != fnv1a(bytes, 88)) return PacketError::kMalformed;
+    if (key) return PacketError::kUnauthenticated;  // well-formed, but anyone could have sent it
+    return decodeBody(bytes, out);
+  }
+  if (version == kSignedPacketVersion && size == kSignedPacketSize) {
+    // The MAC first: nothing of an unauthenticated packet is looked at further.
+    if (!key || !key->verify(bytes + 96, bytes, 96)) return PacketError::kUnauthenticated;
+    const PacketError error = decodeBody(bytes, out);
+    out.session = get<std::uint64_t>(bytes + 88);
+    return error;
+  }
+  return PacketError::kMalformed;
 }
 
 }  // namespace torsion::device

@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # The torsion tool losing nothing and reporting nothing false: bad input is a clear error,
 # outputs are complete or absent, signals stop a run cleanly (docs/outputs.md).
-#   reliability_checks.sh CASE TORSION ASSETS_DIR FAIL_WRITES_SHIM
+#   reliability_checks.sh CASE TORSION ASSETS_DIR FAIL_WRITES_SHIM [HAPTIC_PEER]
 # Exit 0: pass; 77: skipped (the reason is printed); anything else: fail.
 set -uo pipefail
 
@@ -9,6 +9,7 @@ case_name=$1
 torsion=$2
 assets=$3
 shim=${4:-}
+peer=${5:-}
 scenes=$(cd "$(dirname "$0")/../../demos/scenes" && pwd)
 
 work=$(mktemp -d "${TMPDIR:-/tmp}/torsion-reliability-XXXXXX")
@@ -361,6 +362,106 @@ case "$case_name" in
       --out out --steps 1 --threads 1
     expect_rc 0
     expect_out "^warning: hand 'hand': the network device listens on 0.0.0.0, outside loopback"
+    ;;
+
+  sigint_zeroes_the_network_device)
+    # Ctrl-C while a peer is holding the hand: the run stops marked, and the last wrench the peer
+    # receives is zero (the loop's stop and the device's close each send one).
+    [[ -x $peer ]] || fail "no torsion_haptic_peer given"
+    twist_scene > twist.json
+    cat > hold.json <<'JSON'
+{"segments": [{"duration": 0.6, "angular_velocity": [0, 0, 0.5]}, {"duration": 5}],
+ "buttons": [{"time": 0, "held": [1]}]}
+JSON
+    port=$((20000 + RANDOM % 20000))
+    start_run out twist.json --device "hand=network:$port" --steps 100000 --threads 1
+    for _ in $(seq 100); do
+      grep -q "device network" run.log && break
+      sleep 0.1
+    done
+    "$peer" --trajectory hold.json --port "$port" --log peer.csv >peer.log 2>&1 &
+    peer_pid=$!
+    # Wait until the peer holds a non-zero torque, then interrupt the simulation.
+    for _ in $(seq 100); do
+      awk -F, 'NR > 1 && ($7 > 0.1 || $7 < -0.1) { found = 1 } END { exit !found }' peer.csv \
+        2>/dev/null && break
+      sleep 0.1
+    done
+    kill -INT "$sim"
+    wait "$sim"
+    rc=$?
+    sleep 0.3  # the peer goes on ticking: its log's last rows come after the close
+    kill -TERM "$peer_pid" 2>/dev/null  # the peer stops cleanly: its log ends with a whole row
+    wait "$peer_pid"
+    cat run.log peer.log
+    expect_rc 130
+    [[ $(json_field out/summary.json stopped_by) == SIGINT ]] || fail "summary lacks stopped_by"
+    awk -F, 'NR > 1 && ($7 > 0.1 || $7 < -0.1) { found = 1 } END { exit !found }' peer.csv ||
+      fail "the peer never held a torque"
+    tail -1 peer.csv | awk -F, '{ for (i = 2; i <= 7; i++) if ($i != 0) exit 1 }' ||
+      fail "the peer's last wrench is not zero: $(tail -1 peer.csv)"
+    ;;
+
+  network_device_key)
+    # A shared key (docs/haptics.md, "Authentication"): the signed peer drives the hand while an
+    # unsigned one, sending to the same port at the same time, is refused and counted.
+    [[ -x $peer ]] || fail "no torsion_haptic_peer given"
+    twist_scene > twist.json
+    cat > turn.json <<'JSON'
+{"segments": [{"duration": 0.6, "angular_velocity": [0, 0, 0.5]}, {"duration": 0.2}],
+ "buttons": [{"time": 0, "held": [1]}]}
+JSON
+    (umask 077 && head -c 32 /dev/urandom | od -An -tx1 | tr -d ' \n' > haptic.key)
+    port=$((20000 + RANDOM % 20000))
+    TORSION_HAPTIC_KEY_FILE=haptic.key "$torsion" run twist.json --device "hand=network:$port" \
+      --out net --steps 150 --threads 1 >torsion.log 2>&1 &
+    sim=$!
+    for _ in $(seq 100); do
+      grep -q "device network" torsion.log && break
+      sleep 0.1
+    done
+    grep -q "device network(udp port $port)" torsion.log ||
+      { kill "$sim"; cat torsion.log; fail "torsion did not open the network device"; }
+    "$peer" --trajectory turn.json --port "$port" --rate 500 >hostile.log 2>&1 &
+    hostile=$!
+    "$peer" --trajectory turn.json --port "$port" --key-file haptic.key >peer.log 2>&1 ||
+      { cat peer.log; fail "the signed peer failed"; }
+    wait "$hostile"
+    wait "$sim"
+    rc=$?
+    cat torsion.log peer.log hostile.log
+    expect_rc 0
+    grep -q "signed with the shared key" peer.log || fail "the peer did not sign"
+    python3 - net/summary.json <<'PY' || fail "packet counts"
+import json, sys
+p = json.load(open(sys.argv[1]))["haptics"][0]["packets"]
+print(p)
+assert p["authenticated"] is True, p
+assert p["accepted"] >= 100, p          # the signed peer drove the hand
+assert p["unauthenticated"] >= 100, p   # the unsigned peer was heard and refused
+assert p["foreign"] == 0 and p["replayed"] == 0, p
+PY
+    grep -q "rejected 0" peer.log || fail "the signed peer rejected wrenches"
+    grep -Eq "accepted 0 wrenches" hostile.log || fail "the unsigned peer received a wrench"
+
+    # Bad keys are clear errors before anything runs; a key is never a command-line argument.
+    printf 'short\n' > short.key && chmod 600 short.key
+    run env TORSION_HAPTIC_KEY_FILE=short.key "$torsion" run twist.json \
+      --device hand=network:0 --out bad --steps 1
+    expect_rc 1
+    expect_out "^error: .*key file short.key: the key has 5 bytes, fewer than the 32 required"
+    run env TORSION_HAPTIC_KEY_FILE=missing.key "$torsion" run twist.json \
+      --device hand=network:0 --out bad --steps 1
+    expect_rc 1
+    expect_out "^error: .*key file missing.key: cannot open: No such file or directory"
+    cp haptic.key shared.key && chmod 644 shared.key
+    run "$peer" --trajectory turn.json --port 9 --key-file shared.key
+    expect_rc 1
+    expect_out "^error: key file shared.key: other users can access it; restrict it with chmod 600$"
+    run "$peer" --trajectory turn.json --port 9 --key "$(cat haptic.key)"
+    expect_rc 1
+    expect_out "^error: --key: a key on the command line is visible to every local user"
+    [[ ! -e bad ]] || fail "nothing may be written when the key cannot be read"
     ;;
   *)
     fail "unknown case '$case_name'"

@@ -1,7 +1,8 @@
 # Runs one libFuzzer target for a bounded time (ctest label "fuzz"), on a fresh scratch copy of its
 # seed corpus so the seeds in the source tree are never written:
 #   cmake -D FUZZER=<exe> -D SEEDS=<seed dir> -D WORK_DIR=<scratch dir> -D SECONDS=<n>
-#         [-D SEED=<n>] [-D RUNS=<n>] [-D DICT=<dictionary>] -P run_fuzzer.cmake
+#         [-D SEED=<n>] [-D RUNS=<n>] [-D DICT=<dictionary>] [-D MORE_SEEDS=<dir>]
+#         [-D MAX_LEN=<bytes>] -P run_fuzzer.cmake
 # The environment variables TORSION_FUZZ_SECONDS, TORSION_FUZZ_SEED and TORSION_FUZZ_RUNS, when
 # set, override SECONDS, SEED and RUNS (e.g. TORSION_FUZZ_SEED=0 TORSION_FUZZ_RUNS=-1
 # TORSION_FUZZ_SECONDS=600 for a random ten-minute hunt). Crashing inputs are
@@ -25,6 +26,10 @@ set(artifacts "${WORK_DIR}/artifacts")
 file(REMOVE_RECURSE "${corpus}")
 file(MAKE_DIRECTORY "${corpus}" "${artifacts}")
 file(GLOB seeds LIST_DIRECTORIES false "${SEEDS}/*")
+if(DEFINED MORE_SEEDS)
+  file(GLOB more_seeds LIST_DIRECTORIES false "${MORE_SEEDS}/*")
+  list(APPEND seeds ${more_seeds})
+endif()
 if(NOT seeds)
   message(FATAL_ERROR "run_fuzzer.cmake: no seeds in ${SEEDS}")
 endif()
@@ -53,6 +58,9 @@ endif()
 set(args "${corpus}" -seed=${SEED} -runs=${RUNS} -max_total_time=${SECONDS} -rss_limit_mb=2048
          -timeout=10
          "-artifact_prefix=${artifacts}/" -print_final_stats=1)
+if(DEFINED MAX_LEN)
+  list(APPEND args "-max_len=${MAX_LEN}")
+endif()
 if(DEFINED DICT AND EXISTS "${DICT}")
   list(APPEND args "-dict=${DICT}")
 endif()

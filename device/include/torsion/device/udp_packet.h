@@ -1,10 +1,10 @@
 #pragma once
 // The network device's wire format (docs/haptics.md, "Packet format"). One UDP datagram is one
-// packet of exactly kPacketSize bytes, little-endian:
+// packet, little-endian. Version 1 (unauthenticated) is exactly kPacketSize bytes:
 //
 //   offset size  field
 //   0      4     magic 0x54525348 ("HSRT" in memory; reads "TRSH" as a big-endian word)
-//   4      2     version = 1
+//   4      2     version = 1 (unauthenticated) or 2 (signed)
 //   6      2     kind: 1 = pose (peer -> simulation), 2 = wrench (simulation -> peer)
 //   8      4     sequence number, +1 per packet sent by that side (wraps modulo 2^32)
 //   12     4     flags: bit 0 alive (pose) / force enabled (wrench);
@@ -16,6 +16,12 @@
 //   84     4     reserved, zero
 //   88     4     checksum: FNV-1a 32 of bytes 0..87
 //
+// Version 2 (signed, packet_key.h) is exactly kSignedPacketSize bytes: bytes 0..87 as above, then
+//   88     8     session id: random, chosen by the peer for each session; wrenches echo it
+//   96     32    HMAC-SHA256 of bytes 0..95 under the shared key
+// Within a session the sequence numbers of signed packets only increase (no wrap-around): the
+// MAC covers them, so a recorded packet cannot be replayed as a new one.
+//
 // decodePacket classifies what arrives; NetworkDevice counts every kind of rejection.
 
 #include <array>
@@ -23,12 +29,18 @@
 #include <cstdint>
 
 #include "torsion/device/device_types.h"
+#include "torsion/device/packet_key.h"
 
 namespace torsion::device {
 
 inline constexpr std::size_t kPacketSize = 92;
 inline constexpr std::uint32_t kPacketMagic = 0x54525348;
 inline constexpr std::uint16_t kPacketVersion = 1;
+inline constexpr std::size_t kSignedPacketSize = 128;
+inline constexpr std::uint16_t kSignedPacketVersion = 2;
+/// The longest datagram either version can be (receive buffers hold one more byte, to tell
+/// longer datagrams apart).
+inline constexpr std::size_t kMaxPacketSize = kSignedPacketSize;
 
 enum class PacketKind : std::uint16_t { kPose = 1, kWrench = 2 };
 
@@ -42,19 +54,29 @@ struct Packet {
   Wrench wrench;                    ///< kind wrench
   std::uint32_t buttons = 0;        ///< kind pose
   std::uint32_t echo_sequence = 0;  ///< kind wrench
+  std::uint64_t session = 0;        ///< signed packets: the peer's session id (0: unsigned)
 };
 
 enum class PacketError {
   kNone,
-  kTruncated,  ///< not exactly kPacketSize bytes
+  kTruncated,  ///< not the size of either version
   kMalformed,  ///< bad magic, version, kind or checksum; non-finite numbers; not a unit quaternion
+  /// With a key: not signed, or a MAC that does not verify. Without one: a signed packet (it
+  /// cannot be checked; the sender has a key this side lacks).
+  kUnauthenticated,
 };
 
 using PacketBytes = std::array<unsigned char, kPacketSize>;
+using SignedPacketBytes = std::array<unsigned char, kSignedPacketSize>;
 
+/// Version 1, unauthenticated.
 PacketBytes encodePacket(const Packet& packet);
-/// Decodes `size` bytes; `out` is only meaningful when the result is kNone.
-PacketError decodePacket(const unsigned char* bytes, std::size_t size, Packet& out);
+/// Version 2: `packet.session` and the MAC under `key`.
+SignedPacketBytes encodeSignedPacket(const Packet& packet, const PacketKey& key);
+/// Decodes `size` bytes; `out` is only meaningful when the result is kNone. Without a key only
+/// version 1 is accepted; with one, only version 2 packets whose MAC verifies.
+PacketError decodePacket(const unsigned char* bytes, std::size_t size, Packet& out,
+                         const PacketKey* key = nullptr);
 
 /// Serial-number order of sequence numbers (RFC 1982): true when b comes after a.
 inline bool sequenceAfter(std::uint32_t b, std::uint32_t a) {
