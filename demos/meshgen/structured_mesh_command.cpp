@@ -7,7 +7,7 @@
 #include <vector>
 
 #include "../cli/mesh_command.h"
-#include "torsion/contact/ball_mesh.h"
+#include "torsion/mesh/ball_mesh.h"
 #include "torsion/mesh/box_mesh.h"
 #include "torsion/mesh/mesh_io.h"
 
