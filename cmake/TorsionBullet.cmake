@@ -8,7 +8,7 @@
 # is an ODR violation that crashes at run time. The target forwards it as a usage requirement.
 #
 # Torsion's FEM is double (Eigen) either way; only the Bullet seam converts
-# (torsion/bullet/bt_conversions.h). This file is installed with the package: TorsionConfig.cmake
+# (torsion/bt_conversions.h). This file is installed with the package: TorsionConfig.cmake
 # sets TORSION_BULLET_PRECISION to the precision the package was built for before including it,
 # so consumers get exactly the target the build used.
 #

@@ -6,7 +6,7 @@
 #include <string>
 #include <vector>
 
-#include "torsion/contact/ball_mesh.h"
+#include "torsion/mesh/ball_mesh.h"
 #include "torsion/mesh/box_mesh.h"
 #include "torsion/mesh/mesh_io.h"
 

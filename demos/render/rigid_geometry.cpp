@@ -10,7 +10,7 @@
 #include <BulletDynamics/Dynamics/btRigidBody.h>
 #include <LinearMath/btConvexHullComputer.h>
 
-#include "torsion/bullet/bt_conversions.h"
+#include "torsion/bt_conversions.h"
 
 namespace torsion::render {
 

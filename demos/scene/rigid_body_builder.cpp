@@ -6,7 +6,7 @@
 #include <BulletCollision/CollisionShapes/btTriangleMesh.h>
 #include <btBulletDynamicsCommon.h>
 
-#include "torsion/bullet/bt_conversions.h"
+#include "torsion/bt_conversions.h"
 
 namespace torsion::scene {
 

@@ -6,8 +6,8 @@
 #include <cmath>
 
 #include "multibody_world.h"
-#include "torsion/contact/ball_mesh.h"
 #include "torsion/contact/multibody_partner.h"
+#include "torsion/mesh/ball_mesh.h"
 #include "torsion/mesh/box_mesh.h"
 
 namespace torsion {

@@ -15,7 +15,7 @@
 #include <memory>
 #include <vector>
 
-#include "torsion/bullet/bt_conversions.h"
+#include "torsion/bt_conversions.h"
 #include "torsion/bullet/fem_soft_body_solver.h"
 
 namespace torsion::testing {

@@ -9,8 +9,8 @@
 
 #include <cmath>
 
-#include "torsion/bullet/bt_conversions.h"
-#include "torsion/contact/ball_mesh.h"
+#include "torsion/bt_conversions.h"
+#include "torsion/mesh/ball_mesh.h"
 #include "torsion/mesh/box_mesh.h"
 
 namespace torsion {

@@ -7,9 +7,9 @@
 #include <algorithm>
 #include <memory>
 
-#include "torsion/bullet/bt_conversions.h"
+#include "torsion/bt_conversions.h"
 #include "torsion/bullet/fem_world.h"
-#include "torsion/contact/ball_mesh.h"
+#include "torsion/mesh/ball_mesh.h"
 #include "torsion/mesh/box_mesh.h"
 
 namespace torsion::test {

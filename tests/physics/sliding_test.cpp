@@ -11,7 +11,7 @@
 #include <iostream>
 #include <memory>
 
-#include "torsion/bullet/bt_conversions.h"
+#include "torsion/bt_conversions.h"
 #include "torsion/bullet/fem_world.h"
 #include "torsion/mesh/box_mesh.h"
 #include "validation_output.h"

@@ -23,7 +23,7 @@
 #include "scene_builder.h"
 #include "scene_haptics.h"
 #include "scene_parser.h"
-#include "torsion/bullet/bt_conversions.h"
+#include "torsion/bt_conversions.h"
 
 namespace torsion::scene {
 namespace {

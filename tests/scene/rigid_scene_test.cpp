@@ -13,7 +13,7 @@
 #include "scene_builder.h"
 #include "scene_parser.h"
 #include "scene_runner.h"
-#include "torsion/bullet/bt_conversions.h"
+#include "torsion/bt_conversions.h"
 
 namespace torsion::scene {
 namespace {

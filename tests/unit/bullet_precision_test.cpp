@@ -3,7 +3,7 @@
 #include <BulletCollision/CollisionShapes/btBoxShape.h>
 #include <gtest/gtest.h>
 
-#include "torsion/bullet/bt_conversions.h"
+#include "torsion/bt_conversions.h"
 #include "torsion/contact/shape_distance.h"
 
 namespace torsion {

@@ -3,7 +3,7 @@
 
 #include <gtest/gtest.h>
 
-#include "torsion/bullet/bt_conversions.h"
+#include "torsion/bt_conversions.h"
 #include "torsion/mesh/box_mesh.h"
 
 namespace torsion {

@@ -4,7 +4,7 @@
 
 #include <cmath>
 
-#include "torsion/bullet/bt_conversions.h"
+#include "torsion/bt_conversions.h"
 #include "torsion/bullet/fem_world.h"
 #include "torsion/constraints/hand.h"
 #include "torsion/mesh/box_mesh.h"

@@ -1,6 +1,6 @@
 #include "torsion/bullet/fem_body.h"
 
-#include "torsion/bullet/bt_conversions.h"
+#include "torsion/bt_conversions.h"
 namespace torsion {
 
 FemBody::FemBody(std::string name, std::shared_ptr<const FemModel> model,

@@ -6,7 +6,7 @@
 #include <algorithm>
 #include <sstream>
 
-#include "torsion/bullet/bt_conversions.h"
+#include "torsion/bt_conversions.h"
 
 namespace torsion {
 

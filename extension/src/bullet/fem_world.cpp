@@ -4,7 +4,7 @@
 
 #include <algorithm>
 
-#include "torsion/bullet/bt_conversions.h"
+#include "torsion/bt_conversions.h"
 #include "torsion/bullet/rigid_health.h"
 
 namespace torsion {

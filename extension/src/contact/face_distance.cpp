@@ -11,7 +11,7 @@
 #include <array>
 #include <cmath>
 
-#include "torsion/bullet/bt_conversions.h"
+#include "torsion/bt_conversions.h"
 #include "torsion/contact/shape_distance.h"
 
 namespace torsion {

@@ -4,7 +4,7 @@
 #include <algorithm>
 #include <cmath>
 
-#include "torsion/bullet/bt_conversions.h"
+#include "torsion/bt_conversions.h"
 
 namespace torsion {
 

@@ -1,6 +1,6 @@
 #include "torsion/contact/node_anchors.h"
 
-#include "torsion/bullet/bt_conversions.h"
+#include "torsion/bt_conversions.h"
 #include "torsion/contact/rigid_contact.h"
 
 namespace torsion {

@@ -13,7 +13,7 @@
 #include <cmath>
 #include <limits>
 
-#include "torsion/bullet/bt_conversions.h"
+#include "torsion/bt_conversions.h"
 #include "torsion/contact/face_distance.h"
 
 namespace torsion {

@@ -15,6 +15,7 @@ namespace torsion {
 
 namespace {
 
+using detail::plural;
 using detail::quoted;
 using detail::TextScanner;
 
@@ -79,17 +80,6 @@ std::string describeType(long type) {
   return "type " + std::to_string(type) + (known ? " (" + std::string(known->name) + ")" : "");
 }
 
-std::string plural(long n, const char* singular, const char* many) {
-  return std::to_string(n) + " " + (n == 1 ? singular : many);
-}
-
-// What reserve() may ask for: the declared count, but never more items than the text could hold
-// at min_bytes characters per item (a fuzzed header may declare 10^18 of anything).
-size_t plausibleCount(long declared, size_t text_size, size_t min_bytes) {
-  if (declared <= 0) return 0;
-  return std::min(static_cast<size_t>(declared), text_size / min_bytes + 1);
-}
-
 // A tet as read, its vertices still node tags; resolved to dense indices once all nodes are known.
 struct PendingTet {
   std::array<long, 4> tags;
@@ -107,8 +97,7 @@ struct Progress {
 
 class GmshReader {
  public:
-  GmshReader(std::string_view text, std::string file)
-      : in_(text, std::move(file)), text_size_(text.size()) {}
+  GmshReader(std::string_view text, std::string file) : in_(text, std::move(file)) {}
 
   RawTetMesh read() {
     while (in_.nextLine()) {
@@ -283,7 +272,7 @@ class GmshReader {
   }
 
   void reserveNodes(long count, size_t min_bytes) {
-    const size_t n = plausibleCount(count, text_size_, min_bytes);
+    const size_t n = in_.plausibleCount(count, min_bytes);
     node_tags_.reserve(node_tags_.size() + n);
     node_lines_.reserve(node_lines_.size() + n);
     positions_.reserve(positions_.size() + n);
@@ -479,7 +468,7 @@ class GmshReader {
                  std::to_string(total - read) + " left of the " + std::to_string(total) +
                  " the header (line " + std::to_string(elements_header_line_) + ") declares");
       }
-      if (type == kLinearTet) tets_.reserve(tets_.size() + plausibleCount(n, text_size_, 10));
+      if (type == kLinearTet) tets_.reserve(tets_.size() + in_.plausibleCount(n, 10));
       const int block_line = in_.lineNumber();
       for (long i = 0; i < n; ++i) {
         requireBodyLine(Progress{"elements", n, i, block_line, "block header"});
@@ -600,7 +589,6 @@ class GmshReader {
   }
 
   TextScanner in_;
-  size_t text_size_;
   bool version41_ = false;
   std::string section_;  // header of the section being read, e.g. "$Nodes"
   int section_line_ = 0;

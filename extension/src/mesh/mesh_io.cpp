@@ -19,13 +19,18 @@ std::string lowerExtension(const fs::path& path) {
 namespace {
 
 // TetGen meshes are two files; any of "name", "name.node", "name.ele" names the pair.
-fs::path tetgenBase(const fs::path& path) {
+struct TetGenPaths {
+  fs::path node, ele;
+};
+
+TetGenPaths tetgenPaths(const fs::path& path) {
+  fs::path base = path;
   const std::string ext = lowerExtension(path);
-  if (ext == ".node" || ext == ".ele") {
-    fs::path base = path;
-    return base.replace_extension();
-  }
-  return path;
+  if (ext == ".node" || ext == ".ele") base.replace_extension();
+  TetGenPaths paths{base, base};
+  paths.node += ".node";
+  paths.ele += ".ele";
+  return paths;
 }
 
 }  // namespace
@@ -36,12 +41,10 @@ Result<MeshFormat> meshFormatOf(const fs::path& path) {
   if (ext == ".msh") return MeshFormat::kGmsh;
   if (ext == ".vtk") return MeshFormat::kVtk;
   if (ext.empty()) {
-    fs::path node = path;
-    node += ".node";
     // error_code form: a name too long or a directory we may not search is "not found" here,
     // and the reader then reports the real reason instead of an exception aborting the program.
     std::error_code ec;
-    if (fs::exists(node, ec)) return MeshFormat::kTetGen;
+    if (fs::exists(tetgenPaths(path).node, ec)) return MeshFormat::kTetGen;
   }
   return Error{path.string() + ": unknown mesh format '" + ext +
                "' (known: .node/.ele for TetGen, .msh for Gmsh 2.2/4.1, .vtk for legacy VTK)"};
@@ -70,15 +73,13 @@ Result<LoadedMesh> readMesh(const fs::path& path, const MeshLoadOptions& options
   Result<RawTetMesh> raw = Error{};
   switch (format.value()) {
     case MeshFormat::kTetGen: {
-      const fs::path base = tetgenBase(path);
-      fs::path node_path = base, ele_path = base;
-      node_path += ".node";
-      ele_path += ".ele";
-      Result<std::string> node_text = readTextFile(node_path);
+      const TetGenPaths paths = tetgenPaths(path);
+      Result<std::string> node_text = readTextFile(paths.node);
       if (!node_text) return node_text.error();
-      Result<std::string> ele_text = readTextFile(ele_path);
+      Result<std::string> ele_text = readTextFile(paths.ele);
       if (!ele_text) return ele_text.error();
-      raw = parseTetGen(node_text.value(), node_path.string(), ele_text.value(), ele_path.string());
+      raw =
+          parseTetGen(node_text.value(), paths.node.string(), ele_text.value(), paths.ele.string());
       break;
     }
     case MeshFormat::kGmsh:
@@ -99,14 +100,11 @@ Status writeMesh(const fs::path& path, const TetMesh& mesh, const MeshFields& fi
   if (!format) return format.error();
   switch (format.value()) {
     case MeshFormat::kTetGen: {
-      const fs::path base = tetgenBase(path);
-      fs::path node_path = base, ele_path = base;
-      node_path += ".node";
-      ele_path += ".ele";
+      const TetGenPaths paths = tetgenPaths(path);
       // Both files or neither: a .node beside a stale .ele would be a different mesh.
       TetGenText text = formatTetGen(mesh);
       const std::string error = device::writeFilesTogether(
-          {{node_path.string(), std::move(text.node)}, {ele_path.string(), std::move(text.ele)}});
+          {{paths.node.string(), std::move(text.node)}, {paths.ele.string(), std::move(text.ele)}});
       if (!error.empty()) return Error{error};
       return Ok{};
     }

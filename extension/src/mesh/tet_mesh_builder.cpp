@@ -30,26 +30,30 @@ double longestEdge(const std::array<Eigen::Vector3d, 4>& x) {
   return longest;
 }
 
-}  // namespace
+// Readers without element ids or lines (structured meshes, tests) get the tet's index as its id.
+void numberUnlabelledTets(RawTetMesh& raw) {
+  if (raw.origins.size() == raw.tets.size()) return;
+  raw.origins.resize(raw.tets.size());
+  for (size_t t = 0; t < raw.tets.size(); ++t)
+    raw.origins[t].id = static_cast<long>(t);
+}
 
-Result<LoadedMesh> buildTetMesh(RawTetMesh raw, const MeshLoadOptions& options) {
+Status checkNodes(const RawTetMesh& raw) {
   const std::string& file = raw.element_file;
-  if (raw.origins.size() != raw.tets.size()) {
-    raw.origins.resize(raw.tets.size());
-    for (size_t t = 0; t < raw.tets.size(); ++t)
-      raw.origins[t].id = static_cast<long>(t);
-  }
   if (raw.positions.empty()) return Error{file + ": the mesh has no nodes"};
   if (raw.tets.empty()) return Error{file + ": the mesh has no tetrahedra"};
-
-  const long node_count = static_cast<long>(raw.positions.size());
   for (size_t n = 0; n < raw.positions.size(); ++n) {
     if (!raw.positions[n].allFinite()) {
       return Error{file + ": node " + std::to_string(n) + " has a non-finite coordinate"};
     }
   }
+  return Ok{};
+}
 
-  LoadedMesh loaded;
+// Per tet: indices in range and distinct, a volume that is finite and not flat; an inverted tet
+// is refused or reoriented (two vertices swapped), with one warning for all of them.
+Status checkAndOrientTets(RawTetMesh& raw, const MeshLoadOptions& options, LoadedMesh& loaded) {
+  const long node_count = static_cast<long>(raw.positions.size());
   std::vector<long> inverted_lines;
   for (size_t t = 0; t < raw.tets.size(); ++t) {
     Tet& tet = raw.tets[t];
@@ -94,7 +98,7 @@ Result<LoadedMesh> buildTetMesh(RawTetMesh raw, const MeshLoadOptions& options) 
   if (loaded.reoriented_tets > 0) {
     const bool by_line = raw.origins.front().line > 0;
     std::ostringstream s;
-    s << file << ": " << loaded.reoriented_tets << " inverted tet"
+    s << raw.element_file << ": " << loaded.reoriented_tets << " inverted tet"
       << (loaded.reoriented_tets == 1 ? " was" : "s were") << " reoriented ("
       << (by_line ? "line" : "tet") << (inverted_lines.size() == 1 ? " " : "s ");
     for (size_t i = 0; i < std::min<size_t>(inverted_lines.size(), 5); ++i) {
@@ -103,29 +107,33 @@ Result<LoadedMesh> buildTetMesh(RawTetMesh raw, const MeshLoadOptions& options) 
     s << (inverted_lines.size() > 5 ? ", ...)" : ")");
     loaded.warnings.push_back(s.str());
   }
+  return Ok{};
+}
 
-  // The same four nodes twice would pass the face test below (each face shared by two tets).
-  {
-    std::vector<std::pair<Tet, size_t>> sorted;
-    sorted.reserve(raw.tets.size());
-    for (size_t t = 0; t < raw.tets.size(); ++t) {
-      Tet key = raw.tets[t];
-      std::sort(key.begin(), key.end());
-      sorted.emplace_back(key, t);
-    }
-    std::sort(sorted.begin(), sorted.end());
-    for (size_t i = 1; i < sorted.size(); ++i) {
-      if (sorted[i].first == sorted[i - 1].first) {
-        const size_t later = std::max(sorted[i].second, sorted[i - 1].second);
-        const size_t earlier = std::min(sorted[i].second, sorted[i - 1].second);
-        return Error{where(raw, later) + ": duplicates tet " +
-                     std::to_string(raw.origins[earlier].id) + " (the same four vertices)"};
-      }
+// The same four nodes twice would pass the face tests below (each face shared by two tets).
+Status refuseDuplicateTets(const RawTetMesh& raw) {
+  std::vector<std::pair<Tet, size_t>> sorted;
+  sorted.reserve(raw.tets.size());
+  for (size_t t = 0; t < raw.tets.size(); ++t) {
+    Tet key = raw.tets[t];
+    std::sort(key.begin(), key.end());
+    sorted.emplace_back(key, t);
+  }
+  std::sort(sorted.begin(), sorted.end());
+  for (size_t i = 1; i < sorted.size(); ++i) {
+    if (sorted[i].first == sorted[i - 1].first) {
+      const size_t later = std::max(sorted[i].second, sorted[i - 1].second);
+      const size_t earlier = std::min(sorted[i].second, sorted[i - 1].second);
+      return Error{where(raw, later) + ": duplicates tet " +
+                   std::to_string(raw.origins[earlier].id) + " (the same four vertices)"};
     }
   }
+  return Ok{};
+}
 
-  // A face inside a tet mesh is shared by two tets; three or more means overlapping tets.
-  const std::vector<detail::FaceRecord> faces = detail::sortedFaces(raw.tets);
+// A face inside a tet mesh is shared by two tets; three or more means overlapping tets.
+Status refuseFacesSharedThrice(const RawTetMesh& raw,
+                               const std::vector<detail::FaceRecord>& faces) {
   for (size_t i = 0; i + 2 < faces.size(); ++i) {
     if (faces[i].key == faces[i + 2].key) {
       const auto& k = faces[i].key;
@@ -137,11 +145,15 @@ Result<LoadedMesh> buildTetMesh(RawTetMesh raw, const MeshLoadOptions& options) 
                    ": tets overlap or are duplicated"};
     }
   }
+  return Ok{};
+}
 
-  // Two positively oriented tets sharing a face lie on opposite sides of it exactly when they see
-  // it with opposite orientations. The same orientation puts both on one side: they overlap, even
-  // though every face is shared only twice (a fuzzer found five tets folded over each other that
-  // way, leaving no boundary surface at all).
+// Two positively oriented tets sharing a face lie on opposite sides of it exactly when they see
+// it with opposite orientations. The same orientation puts both on one side: they overlap, even
+// though every face is shared only twice (a fuzzer found five tets folded over each other that
+// way, leaving no boundary surface at all).
+Status refuseTetsOnOneSideOfAFace(const RawTetMesh& raw,
+                                  const std::vector<detail::FaceRecord>& faces) {
   for (size_t i = 0; i + 1 < faces.size(); ++i) {
     if (faces[i].key != faces[i + 1].key) continue;
     const auto oriented = [&](const detail::FaceRecord& face) {
@@ -166,8 +178,12 @@ Result<LoadedMesh> buildTetMesh(RawTetMesh raw, const MeshLoadOptions& options) 
                    std::to_string(raw.origins[earlier].id) + ": tets overlap"};
     }
   }
+  return Ok{};
+}
 
-  // Nodes no tet uses would have no mass and make the system singular: drop them.
+// Nodes no tet uses would have no mass and make the system singular: they are dropped (with a
+// warning) and the tets renumbered. Returns the positions that remain.
+std::vector<Eigen::Vector3d> dropUnusedNodes(RawTetMesh& raw, LoadedMesh& loaded) {
   std::vector<int> new_index(raw.positions.size(), -1);
   for (const Tet& tet : raw.tets) {
     for (int v : tet)
@@ -183,7 +199,7 @@ Result<LoadedMesh> buildTetMesh(RawTetMesh raw, const MeshLoadOptions& options) 
   }
   const size_t unused = raw.positions.size() - positions.size();
   if (unused > 0) {
-    loaded.warnings.push_back(file + ": " + std::to_string(unused) + " node" +
+    loaded.warnings.push_back(raw.element_file + ": " + std::to_string(unused) + " node" +
                               (unused == 1 ? " is" : "s are") + " used by no tet and " +
                               (unused == 1 ? "was" : "were") + " dropped");
     for (Tet& tet : raw.tets) {
@@ -191,9 +207,23 @@ Result<LoadedMesh> buildTetMesh(RawTetMesh raw, const MeshLoadOptions& options) 
         v = new_index[static_cast<size_t>(v)];
     }
   }
+  return positions;
+}
+
+}  // namespace
+
+Result<LoadedMesh> buildTetMesh(RawTetMesh raw, const MeshLoadOptions& options) {
+  numberUnlabelledTets(raw);
+  LoadedMesh loaded;
+  if (Status s = checkNodes(raw); !s) return s.error();
+  if (Status s = checkAndOrientTets(raw, options, loaded); !s) return s.error();
+  if (Status s = refuseDuplicateTets(raw); !s) return s.error();
+  const std::vector<detail::FaceRecord> faces = detail::sortedFaces(raw.tets);
+  if (Status s = refuseFacesSharedThrice(raw, faces); !s) return s.error();
+  if (Status s = refuseTetsOnOneSideOfAFace(raw, faces); !s) return s.error();
+  std::vector<Eigen::Vector3d> positions = dropUnusedNodes(raw, loaded);
   for (const std::string& note : raw.notes)
     loaded.warnings.push_back(note);
-
   loaded.mesh = TetMesh(std::move(positions), std::move(raw.tets));
   return loaded;
 }

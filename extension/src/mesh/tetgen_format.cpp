@@ -15,11 +15,9 @@ using detail::TextScanner;
 // More per-point attributes than this is no mesh we can use; it also keeps field counts small.
 constexpr long kMaxAttributes = 1000;
 
-// A header count is only trusted as far as the text could hold it (each entry is at least one
-// short line), so a hostile header cannot make us reserve gigabytes.
-size_t plausibleCount(long count, const TextScanner& in) {
-  return static_cast<size_t>(std::min<long>(count, static_cast<long>(in.textSize() / 2 + 1)));
-}
+// Each entry of a .node or .ele list is at least one short line ("1\n"): what a header count is
+// trusted for (TextScanner::plausibleCount).
+constexpr size_t kMinCharsPerEntry = 2;
 
 struct NodeTable {
   std::vector<Eigen::Vector3d> positions;
@@ -49,7 +47,7 @@ NodeTable parseNodes(TextScanner& in) {
   const int header_line = in.lineNumber();
 
   NodeTable table;
-  table.positions.reserve(plausibleCount(count, in));
+  table.positions.reserve(in.plausibleCount(count, kMinCharsPerEntry));
   const size_t fields = static_cast<size_t>(4 + attributes + markers);
   for (long i = 0; i < count; ++i) {
     if (!in.nextLine()) {
@@ -108,8 +106,8 @@ void parseElements(TextScanner& in, const NodeTable& nodes, RawTetMesh& raw) {
 
   const long node_count = static_cast<long>(nodes.positions.size());
   const size_t fields = static_cast<size_t>(5 + attributes);
-  raw.tets.reserve(plausibleCount(count, in));
-  raw.origins.reserve(plausibleCount(count, in));
+  raw.tets.reserve(in.plausibleCount(count, kMinCharsPerEntry));
+  raw.origins.reserve(in.plausibleCount(count, kMinCharsPerEntry));
   long first_index = 0;
   for (long i = 0; i < count; ++i) {
     if (!in.nextLine()) {

@@ -1,5 +1,6 @@
 #include "text_scanner.h"
 
+#include <algorithm>
 #include <charconv>
 #include <cmath>
 #include <system_error>
@@ -124,6 +125,15 @@ void TextScanner::fail(const std::string& message) const {
 
 void TextScanner::failAt(int line, const std::string& message) const {
   throw ParseFailure(file_name_ + ":" + std::to_string(line) + ": " + message);
+}
+
+size_t TextScanner::plausibleCount(long declared, size_t min_chars_per_item) const {
+  if (declared <= 0) return 0;
+  return std::min(static_cast<size_t>(declared), text_.size() / min_chars_per_item + 1);
+}
+
+std::string plural(long n, std::string_view one, std::string_view many) {
+  return std::to_string(n) + " " + std::string(n == 1 ? one : many);
 }
 
 std::string quoted(std::string_view token) {

@@ -24,7 +24,10 @@ class TextScanner {
   TextScanner(std::string_view text, std::string file_name, char comment = '\0');
 
   const std::string& fileName() const { return file_name_; }
-  size_t textSize() const { return text_.size(); }
+  /// The file-size guard for reserve(): the declared count of a list, but never more items than
+  /// the whole text could hold at min_chars_per_item characters each (a fuzzed header may declare
+  /// 10^18 of anything, and reserve() would ask for it); 0 for a count <= 0.
+  size_t plausibleCount(long declared, size_t min_chars_per_item) const;
 
   // ---- Line by line ----
   /// Moves to the next line that has a token; false at end of text. Splits it into tokens().
@@ -51,7 +54,6 @@ class TextScanner {
   long parseInteger(std::string_view token, std::string_view what) const;
   double parseReal(std::string_view token, std::string_view what) const;  ///< finite only
   long nextInteger(std::string_view what) { return parseInteger(nextToken(what), what); }
-  double nextReal(std::string_view what) { return parseReal(nextToken(what), what); }
 
   /// Throws ParseFailure("file:line: message") at the current line.
   [[noreturn]] void fail(const std::string& message) const;
@@ -73,5 +75,8 @@ class TextScanner {
 
 /// Quotes a token for an error message, shortened if long.
 std::string quoted(std::string_view token);
+
+/// "1 node", "3 nodes": a count with its noun for an error message.
+std::string plural(long n, std::string_view one, std::string_view many);
 
 }  // namespace torsion::detail

@@ -18,6 +18,7 @@ namespace torsion {
 
 namespace {
 
+using detail::plural;
 using detail::quoted;
 using detail::TextScanner;
 
@@ -100,10 +101,6 @@ const char* cellTypeName(long type) {
   return found == kNames.end() ? "unknown cell type" : found->second;
 }
 
-std::string plural(long n, const char* one, const char* many) {
-  return std::to_string(n) + " " + (n == 1 ? one : many);
-}
-
 // "what is declared" for a counted list, e.g. "POINTS (line 5) declares 900 points"; the reader
 // appends ", found N" when the data runs out early.
 struct List {
@@ -112,8 +109,7 @@ struct List {
 
 class VtkReader {
  public:
-  VtkReader(std::string_view text, std::string_view file)
-      : in_(text, std::string(file)), text_size_(text.size()) {}
+  VtkReader(std::string_view text, std::string_view file) : in_(text, std::string(file)) {}
 
   RawTetMesh read();
 
@@ -163,11 +159,6 @@ class VtkReader {
     return in_.parseInteger(token, what());
   }
 
-  /// A reserve() size that a hostile count cannot blow up: no more items than the text could hold.
-  size_t capacity(long count, size_t min_chars_per_item) const {
-    const size_t most = text_size_ / min_chars_per_item + 1;
-    return count <= 0 ? 0 : std::min(static_cast<size_t>(count), most);
-  }
   std::string atLine(int line) const { return "(line " + std::to_string(line) + ")"; }
   void refuseSecond(int first_line, const char* section) const {
     if (first_line > 0) {
@@ -187,7 +178,6 @@ class VtkReader {
   void skipToKeyword();
 
   TextScanner in_;
-  size_t text_size_;
   std::string_view pending_;
   bool has_pending_ = false;
 
@@ -267,7 +257,7 @@ void VtkReader::readPoints() {
     in_.fail("POINTS data type " + quoted(type) + " is not a numeric type (float, double, int...)");
   }
   const List list{"POINTS " + atLine(line) + " declares " + plural(count, "point", "points")};
-  positions_.reserve(capacity(count, 6));  // "0 0 0\n"
+  positions_.reserve(in_.plausibleCount(count, 6));  // "0 0 0\n"
   for (long i = 0; i < count; ++i) {
     Eigen::Vector3d p;
     for (int d = 0; d < 3; ++d) {
@@ -320,9 +310,9 @@ void VtkReader::readCells() {
 // "CELLS n size", then n rows "k i0 .. ik-1" with size == sum of (k + 1).
 void VtkReader::readClassicCells(long count, long size) {
   const List list{"CELLS " + atLine(cells_line_) + " declares " + plural(count, "cell", "cells")};
-  cell_begin_.reserve(capacity(count, 2) + 1);
-  cell_lines_.reserve(capacity(count, 2));
-  connectivity_.reserve(capacity(size, 2));
+  cell_begin_.reserve(in_.plausibleCount(count, 2) + 1);
+  cell_lines_.reserve(in_.plausibleCount(count, 2));
+  connectivity_.reserve(in_.plausibleCount(size, 2));
   long used = 0;
   for (long c = 0; c < count; ++c) {
     const long k = integerToken(listToken(list, c),
@@ -362,7 +352,7 @@ void VtkReader::readOffsetCells(long offset_count, long size) {
   const List offsets{"CELLS " + atLine(cells_line_) + " declares " +
                      plural(offset_count, "offset", "offsets")};
   cell_begin_.clear();
-  cell_begin_.reserve(capacity(offset_count, 2));
+  cell_begin_.reserve(in_.plausibleCount(offset_count, 2));
   long previous = 0;
   for (long i = 0; i < offset_count; ++i) {
     const long offset =
@@ -402,8 +392,8 @@ void VtkReader::readOffsetCells(long offset_count, long size) {
   const List entries{"CELLS " + atLine(cells_line_) + " declares " +
                      plural(size, "connectivity entry", "connectivity entries")};
   const long cells = offset_count - 1;
-  connectivity_.reserve(capacity(size, 2));
-  cell_lines_.reserve(capacity(cells, 1));
+  connectivity_.reserve(in_.plausibleCount(size, 2));
+  cell_lines_.reserve(in_.plausibleCount(cells, 1));
   for (long c = 0; c < cells; ++c) {
     const size_t points =
         cell_begin_[static_cast<size_t>(c) + 1] - cell_begin_[static_cast<size_t>(c)];

@@ -1,10 +1,11 @@
 #include "torsion/solve/cholmod_solver.h"
 
 #include <Eigen/CholmodSupport>
+#include <algorithm>
+#include <array>
 #include <cmath>
-
-#include "torsion/fem/quadratic_element.h"
-#include "torsion/mesh/tet_mesh.h"
+#include <limits>
+#include <utility>
 
 namespace torsion {
 
@@ -14,14 +15,15 @@ struct CholmodSolver::Impl {
   // (row-major within the block; -1 for the upper triangle of a diagonal block).
   std::vector<std::pair<int, int>> blocks;
   std::vector<std::array<int, 9>> block_values;
-  // Per element, per (a, b) of its N nodes: block id at [N^2 e + N a + b], -1 if i < j.
-  std::vector<int> element_block;
-  std::vector<int> diagonal_block;  // per node
-  // Nodal pressure (nodal_pressure.h): node n's patch (the nodes of its tets, sorted) in
-  // patch_nodes[patch_offsets[n] ..], and the block of every patch pair (i >= j), row by row of
-  // the lower triangle, from patch_pair_offsets[n].
+  // Per slot of the operator's upper-triangle K (row n, column c >= n): the block (c, n) here.
+  std::vector<int> slot_block;
+  // Nodal pressure (nodal_pressure.h): the block of every pair (a >= b) of node n's patch, row by
+  // row of the lower triangle, from patch_pair_offsets[n].
   bool nodal_pressure = false;
-  std::vector<int> patch_offsets, patch_nodes, patch_pair_offsets, patch_pair_blocks;
+  std::vector<int> patch_pair_offsets, patch_pair_blocks;
+  // Scratch for one node's patch (SystemOperator::volumetricPatch).
+  std::vector<int> patch_nodes;
+  std::vector<Eigen::Vector3d> patch_weights;
   bool analysed = false;
   Eigen::CholmodDecomposition<Eigen::SparseMatrix<double>, Eigen::Lower> factor;
   Eigen::VectorXd rhs, prescribed, q, solution;
@@ -31,47 +33,30 @@ CholmodSolver::CholmodSolver() : impl_(std::make_unique<Impl>()) {}
 CholmodSolver::~CholmodSolver() = default;
 
 void CholmodSolver::buildPattern(const SystemOperator& op) {
-  const FemModel& model = op.model();
-  const int n = model.nodeCount();
-  const size_t n_per = static_cast<size_t>(model.nodesPerElement());
-  const std::vector<int>& element_nodes = model.elementNodes();
-  const size_t elements = static_cast<size_t>(model.elementCount());
-  // Node-pair blocks (i >= j) present in some element. Lower triangle of the scalar matrix: in a
-  // diagonal block keep entries r >= c only; off-diagonal blocks (i > j) are dense.
-  std::vector<std::pair<int, int>> pairs;
-  pairs.reserve(elements * n_per * (n_per - 1) / 2 + static_cast<size_t>(n));
-  for (int i = 0; i < n; ++i)
-    pairs.emplace_back(i, i);
-  for (size_t e = 0; e < elements; ++e) {
-    const int* nodes = element_nodes.data() + n_per * e;
-    for (size_t a = 0; a < n_per; ++a) {
-      for (size_t b = 0; b < n_per; ++b) {
-        if (nodes[a] > nodes[b]) pairs.emplace_back(nodes[a], nodes[b]);
-      }
-    }
-  }
-  // The volumetric stiffness of nodal pressure couples every pair of nodes of a node's patch.
+  const int n = op.model().nodeCount();
+  const std::vector<int>& row_offsets = op.blockRowOffsets();
+  const std::vector<int>& columns = op.blockColumns();
   Impl& m = *impl_;
-  m.nodal_pressure = model.nodalPressure();
-  m.patch_offsets.assign(1, 0);
-  m.patch_nodes.clear();
+  // The lower block triangle is the operator's upper one transposed: its slot (row, column)
+  // is the block (column, row) here. Lower triangle of the scalar matrix: in a diagonal block
+  // keep entries r >= c only; off-diagonal blocks (i > j) are dense.
+  std::vector<std::pair<int, int>> pairs;
+  pairs.reserve(columns.size());
+  for (int row = 0; row < n; ++row) {
+    for (int s = row_offsets[static_cast<size_t>(row)];
+         s < row_offsets[static_cast<size_t>(row) + 1]; ++s)
+      pairs.emplace_back(columns[static_cast<size_t>(s)], row);
+  }
+  // The volumetric stiffness of nodal pressure couples every pair of nodes of a node's patch
+  // (nodes two tets apart: outside the operator's pattern).
+  m.nodal_pressure = op.model().nodalPressure();
   if (m.nodal_pressure) {
-    const CompressedRows& node_tets = model.mesh().nodeTets();
-    std::vector<int> patch;
     for (int node = 0; node < n; ++node) {
-      patch.clear();
-      for (int k = node_tets.rowBegin(node); k < node_tets.rowEnd(node); ++k) {
-        const int* nodes = element_nodes.data() + 4 * node_tets.items[static_cast<size_t>(k)];
-        patch.insert(patch.end(), nodes, nodes + 4);
-      }
-      std::sort(patch.begin(), patch.end());
-      patch.erase(std::unique(patch.begin(), patch.end()), patch.end());
-      for (size_t a = 0; a < patch.size(); ++a) {
+      op.volumetricPatch(node, m.patch_nodes, m.patch_weights);
+      for (size_t a = 0; a < m.patch_nodes.size(); ++a) {
         for (size_t b = 0; b < a; ++b)
-          pairs.emplace_back(patch[a], patch[b]);
+          pairs.emplace_back(m.patch_nodes[a], m.patch_nodes[b]);
       }
-      m.patch_nodes.insert(m.patch_nodes.end(), patch.begin(), patch.end());
-      m.patch_offsets.push_back(static_cast<int>(m.patch_nodes.size()));
     }
   }
   std::sort(pairs.begin(), pairs.end());
@@ -113,31 +98,23 @@ void CholmodSolver::buildPattern(const SystemOperator& op) {
     return static_cast<int>(std::lower_bound(pairs.begin(), pairs.end(), std::make_pair(i, j)) -
                             pairs.begin());
   };
-  m.diagonal_block.resize(static_cast<size_t>(n));
-  for (int i = 0; i < n; ++i)
-    m.diagonal_block[static_cast<size_t>(i)] = block_of(i, i);
+  m.slot_block.resize(columns.size());
+  for (int row = 0; row < n; ++row) {
+    for (int s = row_offsets[static_cast<size_t>(row)];
+         s < row_offsets[static_cast<size_t>(row) + 1]; ++s)
+      m.slot_block[static_cast<size_t>(s)] = block_of(columns[static_cast<size_t>(s)], row);
+  }
   m.patch_pair_offsets.assign(1, 0);
   m.patch_pair_blocks.clear();
   if (m.nodal_pressure) {
     for (int node = 0; node < n; ++node) {
-      const int* patch = m.patch_nodes.data() + m.patch_offsets[static_cast<size_t>(node)];
-      const int size = m.patch_offsets[static_cast<size_t>(node) + 1] -
-                       m.patch_offsets[static_cast<size_t>(node)];
-      for (int a = 0; a < size; ++a) {
-        for (int b = 0; b <= a; ++b)
+      op.volumetricPatch(node, m.patch_nodes, m.patch_weights);
+      const std::vector<int>& patch = m.patch_nodes;
+      for (size_t a = 0; a < patch.size(); ++a) {
+        for (size_t b = 0; b <= a; ++b)
           m.patch_pair_blocks.push_back(block_of(patch[a], patch[b]));
       }
       m.patch_pair_offsets.push_back(static_cast<int>(m.patch_pair_blocks.size()));
-    }
-  }
-  m.element_block.assign(elements * n_per * n_per, -1);
-  for (size_t e = 0; e < elements; ++e) {
-    const int* nodes = element_nodes.data() + n_per * e;
-    for (size_t a = 0; a < n_per; ++a) {
-      for (size_t b = 0; b < n_per; ++b) {
-        if (nodes[a] >= nodes[b])
-          m.element_block[n_per * n_per * e + n_per * a + b] = block_of(nodes[a], nodes[b]);
-      }
     }
   }
 }
@@ -151,10 +128,6 @@ const Eigen::SparseMatrix<double>& CholmodSolver::assemble(const SystemOperator&
     m.analysed = false;
   }
   const FemModel& model = op.model();
-  const double mu = model.material().mu();
-  // With nodal pressure the element blocks are deviatoric (lambda -> -2 mu / 3) and the
-  // volumetric part is added per node patch below (nodal_pressure.h).
-  const double lambda = model.nodalPressure() ? -2.0 * mu / 3.0 : model.material().lambda();
   const double c = op.stiffnessCoefficient();
   double* values = m.matrix.valuePtr();
   std::fill(values, values + m.matrix.nonZeros(), 0.0);
@@ -169,78 +142,29 @@ const Eigen::SparseMatrix<double>& CholmodSolver::assemble(const SystemOperator&
     }
   };
 
-  if (model.elementKind() == ElementKind::kTet4) {
-    // K_ab = V R (mu (g_a . g_b) I + mu g_b g_a^T + lambda g_a g_b^T) R^T.
-    for (int t = 0; t < model.elementCount(); ++t) {
-      const TetRestData& rest = model.tetRestData()[static_cast<size_t>(t)];
-      const Eigen::Matrix3d& R = op.rotations()[static_cast<size_t>(t)];
-      const Eigen::Matrix3d& B = rest.rest_shape_inverse;
-      const std::array<Eigen::Vector3d, 4> g = {-(B.row(0) + B.row(1) + B.row(2)).transpose(),
-                                                B.row(0).transpose(), B.row(1).transpose(),
-                                                B.row(2).transpose()};
-      for (size_t a = 0; a < 4; ++a) {
-        for (size_t b = 0; b < 4; ++b) {
-          const int block = m.element_block[16 * static_cast<size_t>(t) + 4 * a + b];
-          if (block < 0) continue;
-          const Eigen::Matrix3d local =
-              rest.volume * (mu * g[a].dot(g[b]) * Eigen::Matrix3d::Identity() +
-                             mu * g[b] * g[a].transpose() + lambda * g[a] * g[b].transpose());
-          add_block(block, c * (R * local * R.transpose()));
-        }
-      }
-    }
-  } else {
-    // The quadrature sum of quadratic_element.h per block.
-    for (int e = 0; e < model.elementCount(); ++e) {
-      const QuadraticRestData& rest = model.quadraticRestData()[static_cast<size_t>(e)];
-      const Eigen::Matrix3d& R = op.rotations()[static_cast<size_t>(e)];
-      for (int a = 0; a < 10; ++a) {
-        for (int b = 0; b < 10; ++b) {
-          const int block = m.element_block[100 * static_cast<size_t>(e) +
-                                            10 * static_cast<size_t>(a) + static_cast<size_t>(b)];
-          if (block < 0) continue;
-          add_block(block, c * quadraticStiffnessBlock(R, rest, mu, lambda, a, b));
-        }
-      }
-    }
-  }
+  // c K from the operator's blocks: slot (row n, column j) is K(n, j) = K(j, n)^T.
+  const std::vector<Eigen::Matrix3d>& stiffness = op.stiffnessBlocks();
+  for (size_t s = 0; s < stiffness.size(); ++s)
+    add_block(m.slot_block[s], c * stiffness[s].transpose());
   if (m.nodal_pressure) {
-    // kappa V_n b_n b_n^T per node n, (b_n)_a = sum_{e ∋ n, a} (V_e / 4) R_e g_a / V_n.
-    const CompressedRows& node_tets = model.mesh().nodeTets();
-    const std::vector<int>& element_nodes = model.elementNodes();
+    // kappa / V_n w_n w_n^T per node n (SystemOperator::volumetricPatch).
     const double kappa = model.material().bulkModulus();
-    std::vector<Eigen::Vector3d> b;
     for (int node = 0; node < model.nodeCount(); ++node) {
-      const int* patch = m.patch_nodes.data() + m.patch_offsets[static_cast<size_t>(node)];
-      const int size = m.patch_offsets[static_cast<size_t>(node) + 1] -
-                       m.patch_offsets[static_cast<size_t>(node)];
-      b.assign(static_cast<size_t>(size), Eigen::Vector3d::Zero());
-      for (int k = node_tets.rowBegin(node); k < node_tets.rowEnd(node); ++k) {
-        const size_t t = static_cast<size_t>(node_tets.items[static_cast<size_t>(k)]);
-        const TetRestData& rest = model.tetRestData()[t];
-        const Eigen::Matrix3d& R = op.rotations()[t];
-        const Eigen::Matrix3d& B = rest.rest_shape_inverse;
-        const std::array<Eigen::Vector3d, 4> g = {-(B.row(0) + B.row(1) + B.row(2)).transpose(),
-                                                  B.row(0).transpose(), B.row(1).transpose(),
-                                                  B.row(2).transpose()};
-        for (size_t a = 0; a < 4; ++a) {
-          const size_t at = static_cast<size_t>(
-              std::lower_bound(patch, patch + size, element_nodes[4 * t + a]) - patch);
-          b[at] += (0.25 * rest.volume) * (R * g[a]);
-        }
-      }
+      op.volumetricPatch(node, m.patch_nodes, m.patch_weights);
+      const std::vector<Eigen::Vector3d>& w = m.patch_weights;
       const double scale = c * kappa / model.nodeVolumes()[static_cast<size_t>(node)];
       const int* blocks =
           m.patch_pair_blocks.data() + m.patch_pair_offsets[static_cast<size_t>(node)];
-      for (size_t a = 0, pair = 0; a < static_cast<size_t>(size); ++a) {
-        for (size_t bi = 0; bi <= a; ++bi, ++pair)
-          add_block(blocks[pair], scale * b[a] * b[bi].transpose());
+      for (size_t a = 0, pair = 0; a < w.size(); ++a) {
+        for (size_t b = 0; b <= a; ++b, ++pair)
+          add_block(blocks[pair], scale * w[a] * w[b].transpose());
       }
     }
   }
   const std::vector<double>& mass = model.nodeMasses();
-  for (int i = 0; i < model.nodeCount(); ++i) {
-    add_block(m.diagonal_block[static_cast<size_t>(i)],
+  const std::vector<int>& row_offsets = op.blockRowOffsets();
+  for (int i = 0; i < model.nodeCount(); ++i) {  // the diagonal block leads its row
+    add_block(m.slot_block[static_cast<size_t>(row_offsets[static_cast<size_t>(i)])],
               op.massCoefficient() * mass[static_cast<size_t>(i)] * Eigen::Matrix3d::Identity());
   }
 

@@ -119,33 +119,39 @@ StepReport ImplicitStepper::step(FemState& state, const NodeConstraints& constra
   StepReport report;
   internal_forces_valid_ = false;
   last_dt_ = dt;
-  const Material& material = model_->material();
+  report.elastic_energy = computeElasticForces(state);
+  if (!buildRightHandSide(state, external_forces, dt, report)) return report;
+  report.solve = solveVelocities(state, constraints, dt);
+  integratePositions(state, dt);
+  checkHealth(state, report);
+  return report;
+}
+
+bool ImplicitStepper::buildRightHandSide(const FemState& state,
+                                         const Eigen::VectorXd& external_forces, double dt,
+                                         StepReport& report) {
   const std::vector<double>& mass = model_->nodeMasses();
   const int n = model_->nodeCount();
-
-  // 1-2. Rotations and elastic forces.
-  report.elastic_energy = computeElasticForces(state);
-
-  // 3. Right-hand side b = M v + dt (f + f_ext).
   rhs_.resize(3 * n);
   for (int i = 0; i < n; ++i) {
     rhs_.segment<3>(3 * i) =
         mass[static_cast<size_t>(i)] * state.velocities.segment<3>(3 * i) +
         dt * (elastic_forces_.segment<3>(3 * i) + external_forces.segment<3>(3 * i));
   }
+  if (rhs_.allFinite()) return true;
+  // Bad forces in, or a state already broken: stop before anything is written.
+  report.health = StepHealth::kNonFinite;
+  report.message =
+      elastic_forces_.allFinite() && external_forces.allFinite()
+          ? "non-finite velocities at the start of the step"
+          : (elastic_forces_.allFinite() ? "non-finite external forces"
+                                         : "non-finite elastic forces (a degenerate tet?)");
+  return false;
+}
 
-  if (!rhs_.allFinite()) {
-    // Bad forces in, or a state already broken: stop before anything is written.
-    report.health = StepHealth::kNonFinite;
-    report.message =
-        elastic_forces_.allFinite() && external_forces.allFinite()
-            ? "non-finite velocities at the start of the step"
-            : (elastic_forces_.allFinite() ? "non-finite external forces"
-                                           : "non-finite elastic forces (a degenerate tet?)");
-    return report;
-  }
-
-  // 4. Solve for v', warm-started from v.
+LinearSolveReport ImplicitStepper::solveVelocities(const FemState& state,
+                                                   const NodeConstraints& constraints, double dt) {
+  const Material& material = model_->material();
   system_.setCoefficients(1.0 + dt * material.mass_damping,
                           dt * dt + dt * material.stiffness_damping);
   // Warm start: extrapolate the velocity linearly from the last two steps (constant acceleration).
@@ -155,22 +161,24 @@ StepReport ImplicitStepper::step(FemState& state, const NodeConstraints& constra
     velocity_next_ = state.velocities;
   }
   previous_velocities_ = state.velocities;
-  if (linear_solve_hook_) {
-    report.solve = linear_solve_hook_(system_, constraints, rhs_, settings_, velocity_next_);
-  } else if (settings_.linear_solver == LinearSolverKind::kCholmod) {
+  if (linear_solve_hook_)
+    return linear_solve_hook_(system_, constraints, rhs_, settings_, velocity_next_);
+  if (settings_.linear_solver == LinearSolverKind::kCholmod) {
     if (!cholmod_) cholmod_ = std::make_unique<CholmodSolver>();
-    report.solve = cholmod_->solve(system_, constraints, rhs_, velocity_next_);
-  } else {
-    report.solve = cg_.solve(system_, constraints, rhs_, settings_, velocity_next_);
+    return cholmod_->solve(system_, constraints, rhs_, velocity_next_);
   }
+  return cg_.solve(system_, constraints, rhs_, settings_, velocity_next_);
+}
 
-  // 5. Integrate positions.
+void ImplicitStepper::integratePositions(FemState& state, double dt) const {
   state.velocities = velocity_next_;
   state.positions += dt * state.velocities;
+}
 
-  // 6. Health.
+void ImplicitStepper::checkHealth(const FemState& state, StepReport& report) const {
+  const std::vector<double>& mass = model_->nodeMasses();
   double kinetic = 0, max_speed_sq = 0;
-  for (int i = 0; i < n; ++i) {
+  for (int i = 0; i < model_->nodeCount(); ++i) {
     const double speed_sq = state.velocities.segment<3>(3 * i).squaredNorm();
     kinetic += 0.5 * mass[static_cast<size_t>(i)] * speed_sq;
     max_speed_sq = std::max(max_speed_sq, speed_sq);
@@ -206,7 +214,6 @@ StepReport ImplicitStepper::step(FemState& state, const NodeConstraints& constra
       << settings_.tolerance;
     report.message = s.str();
   }
-  return report;
 }
 
 const Eigen::VectorXd& ImplicitStepper::internalForces() {

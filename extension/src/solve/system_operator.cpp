@@ -346,6 +346,29 @@ void SystemOperator::addNodalPressureDiagonal(std::vector<Eigen::Matrix3d>& bloc
   });
 }
 
+const std::vector<Eigen::Matrix3d>& SystemOperator::stiffnessBlocks() const {
+  assemble();
+  return block_values_;
+}
+
+void SystemOperator::volumetricPatch(int node, std::vector<int>& patch_nodes,
+                                     std::vector<Eigen::Vector3d>& weights) const {
+  assert(model_->nodalPressure() && "the volumetric patches exist for nodal pressure only");
+  assemble();  // the rotated gradients
+  const size_t r = static_cast<size_t>(node);
+  patch_nodes.assign(patch_nodes_.begin() + patch_offsets_[r],
+                     patch_nodes_.begin() + patch_offsets_[r + 1]);
+  weights.assign(patch_nodes.size(), Eigen::Vector3d::Zero());
+  for (int k = node_offsets_[r]; k < node_offsets_[r + 1]; ++k) {
+    const size_t t = static_cast<size_t>(node_entries_[static_cast<size_t>(k)] / 4);
+    const double quarter_volume = 0.25 * model_->tetRestData()[t].volume;
+    for (size_t b = 0; b < 4; ++b) {
+      weights[static_cast<size_t>(patch_slots_[4 * static_cast<size_t>(k) + b])] +=
+          quarter_volume * rotated_gradients_[4 * t + b];
+    }
+  }
+}
+
 void SystemOperator::replaceModel(std::shared_ptr<const FemModel> model) {
   assert(&model->mesh() == &model_->mesh() && model->elementKind() == model_->elementKind() &&
          "replaceModel wants a model of the same mesh and elements");

@@ -1,8 +1,10 @@
 #pragma once
 // Sparse direct solve of the constrained system with SuiteSparse CHOLMOD (through Eigen's
-// CholmodSupport). The matrix A = M' + c Re Ke Re^T is assembled every step into a fixed sparsity
-// pattern (analysed once); constraints are applied as A' = S A S + (I - S), which is SPD and
-// leaves prescribed components at their prescribed values.
+// CholmodSupport). The matrix A = M' + c K takes the stiffness K the SystemOperator assembled for
+// this step (its upper-triangle node blocks are this lower triangle, transposed; with nodal
+// pressure the volumetric part is added from the operator's patches), in a fixed sparsity pattern
+// made from the operator's (analysed once). Constraints are applied as A' = S A S + (I - S), which
+// is SPD and leaves prescribed components at their prescribed values.
 
 #include <Eigen/Core>
 #include <Eigen/SparseCore>

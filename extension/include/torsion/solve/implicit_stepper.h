@@ -1,17 +1,20 @@
 #pragma once
 // One linearised backward-Euler step of one FEM body (Baraff & Witkin 1998; the report's
-// integrator), as named stages:
+// integrator). step() is this list of stages, each a function of its own:
 //
-//   1. kRotations      F = Ds Bm (tet4) or the element's mean F (tet10) and its rotation R per
-//                      element (warm-started polar decomposition)
-//   2. kElasticForces  f(x) = -Re Ke (Re^T x - X) gathered per node; elastic energy
-//   3. kRightHandSide  b = M v + dt (f(x) + f_ext)
-//   4. kSolve          (M (1 + dt alpha) + (dt^2 + dt beta) K) v' = b, prescribed components of v'
-//                      imposed (projection), free ones solved by CG or CHOLMOD
-//   5. kIntegrate      x' = x + dt v'   (constrained nodes land exactly on their targets)
-//   6. kHealth         non-finite values, speeds beyond SolverSettings::max_speed, a linear solve
-//                      that broke down or stopped above 10x its tolerance (fatal), or one that
-//                      stopped at its cap within 10x (a warning)
+//   1-2. computeElasticForces  per element, in one pass: F = Ds Bm (tet4) or the element's mean F
+//                              (tet10), its rotation R (warm-started polar decomposition), and the
+//                              elastic forces f(x) = -Re Ke (Re^T x - X); gathered per node;
+//                              elastic energy
+//   3. buildRightHandSide      b = M v + dt (f(x) + f_ext); a non-finite b ends the step before
+//                              the state is touched
+//   4. solveVelocities         (M (1 + dt alpha) + (dt^2 + dt beta) K) v' = b, warm-started,
+//                              prescribed components of v' imposed (projection), free ones solved
+//                              by CG, CHOLMOD or the linear-solve hook (contacts)
+//   5. integratePositions      x' = x + dt v'   (constrained nodes land exactly on their targets)
+//   6. checkHealth             non-finite values, speeds beyond SolverSettings::max_speed, a
+//                              linear solve that broke down or stopped above 10x its tolerance
+//                              (fatal), or one that stopped at its cap within 10x (a warning)
 //
 // Internal forces at the end of the step (what the body exerts on whatever holds its nodes) are
 // available afterwards, linearised: f_int = f(x) - (dt + beta) K v'.
@@ -83,9 +86,10 @@ class ImplicitStepper {
   const Eigen::VectorXd& elasticForces() const { return elastic_forces_; }
 
   const SolverSettings& settings() const { return settings_; }
-  /// Replaces stage 4's linear solve when set: hook(system, constraints, b, v), v holding the warm
-  /// start on entry and v' on return. Contacts with rigid bodies use it (contact/rigid_contact.h):
-  /// they add unilateral constraints and rigid-body unknowns to the same projected CG.
+  /// Replaces stage 4's linear solve (solveVelocities) when set: hook(system, constraints, b, v), v
+  /// holding the warm start on entry and v' on return. Contacts with rigid bodies use it
+  /// (contact/rigid_contact.h): they add unilateral constraints and rigid-body unknowns to the same
+  /// projected CG.
   using LinearSolveHook = std::function<LinearSolveReport(
       const SystemOperator&, const NodeConstraints&, const Eigen::VectorXd&, const SolverSettings&,
       Eigen::VectorXd&)>;
@@ -109,12 +113,23 @@ class ImplicitStepper {
   /// Back to a remembered step: the next step continues bit for bit as it did after memory().
   void restore(const Memory& memory);
 
-  /// Stage 1 and 2 alone: rotations and elastic forces at `state` (also used by tests).
+  /// Stages 1-2 alone: rotations and elastic forces at `state`; returns the elastic energy, J
+  /// (also used by tests).
   double computeElasticForces(FemState& state);
 
  private:
   // Stage 2's pressure pass for nodal pressure (adds to element_forces_); the volumetric energy.
   double addNodalPressureForces();
+  // Stage 3: rhs_. False (and report's health and message set) when b is not finite.
+  bool buildRightHandSide(const FemState& state, const Eigen::VectorXd& external_forces, double dt,
+                          StepReport& report);
+  // Stage 4: velocity_next_ = v', warm-started from the last two steps' velocities.
+  LinearSolveReport solveVelocities(const FemState& state, const NodeConstraints& constraints,
+                                    double dt);
+  // Stage 5: v = v', x += dt v'.
+  void integratePositions(FemState& state, double dt) const;
+  // Stage 6: kinetic energy, top speed and the step's health, into report.
+  void checkHealth(const FemState& state, StepReport& report) const;
 
   std::shared_ptr<const FemModel> model_;
   SolverSettings settings_;

@@ -53,6 +53,22 @@ class SystemOperator {
   /// The 3x3 diagonal blocks of A, one per node.
   void diagonalBlocks(std::vector<Eigen::Matrix3d>& blocks) const;
 
+  // ---- The assembled matrix, for direct solvers (CholmodSolver) ----
+  /// K for this step's rotations as upper-triangle 3x3 node blocks (assembled first if stale):
+  /// block row n is slots [blockRowOffsets()[n], blockRowOffsets()[n + 1]), slot s holding
+  /// K(n, blockColumns()[s]) in stiffnessBlocks()[s]; columns ascend from the diagonal block.
+  /// With nodal pressure the blocks are the deviatoric part (the volumetric part:
+  /// volumetricPatch()). The references stay valid for the operator's life.
+  const std::vector<int>& blockRowOffsets() const { return row_offsets_; }
+  const std::vector<int>& blockColumns() const { return block_columns_; }
+  const std::vector<Eigen::Matrix3d>& stiffnessBlocks() const;
+  /// Nodal pressure (tet4) only: the volumetric stiffness is sum over nodes n of
+  /// kappa / V_n w_n w_n^T, where w_n has one 3-vector per node a of n's patch (the nodes of n's
+  /// tets), (w_n)_a = sum over n's tets e holding a of (V_e / 4) R_e g_a. Fills the patch's nodes
+  /// (ascending) and w_n.
+  void volumetricPatch(int node, std::vector<int>& patch_nodes,
+                       std::vector<Eigen::Vector3d>& weights) const;
+
   const FemModel& model() const { return *model_; }
   /// Live edits (FemBody::setMaterial): the same mesh with another material. The node-tet tables,
   /// the block pattern and this step's rotations stay; K is re-assembled with the new material

@@ -1,4 +1,4 @@
-#include "torsion/contact/ball_mesh.h"
+#include "torsion/mesh/ball_mesh.h"
 
 #include <string>
 
