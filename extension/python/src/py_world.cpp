@@ -42,22 +42,28 @@ Result<Ok> PyWorld::step(int n, FailureKind* kind) {
   std::vector<NamedRigidBody> rigid;
   for (const scene::SceneRigidBody& r : scene_->rigid_bodies)
     rigid.push_back({r.name, r.body});
+  // A failed step has already moved the bodies it reached (and the clock): each step starts
+  // from a checkpoint (microseconds against milliseconds of a step) to go back to, so that a
+  // failure leaves the last good state. Device hands cannot be wound back: not for them.
+  const bool keep_last_good = !scene_->haptics;
+  Result<PyWorldState> last_good = Error{""};
+  auto failWith = [&](std::string message) -> Error {
+    if (keep_last_good && last_good) (void)restoreState(last_good.value());
+    failure_ = std::move(message);
+    return Error{failure_};
+  };
   for (int k = 0; k < n; ++k) {
+    if (keep_last_good) last_good = saveState();
     Result<WorldStepReport> stepped = scene::stepScene(*scene_);
     if (!stepped) {
       *kind = FailureKind::kScene;  // a scripted grab that missed: the scene's fault, not fatal
       return Error{scene_->spec.file + ": " + stepped.error().message};
     }
     const WorldStepReport& report = stepped.value();
-    if (!report.ok) {
-      failure_ = report.message;
-      return Error{failure_};
-    }
+    if (!report.ok) return failWith(report.message);
     // As the scene runner: Bullet lets a rigid body become NaN silently.
-    if (auto fault = findUnhealthyRigidBody(rigid)) {
-      failure_ = "step " + std::to_string(report.step) + ": " + fault->message;
-      return Error{failure_};
-    }
+    if (auto fault = findUnhealthyRigidBody(rigid))
+      return failWith("step " + std::to_string(report.step) + ": " + fault->message);
   }
   return Ok{};
 }

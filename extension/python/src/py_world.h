@@ -47,8 +47,9 @@ class PyWorld {
   FemWorld& world() { return *scene_->world; }
 
   /// n steps (scripted hands driven, device hands through their haptics, as `torsion run`).
-  /// Stops at the first failing step; the bodies then hold the last good state and every later
-  /// step fails with the same message.
+  /// Stops at the first failing step; the world is then back at the end of the last good step
+  /// (bodies, hands, clock; not with device hands) and every later step fails with the same
+  /// message until restoreState().
   Result<Ok> step(int n, FailureKind* kind);
 
   /// Adds a body from a mesh file (MeshError on a bad file) or from a built mesh.
