@@ -65,13 +65,32 @@ def test_bad_tets_arrays_are_mesh_errors():
         world.add_body("b", nodes=nodes, tets=tets)
 
 
-def test_a_blow_up_is_an_unstable_error_and_leaves_the_last_good_state(torsion_exe, scenes, tmp_path):
+def unstable_scene(scenes, tmp_path, max_speed):
+    """The twist under gravity with a speed limit that the fall exceeds after max_speed / g s."""
     text = (scenes / "twist_cylinder_2430.json").read_text()
     text = (text.replace("../../assets", str(scenes.parents[1] / "assets"))
                 .replace('"gravity": [0, 0, 0]', '"gravity": [0, 0, -9.81]')
-                .replace('"tolerance": 1e-4', '"tolerance": 1e-4, "max_speed": 0.5'))
+                .replace('"tolerance": 1e-4', f'"tolerance": 1e-4, "max_speed": {max_speed}'))
     path = tmp_path / "unstable.json"
     path.write_text(text)
+    return path
+
+
+def test_a_failing_step_taken_one_call_at_a_time_leaves_the_state_of_the_call_before(scenes, tmp_path):
+    world = torsion.World.from_scene(str(unstable_scene(scenes, tmp_path, 0.5)), threads=1)
+    body = world.body("cylinder")
+    push = np.zeros((body.node_count, 3))
+    with pytest.raises(torsion.UnstableError):
+        for _ in range(200):
+            body.set_external_forces(push)  # a change between steps, each time
+            world.step()
+            last = body.positions.copy(), body.velocities.copy(), world.time
+    assert np.array_equal(body.positions, last[0]) and np.array_equal(body.velocities, last[1])
+    assert world.time == last[2]
+
+
+def test_a_blow_up_is_an_unstable_error_and_leaves_the_last_good_state(torsion_exe, scenes, tmp_path):
+    path = unstable_scene(scenes, tmp_path, 0.5)
     world = torsion.World.from_scene(str(path), threads=1)
     start = world.save_state()
     body = world.body("cylinder")
@@ -92,3 +111,21 @@ def test_a_blow_up_is_an_unstable_error_and_leaves_the_last_good_state(torsion_e
     world.step(error.step - 1)
     assert np.array_equal(failed_at, body.positions)
     assert world.step_count == error.step - 1
+
+
+def test_a_body_falling_past_max_speed_fails_at_the_step_free_fall_predicts():
+    def falling_world():
+        world = torsion.World(gravity=(0, 0, -9.81), dt=0.01, max_speed=7.0, threads=1)
+        nodes, tets = cube_mesh(1)
+        world.add_body("cube", nodes=nodes, tets=tets)
+        return world
+
+    world = falling_world()
+    with pytest.raises(torsion.UnstableError) as info:
+        world.step(200)
+    # implicit Euler in free fall: v_k = g k dt, past 7 m/s at k = 72 (beyond the 64-step anchor)
+    assert info.value.body == "cube" and info.value.step == 72
+    again = falling_world()
+    again.step(71)
+    assert np.array_equal(world.body("cube").positions, again.body("cube").positions)
+    assert world.time == again.time

@@ -121,7 +121,7 @@ void bindParts(py::module_& m) {
       .def(
           "set_material",
           [](const B& b, const Material& material) {
-            WorldGuard guard(*b.world);
+            WorldGuard guard(*b.world, WorldGuard::kWrite);
             if (Status s = b.body->setMaterial(material); !s) throw py::value_error(s.error().message);
             for (Hand* hand : b.world->hands()) {
               if (&hand->body() == b.body) hand->updateSpeedLimit();
@@ -138,14 +138,14 @@ void bindParts(py::module_& m) {
           "set_external_forces",
           [](const B& b, py::object forces) {
             Eigen::VectorXd f = toNodeVectors(forces, b.body->model().nodeCount(), "forces");
-            WorldGuard guard(*b.world);
+            WorldGuard guard(*b.world, WorldGuard::kWrite);
             if (Status s = b.body->setExternalForces(f); !s) throw py::value_error(s.error().message);
           },
           py::arg("forces"), "(n, 3) N per node, applied every step until changed.")
       .def(
           "set_velocity",
           [](const B& b, py::object velocity) {
-            WorldGuard guard(*b.world);
+            WorldGuard guard(*b.world, WorldGuard::kWrite);
             b.body->setVelocity(toVector3(velocity, "velocity"));
           },
           py::arg("velocity"), "Every node's velocity, m/s.")
@@ -206,7 +206,7 @@ void bindParts(py::module_& m) {
           "(6,) [fx, fy, fz, tx, ty, tz]: N and N m the body exerted on the set in the last step, "
           "torque about the set's wrench_about point.")
       .def("release", [](const N& s) {
-        WorldGuard guard(*s.world);
+        WorldGuard guard(*s.world, WorldGuard::kWrite);
         s.set().body->releaseGroup(s.set().group);
       }, "Frees the nodes from the next step on (the wrench then reads zero).");
 
@@ -223,7 +223,7 @@ void bindParts(py::module_& m) {
           "grab",
           [](const H& h, py::object frame) {
             const Frame f = toFrame(frame, "grab");
-            WorldGuard guard(*h.world);
+            WorldGuard guard(*h.world, WorldGuard::kWrite);
             Result<int> n = h.hand->grab(f, h.world->world().time());
             if (!n) throw py::value_error("hand '" + h.hand->name() + "': " + n.error().message);
             return n.value();
@@ -235,13 +235,13 @@ void bindParts(py::module_& m) {
           "move_to",
           [](const H& h, py::object frame) {
             const Frame f = toFrame(frame, "move_to");
-            WorldGuard guard(*h.world);
+            WorldGuard guard(*h.world, WorldGuard::kWrite);
             h.hand->moveTo(f);
           },
           py::arg("frame"), "The goal frame the grabbed patch pursues from the next step on.")
       .def("release",
            [](const H& h) {
-             WorldGuard guard(*h.world);
+             WorldGuard guard(*h.world, WorldGuard::kWrite);
              h.hand->release();
            })
       .def_property_readonly("goal", [](const H& h) { return h.hand->goal(); })
@@ -268,7 +268,7 @@ void bindParts(py::module_& m) {
           "stiffness",
           [](const H& h, double tolerance) {
             if (!h.hand->grabbed()) throw py::value_error("hand '" + h.hand->name() + "': not grabbing");
-            WorldGuard guard(*h.world);
+            WorldGuard guard(*h.world, WorldGuard::kWrite);
             haptics::PatchStiffness k;
             const Eigen::Matrix<double, 6, 6, Eigen::RowMajor> K =
                 k.compute(h.hand->body(), h.hand->group(), h.hand->frame().origin, tolerance);

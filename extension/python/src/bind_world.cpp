@@ -107,13 +107,14 @@ scene::RigidBodySpec::Shape toShape(const std::string& name) {
 void bindWorld(py::module_& m) {
   py::class_<PyWorld>(m, "World", "Bullet world with FEM soft bodies, hands and rigid bodies.")
       .def(py::init([](py::object gravity, double dt, double tolerance, int max_iterations,
-                       const std::string& linear_solver, int threads) {
+                       const std::string& linear_solver, int threads, double max_speed) {
              WorldSettings settings;
              settings.gravity = toVector3(gravity, "gravity");
              settings.solver.time_step = dt;
              settings.solver.tolerance = tolerance;
              settings.solver.max_iterations = max_iterations;
              settings.solver.threads = threads;
+             settings.solver.max_speed = max_speed;
              if (linear_solver == "cholmod") {
                settings.solver.linear_solver = LinearSolverKind::kCholmod;
              } else if (linear_solver != "cg") {
@@ -126,9 +127,9 @@ void bindWorld(py::module_& m) {
            }),
            py::arg("gravity") = py::make_tuple(0.0, 0.0, -9.81), py::arg("dt") = 0.01,
            py::arg("tolerance") = 1e-4, py::arg("max_iterations") = 300,
-           py::arg("linear_solver") = "cg", py::arg("threads") = 0,
+           py::arg("linear_solver") = "cg", py::arg("threads") = 0, py::arg("max_speed") = 1e3,
            "An empty world. gravity: m/s^2; dt: s; tolerance: CG relative residual; threads: "
-           "solver worker threads (0: all cores).")
+           "solver worker threads (0: all cores); max_speed: m/s, a faster node fails the step.")
       .def_static(
           "from_scene",
           [](const std::string& scene, int threads) {
@@ -263,7 +264,7 @@ void bindWorld(py::module_& m) {
               built = meshFromArrays(nodes, tets);
             }
             const Frame pose = frame.is_none() ? Frame{} : toFrame(frame, "add_body frame");
-            WorldGuard guard(w);
+            WorldGuard guard(w, WorldGuard::kWrite);
             Result<FemBody*> body = w.addBody(name, built, material, pose, toElement(element));
             if (!body) throw py::value_error(body.error().message);
             return BodyHandle{owner, &w, body.value()};
@@ -283,7 +284,7 @@ void bindWorld(py::module_& m) {
             FemBody& b = findBody(w, body);
             std::vector<int> nodes =
                 selectedNodes(b.model().mesh(), plane, box, sphere, indices, tolerance);
-            WorldGuard guard(w);
+            WorldGuard guard(w, WorldGuard::kWrite);
             Result<int> index =
                 w.addNodeSet(name, b, std::move(nodes), toVector3(wrench_about, "wrench_about"));
             if (!index) throw py::value_error(index.error().message);
@@ -304,7 +305,7 @@ void bindWorld(py::module_& m) {
             settings.max_drag_strain = max_drag_strain;
             if (Status valid = settings.validate(); !valid)
               throw py::value_error(valid.error().message);
-            WorldGuard guard(w);
+            WorldGuard guard(w, WorldGuard::kWrite);
             return HandHandle{owner, &w, &w.addHand(findBody(w, body), name, settings)};
           },
           py::arg("name"), py::arg("body"), py::arg("max_drag_strain") = 0.2,
@@ -325,7 +326,7 @@ void bindWorld(py::module_& m) {
             spec.pose = frame.is_none() ? Frame{} : toFrame(frame, "add_rigid_body frame");
             spec.friction = friction;
             spec.linear_velocity = toVector3(linear_velocity, "linear_velocity");
-            WorldGuard guard(w);
+            WorldGuard guard(w, WorldGuard::kWrite);
             btRigidBody* body = w.addRigidBody(spec, false);
             return RigidHandle{owner, &w, name, body};
           },
@@ -345,7 +346,7 @@ void bindWorld(py::module_& m) {
             spec.plane_offset = height;
             spec.mass = 0;
             spec.friction = friction;
-            WorldGuard guard(w);
+            WorldGuard guard(w, WorldGuard::kWrite);
             w.addRigidBody(spec, true);
           },
           py::arg("height") = 0.0, py::arg("friction") = 0.5,

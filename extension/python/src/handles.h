@@ -18,9 +18,12 @@ namespace py = pybind11;
 /// GIL) makes the call fail instead of racing it.
 class WorldGuard {
  public:
-  explicit WorldGuard(PyWorld& world) : lock_(world.busy(), std::try_to_lock) {
+  enum Access { kRead, kWrite };
+  explicit WorldGuard(PyWorld& world, Access access = kRead)
+      : lock_(world.busy(), std::try_to_lock) {
     if (!lock_.owns_lock())
       throw std::runtime_error("the world is stepping in another thread; wait for step() to return");
+    if (access == kWrite) world.touched();
   }
 
  private:

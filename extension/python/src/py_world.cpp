@@ -42,21 +42,36 @@ Result<Ok> PyWorld::step(int n, FailureKind* kind) {
   std::vector<NamedRigidBody> rigid;
   for (const scene::SceneRigidBody& r : scene_->rigid_bodies)
     rigid.push_back({r.name, r.body});
-  // A failed step has already moved the bodies it reached (and the clock): each step starts
-  // from a checkpoint (microseconds against milliseconds of a step) to go back to, so that a
-  // failure leaves the last good state. Device hands cannot be wound back: not for them.
-  const bool keep_last_good = !scene_->haptics;
-  Result<PyWorldState> last_good = Error{""};
+  // A failed step has already moved the bodies it reached (and the clock). To leave the last good
+  // state instead, the world goes back to an anchor checkpoint and replays the good steps since,
+  // which repeat bit for bit. Anchors are taken every kAnchorEvery steps and whenever Python
+  // changed the world since (touched()); a checkpoint per step would cost several per cent.
+  // Device hands cannot be wound back: no anchors with them.
+  const bool can_rewind = !scene_->haptics;
   auto failWith = [&](std::string message) -> Error {
-    if (keep_last_good && last_good) (void)restoreState(last_good.value());
+    if (can_rewind && anchor_) {
+      const int good_steps = world().stepCount() - 1 - anchor_step_;
+      const PyWorldState anchor = std::move(*anchor_);
+      (void)restoreState(anchor);
+      for (int k = 0; k < good_steps; ++k)
+        (void)scene::stepScene(*scene_);
+    }
     failure_ = std::move(message);
+    anchor_.reset();
     return Error{failure_};
   };
   for (int k = 0; k < n; ++k) {
-    if (keep_last_good) last_good = saveState();
+    if (can_rewind && (!anchor_ || world().stepCount() - anchor_step_ >= kAnchorEvery)) {
+      Result<PyWorldState> state = saveState();
+      if (state) {
+        anchor_ = std::move(state).value();
+        anchor_step_ = world().stepCount();
+      }
+    }
     Result<WorldStepReport> stepped = scene::stepScene(*scene_);
     if (!stepped) {
       *kind = FailureKind::kScene;  // a scripted grab that missed: the scene's fault, not fatal
+      anchor_.reset();
       return Error{scene_->spec.file + ": " + stepped.error().message};
     }
     const WorldStepReport& report = stepped.value();
@@ -149,6 +164,7 @@ Status PyWorld::restoreState(const PyWorldState& state) {
   for (size_t h = 0; h < scene_->hands.size(); ++h)
     scene_->hands[h].released = state.released[h];
   failure_ = state.failure;
+  anchor_.reset();
   return Ok{};
 }
 

@@ -6,6 +6,7 @@
 
 #include <memory>
 #include <mutex>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -68,6 +69,10 @@ class PyWorld {
   Result<PyWorldState> saveState();
   Status restoreState(const PyWorldState& state);
 
+  /// Python changed the world between steps (forces, hand goals, grabs, materials, parts): a
+  /// failing step can no longer be rewound by replaying from before that change.
+  void touched() { anchor_.reset(); }
+
   /// Serialises the calls that change the world against a step running without the GIL.
   std::mutex& busy() { return busy_; }
 
@@ -76,6 +81,9 @@ class PyWorld {
   std::unique_ptr<scene::BuiltScene> scene_;
   std::vector<std::unique_ptr<Hand>> own_hands_;
   std::string failure_;  // set by the first failed step; the world does not go on after it
+  static constexpr int kAnchorEvery = 64;  // steps between rewind checkpoints (step())
+  std::optional<PyWorldState> anchor_;     // where a failed step rewinds to and replays from
+  int anchor_step_ = 0;                    // world().stepCount() at anchor_
   std::mutex busy_;
 };
 
