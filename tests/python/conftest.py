@@ -8,6 +8,12 @@ import pathlib
 import numpy as np
 import pytest
 
+import torsion
+
+# Relative round-off of Bullet's clock and rigid bodies: the time step is a btScalar, a float in a
+# float-Bullet build (0.01f is 0.0099999998).
+BULLET_RTOL = 1e-12 if torsion.bullet_precision == "double" else 1e-6
+
 SOURCE_DIR = pathlib.Path(os.environ.get("TORSION_SOURCE_DIR",
                                          pathlib.Path(__file__).resolve().parents[2]))
 
