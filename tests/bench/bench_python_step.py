@@ -10,7 +10,9 @@ checkpoint of the last good step. Measured per step, alternating the two so that
 with other work loads both alike:
   cli      the median ms/step `torsion run` reports in summary.json (timer around each step)
   py.step  the median of timing each world.step() call from Python
-  py.loop  world.step(N) in one call, divided by N
+  cli.loop `torsion run` wall time for N steps less that for 1 step, divided by N - 1 (with its
+           per-step CSV rows, as a user runs it)
+  py.loop  world.step(N) in one call, divided by N (wall time, like cli.loop)
 Prints one table; docs/performance.md keeps the numbers.
 """
 
@@ -30,6 +32,16 @@ def cli_ms_per_step(exe, scene, steps, threads):
         subprocess.run([exe, "run", scene, "--steps", str(steps), "--threads", str(threads),
                         "--out", out], check=True, capture_output=True)
         return json.loads((pathlib.Path(out) / "summary.json").read_text())["ms_per_step"]["median"]
+
+
+def cli_loop_ms_per_step(exe, scene, steps, threads):
+    def wall(n):
+        with tempfile.TemporaryDirectory() as out:
+            start = time.perf_counter()
+            subprocess.run([exe, "run", scene, "--steps", str(n), "--threads", str(threads),
+                            "--out", out], check=True, capture_output=True)
+            return (time.perf_counter() - start) * 1e3
+    return (wall(steps) - wall(1)) / (steps - 1)
 
 
 def python_ms_per_step(scene, steps, threads):
@@ -58,18 +70,21 @@ def main():
     parser.add_argument("--threads", type=int, default=1)
     args = parser.parse_args()
 
-    runs = {"cli": [], "py.step": [], "py.loop": []}
+    runs = {"cli": [], "py.step": [], "cli.loop": [], "py.loop": []}
     for _ in range(args.repeats):
         runs["cli"].append(cli_ms_per_step(args.torsion, args.scene, args.steps, args.threads))
         runs["py.step"].append(python_ms_per_step(args.scene, args.steps, args.threads))
+        runs["cli.loop"].append(cli_loop_ms_per_step(args.torsion, args.scene, args.steps,
+                                                     args.threads))
         runs["py.loop"].append(python_loop_ms_per_step(args.scene, args.steps, args.threads))
-    cli = statistics.median(runs["cli"])
+    reference = {"cli": "cli", "py.step": "cli", "cli.loop": "cli.loop", "py.loop": "cli.loop"}
     print(f"{args.scene}, {args.steps} steps x {args.repeats}, threads {args.threads}")
-    print(f"{'':8} {'median ms/step':>15} {'min':>8} {'max':>8} {'vs cli':>8}")
+    print(f"{'':8} {'median ms/step':>15} {'min':>8} {'max':>8} {'vs':>9}")
     for name, values in runs.items():
         median = statistics.median(values)
+        base = statistics.median(runs[reference[name]])
         print(f"{name:8} {median:15.3f} {min(values):8.3f} {max(values):8.3f} "
-              f"{(median / cli - 1) * 100:+7.1f}%")
+              f"{(median / base - 1) * 100:+7.1f}% ({reference[name]})")
 
 
 if __name__ == "__main__":
