@@ -145,3 +145,46 @@ def test_render_gives_a_picture_with_the_body_in_it():
     assert len(np.unique(image.reshape(-1, 3), axis=0)) > 20
     closer = world.render(160, 120, camera={"distance": 5.0})
     assert not np.array_equal(image, closer)
+
+
+def test_a_device_hand_in_lockstep_steps_as_in_torsion_run_to_the_bit(torsion_exe, tmp_path):
+    steps = 40
+    out = tmp_path / "run"
+    subprocess.run([torsion_exe, "run", "haptic_cylinder", "--steps", str(steps), "--threads", "1",
+                    "--haptics", "lockstep", "--out", str(out)], check=True, capture_output=True)
+    world = torsion.World.from_scene("haptic_cylinder", threads=1, haptics="lockstep")
+    assert world.hand("hand").scripted
+    world.step(steps)
+    assert np.array_equal(read_vtk_points(out / "cylinder.vtk"), world.body("cylinder").positions)
+    with pytest.raises(ValueError, match="cannot be wound back"):
+        world.save_state()
+
+
+def test_a_device_override_replaces_a_hands_script_as_the_device_option_does(source_dir):
+    trajectory = str(source_dir / "assets" / "trajectories" / "figure_6_7.json")
+    scripted = torsion.World.from_scene("twist_cylinder_2430", threads=1)
+    driven = torsion.World.from_scene("twist_cylinder_2430", threads=1, haptics="lockstep",
+                                      devices={"hand": "scripted:" + trajectory})
+    as_list = torsion.World.from_scene("twist_cylinder_2430", threads=1, haptics="lockstep",
+                                       devices=["hand=scripted:" + trajectory])
+    for world in (scripted, driven, as_list):
+        world.step(30)
+    assert np.array_equal(driven.body("cylinder").positions, as_list.body("cylinder").positions)
+    assert not np.array_equal(driven.body("cylinder").positions, scripted.body("cylinder").positions)
+    with pytest.raises(ValueError, match="no hand named 'nohand'"):
+        torsion.World.from_scene("twist_cylinder_2430", devices={"nohand": "scripted:" + trajectory})
+
+
+def test_a_tet10_body_lists_ten_nodes_per_element():
+    world = torsion.World.from_scene("twist_cylinder_2430_tet10", threads=1)
+    body = world.bodies[0]
+    assert body.element == "tet10" and body.tets.shape == (body.element_count, 10)
+    assert body.tets.max() == body.node_count - 1  # every node, mid-edge ones too, is in an element
+    # mid-edge nodes sit halfway along their edges at rest (Tet10 order: corners, then edges)
+    x = body.rest_positions
+    t = body.tets[0]
+    edges = [(0, 1), (1, 2), (0, 2), (0, 3), (1, 3), (2, 3)]
+    midpoints = {tuple(np.round((x[t[a]] + x[t[b]]) / 2, 12)) for a, b in edges}
+    assert {tuple(np.round(x[t[k]], 12)) for k in range(4, 10)} == midpoints
+    world.step(3)
+    assert body.von_mises_stress().shape == (8 * body.element_count,)

@@ -65,9 +65,8 @@ void bindParts(py::module_& m) {
                              [](const B& b) { return b.body->model().elementCount(); })
       .def_property_readonly("element",
                              [](const B& b) {
-                               return b.body->model().elementKind() == ElementKind::kTet10
-                                          ? "tet10"
-                                          : "tet4";
+                               return b.body->model().elementKind() == ElementKind::kTet10 ? "tet10"
+                                                                                           : "tet4";
                              })
       .def_property_readonly(
           "positions",
@@ -122,7 +121,8 @@ void bindParts(py::module_& m) {
           "set_material",
           [](const B& b, const Material& material) {
             WorldGuard guard(*b.world, WorldGuard::kWrite);
-            if (Status s = b.body->setMaterial(material); !s) throw py::value_error(s.error().message);
+            if (Status s = b.body->setMaterial(material); !s)
+              throw py::value_error(s.error().message);
             for (Hand* hand : b.world->hands()) {
               if (&hand->body() == b.body) hand->updateSpeedLimit();
             }
@@ -139,7 +139,8 @@ void bindParts(py::module_& m) {
           [](const B& b, py::object forces) {
             Eigen::VectorXd f = toNodeVectors(forces, b.body->model().nodeCount(), "forces");
             WorldGuard guard(*b.world, WorldGuard::kWrite);
-            if (Status s = b.body->setExternalForces(f); !s) throw py::value_error(s.error().message);
+            if (Status s = b.body->setExternalForces(f); !s)
+              throw py::value_error(s.error().message);
           },
           py::arg("forces"), "(n, 3) N per node, applied every step until changed.")
       .def(
@@ -172,22 +173,24 @@ void bindParts(py::module_& m) {
             return vectorArray(out.data(), static_cast<py::ssize_t>(out.size()));
           },
           "Per tet, dimensionless: equivalent strain sqrt(2/3 dev(eps):dev(eps)).")
-      .def_property_readonly("kinetic_energy",
-                             [](const B& b) { return b.body->lastReport().kinetic_energy; },
-                             "J, at the end of the last step")
-      .def_property_readonly("solver_iterations",
-                             [](const B& b) { return b.body->lastReport().solve.iterations; },
-                             "CG iterations of the last step")
+      .def_property_readonly(
+          "kinetic_energy", [](const B& b) { return b.body->lastReport().kinetic_energy; },
+          "J, at the end of the last step")
+      .def_property_readonly(
+          "solver_iterations", [](const B& b) { return b.body->lastReport().solve.iterations; },
+          "CG iterations of the last step")
       .def("__repr__", [](const B& b) {
-        return "<torsion.Body '" + b.body->name() + "': " +
-               std::to_string(b.body->model().nodeCount()) + " nodes>";
+        return "<torsion.Body '" + b.body->name() +
+               "': " + std::to_string(b.body->model().nodeCount()) + " nodes>";
       });
 
   using N = NodeSetHandle;
   py::class_<NodeSetHandle>(m, "NodeSet", "Nodes of a body held in place (or carried by a script).")
       .def_property_readonly("name", [](const N& s) { return s.set().name; })
       .def_property_readonly("body",
-                             [](const N& s) { return BodyHandle{s.owner, s.world, s.set().body}; })
+                             [](const N& s) {
+                               return BodyHandle{s.owner, s.world, s.set().body};
+                             })
       .def_property_readonly(
           "nodes",
           [](const N& s) {
@@ -205,20 +208,25 @@ void bindParts(py::module_& m) {
           },
           "(6,) [fx, fy, fz, tx, ty, tz]: N and N m the body exerted on the set in the last step, "
           "torque about the set's wrench_about point.")
-      .def("release", [](const N& s) {
-        WorldGuard guard(*s.world, WorldGuard::kWrite);
-        s.set().body->releaseGroup(s.set().group);
-      }, "Frees the nodes from the next step on (the wrench then reads zero).");
+      .def(
+          "release",
+          [](const N& s) {
+            WorldGuard guard(*s.world, WorldGuard::kWrite);
+            s.set().body->releaseGroup(s.set().group);
+          },
+          "Frees the nodes from the next step on (the wrench then reads zero).");
 
   using H = HandHandle;
   py::class_<HandHandle>(m, "Hand", "A hand plane acting on one body (docs/hand-plane.md).")
       .def_property_readonly("name", [](const H& h) { return h.hand->name(); })
       .def_property_readonly("body",
-                             [](const H& h) { return BodyHandle{h.owner, h.world, &h.hand->body()}; })
+                             [](const H& h) {
+                               return BodyHandle{h.owner, h.world, &h.hand->body()};
+                             })
       .def_property_readonly("grabbed", [](const H& h) { return h.hand->grabbed(); })
-      .def_property_readonly("scripted",
-                             [](const H& h) { return h.world->handSpec(*h.hand) != nullptr; },
-                             "True for a scene's hand (its script or device moves it at each step)")
+      .def_property_readonly(
+          "scripted", [](const H& h) { return h.world->handSpec(*h.hand) != nullptr; },
+          "True for a scene's hand (its script or device moves it at each step)")
       .def(
           "grab",
           [](const H& h, py::object frame) {
@@ -245,8 +253,9 @@ void bindParts(py::module_& m) {
              h.hand->release();
            })
       .def_property_readonly("goal", [](const H& h) { return h.hand->goal(); })
-      .def_property_readonly("frame", [](const H& h) { return h.hand->frame(); },
-                             "The frame carrying the grabbed nodes in the last step.")
+      .def_property_readonly(
+          "frame", [](const H& h) { return h.hand->frame(); },
+          "The frame carrying the grabbed nodes in the last step.")
       .def_property_readonly(
           "wrench",
           [](const H& h) {
@@ -255,19 +264,21 @@ void bindParts(py::module_& m) {
           },
           "(6,) [fx, fy, fz, tx, ty, tz]: N and N m the body exerted on the grabbed patch in the "
           "last step, torque about the patch frame's origin; zeros when not grabbing.")
+      .def_property_readonly("grabbed_nodes",
+                             [](const H& h) {
+                               const auto& nodes = h.hand->grabbedNodes();
+                               return copyArray(nodes.data(),
+                                                static_cast<py::ssize_t>(nodes.size()), 1)
+                                   .attr("reshape")(-1);
+                             })
       .def_property_readonly(
-          "grabbed_nodes",
-          [](const H& h) {
-            const auto& nodes = h.hand->grabbedNodes();
-            return copyArray(nodes.data(), static_cast<py::ssize_t>(nodes.size()), 1)
-                .attr("reshape")(-1);
-          })
-      .def_property_readonly("speed_limit", [](const H& h) { return h.hand->speedLimit(); },
-                             "m/s, grabbed nodes' speed bound (inf when off)")
+          "speed_limit", [](const H& h) { return h.hand->speedLimit(); },
+          "m/s, grabbed nodes' speed bound (inf when off)")
       .def(
           "stiffness",
           [](const H& h, double tolerance) {
-            if (!h.hand->grabbed()) throw py::value_error("hand '" + h.hand->name() + "': not grabbing");
+            if (!h.hand->grabbed())
+              throw py::value_error("hand '" + h.hand->name() + "': not grabbing");
             WorldGuard guard(*h.world, WorldGuard::kWrite);
             haptics::PatchStiffness k;
             const Eigen::Matrix<double, 6, 6, Eigen::RowMajor> K =
@@ -281,16 +292,18 @@ void bindParts(py::module_& m) {
   using R = RigidHandle;
   py::class_<RigidHandle>(m, "RigidBody", "A Bullet rigid body of the world.")
       .def_property_readonly("name", [](const R& r) { return r.name; })
-      .def_property_readonly("position", [](const R& r) { return rigidPose(*r.body, false); },
-                             "(3,) centre of mass, m")
-      .def_property_readonly("quaternion", [](const R& r) { return rigidPose(*r.body, true); },
-                             "(4,) orientation (x, y, z, w)")
-      .def_property_readonly("linear_velocity",
-                             [](const R& r) { return btArray(r.body->getLinearVelocity()); },
-                             "(3,) m/s")
-      .def_property_readonly("angular_velocity",
-                             [](const R& r) { return btArray(r.body->getAngularVelocity()); },
-                             "(3,) rad/s")
+      .def_property_readonly(
+          "position", [](const R& r) { return rigidPose(*r.body, false); },
+          "(3,) centre of mass, m")
+      .def_property_readonly(
+          "quaternion", [](const R& r) { return rigidPose(*r.body, true); },
+          "(4,) orientation (x, y, z, w)")
+      .def_property_readonly(
+          "linear_velocity", [](const R& r) { return btArray(r.body->getLinearVelocity()); },
+          "(3,) m/s")
+      .def_property_readonly(
+          "angular_velocity", [](const R& r) { return btArray(r.body->getAngularVelocity()); },
+          "(3,) rad/s")
       .def_property_readonly(
           "mass",
           [](const R& r) {

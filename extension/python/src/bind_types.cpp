@@ -54,14 +54,15 @@ void bindTypes(py::module_& m) {
       .def_property_readonly(
           "quaternion", [](const Frame& f) { return quaternionArray(f.rotation); },
           "(x, y, z, w), unit")
-      .def("matrix",
-           [](const Frame& f) {
-             Eigen::Matrix<double, 4, 4, Eigen::RowMajor> h = Eigen::Matrix4d::Identity();
-             h.topLeftCorner<3, 3>() = f.rotation.toRotationMatrix();
-             h.topRightCorner<3, 1>() = f.origin;
-             return copyArray(h.data(), 4, 4);
-           },
-           "The 4x4 homogeneous matrix.")
+      .def(
+          "matrix",
+          [](const Frame& f) {
+            Eigen::Matrix<double, 4, 4, Eigen::RowMajor> h = Eigen::Matrix4d::Identity();
+            h.topLeftCorner<3, 3>() = f.rotation.toRotationMatrix();
+            h.topRightCorner<3, 1>() = f.origin;
+            return copyArray(h.data(), 4, 4);
+          },
+          "The 4x4 homogeneous matrix.")
       .def("__repr__", [](const Frame& f) {
         return "Frame(position=(" + std::to_string(f.origin.x()) + ", " +
                std::to_string(f.origin.y()) + ", " + std::to_string(f.origin.z()) +
@@ -85,7 +86,8 @@ void bindTypes(py::module_& m) {
                                      "': expected 'element' or 'nodal_average'");
              }
              mat.volumetric_strain = *kind;
-             if (Status valid = mat.validate(); !valid) throw py::value_error(valid.error().message);
+             if (Status valid = mat.validate(); !valid)
+               throw py::value_error(valid.error().message);
              return mat;
            }),
            py::arg("E") = 1e5, py::arg("nu") = 0.3, py::arg("rho") = 1000.0,

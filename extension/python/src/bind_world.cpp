@@ -18,7 +18,9 @@ namespace torsion::python {
 
 namespace {
 
-PyWorld& self(py::handle world) { return world.cast<PyWorld&>(); }
+PyWorld& self(py::handle world) {
+  return world.cast<PyWorld&>();
+}
 
 ElementKind toElement(const std::string& name) {
   if (name == "tet4") return ElementKind::kTet4;
@@ -132,15 +134,32 @@ void bindWorld(py::module_& m) {
            "solver worker threads (0: all cores); max_speed: m/s, a faster node fails the step.")
       .def_static(
           "from_scene",
-          [](const std::string& scene, int threads) {
+          [](const std::string& scene, int threads, py::object devices, const std::string& haptics,
+             bool allow_remote_devices) {
+            scene::DeviceOverrides overrides;
+            overrides.haptics = haptics;
+            overrides.allow_remote_devices = allow_remote_devices;
+            if (py::isinstance<py::dict>(devices)) {
+              for (auto item : devices.cast<py::dict>()) {
+                overrides.devices.push_back(item.first.cast<std::string>() + "=" +
+                                            item.second.cast<std::string>());
+              }
+            } else if (!devices.is_none()) {
+              overrides.devices = devices.cast<std::vector<std::string>>();
+            }
             FailureKind kind;
-            Result<std::unique_ptr<PyWorld>> world = PyWorld::fromScene(scene, threads, &kind);
+            Result<std::unique_ptr<PyWorld>> world =
+                PyWorld::fromScene(scene, threads, overrides, &kind);
             if (!world) raise(kind, world.error().message);
             return std::move(world).value();
           },
-          py::arg("scene"), py::arg("threads") = -1,
+          py::arg("scene"), py::arg("threads") = -1, py::kw_only(), py::arg("devices") = py::none(),
+          py::arg("haptics") = "", py::arg("allow_remote_devices") = false,
           "A scene file, or a demo scene's name (resolved like `torsion run NAME`: "
-          "$TORSION_SCENE_PATH, then the source tree's demos/scenes). threads < 0: the scene's.")
+          "$TORSION_SCENE_PATH, then the source tree's demos/scenes). threads < 0: the scene's. "
+          "devices: {hand: 'TYPE[:ARG]'} or ['HAND=TYPE[:ARG]'], as `torsion run --device` "
+          "(scripted:FILE, replay:CSV, network:[HOST:]PORT, spacemouse); haptics: 'lockstep' or "
+          "'threaded' (--haptics); allow_remote_devices: --allow-remote-device.")
       .def(
           "step",
           [](PyWorld& w, int n) {
@@ -157,34 +176,34 @@ void bindWorld(py::module_& m) {
           py::arg("n") = 1,
           "n steps of dt, without the GIL. UnstableError (body and step in the message) when a "
           "step fails: the bodies keep their last good state and the world goes no further.")
-      .def_property_readonly("time", [](PyWorld& w) { return w.world().time(); }, "s")
-      .def_property_readonly("step_count", [](PyWorld& w) { return w.world().stepCount(); })
-      .def_property_readonly("dt",
-                             [](PyWorld& w) { return w.world().settings().solver.time_step; }, "s")
-      .def_property_readonly("scene_steps", [](PyWorld& w) { return w.scene().spec.steps; },
-                             "The scene file's step count (what `torsion run` takes)")
       .def_property_readonly(
-          "bodies",
-          [](py::object owner) {
-            std::vector<BodyHandle> out;
-            for (const auto& b : self(owner).world().bodies())
-              out.push_back({owner, &self(owner), b.get()});
-            return out;
-          })
+          "time", [](PyWorld& w) { return w.world().time(); }, "s")
+      .def_property_readonly("step_count", [](PyWorld& w) { return w.world().stepCount(); })
+      .def_property_readonly(
+          "dt", [](PyWorld& w) { return w.world().settings().solver.time_step; }, "s")
+      .def_property_readonly(
+          "scene_steps", [](PyWorld& w) { return w.scene().spec.steps; },
+          "The scene file's step count (what `torsion run` takes)")
+      .def_property_readonly("bodies",
+                             [](py::object owner) {
+                               std::vector<BodyHandle> out;
+                               for (const auto& b : self(owner).world().bodies())
+                                 out.push_back({owner, &self(owner), b.get()});
+                               return out;
+                             })
       .def(
           "body",
           [](py::object owner, const std::string& name) {
             return BodyHandle{owner, &self(owner), &findBody(self(owner), py::str(name))};
           },
           py::arg("name"))
-      .def_property_readonly(
-          "node_sets",
-          [](py::object owner) {
-            std::vector<NodeSetHandle> out;
-            for (size_t i = 0; i < self(owner).scene().node_sets.size(); ++i)
-              out.push_back({owner, &self(owner), i});
-            return out;
-          })
+      .def_property_readonly("node_sets",
+                             [](py::object owner) {
+                               std::vector<NodeSetHandle> out;
+                               for (size_t i = 0; i < self(owner).scene().node_sets.size(); ++i)
+                                 out.push_back({owner, &self(owner), i});
+                               return out;
+                             })
       .def(
           "node_set",
           [](py::object owner, const std::string& name) {
@@ -195,14 +214,13 @@ void bindWorld(py::module_& m) {
             throw py::key_error("no node set named '" + name + "'");
           },
           py::arg("name"))
-      .def_property_readonly(
-          "hands",
-          [](py::object owner) {
-            std::vector<HandHandle> out;
-            for (Hand* h : self(owner).hands())
-              out.push_back({owner, &self(owner), h});
-            return out;
-          })
+      .def_property_readonly("hands",
+                             [](py::object owner) {
+                               std::vector<HandHandle> out;
+                               for (Hand* h : self(owner).hands())
+                                 out.push_back({owner, &self(owner), h});
+                               return out;
+                             })
       .def(
           "hand",
           [](py::object owner, const std::string& name) {
@@ -368,13 +386,20 @@ void bindWorld(py::module_& m) {
               py::dict c = camera.cast<py::dict>();
               for (auto item : c) {
                 const std::string key = item.first.cast<std::string>();
-                if (key == "target") cam.target = toVector3(item.second, "camera target");
-                else if (key == "up") cam.up = toVector3(item.second, "camera up").normalized();
-                else if (key == "distance") cam.distance = item.second.cast<double>();
-                else if (key == "yaw") cam.yaw = item.second.cast<double>();
-                else if (key == "pitch") cam.pitch = item.second.cast<double>();
-                else if (key == "fov_y") cam.fov_y = item.second.cast<double>();
-                else throw py::value_error("camera: unknown key '" + key + "'");
+                if (key == "target")
+                  cam.target = toVector3(item.second, "camera target");
+                else if (key == "up")
+                  cam.up = toVector3(item.second, "camera up").normalized();
+                else if (key == "distance")
+                  cam.distance = item.second.cast<double>();
+                else if (key == "yaw")
+                  cam.yaw = item.second.cast<double>();
+                else if (key == "pitch")
+                  cam.pitch = item.second.cast<double>();
+                else if (key == "fov_y")
+                  cam.fov_y = item.second.cast<double>();
+                else
+                  throw py::value_error("camera: unknown key '" + key + "'");
               }
             }
             const render::Image image = renderer.value()->render(frame, cam, options);

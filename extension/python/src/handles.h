@@ -22,7 +22,8 @@ class WorldGuard {
   explicit WorldGuard(PyWorld& world, Access access = kRead)
       : lock_(world.busy(), std::try_to_lock) {
     if (!lock_.owns_lock())
-      throw std::runtime_error("the world is stepping in another thread; wait for step() to return");
+      throw std::runtime_error(
+          "the world is stepping in another thread; wait for step() to return");
     if (access == kWrite) world.touched();
   }
 

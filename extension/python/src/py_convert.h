@@ -24,9 +24,10 @@ namespace py = pybind11;
 /// object whose lifetime covers the storage) is kept alive by the array.
 template <class T>
 py::array readOnlyView(const T* data, py::ssize_t rows, py::ssize_t cols, py::handle owner) {
-  py::array_t<T> view({rows, cols}, {static_cast<py::ssize_t>(sizeof(T)) * cols,
-                                     static_cast<py::ssize_t>(sizeof(T))},
-                      data, owner);
+  py::array_t<T> view(
+      {rows, cols},
+      {static_cast<py::ssize_t>(sizeof(T)) * cols, static_cast<py::ssize_t>(sizeof(T))}, data,
+      owner);
   view.attr("setflags")(py::arg("write") = false);
   return std::move(view);
 }

@@ -7,10 +7,15 @@
 namespace torsion::python {
 
 Result<std::unique_ptr<PyWorld>> PyWorld::fromScene(const std::string& name_or_path, int threads,
+                                                    const scene::DeviceOverrides& devices,
                                                     FailureKind* kind) {
   *kind = FailureKind::kScene;
   Result<scene::SceneSpec> spec = scene::loadScene(name_or_path);
   if (!spec) return spec.error();
+  if (Status applied = scene::applyDeviceOverrides(spec.value(), devices); !applied) {
+    *kind = FailureKind::kValue;
+    return applied.error();
+  }
   std::vector<std::string> mesh_paths;
   for (const scene::BodySpec& body : spec.value().bodies)
     mesh_paths.push_back(body.mesh_path);
@@ -94,8 +99,8 @@ Result<int> PyWorld::addNodeSet(const std::string& name, FemBody& body, std::vec
   if (nodes.empty()) return Error{"node set '" + name + "': it holds no node"};
   for (int node : nodes) {
     if (node < 0 || node >= body.model().nodeCount()) {
-      return Error{"node set '" + name + "': node " + std::to_string(node) + " is out of range [0, " +
-                   std::to_string(body.model().nodeCount()) + ")"};
+      return Error{"node set '" + name + "': node " + std::to_string(node) +
+                   " is out of range [0, " + std::to_string(body.model().nodeCount()) + ")"};
     }
   }
   scene::NodeSetHandle handle;
@@ -139,8 +144,9 @@ btRigidBody* PyWorld::addRigidBody(const scene::RigidBodySpec& spec, bool ground
 
 Result<PyWorldState> PyWorld::saveState() {
   if (scene_->haptics) {
-    return Error{"save_state: the scene's device hands run haptic loops, whose devices cannot be "
-                 "wound back"};
+    return Error{
+        "save_state: the scene's device hands run haptic loops, whose devices cannot be "
+        "wound back"};
   }
   PyWorldState state;
   state.world = world().checkpoint();

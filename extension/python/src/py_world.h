@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "device_parser.h"
 #include "scene_builder.h"
 #include "torsion/bullet/fem_world.h"
 #include "torsion/constraints/hand.h"
@@ -39,7 +40,9 @@ class PyWorld {
  public:
   /// A scene file, or a demo scene's name resolved like `torsion run NAME`. threads < 0: the
   /// scene's own solver.threads.
+  /// `devices` are `torsion run`'s --device / --haptics / --allow-remote-device choices.
   static Result<std::unique_ptr<PyWorld>> fromScene(const std::string& name_or_path, int threads,
+                                                    const scene::DeviceOverrides& devices,
                                                     FailureKind* kind);
   /// An empty world (bodies, node sets, hands and rigid bodies added in code).
   explicit PyWorld(const WorldSettings& settings);

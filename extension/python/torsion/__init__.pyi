@@ -117,7 +117,9 @@ class World:
                  tolerance: float = 1e-4, max_iterations: int = 300,
                  linear_solver: str = "cg", threads: int = 0, max_speed: float = 1e3) -> None: ...
     @staticmethod
-    def from_scene(scene: str, threads: int = -1) -> World: ...
+    def from_scene(scene: str, threads: int = -1, *,
+                   devices: Union[dict[str, str], Sequence[str], None] = None,
+                   haptics: str = "", allow_remote_devices: bool = False) -> World: ...
     def step(self, n: int = 1) -> None: ...  # releases the GIL
     time: float  # s
     step_count: int
