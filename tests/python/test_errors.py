@@ -34,6 +34,14 @@ def test_a_bad_scene_key_is_a_scene_error_with_the_clis_message(torsion_exe, sce
     assert info.value.key == "solver" and "time_step = -1" in str(info.value)
 
 
+def test_a_json_syntax_error_is_a_scene_error_naming_the_line(tmp_path):
+    path = tmp_path / "syntax.json"
+    path.write_text('{"name": "x",\n "steps": ,}\n')
+    with pytest.raises(torsion.SceneError, match="invalid JSON") as info:
+        torsion.World.from_scene(str(path))
+    assert info.value.file == str(path) and info.value.line == 2 and info.value.key is None
+
+
 def test_a_malformed_mesh_in_a_scene_is_a_mesh_error_naming_file_and_line(torsion_exe, scenes, tmp_path):
     (tmp_path / "bad.node").write_text("4 3 0 0\n0 0 0 0\n1 1 0 0\n2 0 x 0\n3 0 0 1\n")
     (tmp_path / "bad.ele").write_text("1 4 0\n0 0 1 2 3\n")

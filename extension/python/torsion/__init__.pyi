@@ -19,6 +19,7 @@ class SceneError(Error):
     """A scene file that cannot be read, parsed or built (the CLI's message)."""
     file: Optional[str]
     key: Optional[str]
+    line: Optional[int]  # a JSON syntax error's line
 
 class MeshError(Error):
     """A mesh file or nodes/tets arrays that are not a valid tet mesh."""

@@ -11,16 +11,17 @@ class Error(RuntimeError):
 class SceneError(Error):
     """A scene file that cannot be read, parsed or built.
 
-    ``file`` is the scene file; ``key`` the entry the message names first (e.g.
-    ``"bodies[0]"`` or ``"solver.dt"``), or None.
+    ``file`` is the scene file; ``key`` the entry the message names first (e.g. ``"bodies[0]"``
+    or ``"solver"``), or None; ``line`` the 1-based line of a JSON syntax error, or None.
     """
 
     def __init__(self, message):
         super().__init__(message)
         self.message = message
-        match = re.match(r"(.+?\.json)(?::\d+)?:\s*(\S+?)(?::|\s|$)", message)
+        match = re.match(r"(.+?\.json)(?::(\d+):\d+)?:\s*(\S+?)(?::|\s|$)", message)
         self.file = match.group(1) if match else None
-        self.key = match.group(2) if match else None
+        self.line = int(match.group(2)) if match and match.group(2) else None
+        self.key = match.group(3) if match and not self.line else None
 
 
 class MeshError(Error):
