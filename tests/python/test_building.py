@@ -130,3 +130,13 @@ def test_a_live_material_edit_takes_the_new_density_into_the_masses(assets):
     np.testing.assert_allclose(body.masses, 1.5 * before, rtol=1e-12)
     with pytest.raises(ValueError, match="poisson"):
         body.set_material(torsion.Material.__new__(torsion.Material)) if False else torsion.Material(nu=0.6)
+
+
+def test_an_empty_world_steps_and_refuses_to_write_a_mesh_it_does_not_have(tmp_path):
+    world = torsion.World(threads=1)
+    world.step(3)
+    assert world.step_count == 3 and world.bodies == [] and world.hands == []
+    with pytest.raises(ValueError, match="no body"):
+        world.write_vtk(str(tmp_path / "x.vtk"))
+    with pytest.raises(KeyError):
+        world.body("nothing")

@@ -414,6 +414,8 @@ void bindWorld(py::module_& m) {
           "write_vtk",
           [](PyWorld& w, const std::string& path, py::object body) {
             WorldGuard guard(w);
+            if (w.world().bodies().empty())
+              throw py::value_error("write_vtk: the world has no body");
             FemBody& b = body.is_none() ? *w.world().bodies().front() : findBody(w, body);
             const TetMesh& mesh = b.model().mesh();
             std::vector<Eigen::Vector3d> x(static_cast<size_t>(mesh.nodeCount()));
