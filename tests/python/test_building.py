@@ -135,7 +135,7 @@ def test_a_live_material_edit_takes_the_new_density_into_the_masses(assets):
 def test_an_empty_world_steps_and_refuses_to_write_a_mesh_it_does_not_have(tmp_path):
     world = torsion.World(threads=1)
     world.step(3)
-    assert world.step_count == 3 and world.bodies == [] and world.hands == []
+    assert world.bodies == [] and world.hands == [] and world.rigid_bodies == []
     with pytest.raises(ValueError, match="no body"):
         world.write_vtk(str(tmp_path / "x.vtk"))
     with pytest.raises(KeyError):
