@@ -23,6 +23,8 @@ packages=(
   libgtest-dev libbenchmark-dev clang libclang-rt-14-dev
   # mesh generation (`torsion mesh cylinder` runs the tetgen command)
   tetgen
+  # the Python package (`import torsion`), its tests and examples
+  python3-dev pybind11-dev python3-numpy python3-pytest python3-matplotlib
 )
 
 missing=()

@@ -13,6 +13,9 @@ cmake -S . -B build -G Ninja -DCMAKE_BUILD_TYPE=Release -DTORSION_WARNINGS_AS_ER
 cmake --build build -j"$jobs"
 echo "== Test suite"
 ctest --test-dir build -j"$jobs" --output-on-failure --timeout 900
+# The pytest suite is one CTest test (python.pytest); its own count of tests:
+grep -hEo "^[0-9]+ passed.* in [0-9.]+s" build/Testing/Temporary/LastTest.log | tail -1 |
+  sed 's/^/== pytest (label python): /' || true
 
 echo "== ThreadSanitizer build (build-tsan/, clang): the haptic loop's thread, its buffers, the runtime"
 cmake -S . -B build-tsan -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_CXX_COMPILER=clang++ \

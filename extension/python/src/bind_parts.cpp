@@ -1,0 +1,316 @@
+// torsion.Body, NodeSet, Hand and RigidBody: handles onto the parts of a world.
+#include <pybind11/stl.h>
+
+#include "frame_data.h"
+#include "handles.h"
+#include "py_convert.h"
+#include "torsion/fem/corotated_element.h"
+#include "torsion/haptics/patch_stiffness.h"
+
+namespace torsion::python {
+
+namespace {
+
+// Per tet: the corotated small strain R^T F sym - I (the renderer's and tetVonMises' measure).
+std::vector<Eigen::Matrix3d> tetStrains(const FemBody& body) {
+  const FemModel& model = body.model();
+  const TetMesh& mesh = model.mesh();
+  const FemState& state = body.state();
+  std::vector<Eigen::Matrix3d> strains(static_cast<size_t>(mesh.tetCount()));
+  for (int t = 0; t < mesh.tetCount(); ++t) {
+    const Tet& tet = mesh.tets()[static_cast<size_t>(t)];
+    std::array<Eigen::Vector3d, 4> x;
+    for (size_t a = 0; a < 4; ++a)
+      x[a] = state.position(tet[a]);
+    const Eigen::Matrix3d F =
+        deformationGradient(x, model.tetRestData()[static_cast<size_t>(t)].rest_shape_inverse);
+    const size_t element = static_cast<size_t>(model.elementOfTet(t));
+    const Eigen::Matrix3d R = element < state.element_rotations.size()
+                                  ? state.element_rotations[element].toRotationMatrix()
+                                  : Eigen::Matrix3d::Identity();
+    const Eigen::Matrix3d RtF = R.transpose() * F;
+    strains[static_cast<size_t>(t)] = 0.5 * (RtF + RtF.transpose()) - Eigen::Matrix3d::Identity();
+  }
+  return strains;
+}
+
+py::array_t<double> rigidPose(const btRigidBody& body, bool rotation) {
+  const btTransform& t = body.getCenterOfMassTransform();
+  if (rotation) {
+    const btQuaternion q = t.getRotation();
+    const double xyzw[4] = {static_cast<double>(q.x()), static_cast<double>(q.y()),
+                            static_cast<double>(q.z()), static_cast<double>(q.w())};
+    return vectorArray(xyzw, 4);
+  }
+  const double p[3] = {static_cast<double>(t.getOrigin().x()),
+                       static_cast<double>(t.getOrigin().y()),
+                       static_cast<double>(t.getOrigin().z())};
+  return vectorArray(p, 3);
+}
+
+py::array_t<double> btArray(const btVector3& v) {
+  const double p[3] = {static_cast<double>(v.x()), static_cast<double>(v.y()),
+                       static_cast<double>(v.z())};
+  return vectorArray(p, 3);
+}
+
+}  // namespace
+
+void bindParts(py::module_& m) {
+  using B = BodyHandle;
+  py::class_<BodyHandle>(m, "Body", "An FEM body of a world (alive as long as the world).")
+      .def_property_readonly("name", [](const B& b) { return b.body->name(); })
+      .def_property_readonly("node_count", [](const B& b) { return b.body->model().nodeCount(); })
+      .def_property_readonly("element_count",
+                             [](const B& b) { return b.body->model().elementCount(); })
+      .def_property_readonly("element",
+                             [](const B& b) {
+                               return b.body->model().elementKind() == ElementKind::kTet10 ? "tet10"
+                                                                                           : "tet4";
+                             })
+      .def_property_readonly(
+          "positions",
+          [](const B& b) {
+            return readOnlyView(b.body->state().positions.data(), b.body->model().nodeCount(), 3,
+                                b.owner);
+          },
+          "(n, 3) float64, m. A read-only view of the solver's storage: it changes as the world "
+          "steps (copy it to keep a moment).")
+      .def_property_readonly(
+          "velocities",
+          [](const B& b) {
+            return readOnlyView(b.body->state().velocities.data(), b.body->model().nodeCount(), 3,
+                                b.owner);
+          },
+          "(n, 3) float64, m/s. A read-only view that changes as the world steps.")
+      .def_property_readonly(
+          "rest_positions",
+          [](const B& b) {
+            const auto& rest = b.body->model().mesh().restPositions();
+            return readOnlyView(rest.front().data(), static_cast<py::ssize_t>(rest.size()), 3,
+                                b.owner);
+          },
+          "(n, 3) float64, m. A read-only view (the rest shape never changes).")
+      .def_property_readonly(
+          "masses",
+          [](const B& b) {
+            const auto& masses = b.body->model().nodeMasses();
+            return copyArray(masses.data(), static_cast<py::ssize_t>(masses.size()), 1)
+                .attr("reshape")(-1);
+          },
+          "(n,) float64, kg: lumped node masses (a copy).")
+      .def_property_readonly(
+          "tets",
+          [](const B& b) {
+            const FemModel& model = b.body->model();
+            return readOnlyView(model.elementNodes().data(), model.elementCount(),
+                                model.nodesPerElement(), b.owner);
+          },
+          "(m, 4) or (m, 10) int32: the elements' nodes (tet10: 4 corners then 6 mid-edge "
+          "nodes). A read-only view.")
+      .def_property_readonly(
+          "surface_triangles",
+          [](const B& b) {
+            const auto& tris = b.body->model().mesh().surfaceTriangles();
+            return readOnlyView(tris.front().data(), static_cast<py::ssize_t>(tris.size()), 3,
+                                b.owner);
+          },
+          "(k, 3) int32, counter-clockwise seen from outside. A read-only view.")
+      .def_property_readonly("material", [](const B& b) { return b.body->model().material(); })
+      .def(
+          "set_material",
+          [](const B& b, const Material& material) {
+            WorldGuard guard(*b.world, WorldGuard::kWrite);
+            if (Status s = b.body->setMaterial(material); !s)
+              throw py::value_error(s.error().message);
+            for (Hand* hand : b.world->hands()) {
+              if (&hand->body() == b.body) hand->updateSpeedLimit();
+            }
+          },
+          py::arg("material"), "Live edit: the body goes on from its current state.")
+      .def_property_readonly(
+          "external_forces",
+          [](const B& b) {
+            return copyArray(b.body->externalForces().data(), b.body->model().nodeCount(), 3);
+          },
+          "(n, 3) float64, N: forces besides gravity (a copy).")
+      .def(
+          "set_external_forces",
+          [](const B& b, py::object forces) {
+            Eigen::VectorXd f = toNodeVectors(forces, b.body->model().nodeCount(), "forces");
+            WorldGuard guard(*b.world, WorldGuard::kWrite);
+            if (Status s = b.body->setExternalForces(f); !s)
+              throw py::value_error(s.error().message);
+          },
+          py::arg("forces"), "(n, 3) N per node, applied every step until changed.")
+      .def(
+          "set_velocity",
+          [](const B& b, py::object velocity) {
+            WorldGuard guard(*b.world, WorldGuard::kWrite);
+            b.body->setVelocity(toVector3(velocity, "velocity"));
+          },
+          py::arg("velocity"), "Every node's velocity, m/s.")
+      .def(
+          "von_mises_stress",
+          [](const B& b) {
+            WorldGuard guard(*b.world);
+            std::vector<double> s = render::tetVonMises(*b.body);
+            return vectorArray(s.data(), static_cast<py::ssize_t>(s.size()));
+          },
+          "Per tet of the simulation mesh (tet10: 8 sub-tets per element), Pa: von Mises stress "
+          "of the corotated linear strain.")
+      .def(
+          "von_mises_strain",
+          [](const B& b) {
+            WorldGuard guard(*b.world);
+            std::vector<Eigen::Matrix3d> eps = tetStrains(*b.body);
+            std::vector<double> out;
+            out.reserve(eps.size());
+            for (const Eigen::Matrix3d& e : eps) {
+              const Eigen::Matrix3d dev = e - e.trace() / 3 * Eigen::Matrix3d::Identity();
+              out.push_back(std::sqrt(2.0 / 3.0 * dev.squaredNorm()));
+            }
+            return vectorArray(out.data(), static_cast<py::ssize_t>(out.size()));
+          },
+          "Per tet, dimensionless: equivalent strain sqrt(2/3 dev(eps):dev(eps)).")
+      .def_property_readonly(
+          "kinetic_energy", [](const B& b) { return b.body->lastReport().kinetic_energy; },
+          "J, at the end of the last step")
+      .def_property_readonly(
+          "solver_iterations", [](const B& b) { return b.body->lastReport().solve.iterations; },
+          "CG iterations of the last step")
+      .def("__repr__", [](const B& b) {
+        return "<torsion.Body '" + b.body->name() +
+               "': " + std::to_string(b.body->model().nodeCount()) + " nodes>";
+      });
+
+  using N = NodeSetHandle;
+  py::class_<NodeSetHandle>(m, "NodeSet", "Nodes of a body held in place (or carried by a script).")
+      .def_property_readonly("name", [](const N& s) { return s.set().name; })
+      .def_property_readonly("body",
+                             [](const N& s) {
+                               return BodyHandle{s.owner, s.world, s.set().body};
+                             })
+      .def_property_readonly(
+          "nodes",
+          [](const N& s) {
+            const auto& nodes = s.set().body->groups()[static_cast<size_t>(s.set().group)]->nodes();
+            return copyArray(nodes.data(), static_cast<py::ssize_t>(nodes.size()), 1)
+                .attr("reshape")(-1);
+          },
+          "(k,) int32, ascending (a copy)")
+      .def_property_readonly(
+          "wrench",
+          [](const N& s) {
+            WorldGuard guard(*s.world);
+            const scene::NodeSetHandle& set = s.set();
+            return wrenchArray(set.body->groupWrench(set.group, set.wrench_about));
+          },
+          "(6,) [fx, fy, fz, tx, ty, tz]: N and N m the body exerted on the set in the last step, "
+          "torque about the set's wrench_about point.")
+      .def(
+          "release",
+          [](const N& s) {
+            WorldGuard guard(*s.world, WorldGuard::kWrite);
+            s.set().body->releaseGroup(s.set().group);
+          },
+          "Frees the nodes from the next step on (the wrench then reads zero).");
+
+  using H = HandHandle;
+  py::class_<HandHandle>(m, "Hand", "A hand plane acting on one body (docs/hand-plane.md).")
+      .def_property_readonly("name", [](const H& h) { return h.hand->name(); })
+      .def_property_readonly("body",
+                             [](const H& h) {
+                               return BodyHandle{h.owner, h.world, &h.hand->body()};
+                             })
+      .def_property_readonly("grabbed", [](const H& h) { return h.hand->grabbed(); })
+      .def_property_readonly(
+          "scripted", [](const H& h) { return h.world->handSpec(*h.hand) != nullptr; },
+          "True for a scene's hand (its script or device moves it at each step)")
+      .def(
+          "grab",
+          [](const H& h, py::object frame) {
+            const Frame f = toFrame(frame, "grab");
+            WorldGuard guard(*h.world, WorldGuard::kWrite);
+            Result<int> n = h.hand->grab(f, h.world->world().time());
+            if (!n) throw py::value_error("hand '" + h.hand->name() + "': " + n.error().message);
+            return n.value();
+          },
+          py::arg("frame"),
+          "Grabs the patch the frame's plane (normal k) cuts where the ray from its origin along i "
+          "hits; returns the number of grabbed nodes. ValueError when it misses.")
+      .def(
+          "move_to",
+          [](const H& h, py::object frame) {
+            const Frame f = toFrame(frame, "move_to");
+            WorldGuard guard(*h.world, WorldGuard::kWrite);
+            h.hand->moveTo(f);
+          },
+          py::arg("frame"), "The goal frame the grabbed patch pursues from the next step on.")
+      .def("release",
+           [](const H& h) {
+             WorldGuard guard(*h.world, WorldGuard::kWrite);
+             h.hand->release();
+           })
+      .def_property_readonly("goal", [](const H& h) { return h.hand->goal(); })
+      .def_property_readonly(
+          "frame", [](const H& h) { return h.hand->frame(); },
+          "The frame carrying the grabbed nodes in the last step.")
+      .def_property_readonly(
+          "wrench",
+          [](const H& h) {
+            WorldGuard guard(*h.world);
+            return wrenchArray(h.hand->wrench());
+          },
+          "(6,) [fx, fy, fz, tx, ty, tz]: N and N m the body exerted on the grabbed patch in the "
+          "last step, torque about the patch frame's origin; zeros when not grabbing.")
+      .def_property_readonly("grabbed_nodes",
+                             [](const H& h) {
+                               const auto& nodes = h.hand->grabbedNodes();
+                               return copyArray(nodes.data(),
+                                                static_cast<py::ssize_t>(nodes.size()), 1)
+                                   .attr("reshape")(-1);
+                             })
+      .def_property_readonly(
+          "speed_limit", [](const H& h) { return h.hand->speedLimit(); },
+          "m/s, grabbed nodes' speed bound (inf when off)")
+      .def(
+          "stiffness",
+          [](const H& h, double tolerance) {
+            if (!h.hand->grabbed())
+              throw py::value_error("hand '" + h.hand->name() + "': not grabbing");
+            WorldGuard guard(*h.world, WorldGuard::kWrite);
+            haptics::PatchStiffness k;
+            const Eigen::Matrix<double, 6, 6, Eigen::RowMajor> K =
+                k.compute(h.hand->body(), h.hand->group(), h.hand->frame().origin, tolerance);
+            return copyArray(K.data(), 6, 6);
+          },
+          py::arg("tolerance") = 1e-6,
+          "(6, 6) K_h: dW/dpose of the patch about its origin over the next step (N/m, N, N m/rad; "
+          "rows/columns [translation, rotation]). Six CG solves.");
+
+  using R = RigidHandle;
+  py::class_<RigidHandle>(m, "RigidBody", "A Bullet rigid body of the world.")
+      .def_property_readonly("name", [](const R& r) { return r.name; })
+      .def_property_readonly(
+          "position", [](const R& r) { return rigidPose(*r.body, false); },
+          "(3,) centre of mass, m")
+      .def_property_readonly(
+          "quaternion", [](const R& r) { return rigidPose(*r.body, true); },
+          "(4,) orientation (x, y, z, w)")
+      .def_property_readonly(
+          "linear_velocity", [](const R& r) { return btArray(r.body->getLinearVelocity()); },
+          "(3,) m/s")
+      .def_property_readonly(
+          "angular_velocity", [](const R& r) { return btArray(r.body->getAngularVelocity()); },
+          "(3,) rad/s")
+      .def_property_readonly(
+          "mass",
+          [](const R& r) {
+            const double inverse = static_cast<double>(r.body->getInvMass());
+            return inverse > 0 ? 1 / inverse : 0.0;
+          },
+          "kg (0: static or kinematic)");
+}
+
+}  // namespace torsion::python

@@ -1,0 +1,123 @@
+// torsion.Frame, torsion.Material and torsion.State: plain values.
+#include <pybind11/stl.h>
+
+#include "handles.h"
+#include "py_convert.h"
+#include "torsion/fem/material.h"
+
+namespace torsion::python {
+
+namespace {
+
+py::array_t<double> quaternionArray(const Eigen::Quaterniond& q) {
+  const double xyzw[4] = {q.x(), q.y(), q.z(), q.w()};
+  return vectorArray(xyzw, 4);
+}
+
+Eigen::Quaterniond toQuaternion(py::handle value) {
+  auto a = py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(value);
+  if (!a || a.size() != 4) throw py::value_error("quaternion: expected 4 numbers (x, y, z, w)");
+  Eigen::Quaterniond q(a.data()[3], a.data()[0], a.data()[1], a.data()[2]);
+  if (!(q.norm() > 1e-12)) throw py::value_error("quaternion: zero length");
+  return q.normalized();
+}
+
+}  // namespace
+
+void bindTypes(py::module_& m) {
+  py::class_<Frame>(m, "Frame",
+                    "A rigid frame: origin (m) and rotation as a unit quaternion (x, y, z, w). "
+                    "Maps local p to world R p + origin.")
+      .def(py::init([](py::object position, py::object quaternion) {
+             Frame f;
+             f.origin = toVector3(position, "position");
+             f.rotation = toQuaternion(quaternion);
+             return f;
+           }),
+           py::arg("position") = py::make_tuple(0.0, 0.0, 0.0),
+           py::arg("quaternion") = py::make_tuple(0.0, 0.0, 0.0, 1.0))
+      .def_static(
+          "from_matrix", [](py::object matrix) { return toFrame(matrix, "Frame.from_matrix"); },
+          py::arg("matrix"), "From a 4x4 homogeneous matrix (m).")
+      .def_static(
+          "from_axis_angle",
+          [](py::object position, py::object axis, double angle) {
+            Frame f;
+            f.origin = toVector3(position, "position");
+            f.rotation = Eigen::AngleAxisd(angle, toVector3(axis, "axis").normalized());
+            return f;
+          },
+          py::arg("position"), py::arg("axis"), py::arg("angle"),
+          "Origin (m) and a rotation of `angle` rad about `axis`.")
+      .def_property_readonly(
+          "position", [](const Frame& f) { return vectorArray(f.origin.data(), 3); }, "m, (3,)")
+      .def_property_readonly(
+          "quaternion", [](const Frame& f) { return quaternionArray(f.rotation); },
+          "(x, y, z, w), unit")
+      .def(
+          "matrix",
+          [](const Frame& f) {
+            Eigen::Matrix<double, 4, 4, Eigen::RowMajor> h = Eigen::Matrix4d::Identity();
+            h.topLeftCorner<3, 3>() = f.rotation.toRotationMatrix();
+            h.topRightCorner<3, 1>() = f.origin;
+            return copyArray(h.data(), 4, 4);
+          },
+          "The 4x4 homogeneous matrix.")
+      .def("__repr__", [](const Frame& f) {
+        return "Frame(position=(" + std::to_string(f.origin.x()) + ", " +
+               std::to_string(f.origin.y()) + ", " + std::to_string(f.origin.z()) +
+               "), quaternion=(" + std::to_string(f.rotation.x()) + ", " +
+               std::to_string(f.rotation.y()) + ", " + std::to_string(f.rotation.z()) + ", " +
+               std::to_string(f.rotation.w()) + "))";
+      });
+
+  py::class_<Material>(m, "Material", "Linear elastic material, SI units.")
+      .def(py::init([](double E, double nu, double rho, double mass_damping,
+                       double stiffness_damping, const std::string& volumetric_strain) {
+             Material mat;
+             mat.youngs_modulus = E;
+             mat.poisson_ratio = nu;
+             mat.density = rho;
+             mat.mass_damping = mass_damping;
+             mat.stiffness_damping = stiffness_damping;
+             std::optional<VolumetricStrain> kind = parseVolumetricStrain(volumetric_strain);
+             if (!kind) {
+               throw py::value_error("material: volumetric_strain '" + volumetric_strain +
+                                     "': expected 'element' or 'nodal_average'");
+             }
+             mat.volumetric_strain = *kind;
+             if (Status valid = mat.validate(); !valid)
+               throw py::value_error(valid.error().message);
+             return mat;
+           }),
+           py::arg("E") = 1e5, py::arg("nu") = 0.3, py::arg("rho") = 1000.0,
+           py::arg("mass_damping") = 0.0, py::arg("stiffness_damping") = 0.01,
+           py::arg("volumetric_strain") = "element",
+           "E: Young's modulus, Pa; nu: Poisson's ratio in [0, 0.5); rho: density, kg/m^3; "
+           "mass_damping: 1/s; stiffness_damping: s.")
+      .def_readonly("E", &Material::youngs_modulus, "Young's modulus, Pa")
+      .def_readonly("nu", &Material::poisson_ratio, "Poisson's ratio")
+      .def_readonly("rho", &Material::density, "density, kg/m^3")
+      .def_readonly("mass_damping", &Material::mass_damping, "1/s")
+      .def_readonly("stiffness_damping", &Material::stiffness_damping, "s")
+      .def_property_readonly("volumetric_strain",
+                             [](const Material& mat) { return toString(mat.volumetric_strain); })
+      .def_property_readonly("shear_modulus", &Material::mu, "G, Pa")
+      .def("__repr__", [](const Material& mat) {
+        return "Material(E=" + std::to_string(mat.youngs_modulus) +
+               ", nu=" + std::to_string(mat.poisson_ratio) +
+               ", rho=" + std::to_string(mat.density) + ")";
+      });
+
+  py::class_<PyWorldState>(m, "State",
+                           "A world at a moment (World.save_state), in memory. restore_state "
+                           "continues bit for bit as the world did after save_state.")
+      .def_property_readonly("time", [](const PyWorldState& s) { return s.world.fem.time; })
+      .def("__reduce__", [](const PyWorldState&) -> py::object {
+        throw py::type_error(
+            "torsion.State cannot be pickled: it holds the solver's warm starts and the hands' "
+            "motion state by reference; keep it in the process (World.save_state / restore_state)");
+      });
+}
+
+}  // namespace torsion::python

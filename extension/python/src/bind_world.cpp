@@ -1,0 +1,439 @@
+// torsion.World: scenes from files or built in code, stepping without the GIL, checkpoints,
+// pictures and VTK output.
+#include <pybind11/stl.h>
+
+#include <filesystem>
+
+#include "camera.h"
+#include "frame_data.h"
+#include "handles.h"
+#include "offscreen.h"
+#include "py_convert.h"
+#include "scene_builder.h"
+#include "torsion/mesh/mesh_io.h"
+#include "torsion/mesh/tet_mesh_builder.h"
+#include "torsion/mesh/vtk_format.h"
+
+namespace torsion::python {
+
+namespace {
+
+PyWorld& self(py::handle world) {
+  return world.cast<PyWorld&>();
+}
+
+ElementKind toElement(const std::string& name) {
+  if (name == "tet4") return ElementKind::kTet4;
+  if (name == "tet10") return ElementKind::kTet10;
+  throw py::value_error("element '" + name + "': expected 'tet4' or 'tet10'");
+}
+
+FemBody& findBody(PyWorld& world, py::handle body) {
+  if (py::isinstance<BodyHandle>(body)) return *body.cast<BodyHandle&>().body;
+  const std::string name = body.cast<std::string>();
+  FemBody* found = world.world().body(name);
+  if (!found) throw py::key_error("no body named '" + name + "'");
+  return *found;
+}
+
+// A mesh from numpy nodes (n, 3) and tets (m, 4), validated like a mesh file.
+TetMesh meshFromArrays(py::handle nodes, py::handle tets) {
+  auto x = py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(nodes);
+  auto t = py::array_t<int, py::array::c_style | py::array::forcecast>::ensure(tets);
+  if (!x || x.ndim() != 2 || x.shape(1) != 3)
+    throw py::value_error("nodes: expected an array of shape (n, 3)");
+  if (!t || t.ndim() != 2 || t.shape(1) != 4)
+    throw py::value_error("tets: expected an int array of shape (m, 4) (linear tets)");
+  RawTetMesh raw;
+  raw.element_file = "<tets array>";
+  for (py::ssize_t i = 0; i < x.shape(0); ++i)
+    raw.positions.emplace_back(x.at(i, 0), x.at(i, 1), x.at(i, 2));
+  for (py::ssize_t e = 0; e < t.shape(0); ++e) {
+    Tet tet{t.at(e, 0), t.at(e, 1), t.at(e, 2), t.at(e, 3)};
+    for (int v : tet) {
+      if (v < 0 || v >= static_cast<int>(raw.positions.size())) {
+        raise(FailureKind::kMesh, "<tets array>: row " + std::to_string(e) + ": node " +
+                                      std::to_string(v) + " is out of range [0, " +
+                                      std::to_string(raw.positions.size()) + ")");
+      }
+    }
+    raw.tets.push_back(tet);
+    raw.origins.push_back({static_cast<int>(e) + 1, static_cast<long>(e)});
+  }
+  Result<LoadedMesh> built = buildTetMesh(std::move(raw));
+  if (!built) raise(FailureKind::kMesh, built.error().message);
+  return std::move(built).value().mesh;
+}
+
+std::vector<int> selectedNodes(const TetMesh& mesh, py::object plane, py::object box,
+                               py::object sphere, py::object indices, double tolerance) {
+  const int given = !plane.is_none() + !box.is_none() + !sphere.is_none() + !indices.is_none();
+  if (given != 1)
+    throw py::value_error("add_node_set: give exactly one of plane, box, sphere or indices");
+  if (!indices.is_none()) {
+    auto a = py::array_t<int, py::array::c_style | py::array::forcecast>::ensure(indices);
+    if (!a || a.ndim() != 1) throw py::value_error("indices: expected a 1-D int array");
+    return std::vector<int>(a.data(), a.data() + a.size());
+  }
+  scene::NodeSelection selection;
+  if (!plane.is_none()) {
+    auto p = plane.cast<py::sequence>();
+    selection.kind = scene::NodeSelection::Kind::kPlane;
+    selection.point = toVector3(p[0], "plane point");
+    selection.normal = toVector3(p[1], "plane normal").normalized();
+    selection.tolerance = tolerance;
+  } else if (!box.is_none()) {
+    auto b = box.cast<py::sequence>();
+    selection.kind = scene::NodeSelection::Kind::kBox;
+    selection.min = toVector3(b[0], "box min");
+    selection.max = toVector3(b[1], "box max");
+  } else {
+    auto s = sphere.cast<py::sequence>();
+    selection.kind = scene::NodeSelection::Kind::kSphere;
+    selection.point = toVector3(s[0], "sphere centre");
+    selection.radius = s[1].cast<double>();
+  }
+  return scene::selectNodes(mesh, selection);
+}
+
+scene::RigidBodySpec::Shape toShape(const std::string& name) {
+  using S = scene::RigidBodySpec::Shape;
+  if (name == "box") return S::kBox;
+  if (name == "sphere") return S::kSphere;
+  if (name == "capsule") return S::kCapsule;
+  throw py::value_error("shape '" + name + "': expected 'box', 'sphere' or 'capsule'");
+}
+
+}  // namespace
+
+void bindWorld(py::module_& m) {
+  py::class_<PyWorld>(m, "World", "Bullet world with FEM soft bodies, hands and rigid bodies.")
+      .def(py::init([](py::object gravity, double dt, double tolerance, int max_iterations,
+                       const std::string& linear_solver, int threads, double max_speed) {
+             WorldSettings settings;
+             settings.gravity = toVector3(gravity, "gravity");
+             settings.solver.time_step = dt;
+             settings.solver.tolerance = tolerance;
+             settings.solver.max_iterations = max_iterations;
+             settings.solver.threads = threads;
+             settings.solver.max_speed = max_speed;
+             if (linear_solver == "cholmod") {
+               settings.solver.linear_solver = LinearSolverKind::kCholmod;
+             } else if (linear_solver != "cg") {
+               throw py::value_error("linear_solver '" + linear_solver +
+                                     "': expected 'cg' or 'cholmod'");
+             }
+             if (Status valid = settings.validate(); !valid)
+               throw py::value_error(valid.error().message);
+             return std::make_unique<PyWorld>(settings);
+           }),
+           py::arg("gravity") = py::make_tuple(0.0, 0.0, -9.81), py::arg("dt") = 0.01,
+           py::arg("tolerance") = 1e-4, py::arg("max_iterations") = 300,
+           py::arg("linear_solver") = "cg", py::arg("threads") = 0, py::arg("max_speed") = 1e3,
+           "An empty world. gravity: m/s^2; dt: s; tolerance: CG relative residual; threads: "
+           "solver worker threads (0: all cores); max_speed: m/s, a faster node fails the step.")
+      .def_static(
+          "from_scene",
+          [](const std::string& scene, int threads, py::object devices, const std::string& haptics,
+             bool allow_remote_devices) {
+            scene::DeviceOverrides overrides;
+            overrides.haptics = haptics;
+            overrides.allow_remote_devices = allow_remote_devices;
+            if (py::isinstance<py::dict>(devices)) {
+              for (auto item : devices.cast<py::dict>()) {
+                overrides.devices.push_back(item.first.cast<std::string>() + "=" +
+                                            item.second.cast<std::string>());
+              }
+            } else if (!devices.is_none()) {
+              overrides.devices = devices.cast<std::vector<std::string>>();
+            }
+            FailureKind kind;
+            Result<std::unique_ptr<PyWorld>> world =
+                PyWorld::fromScene(scene, threads, overrides, &kind);
+            if (!world) raise(kind, world.error().message);
+            return std::move(world).value();
+          },
+          py::arg("scene"), py::arg("threads") = -1, py::kw_only(), py::arg("devices") = py::none(),
+          py::arg("haptics") = "", py::arg("allow_remote_devices") = false,
+          "A scene file, or a demo scene's name (resolved like `torsion run NAME`: "
+          "$TORSION_SCENE_PATH, then the source tree's demos/scenes). threads < 0: the scene's. "
+          "devices: {hand: 'TYPE[:ARG]'} or ['HAND=TYPE[:ARG]'], as `torsion run --device` "
+          "(scripted:FILE, replay:CSV, network:[HOST:]PORT, spacemouse); haptics: 'lockstep' or "
+          "'threaded' (--haptics); allow_remote_devices: --allow-remote-device.")
+      .def(
+          "step",
+          [](PyWorld& w, int n) {
+            if (n < 0) throw py::value_error("step: n must be >= 0");
+            FailureKind kind;
+            Result<Ok> stepped = Ok{};
+            {
+              WorldGuard guard(w);
+              py::gil_scoped_release release;
+              stepped = w.step(n, &kind);
+            }
+            if (!stepped) raise(kind, stepped.error().message);
+          },
+          py::arg("n") = 1,
+          "n steps of dt, without the GIL. UnstableError (body and step in the message) when a "
+          "step fails: the bodies keep their last good state and the world goes no further.")
+      .def_property_readonly(
+          "time", [](PyWorld& w) { return w.world().time(); }, "s")
+      .def_property_readonly("step_count", [](PyWorld& w) { return w.world().stepCount(); })
+      .def_property_readonly(
+          "dt", [](PyWorld& w) { return w.world().settings().solver.time_step; }, "s")
+      .def_property_readonly(
+          "scene_steps", [](PyWorld& w) { return w.scene().spec.steps; },
+          "The scene file's step count (what `torsion run` takes)")
+      .def_property_readonly("bodies",
+                             [](py::object owner) {
+                               std::vector<BodyHandle> out;
+                               for (const auto& b : self(owner).world().bodies())
+                                 out.push_back({owner, &self(owner), b.get()});
+                               return out;
+                             })
+      .def(
+          "body",
+          [](py::object owner, const std::string& name) {
+            return BodyHandle{owner, &self(owner), &findBody(self(owner), py::str(name))};
+          },
+          py::arg("name"))
+      .def_property_readonly("node_sets",
+                             [](py::object owner) {
+                               std::vector<NodeSetHandle> out;
+                               for (size_t i = 0; i < self(owner).scene().node_sets.size(); ++i)
+                                 out.push_back({owner, &self(owner), i});
+                               return out;
+                             })
+      .def(
+          "node_set",
+          [](py::object owner, const std::string& name) {
+            const auto& sets = self(owner).scene().node_sets;
+            for (size_t i = 0; i < sets.size(); ++i) {
+              if (sets[i].name == name) return NodeSetHandle{owner, &self(owner), i};
+            }
+            throw py::key_error("no node set named '" + name + "'");
+          },
+          py::arg("name"))
+      .def_property_readonly("hands",
+                             [](py::object owner) {
+                               std::vector<HandHandle> out;
+                               for (Hand* h : self(owner).hands())
+                                 out.push_back({owner, &self(owner), h});
+                               return out;
+                             })
+      .def(
+          "hand",
+          [](py::object owner, const std::string& name) {
+            for (Hand* h : self(owner).hands()) {
+              if (h->name() == name) return HandHandle{owner, &self(owner), h};
+            }
+            throw py::key_error("no hand named '" + name + "'");
+          },
+          py::arg("name"))
+      .def_property_readonly(
+          "rigid_bodies",
+          [](py::object owner) {
+            std::vector<RigidHandle> out;
+            for (const scene::SceneRigidBody& r : self(owner).scene().rigid_bodies)
+              out.push_back({owner, &self(owner), r.name, r.body});
+            return out;
+          })
+      .def(
+          "rigid_body",
+          [](py::object owner, const std::string& name) {
+            for (const scene::SceneRigidBody& r : self(owner).scene().rigid_bodies) {
+              if (r.name == name) return RigidHandle{owner, &self(owner), r.name, r.body};
+            }
+            throw py::key_error("no rigid body named '" + name + "'");
+          },
+          py::arg("name"))
+      .def(
+          "save_state",
+          [](PyWorld& w) {
+            WorldGuard guard(w);
+            Result<PyWorldState> state = w.saveState();
+            if (!state) throw py::value_error(state.error().message);
+            return std::move(state).value();
+          },
+          "The world now (FEM bodies, solver warm starts, hands, node sets, rigid bodies).")
+      .def(
+          "restore_state",
+          [](PyWorld& w, const PyWorldState& state) {
+            WorldGuard guard(w);
+            if (Status s = w.restoreState(state); !s) throw py::value_error(s.error().message);
+          },
+          py::arg("state"), "Back to `state`; the steps after it repeat bit for bit.")
+      .def(
+          "add_body",
+          [](py::object owner, const std::string& name, py::object mesh, py::object nodes,
+             py::object tets, const Material& material, py::object frame,
+             const std::string& element) {
+            PyWorld& w = self(owner);
+            TetMesh built;
+            if (!mesh.is_none()) {
+              if (!nodes.is_none() || !tets.is_none())
+                throw py::value_error("add_body: give mesh or nodes and tets, not both");
+              Result<LoadedMesh> loaded = readMesh(py::str(mesh).cast<std::string>());
+              if (!loaded) raise(FailureKind::kMesh, loaded.error().message);
+              built = std::move(loaded).value().mesh;
+            } else {
+              if (nodes.is_none() || tets.is_none())
+                throw py::value_error("add_body: give mesh, or nodes and tets");
+              built = meshFromArrays(nodes, tets);
+            }
+            const Frame pose = frame.is_none() ? Frame{} : toFrame(frame, "add_body frame");
+            WorldGuard guard(w, WorldGuard::kWrite);
+            Result<FemBody*> body = w.addBody(name, built, material, pose, toElement(element));
+            if (!body) throw py::value_error(body.error().message);
+            return BodyHandle{owner, &w, body.value()};
+          },
+          py::arg("name"), py::arg("mesh") = py::none(), py::kw_only(),
+          py::arg("nodes") = py::none(), py::arg("tets") = py::none(),
+          py::arg("material") = Material{}, py::arg("frame") = py::none(),
+          py::arg("element") = "tet4",
+          "A body from a mesh file (.node/.ele, .msh, .vtk; MeshError names file and line) or "
+          "from nodes (n, 3) m and tets (m, 4), placed at `frame`.")
+      .def(
+          "add_node_set",
+          [](py::object owner, const std::string& name, py::object body, py::object plane,
+             py::object box, py::object sphere, py::object indices, double tolerance,
+             py::object wrench_about) {
+            PyWorld& w = self(owner);
+            FemBody& b = findBody(w, body);
+            std::vector<int> nodes =
+                selectedNodes(b.model().mesh(), plane, box, sphere, indices, tolerance);
+            WorldGuard guard(w, WorldGuard::kWrite);
+            Result<int> index =
+                w.addNodeSet(name, b, std::move(nodes), toVector3(wrench_about, "wrench_about"));
+            if (!index) throw py::value_error(index.error().message);
+            return NodeSetHandle{owner, &w, static_cast<size_t>(index.value())};
+          },
+          py::arg("name"), py::arg("body"), py::kw_only(), py::arg("plane") = py::none(),
+          py::arg("box") = py::none(), py::arg("sphere") = py::none(),
+          py::arg("indices") = py::none(), py::arg("tolerance") = 1e-6,
+          py::arg("wrench_about") = py::make_tuple(0.0, 0.0, 0.0),
+          "Holds the nodes of `body` (a Body or its name) in place, chosen by rest position: "
+          "plane=(point, normal) within tolerance (m), box=(min, max), sphere=(centre, radius), "
+          "or indices.")
+      .def(
+          "add_hand",
+          [](py::object owner, const std::string& name, py::object body, double max_drag_strain) {
+            PyWorld& w = self(owner);
+            HandSettings settings;
+            settings.max_drag_strain = max_drag_strain;
+            if (Status valid = settings.validate(); !valid)
+              throw py::value_error(valid.error().message);
+            WorldGuard guard(w, WorldGuard::kWrite);
+            return HandHandle{owner, &w, &w.addHand(findBody(w, body), name, settings)};
+          },
+          py::arg("name"), py::arg("body"), py::arg("max_drag_strain") = 0.2,
+          "A hand on `body`, not grabbing yet: call grab(frame), then move_to(frame) each step.")
+      .def(
+          "add_rigid_body",
+          [](py::object owner, const std::string& name, const std::string& shape,
+             py::object half_extents, double radius, double half_height, double mass,
+             py::object frame, double friction, py::object linear_velocity) {
+            PyWorld& w = self(owner);
+            scene::RigidBodySpec spec;
+            spec.name = name;
+            spec.shape = toShape(shape);
+            spec.half_extents = toVector3(half_extents, "half_extents");
+            spec.radius = radius;
+            spec.half_height = half_height;
+            spec.mass = mass;
+            spec.pose = frame.is_none() ? Frame{} : toFrame(frame, "add_rigid_body frame");
+            spec.friction = friction;
+            spec.linear_velocity = toVector3(linear_velocity, "linear_velocity");
+            WorldGuard guard(w, WorldGuard::kWrite);
+            btRigidBody* body = w.addRigidBody(spec, false);
+            return RigidHandle{owner, &w, name, body};
+          },
+          py::arg("name"), py::arg("shape") = "box", py::kw_only(),
+          py::arg("half_extents") = py::make_tuple(0.5, 0.5, 0.5), py::arg("radius") = 0.5,
+          py::arg("half_height") = 0.5, py::arg("mass") = 1.0, py::arg("frame") = py::none(),
+          py::arg("friction") = 0.5, py::arg("linear_velocity") = py::make_tuple(0.0, 0.0, 0.0),
+          "A Bullet rigid body: box (half_extents, m), sphere (radius) or capsule along z "
+          "(radius, half_height); mass in kg, 0 for static.")
+      .def(
+          "add_ground",
+          [](PyWorld& w, double height, double friction) {
+            scene::RigidBodySpec spec;
+            spec.name = "ground";
+            spec.shape = scene::RigidBodySpec::Shape::kPlane;
+            spec.plane_normal = Eigen::Vector3d::UnitZ();
+            spec.plane_offset = height;
+            spec.mass = 0;
+            spec.friction = friction;
+            WorldGuard guard(w, WorldGuard::kWrite);
+            w.addRigidBody(spec, true);
+          },
+          py::arg("height") = 0.0, py::arg("friction") = 0.5,
+          "A static ground plane z = height (m).")
+      .def(
+          "render",
+          [](PyWorld& w, int width, int height, py::object camera, bool hud) {
+            if (width <= 0 || height <= 0) throw py::value_error("render: width and height > 0");
+            WorldGuard guard(w);
+            render::FrameData frame = render::captureFrame(w.scene());
+            Result<std::unique_ptr<render::OffscreenRenderer>> renderer =
+                render::OffscreenRenderer::create(width, height);
+            if (!renderer) throw std::runtime_error("render: " + renderer.error().message);
+            render::RenderOptions options;
+            options.hud = hud;
+            options.legend = hud;
+            render::Camera cam = renderer.value()->fitCamera(frame, options);
+            if (!camera.is_none()) {
+              py::dict c = camera.cast<py::dict>();
+              for (auto item : c) {
+                const std::string key = item.first.cast<std::string>();
+                if (key == "target")
+                  cam.target = toVector3(item.second, "camera target");
+                else if (key == "up")
+                  cam.up = toVector3(item.second, "camera up").normalized();
+                else if (key == "distance")
+                  cam.distance = item.second.cast<double>();
+                else if (key == "yaw")
+                  cam.yaw = item.second.cast<double>();
+                else if (key == "pitch")
+                  cam.pitch = item.second.cast<double>();
+                else if (key == "fov_y")
+                  cam.fov_y = item.second.cast<double>();
+                else
+                  throw py::value_error("camera: unknown key '" + key + "'");
+              }
+            }
+            const render::Image image = renderer.value()->render(frame, cam, options);
+            return copyArray(image.rgb.data(), image.height, image.width * 3)
+                .attr("reshape")(image.height, image.width, 3);
+          },
+          py::arg("width") = 640, py::arg("height") = 480, py::arg("camera") = py::none(),
+          py::arg("hud") = false,
+          "An (height, width, 3) uint8 picture (OSMesa, headless), stress-coloured. camera: a "
+          "dict overriding the fitted camera's target, up, distance (m), yaw, pitch, fov_y (rad).")
+      .def(
+          "write_vtk",
+          [](PyWorld& w, const std::string& path, py::object body) {
+            WorldGuard guard(w);
+            if (w.world().bodies().empty())
+              throw py::value_error("write_vtk: the world has no body");
+            FemBody& b = body.is_none() ? *w.world().bodies().front() : findBody(w, body);
+            const TetMesh& mesh = b.model().mesh();
+            std::vector<Eigen::Vector3d> x(static_cast<size_t>(mesh.nodeCount()));
+            MeshField displacement{"displacement", 3, {}};
+            for (int i = 0; i < mesh.nodeCount(); ++i) {
+              x[static_cast<size_t>(i)] = b.state().position(i);
+              const Eigen::Vector3d u =
+                  x[static_cast<size_t>(i)] - mesh.restPositions()[static_cast<size_t>(i)];
+              displacement.values.insert(displacement.values.end(), {u.x(), u.y(), u.z()});
+            }
+            MeshFields fields;
+            fields.node_fields.push_back(std::move(displacement));
+            if (Status s = writeTextFile(path, formatVtk(mesh, x, fields, b.name())); !s)
+              throw std::runtime_error(s.error().message);
+          },
+          py::arg("path"), py::arg("body") = py::none(),
+          "The body's current mesh with its displacement (legacy VTK, %.17g: reads back bit for "
+          "bit), as `torsion run` writes <body>.vtk. Default: the first body.");
+}
+
+}  // namespace torsion::python

@@ -1,0 +1,177 @@
+#include "py_world.h"
+
+#include "scene_haptics.h"
+#include "scene_parser.h"
+#include "torsion/bullet/rigid_health.h"
+
+namespace torsion::python {
+
+Result<std::unique_ptr<PyWorld>> PyWorld::fromScene(const std::string& name_or_path, int threads,
+                                                    const scene::DeviceOverrides& devices,
+                                                    FailureKind* kind) {
+  *kind = FailureKind::kScene;
+  Result<scene::SceneSpec> spec = scene::loadScene(name_or_path);
+  if (!spec) return spec.error();
+  if (Status applied = scene::applyDeviceOverrides(spec.value(), devices); !applied) {
+    *kind = FailureKind::kValue;
+    return applied.error();
+  }
+  std::vector<std::string> mesh_paths;
+  for (const scene::BodySpec& body : spec.value().bodies)
+    mesh_paths.push_back(body.mesh_path);
+  Result<std::unique_ptr<scene::BuiltScene>> built =
+      scene::buildScene(std::move(spec).value(), threads);
+  if (!built) {
+    // A fault inside a body's mesh file names that file and line after the scene entry.
+    for (const std::string& path : mesh_paths) {
+      if (built.error().message.find(": " + path + ":") != std::string::npos)
+        *kind = FailureKind::kMesh;
+    }
+    return built.error();
+  }
+  std::unique_ptr<PyWorld> world(new PyWorld());
+  world->scene_ = std::move(built).value();
+  return world;
+}
+
+PyWorld::PyWorld(const WorldSettings& settings) : scene_(std::make_unique<scene::BuiltScene>()) {
+  scene_->spec.file = "<python>";
+  scene_->spec.name = "python";
+  scene_->spec.world = settings;
+  scene_->world = std::make_unique<FemWorld>(settings);
+}
+
+Result<Ok> PyWorld::step(int n, FailureKind* kind) {
+  *kind = FailureKind::kUnstable;
+  if (!failure_.empty()) return Error{failure_};
+  std::vector<NamedRigidBody> rigid;
+  for (const scene::SceneRigidBody& r : scene_->rigid_bodies)
+    rigid.push_back({r.name, r.body});
+  // A failed step has already moved the bodies it reached (and the clock). To leave the last good
+  // state instead, the world goes back to an anchor checkpoint and replays the good steps since,
+  // which repeat bit for bit. Anchors are taken every kAnchorEvery steps and whenever Python
+  // changed the world since (touched()); a checkpoint per step would cost several per cent.
+  // Device hands cannot be wound back: no anchors with them.
+  const bool can_rewind = !scene_->haptics;
+  auto failWith = [&](std::string message) -> Error {
+    if (can_rewind && anchor_) {
+      const int good_steps = world().stepCount() - 1 - anchor_step_;
+      const PyWorldState anchor = std::move(*anchor_);
+      (void)restoreState(anchor);
+      for (int k = 0; k < good_steps; ++k)
+        (void)scene::stepScene(*scene_);
+    }
+    failure_ = std::move(message);
+    anchor_.reset();
+    return Error{failure_};
+  };
+  for (int k = 0; k < n; ++k) {
+    if (can_rewind && (!anchor_ || world().stepCount() - anchor_step_ >= kAnchorEvery)) {
+      Result<PyWorldState> state = saveState();
+      if (state) {
+        anchor_ = std::move(state).value();
+        anchor_step_ = world().stepCount();
+      }
+    }
+    Result<WorldStepReport> stepped = scene::stepScene(*scene_);
+    if (!stepped) {
+      *kind = FailureKind::kScene;  // a scripted grab that missed: the scene's fault, not fatal
+      anchor_.reset();
+      return Error{scene_->spec.file + ": " + stepped.error().message};
+    }
+    const WorldStepReport& report = stepped.value();
+    if (!report.ok) return failWith(report.message);
+    // As the scene runner: Bullet lets a rigid body become NaN silently.
+    if (auto fault = findUnhealthyRigidBody(rigid))
+      return failWith("step " + std::to_string(report.step) + ": " + fault->message);
+  }
+  return Ok{};
+}
+
+Result<FemBody*> PyWorld::addBody(const std::string& name, const TetMesh& mesh,
+                                  const Material& material, const Frame& pose,
+                                  ElementKind element) {
+  return world().addBody(name, mesh, material, pose, element);
+}
+
+Result<int> PyWorld::addNodeSet(const std::string& name, FemBody& body, std::vector<int> nodes,
+                                const Eigen::Vector3d& wrench_about) {
+  if (nodes.empty()) return Error{"node set '" + name + "': it holds no node"};
+  for (int node : nodes) {
+    if (node < 0 || node >= body.model().nodeCount()) {
+      return Error{"node set '" + name + "': node " + std::to_string(node) +
+                   " is out of range [0, " + std::to_string(body.model().nodeCount()) + ")"};
+    }
+  }
+  scene::NodeSetHandle handle;
+  handle.name = name;
+  handle.body = &body;
+  handle.wrench_about = wrench_about;
+  handle.node_count = static_cast<int>(nodes.size());
+  handle.group = body.carryNodes(name, std::move(nodes),
+                                 FrameMotion([](double) { return Frame{}; }), world().time());
+  scene_->node_sets.push_back(handle);
+  return static_cast<int>(scene_->node_sets.size()) - 1;
+}
+
+Hand& PyWorld::addHand(FemBody& body, const std::string& name, const HandSettings& settings) {
+  own_hands_.push_back(std::make_unique<Hand>(body, name, settings));
+  return *own_hands_.back();
+}
+
+std::vector<Hand*> PyWorld::hands() {
+  std::vector<Hand*> all;
+  for (scene::SceneHand& h : scene_->hands)
+    all.push_back(h.hand.get());
+  for (auto& h : own_hands_)
+    all.push_back(h.get());
+  return all;
+}
+
+const scene::HandSpec* PyWorld::handSpec(const Hand& hand) const {
+  for (const scene::SceneHand& h : scene_->hands) {
+    if (h.hand.get() == &hand) return &h.spec;
+  }
+  return nullptr;
+}
+
+btRigidBody* PyWorld::addRigidBody(const scene::RigidBodySpec& spec, bool ground) {
+  scene::SceneRigidBody added = scene::addSceneRigidBody(world(), spec);
+  btRigidBody* body = added.body;
+  if (!ground) scene_->rigid_bodies.push_back(std::move(added));
+  return body;
+}
+
+Result<PyWorldState> PyWorld::saveState() {
+  if (scene_->haptics) {
+    return Error{
+        "save_state: the scene's device hands run haptic loops, whose devices cannot be "
+        "wound back"};
+  }
+  PyWorldState state;
+  state.world = world().checkpoint();
+  for (Hand* hand : hands())
+    state.hands.push_back(hand->checkpoint());
+  for (const scene::SceneHand& h : scene_->hands)
+    state.released.push_back(h.released);
+  state.node_set_count = scene_->node_sets.size();
+  state.failure = failure_;
+  return state;
+}
+
+Status PyWorld::restoreState(const PyWorldState& state) {
+  std::vector<Hand*> all = hands();
+  if (all.size() != state.hands.size() || state.node_set_count != scene_->node_sets.size()) {
+    return Error{"restore_state: hands or node sets were added since the state was saved"};
+  }
+  if (Status restored = world().restore(state.world); !restored) return restored;
+  for (size_t h = 0; h < all.size(); ++h)
+    all[h]->restore(state.hands[h]);
+  for (size_t h = 0; h < scene_->hands.size(); ++h)
+    scene_->hands[h].released = state.released[h];
+  failure_ = state.failure;
+  anchor_.reset();
+  return Ok{};
+}
+
+}  // namespace torsion::python

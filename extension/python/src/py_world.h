@@ -1,0 +1,93 @@
+#pragma once
+// The C++ side of torsion.World: a built scene (demos/scene, the loader `torsion run` uses) plus
+// what Python adds in code (hands it drives itself), stepped and checkpointed as one. Python-free
+// on purpose: the bindings (bind_*.cpp) translate its errors into exceptions and its storage into
+// numpy arrays.
+
+#include <memory>
+#include <mutex>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "device_parser.h"
+#include "scene_builder.h"
+#include "torsion/bullet/fem_world.h"
+#include "torsion/constraints/hand.h"
+#include "torsion/result.h"
+
+namespace torsion::python {
+
+/// Why a call failed, so the bindings raise the matching exception.
+enum class FailureKind { kScene, kMesh, kUnstable, kValue };
+
+struct Failure {
+  FailureKind kind = FailureKind::kValue;
+  std::string message;  ///< the CLI's message, word for word
+};
+
+/// Everything the next steps of a PyWorld read, in memory (not serialisable: it holds the solver's
+/// warm starts and shared motion state by pointer).
+struct PyWorldState {
+  WorldCheckpoint world;
+  std::vector<HandCheckpoint> hands;  ///< scene hands, then hands added in code
+  std::vector<bool> released;         ///< per scene hand: let go for good (driveHands)
+  size_t node_set_count = 0;
+  std::string failure;
+};
+
+class PyWorld {
+ public:
+  /// A scene file, or a demo scene's name resolved like `torsion run NAME`. threads < 0: the
+  /// scene's own solver.threads.
+  /// `devices` are `torsion run`'s --device / --haptics / --allow-remote-device choices.
+  static Result<std::unique_ptr<PyWorld>> fromScene(const std::string& name_or_path, int threads,
+                                                    const scene::DeviceOverrides& devices,
+                                                    FailureKind* kind);
+  /// An empty world (bodies, node sets, hands and rigid bodies added in code).
+  explicit PyWorld(const WorldSettings& settings);
+
+  scene::BuiltScene& scene() { return *scene_; }
+  FemWorld& world() { return *scene_->world; }
+
+  /// n steps (scripted hands driven, device hands through their haptics, as `torsion run`).
+  /// Stops at the first failing step; the world is then back at the end of the last good step
+  /// (bodies, hands, clock; not with device hands) and every later step fails with the same
+  /// message until restoreState().
+  Result<Ok> step(int n, FailureKind* kind);
+
+  /// Adds a body from a mesh file (MeshError on a bad file) or from a built mesh.
+  Result<FemBody*> addBody(const std::string& name, const TetMesh& mesh, const Material& material,
+                           const Frame& pose, ElementKind element);
+  /// A node set (a fixed or carried group) over `nodes` of `body`; returns its index.
+  Result<int> addNodeSet(const std::string& name, FemBody& body, std::vector<int> nodes,
+                         const Eigen::Vector3d& wrench_about);
+  Hand& addHand(FemBody& body, const std::string& name, const HandSettings& settings);
+  /// All hands: the scene's (in file order), then those added in code.
+  std::vector<Hand*> hands();
+  /// The scene's spec of hand h, or null for a hand added in code.
+  const scene::HandSpec* handSpec(const Hand& hand) const;
+  btRigidBody* addRigidBody(const scene::RigidBodySpec& spec, bool ground);
+
+  Result<PyWorldState> saveState();
+  Status restoreState(const PyWorldState& state);
+
+  /// Python changed the world between steps (forces, hand goals, grabs, materials, parts): a
+  /// failing step can no longer be rewound by replaying from before that change.
+  void touched() { anchor_.reset(); }
+
+  /// Serialises the calls that change the world against a step running without the GIL.
+  std::mutex& busy() { return busy_; }
+
+ private:
+  PyWorld() = default;
+  std::unique_ptr<scene::BuiltScene> scene_;
+  std::vector<std::unique_ptr<Hand>> own_hands_;
+  std::string failure_;  // set by the first failed step; the world does not go on after it
+  static constexpr int kAnchorEvery = 64;  // steps between rewind checkpoints (step())
+  std::optional<PyWorldState> anchor_;     // where a failed step rewinds to and replays from
+  int anchor_step_ = 0;                    // world().stepCount() at anchor_
+  std::mutex busy_;
+};
+
+}  // namespace torsion::python

@@ -1,0 +1,156 @@
+# Type stubs of the torsion package. Units are SI throughout: m, s, kg, N, N m, Pa, rad.
+# Arrays are numpy float64 unless said otherwise; "view" means a read-only array over the
+# solver's own storage that changes as the world steps (copy() it to keep a moment).
+from typing import Optional, Sequence, Union
+
+import numpy as np
+import numpy.typing as npt
+
+__version__: str
+bullet_precision: str  # "double" or "float": the btScalar of the Bullet the module links
+
+ArrayLike = npt.ArrayLike
+FrameLike = Union["Frame", npt.ArrayLike]  # a Frame or a 4x4 homogeneous matrix
+
+class Error(RuntimeError):
+    message: str
+
+class SceneError(Error):
+    """A scene file that cannot be read, parsed or built (the CLI's message)."""
+    file: Optional[str]
+    key: Optional[str]
+    line: Optional[int]  # a JSON syntax error's line
+
+class MeshError(Error):
+    """A mesh file or nodes/tets arrays that are not a valid tet mesh."""
+    file: Optional[str]
+    line: Optional[int]  # 1-based
+
+class UnstableError(Error):
+    """A failed step; the world is back at the end of the last good step."""
+    body: Optional[str]
+    step: Optional[int]  # 1-based index of the failed step
+
+class Frame:
+    """Origin (m) and rotation (unit quaternion x, y, z, w): world p = R p_local + origin."""
+    def __init__(self, position: ArrayLike = (0, 0, 0), quaternion: ArrayLike = (0, 0, 0, 1)) -> None: ...
+    @staticmethod
+    def from_matrix(matrix: ArrayLike) -> Frame: ...
+    @staticmethod
+    def from_axis_angle(position: ArrayLike, axis: ArrayLike, angle: float) -> Frame: ...
+    @property
+    def position(self) -> npt.NDArray[np.float64]: ...  # (3,) m, a copy
+    @property
+    def quaternion(self) -> npt.NDArray[np.float64]: ...  # (4,) x, y, z, w
+    def matrix(self) -> npt.NDArray[np.float64]: ...  # (4, 4)
+
+class Material:
+    """Linear elastic material: E (Pa), nu, rho (kg/m^3), mass_damping (1/s),
+    stiffness_damping (s), volumetric_strain "element" | "nodal_average"."""
+    def __init__(self, E: float = 1e5, nu: float = 0.3, rho: float = 1000.0,
+                 mass_damping: float = 0.0, stiffness_damping: float = 0.01,
+                 volumetric_strain: str = "element") -> None: ...
+    E: float
+    nu: float
+    rho: float
+    mass_damping: float
+    stiffness_damping: float
+    volumetric_strain: str
+    shear_modulus: float  # Pa
+
+class State:
+    """A world at a moment (World.save_state); in memory only, not picklable."""
+    time: float  # s
+
+class Body:
+    name: str
+    node_count: int
+    element_count: int
+    element: str  # "tet4" | "tet10"
+    positions: npt.NDArray[np.float64]  # (n, 3) m, view
+    velocities: npt.NDArray[np.float64]  # (n, 3) m/s, view
+    rest_positions: npt.NDArray[np.float64]  # (n, 3) m, view (constant)
+    masses: npt.NDArray[np.float64]  # (n,) kg, copy
+    tets: npt.NDArray[np.int32]  # (m, 4) or (m, 10), view (constant)
+    surface_triangles: npt.NDArray[np.int32]  # (k, 3), view (constant)
+    material: Material
+    external_forces: npt.NDArray[np.float64]  # (n, 3) N, copy
+    kinetic_energy: float  # J, end of the last step
+    solver_iterations: int  # CG iterations of the last step
+    def set_material(self, material: Material) -> None: ...
+    def set_external_forces(self, forces: ArrayLike) -> None: ...  # (n, 3) N, kept every step
+    def set_velocity(self, velocity: ArrayLike) -> None: ...  # (3,) m/s, every node
+    def von_mises_stress(self) -> npt.NDArray[np.float64]: ...  # per tet, Pa
+    def von_mises_strain(self) -> npt.NDArray[np.float64]: ...  # per tet, dimensionless
+
+class NodeSet:
+    name: str
+    body: Body
+    nodes: npt.NDArray[np.int32]
+    wrench: npt.NDArray[np.float64]  # (6,) N, N m about wrench_about: what the body exerts
+    def release(self) -> None: ...
+
+class Hand:
+    name: str
+    body: Body
+    grabbed: bool
+    scripted: bool  # a scene's hand (driven by its script or device at each step)
+    goal: Frame
+    frame: Frame  # the patch frame of the last step
+    wrench: npt.NDArray[np.float64]  # (6,) N, N m about the patch origin
+    grabbed_nodes: npt.NDArray[np.int32]
+    speed_limit: float  # m/s
+    def grab(self, frame: FrameLike) -> int: ...
+    def move_to(self, frame: FrameLike) -> None: ...
+    def release(self) -> None: ...
+    def stiffness(self, tolerance: float = 1e-6) -> npt.NDArray[np.float64]: ...  # (6, 6) K_h
+
+class RigidBody:
+    name: str
+    position: npt.NDArray[np.float64]  # (3,) m
+    quaternion: npt.NDArray[np.float64]  # (4,) x, y, z, w
+    linear_velocity: npt.NDArray[np.float64]  # (3,) m/s
+    angular_velocity: npt.NDArray[np.float64]  # (3,) rad/s
+    mass: float  # kg, 0 when static or kinematic
+
+class World:
+    def __init__(self, gravity: ArrayLike = (0, 0, -9.81), dt: float = 0.01,
+                 tolerance: float = 1e-4, max_iterations: int = 300,
+                 linear_solver: str = "cg", threads: int = 0, max_speed: float = 1e3) -> None: ...
+    @staticmethod
+    def from_scene(scene: str, threads: int = -1, *,
+                   devices: Union[dict[str, str], Sequence[str], None] = None,
+                   haptics: str = "", allow_remote_devices: bool = False) -> World: ...
+    def step(self, n: int = 1) -> None: ...  # releases the GIL
+    time: float  # s
+    step_count: int
+    dt: float  # s
+    scene_steps: int
+    bodies: list[Body]
+    node_sets: list[NodeSet]
+    hands: list[Hand]
+    rigid_bodies: list[RigidBody]
+    def body(self, name: str) -> Body: ...
+    def node_set(self, name: str) -> NodeSet: ...
+    def hand(self, name: str) -> Hand: ...
+    def rigid_body(self, name: str) -> RigidBody: ...
+    def save_state(self) -> State: ...
+    def restore_state(self, state: State) -> None: ...
+    def add_body(self, name: str, mesh: Optional[str] = None, *, nodes: Optional[ArrayLike] = None,
+                 tets: Optional[ArrayLike] = None, material: Material = ...,
+                 frame: Optional[FrameLike] = None, element: str = "tet4") -> Body: ...
+    def add_node_set(self, name: str, body: Union[Body, str], *,
+                     plane: Optional[tuple[ArrayLike, ArrayLike]] = None,
+                     box: Optional[tuple[ArrayLike, ArrayLike]] = None,
+                     sphere: Optional[tuple[ArrayLike, float]] = None,
+                     indices: Optional[ArrayLike] = None, tolerance: float = 1e-6,
+                     wrench_about: ArrayLike = (0, 0, 0)) -> NodeSet: ...
+    def add_hand(self, name: str, body: Union[Body, str], max_drag_strain: float = 0.2) -> Hand: ...
+    def add_rigid_body(self, name: str, shape: str = "box", *, half_extents: ArrayLike = (0.5, 0.5, 0.5),
+                       radius: float = 0.5, half_height: float = 0.5, mass: float = 1.0,
+                       frame: Optional[FrameLike] = None, friction: float = 0.5,
+                       linear_velocity: ArrayLike = (0, 0, 0)) -> RigidBody: ...
+    def add_ground(self, height: float = 0.0, friction: float = 0.5) -> None: ...
+    def render(self, width: int = 640, height: int = 480, camera: Optional[dict] = None,
+               hud: bool = False) -> npt.NDArray[np.uint8]: ...  # (height, width, 3)
+    def write_vtk(self, path: str, body: Union[Body, str, None] = None) -> None: ...
