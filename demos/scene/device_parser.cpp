@@ -88,6 +88,13 @@ void readLoop(const JsonObject& d, DeviceSpec& spec) {
     l.damper.angular = nonNegative(o, "angular", l.damper.angular, " N m s/rad");
     o.finish();
   }
+  if (d.has("passivity")) {
+    const JsonObject o = d.object("passivity");
+    device::PassivitySettings& p = l.passivity;
+    p.enabled = o.boolean("enabled", p.enabled);
+    p.length_scale = positive(o, "length_scale", p.length_scale, " m");
+    o.finish();
+  }
   if (d.has("safety")) {
     const JsonObject o = d.object("safety");
     device::SafetySettings& s = l.safety;
@@ -111,6 +118,8 @@ const char* toString(DeviceSpec::Kind kind) {
       return "network";
     case DeviceSpec::Kind::kSpaceMouse:
       return "spacemouse";
+    case DeviceSpec::Kind::kPlugin:
+      return "plugin";
   }
   return "?";
 }
@@ -151,8 +160,12 @@ DeviceSpec readDevice(const JsonObject& hand, const std::string& base_directory)
   } else if (type == "spacemouse") {
     spec.kind = DeviceSpec::Kind::kSpaceMouse;
     readSpaceMouse(d, spec);
+  } else if (type == "plugin") {
+    spec.kind = DeviceSpec::Kind::kPlugin;
+    spec.file = resolve(d.string("library"), base_directory);
+    spec.config = d.string("config", "");
   } else {
-    d.fail("type", "'" + type + "' is not one of: scripted, replay, network, spacemouse");
+    d.fail("type", "'" + type + "' is not one of: scripted, replay, network, spacemouse, plugin");
   }
   if (spec.kind == DeviceSpec::Kind::kScripted || spec.kind == DeviceSpec::Kind::kReplay)
     spec.speed = positive(d, "speed", spec.speed, " (playback speed)");
@@ -232,9 +245,16 @@ Status applyDeviceOverride(SceneSpec& scene, const std::string& text) {
   } else if (type == "spacemouse") {
     if (!arg.empty()) return Error{flag + ": spacemouse takes no argument"};
     spec.kind = DeviceSpec::Kind::kSpaceMouse;
+  } else if (type == "plugin") {
+    const size_t config = arg.find(':');
+    spec.kind = DeviceSpec::Kind::kPlugin;
+    spec.file = arg.substr(0, config);
+    spec.config = config == std::string::npos ? "" : arg.substr(config + 1);
+    if (spec.file.empty())
+      return Error{flag + ": plugin needs a shared library: plugin:LIBRARY[:CONFIG]"};
   } else {
     return Error{flag + ": unknown device type '" + type +
-                 "' (known: scripted, replay, network, spacemouse)"};
+                 "' (known: scripted, replay, network, spacemouse, plugin)"};
   }
   if (!hand->keyframes.empty()) {  // the scripted motion gives way; its start is the anchor
     hand->initial = hand->keyframes.front().second;

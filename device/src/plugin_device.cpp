@@ -2,6 +2,7 @@
 
 #include <dlfcn.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <condition_variable>
@@ -119,6 +120,7 @@ std::string PluginDeviceSettings::validate() const {
   if (!(read_deadline > 0 && read_deadline <= 1)) return "read_deadline must be in (0, 1] s";
   if (!(hold_time >= 0 && hold_time <= 1)) return "hold_time must be in [0, 1] s";
   if (!(close_timeout > 0)) return "close_timeout must be positive (s)";
+  if (!(max_force >= 0) || !(max_torque >= 0)) return "max_force and max_torque must be >= 0";
   return {};
 }
 
@@ -182,8 +184,8 @@ Loaded<std::unique_ptr<PluginDevice>> PluginDevice::open(const PluginDeviceSetti
   device->name_ =
       "plugin(" + std::filesystem::path(path).filename().string() + ": " + info.name + ")";
   device->limits_ = defaultDeviceLimits();
-  device->limits_.max_force = info.max_force;
-  device->limits_.max_torque = info.max_torque;
+  device->limits_.max_force = std::min(info.max_force, settings.max_force);
+  device->limits_.max_torque = std::min(info.max_torque, settings.max_torque);
   device->rate_hz_ = info.rate_hz;
   device->stats_ = std::make_shared<PluginStats>();
   auto shared = std::make_shared<Shared>();

@@ -108,6 +108,7 @@ class HapticLoop {
   bool writeLog(const std::string& path, std::string* error = nullptr) const;
   const Wrench& lastOutput() const { return safety_.output(); }
   bool forceEnabled() const { return force_enabled_; }
+  bool passivityEnabled() const { return settings_.passivity.enabled; }
 
  private:
   void run();

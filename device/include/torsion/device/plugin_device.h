@@ -22,6 +22,7 @@
 
 #include <atomic>
 #include <cstdint>
+#include <limits>
 #include <memory>
 #include <string>
 
@@ -36,6 +37,10 @@ struct PluginDeviceSettings {
   double read_deadline = 0.0005;  ///< s the loop waits for one read() of the plug-in
   double hold_time = 0.005;       ///< s a good reading may stand in for late or bad ones
   double close_timeout = 1.0;     ///< s to wait for the plug-in's last calls at destruction
+  /// N and N m: the output stays within these even when the device could do more (a scene may
+  /// ask for less than the hardware's limits; never for more).
+  double max_force = std::numeric_limits<double>::infinity();
+  double max_torque = std::numeric_limits<double>::infinity();
 
   /// Empty when valid, else the message naming the field.
   std::string validate() const;
