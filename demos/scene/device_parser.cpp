@@ -75,6 +75,8 @@ void readCoupling(const JsonObject& d, DeviceSpec& spec) {
       o.integer("stiffness_columns_per_step", c.stiffness_columns_per_step);
   if (c.stiffness_columns_per_step < 1 || c.stiffness_columns_per_step > 6)
     o.fail("stiffness_columns_per_step", "must be in [1, 6]");
+  c.lag_coupling = o.boolean("lag_coupling", c.lag_coupling);
+  c.lag_damping_time = nonNegative(o, "lag_damping_time", c.lag_damping_time, " s");
   o.finish();
 }
 
