@@ -226,14 +226,17 @@ DeviceSample PluginDevice::read(double time) {
   bool answered = false;
   {
     std::unique_lock<std::mutex> lock(s.mutex);
-    if (s.answered_request == request_) {  // the worker is free: ask for a new reading
+    const bool asked = s.answered_request == request_;
+    if (asked) {  // the worker is free: ask for a new reading
       s.read_pending = true;
       s.read_time = time;
       s.read_request = ++request_;
       s.wake.notify_one();
-    }  // else the previous read is still inside the plug-in: wait for that one
+    }  // else the previous read is still inside the plug-in: let it finish, but do not use it
     const auto until = Clock::now() + std::chrono::duration<double>(settings_.read_deadline);
     answered = s.answered.wait_until(lock, until, [&] { return s.answered_request == request_; });
+    // An answer to an earlier tick's request describes the device as it was then: late.
+    answered = answered && asked;
     if (answered) {
       state = s.state;
       status = s.read_status;

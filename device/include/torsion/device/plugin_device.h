@@ -7,7 +7,7 @@
 //     every function pointer must be set, info() must give finite non-negative limits and a
 //     positive rate; otherwise open() fails with a message naming the library and the fault;
 //   - every tick: the plug-in is called on a worker thread of its own, and read() waits for it
-//     only until `read_deadline`; a reading that is late, failed (non-zero return), non-finite
+//     only until `read_deadline` (an answer that comes later, to an earlier tick, is not used); a reading that is late, failed (non-zero return), non-finite
 //     or has a non-unit quaternion is not used: the device keeps its last good reading for at
 //     most `hold_time` (a late tick on a busy machine does not fade the force), then reports
 //     itself dead, so the haptic loop's safety filter fades the output to zero exactly as for a
