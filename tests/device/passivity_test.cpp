@@ -8,7 +8,7 @@
 #include <deque>
 #include <string>
 
-#include "simulated_arm.h"
+#include "arm_device.h"
 #include "torsion/device/haptic_loop.h"
 #include "torsion/device/pose_math.h"
 
@@ -20,37 +20,6 @@ namespace torsion::device {
 namespace {
 
 constexpr double kDt = 0.001;
-
-// A HapticDevice over the simulated arm (what the example plug-in wraps in the C ABI).
-class ArmDevice : public HapticDevice {
- public:
-  explicit ArmDevice(const simulated::SimulatedArmSettings& s) : arm_(s) {}
-  std::string name() const override { return "arm"; }
-  DeviceLimits limits() const override {
-    DeviceLimits l;
-    l.max_force = arm_.settings().max_force;
-    l.max_torque = arm_.settings().max_torque;
-    return l;
-  }
-  DeviceSample read(double time) override {
-    const simulated::ArmState s = arm_.read(time);
-    DeviceSample out;
-    out.time = time;
-    out.pose.position = {s.position[0], s.position[1], s.position[2]};
-    out.pose.orientation = {s.orientation[0], s.orientation[1], s.orientation[2], s.orientation[3]};
-    out.buttons = s.buttons;
-    out.alive = true;
-    return out;
-  }
-  void write(const Wrench& w) override {
-    const double v[6] = {w.force.x, w.force.y, w.force.z, w.torque.x, w.torque.y, w.torque.z};
-    arm_.write(v);
-  }
-  simulated::SimulatedArm& arm() { return arm_; }
-
- private:
-  simulated::SimulatedArm arm_;
-};
 
 struct Scenario {
   double stiffness = 20;        // N m/rad, the object's torsional stiffness at the device
