@@ -9,6 +9,7 @@ std::string PassivitySettings::validate() const {
     return "passivity.length_scale must be positive (m)";
   if (!(min_speed > 0 && std::isfinite(min_speed)))
     return "passivity.min_speed must be positive (m/s)";
+  if (!(max_alpha > 0)) return "passivity.max_alpha must be positive (N s/m)";
   return {};
 }
 
@@ -25,12 +26,12 @@ Wrench PassivityController::damping(const Wrench& planned, const double v[6], do
       v[0] * v[0] + v[1] * v[1] + v[2] * v[2] + l2 * (v[3] * v[3] + v[4] * v[4] + v[5] * v[5]);
   const double predicted = energy_ + power(planned, v) * dt;
   if (!(predicted > 0) || !(speed2 > settings_.min_speed * settings_.min_speed)) return Wrench{};
-  alpha_ = predicted / (speed2 * dt);
+  alpha_ = std::min(predicted / (speed2 * dt), settings_.max_alpha);
   if (!std::isfinite(alpha_)) {
     alpha_ = 0;
     return Wrench{};
   }
-  dissipated_ += predicted;
+  dissipated_ += alpha_ * speed2 * dt;
   ++active_ticks_;
   return {{-alpha_ * v[0], -alpha_ * v[1], -alpha_ * v[2]},
           {-alpha_ * l2 * v[3], -alpha_ * l2 * v[4], -alpha_ * l2 * v[5]}};

@@ -146,6 +146,22 @@ TEST(Passivity, TheControllerRemovesExactlyTheGeneratedEnergy) {
   EXPECT_EQ(pc.portEnergy(), 0);
 }
 
+TEST(Passivity, ABoundedControllerLeavesTheRestOfTheEnergyForTheNextTicks) {
+  PassivitySettings settings;
+  settings.max_alpha = 1;  // N s/m
+  PassivityController pc(settings);
+  const double v[6] = {0.1, 0, 0, 0, 0, 0};
+  const Wrench push{{2, 0, 0}, {}};  // generates 2e-4 J per tick at 0.1 m/s
+  pc.observe(v, 0.001, true);
+  const Wrench d = pc.damping(push, v, 0.001);
+  EXPECT_EQ(pc.alpha(), 1);
+  EXPECT_NEAR(d.force.x, -0.1, 1e-15);  // alpha v, not the 2 N it would take
+  pc.written(push + d);
+  pc.observe(v, 0.001, true);
+  EXPECT_NEAR(pc.portEnergy(), (2 - 0.1) * 0.1 * 0.001, 1e-15);  // left over, booked
+  EXPECT_NEAR(pc.dissipated(), 0.1 * 0.1 * 0.001, 1e-15);
+}
+
 // A delayed stiff object without K_h: the loop renders a wrench tens of milliseconds old.
 TEST(Passivity, DelayedStiffObjectGeneratesEnergyUncontrolledAndSettlesUnderTheController) {
   for (double delay : {0.005, 0.02, 0.05}) {

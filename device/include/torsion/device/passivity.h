@@ -29,6 +29,7 @@
 // The port energy restarts at 0 whenever the hand holds nothing (a new grab is a new contact).
 
 #include <cstdint>
+#include <limits>
 #include <string>
 
 #include "torsion/device/device_types.h"
@@ -39,6 +40,9 @@ struct PassivitySettings {
   bool enabled = true;        ///< the controller; the observer always runs
   double length_scale = 0.1;  ///< m, l above: rotational damping alpha l^2 for linear alpha
   double min_speed = 1e-6;    ///< m/s of |v|_w below which no damping is added (alpha -> inf)
+  /// N s/m, largest alpha (rotation: alpha l^2); infinity: none. A bound leaves some generated
+  /// energy for the following ticks instead of a damping spike at small speeds.
+  double max_alpha = std::numeric_limits<double>::infinity();
 
   /// Empty when valid, else the message naming the field.
   std::string validate() const;
