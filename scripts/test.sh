@@ -23,7 +23,7 @@ cmake -S . -B build-tsan -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_CXX_
 cmake --build build-tsan -j"$jobs" --target torsion_device_tests torsion_bullet_tests
 TSAN_OPTIONS="halt_on_error=1 second_deadlock_stack=1" \
   ctest --test-dir build-tsan -j"$jobs" --output-on-failure --timeout 900 \
-  -R "HapticLoop|TripleBuffer|NetworkDevice|UserWorldHaptics"
+  -R "HapticLoop|TripleBuffer|NetworkDevice|PluginDevice|UserWorldHaptics"
 
 echo "== Float-Bullet build (build-float/): Debian's default Bullet; fast tests and the package"
 # The same code on pkg-config `bullet` (btScalar = float), the Bullet most programs link. The

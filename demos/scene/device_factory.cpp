@@ -3,6 +3,7 @@
 #include <filesystem>
 
 #include "torsion/device/network_device.h"
+#include "torsion/device/plugin_device.h"
 #include "torsion/device/scripted_device.h"
 #include "torsion/device/spacemouse_device.h"
 #include "torsion/device/udp_socket.h"
@@ -28,7 +29,7 @@ std::unique_ptr<device::HapticDevice> scripted(device::Trajectory trajectory,
 
 }  // namespace
 
-Result<std::unique_ptr<device::HapticDevice>> openDevice(const DeviceSpec& spec) {
+Result<std::unique_ptr<device::HapticDevice>> openDevice(const DeviceSpec& spec, bool lockstep) {
   switch (spec.kind) {
     case DeviceSpec::Kind::kScripted: {
       device::Loaded<device::Trajectory> t = device::loadTrajectory(spec.file);
@@ -64,6 +65,17 @@ Result<std::unique_ptr<device::HapticDevice>> openDevice(const DeviceSpec& spec)
       auto opened = device::openSpaceMouse(spec.spacemouse);
       if (!opened) return Error{opened.error};
       return std::move(*opened.value);
+    }
+    case DeviceSpec::Kind::kPlugin: {
+      device::PluginDeviceSettings settings;
+      settings.library = spec.file;
+      settings.config = spec.config;
+      settings.max_force = spec.max_force;
+      settings.max_torque = spec.max_torque;
+      if (lockstep) settings.read_deadline = 0.1;
+      auto opened = device::PluginDevice::open(settings);
+      if (!opened) return Error{opened.error};
+      return std::unique_ptr<device::HapticDevice>(std::move(*opened.value));
     }
   }
   return Error{"unknown device kind"};

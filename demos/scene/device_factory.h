@@ -1,6 +1,7 @@
 #pragma once
 // DeviceSpec -> an open device: loads the trajectory or log, binds the UDP port, connects to
-// spacenavd. Errors say what failed (the file and key, the port, the missing daemon).
+// spacenavd, loads a device plug-in. Errors say what failed (the file and key, the port, the
+// missing daemon).
 
 #include <memory>
 
@@ -10,6 +11,9 @@
 
 namespace torsion::scene {
 
-Result<std::unique_ptr<device::HapticDevice>> openDevice(const DeviceSpec& spec);
+/// `lockstep`: the haptic loop ticks on the simulated clock (a plug-in's reads are then given
+/// a long wall-clock deadline, so that a run is the same whatever the machine's load).
+Result<std::unique_ptr<device::HapticDevice>> openDevice(const DeviceSpec& spec,
+                                                         bool lockstep = false);
 
 }  // namespace torsion::scene

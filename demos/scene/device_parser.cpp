@@ -78,6 +78,8 @@ void readCoupling(const JsonObject& d, DeviceSpec& spec) {
       o.integer("stiffness_columns_per_step", c.stiffness_columns_per_step);
   if (c.stiffness_columns_per_step < 1 || c.stiffness_columns_per_step > 6)
     o.fail("stiffness_columns_per_step", "must be in [1, 6]");
+  c.lag_coupling = o.boolean("lag_coupling", c.lag_coupling);
+  c.lag_damping_time = nonNegative(o, "lag_damping_time", c.lag_damping_time, " s");
   o.finish();
 }
 
@@ -89,6 +91,13 @@ void readLoop(const JsonObject& d, DeviceSpec& spec) {
     const JsonObject o = d.object("damper");
     l.damper.linear = nonNegative(o, "linear", l.damper.linear, " N s/m");
     l.damper.angular = nonNegative(o, "angular", l.damper.angular, " N m s/rad");
+    o.finish();
+  }
+  if (d.has("passivity")) {
+    const JsonObject o = d.object("passivity");
+    device::PassivitySettings& p = l.passivity;
+    p.enabled = o.boolean("enabled", p.enabled);
+    p.length_scale = positive(o, "length_scale", p.length_scale, " m");
     o.finish();
   }
   if (d.has("safety")) {
@@ -122,6 +131,8 @@ const char* toString(DeviceSpec::Kind kind) {
       return "network";
     case DeviceSpec::Kind::kSpaceMouse:
       return "spacemouse";
+    case DeviceSpec::Kind::kPlugin:
+      return "plugin";
   }
   return "?";
 }
@@ -162,8 +173,12 @@ DeviceSpec readDevice(const JsonObject& hand, const std::string& base_directory)
   } else if (type == "spacemouse") {
     spec.kind = DeviceSpec::Kind::kSpaceMouse;
     readSpaceMouse(d, spec);
+  } else if (type == "plugin") {
+    spec.kind = DeviceSpec::Kind::kPlugin;
+    spec.file = resolve(d.string("library"), base_directory);
+    spec.config = d.string("config", "");
   } else {
-    d.fail("type", "'" + type + "' is not one of: scripted, replay, network, spacemouse");
+    d.fail("type", "'" + type + "' is not one of: scripted, replay, network, spacemouse, plugin");
   }
   if (spec.kind == DeviceSpec::Kind::kScripted || spec.kind == DeviceSpec::Kind::kReplay)
     spec.speed = positive(d, "speed", spec.speed, " (playback speed)");
@@ -243,9 +258,16 @@ Status applyDeviceOverride(SceneSpec& scene, const std::string& text) {
   } else if (type == "spacemouse") {
     if (!arg.empty()) return Error{flag + ": spacemouse takes no argument"};
     spec.kind = DeviceSpec::Kind::kSpaceMouse;
+  } else if (type == "plugin") {
+    const size_t config = arg.find(':');
+    spec.kind = DeviceSpec::Kind::kPlugin;
+    spec.file = arg.substr(0, config);
+    spec.config = config == std::string::npos ? "" : arg.substr(config + 1);
+    if (spec.file.empty())
+      return Error{flag + ": plugin needs a shared library: plugin:LIBRARY[:CONFIG]"};
   } else {
     return Error{flag + ": unknown device type '" + type +
-                 "' (known: scripted, replay, network, spacemouse)"};
+                 "' (known: scripted, replay, network, spacemouse, plugin)"};
   }
   if (!hand->keyframes.empty()) {  // the scripted motion gives way; its start is the anchor
     hand->initial = hand->keyframes.front().second;

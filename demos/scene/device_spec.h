@@ -13,9 +13,10 @@
 namespace torsion::scene {
 
 struct DeviceSpec {
-  enum class Kind { kScripted, kReplay, kNetwork, kSpaceMouse } kind = Kind::kScripted;
-  std::string file;                ///< scripted: trajectory JSON; replay: loop log CSV (resolved)
-  double speed = 1;                ///< scripted, replay: playback speed (2: twice as fast)
+  enum class Kind { kScripted, kReplay, kNetwork, kSpaceMouse, kPlugin } kind = Kind::kScripted;
+  std::string file;    ///< scripted: trajectory JSON; replay: loop log CSV; plugin: shared library
+  std::string config;  ///< plugin: the text handed to the plug-in's open()
+  double speed = 1;    ///< scripted, replay: playback speed (2: twice as fast)
   std::string host = "127.0.0.1";  ///< network: IPv4 address the poses arrive on
   int port = 5750;                 ///< network: UDP port
   double timeout = 0.05;           ///< network: s without a pose before the device is dead
@@ -23,7 +24,7 @@ struct DeviceSpec {
   /// TORSION_HAPTIC_KEY from the environment, else unauthenticated packets)
   std::string key_file;
   device::SpaceMouseSettings spacemouse;
-  double max_force = 30;      ///< N, the device's limit (scripted, replay, network)
+  double max_force = 30;      ///< N, the device's limit (a plug-in: at most its own)
   double max_torque = 3;      ///< N m
   double position_scale = 1;  ///< world m per device m
   double force_scale = 1;     ///< device N per world N

@@ -6,6 +6,7 @@
 
 #include "device_factory.h"
 #include "torsion/device/network_device.h"
+#include "torsion/device/plugin_device.h"
 #include "torsion/device/pose_math.h"
 
 namespace torsion::scene {
@@ -18,6 +19,12 @@ constexpr double kMaxLogRows = 600000;
 
 bool livesInWallClockTime(DeviceSpec::Kind kind) {
   return kind == DeviceSpec::Kind::kNetwork || kind == DeviceSpec::Kind::kSpaceMouse;
+}
+
+// A plug-in is usually hardware (threaded by default) but may be a simulation that can tick on
+// the simulated clock, so --haptics lockstep is allowed for it.
+bool prefersWallClockTime(DeviceSpec::Kind kind) {
+  return livesInWallClockTime(kind) || kind == DeviceSpec::Kind::kPlugin;
 }
 
 double percentile(std::vector<double> values, double p) {
@@ -47,7 +54,7 @@ Result<std::unique_ptr<SceneHaptics>> SceneHaptics::attach(BuiltScene& scene) {
   h->dt_ = scene.world->settings().solver.time_step;
   bool live = false;
   for (const SceneHand& s : scene.hands)
-    live = live || (s.spec.device && livesInWallClockTime(s.spec.device->kind));
+    live = live || (s.spec.device && prefersWallClockTime(s.spec.device->kind));
   h->mode_ = scene.spec.haptics_mode;
   if (h->mode_ == HapticsMode::kAuto)
     h->mode_ = live ? HapticsMode::kThreaded : HapticsMode::kLockstep;
@@ -69,7 +76,8 @@ Result<std::unique_ptr<SceneHaptics>> SceneHaptics::attach(BuiltScene& scene) {
     }
     if (Status ok = spec.coupling.validate(); !ok) return Error{entry + ": " + ok.error().message};
     if (std::string bad = spec.loop.validate(); !bad.empty()) return Error{entry + ": " + bad};
-    Result<std::unique_ptr<device::HapticDevice>> opened = openDevice(spec);
+    Result<std::unique_ptr<device::HapticDevice>> opened =
+        openDevice(spec, h->mode_ == HapticsMode::kLockstep);
     if (!opened) return Error{entry + ": " + opened.error().message};
 
     Channel c;
@@ -147,6 +155,11 @@ nlohmann::json SceneHaptics::statistics(const Channel& c) const {
       {"nonfinite", st.nonfinite.load()},
       {"log_dropped", st.log_dropped.load()},
       {"poses_rejected", c.coupling->rejectedPoses()},
+      {"passivity",
+       {{"controller", c.loop->passivityEnabled()},
+        {"max_port_energy_J", st.max_port_energy.load()},
+        {"dissipated_J", st.pc_dissipated.load()},
+        {"active_ticks", st.pc_active.load()}}},
       {"max_output", {{"force", max_force}, {"torque", max_torque}}},
       {"limits",
        {{"max_force", c.device->limits().max_force},
@@ -164,6 +177,13 @@ nlohmann::json SceneHaptics::statistics(const Channel& c) const {
                     {"unauthenticated", p.unauthenticated.load()},
                     {"replayed", p.replayed.load()},
                     {"authenticated", net->authenticated()}};
+  }
+  if (const auto* plugin = dynamic_cast<const device::PluginDevice*>(c.device.get())) {
+    const device::PluginStats& p = plugin->stats();
+    j["plugin"] = {{"rate_hz", plugin->rateHz()},   {"reads", p.reads.load()},
+                   {"late", p.late.load()},         {"failed", p.failed.load()},
+                   {"rejected", p.rejected.load()}, {"held", p.held.load()},
+                   {"dead", p.dead.load()}};
   }
   return j;
 }

@@ -44,6 +44,7 @@ std::string HapticLoopSettings::validate() const {
   if (!(twist_cutoff_hz > 0)) return "twist_cutoff_hz must be positive";
   if (realtime_priority < 0 || realtime_priority > 99)
     return "realtime_priority must be in [0, 99]";
+  if (std::string bad = passivity.validate(); !bad.empty()) return bad;
   return safety.validate();
 }
 
@@ -52,7 +53,8 @@ HapticLoop::HapticLoop(HapticDevice& device, const HapticLoopSettings& settings)
       settings_(settings),
       limits_(device.limits()),
       safety_(settings.safety, limits_),
-      twist_(settings.twist_cutoff_hz) {
+      twist_(settings.twist_cutoff_hz),
+      passivity_(settings.passivity) {
   log_.reserve(settings.log_capacity);
 }
 
@@ -77,6 +79,14 @@ void HapticLoop::tick(double now, double deadline) {
     force_enabled_ = false;
   }
   const double* twist = twist_.update(sample.pose, now);
+  // The unfiltered twist over this tick: the port's energy books the motion that happened.
+  double port_twist[6] = {};
+  if (have_previous_ && dt > 0) {
+    poseDifference(previous_pose_, sample.pose, port_twist);
+    for (double& v : port_twist)
+      v = std::isfinite(v) ? v / dt : 0.0;
+  }
+  previous_pose_ = sample.pose;
 
   // 3. command for the simulation
   HandCommand command;
@@ -110,8 +120,22 @@ void HapticLoop::tick(double now, double deadline) {
   inputs.device_alive = sample.alive;
   inputs.simulation_fresh = published && now - last_fresh_time_ <= settings_.safety.stale_after;
   inputs.grabbed = force_enabled_ && simulated_.grabbed;
-  const Wrench output = safety_.apply(desired, inputs, dt);
+  Wrench output = safety_.apply(desired, inputs, dt);
+  // The passivity controller's damping goes on after the rate limiter, within the device's
+  // limits: it only ever opposes the motion, and a damper held back by the rate limit could not
+  // take back the generated energy in time. Only while healthy and holding: a fading output
+  // fades alone.
+  const bool holding = inputs.grabbed && inputs.device_alive && inputs.simulation_fresh;
+  passivity_.observe(port_twist, dt, holding);
+  if (holding) output = saturate(output + passivity_.damping(output, port_twist, dt), limits_);
   device_.write(output);
+  passivity_.written(output);
+  if (passivity_.alpha() > 0) {
+    stats_.pc_active.store(passivity_.activeTicks(), std::memory_order_relaxed);
+    stats_.pc_dissipated.store(passivity_.dissipated(), std::memory_order_relaxed);
+  }
+  if (passivity_.portEnergy() > stats_.max_port_energy.load(std::memory_order_relaxed))
+    stats_.max_port_energy.store(passivity_.portEnergy(), std::memory_order_relaxed);
 
   // 6. log
   if (settings_.log_capacity > 0) {
@@ -132,6 +156,8 @@ void HapticLoop::tick(double now, double deadline) {
           published ? static_cast<std::int64_t>(tick_ - simulated_.command_tick) : -1;
       row.grabbed = inputs.grabbed;
       row.fresh = fresh;
+      row.port_energy = passivity_.portEnergy();
+      row.pc_alpha = passivity_.alpha();
       log_.push_back(row);
     } else {
       ++stats_.log_dropped;
@@ -191,7 +217,7 @@ bool HapticLoop::writeLog(const std::string& path, std::string* error) const {
   out.precision(10);
   out << "tick,time,period_ms,lateness_ms,px,py,pz,qw,qx,qy,qz,buttons,alive,"
          "fx,fy,fz,tx,ty,tz,sim_fx,sim_fy,sim_fz,sim_tx,sim_ty,sim_tz,"
-         "sim_step,wrench_age_ms,pose_lag_ticks,grabbed,fresh\n";
+         "sim_step,wrench_age_ms,pose_lag_ticks,grabbed,fresh,port_energy,pc_alpha\n";
   for (const LoopLogRow& r : log_) {
     const Pose& p = r.pose;
     const Wrench& w = r.output;
@@ -203,7 +229,7 @@ bool HapticLoop::writeLog(const std::string& path, std::string* error) const {
         << ',' << w.torque.x << ',' << w.torque.y << ',' << w.torque.z << ',' << s.force.x << ','
         << s.force.y << ',' << s.force.z << ',' << s.torque.x << ',' << s.torque.y << ','
         << s.torque.z << ',' << r.sim_step << ',' << 1e3 * r.wrench_age << ',' << r.pose_lag_ticks
-        << ',' << r.grabbed << ',' << r.fresh << '\n';
+        << ',' << r.grabbed << ',' << r.fresh << ',' << r.port_energy << ',' << r.pc_alpha << '\n';
   }
   const std::string failure = writeFileAtomically(path, out.str());
   if (error != nullptr) *error = failure;

@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # The torsion tool as a user runs it: one check per call, named by its first argument.
-#   cli_checks.sh CASE TORSION ASSETS_DIR [HAPTIC_PEER]
+#   cli_checks.sh CASE TORSION ASSETS_DIR [HAPTIC_PEER] [DEVICE_PLUGIN]
 # Exit 0: pass; 77: skipped (e.g. no tetgen on PATH; CTest SKIP_RETURN_CODE); anything else: fail.
 # Each case works in a fresh temporary directory, removed afterwards. TORSION_BULLET_PRECISION
 # (double or float, set by CTest) names the Bullet the tool was built on.
@@ -10,6 +10,7 @@ case_name=$1
 torsion=$2
 assets=$3
 peer=${4:-}
+plugin=${5:-}
 scenes=$(cd "$(dirname "$0")/../../demos/scenes" && pwd)
 
 work=$(mktemp -d "${TMPDIR:-/tmp}/torsion-cli-test-XXXXXX")
@@ -546,6 +547,26 @@ EOF
       expect_out "^error: twist.json: hands\[0\] 'hand': device: SpaceMouse: (cannot connect to the spacenavd daemon|this build of Torsion has no libspnav)"
     fi
     [[ ! -e out/summary.json ]] || fail "no output may be written when a device cannot open"
+    ;;
+
+  run_haptic_plugin)
+    # The example device plug-in (a simulated arm whose operator turns the wrist 0.3 rad, presses
+    # button 2 at 0.8 s) loaded at run time, ticking in lockstep; then a wrong library.
+    [[ -f $plugin ]] || fail "no device plug-in given"
+    sed "s|../../assets/meshes|$assets|" "$scenes/twist_cylinder_2430.json" > twist.json
+    config="intent=twist,intent_rate=0.5,intent_start=0.05,intent_time=0.6,release_time=0.8"
+    run "$torsion" run twist.json --device "hand=plugin:$plugin:$config" --haptics lockstep \
+      --out plug --steps 120 --threads 1
+    expect_rc 0
+    expect_out "hand 'hand': device plugin\(libtorsion_simulated_device.so: simulated 0.3 kg, 200 Hz motors, 0 ms delay\), lockstep"
+    check_haptic_outputs plug lockstep
+    grep -q '"late": 0' plug/summary.json || fail "plug/summary.json: a plug-in read was late"
+    grep -q '"reads": [1-9][0-9][0-9]' plug/summary.json || fail "fewer than 100 plug-in reads"
+    grep -q '"dissipated_J"' plug/summary.json || fail "plug/summary.json: no passivity entry"
+    head -1 plug/haptic_hand.csv | grep -q ",port_energy,pc_alpha$" || fail "no passivity columns"
+    run "$torsion" run twist.json --device "hand=plugin:$assets/cylinder_2430.node" --out bad --steps 5
+    expect_rc nonzero
+    expect_out "^error: twist.json: hands\[0\] 'hand': device: .*cylinder_2430.node: cannot load the device plug-in: "
     ;;
 
   run_press)

@@ -35,12 +35,14 @@ struct CouplingRig {
   device::SimulationWrench published;
 
   CouplingRig(int tets, const SolverSettings& solver, const CouplingSettings& settings = {},
-              double mass_damping = 0, ElementKind element = ElementKind::kTet4) {
+              double mass_damping = 0, ElementKind element = ElementKind::kTet4,
+              double youngs_modulus = 1e5, const DeviceMapping* device_mapping = nullptr) {
     WorldSettings ws;
     ws.gravity.setZero();
     ws.solver = solver;
     world = std::make_unique<FemWorld>(ws);
-    Material material;  // E = 1e5 Pa, nu = 0.3, rho = 1000, as the twist scenes
+    Material material;  // E = 1e5 Pa (by default), nu = 0.3, rho = 1000, as the twist scenes
+    material.youngs_modulus = youngs_modulus;
     material.stiffness_damping = 0.01;
     material.mass_damping = mass_damping;  // 1/s
     body = world->addBody("cylinder", cylinderMesh(tets), material, Frame{}, element).value();
@@ -52,7 +54,7 @@ struct CouplingRig {
     base_group = body->carryNodes(
         "base", base, [](double) { return Frame{}; }, 0);
     hand = std::make_unique<Hand>(*body);
-    DeviceMapping mapping;
+    DeviceMapping mapping = device_mapping ? *device_mapping : DeviceMapping{};
     mapping.anchor.origin = Eigen::Vector3d(0, 0, 9.9);  // the device's zero is the hand plane
     coupling = std::make_unique<HandCoupling>(*hand, mapping, settings);
     command.alive = true;

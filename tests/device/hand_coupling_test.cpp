@@ -2,6 +2,8 @@
 
 #include <gtest/gtest.h>
 
+#include <cstdio>
+
 #include "coupling_rig.h"
 #include "torsion/device/scripted_device.h"
 #include "torsion/haptics/haptic_runtime.h"
@@ -167,6 +169,73 @@ TEST(HapticRuntime, LockstepLoopRendersAForceOpposingThePush) {
       EXPECT_LE(row.wrench_age, 0.01 + 1e-9);
     }
   }
+}
+
+TEST(HandCoupling, ALaggingPatchIsFeltAsAVirtualCouplingThatGivesWayToTheInternalForce) {
+  // The device turns 1 rad about z in 0.25 s; the hand's speed limit (0.2 of the shear wave
+  // speed: about 1.2 rad/s at this patch's reach) holds the patch back, so the device leads it
+  // by up to ~0.7 rad, then the patch catches up.
+  SolverSettings solver;
+  CouplingRig rig(2430, solver, CouplingSettings{}, 5.0);
+  const device::Trajectory turn(
+      {{0, device::Pose{}}, {0.25, displaced(5, 1.0)}, {1.5, displaced(5, 1.0)}}, {{0, 1u}});
+  device::ScriptedDevice scripted(turn, device::defaultDeviceLimits(), "turn");
+  device::HapticLoopSettings loop_settings;
+  loop_settings.log_capacity = 2000;
+  device::HapticLoop loop(scripted, loop_settings);
+  HapticRuntime runtime(*rig.world, {{rig.coupling.get(), &loop, 1000}});
+  const double k_r = 1e5 * CouplingSettings{}.torque_coefficient;  // E c_t, N m/rad
+  double max_lag = 0, previous_lag = 0, previous_torque = 0, peak_coupling = 0, last_before = 0;
+  int growing = 0, caught_up_steps = 0;
+  for (int k = 0; k < 150; ++k) {
+    ASSERT_TRUE(runtime.stepLockstep().ok);
+    const Frame& patch = rig.hand->frame();
+    const Frame& goal = rig.coupling->goal();
+    const double lag = Eigen::AngleAxisd(goal.rotation * patch.rotation.conjugate()).angle();
+    const double torque = rig.coupling->lagWrench().torque.z();
+    max_lag = std::max(max_lag, lag);
+    peak_coupling = std::max(peak_coupling, std::abs(torque));
+    if (lag > 1e-9) {
+      EXPECT_LT(torque, 0);                // pulls the device back toward the patch (lag about +z)
+      if (k < 24 && lag > previous_lag) {  // the device still turning: the lag grows...
+        EXPECT_LT(torque, previous_torque);  // ...and so does the coupling's torque
+        ++growing;
+      }
+    } else {
+      // Caught up: the coupling is gone and the rendering is the internal force about the
+      // device frame's origin, exactly.
+      EXPECT_EQ(rig.coupling->lagWrench().torque.norm(), 0);
+      const Wrench internal = rig.body->groupWrench(rig.hand->group(), goal.origin);
+      EXPECT_EQ((rig.coupling->worldWrench().torque - internal.torque).norm(), 0);
+      EXPECT_EQ((rig.coupling->worldWrench().force - internal.force).norm(), 0);
+      if (k > 30) ++caught_up_steps;
+      if (previous_lag > 1e-9) last_before = std::abs(previous_torque);
+    }
+    previous_lag = lag;
+    previous_torque = torque;
+  }
+  EXPECT_GT(max_lag, 0.5);
+  EXPECT_GT(growing, 15);
+  EXPECT_GT(caught_up_steps, 50);
+  EXPECT_GT(peak_coupling, 0.5 * k_r * 0.5);
+  // The step before the patch arrives the lag is at most one step of the patch's speed: the
+  // coupling has shrunk to a few percent of its peak and then goes (no step back to the
+  // internal force larger than that).
+  EXPECT_LT(last_before, 0.05 * peak_coupling);
+  // What the device got never jumped: every tick within the rate limits.
+  const device::SafetySettings limits;
+  for (size_t t = 1; t < loop.log().size(); ++t) {
+    const device::LoopLogRow& a = loop.log()[t - 1];
+    const device::LoopLogRow& b = loop.log()[t];
+    EXPECT_LE(device::norm(b.output.torque - a.output.torque),
+              limits.max_torque_rate * b.period * (1 + 1e-9));
+    EXPECT_LE(device::norm(b.output.force - a.output.force),
+              limits.max_force_rate * b.period * (1 + 1e-9));
+  }
+  std::printf(
+      "lag coupling: max lag %.3f rad, peak coupling torque %.4g N m (k_r = %.4g N m/rad), "
+      "%.4g N m the step before the patch arrived\n",
+      max_lag, peak_coupling, k_r, last_before);
 }
 
 }  // namespace

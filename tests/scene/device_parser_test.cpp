@@ -130,6 +130,13 @@ TEST(DeviceOverride, TurnsAScriptedHandIntoADeviceHand) {
   ASSERT_TRUE(applyDeviceOverride(s, "hand=replay:log.csv").ok());
   EXPECT_EQ(s.hands[0].device->kind, DeviceSpec::Kind::kReplay);
   EXPECT_EQ(s.hands[0].device->file, "log.csv");
+  // plugin:LIBRARY[:CONFIG]: the configuration is everything after the library, colons included.
+  ASSERT_TRUE(applyDeviceOverride(s, "hand=plugin:/opt/libdev.so:port=/dev/ttyUSB0,gain=2:x").ok());
+  EXPECT_EQ(s.hands[0].device->kind, DeviceSpec::Kind::kPlugin);
+  EXPECT_EQ(s.hands[0].device->file, "/opt/libdev.so");
+  EXPECT_EQ(s.hands[0].device->config, "port=/dev/ttyUSB0,gain=2:x");
+  ASSERT_TRUE(applyDeviceOverride(s, "hand=plugin:libdev.so").ok());
+  EXPECT_EQ(s.hands[0].device->config, "");
 }
 
 TEST(DeviceOverride, KeepsTheScenesMappingAndNamesFaults) {
@@ -148,6 +155,7 @@ TEST(DeviceOverride, KeepsTheScenesMappingAndNamesFaults) {
       failsWith(applyDeviceOverride(s, "hand=network:port"), {"port 'port' is not a number"}));
   EXPECT_TRUE(failsWith(applyDeviceOverride(s, "hand=scripted"), {"scripted needs a file"}));
   EXPECT_TRUE(failsWith(applyDeviceOverride(s, "hand=glove"), {"unknown device type 'glove'"}));
+  EXPECT_TRUE(failsWith(applyDeviceOverride(s, "hand=plugin"), {"plugin needs a shared library"}));
   EXPECT_TRUE(failsWith(parseHapticsMode("fast"), {"--haptics 'fast'", "lockstep or threaded"}));
   EXPECT_TRUE(parseHapticsMode("threaded").ok());
 }

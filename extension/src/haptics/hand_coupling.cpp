@@ -28,6 +28,10 @@ Status CouplingSettings::validate() const {
     return Error{"stiffness_columns_per_step must be in [1, 6]"};
   if (!(stiffness_tolerance > 0 && stiffness_tolerance < 1))
     return Error{"stiffness_tolerance must be in (0, 1)"};
+  if (!(lag_damping_time >= 0 && std::isfinite(lag_damping_time)))
+    return Error{"lag_damping_time must be a non-negative number (s)"};
+  if (!(max_lag_force >= 0) || !(max_lag_torque >= 0))
+    return Error{"max_lag_force and max_lag_torque must be >= 0"};
   return Ok{};
 }
 
@@ -37,6 +41,7 @@ HandCoupling::HandCoupling(Hand& hand, const DeviceMapping& mapping,
 
 Status HandCoupling::apply(const device::HandCommand& command, double now) {
   command_tick_ = command.tick;
+  now_ = now;
   if (command.alive) {  // a dead device's pose is stale: hold the last goal
     // Validated after the mapping: a finite but enormous packet position overflows once scaled.
     const Frame mapped = mapping_.toWorld(command.pose);
@@ -83,6 +88,36 @@ Wrench HandCoupling::frameDifferenceWrench() const {
   return {-e * settings_.force_coefficient * d, -e * settings_.torque_coefficient * theta};
 }
 
+bool HandCoupling::lagCoupling(double now, Wrench& out) {
+  using Vector6d = Eigen::Matrix<double, 6, 1>;
+  const Frame& patch = hand_.frame();
+  Vector6d lag;
+  lag.head<3>() = goal_.origin - patch.origin;
+  lag.tail<3>() = rotationVector(goal_.rotation * patch.rotation.conjugate());
+  Vector6d rate = Vector6d::Zero();
+  if (previous_lag_time_ >= 0 && now > previous_lag_time_)
+    rate = (lag - previous_lag_) / (now - previous_lag_time_);
+  previous_lag_ = lag;
+  previous_lag_time_ = now;
+  if (lag.isZero(0)) return false;
+  const double e = hand_.body().model().material().youngs_modulus;
+  const double k_t = e * settings_.force_coefficient, k_r = e * settings_.torque_coefficient;
+  const double b = settings_.lag_damping_time;
+  auto bounded = [](const Eigen::Vector3d& v, double limit) {
+    const double n = v.norm();
+    return n > limit ? Eigen::Vector3d(v * (limit / n)) : v;
+  };
+  // The damper resists the lag's growth only: while the patch closes in it lets go, so the
+  // coupling shrinks with the lag to exactly zero when the patch arrives (a damper that acts
+  // part of the time still only takes energy out).
+  auto damped = [b](const Eigen::Vector3d& x, const Eigen::Vector3d& v) {
+    return x.dot(v) > 0 ? Eigen::Vector3d(x + b * v) : x;
+  };
+  out.force = bounded(-k_t * damped(lag.head<3>(), rate.head<3>()), settings_.max_lag_force);
+  out.torque = bounded(-k_r * damped(lag.tail<3>(), rate.tail<3>()), settings_.max_lag_torque);
+  return true;
+}
+
 device::SimulationWrench HandCoupling::publish(std::uint64_t step) {
   device::SimulationWrench out;
   out.step = step;
@@ -90,14 +125,20 @@ device::SimulationWrench HandCoupling::publish(std::uint64_t step) {
   out.pose = goal_pose_;
   out.grabbed = hand_.grabbed();
   world_wrench_ = Wrench{};
+  lag_wrench_ = Wrench{};
   world_stiffness_.setZero();
-  if (!out.grabbed) return out;
+  if (!out.grabbed) {
+    previous_lag_time_ = -1;
+    return out;
+  }
 
   if (settings_.rendering == Rendering::kInternalForce) {
     FemBody& body = hand_.body();
     const bool stepped = body.stepper().elasticForces().size() == body.state().positions.size();
     if (stepped) {
-      world_wrench_ = body.groupWrench(hand_.group(), goal_.origin);
+      // About the patch frame's origin: the point the hand holds, the device frame's origin
+      // unless the patch lags.
+      world_wrench_ = body.groupWrench(hand_.group(), hand_.frame().origin);
       ++steps_since_refresh_;
       const bool due =
           settings_.stiffness_refresh_steps > 0 &&
@@ -110,6 +151,18 @@ device::SimulationWrench HandCoupling::publish(std::uint64_t step) {
         steps_since_refresh_ = 0;
       }
       if (stiffness_valid_) world_stiffness_ = stiffness_cache_;
+      if (settings_.lag_coupling && lagCoupling(now_, lag_wrench_)) {
+        // Colgate's virtual coupling across the lag; while the patch runs at its speed limit
+        // the device's motion changes the wrench only through the coupling's spring.
+        world_wrench_.force += lag_wrench_.force;
+        world_wrench_.torque += lag_wrench_.torque;
+        const double e = body.model().material().youngs_modulus;
+        world_stiffness_.setZero();
+        world_stiffness_.topLeftCorner<3, 3>().diagonal().setConstant(-e *
+                                                                      settings_.force_coefficient);
+        world_stiffness_.bottomRightCorner<3, 3>().diagonal().setConstant(
+            -e * settings_.torque_coefficient);
+      }
     }
   } else {
     world_wrench_ = frameDifferenceWrench();

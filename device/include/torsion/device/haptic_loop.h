@@ -7,7 +7,8 @@
 //   3. hand the simulation a HandCommand (lock-free, commands());
 //   4. take the newest SimulationWrench (lock-free, wrenches()) and render the local model
 //      W_sim + K_h dpose - B twist (local_wrench_model.h);
-//   5. pass it through the SafetyFilter and write it to the device;
+//   5. add the passivity controller's damping (passivity.h), pass the wrench through the
+//      SafetyFilter, write it to the device and book its energy at the port;
 //   6. append a row to the in-memory log (no I/O on this thread; writeLog after stop()).
 //
 // Threads: tick() runs on the loop thread (or on a test's thread with a fake clock, never both);
@@ -21,6 +22,7 @@
 
 #include "torsion/device/haptic_device.h"
 #include "torsion/device/local_wrench_model.h"
+#include "torsion/device/passivity.h"
 #include "torsion/device/triple_buffer.h"
 #include "torsion/device/wrench_safety.h"
 
@@ -30,6 +32,7 @@ struct HapticLoopSettings {
   double rate_hz = 1000;  ///< ticks per second
   SafetySettings safety;
   CouplingDamper damper;
+  PassivitySettings passivity;   ///< time-domain passivity observer and controller (on)
   double twist_cutoff_hz = 50;   ///< low-pass of the velocity the damper sees
   std::size_t log_capacity = 0;  ///< rows kept in memory (one per tick); 0: no log
   /// SCHED_FIFO priority (1-99) the loop's thread asks for; it keeps the default policy,
@@ -56,6 +59,8 @@ struct LoopLogRow {
   std::int64_t pose_lag_ticks = -1;  ///< ticks since the pose the simulation used (-1: none)
   bool grabbed = false;
   bool fresh = false;
+  double port_energy = 0;  ///< J, E_obs after this tick (passivity.h; <= 0 when passive)
+  double pc_alpha = 0;     ///< N s/m, the passivity controller's damping this tick
 };
 
 struct LoopStats {
@@ -65,6 +70,9 @@ struct LoopStats {
   std::atomic<std::uint64_t> nonfinite{0};    ///< rendered wrenches with NaN/inf (zeroed)
   std::atomic<std::uint64_t> saturated{0};    ///< ticks whose wrench exceeded a device limit
   std::atomic<bool> realtime{false};          ///< the thread runs under SCHED_FIFO
+  std::atomic<std::uint64_t> pc_active{0};    ///< ticks the passivity controller damped
+  std::atomic<double> pc_dissipated{0};       ///< J the passivity controller took out
+  std::atomic<double> max_port_energy{0};     ///< J, largest E_obs (> 0: energy was generated)
 };
 
 class HapticLoop {
@@ -100,6 +108,7 @@ class HapticLoop {
   bool writeLog(const std::string& path, std::string* error = nullptr) const;
   const Wrench& lastOutput() const { return safety_.output(); }
   bool forceEnabled() const { return force_enabled_; }
+  bool passivityEnabled() const { return settings_.passivity.enabled; }
 
  private:
   void run();
@@ -109,6 +118,8 @@ class HapticLoop {
   DeviceLimits limits_;
   SafetyFilter safety_;
   TwistEstimator twist_;
+  PassivityController passivity_;
+  Pose previous_pose_;
   TripleBuffer<HandCommand> commands_;
   TripleBuffer<SimulationWrench> wrenches_;
   LoopStats stats_;

@@ -6,9 +6,16 @@
 //
 // Rendering:
 //   - internal force (default): the wrench the body exerts on the grabbed nodes, F = sum f_l,
-//     tau = sum (p_l - O) x f_l, f_l elastic + damping forces, O the device's frame origin;
+//     tau = sum (p_l - O) x f_l, f_l elastic + damping forces, O the patch frame's origin;
 //     K_h = PatchStiffness, refreshed every `stiffness_refresh_steps` steps, computed a few
-//     columns per step (`stiffness_columns_per_step`);
+//     columns per step (`stiffness_columns_per_step`). When the patch lags the device (the
+//     hand's speed limit), the device feels a virtual coupling (Colgate's) between the two
+//     frames on top: W_c = -k (lag) - b d(lag)/dt, k_t = E c_f, k_r = E c_t, b = lag_damping_time
+//     k (the damper only while the lag grows), each part's norm at most max_lag_force /
+//     max_lag_torque, lag = (goal O - patch O,
+//     rotation vector of goal R patch R^-1); then K_h = diag(-k_t, -k_r), since the patch
+//     moves at its speed limit whatever the device does. Once the patch has caught up the lag
+//     is zero and the rendering is the internal force alone;
 //   - frame difference (the report's Algorithm 4): F = -E c_f (O - Center - LocalRestPosition),
 //     tau = -E c_t theta(R Orientation^-1 LocalRestOrientation^-1), with Center the grabbed
 //     nodes' rest centroid, Orientation the body's rest orientation (identity), the Local* terms
@@ -20,6 +27,7 @@
 // enables force), a new button-2 request releases (force off). Simulation thread only.
 
 #include <cstdint>
+#include <limits>
 #include <string>
 
 #include "torsion/constraints/hand.h"
@@ -43,6 +51,10 @@ struct CouplingSettings {
   /// 6 steps later; until then the loop holds the simulated wrench).
   int stiffness_columns_per_step = 1;
   double stiffness_tolerance = 1e-3;  ///< relative CG tolerance of the K_h solves
+  bool lag_coupling = true;        ///< internal force: the virtual coupling across the hand's lag
+  double lag_damping_time = 0.05;  ///< s, b / k of the lag coupling's damper
+  double max_lag_force = std::numeric_limits<double>::infinity();   ///< N, world
+  double max_lag_torque = std::numeric_limits<double>::infinity();  ///< N m, world
 
   Status validate() const;
 };
@@ -71,11 +83,16 @@ class HandCoupling {
   const Matrix6d& worldStiffness() const { return world_stiffness_; }
   /// The device's frame in the world (the goal given to the hand).
   const Frame& goal() const { return goal_; }
+  /// The lag coupling's part of the last publish()'s wrench (world, zero when not lagging).
+  const Wrench& lagWrench() const { return lag_wrench_; }
   Hand& hand() { return hand_; }
   const DeviceMapping& mapping() const { return mapping_; }
 
  private:
   Wrench frameDifferenceWrench() const;
+  /// The virtual coupling across the patch's lag behind the goal at world time `now`; false
+  /// (and `out` untouched) when not lagging.
+  bool lagCoupling(double now, Wrench& out);
 
   Hand& hand_;
   DeviceMapping mapping_;
@@ -95,6 +112,10 @@ class HandCoupling {
   Matrix6d stiffness_cache_ = Matrix6d::Zero();
   Matrix6d world_stiffness_ = Matrix6d::Zero();
   Wrench world_wrench_;
+  Wrench lag_wrench_;
+  double now_ = 0;  // world time of the last apply()
+  Eigen::Matrix<double, 6, 1> previous_lag_ = Eigen::Matrix<double, 6, 1>::Zero();
+  double previous_lag_time_ = -1;
 };
 
 }  // namespace torsion::haptics

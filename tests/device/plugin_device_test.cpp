@@ -1,0 +1,205 @@
+#include "torsion/device/plugin_device.h"
+
+#include <gtest/gtest.h>
+
+#include <chrono>
+#include <cmath>
+
+#include "torsion/device/haptic_loop.h"
+#include "torsion/device/pose_math.h"
+
+// Device plug-ins loaded through the C ABI: the example simulated device in closed loop on a
+// fake 1 kHz clock, and plug-ins that misbehave (NaN, non-unit quaternion, failing or blocking
+// reads, a wrong ABI version). Paths come from CMake (TORSION_*_PLUGIN).
+namespace torsion::device {
+namespace {
+
+constexpr double kDt = 0.001;
+
+// A stand-in simulation at 100 Hz: a torsion spring about z (N m/rad) with its exact K_h.
+struct TorsionSpring {
+  double stiffness = 3;
+  std::uint64_t step = 0;
+  void answer(HapticLoop& loop) {
+    HandCommand c;
+    loop.commands().read(c);
+    SimulationWrench w;
+    w.step = ++step;
+    w.command_tick = c.tick;
+    w.grabbed = c.grab_requests > c.release_requests;
+    w.pose = c.pose;
+    w.wrench.torque.z = -stiffness * toRotationVector(c.pose.orientation).z;
+    w.stiffness[35] = -stiffness;
+    loop.wrenches().write(w);
+  }
+};
+
+// A simulation that pushes with a constant 5 N along x once grabbed.
+struct ConstantPush {
+  std::uint64_t step = 0;
+  void answer(HapticLoop& loop) {
+    HandCommand c;
+    loop.commands().read(c);
+    SimulationWrench w;
+    w.step = ++step;
+    w.command_tick = c.tick;
+    w.grabbed = c.grab_requests > c.release_requests;
+    w.pose = c.pose;
+    w.wrench.force.x = 5;
+    loop.wrenches().write(w);
+  }
+};
+
+std::unique_ptr<PluginDevice> openOrFail(const PluginDeviceSettings& settings) {
+  auto opened = PluginDevice::open(settings);
+  EXPECT_TRUE(opened) << opened.error;
+  return opened ? std::move(*opened.value) : nullptr;
+}
+
+TEST(PluginDevice, TheSimulatedDeviceTwistsAgainstASpringAndSettlesWhereTheWristBalancesIt) {
+  PluginDeviceSettings settings;
+  settings.library = TORSION_SIMULATED_DEVICE_PLUGIN;
+  // The operator turns the wrist 0.5 rad about z in 0.5 s and holds; the device's motors push
+  // back with the spring's torque. Deadline generous: this checks the physics, not the clock.
+  settings.config =
+      "intent=twist,intent_rate=1,intent_start=0.1,intent_time=0.5,"
+      "wrist_stiffness=3,max_torque=1";
+  settings.read_deadline = 0.5;
+  std::unique_ptr<PluginDevice> device = openOrFail(settings);
+  ASSERT_TRUE(device);
+  EXPECT_EQ(device->rateHz(), 1000);
+  EXPECT_EQ(device->limits().max_torque, 1);
+  EXPECT_NE(device->name().find("simulated"), std::string::npos) << device->name();
+
+  HapticLoop loop(*device, HapticLoopSettings{});
+  TorsionSpring spring;
+  for (int k = 0; k <= 2500; ++k) {
+    loop.tick(k * kDt);
+    if (k % 10 == 0) spring.answer(loop);
+  }
+  EXPECT_EQ(device->stats().late, 0u);
+  EXPECT_EQ(device->stats().reads, 2501u);
+  EXPECT_EQ(loop.stats().nonfinite, 0u);
+  EXPECT_TRUE(loop.forceEnabled());
+  // Static balance: wrist K_w (0.5 - theta) = spring K theta, K_w = K = 3 N m/rad: 0.25 rad and
+  // 0.75 N m (within the 1 N m limit).
+  HandCommand c;
+  loop.commands().read(c);
+  const double theta = toRotationVector(c.pose.orientation).z;
+  EXPECT_NEAR(theta, 0.25, 0.25 * 0.03);
+  EXPECT_NEAR(loop.lastOutput().torque.z, -0.75, 0.75 * 0.03);
+  // The spring stored energy and gave none back: the port stayed passive, the controller idle.
+  EXPECT_LE(loop.stats().max_port_energy.load(), 1e-9);
+  EXPECT_EQ(loop.stats().pc_active, 0u);
+}
+
+TEST(PluginDevice, AWrongAbiVersionIsRefusedWithBothVersionsNamed) {
+  PluginDeviceSettings settings;
+  settings.library = TORSION_WRONG_ABI_PLUGIN;
+  auto opened = PluginDevice::open(settings);
+  ASSERT_FALSE(opened);
+  EXPECT_NE(opened.error.find("ABI version 99"), std::string::npos) << opened.error;
+  EXPECT_NE(opened.error.find("speaks version 1"), std::string::npos) << opened.error;
+}
+
+TEST(PluginDevice, AMissingLibraryAnAlienLibraryAndABadConfigAreClearErrors) {
+  PluginDeviceSettings settings;
+  settings.library = "/nonexistent/libnodevice.so";
+  auto missing = PluginDevice::open(settings);
+  ASSERT_FALSE(missing);
+  EXPECT_NE(missing.error.find("cannot load"), std::string::npos) << missing.error;
+
+  settings.library = "libm.so.6";  // a real library without the entry point
+  auto alien = PluginDevice::open(settings);
+  ASSERT_FALSE(alien);
+  EXPECT_NE(alien.error.find("no entry point 'torsion_device_plugin'"), std::string::npos)
+      << alien.error;
+
+  settings.library = TORSION_SIMULATED_DEVICE_PLUGIN;
+  settings.config = "device_mass=heavy";
+  auto bad = PluginDevice::open(settings);
+  ASSERT_FALSE(bad);
+  EXPECT_NE(bad.error.find("device_mass: 'heavy' is not a number"), std::string::npos) << bad.error;
+}
+
+// Runs a faulty plug-in under a constant 5 N push until `until` s; the fault starts at 0.3 s.
+struct FaultRun {
+  double before = 0;   // N written just before the fault
+  double at_end = -1;  // N written at `until`
+  bool always_finite = true;
+  bool alive_at_end = true;
+};
+
+FaultRun runFaulty(PluginDevice& device, double until) {
+  HapticLoop loop(device, HapticLoopSettings{});
+  ConstantPush sim;
+  FaultRun run;
+  for (int k = 0; k * kDt <= until + 1e-9; ++k) {
+    loop.tick(k * kDt);
+    sim.answer(loop);
+    const Wrench& w = loop.lastOutput();
+    run.always_finite = run.always_finite && isFinite(w);
+    if (k == 299) run.before = norm(w.force);
+  }
+  HandCommand c;
+  loop.commands().read(c);
+  run.alive_at_end = c.alive;
+  run.at_end = norm(loop.lastOutput().force);
+  return run;
+}
+
+TEST(PluginDevice, NanNonUnitQuaternionAndFailedReadsFadeTheForceAndAreCounted) {
+  for (const char* fault : {"nan", "quat", "fail"}) {
+    SCOPED_TRACE(fault);
+    PluginDeviceSettings settings;
+    settings.library = TORSION_FAULTY_PLUGIN;
+    settings.config = std::string("fault=") + fault + ",after=0.3";
+    settings.read_deadline = 0.5;
+    std::unique_ptr<PluginDevice> device = openOrFail(settings);
+    ASSERT_TRUE(device);
+    // Fault at 0.3 s, held 5 ms, then dead: zero within fade_time (0.2 s) after that.
+    const FaultRun run = runFaulty(*device, 0.3 + 0.005 + 0.2 + 0.002);
+    EXPECT_NEAR(run.before, 5, 1e-9);  // healthy: the push was rendered in full
+    EXPECT_EQ(run.at_end, 0);
+    EXPECT_TRUE(run.always_finite);
+    EXPECT_FALSE(run.alive_at_end);
+    const PluginStats& s = device->stats();
+    EXPECT_GT(std::string(fault) == "fail" ? s.failed.load() : s.rejected.load(), 190u);
+    EXPECT_NEAR(static_cast<double>(s.held.load()), 5, 1);  // hold_time / tick, to rounding
+    EXPECT_EQ(s.late, 0u);
+  }
+}
+
+TEST(PluginDevice, APluginThatBlocksMissesItsDeadlinesTheLoopGoesOnAndTheForceFades) {
+  PluginDeviceSettings settings;
+  settings.library = TORSION_FAULTY_PLUGIN;
+  settings.config = "fault=block,after=0.3,block_ms=30";
+  settings.read_deadline = 0.002;
+  std::unique_ptr<PluginDevice> device = openOrFail(settings);
+  ASSERT_TRUE(device);
+  HapticLoop loop(*device, HapticLoopSettings{});
+  ConstantPush sim;
+  double before = 0, after_fault = 0;
+  for (int k = 0; k * kDt <= 0.3 + 0.005 + 0.2 + 0.002; ++k) {
+    const auto start = std::chrono::steady_clock::now();
+    loop.tick(k * kDt);
+    if (k >= 300)
+      after_fault +=
+          std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    sim.answer(loop);
+    if (k == 299 && device->stats().late == 0) before = norm(loop.lastOutput().force);
+  }
+  // Before the fault the push was rendered in full (unless this busy machine made a healthy read
+  // late, which the check skips). After it, 208 ticks waited at most their 2 ms deadline each:
+  // had they waited for the plug-in's 30 ms reads they would have taken over 6 s (1.5 s allowed
+  // for a busy machine's scheduler).
+  if (before > 0) {
+    EXPECT_NEAR(before, 5, 1e-9);
+  }
+  EXPECT_LT(after_fault, 1.5);
+  EXPECT_GT(device->stats().late, 150u);
+  EXPECT_EQ(norm(loop.lastOutput().force), 0);
+}
+
+}  // namespace
+}  // namespace torsion::device
