@@ -1,9 +1,12 @@
 // torsion: the command-line tool. Each subcommand lives in its own file and registers itself here.
 
+#include <LinearMath/btScalar.h>
+
 #include <CLI/CLI.hpp>
 #include <cmath>
 #include <iostream>
 
+#include "../scene/build_info.h"
 #include "mesh_command.h"
 #include "run_command.h"
 #include "text_only_stderr.h"
@@ -14,6 +17,9 @@ int main(int argc, char** argv) {
   const torsion::cli::TextOnlyStderr text_only_stderr;  // no raw bytes from user input on stderr
   CLI::App app{"torsion: corotational FEM soft bodies with hand-plane torsion, inside Bullet"};
   app.require_subcommand(1);
+  app.set_version_flag("--version", std::string("torsion ") + torsion::scene::torsionVersion() +
+                                        " (git " + torsion::scene::torsionGitCommit() + ", " +
+                                        (sizeof(btScalar) == 8 ? "double" : "float") + " Bullet)");
   app.fallthrough();  // options of the tool (--max-input-mb) may follow a subcommand
   app.add_option_function<double>(
          "--max-input-mb",
