@@ -21,6 +21,8 @@ packages=(
   libgtest-dev libbenchmark-dev clang libclang-rt-14-dev
   # mesh generation (`torsion mesh cylinder` runs the tetgen command)
   tetgen
+  # the ParaView series: zlib compresses it; the series tests read it back with meshio and VTK
+  zlib1g-dev python3-meshio python3-vtk9 python3-numpy
 )
 
 missing=()

@@ -7,6 +7,7 @@
 #include <iostream>
 
 #include "../scene/build_info.h"
+#include "check_command.h"
 #include "mesh_command.h"
 #include "run_command.h"
 #include "text_only_stderr.h"
@@ -32,6 +33,7 @@ int main(int argc, char** argv) {
   torsion::cli::addMeshCommand(app);
   torsion::cli::addRunCommand(app);
   torsion::cli::addViewCommand(app);
+  torsion::cli::addCheckCommand(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {

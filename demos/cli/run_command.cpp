@@ -14,6 +14,7 @@
 #include "progress_bar.h"
 #include "torsion/device/json_check.h"
 #include "torsion/solve/parallel.h"
+#include "vtk_series.h"
 
 namespace torsion::cli {
 
@@ -28,6 +29,7 @@ struct RunArguments {
   std::string render_size = "800x600";
   int render_every = 10;
   bool stop_on_anomaly = false;
+  int vtk_every = -1;  // --vtk-every N: a ParaView series every N steps (vtk_series.h); -1: scene's
   scene::DeviceOverrides devices;  // --device HAND=TYPE[:ARG] (repeatable), --haptics MODE
 };
 
@@ -132,17 +134,33 @@ int run(const RunArguments& args) {
     }
   }
 
+  std::unique_ptr<VtkSeries> series;
+  if (const int every = args.vtk_every >= 0 ? args.vtk_every : s.spec.vtk_every; every > 0) {
+    Result<std::unique_ptr<VtkSeries>> started = VtkSeries::start(args.out, every, s);
+    if (!started) {
+      std::cerr << "error: --vtk-every: " << started.error().message << "\n";
+      return 1;
+    }
+    series = std::move(started).value();
+  }
+  std::string series_error;
+
   ProgressBar bar(device::printableExcerpt(s.spec.name));  // the label goes out through stdio
   scene::RunOptions options;
   options.output_directory = args.out;
   options.steps = args.steps;
   options.stop_on_anomaly = args.stop_on_anomaly;
+  if (series) options.extra_outputs.push_back("series.pvd");
   std::string render_error;
   options.progress = [&](int done, int total, double rate) {
     bar.update(done, total, rate);
     if (recorder && render_error.empty()) {
       Status drawn = done == total ? recorder->capture(s, rate) : recorder->onStep(s, rate);
       if (!drawn) render_error = drawn.error().message;
+    }
+    if (series && series_error.empty()) {
+      Status written = series->onStep(s, done, total);
+      if (!written) series_error = written.error().message;
     }
   };
   options.stop_requested = [] { return static_cast<int>(g_stop_signal); };
@@ -156,6 +174,10 @@ int run(const RunArguments& args) {
     std::cerr << "error: " << outcome.error().message << "\n";
     return 1;
   }
+  if (!series_error.empty()) {
+    std::cerr << "error: --vtk-every: " << series_error << "\n";
+    return 1;
+  }
   if (!render_error.empty()) {
     std::cerr << "error: --render: " << render_error << "\n";
     return 1;
@@ -164,6 +186,9 @@ int run(const RunArguments& args) {
     for (const std::string& w : s.haptics->warnings())
       std::cerr << "warning: haptics: " << w << "\n";
   }
+  if (series)
+    std::cerr << "series: " << args.out << "/series.pvd (" << series->stepsWritten()
+              << " steps, open in ParaView)\n";
   if (recorder) std::cerr << "pictures: " << recorder->finish(s.spec.name) << "\n";
   if (const int signal = outcome.value().stopped_by; signal != 0) {
     std::cerr << "stopped by " << (signal == SIGINT ? "SIGINT" : "SIGTERM") << " after "
@@ -214,6 +239,10 @@ void addRunCommand(CLI::App& app) {
   cmd->add_flag("--stop-on-anomaly", args->stop_on_anomaly,
                 "Stop at the first anomaly (inverted tets, released elastic energy, node speed "
                 "burst) with exit code 4");
+  cmd->add_option("--vtk-every", args->vtk_every,
+                  "Also write a ParaView time series (series.pvd, one .vtu per body per written "
+                  "step) every N steps; 0: none (default: the scene's vtk_every, else none)")
+      ->check(CLI::Range(0, 2000000000).description("an integer from 0 to 2000000000"));
   addDeviceOptions(*cmd, args->devices);
   cmd->callback([args] { setExitCode(run(*args)); });
 }

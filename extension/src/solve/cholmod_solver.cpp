@@ -1,6 +1,10 @@
 #include "torsion/solve/cholmod_solver.h"
 
+#if TORSION_WITH_CHOLMOD
 #include <Eigen/CholmodSupport>
+#else
+#include <Eigen/SparseCholesky>
+#endif
 #include <cmath>
 
 #include "torsion/fem/quadratic_element.h"
@@ -23,12 +27,24 @@ struct CholmodSolver::Impl {
   bool nodal_pressure = false;
   std::vector<int> patch_offsets, patch_nodes, patch_pair_offsets, patch_pair_blocks;
   bool analysed = false;
+#if TORSION_WITH_CHOLMOD
   Eigen::CholmodDecomposition<Eigen::SparseMatrix<double>, Eigen::Lower> factor;
+#else
+  Eigen::SimplicialLLT<Eigen::SparseMatrix<double>, Eigen::Lower> factor;
+#endif
   Eigen::VectorXd rhs, prescribed, q, solution;
 };
 
 CholmodSolver::CholmodSolver() : impl_(std::make_unique<Impl>()) {}
 CholmodSolver::~CholmodSolver() = default;
+
+const char* CholmodSolver::backend() {
+#if TORSION_WITH_CHOLMOD
+  return "CHOLMOD";
+#else
+  return "Eigen SimplicialLLT";
+#endif
+}
 
 void CholmodSolver::buildPattern(const SystemOperator& op) {
   const FemModel& model = op.model();

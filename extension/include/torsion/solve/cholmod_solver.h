@@ -1,6 +1,7 @@
 #pragma once
 // Sparse direct solve of the constrained system with SuiteSparse CHOLMOD (through Eigen's
-// CholmodSupport). The matrix A = M' + c Re Ke Re^T is assembled every step into a fixed sparsity
+// CholmodSupport), or, in a build configured with TORSION_CHOLMOD=OFF (no GPL modules linked),
+// with Eigen's own SimplicialLLT: the same factorisation, single-threaded and without supernodes. The matrix A = M' + c Re Ke Re^T is assembled every step into a fixed sparsity
 // pattern (analysed once); constraints are applied as A' = S A S + (I - S), which is SPD and
 // leaves prescribed components at their prescribed values.
 
@@ -25,6 +26,9 @@ class CholmodSolver {
   /// Solves A v = b for the free components of v (prescribed ones imposed on entry).
   LinearSolveReport solve(const SystemOperator& op, const NodeConstraints& constraints,
                           const Eigen::VectorXd& b, Eigen::VectorXd& v);
+
+  /// The factorisation this build uses: "CHOLMOD" or "Eigen SimplicialLLT".
+  static const char* backend();
 
   /// Assembles the constrained matrix (lower triangle) for the current rotations; for tests.
   const Eigen::SparseMatrix<double>& assemble(const SystemOperator& op,
