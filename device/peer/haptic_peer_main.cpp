@@ -6,6 +6,7 @@
 //                       [--rate 1000] [--log received.csv]
 #include <time.h>
 
+#include <CLI/CLI.hpp>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
@@ -23,13 +24,6 @@ double monotonicSeconds() {
   return static_cast<double>(ts.tv_sec) + 1e-9 * static_cast<double>(ts.tv_nsec);
 }
 
-int usage() {
-  std::fprintf(stderr,
-               "usage: torsion_haptic_peer --trajectory FILE [--port P] [--host 127.0.0.1] "
-               "[--rate HZ] [--log FILE]\n");
-  return 2;
-}
-
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -37,24 +31,22 @@ int main(int argc, char** argv) {
   std::string trajectory_path, log_path, host = "127.0.0.1";
   int port = 5750;
   double rate = 1000;
-  for (int k = 1; k < argc; ++k) {
-    const std::string a = argv[k];
-    const bool has_value = k + 1 < argc;
-    if (a == "--trajectory" && has_value) {
-      trajectory_path = argv[++k];
-    } else if (a == "--port" && has_value) {
-      port = std::atoi(argv[++k]);
-    } else if (a == "--host" && has_value) {
-      host = argv[++k];
-    } else if (a == "--rate" && has_value) {
-      rate = std::atof(argv[++k]);
-    } else if (a == "--log" && has_value) {
-      log_path = argv[++k];
-    } else {
-      return usage();
-    }
+  CLI::App app{"torsion_haptic_peer: sends a scripted device trajectory to a simulation's network "
+               "device over UDP and receives the wrenches (docs/haptics.md)"};
+  app.add_option("--trajectory", trajectory_path, "Trajectory file (JSON)")->required();
+  app.add_option("--port", port, "The simulation's UDP port")
+      ->check(CLI::Range(1, 65535))
+      ->capture_default_str();
+  app.add_option("--host", host, "The simulation's IPv4 address")->capture_default_str();
+  app.add_option("--rate", rate, "Poses sent per second (Hz)")
+      ->check(CLI::Range(1e-3, 1e6))
+      ->capture_default_str();
+  app.add_option("--log", log_path, "Write the received wrenches to this CSV file");
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    return e.get_exit_code() == 0 ? app.exit(e) : (app.exit(e), 2);  // usage errors: exit 2
   }
-  if (trajectory_path.empty() || port <= 0 || port > 65535 || !(rate > 0)) return usage();
   UdpEndpoint simulation;
   simulation.port = static_cast<std::uint16_t>(port);
   if (!parseIpv4(host, simulation.address)) {

@@ -31,7 +31,7 @@ endforeach()
 run(${CMAKE_COMMAND} -S "${CONSUMER_DIR}" -B "${WORK_DIR}/consumer" -G "${GENERATOR}"
     "-DCMAKE_PREFIX_PATH=${prefix}" -DCMAKE_BUILD_TYPE=Release)
 run(${CMAKE_COMMAND} --build "${WORK_DIR}/consumer" --verbose)
-if(last_output MATCHES "cholmod")
+if(last_output MATCHES "libcholmod|-lcholmod")
   message(FATAL_ERROR "the consumer links CHOLMOD:\n${last_output}")
 endif()
 run("${WORK_DIR}/consumer/direct_solver")
