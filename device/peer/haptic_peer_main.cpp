@@ -31,8 +31,9 @@ int main(int argc, char** argv) {
   std::string trajectory_path, log_path, host = "127.0.0.1";
   int port = 5750;
   double rate = 1000;
-  CLI::App app{"torsion_haptic_peer: sends a scripted device trajectory to a simulation's network "
-               "device over UDP and receives the wrenches (docs/haptics.md)"};
+  CLI::App app{
+      "torsion_haptic_peer: sends a scripted device trajectory to a simulation's network "
+      "device over UDP and receives the wrenches (docs/haptics.md)"};
   app.add_option("--trajectory", trajectory_path, "Trajectory file (JSON)")->required();
   app.add_option("--port", port, "The simulation's UDP port")
       ->check(CLI::Range(1, 65535))
