@@ -6,6 +6,7 @@
 #include "mesh_command.h"
 #include "run_comparison.h"
 #include "torsion/device/json_check.h"
+#include "verbosity.h"
 
 namespace torsion::cli {
 
@@ -15,7 +16,6 @@ struct CheckArguments {
   std::string run;
   std::string reference;
   ComparisonTolerance tolerance;
-  bool quiet = false;
 };
 
 int check(const CheckArguments& args) {
@@ -25,7 +25,7 @@ int check(const CheckArguments& args) {
     return 1;
   }
   const RunComparison& c = compared.value();
-  if (!args.quiet) {
+  if (verbosity() != Verbosity::kQuiet) {  // --quiet: the verdict only
     for (const std::string& line : c.report)
       std::cout << device::printableExcerpt(line, 400) << "\n";
   }
@@ -62,7 +62,6 @@ void addCheckCommand(CLI::App& app) {
                   "Absolute tolerance, in each value's unit")
       ->check(CLI::Range(0.0, 1e30).description("a number from 0 to 1e30"))
       ->capture_default_str();
-  cmd->add_flag("--quiet", args->quiet, "Print only the verdict");
   cmd->callback([args] { setExitCode(check(*args)); });
 }
 

@@ -12,6 +12,7 @@
 #include "run_command.h"
 #include "text_only_stderr.h"
 #include "torsion/device/file_io.h"
+#include "verbosity.h"
 #include "view_command.h"
 
 int main(int argc, char** argv) {
@@ -30,6 +31,7 @@ int main(int argc, char** argv) {
          "Largest scene, mesh or trajectory file read, in MB (default 1073.741824, i.e. 1 GiB)")
       ->check(CLI::Range(1e-6, 1e9))
       ->trigger_on_parse();  // before the subcommand's callback reads anything
+  torsion::cli::addVerbosityOptions(app);
   torsion::cli::addMeshCommand(app);
   torsion::cli::addRunCommand(app);
   torsion::cli::addViewCommand(app);

@@ -14,6 +14,7 @@
 #include "progress_bar.h"
 #include "torsion/device/json_check.h"
 #include "torsion/solve/parallel.h"
+#include "verbosity.h"
 #include "vtk_series.h"
 
 namespace torsion::cli {
@@ -101,13 +102,25 @@ int run(const RunArguments& args) {
               << Parallel::usableThreads(asked) << " cores: using "
               << Parallel::usableThreads(asked) << "\n";
   }
+  const bool normal = verbosity() != Verbosity::kQuiet;
+  if (verbosity() == Verbosity::kVerbose) {
+    const SolverSettings& solver = s.world->settings().solver;
+    std::cerr << "scene '" << device::printableExcerpt(s.spec.name) << "' from "
+              << device::printableExcerpt(s.spec.file, 200) << ": "
+              << (args.steps > 0 ? args.steps : s.spec.steps)
+              << " steps of dt = " << solver.time_step << " s, " << toString(solver.linear_solver)
+              << " solver (tolerance " << solver.tolerance << "), "
+              << Parallel::usableThreads(solver.threads) << " threads; output in "
+              << device::printableExcerpt(args.out, 200) << "/\n";
+  }
   for (const auto& body : s.world->bodies()) {
+    if (!normal) break;
     std::cerr << "body '" << body->name() << "': " << body->model().nodeCount() << " nodes, "
               << body->model().elementCount()
               << (body->model().elementKind() == ElementKind::kTet10 ? " tet10 elements\n"
                                                                      : " tets\n");
   }
-  if (s.haptics) {
+  if (s.haptics && normal) {
     for (const std::string& line : s.haptics->describe())
       std::cerr << line << "\n";
   }
@@ -153,7 +166,7 @@ int run(const RunArguments& args) {
   if (series) options.extra_outputs.push_back("series.pvd");
   std::string render_error;
   options.progress = [&](int done, int total, double rate) {
-    bar.update(done, total, rate);
+    if (normal) bar.update(done, total, rate);
     if (recorder && render_error.empty()) {
       Status drawn = done == total ? recorder->capture(s, rate) : recorder->onStep(s, rate);
       if (!drawn) render_error = drawn.error().message;
@@ -169,7 +182,7 @@ int run(const RunArguments& args) {
     StopOnSignals stop_on_signals;
     outcome = scene::runScene(s, options);
   }
-  bar.finish();
+  if (normal) bar.finish();
   if (!outcome) {
     std::cerr << "error: " << outcome.error().message << "\n";
     return 1;
@@ -186,10 +199,10 @@ int run(const RunArguments& args) {
     for (const std::string& w : s.haptics->warnings())
       std::cerr << "warning: haptics: " << w << "\n";
   }
-  if (series)
+  if (series && normal)
     std::cerr << "series: " << args.out << "/series.pvd (" << series->stepsWritten()
               << " steps, open in ParaView)\n";
-  if (recorder) std::cerr << "pictures: " << recorder->finish(s.spec.name) << "\n";
+  if (recorder && normal) std::cerr << "pictures: " << recorder->finish(s.spec.name) << "\n";
   if (const int signal = outcome.value().stopped_by; signal != 0) {
     std::cerr << "stopped by " << (signal == SIGINT ? "SIGINT" : "SIGTERM") << " after "
               << outcome.value().steps_done << " steps; results so far in " << args.out
@@ -206,6 +219,7 @@ int run(const RunArguments& args) {
               << "\nresults up to that step are in " << args.out << "/\n";
     return 4;
   }
+  if (!normal) return 0;
   std::cerr << "done: " << outcome.value().steps_done << " steps; results in " << args.out
             << "/ (summary.json, wrench.csv, energy.csv, "
             << (s.rigid_bodies.empty() ? "" : "rigid.csv, ") << "one .vtk per body"

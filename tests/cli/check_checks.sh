@@ -118,6 +118,24 @@ PY
     expect_rc 0
     ;;
 
+  quiet_and_verbose)
+    # --quiet: nothing on stderr for a clean run, the verdict alone from check; --verbose: the
+    # settings resolved. The results are the same whatever is printed.
+    sed "s|../../assets/meshes|$assets|" "$scenes/twist_cylinder_2430.json" > t.json
+    err=$("$torsion" run t.json --out q --steps 5 --threads 1 --quiet 2>&1 >/dev/null) ||
+      fail "quiet run failed: $err"
+    [[ -z $err ]] || fail "--quiet printed: $err"
+    run "$torsion" --verbose run t.json --out v --steps 5 --threads 1
+    expect_rc 0
+    expect_out "^scene 'twist_cylinder_2430' from t.json: 5 steps of dt = 0.01 s, cg solver \(tolerance 0.0001\), 1 threads; output in v/$"
+    expect_out "^done: 5 steps"
+    run "$torsion" check q v --quiet
+    expect_rc 0
+    [[ $out == "same: q matches v within 1e-06 relative, 1e-12 absolute" ]] || fail "check --quiet: $out"
+    run "$torsion" run t.json --quiet --verbose
+    expect_rc 1
+    ;;
+
   check_unreadable_directory)
     twist a
     run "$torsion" check a no_such_dir
