@@ -81,6 +81,39 @@ case $case_name in
     (($(field tets cube.msh) >= 100)) || fail "expected a refined mesh, got $(field tets cube.msh)"
     ;;
 
+  tetrahedralize_ply)
+    # The cube [0,2]^3 as PLY in each encoding (binary ones with extra properties and an extra
+    # element to skip): each gives a valid mesh of volume exactly 8.
+    need tetgen
+    /usr/bin/python3 - <<'PY' || fail "writing the PLY files"
+import struct
+v = [(0, 0, 0), (2, 0, 0), (2, 2, 0), (0, 2, 0), (0, 0, 2), (2, 0, 2), (2, 2, 2), (0, 2, 2)]
+quads = [(0, 3, 2, 1), (4, 5, 6, 7), (0, 1, 5, 4), (1, 2, 6, 5), (2, 3, 7, 6), (3, 0, 4, 7)]
+head = "ply\nformat %s 1.0\ncomment a cube\nelement vertex 8\nproperty float x\n" \
+       "property float y\nproperty float z\nproperty uchar red\n" \
+       "element face 6\nproperty list uchar int vertex_indices\n" \
+       "element edge 1\nproperty int vertex1\nproperty int vertex2\nend_header\n"
+with open("ascii.ply", "w") as f:
+    f.write(head % "ascii")
+    f.writelines("%g %g %g 7\n" % p for p in v)
+    f.writelines("4 %d %d %d %d\n" % q for q in quads)
+    f.write("0 1\n")
+for name, order in (("little", "<"), ("big", ">")):
+    with open(name + ".ply", "wb") as f:
+        f.write((head % ("binary_%s_endian" % name)).encode())
+        for p in v:
+            f.write(struct.pack(order + "fffB", *p, 7))
+        for q in quads:
+            f.write(struct.pack(order + "Biiii", 4, *q))
+        f.write(struct.pack(order + "ii", 0, 1))
+PY
+    for f in ascii little big; do
+      out=$("$torsion" mesh tetrahedralize $f.ply -o $f.node 2>&1) || fail "$f.ply: $out"
+      grep -q "from $f.ply: 8 vertices, 12 triangles" <<<"$out" || fail "$f.ply: $out"
+      [[ $(field volume $f.node) == 8 ]] || fail "$f.ply: volume $(field volume $f.node)"
+    done
+    ;;
+
   *)
     fail "unknown case $case_name"
     ;;
