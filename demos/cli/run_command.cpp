@@ -202,7 +202,10 @@ int run(const RunArguments& args) {
   if (series && normal)
     std::cerr << "series: " << args.out << "/series.pvd (" << series->stepsWritten()
               << " steps, open in ParaView)\n";
-  if (recorder && normal) std::cerr << "pictures: " << recorder->finish(s.spec.name) << "\n";
+  if (recorder) {  // finish() also makes the video: always, whatever is printed
+    const std::string pictures = recorder->finish(s.spec.name);
+    if (normal) std::cerr << "pictures: " << pictures << "\n";
+  }
   if (const int signal = outcome.value().stopped_by; signal != 0) {
     std::cerr << "stopped by " << (signal == SIGINT ? "SIGINT" : "SIGTERM") << " after "
               << outcome.value().steps_done << " steps; results so far in " << args.out
