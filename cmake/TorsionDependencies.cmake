@@ -3,10 +3,13 @@
 
 find_package(Eigen3 3.3 REQUIRED NO_MODULE)
 include(TorsionBullet)   # Bullet::Bullet, in TORSION_BULLET_PRECISION
-include(TorsionCholmod)  # SuiteSparse::CHOLMOD
+if(TORSION_CHOLMOD)
+  include(TorsionCholmod)  # SuiteSparse::CHOLMOD
+endif()
 find_package(TBB REQUIRED)
 
+find_package(CLI11 REQUIRED)  # headers only: the torsion tool and the haptic peer's options
 if(TORSION_BUILD_DEMOS)
-  find_package(CLI11 REQUIRED)
   find_package(nlohmann_json 3.10 REQUIRED)
+  find_package(ZLIB)  # optional: compresses the ParaView series (demos/cli/vtu_writer.h)
 endif()

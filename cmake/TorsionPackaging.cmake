@@ -27,5 +27,10 @@ install(FILES
   "${PROJECT_BINARY_DIR}/TorsionConfig.cmake"
   "${PROJECT_BINARY_DIR}/TorsionConfigVersion.cmake"
   "${PROJECT_SOURCE_DIR}/cmake/TorsionBullet.cmake"
-  "${PROJECT_SOURCE_DIR}/cmake/TorsionCholmod.cmake"
   DESTINATION "${TORSION_CMAKE_INSTALL_DIR}")
+# Only a build with CHOLMOD installs its finder; TorsionConfig.cmake looks for CHOLMOD when it is
+# there (a prefix holding one build with and one without CHOLMOD asks for it).
+if(TORSION_CHOLMOD)
+  install(FILES "${PROJECT_SOURCE_DIR}/cmake/TorsionCholmod.cmake"
+          DESTINATION "${TORSION_CMAKE_INSTALL_DIR}")
+endif()

@@ -25,6 +25,8 @@ packages=(
   tetgen
   # the Python package (`import torsion`), its tests and examples
   python3-dev pybind11-dev python3-numpy python3-pytest python3-matplotlib
+  # the ParaView series: zlib compresses it; the series tests read it back with meshio and VTK
+  zlib1g-dev python3-meshio python3-vtk9
 )
 
 missing=()

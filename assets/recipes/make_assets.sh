@@ -75,7 +75,7 @@ if (cd "$work" && tetgen -d dragon_surface.off 2>&1) | grep -q "intersects"; the
   exit 1
 fi
 "$torsion" mesh tetrahedralize "$work/dragon_surface.off" -o "$meshes/dragon_4300.node" \
-  --keep-surface --min-dihedral 10
+  --keep-surface --min-dihedral 10 --max-volume 0
 
 # ---- Contact scenes (issue 6): a small rod (tetgen), structured boxes and a ball (no tetgen) ----
 echo "== rod_1200, slab_768, block_162, paddle_108, ball_384"

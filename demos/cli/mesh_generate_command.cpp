@@ -7,6 +7,7 @@
 #include <string>
 
 #include "cylinder_mesher.h"
+#include "gmsh_runner.h"
 #include "surface_mesh.h"
 #include "tetgen_runner.h"
 #include "torsion/mesh/mesh_io.h"
@@ -34,10 +35,16 @@ struct CylinderOptions {
   bool verbose = false;
 };
 
+// Without --max-volume, tets are sized from the surface: edges about 1/10 of its bounding box's
+// diagonal (the volume of a regular tet of that edge: a few thousand tets for a cube), so a small
+// part and a large one get about the same number of tets.
+constexpr double kDefaultEdgesPerDiagonal = 10;
+
 struct TetrahedralizeOptions {
   std::string surface;
   std::string output;
-  double max_volume = 0;
+  std::string mesher = "tetgen";
+  double max_volume = -1;  // < 0: from the surface's size; 0: no bound
   double quality = 1.4;
   double min_dihedral = 0;
   bool keep_surface = false;
@@ -145,10 +152,49 @@ std::string intersectionReport(const fs::path& tetgen, const fs::path& input,
   return report;
 }
 
-int runTetrahedralize(const TetrahedralizeOptions& o) {
+// The volume of a regular tet with edge `edge`, and the edge of one with volume `volume`.
+double regularTetVolume(double edge) {
+  return edge * edge * edge / (6 * std::sqrt(2.0));
+}
+double regularTetEdge(double volume) {
+  return std::cbrt(6 * std::sqrt(2.0) * volume);
+}
+
+int runGmshTetrahedralize(const TetrahedralizeOptions& o, const SurfaceMesh& surface) {
   const std::string cmd = "torsion mesh tetrahedralize: ";
-  if (o.max_volume < 0 || !std::isfinite(o.max_volume)) {
+  Result<fs::path> gmsh = meshgen::findGmsh("tetrahedralize");
+  if (!gmsh) return fail(gmsh.error().message);
+  Result<TempDir> dir = TempDir::create("torsion-tetrahedralize");
+  if (!dir) return fail(dir.error().message);
+  const double edge = o.max_volume > 0 ? regularTetEdge(o.max_volume) : 0.0;
+  if (o.verbose) {
+    std::printf("%s: %zu vertices, %zu triangles; running gmsh -3 (longest edge %s)\n",
+                o.surface.c_str(), surface.vertices.size(), surface.triangles.size(),
+                edge > 0 ? number(edge).c_str() : "gmsh's default");
+  }
+  Result<fs::path> msh = meshgen::runGmsh(gmsh.value(), surface, edge, dir.value().path());
+  if (!msh) return fail(cmd + o.surface + ": " + msh.error().message);
+  Result<LoadedMesh> loaded = readMesh(msh.value());
+  if (!loaded) return fail(cmd + "reading gmsh's output: " + loaded.error().message);
+  const TetMesh& mesh = loaded.value().mesh;
+  Status written = writeMesh(o.output, mesh);
+  if (!written) return fail(written.error().message);
+  std::printf(
+      "wrote %s: %d tets, %d nodes, %d surface triangles (from %s: %zu vertices, %zu "
+      "triangles; gmsh, longest edge %s)\n",
+      o.output.c_str(), mesh.tetCount(), mesh.nodeCount(), mesh.surfaceTriangleCount(),
+      o.surface.c_str(), surface.vertices.size(), surface.triangles.size(),
+      edge > 0 ? number(edge).c_str() : "gmsh's default");
+  return 0;
+}
+
+int runTetrahedralize(TetrahedralizeOptions o) {
+  const std::string cmd = "torsion mesh tetrahedralize: ";
+  if (!std::isfinite(o.max_volume)) {
     return fail(cmd + "--max-volume must be a positive number, got " + number(o.max_volume));
+  }
+  if (o.mesher != "tetgen" && o.mesher != "gmsh") {
+    return fail(cmd + "--mesher must be tetgen or gmsh, got '" + o.mesher + "'");
   }
   if (!(o.quality >= 1.1) || !std::isfinite(o.quality)) {
     return fail(cmd + "--quality (radius-edge ratio bound) must be at least 1.1, got " +
@@ -166,6 +212,15 @@ int runTetrahedralize(const TetrahedralizeOptions& o) {
   SurfaceMesh surface = std::move(read).value();
   Status closed = meshgen::prepareClosedSurface(surface, o.surface);
   if (!closed) return fail(closed.error().message);
+  if (o.max_volume < 0) {  // not given: from the surface's size
+    Eigen::Vector3d lo = surface.vertices.front(), hi = lo;
+    for (const Eigen::Vector3d& v : surface.vertices) {
+      lo = lo.cwiseMin(v);
+      hi = hi.cwiseMax(v);
+    }
+    o.max_volume = regularTetVolume((hi - lo).norm() / kDefaultEdgesPerDiagonal);
+  }
+  if (o.mesher == "gmsh") return runGmshTetrahedralize(o, surface);
 
   Result<fs::path> tetgen = meshgen::findTetgen("tetrahedralize");
   if (!tetgen) return fail(tetgen.error().message);
@@ -221,12 +276,18 @@ void addMeshGenerateCommands(CLI::App& mesh, CommandAction& chosen) {
   auto tet = std::make_shared<TetrahedralizeOptions>();
   CLI::App* tet_cmd = mesh.add_subcommand(
       "tetrahedralize",
-      "Fill a closed triangle surface (.off, .obj, .stl) with tets, using the 'tetgen' command");
-  tet_cmd->add_option("surface", tet->surface, "Closed surface (.off, .obj, .stl)")->required();
+      "Fill a closed triangle surface (.off, .obj, .stl, .ply) with tets, using the 'tetgen' (default) "
+      "or 'gmsh' command");
+  tet_cmd->add_option("surface", tet->surface, "Closed surface (.off, .obj, .stl, .ply)")->required();
   tet_cmd->add_option("-o,--output", tet->output, "Mesh to write (.node/.ele, .msh, .vtk)")
       ->required();
   tet_cmd->add_option("--max-volume", tet->max_volume,
-                      "Largest tet volume (tetgen -a); default: none");
+                      "Largest tet volume (tetgen -a; gmsh: the edge of a regular tet of that "
+                      "volume); default: that of a regular tet with edges 1/10 of the surface's "
+                      "bounding-box diagonal; 0: no bound");
+  tet_cmd->add_option("--mesher", tet->mesher, "Mesh generator: tetgen or gmsh")
+      ->check(CLI::IsMember({"tetgen", "gmsh"}))
+      ->capture_default_str();
   tet_cmd
       ->add_option("--quality", tet->quality, "Radius-edge ratio bound (tetgen -q), at least 1.1")
       ->capture_default_str();

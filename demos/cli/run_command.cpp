@@ -13,6 +13,8 @@
 #include "scene_runner.h"
 #include "torsion/device/json_check.h"
 #include "torsion/solve/parallel.h"
+#include "verbosity.h"
+#include "vtk_series.h"
 
 namespace torsion::cli {
 
@@ -27,6 +29,7 @@ struct RunArguments {
   std::string render_size = "800x600";
   int render_every = 10;
   bool stop_on_anomaly = false;
+  int vtk_every = -1;  // --vtk-every N: a ParaView series every N steps (vtk_series.h); -1: scene's
   scene::DeviceOverrides devices;  // --device HAND=TYPE[:ARG] (repeatable), --haptics MODE
 };
 
@@ -98,13 +101,25 @@ int run(const RunArguments& args) {
               << Parallel::usableThreads(asked) << " cores: using "
               << Parallel::usableThreads(asked) << "\n";
   }
+  const bool normal = verbosity() != Verbosity::kQuiet;
+  if (verbosity() == Verbosity::kVerbose) {
+    const SolverSettings& solver = s.world->settings().solver;
+    std::cerr << "scene '" << device::printableExcerpt(s.spec.name) << "' from "
+              << device::printableExcerpt(s.spec.file, 200) << ": "
+              << (args.steps > 0 ? args.steps : s.spec.steps)
+              << " steps of dt = " << solver.time_step << " s, " << toString(solver.linear_solver)
+              << " solver (tolerance " << solver.tolerance << "), "
+              << Parallel::usableThreads(solver.threads) << " threads; output in "
+              << device::printableExcerpt(args.out, 200) << "/\n";
+  }
   for (const auto& body : s.world->bodies()) {
+    if (!normal) break;
     std::cerr << "body '" << body->name() << "': " << body->model().nodeCount() << " nodes, "
               << body->model().elementCount()
               << (body->model().elementKind() == ElementKind::kTet10 ? " tet10 elements\n"
                                                                      : " tets\n");
   }
-  if (s.haptics) {
+  if (s.haptics && normal) {
     for (const std::string& line : s.haptics->describe())
       std::cerr << line << "\n";
   }
@@ -131,17 +146,33 @@ int run(const RunArguments& args) {
     }
   }
 
+  std::unique_ptr<VtkSeries> series;
+  if (const int every = args.vtk_every >= 0 ? args.vtk_every : s.spec.vtk_every; every > 0) {
+    Result<std::unique_ptr<VtkSeries>> started = VtkSeries::start(args.out, every, s);
+    if (!started) {
+      std::cerr << "error: --vtk-every: " << started.error().message << "\n";
+      return 1;
+    }
+    series = std::move(started).value();
+  }
+  std::string series_error;
+
   ProgressBar bar(device::printableExcerpt(s.spec.name));  // the label goes out through stdio
   scene::RunOptions options;
   options.output_directory = args.out;
   options.steps = args.steps;
   options.stop_on_anomaly = args.stop_on_anomaly;
+  if (series) options.extra_outputs.push_back("series.pvd");
   std::string render_error;
   options.progress = [&](int done, int total, double rate) {
-    bar.update(done, total, rate);
+    if (normal) bar.update(done, total, rate);
     if (recorder && render_error.empty()) {
       Status drawn = done == total ? recorder->capture(s, rate) : recorder->onStep(s, rate);
       if (!drawn) render_error = drawn.error().message;
+    }
+    if (series && series_error.empty()) {
+      Status written = series->onStep(s, done, total);
+      if (!written) series_error = written.error().message;
     }
   };
   options.stop_requested = [] { return static_cast<int>(g_stop_signal); };
@@ -150,9 +181,13 @@ int run(const RunArguments& args) {
     StopOnSignals stop_on_signals;
     outcome = scene::runScene(s, options);
   }
-  bar.finish();
+  if (normal) bar.finish();
   if (!outcome) {
     std::cerr << "error: " << outcome.error().message << "\n";
+    return 1;
+  }
+  if (!series_error.empty()) {
+    std::cerr << "error: --vtk-every: " << series_error << "\n";
     return 1;
   }
   if (!render_error.empty()) {
@@ -163,7 +198,13 @@ int run(const RunArguments& args) {
     for (const std::string& w : s.haptics->warnings())
       std::cerr << "warning: haptics: " << w << "\n";
   }
-  if (recorder) std::cerr << "pictures: " << recorder->finish(s.spec.name) << "\n";
+  if (series && normal)
+    std::cerr << "series: " << args.out << "/series.pvd (" << series->stepsWritten()
+              << " steps, open in ParaView)\n";
+  if (recorder) {  // finish() also makes the video: always, whatever is printed
+    const std::string pictures = recorder->finish(s.spec.name);
+    if (normal) std::cerr << "pictures: " << pictures << "\n";
+  }
   if (const int signal = outcome.value().stopped_by; signal != 0) {
     std::cerr << "stopped by " << (signal == SIGINT ? "SIGINT" : "SIGTERM") << " after "
               << outcome.value().steps_done << " steps; results so far in " << args.out
@@ -180,6 +221,7 @@ int run(const RunArguments& args) {
               << "\nresults up to that step are in " << args.out << "/\n";
     return 4;
   }
+  if (!normal) return 0;
   std::cerr << "done: " << outcome.value().steps_done << " steps; results in " << args.out
             << "/ (summary.json, wrench.csv, energy.csv, "
             << (s.rigid_bodies.empty() ? "" : "rigid.csv, ") << "one .vtk per body"
@@ -213,6 +255,10 @@ void addRunCommand(CLI::App& app, CommandAction& chosen) {
   cmd->add_flag("--stop-on-anomaly", args->stop_on_anomaly,
                 "Stop at the first anomaly (inverted tets, released elastic energy, node speed "
                 "burst) with exit code 4");
+  cmd->add_option("--vtk-every", args->vtk_every,
+                  "Also write a ParaView time series (series.pvd, one .vtu per body per written "
+                  "step) every N steps; 0: none (default: the scene's vtk_every, else none)")
+      ->check(CLI::Range(0, 2000000000).description("an integer from 0 to 2000000000"));
   addDeviceOptions(*cmd, args->devices);
   cmd->callback([&chosen, args] { chosen = [args] { return run(*args); }; });
 }

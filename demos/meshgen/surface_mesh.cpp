@@ -30,14 +30,15 @@ std::string pointText(const Eigen::Vector3d& p) {
 
 Result<SurfaceMesh> readSurface(const fs::path& path) {
   const std::string ext = lowerExtension(path);
-  if (ext != ".off" && ext != ".obj" && ext != ".stl") {
+  if (ext != ".off" && ext != ".obj" && ext != ".stl" && ext != ".ply") {
     return Error{path.string() + ": unknown surface format '" + ext +
-                 "' (known: .off, .obj, .stl)"};
+                 "' (known: .off, .obj, .stl, .ply)"};
   }
   Result<std::string> text = readTextFile(path);
   if (!text) return text.error();
   if (ext == ".off") return parseOff(text.value(), path.string());
   if (ext == ".obj") return parseObj(text.value(), path.string());
+  if (ext == ".ply") return parsePly(text.value(), path.string());
   return parseStl(text.value(), path.string());
 }
 

@@ -34,7 +34,12 @@ Result<SurfaceMesh> parseObj(std::string_view text, const std::string& file);
 /// vertex in each triangle: vertices with identical coordinates are merged.
 Result<SurfaceMesh> parseStl(std::string_view bytes, const std::string& file);
 
-/// Reads a surface by the file's extension (.off, .obj, .stl; case-insensitive).
+/// Stanford PLY, ASCII or binary (either endianness): the "vertex" element's x, y, z (any numeric
+/// type) and the "face" element's vertex_indices (or vertex_index) lists, fan-triangulated; other
+/// elements and properties are skipped. Errors name the file and the element.
+Result<SurfaceMesh> parsePly(std::string_view bytes, const std::string& file);
+
+/// Reads a surface by the file's extension (.off, .obj, .stl, .ply; case-insensitive).
 Result<SurfaceMesh> readSurface(const std::filesystem::path& path);
 
 /// Makes the surface ready for tetgen and checks it is closed: refuses triangles with a repeated

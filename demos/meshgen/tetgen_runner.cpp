@@ -89,20 +89,13 @@ Result<fs::path> findTetgen(std::string_view command) {
 
 namespace {
 
-struct ProcessResult {
-  bool exited = false;
-  int exit_code = 0;
-  int signal = 0;
-  std::string out;
-  std::string err;
-};
-
 std::string slurp(const fs::path& path) {
   Result<std::string> text = readTextFile(path);
   return text ? std::move(text).value() : std::string();
 }
 
-// Runs argv[0] (a path) with stdin from /dev/null and stdout/stderr into files in `dir`.
+}  // namespace
+
 Result<ProcessResult> runProcess(const std::vector<std::string>& argv, const fs::path& dir) {
   const fs::path out_path = dir / "tetgen.stdout";
   const fs::path err_path = dir / "tetgen.stderr";
@@ -133,6 +126,8 @@ Result<ProcessResult> runProcess(const std::vector<std::string>& argv, const fs:
   result.err = slurp(err_path);
   return result;
 }
+
+namespace {
 
 // TetGen buffers stdout and aborts (uncaught exception) on most errors, which loses what it
 // printed; stdbuf -o0 makes its output unbuffered so the last lines survive.

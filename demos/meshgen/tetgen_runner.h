@@ -36,6 +36,19 @@ std::filesystem::path findOnPath(std::string_view name);
 /// package 'tetgen'); it is not on PATH".
 Result<std::filesystem::path> findTetgen(std::string_view command);
 
+/// How a program run by runProcess ended, and what it printed.
+struct ProcessResult {
+  bool exited = false;
+  int exit_code = 0;
+  int signal = 0;
+  std::string out;
+  std::string err;
+};
+
+/// Runs argv[0] (a path) with stdin from /dev/null and stdout/stderr into files in `dir`.
+Result<ProcessResult> runProcess(const std::vector<std::string>& argv,
+                                 const std::filesystem::path& dir);
+
 /// What one tetgen run left behind.
 struct TetgenRun {
   std::filesystem::path node;  ///< <input stem>.1.node

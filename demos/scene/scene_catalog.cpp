@@ -5,6 +5,8 @@
 #include <filesystem>
 #include <sstream>
 
+#include "data_directory.h"
+
 namespace torsion::scene {
 
 namespace fs = std::filesystem;
@@ -16,7 +18,8 @@ std::vector<std::string> sceneDirectories() {
     for (std::string dir; std::getline(list, dir, ':');)
       if (!dir.empty()) dirs.push_back(dir);
   }
-  dirs.emplace_back(TORSION_SCENES_DIR);
+  if (const std::optional<std::string> data = dataDirectory())
+    dirs.push_back((fs::path(*data) / "demos" / "scenes").string());
   return dirs;
 }
 

@@ -1,8 +1,9 @@
 #pragma once
 // The named demo scenes: `torsion run drop` finds demos/scenes/drop.json. A scene argument that
 // names an existing file is used as it is; a bare name (no directory, no extension) is looked up
-// in the scene directories: $TORSION_SCENE_PATH (colon-separated) first, then the source tree's
-// demos/scenes (the scenes refer to assets/ by relative paths, so they run from the tree).
+// in the scene directories: $TORSION_SCENE_PATH (colon-separated) first, then the demo scenes of
+// the installation or build tree the program runs from (data_directory.h; the scenes refer to
+// the assets by relative paths, so they run from either).
 
 #include <string>
 #include <vector>

@@ -264,6 +264,8 @@ Result<SceneSpec> parseScene(std::string_view text, const std::string& file_name
     if (root.has("solver")) scene.world.solver = readSolver(root.object("solver"));
     scene.steps = root.integer("steps", scene.steps);
     if (scene.steps < 1) root.fail("steps", "must be >= 1");
+    scene.vtk_every = root.integer("vtk_every", scene.vtk_every);  // ParaView series, 0: none
+    if (scene.vtk_every < 0) root.fail("vtk_every", "must be >= 0 (0: no series)");
 
     for (const JsonObject& b : root.objects("bodies")) {
       BodySpec body;

@@ -9,6 +9,7 @@
 #include <sstream>
 
 #include "run_directory.h"
+#include "run_provenance.h"
 #include "scene_anomalies.h"
 #include "scene_haptics.h"
 #include "torsion/bullet/rigid_health.h"
@@ -189,6 +190,7 @@ class Run {
       for (const std::string& log : scene_.haptics->logFileNames())
         names.push_back(log);
     }
+    names.insert(names.end(), options_.extra_outputs.begin(), options_.extra_outputs.end());
     return names;
   }
 
@@ -294,6 +296,7 @@ class Run {
 
   nlohmann::json summary() const {
     nlohmann::json summary;
+    addProvenance(summary);  // schema, version, git commit (run_provenance.h)
     summary["completed"] = outcome_.completed;
     if (outcome_.stopped_by != 0) summary["stopped_by"] = signalName(outcome_.stopped_by);
     if (!error_.empty()) summary["error"] = error_;
@@ -345,6 +348,7 @@ class Run {
     summary["stable"] = outcome_.stable;
     if (!outcome_.stable) summary["failure"] = outcome_.failure;
     summary["outputs"] = outputNames();
+    if (!last_good_.empty()) summary["final_state_hash"] = finalStateHash(scene_, last_good_);
     return summary;
   }
 

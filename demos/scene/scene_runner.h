@@ -14,6 +14,7 @@
 
 #include <functional>
 #include <string>
+#include <vector>
 
 #include "scene_builder.h"
 
@@ -29,6 +30,9 @@ struct RunOptions {
   /// Polled after every step: a signal number (SIGINT, SIGTERM) stops the run there, with every
   /// output written for the steps done; 0 goes on.
   std::function<int()> stop_requested;
+  /// Files the caller writes into the directory besides the runner's own (e.g. "series.pvd"):
+  /// listed in summary.json's "outputs", so the next run there removes them (run_directory.h).
+  std::vector<std::string> extra_outputs;
 };
 
 struct RunOutcome {

@@ -114,6 +114,7 @@ struct SceneSpec {
   std::string name;
   WorldSettings world;
   int steps = 100;
+  int vtk_every = 0;  ///< steps between the files of the ParaView series (0: none; run_command)
   std::vector<BodySpec> bodies;
   std::vector<NodeSetSpec> node_sets;
   std::vector<HandSpec> hands;

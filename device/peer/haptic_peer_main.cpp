@@ -10,6 +10,7 @@
 #include <signal.h>
 #include <time.h>
 
+#include <CLI/CLI.hpp>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -36,22 +37,6 @@ double monotonicSeconds() {
   return static_cast<double>(ts.tv_sec) + 1e-9 * static_cast<double>(ts.tv_nsec);
 }
 
-int usage(const std::string& problem) {
-  std::fprintf(stderr,
-               "error: %s\n"
-               "usage: torsion_haptic_peer --trajectory FILE [--port P] [--host 127.0.0.1] "
-               "[--rate HZ] [--log FILE] [--key-file FILE]\n",
-               problem.c_str());
-  return 1;
-}
-
-// Whole-string numbers only: "12abc" or "" is an error, not 12 or 0.
-bool parseNumber(const char* text, double& out) {
-  char* end = nullptr;
-  out = std::strtod(text, &end);
-  return end != text && *end == '\0' && std::isfinite(out);
-}
-
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -60,37 +45,35 @@ int main(int argc, char** argv) {
   int port = 5750;
   double rate = 1000;
   std::string key_path;
-  for (int k = 1; k < argc; ++k) {
+  CLI::App app{
+      "torsion_haptic_peer: sends a scripted device trajectory to a simulation's network "
+      "device over UDP and receives the wrenches (docs/haptics.md)"};
+  app.add_option("--trajectory", trajectory_path, "Trajectory file (JSON)")->required();
+  app.add_option("--port", port, "The simulation's UDP port")
+      ->check(CLI::Range(1, 65535))
+      ->capture_default_str();
+  app.add_option("--host", host, "The simulation's IPv4 address")->capture_default_str();
+  app.add_option("--rate", rate, "Poses sent per second (Hz)")
+      ->check(CLI::Range(1e-3, 1e6))
+      ->capture_default_str();
+  app.add_option("--log", log_path, "Write the received wrenches to this CSV file");
+  app.add_option("--key-file", key_path,
+                 "Shared key file: sign packets (docs/haptics.md, \"Authentication\"); also "
+                 "TORSION_HAPTIC_KEY_FILE or TORSION_HAPTIC_KEY in the environment");
+  for (int k = 1; k < argc; ++k) {  // refused before parsing: never echoed, never used
     const std::string a = argv[k];
-    const bool has_value = k + 1 < argc;
-    double number = 0;
-    if (a == "--trajectory" && has_value) {
-      trajectory_path = argv[++k];
-    } else if (a == "--port" && has_value) {
-      if (!parseNumber(argv[++k], number) || number != std::floor(number) || number < 1 ||
-          number > 65535)
-        return usage("--port: expected a whole number in [1, 65535]");
-      port = static_cast<int>(number);
-    } else if (a == "--host" && has_value) {
-      host = argv[++k];
-    } else if (a == "--rate" && has_value) {
-      if (!parseNumber(argv[++k], number) || !(number > 0) || number > 1e6)
-        return usage("--rate: expected a number of Hz in (0, 1e6]");
-      rate = number;
-    } else if (a == "--log" && has_value) {
-      log_path = argv[++k];
-    } else if (a == "--key-file" && has_value) {
-      key_path = argv[++k];
-    } else if (a == "--key") {
-      return usage(
-          "--key: a key on the command line is visible to every local user; put it in "
-          "a file (--key-file) or in TORSION_HAPTIC_KEY");
-    } else {
-      return usage(has_value || a.rfind("--", 0) != 0 ? "unexpected argument '" + a + "'"
-                                                      : a + " needs a value");
+    if (a == "--key" || a.rfind("--key=", 0) == 0) {
+      std::fprintf(stderr,
+                   "error: --key: a key on the command line is visible to every local user; put "
+                   "it in a file (--key-file) or in TORSION_HAPTIC_KEY\n");
+      return 1;
     }
   }
-  if (trajectory_path.empty()) return usage("--trajectory is required");
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    return e.get_exit_code() == 0 ? app.exit(e) : (app.exit(e), 2);  // usage errors: exit 2
+  }
   std::optional<PacketKey> key;
   if (!key_path.empty()) {
     Loaded<PacketKey> loaded = PacketKey::fromFile(key_path);

@@ -380,7 +380,12 @@ EOF
     printf 'ply\n' >h.ply
     run "$torsion" mesh tetrahedralize h.ply -o h.node
     expect_rc nonzero
-    expect_out "^error: h.ply: unknown surface format '.ply' \(known: .off, .obj, .stl\)$"
+    expect_out "^error: h.ply: no 'end_header' line$"
+
+    printf 'solid\n' >i.wrl
+    run "$torsion" mesh tetrahedralize i.wrl -o i.node
+    expect_rc nonzero
+    expect_out "^error: i.wrl: unknown surface format '.wrl' \(known: .off, .obj, .stl, .ply\)$"
 
     run "$torsion" mesh tetrahedralize missing.off -o m.node
     expect_rc nonzero

@@ -1,6 +1,10 @@
 #include "torsion/solve/cholmod_solver.h"
 
+#if TORSION_WITH_CHOLMOD
 #include <Eigen/CholmodSupport>
+#else
+#include <Eigen/SparseCholesky>
+#endif
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -25,12 +29,24 @@ struct CholmodSolver::Impl {
   std::vector<int> patch_nodes;
   std::vector<Eigen::Vector3d> patch_weights;
   bool analysed = false;
+#if TORSION_WITH_CHOLMOD
   Eigen::CholmodDecomposition<Eigen::SparseMatrix<double>, Eigen::Lower> factor;
+#else
+  Eigen::SimplicialLLT<Eigen::SparseMatrix<double>, Eigen::Lower> factor;
+#endif
   Eigen::VectorXd rhs, prescribed, q, solution;
 };
 
 CholmodSolver::CholmodSolver() : impl_(std::make_unique<Impl>()) {}
 CholmodSolver::~CholmodSolver() = default;
+
+const char* CholmodSolver::backend() {
+#if TORSION_WITH_CHOLMOD
+  return "CHOLMOD";
+#else
+  return "Eigen SimplicialLLT";
+#endif
+}
 
 void CholmodSolver::buildPattern(const SystemOperator& op) {
   const int n = op.model().nodeCount();

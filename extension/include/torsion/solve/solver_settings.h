@@ -9,7 +9,8 @@ namespace torsion {
 
 enum class LinearSolverKind {
   kConjugateGradient,  ///< matrix-free preconditioned CG, warm-started from the last velocity
-  kCholmod,            ///< sparse direct Cholesky (SuiteSparse CHOLMOD), assembled every step
+  kCholmod,            ///< sparse direct Cholesky, assembled every step: SuiteSparse CHOLMOD, or
+                       ///< Eigen's SimplicialLLT in a build with TORSION_CHOLMOD=OFF
 };
 
 enum class PreconditionerKind {

@@ -1,0 +1,48 @@
+#pragma once
+// `torsion run --vtk-every N` (scene key "vtk_every"): a ParaView time series of the run in
+// <out>/series.pvd, one .vtu per written step per body in <out>/series/:
+//   <body>_<step>.vtu        FEM body: the nodes where they are; point data displacement (m) and
+//                            velocity (m/s); cell data von_mises (Pa), strain (max |s_i - 1|,
+//                            deformation_metrics.h) and inverted (1 when det F <= 0); tet4 as
+//                            VTK_TETRA, tet10 as VTK_QUADRATIC_TETRA (then stress and strain are
+//                            the element's: volume mean and maximum over its 8 sub-tets); field
+//                            data TimeValue, step and the wrench [fx fy fz tx ty tz] of each node
+//                            set and hand on the body ("wrench_<name>", N and N m)
+//   rigid_<name>_<step>.vtu  rigid body: its surface (rigid_surface.h) in its pose; field data
+//                            TimeValue, step, position (m) and orientation [qx qy qz qw]
+// Steps 0, N, 2N, ... and the last step are written. series/ is emptied of .vtu files when a
+// series starts; series.pvd is rewritten (whole) after each written step, so a stopped run leaves
+// a series ParaView opens.
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "scene_builder.h"
+#include "torsion/result.h"
+#include "vtu_writer.h"
+
+namespace torsion::cli {
+
+class VtkSeries {
+ public:
+  /// Empties <out_dir>/series of .vtu files and writes step 0.
+  static Result<std::unique_ptr<VtkSeries>> start(const std::string& out_dir, int every,
+                                                  const scene::BuiltScene& scene);
+
+  /// After step `step` of `total`: writes it when it is due (every N-th, or the last).
+  Status onStep(const scene::BuiltScene& scene, int step, int total);
+
+  int stepsWritten() const { return steps_written_; }
+
+ private:
+  VtkSeries(std::string out_dir, int every) : out_dir_(std::move(out_dir)), every_(every) {}
+  Status write(const scene::BuiltScene& scene, int step);
+
+  std::string out_dir_;
+  int every_ = 1;
+  int steps_written_ = 0;
+  std::vector<PvdEntry> entries_;
+};
+
+}  // namespace torsion::cli

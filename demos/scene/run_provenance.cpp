@@ -1,0 +1,53 @@
+#include "run_provenance.h"
+
+#include <LinearMath/btScalar.h>
+
+#include <cstdint>
+#include <cstdio>
+
+#include "build_info.h"
+
+namespace torsion::scene {
+
+namespace {
+
+struct Fnv1a {
+  std::uint64_t h = 14695981039346656037ull;
+  void add(const void* data, size_t n) {
+    const auto* p = static_cast<const unsigned char*>(data);
+    for (size_t i = 0; i < n; ++i) {
+      h ^= p[i];
+      h *= 1099511628211ull;
+    }
+  }
+  void add(double v) { add(&v, sizeof v); }
+};
+
+}  // namespace
+
+void addProvenance(nlohmann::json& summary) {
+  summary["schema_version"] = kSummarySchemaVersion;
+  summary["torsion_version"] = torsionVersion();
+  summary["git_commit"] = torsionGitCommit();
+  summary["bullet_precision"] = sizeof(btScalar) == 8 ? "double" : "float";
+}
+
+std::string finalStateHash(const BuiltScene& scene,
+                           const std::vector<Eigen::VectorXd>& final_positions) {
+  Fnv1a fnv;
+  for (const Eigen::VectorXd& x : final_positions)
+    fnv.add(x.data(), sizeof(double) * static_cast<size_t>(x.size()));
+  for (const SceneRigidBody& r : scene.rigid_bodies) {
+    const btTransform& t = r.body->getCenterOfMassTransform();
+    const btQuaternion q = t.getRotation();
+    for (int a = 0; a < 3; ++a)
+      fnv.add(static_cast<double>(t.getOrigin()[a]));
+    for (const btScalar c : {q.x(), q.y(), q.z(), q.w()})
+      fnv.add(static_cast<double>(c));
+  }
+  char hex[17];
+  std::snprintf(hex, sizeof hex, "%016llx", static_cast<unsigned long long>(fnv.h));
+  return hex;
+}
+
+}  // namespace torsion::scene
