@@ -21,6 +21,8 @@ packages=(
   libgtest-dev libbenchmark-dev clang libclang-rt-14-dev
   # mesh generation (`torsion mesh cylinder` runs the tetgen command)
   tetgen
+  # static analysis in CI (scripts/clang_tidy.sh, the committed .clang-tidy)
+  clang-tidy-14
 )
 
 missing=()

@@ -4,7 +4,7 @@
 //
 //   torsion_haptic_peer --trajectory assets/trajectories/figure_6_7.json [--port 5750]
 //                       [--rate 1000] [--log received.csv]
-#include <time.h>
+#include <time.h>  // NOLINT(modernize-deprecated-headers): POSIX clock_gettime and friends
 
 #include <cmath>
 #include <cstdio>
