@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
-# The whole test suite, from a fresh machine: set-up, Release build, every CTest test, the fast
-# tests again on float Bullet, then a clang build with ASan+UBSan that runs the unit tests again
-# and fuzzes each mesh reader for a bounded time. `.ci/run` calls exactly this.
+# The whole test suite, from a fresh machine: set-up, Release build, every CTest test, clang-tidy
+# over the libraries, the fast tests again on float Bullet, then a clang build with ASan+UBSan
+# that runs the unit tests again and fuzzes each mesh reader for a bounded time. `.ci/run` calls
+# exactly this.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 jobs=$(nproc 2>/dev/null || echo 2)
@@ -16,6 +17,8 @@ ctest --test-dir build -j"$jobs" --output-on-failure --timeout 900
 # The pytest suite is one CTest test (python.pytest); its own count of tests:
 grep -hEo "^[0-9]+ passed.* in [0-9.]+s" build/Testing/Temporary/LastTest.log | tail -1 |
   sed 's/^/== pytest (label python): /' || true
+echo "== clang-tidy (.clang-tidy) over extension/ and device/, from build/compile_commands.json"
+bash scripts/clang_tidy.sh build
 
 echo "== ThreadSanitizer build (build-tsan/, clang): the haptic loop's thread, its buffers, the runtime"
 cmake -S . -B build-tsan -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_CXX_COMPILER=clang++ \

@@ -71,28 +71,20 @@ class StopOnSignals {
   struct sigaction previous_term_ {};
 };
 
-// Exit codes: 0 done and stable, 1 bad input or output error, 3 the simulation went unstable,
-// 4 stopped at an anomaly (--stop-on-anomaly), 128 + signal when SIGINT (130) or SIGTERM (143)
-// stopped the run.
-int run(const RunArguments& args) {
+// The scene file, with --device / --haptics applied, built into a live world.
+Result<std::unique_ptr<scene::BuiltScene>> loadAndBuild(const RunArguments& args) {
   Result<scene::SceneSpec> spec = scene::loadScene(args.scene);
-  if (!spec) {
-    std::cerr << "error: " << spec.error().message << "\n";
-    return 1;
-  }
-  if (Status applied = scene::applyDeviceOverrides(spec.value(), args.devices); !applied) {
-    std::cerr << "error: " << applied.error().message << "\n";
-    return 1;
-  }
+  if (!spec) return spec.error();
+  if (Status applied = scene::applyDeviceOverrides(spec.value(), args.devices); !applied)
+    return applied.error();
   for (const std::string& w : scene::remoteDeviceWarnings(spec.value()))
     std::cerr << "warning: " << w << "\n";
-  Result<std::unique_ptr<scene::BuiltScene>> built =
-      scene::buildScene(std::move(spec).value(), args.threads);
-  if (!built) {
-    std::cerr << "error: " << built.error().message << "\n";
-    return 1;
-  }
-  scene::BuiltScene& s = *built.value();
+  return scene::buildScene(std::move(spec).value(), args.threads);
+}
+
+// On stderr: the build's warnings, the threads used, and unless --quiet each body's size and each
+// device hand (--verbose: the run's settings too).
+void describe(const RunArguments& args, const scene::BuiltScene& s) {
   for (const std::string& w : s.warnings)
     std::cerr << "warning: " << w << "\n";
   if (const int asked = s.world->settings().solver.threads;
@@ -101,7 +93,7 @@ int run(const RunArguments& args) {
               << Parallel::usableThreads(asked) << " cores: using "
               << Parallel::usableThreads(asked) << "\n";
   }
-  const bool normal = verbosity() != Verbosity::kQuiet;
+  if (verbosity() == Verbosity::kQuiet) return;
   if (verbosity() == Verbosity::kVerbose) {
     const SolverSettings& solver = s.world->settings().solver;
     std::cerr << "scene '" << device::printableExcerpt(s.spec.name) << "' from "
@@ -113,87 +105,94 @@ int run(const RunArguments& args) {
               << device::printableExcerpt(args.out, 200) << "/\n";
   }
   for (const auto& body : s.world->bodies()) {
-    if (!normal) break;
     std::cerr << "body '" << body->name() << "': " << body->model().nodeCount() << " nodes, "
               << body->model().elementCount()
               << (body->model().elementKind() == ElementKind::kTet10 ? " tet10 elements\n"
                                                                      : " tets\n");
   }
-  if (s.haptics && normal) {
+  if (s.haptics) {
     for (const std::string& line : s.haptics->describe())
       std::cerr << line << "\n";
   }
+}
 
-  std::unique_ptr<render::FrameRecorder> recorder;
-  if (!args.render.empty()) {
-    render::RecorderOptions ro;
-    ro.directory = args.render;
-    ro.every = args.render_every;
-    if (std::sscanf(args.render_size.c_str(), "%dx%d", &ro.width, &ro.height) != 2) {
-      std::cerr << "error: --render-size '" << args.render_size
-                << "': expected WxH, e.g. 800x600\n";
-      return 1;
-    }
-    Result<std::unique_ptr<render::FrameRecorder>> made = render::FrameRecorder::create(ro);
-    if (!made) {
-      std::cerr << "error: --render: " << made.error().message << "\n";
-      return 1;
-    }
-    recorder = std::move(made).value();
-    if (Status drawn = recorder->capture(s, 0); !drawn) {
-      std::cerr << "error: --render: " << drawn.error().message << "\n";
-      return 1;
-    }
-  }
+// --render DIR: the recorder with the first picture taken (null without --render).
+Result<std::unique_ptr<render::FrameRecorder>> startRecorder(const RunArguments& args,
+                                                             scene::BuiltScene& s) {
+  if (args.render.empty()) return std::unique_ptr<render::FrameRecorder>();
+  render::RecorderOptions ro;
+  ro.directory = args.render;
+  ro.every = args.render_every;
+  if (std::sscanf(args.render_size.c_str(), "%dx%d", &ro.width, &ro.height) != 2)
+    return Error{"--render-size '" + args.render_size + "': expected WxH, e.g. 800x600"};
+  Result<std::unique_ptr<render::FrameRecorder>> made = render::FrameRecorder::create(ro);
+  if (!made) return Error{"--render: " + made.error().message};
+  if (Status drawn = made.value()->capture(s, 0); !drawn)
+    return Error{"--render: " + drawn.error().message};
+  return made;
+}
 
-  std::unique_ptr<VtkSeries> series;
-  if (const int every = args.vtk_every >= 0 ? args.vtk_every : s.spec.vtk_every; every > 0) {
-    Result<std::unique_ptr<VtkSeries>> started = VtkSeries::start(args.out, every, s);
-    if (!started) {
-      std::cerr << "error: --vtk-every: " << started.error().message << "\n";
-      return 1;
-    }
-    series = std::move(started).value();
-  }
-  std::string series_error;
+// --vtk-every N (or the scene's vtk_every): the ParaView series started (null without one).
+Result<std::unique_ptr<VtkSeries>> startSeries(const RunArguments& args, scene::BuiltScene& s) {
+  const int every = args.vtk_every >= 0 ? args.vtk_every : s.spec.vtk_every;
+  if (every <= 0) return std::unique_ptr<VtkSeries>();
+  Result<std::unique_ptr<VtkSeries>> started = VtkSeries::start(args.out, every, s);
+  if (!started) return Error{"--vtk-every: " + started.error().message};
+  return started;
+}
 
+struct Ran {
+  Result<scene::RunOutcome> outcome = Error{};
+  std::string render_error;  ///< the first picture that could not be drawn ("" when none)
+  std::string series_error;  ///< the first series step that could not be written
+};
+
+// The headless run with a progress bar, a picture every --render-every steps, and SIGINT /
+// SIGTERM stopping it at the end of a step.
+Ran runWithProgress(const RunArguments& args, scene::BuiltScene& s,
+                    render::FrameRecorder* recorder, VtkSeries* series) {
+  Ran ran;
+  const bool normal = verbosity() != Verbosity::kQuiet;
   ProgressBar bar(device::printableExcerpt(s.spec.name));  // the label goes out through stdio
   scene::RunOptions options;
   options.output_directory = args.out;
   options.steps = args.steps;
   options.stop_on_anomaly = args.stop_on_anomaly;
   if (series) options.extra_outputs.push_back("series.pvd");
-  std::string render_error;
   options.progress = [&](int done, int total, double rate) {
     if (normal) bar.update(done, total, rate);
-    if (recorder && render_error.empty()) {
+    if (recorder && ran.render_error.empty()) {
       Status drawn = done == total ? recorder->capture(s, rate) : recorder->onStep(s, rate);
-      if (!drawn) render_error = drawn.error().message;
+      if (!drawn) ran.render_error = drawn.error().message;
     }
-    if (series && series_error.empty()) {
+    if (series && ran.series_error.empty()) {
       Status written = series->onStep(s, done, total);
-      if (!written) series_error = written.error().message;
+      if (!written) ran.series_error = written.error().message;
     }
   };
   options.stop_requested = [] { return static_cast<int>(g_stop_signal); };
-  Result<scene::RunOutcome> outcome = Error{};
   {
     StopOnSignals stop_on_signals;
-    outcome = scene::runScene(s, options);
+    ran.outcome = scene::runScene(s, options);
   }
   if (normal) bar.finish();
-  if (!outcome) {
-    std::cerr << "error: " << outcome.error().message << "\n";
-    return 1;
-  }
-  if (!series_error.empty()) {
-    std::cerr << "error: --vtk-every: " << series_error << "\n";
-    return 1;
-  }
-  if (!render_error.empty()) {
-    std::cerr << "error: --render: " << render_error << "\n";
-    return 1;
-  }
+  return ran;
+}
+
+int fail(const std::string& message) {
+  std::cerr << "error: " << message << "\n";
+  return 1;
+}
+
+// Exit codes: 0 done and stable, 1 bad input or output error, 3 the simulation went unstable,
+// 4 stopped at an anomaly (--stop-on-anomaly), 128 + signal when SIGINT (130) or SIGTERM (143)
+// stopped the run.
+int reportOutcome(const RunArguments& args, const scene::BuiltScene& s, const Ran& ran,
+                  render::FrameRecorder* recorder, const VtkSeries* series) {
+  const bool normal = verbosity() != Verbosity::kQuiet;
+  if (!ran.outcome) return fail(ran.outcome.error().message);
+  if (!ran.series_error.empty()) return fail("--vtk-every: " + ran.series_error);
+  if (!ran.render_error.empty()) return fail("--render: " + ran.render_error);
   if (s.haptics) {
     for (const std::string& w : s.haptics->warnings())
       std::cerr << "warning: haptics: " << w << "\n";
@@ -205,28 +204,43 @@ int run(const RunArguments& args) {
     const std::string pictures = recorder->finish(s.spec.name);
     if (normal) std::cerr << "pictures: " << pictures << "\n";
   }
-  if (const int signal = outcome.value().stopped_by; signal != 0) {
+  const scene::RunOutcome& outcome = ran.outcome.value();
+  if (const int signal = outcome.stopped_by; signal != 0) {
     std::cerr << "stopped by " << (signal == SIGINT ? "SIGINT" : "SIGTERM") << " after "
-              << outcome.value().steps_done << " steps; results so far in " << args.out
+              << outcome.steps_done << " steps; results so far in " << args.out
               << "/ (summary.json says \"completed\": false)\n";
     return 128 + signal;
   }
-  if (!outcome.value().stable) {
-    std::cerr << "error: simulation unstable: " << outcome.value().failure << "\n"
+  if (!outcome.stable) {
+    std::cerr << "error: simulation unstable: " << outcome.failure << "\n"
               << "results up to the last good step are in " << args.out << "/\n";
     return 3;
   }
-  if (!outcome.value().stopped_on_anomaly.empty()) {
-    std::cerr << "error: stopped at the first anomaly: " << outcome.value().stopped_on_anomaly
+  if (!outcome.stopped_on_anomaly.empty()) {
+    std::cerr << "error: stopped at the first anomaly: " << outcome.stopped_on_anomaly
               << "\nresults up to that step are in " << args.out << "/\n";
     return 4;
   }
   if (!normal) return 0;
-  std::cerr << "done: " << outcome.value().steps_done << " steps; results in " << args.out
+  std::cerr << "done: " << outcome.steps_done << " steps; results in " << args.out
             << "/ (summary.json, wrench.csv, energy.csv, "
             << (s.rigid_bodies.empty() ? "" : "rigid.csv, ") << "one .vtk per body"
             << (s.haptics ? ", haptic_<hand>.csv per device hand" : "") << ")\n";
   return 0;
+}
+
+// `torsion run` as its stages; the exit code as reportOutcome documents it.
+int run(const RunArguments& args) {
+  Result<std::unique_ptr<scene::BuiltScene>> built = loadAndBuild(args);
+  if (!built) return fail(built.error().message);
+  scene::BuiltScene& s = *built.value();
+  describe(args, s);
+  Result<std::unique_ptr<render::FrameRecorder>> recorder = startRecorder(args, s);
+  if (!recorder) return fail(recorder.error().message);
+  Result<std::unique_ptr<VtkSeries>> series = startSeries(args, s);
+  if (!series) return fail(series.error().message);
+  const Ran ran = runWithProgress(args, s, recorder.value().get(), series.value().get());
+  return reportOutcome(args, s, ran, recorder.value().get(), series.value().get());
 }
 
 }  // namespace

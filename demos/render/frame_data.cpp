@@ -100,6 +100,97 @@ std::vector<std::vector<int>> restStripes(const TetMesh& mesh) {
   return stripes;
 }
 
+namespace {
+
+// Per node: the area-weighted normal of the surface triangles around it (+z where there is none).
+std::vector<Eigen::Vector3f> surfaceNormals(const FemBody& body) {
+  const TetMesh& mesh = body.model().mesh();
+  const int n = mesh.nodeCount();
+  std::vector<Eigen::Vector3d> normals(static_cast<size_t>(n), Eigen::Vector3d::Zero());
+  for (const Triangle& tri : mesh.surfaceTriangles()) {
+    const Eigen::Vector3d a = body.state().position(tri[0]);
+    const Eigen::Vector3d area_normal =
+        (body.state().position(tri[1]) - a).cross(body.state().position(tri[2]) - a);
+    for (int v : tri)
+      normals[static_cast<size_t>(v)] += area_normal;
+  }
+  std::vector<Eigen::Vector3f> unit(static_cast<size_t>(n));
+  for (int i = 0; i < n; ++i) {
+    const double len = normals[static_cast<size_t>(i)].norm();
+    unit[static_cast<size_t>(i)] = (len > 0 ? Eigen::Vector3d(normals[static_cast<size_t>(i)] / len)
+                                            : Eigen::Vector3d::UnitZ())
+                                       .cast<float>();
+  }
+  return unit;
+}
+
+// Per node: volume-weighted mean of its tets' von Mises stress.
+std::vector<float> nodalStress(const FemBody& body) {
+  const TetMesh& mesh = body.model().mesh();
+  const std::vector<double> tet_stress = tetVonMises(body);
+  std::vector<float> stress(static_cast<size_t>(mesh.nodeCount()));
+  for (int i = 0; i < mesh.nodeCount(); ++i) {
+    double sum = 0, weight = 0;
+    for (int k = mesh.nodeTets().rowBegin(i); k < mesh.nodeTets().rowEnd(i); ++k) {
+      const int t = mesh.nodeTets().items[static_cast<size_t>(k)];
+      const double v = body.model().tetRestData()[static_cast<size_t>(t)].volume;
+      sum += v * tet_stress[static_cast<size_t>(t)];
+      weight += v;
+    }
+    stress[static_cast<size_t>(i)] = static_cast<float>(weight > 0 ? sum / weight : 0.0);
+  }
+  return stress;
+}
+
+// One FEM body: positions (extending the frame's bounds), surface with normals, the rest-shape
+// stripes and the nodal stress.
+BodyDrawData bodyDrawData(const FemBody& body, Eigen::AlignedBox3d& bounds) {
+  const TetMesh& mesh = body.model().mesh();
+  const int n = mesh.nodeCount();
+  BodyDrawData d;
+  d.name = body.name();
+  d.positions.resize(static_cast<size_t>(n));
+  for (int i = 0; i < n; ++i) {
+    d.positions[static_cast<size_t>(i)] = body.state().position(i).cast<float>();
+    bounds.extend(body.state().position(i));
+  }
+  for (const Triangle& tri : mesh.surfaceTriangles())
+    d.triangles.push_back({tri[0], tri[1], tri[2]});
+  d.stripes = restStripes(mesh);
+  d.normals = surfaceNormals(body);
+  d.stress = nodalStress(body);
+  return d;
+}
+
+// One hand: its frame, and a square covering the grabbed patch with a margin (or a tenth of the
+// scene); the nodes it holds are marked on their body.
+HandDrawData handDrawData(const scene::SceneHand& h, double time, FrameData& frame) {
+  HandDrawData d;
+  d.name = h.spec.name;
+  d.frame = h.hand->grabbed() ? h.hand->frame() : h.spec.frameAt(time);
+  d.holding = h.hand->grabbed();
+  double reach = 0;
+  if (d.holding) {
+    const FemBody& body = h.hand->body();
+    for (int i : h.hand->grabbedNodes())
+      reach = std::max(reach, (body.state().position(i) - d.frame.origin).norm());
+    for (BodyDrawData& b : frame.bodies) {
+      if (b.name == body.name()) {
+        b.grabbed_nodes.insert(b.grabbed_nodes.end(), h.hand->grabbedNodes().begin(),
+                               h.hand->grabbedNodes().end());
+      }
+    }
+  }
+  d.plane_half_size = reach > 0
+                          ? 1.3 * reach
+                          : 0.1 * (frame.bounds.isEmpty() ? 1.0 : frame.bounds.diagonal().norm());
+  return d;
+}
+
+}  // namespace
+
+// The frame as its stages: the header, the FEM bodies, the hands and wrenches, the rigid bodies,
+// then the bounds and the stress scale over all of them.
 FrameData captureFrame(scene::BuiltScene& scene, double steps_per_second) {
   FemWorld& world = *scene.world;
   FrameData frame;
@@ -115,76 +206,15 @@ FrameData captureFrame(scene::BuiltScene& scene, double steps_per_second) {
   for (const auto& body : world.bodies())
     stress_max = std::max(stress_max, 1e-6 * body->model().material().youngs_modulus);
 
-  for (const auto& body_ptr : world.bodies()) {
-    const FemBody& body = *body_ptr;
-    const TetMesh& mesh = body.model().mesh();
-    const int n = mesh.nodeCount();
-    BodyDrawData d;
-    d.name = body.name();
-    d.positions.resize(static_cast<size_t>(n));
-    for (int i = 0; i < n; ++i) {
-      d.positions[static_cast<size_t>(i)] = body.state().position(i).cast<float>();
-      frame.bounds.extend(body.state().position(i));
-    }
-    std::vector<Eigen::Vector3d> normals(static_cast<size_t>(n), Eigen::Vector3d::Zero());
-    for (const Triangle& tri : mesh.surfaceTriangles()) {
-      const Eigen::Vector3d a = body.state().position(tri[0]);
-      const Eigen::Vector3d area_normal =
-          (body.state().position(tri[1]) - a).cross(body.state().position(tri[2]) - a);
-      for (int v : tri)
-        normals[static_cast<size_t>(v)] += area_normal;
-      d.triangles.push_back({tri[0], tri[1], tri[2]});
-    }
-    d.stripes = restStripes(mesh);
-    d.normals.resize(static_cast<size_t>(n));
-    for (int i = 0; i < n; ++i) {
-      const double len = normals[static_cast<size_t>(i)].norm();
-      d.normals[static_cast<size_t>(i)] =
-          (len > 0 ? Eigen::Vector3d(normals[static_cast<size_t>(i)] / len)
-                   : Eigen::Vector3d::UnitZ())
-              .cast<float>();
-    }
-    // Per node: volume-weighted mean of its tets' von Mises stress.
-    const std::vector<double> tet_stress = tetVonMises(body);
-    d.stress.resize(static_cast<size_t>(n));
-    for (int i = 0; i < n; ++i) {
-      double sum = 0, weight = 0;
-      for (int k = mesh.nodeTets().rowBegin(i); k < mesh.nodeTets().rowEnd(i); ++k) {
-        const int t = mesh.nodeTets().items[static_cast<size_t>(k)];
-        const double v = body.model().tetRestData()[static_cast<size_t>(t)].volume;
-        sum += v * tet_stress[static_cast<size_t>(t)];
-        weight += v;
-      }
-      d.stress[static_cast<size_t>(i)] = static_cast<float>(weight > 0 ? sum / weight : 0.0);
-    }
-    for (int i : mesh.surfaceNodes())
-      stress_max = std::max(stress_max, static_cast<double>(d.stress[static_cast<size_t>(i)]));
-    frame.bodies.push_back(std::move(d));
+  for (const auto& body : world.bodies()) {
+    frame.bodies.push_back(bodyDrawData(*body, frame.bounds));
+    for (int i : body->model().mesh().surfaceNodes())
+      stress_max = std::max(
+          stress_max, static_cast<double>(frame.bodies.back().stress[static_cast<size_t>(i)]));
   }
-
-  for (scene::SceneHand& h : scene.hands) {
-    HandDrawData d;
-    d.name = h.spec.name;
-    d.frame = h.hand->grabbed() ? h.hand->frame() : h.spec.frameAt(world.time());
-    d.holding = h.hand->grabbed();
-    // The drawn square covers the grabbed patch with a margin (or a tenth of the scene).
-    double reach = 0;
-    if (d.holding) {
-      const FemBody& body = h.hand->body();
-      for (int i : h.hand->grabbedNodes())
-        reach = std::max(reach, (body.state().position(i) - d.frame.origin).norm());
-      for (BodyDrawData& b : frame.bodies) {
-        if (b.name == body.name()) {
-          b.grabbed_nodes.insert(b.grabbed_nodes.end(), h.hand->grabbedNodes().begin(),
-                                 h.hand->grabbedNodes().end());
-        }
-      }
-    }
-    d.plane_half_size = reach > 0
-                            ? 1.3 * reach
-                            : 0.1 * (frame.bounds.isEmpty() ? 1.0 : frame.bounds.diagonal().norm());
-    frame.bounds.extend(d.frame.origin);
-    frame.hands.push_back(d);
+  for (const scene::SceneHand& h : scene.hands) {
+    frame.hands.push_back(handDrawData(h, world.time(), frame));
+    frame.bounds.extend(frame.hands.back().frame.origin);
     const Wrench w = h.hand->wrench();
     frame.wrenches.push_back({h.spec.name, w.force, w.torque});
   }
@@ -192,7 +222,6 @@ FrameData captureFrame(scene::BuiltScene& scene, double steps_per_second) {
     const Wrench w = s.body->groupWrench(s.group, s.wrench_about);
     frame.wrenches.push_back({s.name, w.force, w.torque});
   }
-
   for (const btRigidBody* rb : world.rigidBodies()) {
     frame.rigids.push_back(rigidDrawData(*rb));
     extendBounds(frame.rigids.back(), frame.bounds);

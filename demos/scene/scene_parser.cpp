@@ -243,6 +243,104 @@ Frame HandSpec::frameAt(double t) const {
   return f;
 }
 
+namespace {
+
+std::string resolved(const std::string& path, const std::string& base_directory) {
+  const std::filesystem::path p(path);
+  return p.is_absolute() ? p.string() : (std::filesystem::path(base_directory) / p).string();
+}
+
+bool hasBody(const SceneSpec& scene, const std::string& name) {
+  bool known = false;
+  for (const BodySpec& body : scene.bodies)
+    known = known || body.name == name;
+  return known;
+}
+
+// name, gravity, solver, steps.
+void readWorld(const JsonObject& root, const std::string& file_name, SceneSpec& scene) {
+  scene.name = root.string("name", std::filesystem::path(file_name).stem().string());
+  scene.world.gravity = root.vector3("gravity", Eigen::Vector3d(0, 0, -9.81));
+  if (Status carried = checkGravity(scene.world.gravity); !carried)
+    root.fail("gravity", carried.error().message);
+  if (root.has("solver")) scene.world.solver = readSolver(root.object("solver"));
+  scene.steps = root.integer("steps", scene.steps);
+  if (scene.steps < 1) root.fail("steps", "must be >= 1");
+  scene.vtk_every = root.integer("vtk_every", scene.vtk_every);  // ParaView series, 0: none
+  if (scene.vtk_every < 0) root.fail("vtk_every", "must be >= 0 (0: no series)");
+}
+
+BodySpec readBody(const JsonObject& b, const SceneSpec& scene, const std::string& base_directory) {
+  BodySpec body;
+  body.name = b.name("name");
+  for (const BodySpec& other : scene.bodies) {
+    if (other.name == body.name) b.fail("name", "duplicate body name '" + body.name + "'");
+  }
+  const std::string mesh = b.string("mesh");
+  body.mesh_path = resolved(mesh, base_directory);
+  body.material = readMaterial(b.object("material"));
+  body.pose = readPose(b, "pose");
+  const std::string element = b.string("element", "tet4");
+  if (auto kind = parseElementKind(element)) {
+    body.element = *kind;
+  } else {
+    b.fail("element", "'" + element + "' is not an element kind (tet4 or tet10)");
+  }
+  if (body.element == ElementKind::kTet10 &&
+      body.material.volumetric_strain == VolumetricStrain::kNodalAverage) {
+    b.fail("material", "volumetric_strain nodal_average is a tet4 option (tet10 does not lock)");
+  }
+  b.finish();
+  return body;
+}
+
+NodeSetSpec readNodeSet(const JsonObject& s, const SceneSpec& scene) {
+  NodeSetSpec set;
+  set.name = s.name("name");
+  for (const NodeSetSpec& other : scene.node_sets) {
+    if (other.name == set.name) s.fail("name", "duplicate node set name '" + set.name + "'");
+  }
+  set.body = s.string("body");
+  if (!hasBody(scene, set.body)) s.fail("body", "no body named '" + set.body + "'");
+  set.selection = readSelection(s.object("select"));
+  set.fixed = !s.has("motion");
+  if (!set.fixed) set.motion = readMotion(s.object("motion"));
+  set.wrench_about = s.vector3("wrench_about", set.motion.pivot);
+  s.finish();
+  return set;
+}
+
+// A hand, checked against the bodies, the other hands and the node sets already read.
+HandSpec readSceneHand(const JsonObject& h, const SceneSpec& scene,
+                       const std::string& base_directory) {
+  HandSpec hand = readHand(h, base_directory);
+  if (!hasBody(scene, hand.body)) h.fail("body", "no body named '" + hand.body + "'");
+  for (const HandSpec& other : scene.hands) {
+    if (other.name == hand.name) h.fail("name", "duplicate hand name '" + hand.name + "'");
+  }
+  // Node sets and hands share wrench.csv's columns ("<name>.fx").
+  for (const NodeSetSpec& set : scene.node_sets) {
+    if (set.name == hand.name)
+      h.fail("name",
+             "'" + hand.name + "' is also a node set's name: both would be columns of wrench.csv");
+  }
+  return hand;
+}
+
+// Rigid bodies, the ground, a .bullet file and the camera.
+void readSurroundings(const JsonObject& root, const std::string& base_directory, SceneSpec& scene) {
+  for (const JsonObject& r : root.objects("rigid_bodies"))
+    scene.rigid_bodies.push_back(readRigidBody(r, scene.rigid_bodies));
+  if (root.has("ground")) scene.ground = readGround(root.object("ground"));
+  if (root.has("bullet_file"))
+    scene.bullet_file = resolved(root.string("bullet_file"), base_directory);
+  scene.camera = readCameraSpec(root);
+}
+
+}  // namespace
+
+// The scene as its stages: strict JSON, the world, the FEM bodies, the node sets, the hands, the
+// surroundings, then no unknown key and a valid world. Faults are SceneFaults (json_reader.h).
 Result<SceneSpec> parseScene(std::string_view text, const std::string& file_name,
                              const std::string& base_directory) {
   // A strict pass first: duplicate keys, numbers beyond a double and syntax, with a position.
@@ -257,90 +355,15 @@ Result<SceneSpec> parseScene(std::string_view text, const std::string& file_name
     SceneSpec scene;
     scene.file = file_name;
     const JsonObject root(json, "", file_name);
-    scene.name = root.string("name", std::filesystem::path(file_name).stem().string());
-    scene.world.gravity = root.vector3("gravity", Eigen::Vector3d(0, 0, -9.81));
-    if (Status carried = checkGravity(scene.world.gravity); !carried)
-      root.fail("gravity", carried.error().message);
-    if (root.has("solver")) scene.world.solver = readSolver(root.object("solver"));
-    scene.steps = root.integer("steps", scene.steps);
-    if (scene.steps < 1) root.fail("steps", "must be >= 1");
-    scene.vtk_every = root.integer("vtk_every", scene.vtk_every);  // ParaView series, 0: none
-    if (scene.vtk_every < 0) root.fail("vtk_every", "must be >= 0 (0: no series)");
-
-    for (const JsonObject& b : root.objects("bodies")) {
-      BodySpec body;
-      body.name = b.name("name");
-      for (const BodySpec& other : scene.bodies) {
-        if (other.name == body.name) b.fail("name", "duplicate body name '" + body.name + "'");
-      }
-      const std::string mesh = b.string("mesh");
-      const std::filesystem::path mesh_path(mesh);
-      body.mesh_path = mesh_path.is_absolute()
-                           ? mesh
-                           : (std::filesystem::path(base_directory) / mesh_path).string();
-      body.material = readMaterial(b.object("material"));
-      body.pose = readPose(b, "pose");
-      const std::string element = b.string("element", "tet4");
-      if (auto kind = parseElementKind(element)) {
-        body.element = *kind;
-      } else {
-        b.fail("element", "'" + element + "' is not an element kind (tet4 or tet10)");
-      }
-      if (body.element == ElementKind::kTet10 &&
-          body.material.volumetric_strain == VolumetricStrain::kNodalAverage) {
-        b.fail("material",
-               "volumetric_strain nodal_average is a tet4 option (tet10 does not lock)");
-      }
-      b.finish();
-      scene.bodies.push_back(std::move(body));
-    }
+    readWorld(root, file_name, scene);
+    for (const JsonObject& b : root.objects("bodies"))
+      scene.bodies.push_back(readBody(b, scene, base_directory));
     if (scene.bodies.empty()) root.fail("bodies", "a scene needs at least one FEM body");
-
-    for (const JsonObject& s : root.objects("node_sets")) {
-      NodeSetSpec set;
-      set.name = s.name("name");
-      for (const NodeSetSpec& other : scene.node_sets) {
-        if (other.name == set.name) s.fail("name", "duplicate node set name '" + set.name + "'");
-      }
-      set.body = s.string("body");
-      bool known = false;
-      for (const BodySpec& body : scene.bodies)
-        known = known || body.name == set.body;
-      if (!known) s.fail("body", "no body named '" + set.body + "'");
-      set.selection = readSelection(s.object("select"));
-      set.fixed = !s.has("motion");
-      if (!set.fixed) set.motion = readMotion(s.object("motion"));
-      set.wrench_about = s.vector3("wrench_about", set.motion.pivot);
-      s.finish();
-      scene.node_sets.push_back(std::move(set));
-    }
-    for (const JsonObject& h : root.objects("hands")) {
-      HandSpec hand = readHand(h, base_directory);
-      bool known = false;
-      for (const BodySpec& body : scene.bodies)
-        known = known || body.name == hand.body;
-      if (!known) h.fail("body", "no body named '" + hand.body + "'");
-      for (const HandSpec& other : scene.hands) {
-        if (other.name == hand.name) h.fail("name", "duplicate hand name '" + hand.name + "'");
-      }
-      // Node sets and hands share wrench.csv's columns ("<name>.fx").
-      for (const NodeSetSpec& set : scene.node_sets) {
-        if (set.name == hand.name)
-          h.fail("name", "'" + hand.name +
-                             "' is also a node set's name: both would be columns of wrench.csv");
-      }
-      scene.hands.push_back(std::move(hand));
-    }
-    for (const JsonObject& r : root.objects("rigid_bodies"))
-      scene.rigid_bodies.push_back(readRigidBody(r, scene.rigid_bodies));
-    if (root.has("ground")) scene.ground = readGround(root.object("ground"));
-    if (root.has("bullet_file")) {
-      const std::filesystem::path bullet_path(root.string("bullet_file"));
-      scene.bullet_file = bullet_path.is_absolute()
-                              ? bullet_path.string()
-                              : (std::filesystem::path(base_directory) / bullet_path).string();
-    }
-    scene.camera = readCameraSpec(root);
+    for (const JsonObject& s : root.objects("node_sets"))
+      scene.node_sets.push_back(readNodeSet(s, scene));
+    for (const JsonObject& h : root.objects("hands"))
+      scene.hands.push_back(readSceneHand(h, scene, base_directory));
+    readSurroundings(root, base_directory, scene);
     root.finish();
     Status world_ok = scene.world.validate();
     if (!world_ok) return Error{SceneFault{file_name, "", world_ok.error().message}.text()};

@@ -126,53 +126,14 @@ class Run {
       rigid_bodies_.push_back({r.name, r.body});
   }
 
+  // The run as its stages: open the outputs, step until done or stopped, write the rest.
   Result<RunOutcome> execute() {
     Result<RunDirectory> dir =
         RunDirectory::prepare(options_.output_directory, outputNames(), summary());
     if (!dir) return dir.error();
     dir_.emplace(std::move(dir).value());
     if (Status opened = openCsvs(); !opened) return fail(opened.error());
-
-    for (const auto& body : world_.bodies())
-      last_good_.push_back(body->state().positions);
-    const auto run_start = std::chrono::steady_clock::now();
-    if (scene_.haptics) scene_.haptics->prepareRun(steps_);
-    for (int k = 0; k < steps_; ++k) {
-      if (scene_.haptics) scene_.haptics->pace();  // threaded: wall-clock pacing, not step time
-      const auto t0 = std::chrono::steady_clock::now();
-      Result<WorldStepReport> stepped = stepScene(scene_);
-      if (!stepped) return fail(Error{scene_.spec.file + ": " + stepped.error().message});
-      const WorldStepReport& report = stepped.value();
-      step_ms_.push_back(
-          std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
-      if (!report.ok) {
-        outcome_.stable = false;
-        outcome_.failure = report.message;
-        break;
-      }
-      // Bullet lets a rigid body become NaN silently; such a step is no good step.
-      if (auto fault = findUnhealthyRigidBody(rigid_bodies_)) {
-        outcome_.stable = false;
-        outcome_.failure = "step " + std::to_string(report.step) + ": " + fault->message;
-        break;
-      }
-      outcome_.steps_done = k + 1;
-      if (Status recorded = recordStep(report); !recorded) return fail(recorded.error());
-      // Inverted tets, energy release, speed bursts (scene_anomalies.h): warned, optionally fatal.
-      if (anomalies_.observe(world_, report.step) && options_.stop_on_anomaly) {
-        outcome_.stopped_on_anomaly = anomalies_.firstWarning();
-        break;
-      }
-      if (options_.progress) {
-        const double elapsed =
-            std::chrono::duration<double>(std::chrono::steady_clock::now() - run_start).count();
-        options_.progress(k + 1, steps_, elapsed > 0 ? (k + 1) / elapsed : 0.0);
-      }
-      if (options_.stop_requested) {
-        outcome_.stopped_by = options_.stop_requested();
-        if (outcome_.stopped_by != 0) break;
-      }
-    }
+    if (Status stepped = stepUntilDoneOrStopped(); !stepped) return fail(stepped.error());
     if (Status finished = writeFinalOutputs(); !finished) return fail(finished.error());
     outcome_.completed = outcome_.stable && outcome_.stopped_by == 0 &&
                          outcome_.stopped_on_anomaly.empty() && outcome_.steps_done == steps_;
@@ -181,6 +142,79 @@ class Run {
   }
 
  private:
+  Status stepUntilDoneOrStopped() {
+    for (const auto& body : world_.bodies())
+      last_good_.push_back(body->state().positions);
+    run_start_ = std::chrono::steady_clock::now();
+    if (scene_.haptics) scene_.haptics->prepareRun(steps_);
+    for (int k = 0; k < steps_; ++k) {
+      Result<bool> go_on = runStep(k);
+      if (!go_on) return go_on.error();
+      if (!go_on.value()) break;
+    }
+    return Ok{};
+  }
+
+  // One step as its stages; false when the run ends with it (unstable, an anomaly, a signal).
+  Result<bool> runStep(int k) {
+    if (scene_.haptics) scene_.haptics->pace();  // threaded: wall-clock pacing, not step time
+    Result<WorldStepReport> stepped = timedStep();
+    if (!stepped) return Error{scene_.spec.file + ": " + stepped.error().message};
+    const WorldStepReport& report = stepped.value();
+    if (!stepWasGood(report)) return false;
+    outcome_.steps_done = k + 1;
+    if (Status recorded = recordStep(report); !recorded) return recorded.error();
+    if (stopsAtAnomaly(report.step)) return false;
+    reportProgress(k + 1);
+    return !stopWasRequested();
+  }
+
+  Result<WorldStepReport> timedStep() {
+    const auto t0 = std::chrono::steady_clock::now();
+    Result<WorldStepReport> stepped = stepScene(scene_);
+    if (stepped) {
+      step_ms_.push_back(
+          std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
+    }
+    return stepped;
+  }
+
+  // A step whose solve failed, or after which a rigid body is not finite, ends the run unstable.
+  bool stepWasGood(const WorldStepReport& report) {
+    if (!report.ok) {
+      outcome_.stable = false;
+      outcome_.failure = report.message;
+      return false;
+    }
+    // Bullet lets a rigid body become NaN silently; such a step is no good step.
+    if (auto fault = findUnhealthyRigidBody(rigid_bodies_)) {
+      outcome_.stable = false;
+      outcome_.failure = "step " + std::to_string(report.step) + ": " + fault->message;
+      return false;
+    }
+    return true;
+  }
+
+  // Inverted tets, energy release, speed bursts (scene_anomalies.h): warned, optionally fatal.
+  bool stopsAtAnomaly(int step) {
+    if (!anomalies_.observe(world_, step) || !options_.stop_on_anomaly) return false;
+    outcome_.stopped_on_anomaly = anomalies_.firstWarning();
+    return true;
+  }
+
+  void reportProgress(int done) const {
+    if (!options_.progress) return;
+    const double elapsed =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - run_start_).count();
+    options_.progress(done, steps_, elapsed > 0 ? done / elapsed : 0.0);
+  }
+
+  bool stopWasRequested() {
+    if (!options_.stop_requested) return false;
+    outcome_.stopped_by = options_.stop_requested();
+    return outcome_.stopped_by != 0;
+  }
+
   std::vector<std::string> outputNames() const {
     std::vector<std::string> names = {"wrench.csv", "energy.csv"};
     if (!scene_.rigid_bodies.empty()) names.push_back("rigid.csv");
@@ -361,6 +395,7 @@ class Run {
   CsvOutput wrench_csv_, energy_csv_, rigid_csv_;
   std::vector<Eigen::VectorXd> last_good_;
   RunOutcome outcome_;
+  std::chrono::steady_clock::time_point run_start_;
   std::vector<double> step_ms_;  // grows with the steps done, never reserved for the requested
   long iteration_sum_ = 0;
   int iteration_max_ = 0;

@@ -473,72 +473,76 @@ WindowState* stateOf(GLFWwindow* w) {
   return static_cast<WindowState*>(glfwGetWindowUserPointer(w));
 }
 
-}  // namespace
-
-int runViewer(const ViewerOptions& options) {
-  Result<scene::SceneSpec> spec = scene::loadScene(options.scene);
-  if (!spec) {
-    std::cerr << "error: " << spec.error().message << "\n";
-    return 1;
-  }
+// The scene file with --device / --haptics applied, and the --script events.
+struct ViewerInput {
+  scene::SceneSpec spec;
   std::vector<InputEvent> script;
+};
+
+Result<ViewerInput> loadInput(const ViewerOptions& options) {
+  Result<scene::SceneSpec> spec = scene::loadScene(options.scene);
+  if (!spec) return spec.error();
+  ViewerInput input;
   if (!options.script.empty()) {
     auto read = readScript(options.script);
-    if (!read) {
-      std::cerr << "error: " << read.error().message << "\n";
-      return 1;
-    }
-    script = std::move(read).value();
+    if (!read) return read.error();
+    input.script = std::move(read).value();
   }
-  if (Status applied = scene::applyDeviceOverrides(spec.value(), options.devices); !applied) {
-    std::cerr << "error: " << applied.error().message << "\n";
-    return 1;
-  }
+  if (Status applied = scene::applyDeviceOverrides(spec.value(), options.devices); !applied)
+    return applied.error();
   for (const std::string& w : scene::remoteDeviceWarnings(spec.value()))
     std::cerr << "warning: " << w << "\n";  // as `torsion run` says it
-  Viewer viewer(options, std::move(spec).value());
-  // Opens the devices too: a SpaceMouse without its daemon stops here, before any window.
-  if (Status built = viewer.rebuild(); !built) {
-    std::cerr << "error: " << built.error().message << "\n";
-    return 1;
-  }
-  for (const std::string& line : viewer.hapticsDescription())
-    std::cerr << line << "\n";
+  input.spec = std::move(spec).value();
+  return input;
+}
 
-  glfwSetErrorCallback([](int code, const char* text) {
-    std::cerr << "glfw error " << code << ": " << text << "\n";
-  });
-  if (!glfwInit()) {
-    std::cerr << "error: no display for a window (set DISPLAY, or run under xvfb-run)\n";
-    return 1;
+// The GLFW window with its OpenGL 2.1 context current and the GL entry points loaded; closing it
+// terminates GLFW.
+class ViewerWindow {
+ public:
+  static Result<std::unique_ptr<ViewerWindow>> open(const ViewerOptions& options) {
+    glfwSetErrorCallback([](int code, const char* text) {
+      std::cerr << "glfw error " << code << ": " << text << "\n";
+    });
+    if (!glfwInit()) return Error{"no display for a window (set DISPLAY, or run under xvfb-run)"};
+    glfwWindowHint(GLFW_CONTEXT_VERSION_MAJOR, 2);
+    glfwWindowHint(GLFW_CONTEXT_VERSION_MINOR, 1);
+    glfwWindowHint(GLFW_SAMPLES, 4);
+    GLFWwindow* window =
+        glfwCreateWindow(options.width, options.height, ("torsion view: " + options.scene).c_str(),
+                         nullptr, nullptr);
+    if (!window) {
+      glfwTerminate();
+      return Error{"could not open an OpenGL 2.1 window"};
+    }
+    auto opened = std::make_unique<ViewerWindow>(window);
+    glfwMakeContextCurrent(window);
+    glfwSwapInterval(options.frames > 0 ? 0 : 1);
+    const std::string missing = render::loadGlApi(opened->gl_, [](const char* name) -> void* {
+      return reinterpret_cast<void*>(glfwGetProcAddress(name));
+    });
+    if (!missing.empty()) return Error{"the OpenGL context lacks " + missing};
+    opened->gl_.Enable(GL_MULTISAMPLE);
+    return opened;
   }
-  glfwWindowHint(GLFW_CONTEXT_VERSION_MAJOR, 2);
-  glfwWindowHint(GLFW_CONTEXT_VERSION_MINOR, 1);
-  glfwWindowHint(GLFW_SAMPLES, 4);
-  GLFWwindow* window = glfwCreateWindow(
-      options.width, options.height, ("torsion view: " + options.scene).c_str(), nullptr, nullptr);
-  if (!window) {
+  explicit ViewerWindow(GLFWwindow* window) : window_(window) {}  ///< takes the window
+  ~ViewerWindow() {
+    glfwDestroyWindow(window_);
     glfwTerminate();
-    std::cerr << "error: could not open an OpenGL 2.1 window\n";
-    return 1;
   }
-  glfwMakeContextCurrent(window);
-  glfwSwapInterval(options.frames > 0 ? 0 : 1);
-  render::GlApi gl;
-  const std::string missing = render::loadGlApi(gl, [](const char* name) -> void* {
-    return reinterpret_cast<void*>(glfwGetProcAddress(name));
-  });
-  if (!missing.empty()) {
-    std::cerr << "error: the OpenGL context lacks " << missing << "\n";
-    glfwDestroyWindow(window);
-    glfwTerminate();
-    return 1;
-  }
-  gl.Enable(GL_MULTISAMPLE);
-  render::Renderer renderer(gl);
+  ViewerWindow(const ViewerWindow&) = delete;
+  ViewerWindow& operator=(const ViewerWindow&) = delete;
 
-  WindowState state;
-  state.viewer = &viewer;
+  GLFWwindow* handle() const { return window_; }
+  const render::GlApi& gl() const { return gl_; }
+
+ private:
+  GLFWwindow* window_;
+  render::GlApi gl_;
+};
+
+// Keys, drags (Ctrl for the hand) and the wheel reach the viewer through the window's state.
+void connectInput(GLFWwindow* window, WindowState& state) {
   glfwSetWindowUserPointer(window, &state);
   glfwSetKeyCallback(window, [](GLFWwindow* w, int key, int, int action, int mods) {
     if (action == GLFW_PRESS || action == GLFW_REPEAT)
@@ -560,18 +564,41 @@ int runViewer(const ViewerOptions& options) {
   });
   glfwSetScrollCallback(window,
                         [](GLFWwindow* w, double, double dy) { stateOf(w)->viewer->onScroll(dy); });
+}
 
+// The framebuffer as drawn (GL rows go bottom to top) into a PNG.
+void writeScreenshot(const render::GlApi& gl, int width, int height, const std::string& path) {
+  render::Image image;
+  image.width = width;
+  image.height = height;
+  std::vector<unsigned char> pixels(static_cast<size_t>(width) * static_cast<size_t>(height) * 3);
+  gl.PixelStorei(GL_PACK_ALIGNMENT, 1);
+  gl.ReadPixels(0, 0, width, height, GL_RGB, GL_UNSIGNED_BYTE, pixels.data());
+  image.rgb.resize(pixels.size());
+  for (int y = 0; y < height; ++y) {
+    std::copy_n(&pixels[3 * static_cast<size_t>(height - 1 - y) * static_cast<size_t>(width)],
+                3 * static_cast<size_t>(width), image.pixel(0, y));
+  }
+  if (Status w = render::writePng(image, path); !w)
+    std::cerr << "error: " << w.error().message << "\n";
+}
+
+// Frames until the window closes, Q, or --frames: script events due, reframe, one advance of the
+// simulation, draw, and on the last frame the screenshot. Returns the frames shown.
+int showFrames(Viewer& viewer, ViewerWindow& window, WindowState& state,
+               const std::vector<InputEvent>& script, const ViewerOptions& options) {
+  render::Renderer renderer(window.gl());
+  GLFWwindow* w = window.handle();
   int width = 0, height = 0;
-  glfwGetFramebufferSize(window, &width, &height);
+  glfwGetFramebufferSize(w, &width, &height);
   viewer.frameAll(width, height);
   size_t next_event = 0;
   int frames = 0;
-  std::vector<unsigned char> pixels;
-  while (!glfwWindowShouldClose(window) && !viewer.quit()) {
+  while (!glfwWindowShouldClose(w) && !viewer.quit()) {
     glfwPollEvents();
     while (next_event < script.size() && script[next_event].frame <= frames)
       viewer.apply(script[next_event++], height);
-    glfwGetFramebufferSize(window, &width, &height);
+    glfwGetFramebufferSize(w, &width, &height);
     state.height = height;
     if (viewer.takeReframe()) viewer.frameAll(width, height);
     viewer.advance();
@@ -579,26 +606,17 @@ int runViewer(const ViewerOptions& options) {
     renderer.draw(viewer.frame(), viewer.camera(), width, height, ro);
     ++frames;
     const bool last = options.frames > 0 && frames >= options.frames;
-    if ((last || viewer.quit()) && !options.screenshot.empty()) {
-      render::Image image;
-      image.width = width;
-      image.height = height;
-      pixels.resize(static_cast<size_t>(width) * static_cast<size_t>(height) * 3);
-      gl.PixelStorei(GL_PACK_ALIGNMENT, 1);
-      gl.ReadPixels(0, 0, width, height, GL_RGB, GL_UNSIGNED_BYTE, pixels.data());
-      image.rgb.resize(pixels.size());
-      for (int y = 0; y < height; ++y) {  // GL rows go bottom to top
-        std::copy_n(&pixels[3 * static_cast<size_t>(height - 1 - y) * static_cast<size_t>(width)],
-                    3 * static_cast<size_t>(width), image.pixel(0, y));
-      }
-      if (Status w = render::writePng(image, options.screenshot); !w)
-        std::cerr << "error: " << w.error().message << "\n";
-    }
-    glfwSwapBuffers(window);
+    if ((last || viewer.quit()) && !options.screenshot.empty())
+      writeScreenshot(window.gl(), width, height, options.screenshot);
+    glfwSwapBuffers(w);
     if (last) break;
   }
-  glfwDestroyWindow(window);
-  glfwTerminate();
+  return frames;
+}
+
+// On stdout at exit: frames, steps, the hand's mode and hold, stability, the live settings and
+// each hand's goal and patch.
+void printExitReport(Viewer& viewer, int frames) {
   std::cout << "viewer: " << frames << " frames, " << viewer.steps() << " steps, hand "
             << (viewer.manual()       ? "manual"
                 : viewer.deviceHand() ? "device"
@@ -608,6 +626,39 @@ int runViewer(const ViewerOptions& options) {
   std::cout << "viewer: " << viewer.worldText() << "\n";
   for (const std::string& line : viewer.handReport())
     std::cout << "viewer: " << line << "\n";
+}
+
+}  // namespace
+
+// The viewer as its stages: the input, the scene built (devices opened), the window, the frames,
+// the exit report.
+int runViewer(const ViewerOptions& options) {
+  Result<ViewerInput> input = loadInput(options);
+  if (!input) {
+    std::cerr << "error: " << input.error().message << "\n";
+    return 1;
+  }
+  Viewer viewer(options, std::move(input.value().spec));
+  // Opens the devices too: a SpaceMouse without its daemon stops here, before any window.
+  if (Status built = viewer.rebuild(); !built) {
+    std::cerr << "error: " << built.error().message << "\n";
+    return 1;
+  }
+  for (const std::string& line : viewer.hapticsDescription())
+    std::cerr << line << "\n";
+  int frames = 0;
+  {
+    Result<std::unique_ptr<ViewerWindow>> window = ViewerWindow::open(options);
+    if (!window) {
+      std::cerr << "error: " << window.error().message << "\n";
+      return 1;
+    }
+    WindowState state;
+    state.viewer = &viewer;
+    connectInput(window.value()->handle(), state);
+    frames = showFrames(viewer, *window.value(), state, input.value().script, options);
+  }  // the window closes before the report
+  printExitReport(viewer, frames);
   return viewer.stable() ? 0 : 3;
 }
 

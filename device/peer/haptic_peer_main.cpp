@@ -7,8 +7,8 @@
 //
 // With --key-file (or TORSION_HAPTIC_KEY_FILE / TORSION_HAPTIC_KEY in the environment) it signs
 // its packets with the shared key (packet_key.h); the key itself is never an argument.
-#include <signal.h>
-#include <time.h>
+#include <signal.h>  // NOLINT(modernize-deprecated-headers): POSIX sigaction
+#include <time.h>    // NOLINT(modernize-deprecated-headers): POSIX clock_gettime and friends
 
 #include <CLI/CLI.hpp>
 #include <cmath>

@@ -2,7 +2,7 @@
 
 #include <pthread.h>
 #include <sched.h>
-#include <time.h>
+#include <time.h>  // NOLINT(modernize-deprecated-headers): POSIX clock_gettime and friends
 
 #include <cmath>
 #include <sstream>

@@ -124,7 +124,7 @@ double slideDistance(double theta, double mu, double seconds) {
   addGround(world, mu);
   const Material m = softMaterial(1e5, 500);
   FemBody* block = addBox(world, "block", {-0.1, -0.1, 0}, {0.1, 0.1, 0.2}, 2, 2, 2, m);
-  ASSERT_NE(block, nullptr);
+  if (!block) return std::nan("");  // addBox reported why
   // Settle without tilt first would change the set-up; start in contact, at rest.
   const double x0 = centreOfMass(*block).x();
   const int steps = static_cast<int>(std::lround(seconds / s.solver.time_step));

@@ -135,7 +135,7 @@ double tet10SlideDistance(double theta, double mu, double seconds) {
   addGround(world, mu);
   FemBody* block = addTet10Box(world, "block", {-0.1, -0.1, 0}, {0.1, 0.1, 0.2}, 2, 2, 2,
                                softMaterial(1e5, 500));
-  ASSERT_NE(block, nullptr);
+  if (!block) return std::nan("");  // addTet10Box reported why
   const double x0 = centreOfMass(*block).x();
   const int steps = static_cast<int>(std::lround(seconds / s.solver.time_step));
   for (int k = 0; k < steps; ++k)

@@ -69,7 +69,7 @@ struct CouplingRig {
     command.release_requests = releases;
     Status applied = coupling->apply(command, world->time());
     EXPECT_TRUE(applied.ok()) << (applied.ok() ? "" : applied.error().message);
-    const WorldStepReport r = world->step();
+    WorldStepReport r = world->step();  // not const: returned by move
     EXPECT_TRUE(r.ok) << r.message;
     published = coupling->publish(static_cast<std::uint64_t>(world->stepCount()));
     return r;

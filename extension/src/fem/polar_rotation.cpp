@@ -19,7 +19,7 @@ Eigen::Matrix3d rotationBySvd(const Eigen::Matrix3d& F) {
 Eigen::Matrix3d extractRotation(const Eigen::Matrix3d& F, Eigen::Quaterniond& q, int max_iterations,
                                 double tolerance) {
   if (!(F.determinant() > 0)) {
-    const Eigen::Matrix3d R = rotationBySvd(F);
+    Eigen::Matrix3d R = rotationBySvd(F);  // not const: returned by move
     q = Eigen::Quaterniond(R);
     return R;
   }

@@ -18,7 +18,7 @@ Result<TetMesh> makeBoxTetMesh(const Eigen::Vector3d& min_corner, const Eigen::V
     for (int j = 0; j <= ny; ++j) {
       for (int i = 0; i <= nx; ++i) {
         const Eigen::Vector3d f(double(i) / nx, double(j) / ny, double(k) / nz);
-        positions.push_back(min_corner + f.cwiseProduct(max_corner - min_corner));
+        positions.emplace_back(min_corner + f.cwiseProduct(max_corner - min_corner));
       }
     }
   }

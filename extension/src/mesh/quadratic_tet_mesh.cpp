@@ -83,8 +83,8 @@ QuadraticTetMesh buildQuadraticTetMesh(const TetMesh& linear) {
   std::vector<Eigen::Vector3d> positions = linear.restPositions();
   positions.reserve(positions.size() + edges.size());
   for (const auto& [p, q] : edges) {
-    positions.push_back(0.5 * (linear.restPositions()[static_cast<size_t>(p)] +
-                               linear.restPositions()[static_cast<size_t>(q)]));
+    positions.emplace_back(0.5 * (linear.restPositions()[static_cast<size_t>(p)] +
+                                  linear.restPositions()[static_cast<size_t>(q)]));
   }
 
   QuadraticTetMesh result;
