@@ -16,6 +16,14 @@ inline constexpr double kMaxStiffnessRatio = 1e100;
 /// Rigid-body lengths (sizes, margins, hull points) above this (m) are refused: Bullet forms
 /// inertias ~ mass * size^2 and products of them.
 inline constexpr double kMaxRigidLength = 1e6;
+/// Where bodies are placed (a body's pose position, a rigid body's, the ground's height), m
+/// from the origin: beyond it a unit-sized body's coordinates lose their digits (1e300 + 1 ==
+/// 1e300) and the first step returns inf or NaN.
+inline constexpr double kMaxPlacement = 1e6;
+/// A dynamic rigid body's mass, kg: Bullet divides by it and multiplies it by sizes squared; at
+/// 1e300 or 1e-300 a contact impulse overflows in the first step.
+inline constexpr double kMinRigidMass = 1e-9;
+inline constexpr double kMaxRigidMass = 1e12;
 
 /// "magnitude 1e+160 m/s^2 is above the bound 1e+06 m/s^2 ..." or Ok; the caller names where
 /// the gravity came from (the scene parser: its key path).

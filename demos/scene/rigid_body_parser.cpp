@@ -1,8 +1,10 @@
 #include "rigid_body_parser.h"
 
 #include <algorithm>
+#include <cmath>
 
 #include "arithmetic_bounds.h"
+#include "torsion/format_number.h"
 
 namespace torsion::scene {
 
@@ -127,6 +129,11 @@ RigidBodySpec readRigidBody(const JsonObject& r, const std::vector<RigidBodySpec
     r.fail("mass", "planes and triangle meshes are static (mass 0)");
   if (spec.isKinematic() && spec.mass != 0)
     r.fail("mass", "a kinematic body has no mass (leave it out or give 0)");
+  if (spec.mass != 0 && (spec.mass < kMinRigidMass || spec.mass > kMaxRigidMass)) {
+    r.fail("mass", formatNumber(spec.mass) + " kg is outside [" + formatNumber(kMinRigidMass) +
+                       ", " + formatNumber(kMaxRigidMass) +
+                       "] kg (Bullet's contact impulses would overflow)");
+  }
   spec.pose = parsePose(r, "pose");
   spec.linear_velocity = r.vector3("linear_velocity", Eigen::Vector3d::Zero());
   spec.angular_velocity = r.vector3("angular_velocity", Eigen::Vector3d::Zero());
@@ -148,6 +155,10 @@ RigidBodySpec readGround(const JsonObject& g) {
   spec.shape = RigidBodySpec::Shape::kPlane;
   spec.mass = 0;
   spec.plane_offset = g.number("height", 0.0);
+  if (std::abs(spec.plane_offset) > kMaxPlacement) {
+    g.fail("height", formatNumber(spec.plane_offset) + " m is beyond the bound " +
+                         formatNumber(kMaxPlacement) + " m from the origin");
+  }
   spec.friction = readCoefficient(g, "friction", spec.friction);
   spec.restitution = readCoefficient(g, "restitution", spec.restitution);
   if (spec.restitution > 1) g.fail("restitution", "must be <= 1");

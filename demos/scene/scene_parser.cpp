@@ -41,6 +41,11 @@ Frame readPose(const JsonObject& parent, const std::string& key) {
   if (!parent.has(key)) return pose;
   const JsonObject p = parent.object(key);
   pose.origin = p.vector3("position", Eigen::Vector3d::Zero());
+  if (pose.origin.cwiseAbs().maxCoeff() > kMaxPlacement) {
+    p.fail("position", "a coordinate of " + formatNumber(pose.origin.cwiseAbs().maxCoeff()) +
+                           " m is beyond the bound " + formatNumber(kMaxPlacement) +
+                           " m (a body's coordinates would lose their digits)");
+  }
   if (p.has("axis_angle")) pose.rotation = readAxisAngle(p.object("axis_angle"));
   p.finish();
   return pose;

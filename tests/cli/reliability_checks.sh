@@ -370,7 +370,7 @@ case "$case_name" in
     [[ -x $peer ]] || fail "no torsion_haptic_peer given"
     twist_scene > twist.json
     cat > hold.json <<'JSON'
-{"segments": [{"duration": 0.6, "angular_velocity": [0, 0, 0.5]}, {"duration": 5}],
+{"segments": [{"duration": 0.6, "angular_velocity": [0, 0, 0.5]}, {"duration": 60}],
  "buttons": [{"time": 0, "held": [1]}]}
 JSON
     port=$((20000 + RANDOM % 20000))
@@ -381,8 +381,9 @@ JSON
     done
     "$peer" --trajectory hold.json --port "$port" --log peer.csv >peer.log 2>&1 &
     peer_pid=$!
-    # Wait until the peer holds a non-zero torque, then interrupt the simulation.
-    for _ in $(seq 100); do
+    # Wait until the peer holds a non-zero torque (up to 30 s: slow under sanitizers), then
+    # interrupt the simulation.
+    for _ in $(seq 300); do
       awk -F, 'NR > 1 && ($7 > 0.1 || $7 < -0.1) { found = 1 } END { exit !found }' peer.csv \
         2>/dev/null && break
       sleep 0.1

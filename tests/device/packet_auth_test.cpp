@@ -254,6 +254,14 @@ TEST_F(KeyFile, MissingShortSharedOrNonRegularKeyFilesAreClearErrors) {
   EXPECT_NE(key.error.find("key file " + fifo + ": "), std::string::npos) << key.error;
   EXPECT_NE(key.error.find("not a regular file"), std::string::npos) << key.error;
 
+  const std::string directory = (dir_ / "a_directory.key").string();
+  std::filesystem::create_directory(directory);
+  ::chmod(directory.c_str(), 0700);
+  key = PacketKey::fromFile(directory);
+  ASSERT_FALSE(key);
+  EXPECT_NE(key.error.find("key file " + directory + ": "), std::string::npos) << key.error;
+  EXPECT_NE(key.error.find("not a regular file"), std::string::npos) << key.error;
+
   if (::geteuid() != 0) {  // root reads any file whatever its mode
     const std::string unreadable = write("unreadable.key", kSecret, 0000);
     key = PacketKey::fromFile(unreadable);

@@ -2,7 +2,7 @@
 # seed corpus so the seeds in the source tree are never written:
 #   cmake -D FUZZER=<exe> -D SEEDS=<seed dir> -D WORK_DIR=<scratch dir> -D SECONDS=<n>
 #         [-D SEED=<n>] [-D RUNS=<n>] [-D DICT=<dictionary>] [-D MORE_SEEDS=<dir>]
-#         [-D MAX_LEN=<bytes>] -P run_fuzzer.cmake
+#         [-D MAX_LEN=<bytes>] [-D TIMEOUT=<s per input, default 10>] -P run_fuzzer.cmake
 # The environment variables TORSION_FUZZ_SECONDS, TORSION_FUZZ_SEED and TORSION_FUZZ_RUNS, when
 # set, override SECONDS, SEED and RUNS (e.g. TORSION_FUZZ_SEED=0 TORSION_FUZZ_RUNS=-1
 # TORSION_FUZZ_SECONDS=600 for a random ten-minute hunt). Crashing inputs are
@@ -55,8 +55,11 @@ if(NOT SEED MATCHES "^[0-9]+$" OR NOT RUNS MATCHES "^-?[0-9]+$")
   message(FATAL_ERROR "run_fuzzer.cmake: seed '${SEED}' and runs '${RUNS}' must be whole numbers")
 endif()
 
+if(NOT DEFINED TIMEOUT)
+  set(TIMEOUT 10)
+endif()
 set(args "${corpus}" -seed=${SEED} -runs=${RUNS} -max_total_time=${SECONDS} -rss_limit_mb=2048
-         -timeout=10
+         -timeout=${TIMEOUT}
          "-artifact_prefix=${artifacts}/" -print_final_stats=1)
 if(DEFINED MAX_LEN)
   list(APPEND args "-max_len=${MAX_LEN}")
