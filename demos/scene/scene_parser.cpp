@@ -278,6 +278,15 @@ Result<SceneSpec> parseScene(std::string_view text, const std::string& file_name
         b.fail("material",
                "volumetric_strain nodal_average is a tet4 option (tet10 does not lock)");
       }
+      if (b.has("self_contact")) {
+        const JsonObject c = b.object("self_contact");
+        SelfContactSettings self;
+        self.friction = c.number("friction", self.friction);
+        self.gap_tolerance = c.number("gap_tolerance", self.gap_tolerance);
+        c.finish();
+        if (Status valid = self.validate(); !valid) b.fail("self_contact", valid.error().message);
+        body.self_contact = self;
+      }
       b.finish();
       scene.bodies.push_back(std::move(body));
     }
