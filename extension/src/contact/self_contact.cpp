@@ -228,6 +228,14 @@ void SelfContactSolver::addEdgeCandidates(const Eigen::VectorXd& x, const Eigen:
         if (!(n0.norm() > 1e-3 * scale)) continue;  // nearly parallel: nodes and faces hold them
         n0.normalize();
         double g0 = n0.dot(p0 - r0);
+        {
+          // Cheap rejection first: apart now and at the end of the path, on the same side.
+          const Eigen::Vector3d m1 = (q1 - p1).cross(s1 - r1);
+          const double h1 = m1.norm() > 0 ? m1.normalized().dot(p1 - r1) : g0;
+          if (std::abs(g0) > margin && std::abs(h1) > margin &&
+              (g0 > 0) == (m1.dot(n0) >= 0 ? h1 > 0 : h1 < 0))
+            continue;
+        }
         SurfaceContact contact;
         contact.triangle = j;
         contact.edge = static_cast<int>(i);
@@ -336,8 +344,13 @@ LinearSolveReport SelfContactSolver::solve(const SystemOperator& op,
     if (!settled) continue;
     // Converged on these candidates. The solved motion can differ from the predicted one the
     // candidates were found along (a kink snapping through): look again along x + dt v.
+    // Unless every node ends within half the margin of its predicted end: then any pair the
+    // solved path meets was found along the predicted one (within the margin at its end).
+    const double margin = settings_.margin * mean_edge_;
+    const double moved = (dt_ * v - (end_ - *start_)).lpNorm<Eigen::Infinity>();
     end_ = *start_ + dt_ * v;
-    if (redetections < kMaxRedetections && addCandidates(*start_, end_) > 0) {
+    if (moved > 0.5 * margin / std::sqrt(3.0) && redetections < kMaxRedetections &&
+        addCandidates(*start_, end_) > 0) {
       ++redetections;
       set_.setPenalties(blocks_, settings_.penalty_factor);
       set_.update(v, dt_, activation, gap_tolerance_);  // activates the new ones
