@@ -74,6 +74,10 @@ Result<std::unique_ptr<BuiltScene>> buildScene(SceneSpec spec, int threads_overr
     Result<FemBody*> added =
         world.addBody(body.name, mesh.value().mesh, body.material, body.pose, body.element);
     if (!added) return Error{entry + ": " + added.error().message};
+    if (body.self_contact) {
+      if (Status on = added.value()->enableSelfContact(*body.self_contact); !on)
+        return Error{entry + ": " + on.error().message};
+    }
   }
 
   for (size_t s = 0; s < spec.node_sets.size(); ++s) {

@@ -295,6 +295,15 @@ BodySpec readBody(const JsonObject& b, const SceneSpec& scene, const std::string
       body.material.volumetric_strain == VolumetricStrain::kNodalAverage) {
     b.fail("material", "volumetric_strain nodal_average is a tet4 option (tet10 does not lock)");
   }
+  if (b.has("self_contact")) {
+    const JsonObject c = b.object("self_contact");
+    SelfContactSettings self;
+    self.friction = c.number("friction", self.friction);
+    self.gap_tolerance = c.number("gap_tolerance", self.gap_tolerance);
+    c.finish();
+    if (Status valid = self.validate(); !valid) b.fail("self_contact", valid.error().message);
+    body.self_contact = self;
+  }
   b.finish();
   return body;
 }

@@ -78,6 +78,14 @@ struct ContactTotals {
     int active = 0;
     bool converged = true;
     for (const auto& body : world.bodies()) {
+      if (const SelfContactSolver* self = body->selfContact()) {
+        const SelfContactStats& s = self->stats();
+        self_active_max = std::max(self_active_max, s.active);
+        self_iterations_max = std::max(self_iterations_max, s.iterations);
+        self_end_penetration = std::max(self_end_penetration, s.max_end_penetration);
+        if (!s.converged) ++self_unconverged_steps;
+        has_self_contact = true;
+      }
       const ContactStepStats& s = body->contacts().stats();
       active += s.active;
       normal_impulse += s.normal_impulse;
@@ -90,13 +98,27 @@ struct ContactTotals {
     active_max = std::max(active_max, active);
     if (!converged) ++unconverged_steps;
   }
+  // Self-contact (bodies with "self_contact"): summed over bodies, steps counted per body.
+  bool has_self_contact = false;
+  int self_active_max = 0;
+  int self_iterations_max = 0;
+  int self_unconverged_steps = 0;
+  double self_end_penetration = 0;  // m, linearised, after the solve
+
   nlohmann::json json() const {
-    return {{"active_mean", steps > 0 ? double(active_sum) / steps : 0.0},
-            {"active_max", active_max},
-            {"normal_impulse_total_Ns", normal_impulse},
-            {"max_penetration_m", max_penetration},
-            {"active_set_iterations_max", active_set_iterations_max},
-            {"active_set_unconverged_steps", unconverged_steps}};
+    nlohmann::json j = {{"active_mean", steps > 0 ? double(active_sum) / steps : 0.0},
+                        {"active_max", active_max},
+                        {"normal_impulse_total_Ns", normal_impulse},
+                        {"max_penetration_m", max_penetration},
+                        {"active_set_iterations_max", active_set_iterations_max},
+                        {"active_set_unconverged_steps", unconverged_steps}};
+    if (has_self_contact) {
+      j["self_contact"] = {{"active_max", self_active_max},
+                           {"iterations_max", self_iterations_max},
+                           {"unconverged_steps", self_unconverged_steps},
+                           {"max_end_penetration_m", self_end_penetration}};
+    }
+    return j;
   }
 };
 

@@ -15,6 +15,7 @@
 #include "torsion/bullet/fem_world.h"
 #include "torsion/constraints/frame.h"
 #include "torsion/constraints/hand.h"
+#include "torsion/contact/self_contact.h"
 #include "torsion/fem/element_kind.h"
 #include "torsion/fem/material.h"
 
@@ -26,6 +27,8 @@ struct BodySpec {
   Material material;
   Frame pose;
   ElementKind element = ElementKind::kTet4;  ///< "element": "tet4" | "tet10"
+  /// "self_contact": {"friction", "gap_tolerance"}: on when present (docs/contact.md).
+  std::optional<SelfContactSettings> self_contact;
 };
 
 /// Which nodes of a body a set takes (rest positions, after the body's pose).

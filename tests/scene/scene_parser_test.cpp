@@ -134,6 +134,30 @@ TEST(SceneParserFaults, OutOfRangeValues) {
   EXPECT_TRUE(failsWith(parse(text), {"s.json: solver", "time_step"}));
 }
 
+TEST(SceneParser, SelfContactIsOnWhereAskedForWithItsSettings) {
+  Result<SceneSpec> off = parse(kValid);
+  ASSERT_TRUE(off.ok()) << off.error().message;
+  EXPECT_FALSE(off.value().bodies[0].self_contact.has_value());
+  Result<SceneSpec> on = parse(replaced(kValid, R"("mesh": "meshes/cyl.node",)",
+                                        R"("mesh": "meshes/cyl.node",
+                                           "self_contact": {"friction": 0.5},)"));
+  ASSERT_TRUE(on.ok()) << on.error().message;
+  ASSERT_TRUE(on.value().bodies[0].self_contact.has_value());
+  EXPECT_EQ(on.value().bodies[0].self_contact->friction, 0.5);
+  EXPECT_EQ(on.value().bodies[0].self_contact->gap_tolerance, 0.0);  // from the mesh
+}
+
+TEST(SceneParserFaults, BadSelfContactSettingsAreNamed) {
+  EXPECT_TRUE(failsWith(parse(replaced(kValid, R"("mesh": "meshes/cyl.node",)",
+                                       R"("mesh": "meshes/cyl.node",
+                                          "self_contact": {"friction": -1},)")),
+                        {"bodies[0]", "self_contact", "friction", ">= 0"}));
+  EXPECT_TRUE(failsWith(parse(replaced(kValid, R"("mesh": "meshes/cyl.node",)",
+                                       R"("mesh": "meshes/cyl.node",
+                                          "self_contact": {"penalty": 3},)")),
+                        {"bodies[0].self_contact", "penalty"}));
+}
+
 TEST(SceneParserFaults, UnknownBodyInNodeSet) {
   std::string text = kValid;
   text.replace(text.find("\"body\": \"cyl\""), 13, "\"body\": \"cyl2\"");

@@ -122,6 +122,7 @@ Status FemBody::setMaterial(const Material& material) {
   model_ = std::move(model).value();
   stepper_.replaceModel(model_);
   contacts_->replaceModel(model_);  // gravity follows the new masses at the next step
+  if (self_contact_) self_contact_->replaceModel(model_);
   for (int i = 0; i < model_->nodeCount(); ++i)
     soft_body_->m_nodes[i].m_im = toBtScalar(1 / model_->nodeMasses()[static_cast<size_t>(i)]);
   return Ok{};
@@ -156,18 +157,54 @@ const StepReport& FemBody::advance(const StepContext& ctx) {
   for (int i = 0; i < model_->nodeCount(); ++i)
     step_forces_.segment<3>(3 * i) += model_->nodeMasses()[static_cast<size_t>(i)] * ctx.gravity;
   // Contacts with rigid bodies: unilateral constraints in the same projected solve.
-  if (contacts_->detect(state_, constraints_, dt)) {
+  const bool rigid = contacts_->detect(state_, constraints_, dt);
+  // Self-contact: an augmented Lagrangian added to the system, around the same solve.
+  // Its solve runs whenever it is on, candidates or not: it looks again along the solved motion.
+  const bool self = self_contact_ != nullptr;
+  if (self) self_contact_->detect(state_, constraints_, dt);
+  ImplicitStepper::LinearSolveHook rigid_solve;
+  if (rigid) {
+    rigid_solve = [this](const SystemOperator& op, const NodeConstraints& c,
+                         const Eigen::VectorXd& b, const SolverSettings& s,
+                         Eigen::VectorXd& v) { return contacts_->solve(op, c, b, s, v); };
+  }
+  if (self) {
+    stepper_.setAddedOperatorTerm(&self_contact_->term());
     stepper_.setLinearSolveHook(
-        [this](const SystemOperator& op, const NodeConstraints& c, const Eigen::VectorXd& b,
-               const SolverSettings& s,
-               Eigen::VectorXd& v) { return contacts_->solve(op, c, b, s, v); });
+        [this, rigid_solve](const SystemOperator& op, const NodeConstraints& c,
+                            const Eigen::VectorXd& b, const SolverSettings& s, Eigen::VectorXd& v) {
+          return self_contact_->solve(op, c, b, s, v, rigid_solve);
+        });
   } else {
-    stepper_.setLinearSolveHook({});
+    stepper_.setLinearSolveHook(rigid_solve);
   }
   last_report_ = stepper_.step(state_, constraints_, step_forces_, dt);
+  stepper_.setAddedOperatorTerm(nullptr);
+  if (self && !self_contact_->stats().converged && !isFatal(last_report_.health)) {
+    // Reported per step, never accepted silently (a warning: the step is usable).
+    const SelfContactStats& s = self_contact_->stats();
+    if (last_report_.health == StepHealth::kOk)
+      last_report_.health = StepHealth::kContactNotConverged;
+    last_report_.message += (last_report_.message.empty() ? "" : "; ") +
+                            std::string("self-contact did not converge in ") +
+                            std::to_string(s.iterations) + " updates (end penetration " +
+                            std::to_string(s.max_end_penetration) + " m, tolerance " +
+                            std::to_string(self_contact_->gapTolerance()) + " m)";
+  }
   if (!isFatal(last_report_.health)) contacts_->finish();
   if (!isFatal(last_report_.health)) writeBack();
   return last_report_;
+}
+
+Status FemBody::enableSelfContact(const SelfContactSettings& settings) {
+  if (Status valid = settings.validate(); !valid)
+    return Error{"body '" + name_ + "': " + valid.error().message};
+  self_contact_ = std::make_unique<SelfContactSolver>(model_, settings);
+  return Ok{};
+}
+
+void FemBody::disableSelfContact() {
+  self_contact_.reset();
 }
 
 FemBodyCheckpoint FemBody::checkpoint() {
@@ -180,6 +217,11 @@ FemBodyCheckpoint FemBody::checkpoint() {
   for (const auto& group : groups_)
     c.groups.push_back(*group);
   c.contacts = std::make_shared<const RigidContactSolver>(*contacts_);
+  if (self_contact_) {
+    c.self_contact = true;
+    c.self_contact_settings = self_contact_->settings();
+    c.self_contact_warm_starts = self_contact_->warmStarts();
+  }
   c.last_report = last_report_;
   return c;
 }
@@ -198,6 +240,11 @@ void FemBody::restore(const FemBodyCheckpoint& c) {
   for (const CarriedNodes& group : c.groups)
     groups_.push_back(std::make_unique<CarriedNodes>(group));
   *contacts_ = *c.contacts;
+  self_contact_.reset();
+  if (c.self_contact) {
+    self_contact_ = std::make_unique<SelfContactSolver>(model_, c.self_contact_settings);
+    self_contact_->restoreWarmStarts(c.self_contact_warm_starts);
+  }
   last_report_ = c.last_report;
   writeBack();
 }

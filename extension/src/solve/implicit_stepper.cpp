@@ -22,6 +22,8 @@ const char* toString(StepHealth health) {
       return "ok";
     case StepHealth::kSolverNotConverged:
       return "solver not converged";
+    case StepHealth::kContactNotConverged:
+      return "contact not converged";
     case StepHealth::kSolverFailed:
       return "solver failed";
     case StepHealth::kNonFinite:

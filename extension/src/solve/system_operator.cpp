@@ -270,6 +270,7 @@ void SystemOperator::gather(const std::vector<Eigen::Vector3d>& element_values, 
 
 void SystemOperator::multiply(const Eigen::VectorXd& y, Eigen::VectorXd& out) const {
   apply(y, out, mass_coefficient_, stiffness_coefficient_);
+  if (added_term_ != nullptr) added_term_->addProduct(y, out);
 }
 
 void SystemOperator::multiplyStiffness(const Eigen::VectorXd& y, Eigen::VectorXd& out) const {
@@ -285,6 +286,7 @@ void SystemOperator::diagonalBlocks(std::vector<Eigen::Matrix3d>& blocks) const 
                 stiffness_coefficient_ * block_values_[static_cast<size_t>(diagonal_slots_[n])];
   }
   if (model_->nodalPressure()) addNodalPressureDiagonal(blocks);
+  if (added_term_ != nullptr) added_term_->addDiagonalBlocks(blocks);
 }
 
 void SystemOperator::buildPatches() {

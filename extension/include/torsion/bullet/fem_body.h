@@ -13,6 +13,7 @@
 #include "torsion/bullet/step_context.h"
 #include "torsion/constraints/carried_nodes.h"
 #include "torsion/contact/rigid_contact.h"
+#include "torsion/contact/self_contact.h"
 #include "torsion/fem/fem_model.h"
 #include "torsion/result.h"
 #include "torsion/solve/implicit_stepper.h"
@@ -27,6 +28,9 @@ struct FemBodyCheckpoint {
   ImplicitStepper::Memory stepper;
   std::vector<CarriedNodes> groups;  ///< node groups then (hands: see Hand::checkpoint)
   std::shared_ptr<const RigidContactSolver> contacts;  ///< warm starts of the contact solve
+  bool self_contact = false;                           ///< self-contact was on
+  SelfContactSettings self_contact_settings;
+  SurfaceContactSet::WarmStarts self_contact_warm_starts;  ///< its multipliers
   StepReport last_report;
 };
 
@@ -103,6 +107,14 @@ class FemBody {
   const RigidContactSolver& contacts() const { return *contacts_; }
   ImplicitStepper& stepper() { return stepper_; }
 
+  /// Self-contact (docs/contact.md, "Self-contact"): from the next step on, the body's surface
+  /// nodes are kept out of its own surface triangles, with Coulomb friction, inside its implicit
+  /// step. Errors: invalid settings (and then nothing changes).
+  Status enableSelfContact(const SelfContactSettings& settings);
+  void disableSelfContact();
+  /// The self-contact solver (its last step's contacts and statistics), or nullptr when off.
+  const SelfContactSolver* selfContact() const { return self_contact_.get(); }
+
  private:
   void writeBack();
 
@@ -116,6 +128,7 @@ class FemBody {
   std::vector<std::unique_ptr<CarriedNodes>> groups_;
   std::unique_ptr<btSoftBody> soft_body_;
   std::unique_ptr<RigidContactSolver> contacts_;
+  std::unique_ptr<SelfContactSolver> self_contact_;
   StepReport last_report_;
 };
 

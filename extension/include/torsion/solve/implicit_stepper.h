@@ -40,9 +40,12 @@ class CholmodSolver;
 enum class StepHealth {
   kOk,
   kSolverNotConverged,  ///< CG hit its cap within 10x tolerance: usable but inaccurate (warning)
-  kSolverFailed,        ///< breakdown, or CG stuck far above tolerance: the step is meaningless
-  kNonFinite,           ///< NaN or inf in positions or velocities: the state is unusable
-  kBlowUp,              ///< a node moves faster than max_speed: unstable
+  /// Self-contact's multipliers stopped at their cap with end gaps beyond the tolerance: usable,
+  /// the penetration is in the message and the contact statistics (warning; set by FemBody).
+  kContactNotConverged,
+  kSolverFailed,  ///< breakdown, or CG stuck far above tolerance: the step is meaningless
+  kNonFinite,     ///< NaN or inf in positions or velocities: the state is unusable
+  kBlowUp,        ///< a node moves faster than max_speed: unstable
 };
 const char* toString(StepHealth health);
 inline bool isFatal(StepHealth h) {
@@ -94,6 +97,9 @@ class ImplicitStepper {
       const SystemOperator&, const NodeConstraints&, const Eigen::VectorXd&, const SolverSettings&,
       Eigen::VectorXd&)>;
   void setLinearSolveHook(LinearSolveHook hook) { linear_solve_hook_ = std::move(hook); }
+  /// Adds `term` (not owned; nullptr removes it) to the system of the following steps' solves
+  /// (SystemOperator::setAddedTerm): self-contact's augmented Lagrangian.
+  void setAddedOperatorTerm(const AddedOperatorTerm* term) { system_.setAddedTerm(term); }
   /// Takes effect at the next step (linear solver, tolerance...); the caller validates.
   void setSettings(const SolverSettings& settings) { settings_ = settings; }
   /// Live material edit between steps (FemBody::setMaterial): `model` has the same mesh. The

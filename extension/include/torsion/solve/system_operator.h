@@ -22,6 +22,7 @@
 #include <vector>
 
 #include "torsion/fem/fem_model.h"
+#include "torsion/solve/added_operator_term.h"
 #include "torsion/solve/parallel.h"
 
 namespace torsion {
@@ -41,7 +42,12 @@ class SystemOperator {
   /// The system coefficients: A = mass_coefficient M + stiffness_coefficient K.
   void setCoefficients(double mass_coefficient, double stiffness_coefficient);
 
-  /// out = A y.
+  /// Adds `term` (not owned; nullptr removes it) to A in multiply() and diagonalBlocks() until
+  /// removed: contact penalties of an augmented Lagrangian (added_operator_term.h).
+  void setAddedTerm(const AddedOperatorTerm* term) { added_term_ = term; }
+  const AddedOperatorTerm* addedTerm() const { return added_term_; }
+
+  /// out = A y (plus the added term, if any).
   void multiply(const Eigen::VectorXd& y, Eigen::VectorXd& out) const;
   /// out = K y.
   void multiplyStiffness(const Eigen::VectorXd& y, Eigen::VectorXd& out) const;
@@ -50,7 +56,7 @@ class SystemOperator {
   /// ascending order.
   void gather(const std::vector<Eigen::Vector3d>& element_values, double scale,
               Eigen::VectorXd& out) const;
-  /// The 3x3 diagonal blocks of A, one per node.
+  /// The 3x3 diagonal blocks of A (plus the added term's), one per node.
   void diagonalBlocks(std::vector<Eigen::Matrix3d>& blocks) const;
 
   // ---- The assembled matrix, for direct solvers (CholmodSolver) ----
@@ -95,6 +101,7 @@ class SystemOperator {
   std::shared_ptr<const FemModel> model_;
   const Parallel& parallel_;
   std::vector<Eigen::Matrix3d> rotations_;
+  const AddedOperatorTerm* added_term_ = nullptr;
   double mass_coefficient_ = 1;
   double stiffness_coefficient_ = 0;
 

@@ -1,0 +1,142 @@
+#pragma once
+// Self-contact of one FEM body: its surface nodes against its own surface triangles, with
+// Coulomb friction, inside the body's implicit step (docs/contact.md, "Self-contact"). Touched
+// only by the simulation thread.
+//
+// Per step:
+//   detect (before the solve)  the surface triangle tree (surface_tree.h) is refitted to the
+//                              triangles swept over the predicted motion x + s dt v, s in [0, 1];
+//                              every surface node queries it with its own swept box. A pair
+//                              (node, triangle) is a candidate unless the triangle is in the
+//                              node's one-ring (has the node as a corner), when the node lies in
+//                              front of the triangle or at most max_depth behind it, and when its
+//                              projection falls inside the triangle at the moment of the
+//                              predicted motion where it crosses the triangle's plane (or now, if
+//                              it is within the margin): a continuous test on the predicted path.
+//   solve (the step's solve)   the candidates' augmented Lagrangian (surface_contact_set.h) is
+//                              added to the body's system operator; Uzawa updates alternate with
+//                              warm-started CG solves until every end-of-step gap is within
+//                              gap_tolerance (or max_iterations: reported, not accepted
+//                              silently). With rigid contacts in the same step, the rigid
+//                              contact solve runs once on the augmented system and the
+//                              multipliers are updated once (the gap then converges over steps).
+
+#include <Eigen/Core>
+#include <array>
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <set>
+#include <vector>
+
+#include "torsion/contact/surface_contact_set.h"
+#include "torsion/contact/surface_tree.h"
+#include "torsion/fem/fem_model.h"
+#include "torsion/result.h"
+#include "torsion/solve/fem_state.h"
+#include "torsion/solve/node_constraints.h"
+#include "torsion/solve/projected_cg.h"
+#include "torsion/solve/solver_settings.h"
+#include "torsion/solve/system_operator.h"
+
+namespace torsion {
+
+struct SelfContactSettings {
+  double friction = 0.3;  ///< Coulomb coefficient between two parts of the body's surface
+  /// m: the end-of-step gap every contact is driven to within (no penetration beyond it).
+  /// 0: 1e-3 times the mean surface edge of the rest mesh.
+  double gap_tolerance = 0;
+  /// Candidates: nodes within this fraction of the mean surface edge of a triangle at the start
+  /// of the step (resting contacts), besides those whose predicted path crosses it.
+  double margin = 0.25;
+  /// A node this fraction of the triangle's shortest edge behind it is on the far side of the
+  /// body, not through the surface: no candidate (see docs/contact.md for why 0.25).
+  double max_depth = 0.25;
+  /// rho in units of the contact's effective mass (surface_contact_set.h).
+  double penalty_factor = 20;
+  /// Uzawa updates (each one warm-started CG solve) per step.
+  int max_iterations = 40;
+
+  Status validate() const;
+};
+
+struct SelfContactStats {
+  int candidates = 0;  ///< (node, triangle) pairs this step
+  int active = 0;      ///< pushing at the end of the step
+  int sticking = 0;    ///< of which sticking
+  int iterations = 0;  ///< Uzawa updates (CG solves) this step
+  bool converged = true;
+  double normal_impulse = 0;       ///< N s, sum over active contacts
+  double max_penetration = 0;      ///< m, deepest candidate node behind its triangle at the start
+  double max_end_penetration = 0;  ///< m, deepest linearised end-of-step gap after the solve
+};
+
+class SelfContactSolver {
+ public:
+  SelfContactSolver(std::shared_ptr<const FemModel> model, const SelfContactSettings& settings);
+
+  const SelfContactSettings& settings() const { return settings_; }
+  /// The gap tolerance in use (m): settings().gap_tolerance or its default from the mesh.
+  double gapTolerance() const { return gap_tolerance_; }
+
+  /// Before the solve: candidates from the state at the start of the step and its predicted
+  /// motion. Returns whether there are any (then the solve hook and operator term are needed).
+  bool detect(const FemState& state, const NodeConstraints& constraints, double dt);
+  /// The augmented Lagrangian term to add to the body's system operator for this step.
+  const AddedOperatorTerm& term() const { return set_; }
+  /// The step's linear solve (ImplicitStepper's hook). `inner`, when given, is the solve that
+  /// would run without self-contact (the rigid contact solve): it runs once on the augmented
+  /// system. Without it, CG solves alternate with Uzawa updates until converged.
+  using InnerSolve = std::function<LinearSolveReport(const SystemOperator&, const NodeConstraints&,
+                                                     const Eigen::VectorXd&, const SolverSettings&,
+                                                     Eigen::VectorXd&)>;
+  LinearSolveReport solve(const SystemOperator& op, const NodeConstraints& constraints,
+                          const Eigen::VectorXd& b, const SolverSettings& settings,
+                          Eigen::VectorXd& v, const InnerSolve& inner);
+
+  const SelfContactStats& stats() const { return stats_; }
+  const std::vector<SurfaceContact>& contacts() const { return set_.contacts(); }
+  /// The multipliers the next step starts from (checkpoints).
+  SurfaceContactSet::WarmStarts warmStarts() const { return set_.warmStarts(); }
+  void restoreWarmStarts(SurfaceContactSet::WarmStarts warm) {
+    set_.setWarmStarts(std::move(warm));
+  }
+  /// Live material edit: the same mesh, new masses.
+  void replaceModel(std::shared_ptr<const FemModel> model) { model_ = std::move(model); }
+
+ private:
+  // Adds the (node, triangle) pairs found along the motion from x to end that this step does not
+  // have yet; returns how many.
+  int addCandidates(const Eigen::VectorXd& x, const Eigen::VectorXd& end);
+  // Edge-against-edge pairs along the same motion (crossing edges that no node meets).
+  void addEdgeCandidates(const Eigen::VectorXd& x, const Eigen::VectorXd& end);
+  // Unit mean outward normal of the surface triangles on a surface edge, at positions x.
+  Eigen::Vector3d edgeNormal(const std::array<int, 2>& edge, const Eigen::VectorXd& x) const;
+
+  std::shared_ptr<const FemModel> model_;
+  SelfContactSettings settings_;
+  double mean_edge_ = 0;
+  double gap_tolerance_ = 0;
+  SurfaceTree tree_;
+  std::vector<char> one_ring_mark_;               // scratch: triangles incident to the current node
+  std::vector<std::vector<int>> node_triangles_;  // surface triangles of each node
+  std::vector<std::vector<int>> node_contacts_;   // this step's contacts of each node
+  std::vector<int> touched_nodes_;                // nodes with an entry in node_contacts_
+  std::vector<std::array<int, 2>> edges_;         // surface edges, corners ascending
+  std::vector<std::vector<int>> triangle_edges_;  // the three edges of each surface triangle
+  std::vector<int> edge_mark_;                    // scratch: edges seen by the current query
+  int edge_stamp_ = 0;
+  std::set<std::uint64_t> edge_pairs_;      // this step's edge pairs (i << 32 | j)
+  const Eigen::VectorXd* start_ = nullptr;  // positions at the step's start (the state's)
+  const NodeConstraints* constraints_ = nullptr;
+  SurfaceContactSet set_;
+  SelfContactStats stats_;
+  double dt_ = 0;
+  ProjectedCg cg_;
+  std::vector<Eigen::Matrix3d> blocks_;
+  Eigen::VectorXd end_, b_aug_, best_v_;
+  std::vector<SurfaceContact> best_contacts_;
+  std::vector<int> found_;
+};
+
+}  // namespace torsion

@@ -1,0 +1,128 @@
+#pragma once
+// Node-against-triangle (and edge-against-edge) contacts between FEM surfaces (one body against
+// itself: self_contact.h), solved inside the implicit step's linear solves by an augmented
+// Lagrangian (docs/contact.md, "Self-contact"). Touched only by the simulation thread.
+//
+// A contact c joins a surface node p and a surface triangle (a, b, c) it must not pass through.
+// With the triangle point's barycentric weights w, the relative velocity is
+//   u = v_p - (w_a v_a + w_b v_b + w_c v_c) = sum_k beta_k v_k,   beta = (1, -w_a, -w_b, -w_c),
+// and the linearised gap at the end of the step is gap + dt n.u >= 0 (n: the triangle's outward
+// normal at the step's start). The impulse lambda (N s) acts on p and -w_j lambda on the
+// triangle's corners, so the pair exchanges momentum exactly (sum beta_k = 0) and, the lever being
+// the same point, angular momentum up to the linearisation.
+//
+// Augmented Lagrangian (Alart & Curnier 1991; Uzawa's update): each linear solve takes the
+// impulse as lambda = Lambda - rho P h with h = u + n gap / dt, P = I (sticking) or n n^T
+// (sliding, the tangential part of Lambda being Coulomb's friction). That adds rho beta_k beta_l P
+// to the system (this class is the AddedOperatorTerm) and beta_k (Lambda - rho n gap / dt) to its
+// right-hand side. After each solve, update() projects Lambda - rho h onto Coulomb's cone:
+// lambda_n = max(0, .), sticking while |lambda_t| <= mu lambda_n, sliding at mu lambda_n along it
+// otherwise. rho is `penalty_factor` times the contact's effective mass from the system's 3x3
+// diagonal blocks.
+
+#include <Eigen/Core>
+#include <array>
+#include <cstdint>
+#include <vector>
+
+#include "torsion/solve/added_operator_term.h"
+
+namespace torsion {
+
+struct SurfaceContact {
+  enum class State : std::uint8_t { kInactive, kStick, kSlide };
+  std::array<int, 4> nodes{};    ///< p, then the triangle's corners (indices of the solve)
+  std::array<double, 4> beta{};  ///< 1, -w_a, -w_b, -w_c
+  int triangle = -1;       ///< the triangle's index, or the second edge's for an edge pair (key)
+  int edge = -1;           ///< edge-against-edge: the first edge's index (key); -1: node-triangle
+  Eigen::Vector3d normal;  ///< unit, the triangle's outward normal at the step's start
+  double gap = 0;          ///< m, signed distance of p along normal, start of the step
+  double friction = 0;     ///< Coulomb coefficient mu
+  double penalty = 0;      ///< rho, kg
+  Eigen::Vector3d multiplier = Eigen::Vector3d::Zero();  ///< Lambda, N s on p
+  State state = State::kInactive;
+  bool determined = false;  ///< all four nodes fully prescribed: sits the solves out
+  int releases = 0;         ///< releases this step (anti-cycling: one)
+  int switches = 0;         ///< stick/slide switches this step (anti-cycling: then it slides)
+  double end_gap = 0;       ///< m, the linearised end-of-step gap after the last solve
+};
+
+class SurfaceContactSet final : public AddedOperatorTerm {
+ public:
+  /// Forgets the last step's candidates; their multipliers stay as warm starts (keyed by node and
+  /// triangle) for add().
+  void beginStep();
+  /// A candidate for this step (state kInactive unless a warm start makes it active).
+  void add(SurfaceContact contact);
+  /// Whether (node, triangle) was active at the end of the last step (has a warm start).
+  bool wasActive(int node, int triangle) const {
+    return warmStartOf(key(node, triangle)) != nullptr;
+  }
+  /// The multiplier a contact with these keys ended the last step with, or nullptr.
+  const Eigen::Vector3d* warmStartOf(const SurfaceContact& c) const { return warmStartOf(key(c)); }
+  std::vector<SurfaceContact>& contacts() { return contacts_; }
+  const std::vector<SurfaceContact>& contacts() const { return contacts_; }
+  bool empty() const { return contacts_.empty(); }
+
+  /// rho of every contact from the system's diagonal blocks (without this term).
+  void setPenalties(const std::vector<Eigen::Matrix3d>& diagonal_blocks, double penalty_factor);
+  /// Marks contacts whose nodes the solve cannot move (is_fixed(node) for all four).
+  template <typename IsFixed>
+  void markDetermined(IsFixed is_fixed) {
+    for (SurfaceContact& c : contacts_) {
+      c.determined = true;
+      for (int node : c.nodes)
+        c.determined = c.determined && is_fixed(node);
+    }
+  }
+  /// b += sum over active contacts of beta_k (Lambda - rho n gap / dt).
+  void addRightHandSide(double dt, Eigen::VectorXd& b) const;
+  /// Uzawa's projection after a solve with velocities v (3n). Activates contacts whose end gap is
+  /// below -activation_tolerance. Returns whether the set has converged: no contact changed
+  /// state, every end gap within gap_tolerance (no penetration beyond it, no active contact
+  /// pushing across a gap beyond it) and no sticking contact slipping more than gap_tolerance.
+  bool update(const Eigen::VectorXd& v, double dt, double activation_tolerance,
+              double gap_tolerance);
+  /// m, the deepest linearised end-of-step penetration of any candidate (>= 0).
+  double maxEndPenetration() const;
+  /// m, the largest gap error after the last update: penetration of any candidate, or an active
+  /// contact's end gap away from zero.
+  double maxGapError() const;
+
+  // AddedOperatorTerm: rho beta_k beta_l P of the active contacts.
+  void addProduct(const Eigen::VectorXd& y, Eigen::VectorXd& out) const override;
+  void addDiagonalBlocks(std::vector<Eigen::Matrix3d>& blocks) const override;
+  /// While suspended the term adds nothing (the penalties are taken from A alone).
+  void setSuspended(bool suspended) { suspended_ = suspended; }
+
+  /// Warm starts the next step starts from: (key, Lambda) of the active contacts, sorted by key.
+  using WarmStarts = std::vector<std::pair<std::uint64_t, Eigen::Vector3d>>;
+  WarmStarts warmStarts() const;
+  /// Back to warm starts taken by warmStarts() (checkpoints): the next beginStep() uses them.
+  void setWarmStarts(WarmStarts warm) {
+    contacts_.clear();
+    warm_ = std::move(warm);
+    restored_ = true;
+  }
+
+ private:
+  static std::uint64_t key(const SurfaceContact& c) {
+    return c.edge >= 0 ? key(-1 - c.edge, c.triangle) : key(c.nodes[0], c.triangle);
+  }
+  static std::uint64_t key(int node, int triangle) {
+    return (static_cast<std::uint64_t>(static_cast<std::uint32_t>(node)) << 32) |
+           static_cast<std::uint32_t>(triangle);
+  }
+  const Eigen::Vector3d* warmStartOf(std::uint64_t k) const;
+  bool participates(const SurfaceContact& c) const {
+    return !suspended_ && !c.determined && c.state != SurfaceContact::State::kInactive;
+  }
+  Eigen::Vector3d relativeVelocity(const SurfaceContact& c, const Eigen::VectorXd& v) const;
+
+  std::vector<SurfaceContact> contacts_;
+  WarmStarts warm_;  // the last step's, looked up by add()
+  bool suspended_ = false;
+  bool restored_ = false;  // warm_ was set by setWarmStarts: beginStep keeps it
+};
+
+}  // namespace torsion

@@ -1,0 +1,35 @@
+#pragma once
+// A bounding-volume tree over a body's surface triangles (Bullet's btDbvt), refitted every step
+// to the triangles swept over the step's predicted motion, for node-against-triangle contact
+// (self_contact.h). Leaves are created once, in triangle order, and refitted in that order, so
+// the tree (and every query's order) is the same for any thread count.
+
+#include <BulletCollision/BroadphaseCollision/btDbvt.h>
+
+#include <Eigen/Core>
+#include <vector>
+
+#include "torsion/mesh/tet_mesh.h"
+
+namespace torsion {
+
+class SurfaceTree {
+ public:
+  explicit SurfaceTree(std::vector<Triangle> triangles);
+  ~SurfaceTree();
+  SurfaceTree(const SurfaceTree&) = delete;
+  SurfaceTree& operator=(const SurfaceTree&) = delete;
+
+  /// Each triangle's box covers it at `start` and at `end` (3n positions), grown by `pad` (m).
+  void refit(const Eigen::VectorXd& start, const Eigen::VectorXd& end, double pad);
+  /// Indices of the triangles whose boxes overlap [lo, hi], ascending.
+  void query(const Eigen::Vector3d& lo, const Eigen::Vector3d& hi, std::vector<int>& out) const;
+  const std::vector<Triangle>& triangles() const { return triangles_; }
+
+ private:
+  std::vector<Triangle> triangles_;
+  btDbvt tree_;
+  std::vector<btDbvtNode*> leaves_;
+};
+
+}  // namespace torsion

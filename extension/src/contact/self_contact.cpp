@@ -1,0 +1,374 @@
+#include "torsion/contact/self_contact.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "torsion/format_number.h"
+
+namespace torsion {
+
+namespace {
+
+// A projection within this of a triangle's edge (in barycentric units) still counts as inside:
+// a node passing exactly over an edge is caught by both triangles (one is kept).
+constexpr double kInsideTolerance = 0.05;
+// Searches along the solved motion per step (each may add candidates and solves).
+constexpr int kMaxRedetections = 3;
+
+// Barycentric coordinates of p's projection onto the plane of (a, b, c).
+Eigen::Vector3d barycentric(const Eigen::Vector3d& p, const Eigen::Vector3d& a,
+                            const Eigen::Vector3d& b, const Eigen::Vector3d& c) {
+  const Eigen::Vector3d e0 = b - a, e1 = c - a, d = p - a;
+  const double d00 = e0.dot(e0), d01 = e0.dot(e1), d11 = e1.dot(e1);
+  const double d20 = d.dot(e0), d21 = d.dot(e1);
+  const double det = d00 * d11 - d01 * d01;
+  const double v = (d11 * d20 - d01 * d21) / det;
+  const double w = (d00 * d21 - d01 * d20) / det;
+  return {1.0 - v - w, v, w};
+}
+
+}  // namespace
+
+Status SelfContactSettings::validate() const {
+  if (!(std::isfinite(friction) && friction >= 0))
+    return Error{"self_contact: friction = " + formatNumber(friction) + ": must be >= 0"};
+  if (!(std::isfinite(gap_tolerance) && gap_tolerance >= 0))
+    return Error{"self_contact: gap_tolerance = " + formatNumber(gap_tolerance) +
+                 ": must be >= 0 m (0: from the mesh)"};
+  if (!(std::isfinite(margin) && margin >= 0 && margin <= 1))
+    return Error{"self_contact: margin = " + formatNumber(margin) + ": must be in [0, 1]"};
+  if (!(std::isfinite(max_depth) && max_depth > 0 && max_depth <= 0.5))
+    return Error{"self_contact: max_depth = " + formatNumber(max_depth) + ": must be in (0, 0.5]"};
+  if (!(std::isfinite(penalty_factor) && penalty_factor > 0))
+    return Error{"self_contact: penalty_factor = " + formatNumber(penalty_factor) +
+                 ": must be > 0"};
+  if (max_iterations < 1)
+    return Error{"self_contact: max_iterations = " + std::to_string(max_iterations) +
+                 ": must be >= 1"};
+  return Ok{};
+}
+
+SelfContactSolver::SelfContactSolver(std::shared_ptr<const FemModel> model,
+                                     const SelfContactSettings& settings)
+    : model_(std::move(model)), settings_(settings), tree_(model_->mesh().surfaceTriangles()) {
+  const TetMesh& mesh = model_->mesh();
+  const std::vector<Triangle>& triangles = mesh.surfaceTriangles();
+  node_triangles_.assign(static_cast<size_t>(mesh.nodeCount()), {});
+  double edges = 0;
+  for (size_t t = 0; t < triangles.size(); ++t) {
+    for (size_t a = 0; a < 3; ++a) {
+      node_triangles_[static_cast<size_t>(triangles[t][a])].push_back(static_cast<int>(t));
+      edges += (mesh.restPositions()[static_cast<size_t>(triangles[t][a])] -
+                mesh.restPositions()[static_cast<size_t>(triangles[t][(a + 1) % 3])])
+                   .norm();
+    }
+  }
+  mean_edge_ = triangles.empty() ? 0 : edges / (3.0 * static_cast<double>(triangles.size()));
+  gap_tolerance_ = settings_.gap_tolerance > 0 ? settings_.gap_tolerance : 1e-3 * mean_edge_;
+  one_ring_mark_.assign(triangles.size(), 0);
+  node_contacts_.assign(static_cast<size_t>(mesh.nodeCount()), {});
+  // Surface edges, each once, and the three of every triangle.
+  std::vector<std::pair<std::array<int, 2>, int>> halves;  // (sorted corners, triangle)
+  for (size_t t = 0; t < triangles.size(); ++t) {
+    for (size_t a = 0; a < 3; ++a) {
+      std::array<int, 2> e = {triangles[t][a], triangles[t][(a + 1) % 3]};
+      if (e[0] > e[1]) std::swap(e[0], e[1]);
+      halves.push_back({e, static_cast<int>(t)});
+    }
+  }
+  std::sort(halves.begin(), halves.end());
+  triangle_edges_.assign(triangles.size(), {});
+  for (size_t k = 0; k < halves.size(); ++k) {
+    if (k == 0 || halves[k].first != halves[k - 1].first) edges_.push_back(halves[k].first);
+    triangle_edges_[static_cast<size_t>(halves[k].second)].push_back(
+        static_cast<int>(edges_.size()) - 1);
+  }
+  edge_mark_.assign(edges_.size(), 0);
+}
+
+bool SelfContactSolver::detect(const FemState& state, const NodeConstraints& constraints,
+                               double dt) {
+  dt_ = dt;
+  stats_ = SelfContactStats{};
+  set_.beginStep();
+  for (int p : touched_nodes_)
+    node_contacts_[static_cast<size_t>(p)].clear();
+  edge_pairs_.clear();
+  touched_nodes_.clear();
+  start_ = &state.positions;
+  constraints_ = &constraints;
+  end_ = state.positions + dt * state.velocities;  // the predicted motion, before contacts
+  addCandidates(state.positions, end_);
+  stats_.candidates = static_cast<int>(set_.contacts().size());
+  return !set_.empty();
+}
+
+int SelfContactSolver::addCandidates(const Eigen::VectorXd& x, const Eigen::VectorXd& end) {
+  const double margin = settings_.margin * mean_edge_;
+  tree_.refit(x, end, margin);
+  const std::vector<Triangle>& triangles = tree_.triangles();
+  const size_t before = set_.contacts().size();
+
+  struct Candidate {
+    SurfaceContact contact;
+  };
+  std::vector<Candidate> found;
+  for (int p : model_->mesh().surfaceNodes()) {
+    const Eigen::Vector3d xp = x.segment<3>(3 * p), ep = end.segment<3>(3 * p);
+    tree_.query(xp.cwiseMin(ep), xp.cwiseMax(ep), found_);
+    if (found_.empty()) continue;
+    std::vector<int>& kept = node_contacts_[static_cast<size_t>(p)];
+    for (int t : node_triangles_[static_cast<size_t>(p)])
+      one_ring_mark_[static_cast<size_t>(t)] = 1;
+    for (int k : kept)  // pairs this step has already
+      one_ring_mark_[static_cast<size_t>(set_.contacts()[static_cast<size_t>(k)].triangle)] = 1;
+    found.clear();
+    for (int t : found_) {
+      if (one_ring_mark_[static_cast<size_t>(t)]) continue;  // the node's own one-ring
+      const Triangle& tri = triangles[static_cast<size_t>(t)];
+      const Eigen::Vector3d a0 = x.segment<3>(3 * tri[0]), b0 = x.segment<3>(3 * tri[1]),
+                            c0 = x.segment<3>(3 * tri[2]);
+      Eigen::Vector3d n0 = (b0 - a0).cross(c0 - a0);
+      if (!(n0.norm() > 0)) continue;  // degenerate: no plane to stay out of
+      n0.normalize();
+      const double g0 = n0.dot(xp - a0);
+      const double shortest = std::min({(b0 - a0).norm(), (c0 - b0).norm(), (a0 - c0).norm()});
+      if (g0 < -settings_.max_depth * shortest) continue;  // the far side of the body
+      // Behind the plane beyond the tolerance: only a contact already held last step is still one
+      // (it sank within its tolerance); a new pair there is a node across a sharp convex crease
+      // (behind the plane, not through the surface), which a contact would throw out violently.
+      if (g0 < -2 * gap_tolerance_ && !set_.wasActive(p, t)) continue;
+      const Eigen::Vector3d a1 = end.segment<3>(3 * tri[0]), b1 = end.segment<3>(3 * tri[1]),
+                            c1 = end.segment<3>(3 * tri[2]);
+      Eigen::Vector3d n1 = (b1 - a1).cross(c1 - a1);
+      if (!(n1.norm() > 0)) n1 = n0;
+      const double g1 = n1.normalized().dot(ep - a1);
+      // When on the path the node meets the plane: now if it is within the margin, at the
+      // crossing if it passes through, at the end if it ends within the margin.
+      double s;
+      if (g0 <= margin) {
+        s = 0;
+      } else if (g1 < 0) {
+        s = g0 / (g0 - g1);
+      } else if (g1 <= margin) {
+        s = 1;
+      } else {
+        continue;
+      }
+      const Eigen::Vector3d w = barycentric(xp + s * (ep - xp), a0 + s * (a1 - a0),
+                                            b0 + s * (b1 - b0), c0 + s * (c1 - c0));
+      if (!w.allFinite() || w.minCoeff() < -kInsideTolerance) continue;
+      const Eigen::Vector3d wc = w.cwiseMax(0.0) / w.cwiseMax(0.0).sum();
+      Candidate c;
+      c.contact.nodes = {p, tri[0], tri[1], tri[2]};
+      c.contact.beta = {1.0, -wc[0], -wc[1], -wc[2]};
+      c.contact.triangle = t;
+      c.contact.normal = n0;
+      c.contact.gap = g0;  // to the triangle's plane, at the start of the step
+      c.contact.friction = settings_.friction;
+      found.push_back(c);
+    }
+    for (int t : node_triangles_[static_cast<size_t>(p)])
+      one_ring_mark_[static_cast<size_t>(t)] = 0;
+    for (int k : kept)
+      one_ring_mark_[static_cast<size_t>(set_.contacts()[static_cast<size_t>(k)].triangle)] = 0;
+    // Every triangle found is kept: a node passing over an edge or a corner gets a contact with
+    // each triangle there (redundant constraints share the impulse; one alone would let the node
+    // cross the neighbour's plane).
+    for (const Candidate& c : found) {
+      if (kept.empty()) touched_nodes_.push_back(p);
+      kept.push_back(static_cast<int>(set_.contacts().size()));
+      set_.add(c.contact);
+      stats_.max_penetration = std::max(stats_.max_penetration, -c.contact.gap);
+    }
+  }
+  addEdgeCandidates(x, end);
+  const NodeConstraints& constraints = *constraints_;
+  set_.markDetermined(
+      [&](int node) { return constraints.kind(node) == NodeConstraints::Kind::kFull; });
+  return static_cast<int>(set_.contacts().size() - before);
+}
+
+Eigen::Vector3d SelfContactSolver::edgeNormal(const std::array<int, 2>& edge,
+                                              const Eigen::VectorXd& x) const {
+  Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+  for (int t : node_triangles_[static_cast<size_t>(edge[0])]) {
+    const Triangle& tri = tree_.triangles()[static_cast<size_t>(t)];
+    if (tri[0] != edge[1] && tri[1] != edge[1] && tri[2] != edge[1]) continue;
+    const Eigen::Vector3d a = x.segment<3>(3 * tri[0]);
+    sum += (x.segment<3>(3 * tri[1]) - a).cross(x.segment<3>(3 * tri[2]) - a).normalized();
+  }
+  return sum.normalized();
+}
+
+void SelfContactSolver::addEdgeCandidates(const Eigen::VectorXd& x, const Eigen::VectorXd& end) {
+  const double margin = settings_.margin * mean_edge_;
+  for (size_t i = 0; i < edges_.size(); ++i) {
+    const std::array<int, 2>& e = edges_[i];
+    const Eigen::Vector3d p0 = x.segment<3>(3 * e[0]), q0 = x.segment<3>(3 * e[1]);
+    const Eigen::Vector3d p1 = end.segment<3>(3 * e[0]), q1 = end.segment<3>(3 * e[1]);
+    tree_.query(p0.cwiseMin(q0).cwiseMin(p1).cwiseMin(q1),
+                p0.cwiseMax(q0).cwiseMax(p1).cwiseMax(q1), found_);
+    ++edge_stamp_;
+    for (int t : found_) {
+      for (int j : triangle_edges_[static_cast<size_t>(t)]) {
+        if (static_cast<size_t>(j) <= i || edge_mark_[static_cast<size_t>(j)] == edge_stamp_)
+          continue;
+        edge_mark_[static_cast<size_t>(j)] = edge_stamp_;
+        const std::array<int, 2>& f = edges_[static_cast<size_t>(j)];
+        if (f[0] == e[0] || f[0] == e[1] || f[1] == e[0] || f[1] == e[1]) continue;  // adjacent
+        const std::uint64_t pair =
+            (static_cast<std::uint64_t>(i) << 32) | static_cast<std::uint32_t>(j);
+        if (edge_pairs_.count(pair) != 0) continue;  // this step has it already
+        const Eigen::Vector3d r0 = x.segment<3>(3 * f[0]), s0 = x.segment<3>(3 * f[1]);
+        const Eigen::Vector3d r1 = end.segment<3>(3 * f[0]), s1 = end.segment<3>(3 * f[1]);
+        // Normal: across both edges, pointing from edge f to edge e at the start.
+        Eigen::Vector3d n0 = (q0 - p0).cross(s0 - r0);
+        const double scale = (q0 - p0).norm() * (s0 - r0).norm();
+        if (!(n0.norm() > 1e-3 * scale)) continue;  // nearly parallel: nodes and faces hold them
+        n0.normalize();
+        double g0 = n0.dot(p0 - r0);
+        {
+          // Cheap rejection first: apart now and at the end of the path, on the same side.
+          const Eigen::Vector3d m1 = (q1 - p1).cross(s1 - r1);
+          const double h1 = m1.norm() > 0 ? m1.normalized().dot(p1 - r1) : g0;
+          if (std::abs(g0) > margin && std::abs(h1) > margin &&
+              (g0 > 0) == (m1.dot(n0) >= 0 ? h1 > 0 : h1 < 0))
+            continue;
+        }
+        SurfaceContact contact;
+        contact.triangle = j;
+        contact.edge = static_cast<int>(i);
+        // Oriented to separate them: as they are now, or, for a pair held last step (which may
+        // have crossed within the tolerance), as its impulse pushed.
+        // Oriented out of f's surface into e's (the sum of each edge's triangles' outward
+        // normals): the sign of the gap alone is arbitrary for edges lying in one plane, as those
+        // of two faces pressed together do, and a wrong sign pushes one face into the other. A
+        // pair held last step keeps the side its impulse pushed.
+        const Eigen::Vector3d* held = set_.warmStartOf(contact);
+        const Eigen::Vector3d outward = edgeNormal(f, x) - edgeNormal(e, x);
+        const double side = held != nullptr ? n0.dot(*held) : n0.dot(outward);
+        if (held == nullptr && std::abs(side) < 0.5 * outward.norm()) continue;  // not facing
+        if (side < 0) {
+          n0 = -n0;
+          g0 = -g0;
+        }
+        if (g0 < -2 * gap_tolerance_ && held == nullptr) continue;  // crossed before, or apart
+        if (g0 < -settings_.max_depth * (q0 - p0).norm()) continue;
+        Eigen::Vector3d n1 = (q1 - p1).cross(s1 - r1);
+        if (n1.dot(n0) < 0) n1 = -n1;
+        if (!(n1.norm() > 0)) n1 = n0;
+        const double g1 = n1.normalized().dot(p1 - r1);
+        double when;
+        if (g0 <= margin) {
+          when = 0;
+        } else if (g1 < 0) {
+          when = g0 / (g0 - g1);
+        } else if (g1 <= margin) {
+          when = 1;
+        } else {
+          continue;
+        }
+        // Closest points of the two lines at that moment; both must lie inside their edges.
+        const Eigen::Vector3d a = p0 + when * (p1 - p0), b = q0 + when * (q1 - q0);
+        const Eigen::Vector3d c = r0 + when * (r1 - r0), d = s0 + when * (s1 - s0);
+        const Eigen::Vector3d d1 = b - a, d2 = d - c, w = a - c;
+        const double aa = d1.dot(d1), bb = d1.dot(d2), cc = d2.dot(d2), dd = d1.dot(w),
+                     ee = d2.dot(w);
+        const double denominator = aa * cc - bb * bb;
+        if (!(denominator > 1e-12 * aa * cc)) continue;
+        const double u = (bb * ee - cc * dd) / denominator;
+        const double v = (aa * ee - bb * dd) / denominator;
+        if (!(u > 0 && u < 1 && v > 0 && v < 1)) continue;
+        // Closer at the start than the margin, or crossing on the path, but not closer than the
+        // points: a pair whose lines pass near while the edges stay apart is no contact.
+        const double distance = (a + u * d1 - c - v * d2).norm();
+        if (when == 0 && distance > margin) continue;
+        contact.nodes = {e[0], e[1], f[0], f[1]};
+        contact.beta = {1.0 - u, u, -(1.0 - v), -v};
+        contact.normal = n0;
+        contact.gap = g0;
+        contact.friction = settings_.friction;
+        edge_pairs_.insert(pair);
+        set_.add(contact);
+      }
+    }
+  }
+}
+
+LinearSolveReport SelfContactSolver::solve(const SystemOperator& op,
+                                           const NodeConstraints& constraints,
+                                           const Eigen::VectorXd& b, const SolverSettings& settings,
+                                           Eigen::VectorXd& v, const InnerSolve& inner) {
+  // Penalties from the system without the term (the operator includes it otherwise).
+  set_.setSuspended(true);
+  op.diagonalBlocks(blocks_);
+  set_.setSuspended(false);
+  set_.setPenalties(blocks_, settings_.penalty_factor);
+  // Activation below a tenth of the tolerance: a contact hovering at zero gap does not flip.
+  const double activation = 0.1 * gap_tolerance_;
+
+  LinearSolveReport total;
+  stats_.converged = false;
+  const int rounds = inner ? 1 : settings_.max_iterations;
+  int redetections = 0;
+  double best_error = 0;
+  int worse = 0;
+  for (int round = 0; round < rounds; ++round) {
+    b_aug_ = b;
+    set_.addRightHandSide(dt_, b_aug_);
+    const LinearSolveReport r = inner ? inner(op, constraints, b_aug_, settings, v)
+                                      : cg_.solve(op, constraints, b_aug_, settings, v);
+    total.iterations += r.iterations;
+    total.relative_residual = r.relative_residual;
+    total.converged = r.converged;
+    total.breakdown = r.breakdown;
+    total.breakdown_reason = r.breakdown_reason;
+    ++stats_.iterations;
+    if (r.breakdown) break;
+    const bool settled = set_.update(v, dt_, activation, gap_tolerance_);
+    // Safeguard: where constraints contradict each other (crossed before, a crease) Uzawa can
+    // diverge. The best solve so far is kept; three worse ones in a row end the step with it
+    // (reported as not converged).
+    const double error = set_.maxGapError();
+    if (round == 0 || error < best_error) {
+      best_error = error;
+      best_v_ = v;
+      best_contacts_ = set_.contacts();
+      worse = 0;
+    } else if (++worse >= 3) {
+      v = best_v_;
+      set_.contacts() = best_contacts_;
+      break;
+    }
+    if (!settled) continue;
+    // Converged on these candidates. The solved motion can differ from the predicted one the
+    // candidates were found along (a kink snapping through): look again along x + dt v.
+    // Unless every node ends within half the margin of its predicted end: then any pair the
+    // solved path meets was found along the predicted one (within the margin at its end).
+    const double margin = settings_.margin * mean_edge_;
+    const double moved = (dt_ * v - (end_ - *start_)).lpNorm<Eigen::Infinity>();
+    end_ = *start_ + dt_ * v;
+    if (moved > 0.5 * margin / std::sqrt(3.0) && redetections < kMaxRedetections &&
+        addCandidates(*start_, end_) > 0) {
+      ++redetections;
+      set_.setPenalties(blocks_, settings_.penalty_factor);
+      set_.update(v, dt_, activation, gap_tolerance_);  // activates the new ones
+      continue;
+    }
+    stats_.converged = true;
+    break;
+  }
+  stats_.candidates = static_cast<int>(set_.contacts().size());
+
+  for (const SurfaceContact& c : set_.contacts()) {
+    if (c.determined || c.state == SurfaceContact::State::kInactive) continue;
+    ++stats_.active;
+    if (c.state == SurfaceContact::State::kStick) ++stats_.sticking;
+    stats_.normal_impulse += c.normal.dot(c.multiplier);
+  }
+  stats_.max_end_penetration = set_.maxEndPenetration();
+  return total;
+}
+
+}  // namespace torsion

@@ -1,0 +1,65 @@
+#include "torsion/contact/surface_tree.h"
+
+#include <algorithm>
+
+#include "torsion/bullet/bt_conversions.h"
+
+namespace torsion {
+
+namespace {
+
+// Collects leaf indices of a box query.
+struct Collector : btDbvt::ICollide {
+  std::vector<int>* out = nullptr;
+  void Process(const btDbvtNode* leaf) override { out->push_back(leaf->dataAsInt); }
+};
+
+btDbvtVolume boxOf(const Eigen::Vector3d& lo, const Eigen::Vector3d& hi) {
+  // Float Bullet rounds the corners: widen by one float ulp of the extent so no overlap is lost.
+  const Eigen::Vector3d slack = Eigen::Vector3d::Constant(
+      kBulletEpsilon * (1.0 + std::max(lo.cwiseAbs().maxCoeff(), hi.cwiseAbs().maxCoeff())));
+  return btDbvtVolume::FromMM(toBt(lo - slack), toBt(hi + slack));
+}
+
+}  // namespace
+
+SurfaceTree::SurfaceTree(std::vector<Triangle> triangles) : triangles_(std::move(triangles)) {}
+
+SurfaceTree::~SurfaceTree() {
+  tree_.clear();
+}
+
+void SurfaceTree::refit(const Eigen::VectorXd& start, const Eigen::VectorXd& end, double pad) {
+  const bool first = leaves_.empty();
+  if (first) leaves_.resize(triangles_.size());
+  for (size_t t = 0; t < triangles_.size(); ++t) {
+    Eigen::Vector3d lo = start.segment<3>(3 * triangles_[t][0]);
+    Eigen::Vector3d hi = lo;
+    for (int corner : triangles_[t]) {
+      for (const Eigen::VectorXd* x : {&start, &end}) {
+        lo = lo.cwiseMin(x->segment<3>(3 * corner));
+        hi = hi.cwiseMax(x->segment<3>(3 * corner));
+      }
+    }
+    btDbvtVolume volume =
+        boxOf(lo - Eigen::Vector3d::Constant(pad), hi + Eigen::Vector3d::Constant(pad));
+    if (first) {
+      leaves_[t] = tree_.insert(volume, nullptr);
+      leaves_[t]->dataAsInt = static_cast<int>(t);
+    } else {
+      tree_.update(leaves_[t], volume);
+    }
+  }
+}
+
+void SurfaceTree::query(const Eigen::Vector3d& lo, const Eigen::Vector3d& hi,
+                        std::vector<int>& out) const {
+  out.clear();
+  if (tree_.m_root == nullptr) return;
+  Collector collector;
+  collector.out = &out;
+  tree_.collideTV(tree_.m_root, boxOf(lo, hi), collector);
+  std::sort(out.begin(), out.end());
+}
+
+}  // namespace torsion
