@@ -77,7 +77,7 @@ fi
 "$torsion" mesh tetrahedralize "$work/dragon_surface.off" -o "$meshes/dragon_4300.node" \
   --keep-surface --min-dihedral 10 --max-volume 0
 
-# ---- Contact scenes (issue 6): a small rod (tetgen), structured boxes and a ball (no tetgen) ----
+# ---- Contact scenes: a small rod (tetgen), structured boxes and a ball (no tetgen) ----
 echo "== rod_1200, slab_768, block_162, paddle_108, ball_384"
 "$torsion" mesh cylinder --radius 0.15 --length 1.2 --tets 1200 -o "$meshes/rod_1200.node"
 "$torsion" mesh box --min -0.5 -0.5 0 --max 0.5 0.5 0.2 --cells 8 8 2 -o "$meshes/slab_768.node"

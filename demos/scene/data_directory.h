@@ -14,9 +14,9 @@
 
 namespace torsion::scene {
 
-/// The first `share/torsion` directory found in the running program's directory or one of its
-/// three nearest ancestors (a test binary lives deeper in the build tree than `torsion`); none
-/// when the program's path cannot be read (no /proc) or no such directory exists.
+/// The first `share/torsion` directory found beside, or up to a few levels above, the file this
+/// code was loaded from (a shared object such as the Python module, then the running program; a
+/// test binary lives deeper in the build tree than `torsion`); none when no such directory exists.
 std::optional<std::string> dataDirectory();
 
 }  // namespace torsion::scene

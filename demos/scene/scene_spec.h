@@ -63,7 +63,7 @@ struct NodeSetSpec {
   Eigen::Vector3d wrench_about = Eigen::Vector3d::Zero();  ///< point for the reported torque
 };
 
-/// A hand-plane on one body (DESIGN.md section 3): it grabs at `grab_at` the surface patch its
+/// A hand-plane on one body (docs/design.md section 3): it grabs at `grab_at` the surface patch its
 /// plane cuts where the ray from O along i hits, carries it along its trajectory and lets go at
 /// `release_at`. The trajectory is either `initial` moved by `motion`, or keyframes (origin
 /// interpolated linearly, rotation by slerp, held before the first and after the last).

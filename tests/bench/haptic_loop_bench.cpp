@@ -1,4 +1,4 @@
-// Haptic loop benchmark and headless Figure 6.7 runs (issue 5). Not a test: it measures.
+// Haptic loop benchmark and headless Figure 6.7 runs. Not a test: it measures.
 //
 //   bench_haptic_loop threaded MESH_TETS SECONDS [LOG.csv] [--priority P] [--kh-columns N]
 //       The 1 kHz loop on its own thread (scripted Figure 6.7 device) while the simulation thread

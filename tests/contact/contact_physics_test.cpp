@@ -1,5 +1,5 @@
-// Contact between FEM bodies and Bullet rigid bodies: physical facts (DESIGN.md section 5,
-// "rigid coexistence"; issue 6). Meshes are coarse on purpose: each case checks the contact
+// Contact between FEM bodies and Bullet rigid bodies: physical facts (docs/design.md section 5,
+// "rigid coexistence"). Meshes are coarse on purpose: each case checks the contact
 // scheme, not the FEM discretisation (docs/validation.md covers that).
 
 #include <gtest/gtest.h>
@@ -49,8 +49,8 @@ TEST(ContactPhysics, DroppedBallRestsOnGround) {
 //
 // The slab is meshed for the box (punch_reference.h): node rows 1 mm inside the box's edges, so
 // the nodes under the box are its footprint. Its static equilibrium on the same mesh (bonded
-// rigid punch) is what the contact scheme must reach; the mesh-converged reference and the 10 %
-// of issue 6 are checked on a tet10 slab (ContactTet10.BoxRestsOnSlabWithConvergedSag): tet4 is
+// rigid punch) is what the contact scheme must reach; the mesh-converged reference and the 10 % bound
+// are checked on a tet10 slab (ContactTet10.BoxRestsOnSlabWithConvergedSag): tet4 is
 // stiff here, 22 % below the converged sag on these 8x8x2 cells, still 9 % below on 24x24x4
 // (3125 nodes, 24 s a run), while tet10 on 8x8x2 cells (1445 nodes) is 7 % below.
 TEST(ContactPhysics, BoxRestsOnSlabWithStaticSag) {

@@ -121,7 +121,7 @@ TEST(ContactTet10, MomentumExchangedWithFreeBox) {
   // The heavier block (5.4 kg) passes momentum to the 4 kg box: the box ends faster than it.
   EXPECT_GT(box_speed, block_speed);
   EXPECT_GT(box_speed, 0.5);
-  // Conserved within 1 % (issue 6): the exchange is implicit and exact up to the CG tolerance.
+  // Conserved within 1 %: the exchange is implicit and exact up to the CG tolerance.
   EXPECT_NEAR(after, before, 0.01 * std::abs(before));
   EXPECT_GT(minZ(*block), -1e-4);  // 0.1 mm: never into the ground
 }
@@ -161,7 +161,7 @@ TEST(ContactTet10, FrictionHoldsBelowAngleSlidesAbove) {
 
 // A rigid box resting on a tet10 slab stays at rest above it (penetration within the tet4 test's
 // tolerance over 10 s, every node counted), and the slab's sag matches its static equilibrium
-// under the box's weight within 10 % of a mesh-converged reference (issue 6). The slab and the
+// under the box's weight within 10 % of a mesh-converged reference. The slab and the
 // box are ContactPhysics.BoxRestsOnSlabWithStaticSag's: 1 x 1 x 0.2 m, E = 20 kPa, a 20 kg box
 // 0.54 m square; 8x8x2 cells, node rows 1 mm inside the box's edges (punch_reference.h).
 TEST(ContactTet10, BoxRestsOnSlabWithConvergedSag) {
@@ -202,7 +202,7 @@ TEST(ContactTet10, BoxRestsOnSlabWithConvergedSag) {
   // The dynamic rest is the same discrete slab's static equilibrium (bonded punch): see the tet4
   // test; measured 0.1 %.
   EXPECT_NEAR(run.sag, same_mesh.sag, 0.02 * same_mesh.sag);
-  // Issue 6: within 10 % of the converged reference (measured -7 %: the 8x8x2 mesh is still
+  // Within 10 % of the converged reference (measured -7 %: the 8x8x2 mesh is still
   // stiff at the punch's edge, where the stress is singular).
   EXPECT_NEAR(run.sag, reference, 0.1 * reference);
 }

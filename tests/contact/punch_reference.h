@@ -1,5 +1,5 @@
 #pragma once
-// The static reference for a rigid box resting on a deformable slab (issue 6: "the slab's sag
+// The static reference for a rigid box resting on a deformable slab ("the slab's sag
 // matches its static equilibrium under the box's weight within 10 % of a converged reference").
 //
 // A rigid box resting flat on a slab, sticking, is a bonded rigid flat punch: the slab's top

@@ -1,4 +1,4 @@
-// Cantilever under its own weight vs Euler-Bernoulli (DESIGN.md section 5): clamped at x = 0,
+// Cantilever under its own weight vs Euler-Bernoulli (docs/design.md section 5): clamped at x = 0,
 // gravity along -z, tip deflection q L^4 / (8 E I) with q = rho g A. The beam is 10 x 1 x 1, so
 // shear adds (Timoshenko) q L^2 / (2 kappa G A), about 1 % here; the reference includes it.
 // Linear tets lock in bending: the deflection converges from below as the mesh is refined.

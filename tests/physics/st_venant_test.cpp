@@ -1,4 +1,4 @@
-// St-Venant torsion of the cylinder assets (r = 1, L = 10; DESIGN.md section 5): one end fixed,
+// St-Venant torsion of the cylinder assets (r = 1, L = 10; docs/design.md section 5): one end fixed,
 // the other turned about the axis. Away from the ends each section turns rigidly, the angle is
 // linear in z, and the torque through every section is T = G J theta'. J is the polar moment of
 // the meshed (polygonal) section, computed exactly from the tets; theta' is fitted over the
@@ -252,7 +252,7 @@ TEST(StVenantNearlyIncompressible, NodalPressureTorqueDoesNotDependOnNu) {
   }
 }
 
-// Through the hand plane (DESIGN.md section 5): the same small twist, applied by a hand whose
+// Through the hand plane (docs/design.md section 5): the same small twist, applied by a hand whose
 // plane z = 9.9 grabs the ring of surface triangles it cuts (the end cap and the interior stay
 // free). The twist is still uniform in the middle, the hand's torque balances the fixed base's,
 // and T / (G J theta') is the mesh's own ratio from the end-rotation test above: the hand adds no

@@ -1,4 +1,4 @@
-// The hand plane (DESIGN.md section 3): the grabbed patch against a brute-force reference on a
+// The hand plane (docs/design.md section 3): the grabbed patch against a brute-force reference on a
 // cylinder and a U, the on-plane rule, and a Hand carrying a twist, letting go and grabbing again.
 #include "torsion/constraints/hand_plane.h"
 

@@ -57,7 +57,7 @@ struct HandCommand {
 };
 
 /// What the simulation hands the haptic loop after each step (device frame and units). The loop
-/// renders W = wrench + stiffness * (pose now - pose) between steps (DESIGN.md section 4).
+/// renders W = wrench + stiffness * (pose now - pose) between steps (docs/design.md section 4).
 struct SimulationWrench {
   std::uint64_t step = 0;          ///< simulation step that produced it; 0: nothing published yet
   std::uint64_t command_tick = 0;  ///< HandCommand::tick of the pose the step used

@@ -1,5 +1,5 @@
 #pragma once
-// What the haptic loop renders between two simulation steps (DESIGN.md section 4): the last
+// What the haptic loop renders between two simulation steps (docs/design.md section 4): the last
 // simulated wrench corrected by the patch's local stiffness for the pose change since, plus a
 // virtual-coupling damper that takes energy out (passivity at 1 kHz against a 30-200 Hz
 // simulation):

@@ -15,7 +15,7 @@ bool isFinite(const Wrench& wrench);
 /// A wrench with any non-finite component becomes zero: NaN never reaches a device.
 Wrench saturate(const Wrench& wrench, const DeviceLimits& limits);
 
-/// The safety rules of DESIGN.md section 4, with their time constants.
+/// The safety rules of docs/design.md section 4, with their time constants.
 struct SafetySettings {
   double max_force_rate = 300;  ///< N/s: output force never changes faster
   double max_torque_rate = 30;  ///< N m/s

@@ -1,5 +1,5 @@
 #pragma once
-// A hand acting on one FEM body through the hand plane (DESIGN.md section 3; the report's
+// A hand acting on one FEM body through the hand plane (docs/design.md section 3; the report's
 // Algorithms 1 and 2).
 //
 //   Hand hand(*body);
@@ -24,7 +24,7 @@
 // complaint; docs/hand-plane.md measures it). That is physics, not a solver fault: smaller time
 // steps make it worse, not better. The bound is a fraction of the shear wave speed
 // c_s = sqrt(G / rho), since a boundary moving at speed v drives a strain of about v / c_s.
-// The lag between goal and patch is what a haptic coupling renders as a spring (issue 5).
+// The lag between goal and patch is what a haptic coupling renders as a spring.
 //
 // Simulation thread only, like the body. The body must outlive the hand's calls. Destroying a
 // grabbing hand does not touch the body: its nodes stay held by the pursuit state (the motion owns

@@ -1,5 +1,5 @@
 #pragma once
-// The simulation side of the haptic coupling for one hand (DESIGN.md section 4; the report's
+// The simulation side of the haptic coupling for one hand (docs/design.md section 4; the report's
 // chapter 5): it turns the loop's HandCommands into Hand::grab / moveTo / release before each
 // step, and after the step publishes what the loop renders: the wrench in the device frame, the
 // device pose it belongs to and the 6x6 local stiffness K_h.
