@@ -31,6 +31,10 @@
 
 namespace torsion {
 
+/// A face contact whose nodes free along its normal carry less than this share of its weights
+/// sits the solve out (FaceContactSet::markDetermined).
+inline constexpr double kDeterminedFreeWeight = 0.1;
+
 struct FaceContact {
   enum class State { kInactive, kSlide, kStick };
   std::array<int, 3> nodes{};                         ///< the surface triangle's nodes
@@ -87,11 +91,12 @@ class FaceContactSet {
   template <class Prescribed>
   void markDetermined(const Prescribed& prescribed_along) {
     for (FaceContact& c : contacts_) {
-      c.determined = true;
+      double free_weight = 0;
       for (size_t j = 0; j < 3; ++j) {
         if (c.weights[static_cast<Eigen::Index>(j)] > 0 && !prescribed_along(c.nodes[j], c.normal))
-          c.determined = false;
+          free_weight += c.weights[static_cast<Eigen::Index>(j)];
       }
+      c.determined = free_weight < kDeterminedFreeWeight;
     }
   }
   /// rho of each contact: `scale` times the effective mass of its face point from the system's
