@@ -16,7 +16,6 @@ namespace {
 // edge's (or the node's), whichever triangle found it.
 constexpr double kEdgeWeight = 1e-6;
 constexpr int kMaxStalls = 3;
-constexpr int kMaxReleases = 2;
 // A face point must come this fraction of the detection reach nearer the shape than its nodes'
 // interpolated distances to be a contact of its own (round-off on flat-on-flat is far below).
 constexpr double kDuplicateMargin = 1e-3;
@@ -313,7 +312,7 @@ bool FaceContactSet::update(const Eigen::VectorXd& v, const std::vector<RigidPar
       // Within the stated tolerance a face stays out: activating an edge contact for a
       // micrometre, releasing it the next solve, and the nodes' friction following each time,
       // was most of the active-set iterations of rigid_mix.
-      if (end_gap < -std::max(activation_tolerance, gap_tolerance) && c.releases < kMaxReleases) {
+      if (end_gap < -std::max(activation_tolerance, gap_tolerance)) {
         // Starts stuck, even under a body sliding over it: starting slipping faces sliding (as
         // slipping nodes the body sweeps over do, rigid_contact.cpp) brings a box sliding over a
         // soft slab to Coulomb's distance within 27 % instead of 71 %, but made rigid_mix's

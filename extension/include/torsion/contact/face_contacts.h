@@ -52,7 +52,7 @@ struct FaceContact {
   /// N s on the face: the multiplier estimate, warm-started from the last step.
   Eigen::Vector3d multiplier = Eigen::Vector3d::Zero();
   Eigen::Vector3d impulse = Eigen::Vector3d::Zero();  ///< N s the rigid body gave the face
-  int releases = 0;                                   ///< this step (anti-cycling: once)
+  int releases = 0;                                   ///< releases this step
   /// Every weighted node is prescribed along the normal this solve (held, sticking, or sliding
   /// on a parallel normal): the nodes decide, the contact sits out (an exact node constraint and
   /// a multiplier on the same motion would make the multiplier grow without bound).
