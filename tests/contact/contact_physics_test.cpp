@@ -78,11 +78,11 @@ TEST(ContactPhysics, BoxRestsOnSlabWithStaticSag) {
   // equilibrium, e.g. by a penalty stiffness or a lost contact.
   EXPECT_NEAR(run.sag, same_mesh.sag, 0.02 * same_mesh.sag);
   // The slab follows the box: no node under it hangs below it by more than 10 % of the sag (the
-  // box is carried by the interior nodes and, 1 mm beyond the rim row, by face contacts along its
-  // edges; measured 9 node and 16 face contacts).
+  // box is carried by the 25 nodes under it; its edges lie 1 mm beyond the rim row, so the face
+  // points along them are held by the rim nodes, which carry over 90 % of their weights, and the
+  // face contacts sit out: docs/contact.md, "Sliding over nodes").
   EXPECT_LT(run.largest_gap_under_box, 0.1 * run.sag);
   EXPECT_GT(run.contacts, 0);
-  EXPECT_GT(run.face_contacts, 0);
 }
 
 // A deformable block slides on frictionless ground into a free rigid box: the horizontal momentum

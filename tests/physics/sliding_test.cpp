@@ -10,6 +10,7 @@
 #include <cmath>
 #include <iostream>
 #include <memory>
+#include <utility>
 
 #include "torsion/bt_conversions.h"
 #include "torsion/bullet/fem_world.h"
@@ -134,26 +135,27 @@ TEST(Sliding, FrictionlessBoxSlidesOverACoarseTet10Slab) {
   expectCoulomb(s, 0.05, "frictionless_tet10");
 }
 
-// With friction (mu = 0.3 on 20 deg) the box moved 10 cm of Coulomb's 29.5 cm on the stiff slab
-// before the fix, stopping at a node row. Now -34 %: not yet the 5 % the frictionless runs meet.
-// Face contacts at the box's edges start stuck and a face contact and the node contacts on its
-// corners share the load as pushes and pulls (docs/contact.md, "Sliding over nodes", open); on
-// the soft slab the box still moves only 29 % of Coulomb's distance, as before, and is not
-// asserted here. The bounds hold what is measured on the stiff slab and fail the behaviour
-// before the fix.
-TEST(Sliding, BoxWithFrictionSlidesPastNodeRowsOnAStiffSlab) {
-  Slope s;
-  s.youngs_modulus = 1e8;
-  const double moved = slideDistance(s, 1.0);
-  const double coulomb = coulombDistance(s, 1.0);
-  std::cout << "[figures] sliding friction_stiff: 20 deg, mu 0.3, E 1e8, 20 cells: moved " << moved
-            << " m, Coulomb " << coulomb << " m (" << 100 * (moved / coulomb - 1) << " %)\n";
-  EXPECT_GT(moved, 0.55 * coulomb);
-  EXPECT_LT(moved, 1.05 * coulomb);
+// With friction, on a stiff slab, the box feels Coulomb's friction of its net normal force. Before
+// the fix it moved 66 % of Coulomb's distance at 20 deg with mu = 0.3: face contacts at its edges
+// ended steps stuck beyond Coulomb's cone or pulling, and a face and the node contacts at its
+// corners split the load as a push and a pull whose push alone bounded the friction
+// (docs/contact.md, "Sliding over nodes"). The distance magnifies a friction error by
+// mu cos a / (sin a - mu cos a): 4.5 at 20 deg with mu = 0.3. Steeper slopes and mu = 0.1 at
+// 20 deg are still short, and on a soft slab the box moves 31 % of Coulomb's distance
+// (docs/validation.md, open); those are not asserted.
+TEST(Sliding, BoxWithFrictionSlidesAsCoulombSaysOnAStiffSlab) {
+  const std::pair<double, double> cases[] = {{10, 0.1}, {20, 0.3}};
+  for (const auto& [degrees, mu] : cases) {
+    Slope s;
+    s.degrees = degrees;
+    s.mu = mu;
+    s.youngs_modulus = 1e8;
+    expectCoulomb(s, 0.05, "friction_stiff");
+  }
 }
 
 // The stick/slip threshold tan(a) = mu (16.7 deg for mu = 0.3), on a stiff slab: 1 deg below the
-// box stays, 1 deg above it slides (Coulomb: 8.9 cm in 1 s).
+// box stays (creep within 2 mm in 1 s), 1 deg above it slides as Coulomb says (8.9 cm in 1 s).
 TEST(Sliding, StiffSlabHoldsTheBoxBelowTheFrictionAngleAndLetsItSlideAbove) {
   Slope s;
   s.youngs_modulus = 1e8;
@@ -167,7 +169,7 @@ TEST(Sliding, StiffSlabHoldsTheBoxBelowTheFrictionAngleAndLetsItSlideAbove) {
             << " deg moved " << below << " m; " << friction_angle + 1 << " deg moved " << above
             << " m (Coulomb " << coulomb << " m)\n";
   EXPECT_LT(std::abs(below), 2e-3);
-  EXPECT_GT(above, 0.5 * coulomb);
+  EXPECT_NEAR(above, coulomb, 0.15 * coulomb);
 }
 
 }  // namespace

@@ -101,7 +101,10 @@ void FaceContactSet::beginStep(const std::vector<RigidPartner>& partners) {
   previous_.clear();
   for (const FaceContact& c : contacts_) {
     if (c.state == FaceContact::State::kInactive) continue;
-    previous_[{c.key, partners[static_cast<size_t>(c.partner)].object}] = {c.state, c.multiplier};
+    // A stalled contact's multiplier grew against constraints that left it no room: carried
+    // over, it would grow again each step without bound.
+    const Eigen::Vector3d carried = c.stalls > kMaxStalls ? Eigen::Vector3d::Zero() : c.multiplier;
+    previous_[{c.key, partners[static_cast<size_t>(c.partner)].object}] = {c.state, carried};
   }
   contacts_.clear();
   index_.clear();
@@ -333,33 +336,39 @@ bool FaceContactSet::update(const Eigen::VectorXd& v, const std::vector<RigidPar
     const Eigen::Vector3d trial = c.multiplier - c.penalty * h;
     const double lambda = c.normal.dot(trial);
     if (lambda <= 0) {
-      if (c.releases == 0) {
-        ++c.releases;
-        c.state = FaceContact::State::kInactive;
-        c.multiplier.setZero();
-        again = true;
-      } else {
-        c.multiplier.setZero();  // released once already this step: stays, pushing nothing
-      }
+      ++c.releases;
+      c.state = FaceContact::State::kInactive;
+      c.multiplier.setZero();
+      again = true;
       continue;
     }
     const Eigen::Vector3d tangential = trial - c.normal * lambda;
-    const double bound = c.friction * lambda;
+    const double bound =
+        partners[static_cast<size_t>(c.partner)].friction_share * c.friction * lambda;
     const FaceContact::State before = c.state;
     const double applied_friction = (c.multiplier - c.normal * c.normal.dot(c.multiplier)).norm();
     if (c.friction > 0 && tangential.norm() <= bound) {
-      c.state = FaceContact::State::kStick;
+      // Within the cone: sticks, or, after kMaxSwitches slide-to-stick switches this step (they
+      // can cycle: neighbouring contacts' tangential impulses are coupled through the body),
+      // keeps sliding with the trial's friction, which is within mu lambda (Uzawa on the
+      // tangential multiplier alone).
+      if (before != FaceContact::State::kSlide || c.switches < kMaxSwitches)
+        c.state = FaceContact::State::kStick;
       c.multiplier = trial;
     } else {
       c.state = FaceContact::State::kSlide;
       c.multiplier = c.normal * lambda;
       if (c.friction > 0) c.multiplier += bound * tangential.normalized();
     }
-    // Another solve while the end gap is off, or for a stick/slide switch, at most kMaxSwitches
-    // per step: the tangential impulses of neighbouring contacts are coupled through the body and
-    // switching can cycle (as for nodes). The stick's slip is not a criterion: its penalty keeps
-    // it at the scale of the gap tolerance, and friction needs no more.
-    if (c.state != before && c.switches++ < kMaxSwitches) again = true;
+    // Another solve while the end gap is off, or for a stick/slide switch. Stick to slide always
+    // solves again: a stuck face's impulse in the solve just done (Lambda - rho h, the trial) is
+    // beyond the cone, and a step must not end on it (a sliding box's edge glued to each new
+    // triangle it reached). The way back is bounded above (kMaxSwitches). The stick's slip is
+    // not a criterion: its penalty keeps it at the scale of the gap tolerance.
+    if (c.state != before) {
+      if (c.state == FaceContact::State::kStick) ++c.switches;
+      again = true;
+    }
     if (violation > gap_tolerance) again = true;
     // A sliding face's friction was set from the multiplier of the solve before; its normal
     // impulse in this solve (Lambda - rho h) can differ by rho times an end gap still within the

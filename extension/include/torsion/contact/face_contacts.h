@@ -31,6 +31,10 @@
 
 namespace torsion {
 
+/// A face contact whose nodes free along its normal carry less than this share of its weights
+/// sits the solve out (FaceContactSet::markDetermined).
+inline constexpr double kDeterminedFreeWeight = 0.1;
+
 struct FaceContact {
   enum class State { kInactive, kSlide, kStick };
   std::array<int, 3> nodes{};                         ///< the surface triangle's nodes
@@ -48,7 +52,7 @@ struct FaceContact {
   /// N s on the face: the multiplier estimate, warm-started from the last step.
   Eigen::Vector3d multiplier = Eigen::Vector3d::Zero();
   Eigen::Vector3d impulse = Eigen::Vector3d::Zero();  ///< N s the rigid body gave the face
-  int releases = 0;                                   ///< this step (anti-cycling: once)
+  int releases = 0;                                   ///< releases this step
   /// Every weighted node is prescribed along the normal this solve (held, sticking, or sliding
   /// on a parallel normal): the nodes decide, the contact sits out (an exact node constraint and
   /// a multiplier on the same motion would make the multiplier grow without bound).
@@ -87,11 +91,12 @@ class FaceContactSet {
   template <class Prescribed>
   void markDetermined(const Prescribed& prescribed_along) {
     for (FaceContact& c : contacts_) {
-      c.determined = true;
+      double free_weight = 0;
       for (size_t j = 0; j < 3; ++j) {
         if (c.weights[static_cast<Eigen::Index>(j)] > 0 && !prescribed_along(c.nodes[j], c.normal))
-          c.determined = false;
+          free_weight += c.weights[static_cast<Eigen::Index>(j)];
       }
+      c.determined = free_weight < kDeterminedFreeWeight;
     }
   }
   /// rho of each contact: `scale` times the effective mass of its face point from the system's

@@ -165,11 +165,12 @@ class RigidContactSolver {
   void precondition(const Eigen::VectorXd& r, Eigen::VectorXd& z) const;
   LinearSolveReport conjugateGradient(const SystemOperator& op, const Eigen::VectorXd& beta,
                                       const SolverSettings& settings, Eigen::VectorXd& q);
-  /// `p`: the node constraints' impulses; `p_net`: with the face contacts' shares (friction
-  /// bounds).
-  bool updateActiveSet(const Eigen::VectorXd& v, const Eigen::VectorXd& p,
-                       const Eigen::VectorXd& p_net, double dt);
+  /// `p`: the node constraints' impulses (Coulomb's bounds: each scaled by its partner's
+  /// friction_share).
+  bool updateActiveSet(const Eigen::VectorXd& v, const Eigen::VectorXd& p, double dt);
   void solveHeld(const Eigen::VectorXd& v, double dt);
+  /// Each partner's friction_share from the solve just done (node impulses in product_).
+  void measureFrictionShares();
 
   std::shared_ptr<const FemModel> model_;
   btSoftBody* soft_body_;
@@ -192,7 +193,7 @@ class RigidContactSolver {
   // Solve workspace.
   std::vector<Eigen::Matrix3d> block_inverse_;
   std::vector<Eigen::Matrix<double, 6, 6>> rigid_inverse_;
-  Eigen::VectorXd v_c_, scratch_, product_, r_, beta_, q_, rigid_scratch_, b_solve_, net_impulse_;
+  Eigen::VectorXd v_c_, scratch_, product_, r_, beta_, q_, rigid_scratch_, b_solve_;
   PcgScratch cg_;
 };
 

@@ -37,6 +37,11 @@ struct RigidPartner {
   Vector6d velocity = Vector6d::Zero();        ///< (v, omega) current estimate / result
   Vector6d impulse = Vector6d::Zero();         ///< (force, torque about com) x dt from this body
   int unknown = -1;                            ///< offset of its 6 unknowns in the CG vector
+  /// The net normal impulse of this body's contacts over the sum of their pushes, in the last
+  /// solve (1 without pulls): Coulomb's bounds of the pushing contacts are scaled by it, so that
+  /// their friction together is mu times the net normal impulse (docs/contact.md, "Sliding over
+  /// nodes").
+  double friction_share = 1;
 };
 
 /// M V: the partner's momentum (linear, angular about com) at velocity V (dynamic partners). A
