@@ -9,7 +9,7 @@
 #include <algorithm>
 #include <cmath>
 
-#include "torsion/bullet/bt_conversions.h"
+#include "torsion/bt_conversions.h"
 #include "torsion/contact/shape_distance.h"
 #include "torsion/solve/pcg_iterations.h"
 

@@ -2,7 +2,7 @@
 
 #include <algorithm>
 
-#include "torsion/bullet/bt_conversions.h"
+#include "torsion/bt_conversions.h"
 
 namespace torsion {
 
