@@ -47,6 +47,14 @@ std::string bodyFile(const FemBody& body, const scene::BuiltScene& scene, int st
   vtu.setPoints(std::move(points));
   vtu.addPointData("displacement", 3, std::move(displacement));
   vtu.addPointData("velocity", 3, std::move(velocity));
+  // Each hand on this body: its grabbed nodes (1, else 0), to colour or threshold in ParaView.
+  for (const scene::SceneHand& h : scene.hands) {
+    if (h.spec.body != body.name()) continue;
+    std::vector<double> grabbed(static_cast<size_t>(n), 0.0);
+    for (int node : h.hand->grabbedNodes())
+      grabbed[static_cast<size_t>(node)] = 1.0;
+    vtu.addPointData("grabbed_" + h.spec.name, 1, std::move(grabbed));
+  }
 
   // Per tet of mesh(), then per element (a tet4 element is its tet).
   const std::vector<double> tet_stress = render::tetVonMises(body);
@@ -91,8 +99,14 @@ std::string bodyFile(const FemBody& body, const scene::BuiltScene& scene, int st
                        wrenchValues(s.body->groupWrench(s.group, s.wrench_about)));
   }
   for (const scene::SceneHand& h : scene.hands) {
-    if (h.spec.body == body.name())
-      vtu.addFieldData("wrench_" + h.spec.name, wrenchValues(h.hand->wrench()));
+    if (h.spec.body != body.name()) continue;
+    vtu.addFieldData("wrench_" + h.spec.name, wrenchValues(h.hand->wrench()));
+    // The frame carrying the patch (origin, then the quaternion x y z w): the hand's plane passes
+    // through the origin with the frame's z axis as its normal (hand_plane.h).
+    const Frame& f = h.hand->frame();
+    vtu.addFieldData("hand_frame_" + h.spec.name,
+                     {f.origin.x(), f.origin.y(), f.origin.z(), f.rotation.x(), f.rotation.y(),
+                      f.rotation.z(), f.rotation.w()});
   }
   return vtu.text();
 }

@@ -130,6 +130,41 @@ def case_wrenches_are_field_data():
                 close(w[part], rows[5, cols[part]], max(scale, 1e-300), rel=1e-9)
 
 
+def rotation(q):
+    """Rotation matrix of the quaternion (x, y, z, w)."""
+    x, y, z, w = q
+    return np.array([[1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)],
+                     [2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)],
+                     [2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)]])
+
+
+def case_hand_patch_and_frame():
+    # The grabbed nodes are carried rigidly by the hand's frame: their coordinates in that frame
+    # are the same at every written step, while the frame itself turns; they lie near its plane
+    # (the plane cuts their triangles: within one element of it).
+    with tempfile.TemporaryDirectory() as work:
+        _, out = twist_series(work)
+        local, angles = [], []
+        for step in (3, 6, 9):
+            g = read_vtk(os.path.join(out, "series", f"cylinder_{step:06d}.vtu"))
+            flags = vtk_to_numpy(g.GetPointData().GetArray("grabbed_hand"))
+            grabbed = np.flatnonzero(flags == 1)
+            assert len(grabbed) > 0 and set(np.unique(flags)) <= {0.0, 1.0}
+            frame = vtk_to_numpy(g.GetFieldData().GetArray("hand_frame_hand")).ravel()
+            origin, q = frame[:3], frame[3:]
+            assert abs(np.linalg.norm(q) - 1) < 1e-12
+            R = rotation(q)
+            x = vtk_to_numpy(g.GetPoints().GetData())[grabbed]
+            p_hat = (x - origin) @ R  # R^T (x - O), row by row
+            local.append(p_hat)
+            angles.append(np.arctan2(R[1, 0], R[0, 0]))
+            size = size_of(vtk_to_numpy(g.GetPoints().GetData()))
+            assert np.abs(p_hat[:, 2]).max() < 0.1 * size, np.abs(p_hat[:, 2]).max()
+        for p_hat in local[1:]:
+            close(p_hat, local[0], np.abs(local[0]).max(), rel=1e-9)
+        assert abs(angles[2] - angles[0]) > 1e-3, angles  # the hand turned in between
+
+
 def case_tet10_cells_in_vtk_order():
     with tempfile.TemporaryDirectory() as work:
         path = scene(work, "twist_cylinder_2430_tet10")
