@@ -437,15 +437,15 @@ void RigidContactSolver::precondition(const Eigen::VectorXd& r, Eigen::VectorXd&
 }
 
 LinearSolveReport RigidContactSolver::conjugateGradient(const SystemOperator& op,
-                                                        const Eigen::VectorXd& beta,
+                                                        const Eigen::VectorXd& reduced_rhs,
                                                         const SolverSettings& settings,
                                                         Eigen::VectorXd& q) {
   applyOperator(op, q, cg_.q);
-  r_ = beta - cg_.q;
+  r_ = reduced_rhs - cg_.q;
   return pcgIterations(
       [&](const Eigen::VectorXd& in, Eigen::VectorXd& out) { applyOperator(op, in, out); },
-      [&](const Eigen::VectorXd& in, Eigen::VectorXd& out) { precondition(in, out); }, beta.norm(),
-      settings, q, r_, cg_);
+      [&](const Eigen::VectorXd& in, Eigen::VectorXd& out) { precondition(in, out); },
+      reduced_rhs.norm(), settings, q, r_, cg_);
 }
 
 bool RigidContactSolver::updateActiveSet(const Eigen::VectorXd& v, const Eigen::VectorXd& p,
@@ -652,7 +652,7 @@ LinearSolveReport RigidContactSolver::solve(const SystemOperator& op,
     b_solve_ = b_friction;
     faces_.addRightHandSide(v_c_, partners_, dt, 3 * n, b_solve_, rigid_rhs);
     op.multiply(v_c_, product_);
-    contract(b_solve_ - product_, rigid_rhs, beta_);
+    contract(b_solve_ - product_, rigid_rhs, reduced_rhs_);
 
     // Keep the warm start inside the reduced space (the rigid part is kept as is).
     {
@@ -671,7 +671,7 @@ LinearSolveReport RigidContactSolver::solve(const SystemOperator& op,
       }
     }
     buildPreconditioner(op);
-    const LinearSolveReport r = conjugateGradient(op, beta_, settings, q_);
+    const LinearSolveReport r = conjugateGradient(op, reduced_rhs_, settings, q_);
     total.iterations += r.iterations;
     total.relative_residual = r.relative_residual;
     total.converged = r.converged;

@@ -163,7 +163,7 @@ class RigidContactSolver {
   void applyOperator(const SystemOperator& op, const Eigen::VectorXd& q, Eigen::VectorXd& out);
   void buildPreconditioner(const SystemOperator& op);
   void precondition(const Eigen::VectorXd& r, Eigen::VectorXd& z) const;
-  LinearSolveReport conjugateGradient(const SystemOperator& op, const Eigen::VectorXd& beta,
+  LinearSolveReport conjugateGradient(const SystemOperator& op, const Eigen::VectorXd& reduced_rhs,
                                       const SolverSettings& settings, Eigen::VectorXd& q);
   /// `p`: the node constraints' impulses (Coulomb's bounds: each scaled by its partner's
   /// friction_share).
@@ -193,7 +193,7 @@ class RigidContactSolver {
   // Solve workspace.
   std::vector<Eigen::Matrix3d> block_inverse_;
   std::vector<Eigen::Matrix<double, 6, 6>> rigid_inverse_;
-  Eigen::VectorXd v_c_, scratch_, product_, r_, beta_, q_, rigid_scratch_, b_solve_;
+  Eigen::VectorXd v_c_, scratch_, product_, r_, reduced_rhs_, q_, rigid_scratch_, b_solve_;
   PcgScratch cg_;
 };
 
