@@ -61,6 +61,7 @@ namespace torsion::render {
 // clang-format on
 
 struct GlApi {
+// NOLINTNEXTLINE(bugprone-macro-parentheses): `name` is pasted into identifiers, not an expression
 #define TORSION_GL_MEMBER(name) decltype(&::gl##name) name = nullptr;
   TORSION_GL_FUNCTIONS(TORSION_GL_MEMBER)
 #undef TORSION_GL_MEMBER

@@ -15,6 +15,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <exception>
 #include <fstream>
 #include <optional>
 #include <string>
@@ -39,7 +40,10 @@ double monotonicSeconds() {
 
 }  // namespace
 
-int main(int argc, char** argv) {
+namespace {
+
+// The peer; main() below only turns an escaping exception (out of memory) into an error line.
+int runPeer(int argc, char** argv) {
   using namespace torsion::device;
   std::string trajectory_path, log_path, host = "127.0.0.1";
   int port = 5750;
@@ -148,4 +152,15 @@ int main(int argc, char** argv) {
                static_cast<unsigned long long>(s.unauthenticated.load()),
                static_cast<unsigned long long>(s.replayed.load()));
   return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  try {
+    return runPeer(argc, argv);
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "error: %s\n", e.what());
+    return 1;
+  }
 }

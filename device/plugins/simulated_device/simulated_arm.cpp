@@ -74,7 +74,7 @@ std::string SimulatedArmSettings::parse(const std::string& config) {
     char* end = nullptr;
     const double v = std::strtod(text.c_str(), &end);
     if (text.empty() || end != text.c_str() + text.size() || !std::isfinite(v))
-      return key + ": '" + text + "' is not a number";
+      return std::string(key).append(": '").append(text).append("' is not a number");
     double* field = nullptr;
     const std::pair<const char*, double*> fields[] = {{"device_mass", &device_mass},
                                                       {"device_inertia", &device_inertia},

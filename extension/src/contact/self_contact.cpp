@@ -73,7 +73,7 @@ SelfContactSolver::SelfContactSolver(std::shared_ptr<const FemModel> model,
     for (size_t a = 0; a < 3; ++a) {
       std::array<int, 2> e = {triangles[t][a], triangles[t][(a + 1) % 3]};
       if (e[0] > e[1]) std::swap(e[0], e[1]);
-      halves.push_back({e, static_cast<int>(t)});
+      halves.emplace_back(e, static_cast<int>(t));
     }
   }
   std::sort(halves.begin(), halves.end());

@@ -25,6 +25,8 @@
 #ifndef TORSION_DEVICE_PLUGIN_ABI_H
 #define TORSION_DEVICE_PLUGIN_ABI_H
 
+/* A C header, read by C and C++ plug-ins alike: C's headers and typedefs, not C++'s. */
+/* NOLINTBEGIN(modernize-deprecated-headers,modernize-use-using,modernize-redundant-void-arg) */
 #include <stddef.h>
 #include <stdint.h>
 
@@ -73,5 +75,7 @@ typedef const torsion_device_v1* (*torsion_device_entry_fn)(void);
 #ifdef __cplusplus
 }
 #endif
+
+/* NOLINTEND(modernize-deprecated-headers,modernize-use-using,modernize-redundant-void-arg) */
 
 #endif /* TORSION_DEVICE_PLUGIN_ABI_H */
