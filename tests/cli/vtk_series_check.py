@@ -72,7 +72,8 @@ def twist_series(work):
     steps = [int(re.search(r"_(\d+)\.vtu", f).group(1)) for _, _, f in entries]
     assert steps == [0, 3, 6, 9, 10], steps
     times = [t for t, _, _ in entries]
-    assert np.allclose(times, [0, 0.03, 0.06, 0.09, 0.10], rtol=0, atol=1e-12), times
+    # Bullet's clock sums dt in btScalar: on float Bullet 0.01f is 2e-10 s short, 2e-9 s in 10 steps.
+    assert np.allclose(times, [0, 0.03, 0.06, 0.09, 0.10], rtol=0, atol=1e-8), times
     return path, out
 
 
