@@ -112,7 +112,8 @@ def case_velocity_is_the_position_update():
             v = x[k].point_data["velocity"]
             speed = float(np.abs(v).max())
             assert speed > 0
-            close(v, (x[k].points - x[k - 1].points) / dt, speed, rel=1e-9)
+            # 1e-7: on float Bullet the step's dt is 0.01f, 2e-8 relative off the summary's dt.
+            close(v, (x[k].points - x[k - 1].points) / dt, speed, rel=1e-7)
 
 
 def case_wrenches_are_field_data():
@@ -122,7 +123,8 @@ def case_wrenches_are_field_data():
         header = open(os.path.join(out, "wrench.csv")).readline().strip().split(",")
         g = read_vtk(os.path.join(out, "series", "cylinder_000006.vtu"))
         fields = g.GetFieldData()
-        assert abs(vtk_to_numpy(fields.GetArray("TimeValue"))[0] - rows[5, 1]) < 1e-12
+        # 1e-8 s: the clocks agree to the bit on double Bullet; float Bullet's sums dt in float.
+        assert abs(vtk_to_numpy(fields.GetArray("TimeValue"))[0] - rows[5, 1]) < 1e-8
         for name in ("base", "hand"):
             w = vtk_to_numpy(fields.GetArray("wrench_" + name)).ravel()
             cols = [header.index(f"{name}.{c}") for c in ("fx", "fy", "fz", "tx", "ty", "tz")]
