@@ -382,10 +382,12 @@ JSON
     "$peer" --trajectory hold.json --port "$port" --log peer.csv >peer.log 2>&1 &
     peer_pid=$!
     # Wait until the peer holds a non-zero torque (up to 30 s: slow under sanitizers), then
-    # interrupt the simulation.
+    # interrupt the simulation. Whole rows only: the peer's log is being written, and its last
+    # line may be cut inside a number ("-1.2e-05" read as "-1.2" looked like a held torque).
     for _ in $(seq 300); do
-      awk -F, 'NR > 1 && ($7 > 0.1 || $7 < -0.1) { found = 1 } END { exit !found }' peer.csv \
-        2>/dev/null && break
+      head -n -1 peer.csv 2>/dev/null |
+        awk -F, 'NR > 1 && NF == 8 && ($7 > 0.1 || $7 < -0.1) { found = 1 } END { exit !found }' &&
+        break
       sleep 0.1
     done
     kill -INT "$sim"
