@@ -30,7 +30,7 @@ int main(int argc, char** argv) {
          },
          "Largest scene, mesh or trajectory file read, in MB (default 1073.741824, i.e. 1 GiB)")
       ->check(CLI::Range(1e-6, 1e9))
-      ->trigger_on_parse();            // before the subcommand's callback reads anything
+      ->trigger_on_parse();  // before the subcommand's callback reads anything
   torsion::cli::addVerbosityOptions(app);
   torsion::cli::CommandAction chosen;  // set by the subcommand the command line names
   torsion::cli::addMeshCommand(app, chosen);

@@ -274,11 +274,12 @@ void addMeshGenerateCommands(CLI::App& mesh, CommandAction& chosen) {
   cyl_cmd->callback([&chosen, cyl] { chosen = [cyl] { return runCylinder(*cyl); }; });
 
   auto tet = std::make_shared<TetrahedralizeOptions>();
-  CLI::App* tet_cmd = mesh.add_subcommand(
-      "tetrahedralize",
-      "Fill a closed triangle surface (.off, .obj, .stl, .ply) with tets, using the 'tetgen' (default) "
-      "or 'gmsh' command");
-  tet_cmd->add_option("surface", tet->surface, "Closed surface (.off, .obj, .stl, .ply)")->required();
+  CLI::App* tet_cmd = mesh.add_subcommand("tetrahedralize",
+                                          "Fill a closed triangle surface (.off, .obj, .stl, .ply) "
+                                          "with tets, using the 'tetgen' (default) "
+                                          "or 'gmsh' command");
+  tet_cmd->add_option("surface", tet->surface, "Closed surface (.off, .obj, .stl, .ply)")
+      ->required();
   tet_cmd->add_option("-o,--output", tet->output, "Mesh to write (.node/.ele, .msh, .vtk)")
       ->required();
   tet_cmd->add_option("--max-volume", tet->max_volume,

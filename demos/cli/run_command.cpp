@@ -149,8 +149,8 @@ struct Ran {
 
 // The headless run with a progress bar, a picture every --render-every steps, and SIGINT /
 // SIGTERM stopping it at the end of a step.
-Ran runWithProgress(const RunArguments& args, scene::BuiltScene& s,
-                    render::FrameRecorder* recorder, VtkSeries* series) {
+Ran runWithProgress(const RunArguments& args, scene::BuiltScene& s, render::FrameRecorder* recorder,
+                    VtkSeries* series) {
   Ran ran;
   const bool normal = verbosity() != Verbosity::kQuiet;
   ProgressBar bar(device::printableExcerpt(s.spec.name));  // the label goes out through stdio

@@ -15,9 +15,9 @@ namespace torsion::scene {
 DeviceSpec readDevice(const JsonObject& hand, const std::string& base_directory);
 
 /// Applies `--device HAND=TYPE[:ARG]`: scripted:FILE, replay:FILE, network[:PORT] or
-/// network:HOST:PORT, spacemouse, plugin:LIBRARY[:CONFIG] (CONFIG: the rest, colons included). A hand that had a scripted motion keeps its starting frame as
-/// the device's anchor; one that had a device keeps its mapping, limits and coupling. FILE is
-/// relative to the working directory.
+/// network:HOST:PORT, spacemouse, plugin:LIBRARY[:CONFIG] (CONFIG: the rest, colons included). A
+/// hand that had a scripted motion keeps its starting frame as the device's anchor; one that had a
+/// device keeps its mapping, limits and coupling. FILE is relative to the working directory.
 Status applyDeviceOverride(SceneSpec& scene, const std::string& text);
 
 /// "lockstep" or "threaded" (the CLI's --haptics).

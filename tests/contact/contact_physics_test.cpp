@@ -49,10 +49,10 @@ TEST(ContactPhysics, DroppedBallRestsOnGround) {
 //
 // The slab is meshed for the box (punch_reference.h): node rows 1 mm inside the box's edges, so
 // the nodes under the box are its footprint. Its static equilibrium on the same mesh (bonded
-// rigid punch) is what the contact scheme must reach; the mesh-converged reference and the 10 % bound
-// are checked on a tet10 slab (ContactTet10.BoxRestsOnSlabWithConvergedSag): tet4 is
-// stiff here, 22 % below the converged sag on these 8x8x2 cells, still 9 % below on 24x24x4
-// (3125 nodes, 24 s a run), while tet10 on 8x8x2 cells (1445 nodes) is 7 % below.
+// rigid punch) is what the contact scheme must reach; the mesh-converged reference and the 10 %
+// bound are checked on a tet10 slab (ContactTet10.BoxRestsOnSlabWithConvergedSag): tet4 is stiff
+// here, 22 % below the converged sag on these 8x8x2 cells, still 9 % below on 24x24x4 (3125 nodes,
+// 24 s a run), while tet10 on 8x8x2 cells (1445 nodes) is 7 % below.
 TEST(ContactPhysics, BoxRestsOnSlabWithStaticSag) {
   PunchProblem p;
   p.punch_half_width = 0.27;  // the box's footprint, 0.54 m square

@@ -1,6 +1,6 @@
-// St-Venant torsion of the cylinder assets (r = 1, L = 10; docs/design.md section 5): one end fixed,
-// the other turned about the axis. Away from the ends each section turns rigidly, the angle is
-// linear in z, and the torque through every section is T = G J theta'. J is the polar moment of
+// St-Venant torsion of the cylinder assets (r = 1, L = 10; docs/design.md section 5): one end
+// fixed, the other turned about the axis. Away from the ends each section turns rigidly, the angle
+// is linear in z, and the torque through every section is T = G J theta'. J is the polar moment of
 // the meshed (polygonal) section, computed exactly from the tets; theta' is fitted over the
 // middle 60 %.
 #include <gtest/gtest.h>

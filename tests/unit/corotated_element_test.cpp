@@ -1,6 +1,6 @@
-// Element facts of the corotated linear tet (docs/design.md section 5): zero force at rest and under
-// rigid motion, a symmetric positive semi-definite stiffness with exactly six zero modes, force
-// differentials that match finite differences, and the assembled blocks used by CHOLMOD.
+// Element facts of the corotated linear tet (docs/design.md section 5): zero force at rest and
+// under rigid motion, a symmetric positive semi-definite stiffness with exactly six zero modes,
+// force differentials that match finite differences, and the assembled blocks used by CHOLMOD.
 #include "torsion/fem/corotated_element.h"
 
 #include <gtest/gtest.h>

@@ -1,5 +1,5 @@
-// Element facts of the corotated quadratic (10-node) tet (docs/design.md section 5, the same facts as
-// corotated_element_test.cpp for the linear tet): zero force at rest and under rigid motion, a
+// Element facts of the corotated quadratic (10-node) tet (docs/design.md section 5, the same facts
+// as corotated_element_test.cpp for the linear tet): zero force at rest and under rigid motion, a
 // symmetric positive semi-definite 30x30 stiffness with exactly six zero modes (the 4-point rule
 // is exact, so no spurious zero-energy modes), blocks that agree with the force differential,
 // force differentials that match finite differences, the exact strain of a linear field, and

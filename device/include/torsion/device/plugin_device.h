@@ -7,11 +7,12 @@
 //     every function pointer must be set, info() must give finite non-negative limits and a
 //     positive rate; otherwise open() fails with a message naming the library and the fault;
 //   - every tick: the plug-in is called on a worker thread of its own, and read() waits for it
-//     only until `read_deadline` (an answer that comes later, to an earlier tick, is not used); a reading that is late, failed (non-zero return), non-finite
-//     or has a non-unit quaternion is not used: the device keeps its last good reading for at
-//     most `hold_time` (a late tick on a busy machine does not fade the force), then reports
-//     itself dead, so the haptic loop's safety filter fades the output to zero exactly as for a
-//     built-in device that stopped answering. Each kind of fault is counted (stats()).
+//     only until `read_deadline` (an answer that comes later, to an earlier tick, is not used); a
+//     reading that is late, failed (non-zero return), non-finite or has a non-unit quaternion is
+//     not used: the device keeps its last good reading for at most `hold_time` (a late tick on a
+//     busy machine does not fade the force), then reports itself dead, so the haptic loop's safety
+//     filter fades the output to zero exactly as for a built-in device that stopped answering. Each
+//     kind of fault is counted (stats()).
 //   - a plug-in that never returns is abandoned at destruction after `close_timeout`: its
 //     thread is detached and the library stays loaded (unloading code that may still run would
 //     crash), and the run goes on.

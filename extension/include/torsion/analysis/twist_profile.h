@@ -1,6 +1,6 @@
 #pragma once
-// Measuring torsion of a body along the z axis (docs/design.md section 5): the rotation angle of thin
-// slices and the twist rate, for validation against St-Venant (T = G J theta').
+// Measuring torsion of a body along the z axis (docs/design.md section 5): the rotation angle of
+// thin slices and the twist rate, for validation against St-Venant (T = G J theta').
 
 #include <Eigen/Core>
 #include <array>

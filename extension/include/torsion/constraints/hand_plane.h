@@ -1,6 +1,6 @@
 #pragma once
-// The hand plane's contact patch (docs/design.md section 3; the report's Algorithm 1, done right), as
-// pure functions of a mesh and its current node positions.
+// The hand plane's contact patch (docs/design.md section 3; the report's Algorithm 1, done right),
+// as pure functions of a mesh and its current node positions.
 //
 // A hand is a frame (O, R = [i j k]). Its plane passes through O, spanned by i and j (normal k).
 // The hand holds the connected patch of boundary-surface triangles that the plane cuts and that

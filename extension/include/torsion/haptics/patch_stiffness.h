@@ -1,7 +1,7 @@
 #pragma once
-// The 6x6 local stiffness K_h of a grabbed patch (docs/design.md section 4): how the wrench the body
-// exerts on the patch after the next step changes when the patch's rigid pose changes by a small
-// twist (translation m, rotation vector rad, about the point O) over that step, every other
+// The 6x6 local stiffness K_h of a grabbed patch (docs/design.md section 4): how the wrench the
+// body exerts on the patch after the next step changes when the patch's rigid pose changes by a
+// small twist (translation m, rotation vector rad, about the point O) over that step, every other
 // constrained node held. It is the condensed stiffness of the implicit step itself: for a unit
 // twist e_k, the grabbed nodes get velocity J e_k / dt (J = [I, -[x - O]x]), the free ones
 //   A_ff dv_f = -A_fg dv_g     (A the step's system matrix, projected CG)
