@@ -3,6 +3,8 @@
 #include <Eigen/Geometry>
 #include <cmath>
 
+#include "torsion/device/passive_stiffness.h"
+
 namespace torsion::haptics {
 
 namespace {
@@ -173,6 +175,9 @@ device::SimulationWrench HandCoupling::publish(std::uint64_t step) {
   }
   out.wrench = mapping_.wrenchToDevice(world_wrench_);
   mapping_.stiffnessToDevice(world_stiffness_, out.stiffness);
+  // In device units (the mapping scales force and torque apart, which can change definiteness):
+  // the loop predicts with a restoring, conservative spring only (passive_stiffness.h).
+  if (settings_.passive_stiffness) device::passiveStiffness(out.stiffness, out.stiffness);
   return out;
 }
 

@@ -51,6 +51,9 @@ struct CouplingSettings {
   /// 6 steps later; until then the loop holds the simulated wrench).
   int stiffness_columns_per_step = 1;
   double stiffness_tolerance = 1e-3;  ///< relative CG tolerance of the K_h solves
+  /// Publish only K_h's passive part (symmetric, negative semidefinite in device units;
+  /// device/passive_stiffness.h), so the loop's prediction between steps cannot generate energy.
+  bool passive_stiffness = true;
   bool lag_coupling = true;        ///< internal force: the virtual coupling across the hand's lag
   double lag_damping_time = 0.05;  ///< s, b / k of the lag coupling's damper
   double max_lag_force = std::numeric_limits<double>::infinity();   ///< N, world
