@@ -2,6 +2,7 @@
 
 #include <filesystem>
 
+#include "data_directory.h"
 #include "torsion/device/network_device.h"
 #include "torsion/device/plugin_device.h"
 #include "torsion/device/scripted_device.h"
@@ -25,6 +26,20 @@ std::unique_ptr<device::HapticDevice> scripted(device::Trajectory trajectory,
                            std::filesystem::path(spec.file).filename().string() + ")";
   return std::make_unique<device::ScriptedDevice>(trajectory.playedAt(spec.speed), limitsOf(spec),
                                                   name);
+}
+
+// A plug-in that is not where it was named (a bare file name, or one the scene's directory does
+// not hold) is looked for among the plug-ins installed with Torsion, <libdir>/torsion/plugins,
+// found from the data directory (data_directory.h); otherwise the name is left to dlopen.
+std::string pluginPath(const std::string& named) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  if (fs::exists(named, ec)) return named;
+  const std::optional<std::string> data = dataDirectory();
+  if (!data) return named;
+  const fs::path installed =
+      fs::path(*data) / TORSION_PLUGINS_FROM_DATA / fs::path(named).filename();
+  return fs::is_regular_file(installed, ec) ? installed.lexically_normal().string() : named;
 }
 
 }  // namespace
@@ -68,7 +83,7 @@ Result<std::unique_ptr<device::HapticDevice>> openDevice(const DeviceSpec& spec,
     }
     case DeviceSpec::Kind::kPlugin: {
       device::PluginDeviceSettings settings;
-      settings.library = spec.file;
+      settings.library = pluginPath(spec.file);
       settings.config = spec.config;
       settings.max_force = spec.max_force;
       settings.max_torque = spec.max_torque;

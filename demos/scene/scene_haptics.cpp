@@ -128,12 +128,13 @@ WorldStepReport SceneHaptics::step() {
 
 nlohmann::json SceneHaptics::statistics(const Channel& c) const {
   const std::vector<device::LoopLogRow>& log = c.loop->log();
-  std::vector<double> period_error, age, lateness;
+  std::vector<double> period_error, age, information_age, lateness;
   double max_force = 0, max_torque = 0;
   for (size_t k = 0; k < log.size(); ++k) {
     const device::LoopLogRow& r = log[k];
     if (k > 0) period_error.push_back(1e3 * std::abs(r.period - 1.0 / c.rate_hz));
     if (r.sim_step > 0) age.push_back(1e3 * r.wrench_age);
+    if (r.sim_step > 0 && r.grabbed) information_age.push_back(1e3 * r.information_age);
     max_force = std::max(max_force, device::norm(r.output.force));
     max_torque = std::max(max_torque, device::norm(r.output.torque));
   }
@@ -150,6 +151,7 @@ nlohmann::json SceneHaptics::statistics(const Channel& c) const {
       {"ticks", st.ticks.load()},
       {"period_error_ms", spread(period_error)},
       {"wrench_age_ms", spread(age)},
+      {"information_age_ms", spread(information_age)},
       {"saturated_ticks", st.saturated.load()},
       {"overruns", st.overruns.load()},
       {"nonfinite", st.nonfinite.load()},

@@ -4,6 +4,7 @@
 #include <sched.h>
 #include <time.h>  // NOLINT(modernize-deprecated-headers): POSIX clock_gettime and friends
 
+#include <algorithm>
 #include <cmath>
 #include <sstream>
 
@@ -104,7 +105,7 @@ void HapticLoop::tick(double now, double deadline) {
   const bool published = simulated_.step > 0;
   Wrench desired;
   if (published && simulated_.grabbed) {
-    desired = renderLocalModel(simulated_, sample.pose, twist, settings_.damper);
+    desired = renderLocalModel(simulated_, sample.pose, twist, settings_.damper, &limits_);
   }
   if (!isFinite(desired)) {
     ++stats_.nonfinite;
@@ -152,6 +153,13 @@ void HapticLoop::tick(double now, double deadline) {
       row.simulated = simulated_.wrench;
       row.sim_step = simulated_.step;
       row.wrench_age = published ? now - last_fresh_time_ : 0;
+      // The newest information in the wrench: with a prediction, the device pose read this
+      // tick (its reading's age); without, the pose the simulation step used.
+      if (published) {
+        row.information_age = predicts(simulated_) && simulated_.grabbed
+                                  ? std::max(0.0, now - sample.time)
+                                  : now - simulated_.command_time;
+      }
       row.pose_lag_ticks =
           published ? static_cast<std::int64_t>(tick_ - simulated_.command_tick) : -1;
       row.grabbed = inputs.grabbed;
@@ -217,7 +225,8 @@ bool HapticLoop::writeLog(const std::string& path, std::string* error) const {
   out.precision(10);
   out << "tick,time,period_ms,lateness_ms,px,py,pz,qw,qx,qy,qz,buttons,alive,"
          "fx,fy,fz,tx,ty,tz,sim_fx,sim_fy,sim_fz,sim_tx,sim_ty,sim_tz,"
-         "sim_step,wrench_age_ms,pose_lag_ticks,grabbed,fresh,port_energy,pc_alpha\n";
+         "sim_step,wrench_age_ms,pose_lag_ticks,grabbed,fresh,port_energy,pc_alpha,"
+         "information_age_ms\n";
   for (const LoopLogRow& r : log_) {
     const Pose& p = r.pose;
     const Wrench& w = r.output;
@@ -229,7 +238,7 @@ bool HapticLoop::writeLog(const std::string& path, std::string* error) const {
         << ',' << w.torque.x << ',' << w.torque.y << ',' << w.torque.z << ',' << s.force.x << ','
         << s.force.y << ',' << s.force.z << ',' << s.torque.x << ',' << s.torque.y << ','
         << s.torque.z << ',' << r.sim_step << ',' << 1e3 * r.wrench_age << ',' << r.pose_lag_ticks
-        << ',' << r.grabbed << ',' << r.fresh << ',' << r.port_energy << ',' << r.pc_alpha << '\n';
+        << ',' << r.grabbed << ',' << r.fresh << ',' << r.port_energy << ',' << r.pc_alpha << ',' << 1e3 * r.information_age << '\n';
   }
   const std::string failure = writeFileAtomically(path, out.str());
   if (error != nullptr) *error = failure;

@@ -6,17 +6,45 @@
 
 namespace torsion::device {
 
+namespace {
+
+// Scales v (3) down to norm `limit`, direction kept.
+void clampNorm3(double* v, double limit) {
+  const double n = std::sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
+  if (n > limit && n > 0) {
+    const double s = limit / n;
+    for (int k = 0; k < 3; ++k)
+      v[k] *= s;
+  }
+}
+
+}  // namespace
+
+bool predicts(const SimulationWrench& simulated) {
+  for (double k : simulated.stiffness)
+    if (k != 0) return true;
+  return false;
+}
+
 Wrench renderLocalModel(const SimulationWrench& simulated, const Pose& pose, const double twist[6],
-                        const CouplingDamper& damper) {
+                        const CouplingDamper& damper, const DeviceLimits* bound) {
   double delta[6];
   poseDifference(simulated.pose, pose, delta);
-  double w[6] = {simulated.wrench.force.x,  simulated.wrench.force.y,  simulated.wrench.force.z,
-                 simulated.wrench.torque.x, simulated.wrench.torque.y, simulated.wrench.torque.z};
-  for (int r = 0; r < 6; ++r) {
+  double prediction[6] = {};
+  for (int r = 0; r < 6; ++r)
     for (int c = 0; c < 6; ++c)
-      w[r] += simulated.stiffness[6 * r + c] * delta[c];
-    w[r] -= (r < 3 ? damper.linear : damper.angular) * twist[r];
+      prediction[r] += simulated.stiffness[6 * r + c] * delta[c];
+  if (bound != nullptr) {
+    clampNorm3(prediction, bound->max_force);
+    clampNorm3(prediction + 3, bound->max_torque);
   }
+  const double w[6] = {
+      simulated.wrench.force.x + prediction[0] - damper.linear * twist[0],
+      simulated.wrench.force.y + prediction[1] - damper.linear * twist[1],
+      simulated.wrench.force.z + prediction[2] - damper.linear * twist[2],
+      simulated.wrench.torque.x + prediction[3] - damper.angular * twist[3],
+      simulated.wrench.torque.y + prediction[4] - damper.angular * twist[4],
+      simulated.wrench.torque.z + prediction[5] - damper.angular * twist[5]};
   return {{w[0], w[1], w[2]}, {w[3], w[4], w[5]}};
 }
 

@@ -258,9 +258,8 @@ DeviceSample PluginDevice::read(double time) {
   }
   if (have_good_ && last_good_.alive && time - last_good_.time <= settings_.hold_time) {
     ++stats_->held;
-    DeviceSample held = last_good_;
-    held.time = time;
-    return held;
+    // Keeps the time of its reading: the loop books the age of the pose it renders from.
+    return last_good_;
   }
   ++stats_->dead;
   DeviceSample dead = have_good_ ? last_good_ : DeviceSample{};

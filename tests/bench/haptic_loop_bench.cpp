@@ -3,7 +3,9 @@
 //   bench_haptic_loop threaded MESH_TETS SECONDS [LOG.csv] [--priority P] [--kh-columns N]
 //       The 1 kHz loop on its own thread (scripted Figure 6.7 device) while the simulation thread
 //       steps the cylinder as fast as it can; prints loop rate, period jitter p50/p99/max,
-//       overruns, wrench age, simulation step time p50/p99/max and steps per second, and
+//       overruns, wrench age (since the simulation's wrench arrived) and information age (of the
+//       newest information in the rendered wrench: the device pose the K_h prediction used, or
+//       without K_h the pose the step used), simulation step time p50/p99/max and steps per second, and
 //       whether the loop got SCHED_FIFO. --priority 0 keeps the default scheduling (default: the
 //       loop's 80); --kh-columns 6 refreshes K_h in one step (default 1 column per step).
 //   bench_haptic_loop figure67 internal_force|frame_difference LOG.csv [MESH_TETS]
@@ -104,23 +106,30 @@ int threaded(int tets, double seconds, const char* log_path, int priority, int k
   });
   const double wall =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  std::vector<double> period_error, age;
+  std::vector<double> period_error, period, age, information_age;
   for (size_t k = 1; k < loop.log().size(); ++k) {
     const device::LoopLogRow& r = loop.log()[k];
     period_error.push_back(std::abs(r.period - 0.001) * 1e3);
+    period.push_back(r.period * 1e3);
     if (r.sim_step > 0) age.push_back(r.wrench_age * 1e3);
+    // Only while a patch is held: the age of what the device feels.
+    if (r.sim_step > 0 && r.grabbed) information_age.push_back(r.information_age * 1e3);
   }
   const auto& log = loop.log();
   const double span = log.size() > 1 ? log.back().time - log.front().time : 0;
   std::printf(
       "{\"tets\": %d, \"seconds\": %.1f, \"loop_rate_hz\": %.1f, \"period_error_ms\": {\"p50\": "
-      "%.4f, \"p99\": %.4f, \"max\": %.3f}, \"overruns\": %llu, \"wrench_age_ms\": {\"p50\": "
-      "%.2f, \"p99\": %.2f, \"max\": %.2f}, \"sim_steps_per_s\": %.1f, \"sim_step_ms\": {\"p50\": "
+      "%.4f, \"p99\": %.4f, \"max\": %.3f}, \"period_ms\": {\"p50\": %.4f, \"p99\": %.4f}, "
+      "\"overruns\": %llu, \"wrench_age_ms\": {\"p50\": "
+      "%.2f, \"p99\": %.2f, \"max\": %.2f}, \"information_age_ms\": {\"p50\": %.2f, \"p99\": "
+      "%.2f, \"max\": %.2f}, \"sim_steps_per_s\": %.1f, \"sim_step_ms\": {\"p50\": "
       "%.2f, \"p99\": %.2f, \"max\": %.2f}, \"kh_columns_per_step\": %d, \"realtime\": %s}\n",
       tets, wall, span > 0 ? static_cast<double>(log.size() - 1) / span : 0.0,
       percentile(period_error, 0.5), percentile(period_error, 0.99), percentile(period_error, 1.0),
+      percentile(period, 0.5), percentile(period, 0.99),
       static_cast<unsigned long long>(loop.stats().overruns.load()), percentile(age, 0.5),
-      percentile(age, 0.99), percentile(age, 1.0), steps / wall, percentile(step_ms, 0.5),
+      percentile(age, 0.99), percentile(age, 1.0), percentile(information_age, 0.5),
+      percentile(information_age, 0.99), percentile(information_age, 1.0), steps / wall, percentile(step_ms, 0.5),
       percentile(step_ms, 0.99), percentile(step_ms, 1.0), kh_columns,
       loop.stats().realtime ? "true" : "false");
   if (log_path && !loop.writeLog(log_path)) return 1;

@@ -167,7 +167,7 @@ check_haptic_outputs() {
   local dir=$1 mode=$2
   for f in summary.json wrench.csv haptic_hand.csv; do [[ -s $dir/$f ]] || fail "missing $dir/$f"; done
   grep -q "\"mode\": \"$mode\"" "$dir/summary.json" || fail "$dir/summary.json: no $mode haptics stats"
-  for key in achieved_rate_hz period_error_ms wrench_age_ms saturated_ticks; do
+  for key in achieved_rate_hz period_error_ms wrench_age_ms information_age_ms saturated_ticks; do
     grep -q "\"$key\"" "$dir/summary.json" || fail "$dir/summary.json lacks $key"
   done
   awk -F, '
@@ -568,7 +568,13 @@ EOF
     grep -q '"late": 0' plug/summary.json || fail "plug/summary.json: a plug-in read was late"
     grep -q '"reads": [1-9][0-9][0-9]' plug/summary.json || fail "fewer than 100 plug-in reads"
     grep -q '"dissipated_J"' plug/summary.json || fail "plug/summary.json: no passivity entry"
-    head -1 plug/haptic_hand.csv | grep -q ",port_energy,pc_alpha$" || fail "no passivity columns"
+    head -1 plug/haptic_hand.csv | grep -q ",port_energy,pc_alpha,information_age_ms$" || fail "no passivity and information-age columns"
+    # Named without a directory: the plug-in built (and installed) with Torsion, here with a
+    # 20 ms link delay each way.
+    run "$torsion" run twist.json --device "hand=plugin:libtorsion_simulated_device.so:$config,delay=0.02" \
+      --haptics lockstep --out delayed --steps 20 --threads 1
+    expect_rc 0
+    expect_out "hand 'hand': device plugin\(libtorsion_simulated_device.so: simulated 0.3 kg, 200 Hz motors, 20 ms delay\), lockstep"
     run "$torsion" run twist.json --device "hand=plugin:$assets/cylinder_2430.node" --out bad --steps 5
     expect_rc nonzero
     expect_out "^error: twist.json: hands\[0\] 'hand': device: .*cylinder_2430.node: cannot load the device plug-in: "

@@ -57,4 +57,12 @@ string(JSON steps GET "${summary}" steps)
 if(NOT steps EQUAL 7)
   message(FATAL_ERROR "TORSION_SCENE_PATH's drop.json (7 steps) was not the one run: ${summary}")
 endif()
+# The example device plug-in is installed with it and found by its file name, a link delay set
+# in its configuration.
+run(${clean_env} "${program}" run twist_cylinder_2430 --device
+    "hand=plugin:libtorsion_simulated_device.so:delay=0.02" --haptics lockstep --steps 5
+    --threads 1 --out plugin)
+if(NOT last_output MATCHES "simulated 0.3 kg, 200 Hz motors, 20 ms delay")
+  message(FATAL_ERROR "the installed plug-in did not run with its delay: ${last_output}")
+endif()
 message(STATUS "installed torsion ran the demo scene from its moved prefix")

@@ -19,16 +19,18 @@ constexpr double kDt = 0.001;
 struct SpringSimulation {
   double stiffness = 200;  // N/m
   std::uint64_t step = 0;
+  bool with_stiffness = true;  // publish K_h (the loop then predicts between steps)
   void answer(HapticLoop& loop) {
     HandCommand c;
     loop.commands().read(c);
     SimulationWrench w;
     w.step = ++step;
     w.command_tick = c.tick;
+    w.command_time = c.time;
     w.grabbed = c.grab_requests > c.release_requests;
     w.pose = c.pose;
     w.wrench.force = -stiffness * c.pose.position;
-    for (int k = 0; k < 3; ++k)
+    for (int k = 0; k < 3 && with_stiffness; ++k)
       w.stiffness[7 * k] = -stiffness;
     loop.wrenches().write(w);
   }
@@ -73,6 +75,60 @@ TEST(HapticLoop, LocalModelAndDamperBetweenSteps) {
   const double moving[6] = {0.5, 0, 0, 0, 0, 0};
   const Wrench d = renderLocalModel(sim, sim.pose, moving, CouplingDamper{3, 0});
   EXPECT_NEAR(d.force.x, -2 - 1.5, 1e-12);  // the damper opposes the velocity
+}
+
+TEST(HapticLoop, ThePredictionFromTheLocalStiffnessIsBoundedByTheDeviceLimits) {
+  SimulationWrench sim;
+  sim.wrench.force = {-2, 0, 0};
+  sim.stiffness[0] = -200;        // dFx/dx, N/m
+  sim.stiffness[6 * 5 + 5] = -4;  // dTz/dthetaz, N m/rad
+  DeviceLimits limits;
+  limits.max_force = 10;
+  limits.max_torque = 1;
+  const double still[6] = {};
+  // 1 m and 1 rad away: unbounded the prediction is -200 N and -4 N m.
+  const Pose far{{1, 0, 0}, fromRotationVector({0, 0, 1})};
+  const Wrench w = renderLocalModel(sim, far, still, CouplingDamper{}, &limits);
+  EXPECT_NEAR(w.force.x, -2 - 10, 1e-12);  // the simulated wrench plus the bounded prediction
+  EXPECT_NEAR(w.torque.z, -1, 1e-12);
+  // Near the simulated pose the bound changes nothing.
+  const Pose near{{0.01, 0, 0}, fromRotationVector({0, 0, 0.1})};
+  const Wrench n = renderLocalModel(sim, near, still, CouplingDamper{}, &limits);
+  EXPECT_NEAR(n.force.x, -4, 1e-12);
+  EXPECT_NEAR(n.torque.z, -0.4, 1e-12);
+}
+
+TEST(HapticLoop, InformationAgeIsThePoseAgeWhenPredictingAndTheStepsPoseAgeWhenNot) {
+  // A simulation answering every 10 ticks with the command of the tick it answered: without
+  // K_h the rendered wrench is that pose's, 0-9 ms old and growing through the step; with K_h
+  // the loop renders from this tick's pose: age 0 (the scripted device reads at the tick).
+  for (bool with_stiffness : {false, true}) {
+    SCOPED_TRACE(with_stiffness);
+    ScriptedDevice device(pushAlongX(0.05), defaultDeviceLimits(), "push");
+    HapticLoopSettings settings;
+    settings.log_capacity = 400;
+    HapticLoop loop(device, settings);
+    SpringSimulation sim;
+    sim.with_stiffness = with_stiffness;
+    for (int k = 0; k < 400; ++k) {
+      loop.tick(k * kDt);
+      if (k % 10 == 0) sim.answer(loop);
+    }
+    double largest = 0;
+    for (const LoopLogRow& r : loop.log()) {
+      if (r.sim_step == 0) continue;
+      largest = std::max(largest, r.information_age);
+      if (with_stiffness) {
+        EXPECT_EQ(r.information_age, 0) << r.tick;
+      } else {
+        // The wrench arrived after the tick of its command: since-arrival is 1 ms younger.
+        EXPECT_NEAR(r.information_age, r.wrench_age + kDt, 1e-9) << r.tick;
+      }
+    }
+    if (!with_stiffness) {
+      EXPECT_NEAR(largest, 0.010, 1e-9);
+    }
+  }
 }
 
 TEST(HapticLoop, ForceOpposesThePushAndTracksTheSimulation) {

@@ -43,6 +43,7 @@ HandCoupling::HandCoupling(Hand& hand, const DeviceMapping& mapping,
 
 Status HandCoupling::apply(const device::HandCommand& command, double now) {
   command_tick_ = command.tick;
+  command_time_ = command.time;
   now_ = now;
   if (command.alive) {  // a dead device's pose is stale: hold the last goal
     // Validated after the mapping: a finite but enormous packet position overflows once scaled.
@@ -124,6 +125,7 @@ device::SimulationWrench HandCoupling::publish(std::uint64_t step) {
   device::SimulationWrench out;
   out.step = step;
   out.command_tick = command_tick_;
+  out.command_time = command_time_;
   out.pose = goal_pose_;
   out.grabbed = hand_.grabbed();
   world_wrench_ = Wrench{};
@@ -147,7 +149,9 @@ device::SimulationWrench HandCoupling::publish(std::uint64_t step) {
           (!stiffness_valid_ || steps_since_refresh_ >= settings_.stiffness_refresh_steps);
       if ((due || stiffness_.inProgress()) &&
           stiffness_.advance(body, hand_.group(), goal_.origin, settings_.stiffness_tolerance,
-                             settings_.stiffness_columns_per_step)) {
+                             !stiffness_valid_ && settings_.first_stiffness_whole
+                                 ? 6
+                                 : settings_.stiffness_columns_per_step)) {
         stiffness_cache_ = stiffness_.matrix();
         stiffness_valid_ = true;
         steps_since_refresh_ = 0;

@@ -38,7 +38,7 @@ struct DeviceLimits {
 
 /// One reading of the device.
 struct DeviceSample {
-  double time = 0;  ///< s, monotonic clock of the reader
+  double time = 0;  ///< s, loop clock of the reading (earlier than now when a device holds an old one)
   Pose pose;
   std::uint32_t buttons = 0;  ///< bit k set: button k+1 held (bit 0 is the report's button 1)
   bool alive = false;         ///< false when the device stopped answering
@@ -61,6 +61,7 @@ struct HandCommand {
 struct SimulationWrench {
   std::uint64_t step = 0;          ///< simulation step that produced it; 0: nothing published yet
   std::uint64_t command_tick = 0;  ///< HandCommand::tick of the pose the step used
+  double command_time = 0;         ///< s, HandCommand::time of that pose (loop clock)
   bool grabbed = false;            ///< the hand holds a patch and force output is enabled
   Pose pose;                       ///< device pose the wrench belongs to
   Wrench wrench;                   ///< what the body pushes the hand with, N and N m

@@ -18,8 +18,16 @@ struct CouplingDamper {
 };
 
 /// The wrench for the device at `pose`, moving with `twist` (6: linear m/s, angular rad/s).
+/// With `bound`, the prediction K_h (pose - pose_sim) is scaled down (force and torque each as a
+/// vector, direction kept) to the device's max_force and max_torque: a pose far from the one
+/// the simulation used (a stalled simulation, a jump of the device) cannot extrapolate a
+/// linearisation into a wrench beyond what the device may render.
 Wrench renderLocalModel(const SimulationWrench& simulated, const Pose& pose, const double twist[6],
-                        const CouplingDamper& damper);
+                        const CouplingDamper& damper, const DeviceLimits* bound = nullptr);
+
+/// True when `simulated` carries a local stiffness (any entry non-zero): the loop then predicts
+/// between steps from the current pose.
+bool predicts(const SimulationWrench& simulated);
 
 /// Estimates the device's twist from successive poses, low-pass filtered (first order) so that
 /// the damper does not amplify sensor noise.

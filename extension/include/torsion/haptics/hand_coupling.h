@@ -47,9 +47,13 @@ struct CouplingSettings {
   double torque_coefficient = 0.05;  ///< c_t, m^3 (frame difference)
   int stiffness_refresh_steps = 10;  ///< internal force: K_h every this many steps; 0: K_h = 0
   /// K_h columns (one CG solve each) computed per step; 6: the whole refresh in one step. 1
-  /// keeps every step about as long as the others (after a grab the first K_h is then ready
-  /// 6 steps later; until then the loop holds the simulated wrench).
+  /// keeps every step about as long as the others (the first K_h after a grab: see
+  /// first_stiffness_whole).
   int stiffness_columns_per_step = 1;
+  /// After a grab, the first K_h whole in the first step (one longer step), so that the loop
+  /// predicts from the first published wrench on instead of holding six steps' wrenches; the
+  /// refreshes after it go `stiffness_columns_per_step` columns per step.
+  bool first_stiffness_whole = true;
   double stiffness_tolerance = 1e-3;  ///< relative CG tolerance of the K_h solves
   /// Publish only K_h's passive part (symmetric, negative semidefinite in device units;
   /// device/passive_stiffness.h), so the loop's prediction between steps cannot generate energy.
@@ -102,6 +106,7 @@ class HandCoupling {
   CouplingSettings settings_;
   std::uint32_t grabs_seen_ = 0, releases_seen_ = 0;
   std::uint64_t command_tick_ = 0;
+  double command_time_ = 0;
   device::Pose goal_pose_;
   std::uint64_t rejected_poses_ = 0;
   Frame goal_;
