@@ -238,7 +238,8 @@ bool HapticLoop::writeLog(const std::string& path, std::string* error) const {
         << ',' << w.torque.x << ',' << w.torque.y << ',' << w.torque.z << ',' << s.force.x << ','
         << s.force.y << ',' << s.force.z << ',' << s.torque.x << ',' << s.torque.y << ','
         << s.torque.z << ',' << r.sim_step << ',' << 1e3 * r.wrench_age << ',' << r.pose_lag_ticks
-        << ',' << r.grabbed << ',' << r.fresh << ',' << r.port_energy << ',' << r.pc_alpha << ',' << 1e3 * r.information_age << '\n';
+        << ',' << r.grabbed << ',' << r.fresh << ',' << r.port_energy << ',' << r.pc_alpha << ','
+        << 1e3 * r.information_age << '\n';
   }
   const std::string failure = writeFileAtomically(path, out.str());
   if (error != nullptr) *error = failure;

@@ -38,13 +38,12 @@ Wrench renderLocalModel(const SimulationWrench& simulated, const Pose& pose, con
     clampNorm3(prediction, bound->max_force);
     clampNorm3(prediction + 3, bound->max_torque);
   }
-  const double w[6] = {
-      simulated.wrench.force.x + prediction[0] - damper.linear * twist[0],
-      simulated.wrench.force.y + prediction[1] - damper.linear * twist[1],
-      simulated.wrench.force.z + prediction[2] - damper.linear * twist[2],
-      simulated.wrench.torque.x + prediction[3] - damper.angular * twist[3],
-      simulated.wrench.torque.y + prediction[4] - damper.angular * twist[4],
-      simulated.wrench.torque.z + prediction[5] - damper.angular * twist[5]};
+  const double w[6] = {simulated.wrench.force.x + prediction[0] - damper.linear * twist[0],
+                       simulated.wrench.force.y + prediction[1] - damper.linear * twist[1],
+                       simulated.wrench.force.z + prediction[2] - damper.linear * twist[2],
+                       simulated.wrench.torque.x + prediction[3] - damper.angular * twist[3],
+                       simulated.wrench.torque.y + prediction[4] - damper.angular * twist[4],
+                       simulated.wrench.torque.z + prediction[5] - damper.angular * twist[5]};
   return {{w[0], w[1], w[2]}, {w[3], w[4], w[5]}};
 }
 

@@ -5,9 +5,9 @@
 //       steps the cylinder as fast as it can; prints loop rate, period jitter p50/p99/max,
 //       overruns, wrench age (since the simulation's wrench arrived) and information age (of the
 //       newest information in the rendered wrench: the device pose the K_h prediction used, or
-//       without K_h the pose the step used), simulation step time p50/p99/max and steps per second, and
-//       whether the loop got SCHED_FIFO. --priority 0 keeps the default scheduling (default: the
-//       loop's 80); --kh-columns 6 refreshes K_h in one step (default 1 column per step).
+//       without K_h the pose the step used), simulation step time p50/p99/max and steps per second,
+//       and whether the loop got SCHED_FIFO. --priority 0 keeps the default scheduling (default:
+//       the loop's 80); --kh-columns 6 refreshes K_h in one step (default 1 column per step).
 //   bench_haptic_loop figure67 internal_force|frame_difference LOG.csv [MESH_TETS]
 //       The Figure 6.7 sequence on a simulated clock (lockstep, deterministic), loop log to CSV
 //       for docs/haptics.md (tests/bench/plot_haptics.py draws it).
@@ -129,8 +129,8 @@ int threaded(int tets, double seconds, const char* log_path, int priority, int k
       percentile(period, 0.5), percentile(period, 0.99),
       static_cast<unsigned long long>(loop.stats().overruns.load()), percentile(age, 0.5),
       percentile(age, 0.99), percentile(age, 1.0), percentile(information_age, 0.5),
-      percentile(information_age, 0.99), percentile(information_age, 1.0), steps / wall, percentile(step_ms, 0.5),
-      percentile(step_ms, 0.99), percentile(step_ms, 1.0), kh_columns,
+      percentile(information_age, 0.99), percentile(information_age, 1.0), steps / wall,
+      percentile(step_ms, 0.5), percentile(step_ms, 0.99), percentile(step_ms, 1.0), kh_columns,
       loop.stats().realtime ? "true" : "false");
   if (log_path && !loop.writeLog(log_path)) return 1;
   return 0;

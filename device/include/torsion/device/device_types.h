@@ -38,7 +38,8 @@ struct DeviceLimits {
 
 /// One reading of the device.
 struct DeviceSample {
-  double time = 0;  ///< s, loop clock of the reading (earlier than now when a device holds an old one)
+  /// s, loop clock of the reading (earlier than now when a device holds an old one)
+  double time = 0;
   Pose pose;
   std::uint32_t buttons = 0;  ///< bit k set: button k+1 held (bit 0 is the report's button 1)
   bool alive = false;         ///< false when the device stopped answering

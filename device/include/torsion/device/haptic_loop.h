@@ -55,7 +55,7 @@ struct LoopLogRow {
   Wrench output;     ///< what was written to the device
   Wrench simulated;  ///< the simulation's wrench the local model started from
   std::uint64_t sim_step = 0;
-  double wrench_age = 0;             ///< s since that simulation wrench arrived
+  double wrench_age = 0;  ///< s since that simulation wrench arrived
   /// s, age of the newest information in the rendered wrench: with a local stiffness, the age of
   /// the device pose the prediction used (read this tick); without, now minus the time of the
   /// pose the simulation step used (HandCommand::time). 0 before the first publication.
