@@ -120,13 +120,13 @@ def fnv1a(data):
 
 
 def test_bytes_altered_behind_a_valid_hash_are_refused_or_restored_never_a_crash():
-    world = torsion.World.from_scene("two_hands", threads=1)
-    world.step(30)
+    world = torsion.World.from_scene("drop", threads=1)
+    world.step(80)  # resting on the ground: contacts in the bytes
     data = world.save_state().to_bytes()
     header, payload = data[:28], data[28:]
     rng = np.random.default_rng(7)
     refused = 0
-    for trial in range(300):
+    for trial in range(200):
         altered = bytearray(payload)
         for at in rng.integers(0, len(payload), size=3):
             altered[at] = int(rng.integers(0, 256))
