@@ -4,6 +4,7 @@
 #include <cstdint>
 #include <cstring>
 #include <deque>
+#include <mutex>
 #include <type_traits>
 
 namespace torsion {
@@ -160,7 +161,9 @@ std::uint64_t meshHash(const FemModel& model) {
 
 // A static string for LinearSolveReport::breakdown_reason (reports hold them by pointer).
 const char* internReason(const std::string& reason) {
+  static std::mutex mutex;
   static std::deque<std::string> reasons;
+  const std::lock_guard<std::mutex> lock(mutex);
   for (const std::string& r : reasons) {
     if (r == reason) return r.c_str();
   }
