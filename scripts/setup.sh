@@ -27,6 +27,8 @@ packages=(
   python3-dev pybind11-dev python3-numpy python3-pytest python3-matplotlib
   # the ParaView series: zlib compresses it; the series tests read it back with meshio and VTK
   zlib1g-dev python3-meshio python3-vtk9
+  # instruction counts per step (tests/bench/bench_python_step.py --instructions: callgrind)
+  valgrind
   # static analysis in CI (scripts/clang_tidy.sh, the committed .clang-tidy)
   clang-tidy-14
 )

@@ -9,6 +9,7 @@ import numpy as np
 import pytest
 
 import torsion
+from conftest import SOURCE_DIR, cube_mesh
 
 
 def snapshot(world):
@@ -48,10 +49,110 @@ def test_a_state_from_before_a_hand_was_added_is_refused():
         world.restore_state(state)
 
 
-def test_a_state_says_why_it_cannot_be_pickled():
-    state = torsion.World.from_scene("drop", threads=1).save_state()
-    with pytest.raises(TypeError, match="cannot be pickled"):
-        pickle.dumps(state)
+# Saved at step 30 (drop: still falling) and at step 80 (drop: resting on the ground, so the
+# rigid-contact warm starts are in the bytes). Restored into the same world and into a new one.
+@pytest.mark.parametrize("scene,steps", [("twist_cylinder_2430", 30), ("drop", 30), ("drop", 80),
+                                         ("two_hands", 30)])
+def test_a_pickled_state_continues_bit_for_bit_here_and_in_a_new_world(scene, steps):
+    world = torsion.World.from_scene(scene, threads=1)
+    world.step(steps)
+    data = pickle.dumps(world.save_state())
+    world.step(25)
+    first = snapshot(world)
+    state = pickle.loads(data)
+    assert state.time == pytest.approx(0.01 * steps)
+    world.restore_state(state)
+    world.step(25)
+    fresh = torsion.World.from_scene(scene, threads=1)
+    fresh.restore_state(pickle.loads(data))
+    assert fresh.step_count == steps
+    fresh.step(25)
+    for other in (snapshot(world), snapshot(fresh)):
+        assert all(np.array_equal(a, b) for a, b in zip(first, other))
+
+
+def test_a_pickled_state_keeps_a_grab_made_after_the_world_was_built():
+    world = torsion.World(dt=0.01, threads=1)
+    world.add_body("cyl", str(SOURCE_DIR / "assets/meshes/cylinder_2430.node"))
+    world.add_node_set("base", "cyl", plane=((0, 0, 0), (0, 0, 1)))
+    hand = world.add_hand("hand", "cyl")
+    hand.grab(torsion.Frame(position=(0, 0, 10)))
+    for k in range(20):
+        hand.move_to(torsion.Frame.from_axis_angle((0, 0, 10), (0, 0, 1), 0.002 * k))
+        world.step()
+    data = pickle.dumps(world.save_state())
+    world.step(20)
+    first = snapshot(world)
+
+    fresh = torsion.World(dt=0.01, threads=1)  # built the same way, never grabbed
+    fresh.add_body("cyl", str(SOURCE_DIR / "assets/meshes/cylinder_2430.node"))
+    fresh.add_node_set("base", "cyl", plane=((0, 0, 0), (0, 0, 1)))
+    fresh.add_hand("hand", "cyl")
+    fresh.restore_state(pickle.loads(data))
+    assert fresh.hand("hand").grabbed
+    fresh.step(20)
+    assert all(np.array_equal(a, b) for a, b in zip(first, snapshot(fresh)))
+
+
+def test_truncated_corrupted_or_foreign_bytes_raise_a_clear_error():
+    data = torsion.World.from_scene("drop", threads=1).save_state().to_bytes()
+    assert data.startswith(b"TRSNCKPT")
+    for cut in (0, 5, 20, 27, 28, len(data) // 2, len(data) - 1):
+        with pytest.raises(ValueError, match="truncated|not a torsion checkpoint"):
+            torsion.State.from_bytes(data[:cut])
+    flipped = bytearray(data)
+    flipped[len(data) // 2] ^= 0x10
+    with pytest.raises(ValueError, match="corrupted"):
+        pickle.loads(pickle.dumps(torsion.State.from_bytes(data)).replace(data, bytes(flipped)))
+    with pytest.raises(ValueError, match="not a torsion checkpoint"):
+        torsion.State.from_bytes(b"PK\x03\x04 a zip file, not a checkpoint")
+    newer = bytearray(data)
+    newer[8] = 99  # the version
+    with pytest.raises(ValueError, match="version 99"):
+        torsion.State.from_bytes(bytes(newer))
+
+
+def fnv1a(data):
+    h = 1469598103934665603
+    for byte in data:
+        h = ((h ^ byte) * 1099511628211) & 0xFFFFFFFFFFFFFFFF
+    return h
+
+
+def test_bytes_altered_behind_a_valid_hash_are_refused_or_restored_never_a_crash():
+    world = torsion.World.from_scene("drop", threads=1)
+    world.step(80)  # resting on the ground: contacts in the bytes
+    data = world.save_state().to_bytes()
+    header, payload = data[:28], data[28:]
+    rng = np.random.default_rng(7)
+    refused = 0
+    for trial in range(200):
+        altered = bytearray(payload)
+        for at in rng.integers(0, len(payload), size=3):
+            altered[at] = int(rng.integers(0, 256))
+        blob = header[:20] + fnv1a(altered).to_bytes(8, "little") + bytes(altered)
+        try:
+            world.restore_state(torsion.State.from_bytes(blob))
+            world.step(1)
+        except (ValueError, torsion.UnstableError):
+            refused += 1
+    assert refused > 0  # counts, sizes and indices are checked (most bytes are doubles)
+
+
+def test_a_state_restored_into_another_world_says_so():
+    twist = torsion.World.from_scene("twist_cylinder_2430", threads=1).save_state()
+    with pytest.raises(ValueError, match="another world"):
+        torsion.World.from_scene("drop", threads=1).restore_state(pickle.loads(pickle.dumps(twist)))
+
+    def cube_world(cells):
+        world = torsion.World(threads=1)
+        nodes, tets = cube_mesh(cells)
+        world.add_body("cube", nodes=nodes, tets=tets)
+        return world
+
+    state = pickle.dumps(cube_world(2).save_state())
+    with pytest.raises(ValueError, match="another world: body 'cube' has another mesh"):
+        cube_world(3).restore_state(pickle.loads(state))
 
 
 def rss_kib():

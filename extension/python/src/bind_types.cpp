@@ -3,9 +3,24 @@
 
 #include "handles.h"
 #include "py_convert.h"
+#include "torsion/bullet/checkpoint_io.h"
 #include "torsion/fem/material.h"
 
 namespace torsion::python {
+namespace {
+
+// A state of bytes alone; their header, length and hash are checked now, the rest when restored.
+PyWorldState stateFromBytes(const py::bytes& data) {
+  PyWorldState state;
+  state.in_memory = false;
+  state.bytes = data;
+  Result<double> time = checkpointTime(state.bytes);
+  if (!time) throw py::value_error("torsion.State: " + time.error().message);
+  state.time = time.value();
+  return state;
+}
+
+}  // namespace
 
 namespace {
 
@@ -110,14 +125,16 @@ void bindTypes(py::module_& m) {
       });
 
   py::class_<PyWorldState>(m, "State",
-                           "A world at a moment (World.save_state), in memory. restore_state "
-                           "continues bit for bit as the world did after save_state.")
-      .def_property_readonly("time", [](const PyWorldState& s) { return s.world.fem.time; })
-      .def("__reduce__", [](const PyWorldState&) -> py::object {
-        throw py::type_error(
-            "torsion.State cannot be pickled: it holds the solver's warm starts and the hands' "
-            "motion state by reference; keep it in the process (World.save_state / restore_state)");
-      });
+                           "A world at a moment (World.save_state). restore_state continues bit "
+                           "for bit as the world did after save_state, also after pickling.")
+      .def_property_readonly("time", [](const PyWorldState& s) { return s.time; })
+      .def(
+          "to_bytes", [](const PyWorldState& s) { return py::bytes(s.bytes); },
+          "The versioned checkpoint bytes pickle stores.")
+      .def_static("from_bytes", &stateFromBytes, py::arg("data"),
+                  "A state of checkpoint bytes (to_bytes); errors on bytes that are not one.")
+      .def(py::pickle([](const PyWorldState& s) { return py::bytes(s.bytes); },
+                      [](const py::bytes& data) { return stateFromBytes(data); }));
 }
 
 }  // namespace torsion::python

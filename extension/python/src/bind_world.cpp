@@ -253,6 +253,7 @@ void bindWorld(py::module_& m) {
             WorldGuard guard(w);
             Result<PyWorldState> state = w.saveState();
             if (!state) throw py::value_error(state.error().message);
+            state.value().bytes = w.serialize(state.value());  // what pickle takes
             return std::move(state).value();
           },
           "The world now (FEM bodies, solver warm starts, hands, node sets, rigid bodies).")

@@ -2,6 +2,7 @@
 
 #include "scene_haptics.h"
 #include "scene_parser.h"
+#include "torsion/bullet/checkpoint_io.h"
 #include "torsion/bullet/rigid_health.h"
 
 namespace torsion::python {
@@ -156,10 +157,55 @@ Result<PyWorldState> PyWorld::saveState() {
     state.released.push_back(h.released);
   state.node_set_count = scene_->node_sets.size();
   state.failure = failure_;
+  state.time = state.world.fem.time;
   return state;
 }
 
+// PyWorldState's own fields travel as the checkpoint's extra bytes: "<node sets>\n<released
+// flags as 0 and 1>\n<failure>".
+std::string PyWorld::serialize(const PyWorldState& state) {
+  std::string extra = std::to_string(state.node_set_count) + "\n";
+  for (bool released : state.released)
+    extra += released ? '1' : '0';
+  extra += "\n" + state.failure;
+  return writeCheckpoint(world(), state.world, hands(), state.hands, extra);
+}
+
+namespace {
+
+Result<PyWorldState> deserialize(const std::string& bytes, FemWorld& world,
+                                 const std::vector<Hand*>& hands, size_t scene_hands) {
+  Result<StoredCheckpoint> stored = readCheckpoint(bytes, world, hands);
+  if (!stored) return Error{"restore_state: " + stored.error().message};
+  PyWorldState state;
+  state.world = std::move(stored.value().world);
+  state.hands = std::move(stored.value().hands);
+  state.time = state.world.fem.time;
+  const std::string& extra = stored.value().extra;
+  const size_t first = extra.find('\n');
+  const size_t second = first == std::string::npos ? first : extra.find('\n', first + 1);
+  const std::string counted = extra.substr(0, first);
+  if (second == std::string::npos || counted.empty() ||
+      counted.find_first_not_of("0123456789") != std::string::npos) {
+    return Error{"restore_state: the checkpoint is corrupted (its Python fields)"};
+  }
+  state.node_set_count = std::stoul(counted);
+  for (size_t k = first + 1; k < second; ++k)
+    state.released.push_back(extra[k] == '1');
+  if (state.released.size() != scene_hands)
+    return Error{"restore_state: the checkpoint was saved from another world: other scene hands"};
+  state.failure = extra.substr(second + 1);
+  return state;
+}
+
+}  // namespace
+
 Status PyWorld::restoreState(const PyWorldState& state) {
+  if (!state.in_memory) {
+    Result<PyWorldState> read = deserialize(state.bytes, world(), hands(), scene_->hands.size());
+    if (!read) return read.error();
+    return restoreState(read.value());
+  }
   std::vector<Hand*> all = hands();
   if (all.size() != state.hands.size() || state.node_set_count != scene_->node_sets.size()) {
     return Error{"restore_state: hands or node sets were added since the state was saved"};

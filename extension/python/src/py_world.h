@@ -26,9 +26,13 @@ struct Failure {
   std::string message;  ///< the CLI's message, word for word
 };
 
-/// Everything the next steps of a PyWorld read, in memory (not serialisable: it holds the solver's
-/// warm starts and shared motion state by pointer).
+/// Everything the next steps of a PyWorld read. In memory (`world`, `hands`, ...: the solver's warm
+/// starts and shared motion state by pointer) and, for states Python holds, also as `bytes`
+/// (bullet/checkpoint_io.h), which is all an unpickled state has.
 struct PyWorldState {
+  bool in_memory = true;  ///< false: only `bytes` (and `time`) hold it
+  double time = 0;        ///< s
+  std::string bytes;      ///< the serialised form (PyWorld::serialize), or empty
   WorldCheckpoint world;
   std::vector<HandCheckpoint> hands;  ///< scene hands, then hands added in code
   std::vector<bool> released;         ///< per scene hand: let go for good (driveHands)
@@ -70,7 +74,11 @@ class PyWorld {
   btRigidBody* addRigidBody(const scene::RigidBodySpec& spec, bool ground);
 
   Result<PyWorldState> saveState();
+  /// Back to `state`; a state of bytes alone is read for this world first (errors: corrupted
+  /// bytes, or a world other than the one saved).
   Status restoreState(const PyWorldState& state);
+  /// The bytes of a state saved from this world (saveState), pickled as torsion.State.
+  std::string serialize(const PyWorldState& state);
 
   /// Python changed the world between steps (forces, hand goals, grabs, materials, parts): a
   /// failing step can no longer be rewound by replaying from before that change.

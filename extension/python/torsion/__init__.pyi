@@ -59,8 +59,13 @@ class Material:
     shear_modulus: float  # Pa
 
 class State:
-    """A world at a moment (World.save_state); in memory only, not picklable."""
+    """A world at a moment (World.save_state); picklable (versioned checkpoint bytes)."""
     time: float  # s
+    def to_bytes(self) -> bytes: ...  # what pickle stores: "TRSNCKPT", version, length, hash, data
+    @staticmethod
+    def from_bytes(data: bytes) -> State: ...  # ValueError: truncated, corrupted, not a checkpoint
+    def __getstate__(self) -> bytes: ...
+    def __setstate__(self, data: bytes) -> None: ...
 
 class Body:
     name: str

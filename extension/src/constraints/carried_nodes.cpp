@@ -11,6 +11,13 @@ CarriedNodes::CarriedNodes(std::string name, std::vector<int> nodes, FrameMotion
     local_.push_back(frame.toLocal(state.position(node)));
 }
 
+CarriedNodes::CarriedNodes(std::string name, std::vector<int> nodes,
+                           std::vector<Eigen::Vector3d> local, FrameMotion motion)
+    : name_(std::move(name)),
+      nodes_(std::move(nodes)),
+      local_(std::move(local)),
+      motion_(std::move(motion)) {}
+
 void CarriedNodes::prescribe(double time_next, double dt, const FemState& state,
                              NodeConstraints& constraints) const {
   const Frame frame = motion_(time_next);

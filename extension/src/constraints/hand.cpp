@@ -62,15 +62,15 @@ Result<int> Hand::grab(const Frame& frame, double now) {
   for (int node : selection_.nodes)
     pursuit_->reach =
         std::max(pursuit_->reach, (body_->state().position(node) - frame.origin).norm());
-  std::shared_ptr<HandPursuit> pursuit = pursuit_;
-  group_ = body_->carryNodes(
-      name_, selection_.nodes,
-      [pursuit](double t) {
-        pursuit->advanceTo(t);
-        return pursuit->patch;
-      },
-      now);
+  group_ = body_->carryNodes(name_, selection_.nodes, followPursuit(pursuit_), now);
   return static_cast<int>(selection_.nodes.size());
+}
+
+FrameMotion followPursuit(std::shared_ptr<HandPursuit> pursuit) {
+  return [pursuit = std::move(pursuit)](double t) {
+    pursuit->advanceTo(t);
+    return pursuit->patch;
+  };
 }
 
 void Hand::moveTo(const Frame& frame) {

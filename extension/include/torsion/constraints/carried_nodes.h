@@ -26,11 +26,16 @@ class CarriedNodes {
   /// at `time`.
   CarriedNodes(std::string name, std::vector<int> nodes, FrameMotion motion, const FemState& state,
                double time);
+  /// A group as it was (checkpoints read back from bytes, bullet/checkpoint_io.h): `local` are
+  /// the nodes' p_hat as localCoordinates() gave them.
+  CarriedNodes(std::string name, std::vector<int> nodes, std::vector<Eigen::Vector3d> local,
+               FrameMotion motion);
 
   const std::string& name() const { return name_; }
   const std::vector<int>& nodes() const { return nodes_; }
   const std::vector<Eigen::Vector3d>& localCoordinates() const { return local_; }
   Frame frameAt(double time) const { return motion_(time); }
+  const FrameMotion& motion() const { return motion_; }
 
   /// Prescribes each node's velocity so it reaches R(t_next) p_hat + O(t_next) after dt.
   void prescribe(double time_next, double dt, const FemState& state,

@@ -68,6 +68,9 @@ struct HandPursuit {
   void advanceTo(double t);
 };
 
+/// The motion of a grabbed patch: the pursuit advanced to each time asked, its patch frame.
+FrameMotion followPursuit(std::shared_ptr<HandPursuit> pursuit);
+
 /// A hand's state at a moment (Hand::checkpoint), to go back to with the body's checkpoint.
 struct HandCheckpoint {
   std::shared_ptr<HandPursuit> pursuit;  ///< the pursuit the body's node group follows then

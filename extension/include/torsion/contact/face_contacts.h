@@ -84,6 +84,12 @@ class FaceContactSet {
               const btTransform& transform, const Eigen::Vector3d& lo, const Eigen::Vector3d& hi,
               double reach, double dt, int partner, const RigidPartner& p, double friction);
   const std::vector<FaceContact>& contacts() const { return contacts_; }
+  /// Back to contacts as contacts() gave them (checkpoints read back from bytes): the next
+  /// beginStep() takes over their states and multipliers.
+  void restoreContacts(std::vector<FaceContact> contacts) {
+    contacts_ = std::move(contacts);
+    index_.clear();
+  }
   bool empty() const { return contacts_.empty(); }
 
   // ---- terms of the reduced solve (rigid_contact.cpp) ----

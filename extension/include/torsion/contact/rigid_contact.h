@@ -112,6 +112,27 @@ struct ContactStepStats {
   double max_end_penetration = 0;  ///< m, deepest linearised end-of-step gap after the solve
 };
 
+/// What a RigidContactSolver's next step takes over from its last (its warm starts), with the
+/// rigid objects by pointer: the active node contacts (their stick or slide state) and the face
+/// contacts (state, multiplier). Checkpoints that leave memory (bullet/checkpoint_io.h) store this
+/// instead of the whole solver; it must list everything detect() reads from the last step.
+struct CarriedContacts {
+  struct Node {
+    int node = -1;
+    const btCollisionObject* object = nullptr;
+    NodeContact::State state = NodeContact::State::kSlide;
+  };
+  struct Face {
+    std::array<int, 3> key{};
+    const btCollisionObject* object = nullptr;
+    FaceContact::State state = FaceContact::State::kSlide;
+    Eigen::Vector3d multiplier = Eigen::Vector3d::Zero();
+    int stalls = 0;
+  };
+  std::vector<Node> nodes;
+  std::vector<Face> faces;
+};
+
 class RigidContactSolver {
  public:
   RigidContactSolver(std::shared_ptr<const FemModel> model, btSoftBody* soft_body);
@@ -148,6 +169,12 @@ class RigidContactSolver {
   const std::vector<FaceContact>& faceContacts() const { return faces_.contacts(); }
   const std::vector<RigidPartner>& partners() const { return partners_; }
   const ContactStepStats& stats() const { return stats_; }
+
+  /// The warm starts the next step takes over (checkpoints: carried_contacts.cpp).
+  CarriedContacts carriedContacts() const;
+  /// Back to carried contacts: the next step starts as it did after carriedContacts(). The last
+  /// step's contacts() then list them alone, without their geometry and impulses.
+  void restoreCarriedContacts(const CarriedContacts& carried);
 
  private:
   int partnerIndex(const btCollisionObject* object);

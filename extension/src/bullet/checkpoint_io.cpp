@@ -1,0 +1,663 @@
+#include "torsion/bullet/checkpoint_io.h"
+
+#include <algorithm>
+#include <cstdint>
+#include <cstring>
+#include <deque>
+#include <mutex>
+#include <type_traits>
+
+namespace torsion {
+namespace {
+
+#if defined(__BYTE_ORDER__)
+static_assert(__BYTE_ORDER__ == __ORDER_LITTLE_ENDIAN__, "checkpoint bytes are little-endian");
+#endif
+
+constexpr char kMagic[8] = {'T', 'R', 'S', 'N', 'C', 'K', 'P', 'T'};
+constexpr std::uint32_t kVersion = 1;
+constexpr size_t kHeaderSize = sizeof(kMagic) + 4 + 8 + 8;
+
+std::uint64_t fnv1a(std::string_view bytes) {
+  std::uint64_t h = 1469598103934665603ull;
+  for (unsigned char c : bytes) {
+    h ^= c;
+    h *= 1099511628211ull;
+  }
+  return h;
+}
+
+class Writer {
+ public:
+  template <typename T>
+  void raw(T value) {
+    static_assert(std::is_arithmetic_v<T>);
+    char bytes[sizeof(T)];
+    std::memcpy(bytes, &value, sizeof(T));
+    out_.append(bytes, sizeof(T));
+  }
+  void u8(int v) { raw(static_cast<std::uint8_t>(v)); }
+  void u32(size_t v) { raw(static_cast<std::uint32_t>(v)); }
+  void i32(int v) { raw(static_cast<std::int32_t>(v)); }
+  void i64(std::int64_t v) { raw(v); }
+  void f64(double v) { raw(v); }
+  void str(std::string_view s) {
+    u32(s.size());
+    out_.append(s.data(), s.size());
+  }
+  void vec3(const Eigen::Vector3d& v) {
+    for (int k = 0; k < 3; ++k)
+      f64(v[k]);
+  }
+  void vector(const Eigen::VectorXd& v) {
+    u32(static_cast<size_t>(v.size()));
+    for (Eigen::Index k = 0; k < v.size(); ++k)
+      f64(v[k]);
+  }
+  void ints(const std::vector<int>& v) {
+    u32(v.size());
+    for (int x : v)
+      i32(x);
+  }
+  void frame(const Frame& f) {
+    vec3(f.origin);
+    for (double c : {f.rotation.x(), f.rotation.y(), f.rotation.z(), f.rotation.w()})
+      f64(c);
+  }
+  std::string& bytes() { return out_; }
+
+ private:
+  std::string out_;
+};
+
+// Every read checks the bytes left; the first failure sticks and later reads return zeros, so a
+// reader can parse on and check ok() at the points where a wrong value would do harm.
+class Reader {
+ public:
+  explicit Reader(std::string_view bytes) : in_(bytes) {}
+  bool ok() const { return ok_; }
+  template <typename T>
+  T raw() {
+    T value{};
+    if (!take(sizeof(T))) return value;
+    std::memcpy(&value, in_.data() + at_ - sizeof(T), sizeof(T));
+    return value;
+  }
+  int u8() { return raw<std::uint8_t>(); }
+  size_t u32() { return raw<std::uint32_t>(); }
+  int i32() { return raw<std::int32_t>(); }
+  std::int64_t i64() { return raw<std::int64_t>(); }
+  double f64() { return raw<double>(); }
+  /// A count of items of at least `item_size` bytes each: no more than the bytes left hold.
+  size_t count(size_t item_size) {
+    const size_t n = u32();
+    if (n * item_size > in_.size() - at_) ok_ = false;
+    return ok_ ? n : 0;
+  }
+  std::string str() {
+    const size_t n = count(1);
+    if (!take(n)) return {};
+    return std::string(in_.substr(at_ - n, n));
+  }
+  Eigen::Vector3d vec3() {
+    Eigen::Vector3d v;
+    for (int k = 0; k < 3; ++k)
+      v[k] = f64();
+    return v;
+  }
+  Eigen::VectorXd vector() {
+    Eigen::VectorXd v(static_cast<Eigen::Index>(count(8)));
+    for (Eigen::Index k = 0; k < v.size(); ++k)
+      v[k] = f64();
+    return v;
+  }
+  std::vector<int> ints() {
+    std::vector<int> v(count(4));
+    for (int& x : v)
+      x = i32();
+    return v;
+  }
+  Frame frame() {
+    Frame f;
+    f.origin = vec3();
+    const double x = f64(), y = f64(), z = f64(), w = f64();
+    f.rotation = Eigen::Quaterniond(w, x, y, z);
+    return f;
+  }
+  /// An enum stored as u8, at most `last`.
+  template <typename E>
+  E enumeration(E last) {
+    const int v = u8();
+    if (v > static_cast<int>(last)) ok_ = false;
+    return static_cast<E>(ok_ ? v : 0);
+  }
+  void fail() { ok_ = false; }
+  bool atEnd() const { return at_ == in_.size(); }
+
+ private:
+  bool take(size_t n) {
+    if (!ok_ || n > in_.size() - at_) {
+      ok_ = false;
+      return false;
+    }
+    at_ += n;
+    return true;
+  }
+  std::string_view in_;
+  size_t at_ = 0;
+  bool ok_ = true;
+};
+
+// The bytes of a mesh's rest positions and elements: a body restored onto another mesh would
+// index the wrong nodes.
+std::uint64_t meshHash(const FemModel& model) {
+  std::string bytes;
+  for (const Eigen::Vector3d& x : model.mesh().restPositions())
+    bytes.append(reinterpret_cast<const char*>(x.data()), 3 * sizeof(double));
+  for (int node : model.elementNodes())
+    bytes.append(reinterpret_cast<const char*>(&node), sizeof(int));
+  return fnv1a(bytes);
+}
+
+// A static string for LinearSolveReport::breakdown_reason (reports hold them by pointer).
+const char* internReason(const std::string& reason) {
+  static std::mutex mutex;
+  static std::deque<std::string> reasons;
+  const std::lock_guard<std::mutex> lock(mutex);
+  for (const std::string& r : reasons) {
+    if (r == reason) return r.c_str();
+  }
+  return reasons.emplace_back(reason).c_str();
+}
+
+int collisionObjectIndex(FemWorld& world, const btCollisionObject* object) {
+  return world.bulletWorld().getCollisionObjectArray().findLinearSearch(
+      const_cast<btCollisionObject*>(object));
+}
+
+// How a node group moves, which is code, not data: a group of the world with the same index and
+// name (node sets and scripted ends, made when the world is built), a hand's pursuit, or nothing
+// (a released group holds no node).
+enum class GroupMotion { kWorldGroup, kHand, kNone };
+
+void writeMaterial(Writer& w, const Material& m) {
+  for (double v :
+       {m.youngs_modulus, m.poisson_ratio, m.density, m.mass_damping, m.stiffness_damping})
+    w.f64(v);
+  w.u8(static_cast<int>(m.volumetric_strain));
+}
+
+Material readMaterial(Reader& r) {
+  Material m;
+  m.youngs_modulus = r.f64();
+  m.poisson_ratio = r.f64();
+  m.density = r.f64();
+  m.mass_damping = r.f64();
+  m.stiffness_damping = r.f64();
+  m.volumetric_strain = r.enumeration(VolumetricStrain::kNodalAverage);
+  return m;
+}
+
+bool sameMaterial(const Material& a, const Material& b) {
+  return a.youngs_modulus == b.youngs_modulus && a.poisson_ratio == b.poisson_ratio &&
+         a.density == b.density && a.mass_damping == b.mass_damping &&
+         a.stiffness_damping == b.stiffness_damping && a.volumetric_strain == b.volumetric_strain;
+}
+
+void writeReport(Writer& w, const StepReport& s) {
+  w.i32(s.solve.iterations);
+  w.f64(s.solve.relative_residual);
+  w.u8(s.solve.converged);
+  w.u8(s.solve.breakdown);
+  w.u8(s.solve.breakdown_reason != nullptr);
+  w.str(s.solve.breakdown_reason != nullptr ? s.solve.breakdown_reason : "");
+  w.f64(s.elastic_energy);
+  w.f64(s.kinetic_energy);
+  w.f64(s.max_speed);
+  w.u8(static_cast<int>(s.health));
+  w.str(s.message);
+}
+
+StepReport readReport(Reader& r) {
+  StepReport s;
+  s.solve.iterations = r.i32();
+  s.solve.relative_residual = r.f64();
+  s.solve.converged = r.u8() != 0;
+  s.solve.breakdown = r.u8() != 0;
+  const bool has_reason = r.u8() != 0;
+  const std::string reason = r.str();
+  if (has_reason && r.ok()) s.solve.breakdown_reason = internReason(reason);
+  s.elastic_energy = r.f64();
+  s.kinetic_energy = r.f64();
+  s.max_speed = r.f64();
+  s.health = r.enumeration(StepHealth::kBlowUp);
+  s.message = r.str();
+  return s;
+}
+
+void writeHand(Writer& w, const Hand& hand, const HandCheckpoint& c) {
+  w.str(hand.name());
+  w.str(hand.body().name());
+  w.frame(c.values.goal);
+  w.frame(c.values.patch);
+  for (double v : {c.values.time, c.values.max_speed, c.values.reach, c.speed_limit})
+    w.f64(v);
+  const HandSelection& s = c.selection;
+  w.u8(static_cast<int>(s.status));
+  w.str(s.message);
+  w.i32(s.cut_triangle_count);
+  w.i32(s.hit_triangle);
+  w.f64(s.hit_distance);
+  w.vec3(s.hit_point);
+  w.ints(s.triangles);
+  w.ints(s.nodes);
+  w.i32(c.group);
+}
+
+HandCheckpoint readHand(Reader& r) {
+  HandCheckpoint c;
+  c.values.goal = r.frame();
+  c.values.patch = r.frame();
+  c.values.time = r.f64();
+  c.values.max_speed = r.f64();
+  c.values.reach = r.f64();
+  c.speed_limit = r.f64();
+  HandSelection& s = c.selection;
+  s.status = r.enumeration(HandSelectionStatus::kRayMissed);
+  s.message = r.str();
+  s.cut_triangle_count = r.i32();
+  s.hit_triangle = r.i32();
+  s.hit_distance = r.f64();
+  s.hit_point = r.vec3();
+  s.triangles = r.ints();
+  s.nodes = r.ints();
+  c.group = r.i32();
+  c.pursuit = std::make_shared<HandPursuit>(c.values);
+  return c;
+}
+
+void writeBody(Writer& w, FemWorld& world, const FemBody& body, const FemBodyCheckpoint& c,
+               const std::vector<Hand*>& hands,
+               const std::vector<HandCheckpoint>& hand_checkpoints) {
+  const FemModel& model = *c.model;
+  w.str(body.name());
+  w.u32(static_cast<size_t>(model.nodeCount()));
+  w.u32(static_cast<size_t>(model.elementCount()));
+  w.u8(static_cast<int>(model.elementKind()));
+  w.raw(meshHash(model));
+  writeMaterial(w, model.material());
+
+  w.vector(c.state.positions);
+  w.vector(c.state.velocities);
+  w.u32(c.state.element_rotations.size());
+  for (const Eigen::Quaterniond& q : c.state.element_rotations) {
+    for (double v : {q.x(), q.y(), q.z(), q.w()})
+      w.f64(v);
+  }
+  w.vector(c.external_forces);
+  w.vector(c.stepper.previous_velocities);
+  w.vector(c.stepper.velocity_next);
+  w.vector(c.stepper.elastic_forces);
+  w.vector(c.stepper.internal_forces);
+  w.f64(c.stepper.last_dt);
+
+  w.u32(c.groups.size());
+  for (size_t g = 0; g < c.groups.size(); ++g) {
+    const CarriedNodes& group = c.groups[g];
+    w.str(group.name());
+    w.ints(group.nodes());
+    w.u32(group.localCoordinates().size());
+    for (const Eigen::Vector3d& p : group.localCoordinates())
+      w.vec3(p);
+    GroupMotion motion = group.nodes().empty() ? GroupMotion::kNone : GroupMotion::kWorldGroup;
+    size_t owner = 0;
+    for (size_t h = 0; h < hands.size(); ++h) {
+      if (&hands[h]->body() == &body && hand_checkpoints[h].group == static_cast<int>(g)) {
+        motion = GroupMotion::kHand;
+        owner = h;
+      }
+    }
+    w.u8(static_cast<int>(motion));
+    w.u32(owner);
+  }
+
+  const CarriedContacts carried = c.contacts->carriedContacts();
+  w.u32(carried.nodes.size());
+  for (const CarriedContacts::Node& n : carried.nodes) {
+    w.i32(n.node);
+    w.i32(collisionObjectIndex(world, n.object));
+    w.u8(static_cast<int>(n.state));
+  }
+  w.u32(carried.faces.size());
+  for (const CarriedContacts::Face& f : carried.faces) {
+    for (int node : f.key)
+      w.i32(node);
+    w.i32(collisionObjectIndex(world, f.object));
+    w.u8(static_cast<int>(f.state));
+    w.vec3(f.multiplier);
+    w.i32(f.stalls);
+  }
+
+  w.u8(c.self_contact);
+  const SelfContactSettings& s = c.self_contact_settings;
+  for (double v : {s.friction, s.gap_tolerance, s.margin, s.max_depth, s.penalty_factor})
+    w.f64(v);
+  w.i32(s.max_iterations);
+  w.u32(c.self_contact_warm_starts.size());
+  for (const auto& [key, lambda] : c.self_contact_warm_starts) {
+    w.raw(key);
+    w.vec3(lambda);
+  }
+  writeReport(w, c.last_report);
+}
+
+std::string anotherWorld(const std::string& why) {
+  return "the checkpoint was saved from another world: " + why;
+}
+
+// Reads one body's checkpoint onto `body` of the world being restored (its current checkpoint
+// `now` gives what is code rather than data: the motions of its groups, its contact solver's
+// settings and anchors).
+Result<FemBodyCheckpoint> readBody(Reader& r, FemWorld& world, FemBody& body,
+                                   const std::vector<Hand*>& hands,
+                                   const std::vector<HandCheckpoint>& hand_checkpoints) {
+  FemBodyCheckpoint now = body.checkpoint();
+  const FemModel& model = *now.model;
+  const size_t nodes = r.u32(), elements = r.u32();
+  const auto kind = r.enumeration(ElementKind::kTet10);
+  const auto hash = r.raw<std::uint64_t>();
+  const Material material = readMaterial(r);
+  if (!r.ok()) return Error{"the checkpoint is truncated or corrupted"};
+  if (nodes != static_cast<size_t>(model.nodeCount()) ||
+      elements != static_cast<size_t>(model.elementCount()) || kind != model.elementKind() ||
+      hash != meshHash(model)) {
+    return Error{anotherWorld("body '" + body.name() + "' has another mesh (" +
+                              std::to_string(nodes) + " nodes, " + std::to_string(elements) +
+                              " elements in the checkpoint; " + std::to_string(model.nodeCount()) +
+                              ", " + std::to_string(model.elementCount()) + " here)")};
+  }
+  FemBodyCheckpoint c;
+  if (sameMaterial(material, model.material())) {
+    c.model = now.model;
+  } else {
+    Result<std::shared_ptr<const FemModel>> edited = model.withMaterial(material);
+    if (!edited) return Error{"the checkpoint is corrupted: " + edited.error().message};
+    c.model = std::move(edited).value();
+  }
+
+  const Eigen::Index dofs = 3 * model.nodeCount();
+  c.state.positions = r.vector();
+  c.state.velocities = r.vector();
+  c.state.element_rotations.resize(r.count(32));
+  for (Eigen::Quaterniond& q : c.state.element_rotations) {
+    const double x = r.f64(), y = r.f64(), z = r.f64(), w = r.f64();
+    q = Eigen::Quaterniond(w, x, y, z);
+  }
+  c.external_forces = r.vector();
+  c.stepper.previous_velocities = r.vector();
+  c.stepper.velocity_next = r.vector();
+  c.stepper.elastic_forces = r.vector();
+  c.stepper.internal_forces = r.vector();
+  c.stepper.last_dt = r.f64();
+  // Sizes the solver indexes by: wrong ones would read out of bounds. The stepper's memory is
+  // empty before a body's first step.
+  auto dofsOrEmpty = [dofs](const Eigen::VectorXd& v) { return v.size() == dofs || v.size() == 0; };
+  if (!r.ok() || c.state.positions.size() != dofs || c.state.velocities.size() != dofs ||
+      c.external_forces.size() != dofs ||
+      c.state.element_rotations.size() != now.state.element_rotations.size() ||
+      !dofsOrEmpty(c.stepper.previous_velocities) || !dofsOrEmpty(c.stepper.velocity_next) ||
+      !dofsOrEmpty(c.stepper.elastic_forces) || !dofsOrEmpty(c.stepper.internal_forces)) {
+    return Error{"the checkpoint is truncated or corrupted"};
+  }
+
+  const size_t group_count = r.count(4);
+  for (size_t g = 0; g < group_count && r.ok(); ++g) {
+    std::string name = r.str();
+    std::vector<int> group_nodes = r.ints();
+    std::vector<Eigen::Vector3d> local(r.count(24));
+    for (Eigen::Vector3d& p : local)
+      p = r.vec3();
+    const auto motion = r.enumeration(GroupMotion::kNone);
+    const size_t owner = r.u32();
+    if (!r.ok()) break;
+    for (int node : group_nodes) {
+      if (node < 0 || node >= model.nodeCount() || local.size() != group_nodes.size())
+        return Error{"the checkpoint is corrupted: node group '" + name + "' is out of range"};
+    }
+    FrameMotion follow = [](double) { return Frame{}; };
+    if (motion == GroupMotion::kWorldGroup) {
+      if (g >= body.groups().size() || body.groups()[g]->name() != name) {
+        return Error{anotherWorld("body '" + body.name() + "' has no node group '" + name +
+                                  "' at index " + std::to_string(g))};
+      }
+      follow = body.groups()[g]->motion();
+    } else if (motion == GroupMotion::kHand) {
+      if (owner >= hands.size() || &hands[owner]->body() != &body)
+        return Error{anotherWorld("node group '" + name + "' belongs to no hand of this world")};
+      follow = followPursuit(hand_checkpoints[owner].pursuit);
+    }
+    c.groups.emplace_back(std::move(name), std::move(group_nodes), std::move(local),
+                          std::move(follow));
+  }
+
+  auto objectAt = [&](int index) -> const btCollisionObject* {
+    const btCollisionObjectArray& objects = world.bulletWorld().getCollisionObjectArray();
+    if (index < 0 || index >= objects.size()) {
+      r.fail();
+      return nullptr;
+    }
+    return objects[index];
+  };
+  CarriedContacts carried;
+  carried.nodes.resize(r.count(9));
+  for (CarriedContacts::Node& n : carried.nodes) {
+    n.node = r.i32();
+    n.object = objectAt(r.i32());
+    n.state = r.enumeration(NodeContact::State::kStick);
+    if (n.node < 0 || n.node >= model.nodeCount()) r.fail();
+  }
+  carried.faces.resize(r.count(45));
+  for (CarriedContacts::Face& f : carried.faces) {
+    for (int& node : f.key)
+      node = r.i32();
+    f.object = objectAt(r.i32());
+    f.state = r.enumeration(FaceContact::State::kStick);
+    f.multiplier = r.vec3();
+    f.stalls = r.i32();
+  }
+  auto contacts = std::make_shared<RigidContactSolver>(*now.contacts);
+  contacts->replaceModel(c.model);
+  contacts->restoreCarriedContacts(carried);
+  c.contacts = std::move(contacts);
+
+  c.self_contact = r.u8() != 0;
+  SelfContactSettings& s = c.self_contact_settings;
+  s.friction = r.f64();
+  s.gap_tolerance = r.f64();
+  s.margin = r.f64();
+  s.max_depth = r.f64();
+  s.penalty_factor = r.f64();
+  s.max_iterations = r.i32();
+  c.self_contact_warm_starts.resize(r.count(32));
+  for (auto& [key, lambda] : c.self_contact_warm_starts) {
+    key = r.raw<std::uint64_t>();
+    lambda = r.vec3();
+  }
+  c.last_report = readReport(r);
+  if (!r.ok()) return Error{"the checkpoint is truncated or corrupted"};
+  return c;
+}
+
+// The payload after a checked header, or why there is none.
+Result<std::string_view> payloadOf(std::string_view bytes) {
+  if (bytes.size() < sizeof(kMagic) || std::memcmp(bytes.data(), kMagic, sizeof(kMagic)) != 0)
+    return Error{"not a torsion checkpoint (its first bytes are not \"TRSNCKPT\")"};
+  Reader header(bytes.substr(sizeof(kMagic)));
+  const size_t version = header.u32();
+  const auto length = header.raw<std::uint64_t>();
+  const auto hash = header.raw<std::uint64_t>();
+  if (!header.ok()) return Error{"the checkpoint is truncated: its header is incomplete"};
+  if (version != kVersion) {
+    return Error{"the checkpoint has format version " + std::to_string(version) +
+                 "; this build reads version " + std::to_string(kVersion)};
+  }
+  if (length != bytes.size() - kHeaderSize) {
+    return Error{"the checkpoint is truncated or padded: its header says " +
+                 std::to_string(length) + " bytes follow, " +
+                 std::to_string(bytes.size() - kHeaderSize) + " do"};
+  }
+  const std::string_view payload = bytes.substr(kHeaderSize);
+  if (fnv1a(payload) != hash) return Error{"the checkpoint is corrupted: its hash does not match"};
+  return payload;
+}
+
+}  // namespace
+
+std::string writeCheckpoint(FemWorld& world, const WorldCheckpoint& checkpoint,
+                            const std::vector<Hand*>& hands,
+                            const std::vector<HandCheckpoint>& hand_checkpoints,
+                            std::string_view extra) {
+  Writer w;
+  const FemCheckpoint& fem = checkpoint.fem;
+  w.f64(fem.time);
+  w.i64(fem.steps);
+  w.f64(fem.last_dt);
+  w.u8(fem.status.ok);
+  w.i64(fem.status.failed_step);
+  w.str(fem.status.message);
+
+  w.u32(hands.size());
+  for (size_t h = 0; h < hands.size(); ++h)
+    writeHand(w, *hands[h], hand_checkpoints[h]);
+
+  w.u32(fem.bodies.size());
+  for (const auto& [body, saved] : fem.bodies)
+    writeBody(w, world, *body, saved, hands, hand_checkpoints);
+
+  w.u32(checkpoint.rigid.size());
+  for (const WorldCheckpoint::RigidState& r : checkpoint.rigid) {
+    for (int row = 0; row < 3; ++row) {
+      for (int col = 0; col < 3; ++col)
+        w.f64(static_cast<double>(r.pose.getBasis()[row][col]));
+    }
+    for (const btVector3* v : {&r.pose.getOrigin(), &r.linear_velocity, &r.angular_velocity}) {
+      for (int k = 0; k < 3; ++k)
+        w.f64(static_cast<double>((*v)[k]));
+    }
+  }
+  w.str(extra);
+
+  Writer out;
+  out.bytes().append(kMagic, sizeof(kMagic));
+  out.raw(kVersion);
+  out.raw(static_cast<std::uint64_t>(w.bytes().size()));
+  out.raw(fnv1a(w.bytes()));
+  out.bytes() += w.bytes();
+  return std::move(out.bytes());
+}
+
+Result<double> checkpointTime(std::string_view bytes) {
+  Result<std::string_view> payload = payloadOf(bytes);
+  if (!payload) return payload.error();
+  Reader r(payload.value());
+  const double time = r.f64();
+  if (!r.ok()) return Error{"the checkpoint is truncated: it holds no clock"};
+  return time;
+}
+
+Result<StoredCheckpoint> readCheckpoint(std::string_view bytes, FemWorld& world,
+                                        const std::vector<Hand*>& hands) {
+  Result<std::string_view> payload = payloadOf(bytes);
+  if (!payload) return payload.error();
+  Reader r(payload.value());
+  const Error truncated{"the checkpoint is truncated or corrupted"};
+  StoredCheckpoint stored;
+  FemCheckpoint& fem = stored.world.fem;
+  fem.time = r.f64();
+  fem.steps = r.i64();
+  fem.last_dt = r.f64();
+  fem.status.ok = r.u8() != 0;
+  fem.status.failed_step = r.i64();
+  fem.status.message = r.str();
+
+  const size_t hand_count = r.count(8);
+  if (!r.ok()) return truncated;
+  if (hand_count != hands.size()) {
+    return Error{anotherWorld("it has " + std::to_string(hand_count) + " hands, this world " +
+                              std::to_string(hands.size()))};
+  }
+  for (size_t h = 0; h < hand_count; ++h) {
+    const std::string name = r.str(), body = r.str();
+    if (!r.ok()) return truncated;
+    if (name != hands[h]->name() || body != hands[h]->body().name()) {
+      return Error{anotherWorld("its hand " + std::to_string(h) + " is '" + name + "' on body '" +
+                                body + "', here '" + hands[h]->name() + "' on body '" +
+                                hands[h]->body().name() + "'")};
+    }
+    stored.hands.push_back(readHand(r));
+    const HandSelection& s = stored.hands.back().selection;
+    const TetMesh& mesh = hands[h]->body().model().mesh();
+    const bool in_range =
+        std::all_of(s.nodes.begin(), s.nodes.end(),
+                    [&](int n) { return n >= 0 && n < mesh.nodeCount(); }) &&
+        std::all_of(s.triangles.begin(), s.triangles.end(), [&](int t) {
+          return t >= 0 && static_cast<size_t>(t) < mesh.surfaceTriangles().size();
+        });
+    if (!r.ok() || !in_range) return truncated;
+  }
+
+  const size_t body_count = r.count(8);
+  if (!r.ok()) return truncated;
+  if (body_count != world.bodies().size()) {
+    return Error{anotherWorld("it has " + std::to_string(body_count) + " FEM bodies, this world " +
+                              std::to_string(world.bodies().size()))};
+  }
+  for (size_t b = 0; b < body_count; ++b) {
+    const std::string name = r.str();
+    if (!r.ok()) return truncated;
+    FemBody* body = world.body(name);
+    if (body == nullptr) return Error{anotherWorld("this world has no body '" + name + "'")};
+    Result<FemBodyCheckpoint> saved = readBody(r, world, *body, hands, stored.hands);
+    if (!saved) return saved.error();
+    fem.bodies.emplace_back(body, std::move(saved).value());
+  }
+
+  // A hand's group indexes its body's groups (its wrench reads it).
+  for (size_t h = 0; h < hand_count; ++h) {
+    const int group = stored.hands[h].group;
+    for (const auto& [body, saved] : fem.bodies) {
+      if (body == &hands[h]->body() &&
+          (group < -1 || group >= static_cast<int>(saved.groups.size())))
+        return truncated;
+    }
+  }
+
+  const size_t rigid_count = r.count(18 * 8);
+  if (!r.ok()) return truncated;
+  if (rigid_count != world.rigidBodies().size()) {
+    return Error{anotherWorld("it has " + std::to_string(rigid_count) +
+                              " rigid bodies, this world " +
+                              std::to_string(world.rigidBodies().size()))};
+  }
+  stored.world.rigid.resize(rigid_count);
+  for (WorldCheckpoint::RigidState& rigid : stored.world.rigid) {
+    btMatrix3x3 basis;
+    for (int row = 0; row < 3; ++row) {
+      for (int col = 0; col < 3; ++col)
+        basis[row][col] = static_cast<btScalar>(r.f64());
+    }
+    btVector3 v[3];
+    for (btVector3& vector : v) {
+      for (int k = 0; k < 3; ++k)
+        vector[k] = static_cast<btScalar>(r.f64());
+    }
+    rigid.pose = btTransform(basis, v[0]);
+    rigid.linear_velocity = v[1];
+    rigid.angular_velocity = v[2];
+  }
+  stored.extra = r.str();
+  if (!r.ok() || !r.atEnd()) return truncated;
+  return stored;
+}
+
+}  // namespace torsion

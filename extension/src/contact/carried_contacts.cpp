@@ -1,0 +1,59 @@
+// The warm starts of RigidContactSolver in a form that names the rigid objects alone, for
+// checkpoints that leave memory. Mirrors what detect() and FaceContactSet::beginStep() read from
+// the last step: active, non-held node contacts with their partner's object, and face contacts.
+
+#include "torsion/contact/rigid_contact.h"
+
+namespace torsion {
+
+CarriedContacts RigidContactSolver::carriedContacts() const {
+  CarriedContacts carried;
+  for (const NodeContact& c : contacts_) {
+    if (c.state == NodeContact::State::kInactive || c.held) continue;
+    carried.nodes.push_back({c.node, partners_[static_cast<size_t>(c.partner)].object, c.state});
+  }
+  for (const FaceContact& c : faces_.contacts()) {
+    if (c.state == FaceContact::State::kInactive) continue;
+    carried.faces.push_back(
+        {c.key, partners_[static_cast<size_t>(c.partner)].object, c.state, c.multiplier, c.stalls});
+  }
+  return carried;
+}
+
+void RigidContactSolver::restoreCarriedContacts(const CarriedContacts& carried) {
+  // Partners here only name the objects: detect() rebuilds them from this step's candidates.
+  auto partner = [this](const btCollisionObject* object) {
+    for (size_t k = 0; k < partners_.size(); ++k) {
+      if (partners_[k].object == object) return static_cast<int>(k);
+    }
+    RigidPartner p;
+    p.object = object;
+    partners_.push_back(p);
+    return static_cast<int>(partners_.size()) - 1;
+  };
+  partners_.clear();
+  contacts_.clear();
+  std::fill(node_contact_.begin(), node_contact_.end(), -1);
+  for (const CarriedContacts::Node& n : carried.nodes) {
+    NodeContact c;
+    c.normal.setZero();
+    c.lever.setZero();
+    c.node = n.node;
+    c.partner = partner(n.object);
+    c.state = n.state;
+    contacts_.push_back(c);
+  }
+  std::vector<FaceContact> faces;
+  for (const CarriedContacts::Face& f : carried.faces) {
+    FaceContact c;
+    c.key = f.key;
+    c.partner = partner(f.object);
+    c.state = f.state;
+    c.multiplier = f.multiplier;
+    c.stalls = f.stalls;
+    faces.push_back(c);
+  }
+  faces_.restoreContacts(std::move(faces));
+}
+
+}  // namespace torsion
