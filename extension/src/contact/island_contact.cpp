@@ -124,23 +124,6 @@ LinearSolveReport IslandContactSolve::solveBody(Body& body, size_t i, const Eige
   return r;
 }
 
-bool IslandContactSolve::holdStoppedSliders(BodyPairContact& pair, const Eigen::VectorXd& v,
-                                            double dt, double tolerance) {
-  bool changed = false;
-  for (SurfaceContact& c : pair.set().contacts()) {
-    if (c.determined || c.state != SurfaceContact::State::kSlide || !(c.friction > 0)) continue;
-    Eigen::Vector3d u = Eigen::Vector3d::Zero();
-    for (size_t k = 0; k < 4; ++k)
-      u += c.beta[k] * v.segment<3>(3 * c.nodes[k]);
-    const Eigen::Vector3d slip = u - c.normal * c.normal.dot(u);
-    if (dt * slip.norm() > 0.1 * tolerance) continue;
-    // Its friction, at the cone's bound, stopped it: it sticks (the multiplier stays in the cone).
-    c.state = SurfaceContact::State::kStick;
-    changed = true;
-  }
-  return changed;
-}
-
 void IslandContactSolve::sweep(std::vector<Body>& bodies, const std::vector<Pair>& pairs, double dt,
                                bool& broke, double& moved) {
   for (size_t i = 0; i < bodies.size() && !broke; ++i) {
@@ -350,7 +333,6 @@ IslandContactStats IslandContactSolve::solve(std::vector<Body>& bodies,
       const double tolerance = pair->contact->gapTolerance();
       // Activation below a tenth of the tolerance: a contact hovering at zero gap does not flip.
       if (!pair->contact->set().update(pair_v_, dt, 0.1 * tolerance, tolerance)) settled = false;
-      if (holdStoppedSliders(*pair->contact, pair_v_, dt, tolerance)) settled = false;
     }
     if (settled) break;
     // Safeguard (as for self-contact): where the sweeps and updates do not contract (contacts

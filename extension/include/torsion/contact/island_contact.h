@@ -108,10 +108,6 @@ class IslandContactSolve {
   // Returns whether settled; `moved`: m, the largest node motion change from the last sweep.
   void sweep(std::vector<Body>& bodies, const std::vector<Pair>& pairs, double dt, bool& broke,
              double& moved);
-  // Sliding contacts whose friction stopped them (slip over the step within a tenth of the
-  // tolerance) stick from now on. Returns whether any changed.
-  static bool holdStoppedSliders(BodyPairContact& pair, const Eigen::VectorXd& v, double dt,
-                                 double tolerance);
   // The pair terms' product over the joint vector (offsets: each body's first component).
   void addJointProduct(const std::vector<const Pair*>& live, const Eigen::VectorXd& y,
                        Eigen::VectorXd& out) const;
