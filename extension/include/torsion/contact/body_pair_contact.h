@@ -37,7 +37,7 @@ struct BodyContactSettings {
   /// (on its far side), not through its surface: no candidate.
   double max_depth = 0.25;
   /// rho in units of the contact's effective mass (surface_contact_set.h), for the island's
-  /// joint solve; its Gauss-Seidel path uses a twentieth of it (island_contact.h).
+  /// joint solve; its Gauss-Seidel path uses a hundredth of it (island_contact.h).
   double penalty_factor = 20;
   /// Uzawa updates per step (each one linear solve of every body of the island).
   int max_iterations = 60;
