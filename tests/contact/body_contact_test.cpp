@@ -155,7 +155,9 @@ TEST(BodyContact, ASoftBlockThrownAtAnotherKeepsTheLinearMomentumAndDoesNotPassT
   EXPECT_GT(centre(*thrown).x() - centre(*struck).x(), 0.1);
 }
 
-TEST(BodyContact, TwoBlocksPressedTogetherCarryTheAppliedLoadThroughTheirContact) {
+// Two blocks, the lower one's base fixed, the upper one (`element`) pressed down by 5 N spread
+// over its top nodes, no gravity: at rest the contact carries the load.
+void pressBlocks(ElementKind element) {
   WorldSettings settings;
   settings.gravity.setZero();
   settings.solver.time_step = 0.005;
@@ -169,7 +171,7 @@ TEST(BodyContact, TwoBlocksPressedTogetherCarryTheAppliedLoadThroughTheirContact
       world
           .addBody("upper",
                    makeBoxTetMesh({0.02, 0.01, 0.1005}, {0.08, 0.09, 0.1605}, 2, 2, 2).value(),
-                   soft(2e5))
+                   soft(2e5), Frame{}, element)
           .value();
   // 5 N down, spread over the upper block's top nodes.
   const double load = 5;
@@ -189,12 +191,21 @@ TEST(BodyContact, TwoBlocksPressedTogetherCarryTheAppliedLoadThroughTheirContact
   }
   const FemContactStats& s = world.femSolver().femContact()->stats();
   std::printf(
-      "[figures] pressed blocks: load %.3f N, contact force on the upper block %.4f N "
+      "[figures] pressed blocks (upper %s): load %.3f N, contact force on the upper block %.4f N "
       "(lateral %.2e), active %d, end penetration %.2e m, upper block speed %.2e m/s\n",
-      load, force.z(), std::hypot(force.x(), force.y()), s.active, s.max_end_penetration,
+      element == ElementKind::kTet10 ? "tet10" : "tet4", load, force.z(),
+      std::hypot(force.x(), force.y()), s.active, s.max_end_penetration,
       momentum(*upper).norm() / upper->model().totalMass());
   EXPECT_NEAR(force.z(), load, 0.03 * load);
   EXPECT_TRUE(s.converged);
+}
+
+TEST(BodyContact, TwoBlocksPressedTogetherCarryTheAppliedLoadThroughTheirContact) {
+  pressBlocks(ElementKind::kTet4);
+}
+
+TEST(BodyContact, AQuadraticBlockPressedOnALinearOneCarriesTheLoadThroughItsSplitSurface) {
+  pressBlocks(ElementKind::kTet10);
 }
 
 }  // namespace
