@@ -82,8 +82,9 @@ struct FemCheckpoint {
   std::vector<std::pair<const FemBody*, FemBodyCheckpoint>> bodies;
 };
 
-/// What to do when an FEM body touches a body it has no contact with (another FEM body, or one of
-/// Bullet's soft bodies): they would pass through each other.
+/// What to do when an FEM body touches a body it has no contact with (one of Bullet's soft bodies,
+/// or another FEM body while contact between FEM bodies is off): they would pass through each
+/// other.
 enum class UnsupportedContact {
   kError,  ///< the solver fails (status().ok false) naming the pair: the default
   kWarn,   ///< a warning naming the pair, once per pair; the bodies pass through each other
