@@ -59,6 +59,8 @@ Result<std::unique_ptr<BuiltScene>> buildScene(SceneSpec spec, int threads_overr
   if (threads_override >= 0) spec.world.solver.threads = threads_override;
   built->world = std::make_unique<FemWorld>(spec.world);
   FemWorld& world = *built->world;
+  if (Status contact = world.femSolver().setFemContact(spec.fem_contact); !contact)
+    return Error{spec.file + ": fem_contact: " + contact.error().message};
 
   for (size_t b = 0; b < spec.bodies.size(); ++b) {
     const BodySpec& body = spec.bodies[b];

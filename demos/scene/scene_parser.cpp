@@ -263,6 +263,19 @@ bool hasBody(const SceneSpec& scene, const std::string& name) {
 }
 
 // name, gravity, solver, steps.
+// "fem_contact": {"enabled" (default true), "friction", "gap_tolerance"}.
+std::optional<BodyContactSettings> readFemContact(const JsonObject& root) {
+  const JsonObject c = root.object("fem_contact");
+  const bool enabled = c.boolean("enabled", true);
+  BodyContactSettings settings;
+  settings.friction = c.number("friction", settings.friction);
+  settings.gap_tolerance = c.number("gap_tolerance", settings.gap_tolerance);
+  c.finish();
+  if (!enabled) return std::nullopt;
+  if (Status valid = settings.validate(); !valid) root.fail("fem_contact", valid.error().message);
+  return settings;
+}
+
 void readWorld(const JsonObject& root, const std::string& file_name, SceneSpec& scene) {
   scene.name = root.string("name", std::filesystem::path(file_name).stem().string());
   scene.world.gravity = root.vector3("gravity", Eigen::Vector3d(0, 0, -9.81));
@@ -273,6 +286,7 @@ void readWorld(const JsonObject& root, const std::string& file_name, SceneSpec& 
   if (scene.steps < 1) root.fail("steps", "must be >= 1");
   scene.vtk_every = root.integer("vtk_every", scene.vtk_every);  // ParaView series, 0: none
   if (scene.vtk_every < 0) root.fail("vtk_every", "must be >= 0 (0: no series)");
+  if (root.has("fem_contact")) scene.fem_contact = readFemContact(root);
 }
 
 BodySpec readBody(const JsonObject& b, const SceneSpec& scene, const std::string& base_directory) {

@@ -93,6 +93,18 @@ struct ContactTotals {
       active_set_iterations_max = std::max(active_set_iterations_max, s.active_set_iterations);
       converged = converged && s.active_set_converged;
     }
+    if (const FemContactIslands* islands = world.femSolver().femContact()) {
+      const FemContactStats& s = islands->stats();
+      has_fem_contact = true;
+      fem_active_sum += s.active;
+      fem_active_max = std::max(fem_active_max, s.active);
+      fem_candidates_max = std::max(fem_candidates_max, s.candidates);
+      fem_iterations_max = std::max(fem_iterations_max, s.iterations);
+      fem_normal_impulse += s.normal_impulse;
+      fem_end_penetration = std::max(fem_end_penetration, s.max_end_penetration);
+      if (!s.converged) ++fem_unconverged_steps;
+      if (s.islands > 0) ++fem_contact_steps;
+    }
     ++steps;
     active_sum += active;
     active_max = std::max(active_max, active);
@@ -104,6 +116,13 @@ struct ContactTotals {
   int self_iterations_max = 0;
   int self_unconverged_steps = 0;
   double self_end_penetration = 0;  // m, linearised, after the solve
+  // Contact between FEM bodies (on unless the scene says "fem_contact": false).
+  bool has_fem_contact = false;
+  long fem_active_sum = 0;
+  int fem_active_max = 0, fem_candidates_max = 0, fem_iterations_max = 0;
+  int fem_unconverged_steps = 0, fem_contact_steps = 0;
+  double fem_normal_impulse = 0;   // N s
+  double fem_end_penetration = 0;  // m, linearised, after the solve
 
   nlohmann::json json() const {
     nlohmann::json j = {{"active_mean", steps > 0 ? double(active_sum) / steps : 0.0},
@@ -117,6 +136,16 @@ struct ContactTotals {
                            {"iterations_max", self_iterations_max},
                            {"unconverged_steps", self_unconverged_steps},
                            {"max_end_penetration_m", self_end_penetration}};
+    }
+    if (has_fem_contact) {
+      j["fem_contact"] = {{"steps_in_contact", fem_contact_steps},
+                          {"active_mean", steps > 0 ? double(fem_active_sum) / steps : 0.0},
+                          {"active_max", fem_active_max},
+                          {"candidates_max", fem_candidates_max},
+                          {"normal_impulse_total_Ns", fem_normal_impulse},
+                          {"iterations_max", fem_iterations_max},
+                          {"unconverged_steps", fem_unconverged_steps},
+                          {"max_end_penetration_m", fem_end_penetration}};
     }
     return j;
   }
@@ -396,7 +425,8 @@ class Run {
       summary["haptics"] = haptics_.is_null() ? nlohmann::json::array() : haptics_;
       summary["haptic_warnings"] = scene_.haptics->warnings();
     }
-    if (!scene_.rigid_bodies.empty() || scene_.spec.ground)
+    if (!scene_.rigid_bodies.empty() || scene_.spec.ground ||
+        (scene_.spec.bodies.size() > 1 && scene_.spec.fem_contact))
       summary["contacts"] = contact_totals_.json();
     summary["anomalies"] = anomalies_.json();
     if (options_.stop_on_anomaly)

@@ -15,6 +15,7 @@
 #include "torsion/bullet/fem_world.h"
 #include "torsion/constraints/frame.h"
 #include "torsion/constraints/hand.h"
+#include "torsion/contact/body_pair_contact.h"
 #include "torsion/contact/self_contact.h"
 #include "torsion/fem/element_kind.h"
 #include "torsion/fem/material.h"
@@ -127,6 +128,9 @@ struct SceneSpec {
   /// file's directory; empty: none.
   std::string bullet_file;
   CameraSpec camera;  ///< how pictures look at the scene (camera_spec.h)
+  /// "fem_contact": contact between FEM bodies (docs/contact.md): {"enabled" (default true),
+  /// "friction", "gap_tolerance"}; nullopt: off.
+  std::optional<BodyContactSettings> fem_contact = BodyContactSettings{};
   HapticsMode haptics_mode = HapticsMode::kAuto;  ///< not in the file: the CLI's --haptics
 };
 

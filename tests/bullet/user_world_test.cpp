@@ -228,8 +228,9 @@ TEST(UserWorld, BulletClothFallingOnAnFemBodyIsRefusedByNameNotPassedThrough) {
   }
 }
 
-TEST(UserWorld, TwoFemBodiesThatTouchAreReportedAndFarApartAreNot) {
-  UserWorld user;
+// Two FEM balls, 0.5 m apart, then one thrown at the other: with contact between FEM bodies on
+// (the default) they collide and bounce apart; with it off, the pair is refused by name.
+void throwBallAtBall(UserWorld& user) {
   Material material;
   material.youngs_modulus = 1e6;
   user.fem.addBody("left", makeBallTetMesh({0, 0, 0}, 0.5, 2).value(), material).value();
@@ -242,9 +243,30 @@ TEST(UserWorld, TwoFemBodiesThatTouchAreReportedAndFarApartAreNot) {
   user.fem.body("right")->setVelocity(Eigen::Vector3d(-2, 0, 0));
   for (int call = 0; call < 60 && user.fem.status().ok; ++call)
     user.world.stepSimulation(btScalar(1 / 60.), 10, btScalar(1 / 240.));
+}
+
+TEST(UserWorld, TwoFemBodiesThatTouchCollideAndBounceApart) {
+  UserWorld user;
+  throwBallAtBall(user);
+  ASSERT_TRUE(user.fem.status().ok) << user.fem.status().message;
+  const FemBody& left = *user.fem.body("left");
+  const FemBody& right = *user.fem.body("right");
+  double left_x = 0, right_x = 0;
+  for (int i = 0; i < left.model().nodeCount(); ++i)
+    left_x += left.state().position(i).x() / left.model().nodeCount();
+  for (int i = 0; i < right.model().nodeCount(); ++i)
+    right_x += right.state().position(i).x() / right.model().nodeCount();
+  // One second after the throw the balls are apart again, the right one still on the right.
+  EXPECT_GT(right_x - left_x, 1.0);
+  EXPECT_LT(left.state().velocity(0).x(), -0.5) << "the left ball was pushed away";
+}
+
+TEST(UserWorld, TwoFemBodiesThatTouchWithFemContactOffAreReported) {
+  UserWorld user;
+  ASSERT_TRUE(user.fem.setFemContact(std::nullopt).ok());
+  throwBallAtBall(user);
   ASSERT_FALSE(user.fem.status().ok);
-  EXPECT_NE(user.fem.status().message.find("contact between FEM bodies is not supported"),
-            std::string::npos)
+  EXPECT_NE(user.fem.status().message.find("contact between FEM bodies is off"), std::string::npos)
       << user.fem.status().message;
 }
 

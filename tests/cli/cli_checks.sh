@@ -603,6 +603,20 @@ assert c["max_penetration_m"] < 1e-4 and c["active_set_unconverged_steps"] == 0,
 PY
     ;;
 
+  run_soft_stack)
+    # Contact between FEM bodies: three soft blocks stacked on the ground and a soft ball dropped
+    # on them run from the CLI by name; summary.json reports the FEM-FEM contacts of every step
+    # (the stack touches from the start) and the ball lands (more contacts once it does).
+    run "$torsion" run soft_stack --out out --steps 60 --threads 1
+    expect_rc 0
+    python3 - out/summary.json <<'PY' || fail "fem_contact figures"
+import json, sys
+c = json.load(open(sys.argv[1]))["contacts"]["fem_contact"]
+assert c["steps_in_contact"] == 60 and c["active_max"] > 0, c
+assert c["normal_impulse_total_Ns"] > 0, c
+PY
+    ;;
+
   run_bad_rigid_body)
     # A kinematic body with a mass: refused before any step, naming the key.
     sed "s|../../assets/meshes|$assets|; s|\"friction\": 0.8,|\"friction\": 0.8, \"mass\": 3,|" \

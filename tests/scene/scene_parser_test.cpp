@@ -147,6 +147,31 @@ TEST(SceneParser, SelfContactIsOnWhereAskedForWithItsSettings) {
   EXPECT_EQ(on.value().bodies[0].self_contact->gap_tolerance, 0.0);  // from the mesh
 }
 
+TEST(SceneParser, FemContactIsOnByDefaultSetByItsKeyAndOffWhenDisabled) {
+  Result<SceneSpec> plain = parse(kValid);
+  ASSERT_TRUE(plain.ok()) << plain.error().message;
+  ASSERT_TRUE(plain.value().fem_contact.has_value());
+  EXPECT_EQ(plain.value().fem_contact->friction, BodyContactSettings{}.friction);
+  Result<SceneSpec> set = parse(
+      replaced(kValid, R"("steps": 50,)", R"("steps": 50, "fem_contact": {"friction": 0.6},)"));
+  ASSERT_TRUE(set.ok()) << set.error().message;
+  ASSERT_TRUE(set.value().fem_contact.has_value());
+  EXPECT_EQ(set.value().fem_contact->friction, 0.6);
+  Result<SceneSpec> off = parse(
+      replaced(kValid, R"("steps": 50,)", R"("steps": 50, "fem_contact": {"enabled": false},)"));
+  ASSERT_TRUE(off.ok()) << off.error().message;
+  EXPECT_FALSE(off.value().fem_contact.has_value());
+}
+
+TEST(SceneParserFaults, BadFemContactSettingsAreNamed) {
+  EXPECT_TRUE(failsWith(parse(replaced(kValid, R"("steps": 50,)",
+                                       R"("steps": 50, "fem_contact": {"friction": -1},)")),
+                        {"fem_contact", "friction", ">= 0"}));
+  EXPECT_TRUE(failsWith(
+      parse(replaced(kValid, R"("steps": 50,)", R"("steps": 50, "fem_contact": {"mu": 1},)")),
+      {"fem_contact", "mu"}));
+}
+
 TEST(SceneParserFaults, BadSelfContactSettingsAreNamed) {
   EXPECT_TRUE(failsWith(parse(replaced(kValid, R"("mesh": "meshes/cyl.node",)",
                                        R"("mesh": "meshes/cyl.node",

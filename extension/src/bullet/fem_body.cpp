@@ -168,18 +168,31 @@ const StepReport& FemBody::advance(const StepContext& ctx) {
                          const Eigen::VectorXd& b, const SolverSettings& s,
                          Eigen::VectorXd& v) { return contacts_->solve(op, c, b, s, v); };
   }
+  ImplicitStepper::LinearSolveHook own_solve = rigid_solve;
   if (self) {
-    stepper_.setAddedOperatorTerm(&self_contact_->term());
-    stepper_.setLinearSolveHook(
-        [this, rigid_solve](const SystemOperator& op, const NodeConstraints& c,
-                            const Eigen::VectorXd& b, const SolverSettings& s, Eigen::VectorXd& v) {
-          return self_contact_->solve(op, c, b, s, v, rigid_solve);
-        });
-  } else {
-    stepper_.setLinearSolveHook(rigid_solve);
+    own_solve = [this, rigid_solve](const SystemOperator& op, const NodeConstraints& c,
+                                    const Eigen::VectorXd& b, const SolverSettings& s,
+                                    Eigen::VectorXd& v) {
+      return self_contact_->solve(op, c, b, s, v, rigid_solve);
+    };
   }
+  // In an island of touching FEM bodies the island's solve wraps the body's own.
+  const bool island = static_cast<bool>(island_solve_);
+  if (island) {
+    stepper_.setLinearSolveHook(
+        [this, own_solve](const SystemOperator& op, const NodeConstraints& c,
+                          const Eigen::VectorXd& b, const SolverSettings& s,
+                          Eigen::VectorXd& v) { return island_solve_(op, c, b, s, v, own_solve); });
+  } else {
+    stepper_.setLinearSolveHook(own_solve);
+  }
+  added_terms_.set(self ? &self_contact_->term() : nullptr, island ? island_term_ : nullptr);
+  if (self || island) stepper_.setAddedOperatorTerm(&added_terms_);
   last_report_ = stepper_.step(state_, constraints_, step_forces_, dt);
   stepper_.setAddedOperatorTerm(nullptr);
+  stepper_.setLinearSolveHook({});
+  island_solve_ = nullptr;
+  island_term_ = nullptr;
   if (self && !self_contact_->stats().converged && !isFatal(last_report_.health)) {
     // Reported per step, never accepted silently (a warning: the step is usable).
     const SelfContactStats& s = self_contact_->stats();
@@ -194,6 +207,12 @@ const StepReport& FemBody::advance(const StepContext& ctx) {
   if (!isFatal(last_report_.health)) contacts_->finish();
   if (!isFatal(last_report_.health)) writeBack();
   return last_report_;
+}
+
+void FemBody::noteContactNotConverged(const std::string& what) {
+  if (last_report_.health == StepHealth::kOk)
+    last_report_.health = StepHealth::kContactNotConverged;
+  last_report_.message += (last_report_.message.empty() ? "" : "; ") + what;
 }
 
 Status FemBody::enableSelfContact(const SelfContactSettings& settings) {

@@ -56,7 +56,9 @@ Result<FemSoftBodySolver*> attachTo(World& world) {
 }  // namespace
 
 FemSoftBodySolver::FemSoftBodySolver(const SolverSettings& settings)
-    : settings_(settings), parallel_(settings.threads) {}
+    : settings_(settings),
+      parallel_(settings.threads),
+      fem_contact_(std::make_unique<FemContactIslands>(BodyContactSettings{})) {}
 
 // The world uses this solver until it is destroyed, and destroys its collision objects' broadphase
 // proxies then: the world must go first (documented), so here the bodies are only freed.
@@ -118,6 +120,7 @@ void FemSoftBodySolver::removeBody(FemBody* body) {
                          [body](const std::unique_ptr<FemBody>& b) { return b.get() == body; });
   if (it == bodies_.end()) return;
   remove_from_world_((*it)->softBody());
+  if (fem_contact_) fem_contact_->forget(body);
   bodies_.erase(it);
 }
 
@@ -174,6 +177,16 @@ Status FemSoftBodySolver::setSolverSettings(const SolverSettings& settings) {
   return Ok{};
 }
 
+Status FemSoftBodySolver::setFemContact(const std::optional<BodyContactSettings>& settings) {
+  if (!settings) {
+    fem_contact_.reset();
+    return Ok{};
+  }
+  if (Status valid = settings->validate(); !valid) return valid;
+  fem_contact_ = std::make_unique<FemContactIslands>(*settings);
+  return Ok{};
+}
+
 void FemSoftBodySolver::addStepListener(StepListener* listener) {
   listeners_.push_back(listener);
 }
@@ -209,6 +222,7 @@ void FemSoftBodySolver::predictMotion(btScalar solver_dt) {
     for (const auto& body : bodies_)
       body->predict(dt);
   }
+  if (fem_contact_) fem_contact_->beginSubstep();
   bullet_solver_.predictMotion(solver_dt);
 }
 
@@ -225,15 +239,33 @@ void FemSoftBodySolver::solveConstraints(btScalar solver_dt) {
   for (StepListener* listener : listeners_)
     listener->beforeFemStep(ctx);
   bool ok = status_.ok;  // an unsupported contact found in this substep's detection fails it
-  for (const auto& body : bodies_) {
+  // Touching FEM bodies step together as islands, the others alone, in body order.
+  std::vector<FemBody*> bodies;
+  for (const auto& body : bodies_)
+    bodies.push_back(body.get());
+  std::vector<std::vector<FemBody*>> groups;
+  if (fem_contact_ && ok) {
+    groups = fem_contact_->plan(bodies, ctx);
+  } else {
+    for (FemBody* body : bodies)
+      groups.push_back({body});
+  }
+  for (const std::vector<FemBody*>& group : groups) {
     if (!ok) break;
-    const StepReport& report = body->advance(ctx);
-    if (isFatal(report.health)) {
+    if (fem_contact_) {
+      fem_contact_->advance(group, ctx);
+    } else {
+      group.front()->advance(ctx);
+    }
+    for (FemBody* body : group) {
+      const StepReport& report = body->lastReport();
+      if (!isFatal(report.health)) continue;
       std::ostringstream s;
       s << "body '" << body->name() << "', step " << ctx.index << ": " << toString(report.health)
         << ": " << report.message;
       fail(s.str());
       ok = false;
+      break;
     }
   }
   time_ += ctx.dt;
@@ -268,6 +300,11 @@ void FemSoftBodySolver::processCollision(btSoftBody* a, btSoftBody* b) {
     a->defaultCollisionHandler(b);
     return;
   }
+  if (a_fem && b_fem && fem_contact_) {
+    // Their boxes overlap: the pair looks for contact before the FEM step (FemContactIslands).
+    fem_contact_->notePair(femBodyOf(a), femBodyOf(b));
+    return;
+  }
   if (a != b && nodesTouch(*a, *b)) unsupportedPair(a, b);
 }
 
@@ -286,8 +323,8 @@ void FemSoftBodySolver::unsupportedPair(const btSoftBody* a, const btSoftBody* b
   std::ostringstream s;
   s << describe(a) << " and " << describe(b) << " touch at step " << steps_ + 1 << " (t = " << time_
     << " s): "
-    << (both_fem ? "contact between FEM bodies is not supported: they would pass through each "
-                   "other"
+    << (both_fem ? "contact between FEM bodies is off (FemSoftBodySolver::setFemContact; scene key "
+                   "\"fem_contact\"): they would pass through each other"
                  : "Torsion's FEM bodies do not collide with Bullet's soft bodies: they would pass "
                    "through each other")
     << ". To let them, put them in collision filter groups that do not collide, or set "

@@ -6,6 +6,7 @@
 #include <BulletSoftBody/btSoftBody.h>
 #include <btBulletDynamicsCommon.h>
 
+#include <functional>
 #include <memory>
 #include <string>
 #include <vector>
@@ -17,6 +18,7 @@
 #include "torsion/fem/fem_model.h"
 #include "torsion/result.h"
 #include "torsion/solve/implicit_stepper.h"
+#include "torsion/solve/summed_operator_term.h"
 
 namespace torsion {
 
@@ -44,6 +46,8 @@ class FemBody {
 
   const std::string& name() const { return name_; }
   const FemModel& model() const { return *model_; }
+  /// The model, shared (contact between FEM bodies keeps the meshes it detects on).
+  std::shared_ptr<const FemModel> modelPointer() const { return model_; }
   const FemState& state() const { return state_; }
   btSoftBody* softBody() { return soft_body_.get(); }
 
@@ -115,6 +119,22 @@ class FemBody {
   /// The self-contact solver (its last step's contacts and statistics), or nullptr when off.
   const SelfContactSolver* selfContact() const { return self_contact_.get(); }
 
+  // ---- contact between FEM bodies (FemSoftBodySolver's islands, docs/contact.md) ----
+  /// The island's solve: gets this body's system and its own solve (rigid / self-contact; empty:
+  /// plain CG) and returns v' in v.
+  using IslandSolve = std::function<LinearSolveReport(
+      const SystemOperator&, const NodeConstraints&, const Eigen::VectorXd&, const SolverSettings&,
+      Eigen::VectorXd&, const ImplicitStepper::LinearSolveHook& own)>;
+  /// For the next advance() only: its linear solve goes through `solve`, and `term` (the pair
+  /// contacts' penalty on this body, not owned) is added to its system.
+  void setIslandSolve(IslandSolve solve, const AddedOperatorTerm* term) {
+    island_solve_ = std::move(solve);
+    island_term_ = term;
+  }
+  /// Marks the last step's report as not converged in contact (a warning, unless the step was
+  /// already worse) and appends `what` to its message.
+  void noteContactNotConverged(const std::string& what);
+
  private:
   void writeBack();
 
@@ -129,6 +149,9 @@ class FemBody {
   std::unique_ptr<btSoftBody> soft_body_;
   std::unique_ptr<RigidContactSolver> contacts_;
   std::unique_ptr<SelfContactSolver> self_contact_;
+  IslandSolve island_solve_;  // the next advance()'s island solve, or empty
+  const AddedOperatorTerm* island_term_ = nullptr;
+  SummedOperatorTerm added_terms_;  // self-contact and island terms together
   StepReport last_report_;
 };
 

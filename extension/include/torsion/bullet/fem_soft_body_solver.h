@@ -19,8 +19,10 @@
 //
 // Bullet's own soft bodies (cloth, ropes, btSoftBodyHelpers volumes) in the same world are handed
 // to Bullet's default solver, so they move and collide with rigid bodies as without Torsion.
-// FEM bodies touch rigid bodies and multibody links (contact/rigid_contact.h) but not Bullet's soft
-// bodies nor each other: when such a pair touches, the solver says so (UnsupportedContact).
+// FEM bodies touch rigid bodies and multibody links (contact/rigid_contact.h) and each other
+// (bullet/fem_contact_islands.h: on by default, setFemContact), but not Bullet's soft bodies: when
+// such a pair touches, the solver says so (UnsupportedContact), as it does for two FEM bodies
+// while contact between them is off.
 //
 // Simulation thread only. The solver must be constructed before the world that uses it and
 // destroyed after it (Bullet keeps a pointer to it and to the bodies' btSoftBody objects until the
@@ -32,12 +34,14 @@
 #include <cstdint>
 #include <functional>
 #include <memory>
+#include <optional>
 #include <set>
 #include <string>
 #include <utility>
 #include <vector>
 
 #include "torsion/bullet/fem_body.h"
+#include "torsion/bullet/fem_contact_islands.h"
 #include "torsion/bullet/step_context.h"
 #include "torsion/constraints/frame.h"
 #include "torsion/mesh/tet_mesh.h"
@@ -78,8 +82,9 @@ struct FemCheckpoint {
   std::vector<std::pair<const FemBody*, FemBodyCheckpoint>> bodies;
 };
 
-/// What to do when an FEM body touches a body it has no contact with (another FEM body, or one of
-/// Bullet's soft bodies): they would pass through each other.
+/// What to do when an FEM body touches a body it has no contact with (one of Bullet's soft bodies,
+/// or another FEM body while contact between FEM bodies is off): they would pass through each
+/// other.
 enum class UnsupportedContact {
   kError,  ///< the solver fails (status().ok false) naming the pair: the default
   kWarn,   ///< a warning naming the pair, once per pair; the bodies pass through each other
@@ -135,6 +140,12 @@ class FemSoftBodySolver : public btSoftBodySolver {
   /// under UnsupportedContact::kWarn), each said once.
   const std::vector<std::string>& warnings() const { return warnings_; }
   void setUnsupportedContact(UnsupportedContact policy) { unsupported_contact_ = policy; }
+  /// Contact between FEM bodies (docs/contact.md, "Contact between FEM bodies"): on with default
+  /// settings from construction; std::nullopt turns it off (touching FEM bodies are then
+  /// UnsupportedContact). Errors, changing nothing: invalid settings.
+  Status setFemContact(const std::optional<BodyContactSettings>& settings);
+  /// Its islands and last substep's statistics, or nullptr when off.
+  const FemContactIslands* femContact() const { return fem_contact_.get(); }
 
   const SolverSettings& solverSettings() const { return settings_; }
   /// Live edit between steps: linear solver, tolerance, caps (time_step is Bullet's). Errors,
@@ -174,6 +185,7 @@ class FemSoftBodySolver : public btSoftBodySolver {
   std::function<void(btSoftBody*)> add_to_world_, remove_from_world_;
 
   std::vector<std::unique_ptr<FemBody>> bodies_;
+  std::unique_ptr<FemContactIslands> fem_contact_;  // nullptr: FEM-FEM contact off
   std::vector<StepListener*> listeners_;
 
   double time_ = 0;

@@ -1,0 +1,90 @@
+#pragma once
+// Contact between FEM bodies in a Bullet world (docs/contact.md, "Contact between FEM bodies"):
+// which bodies touch, grouped into islands, and each island stepped with its bodies' velocities
+// solved together (contact/island_contact.h). Owned by FemSoftBodySolver; simulation thread only.
+//
+// Per substep:
+//   notePair   Bullet's broadphase hands over the FEM pairs whose boxes (over the predicted
+//              motion) overlap (FemSoftBodySolver::processCollision)
+//   plan       each such pair looks for contact candidates (BodyPairContact::detect); pairs with
+//              candidates join their bodies into islands (connected components), in body order
+//   advance    a lone body steps as always; an island's bodies step one inside the other: each
+//              body's stepper reaches its linear solve, hands its system over and steps the next
+//              body; the last one runs the island solve for all, then every stepper finishes its
+//              step with its own velocities (no change to ImplicitStepper). A body that stops
+//              before its solve (non-finite forces) leaves the island; its pairs sit the step out.
+// Bodies apart cost nothing: no pair is noted, nothing is detected.
+
+#include <cstdint>
+#include <map>
+#include <memory>
+#include <utility>
+#include <vector>
+
+#include "torsion/bullet/fem_body.h"
+#include "torsion/bullet/step_context.h"
+#include "torsion/contact/body_pair_contact.h"
+#include "torsion/contact/island_contact.h"
+
+namespace torsion {
+
+/// The last substep's contact between FEM bodies, summed over its islands.
+struct FemContactStats {
+  int touching_pairs = 0;          ///< pairs whose boxes overlap
+  int islands = 0;                 ///< islands of two or more bodies
+  int candidates = 0;              ///< node-triangle pairs
+  int active = 0;                  ///< pushing at the end of the step
+  int sticking = 0;                ///< of which sticking
+  int iterations = 0;              ///< Uzawa updates, the most of any island
+  bool converged = true;           ///< every island
+  double normal_impulse = 0;       ///< N s, sum over active contacts
+  double max_end_penetration = 0;  ///< m, deepest linearised end gap
+};
+
+class FemContactIslands {
+ public:
+  explicit FemContactIslands(const BodyContactSettings& settings) : settings_(settings) {}
+
+  const BodyContactSettings& settings() const { return settings_; }
+
+  /// A new substep: forget the last one's broadphase pairs.
+  void beginSubstep() { touching_.clear(); }
+  /// Bullet's broadphase: the boxes of these two FEM bodies overlap this substep.
+  void notePair(FemBody* a, FemBody* b);
+  /// The body is being removed: its pairs go.
+  void forget(const FemBody* body);
+
+  /// Groups `bodies` (the solver's order) for this step: islands of touching bodies and lone
+  /// bodies, each group in body order, groups in the order of their first body.
+  std::vector<std::vector<FemBody*>> plan(const std::vector<FemBody*>& bodies,
+                                          const StepContext& ctx);
+  /// Steps one group from plan(): a lone body as always, an island as one system.
+  void advance(const std::vector<FemBody*>& group, const StepContext& ctx);
+
+  const FemContactStats& stats() const { return stats_; }
+  /// The pair contact of two bodies (either order), or nullptr when they are not touching.
+  const BodyPairContact* pair(const FemBody* a, const FemBody* b) const;
+
+ private:
+  using Key = std::pair<const FemBody*, const FemBody*>;
+  // Steps group body k, whose solve steps body k + 1 (and so on) before the island solve.
+  void advanceFrom(size_t k, const StepContext& ctx);
+
+  BodyContactSettings settings_;
+  std::vector<std::pair<FemBody*, FemBody*>> touching_;    // this substep's, as Bullet gave them
+  std::map<Key, std::unique_ptr<BodyPairContact>> pairs_;  // keyed by (lower, higher) index
+  std::vector<std::pair<Key, BodyPairContact*>> live_;     // pairs with candidates, in body order
+  FemContactStats stats_;
+
+  // The island being stepped.
+  std::vector<FemBody*> group_;
+  std::vector<IslandContactSolve::Body> slots_;
+  std::vector<IslandContactSolve::Pair> island_pairs_;
+  std::vector<PairContactTerm> terms_;
+  std::vector<char> advanced_;
+  bool solved_ = false;
+  IslandContactStats island_stats_;
+  IslandContactSolve solver_;
+};
+
+}  // namespace torsion

@@ -1,0 +1,90 @@
+#pragma once
+// Contact between two FEM bodies (docs/contact.md, "Contact between FEM bodies"): the surface
+// nodes of each body against the surface triangles of the other, with Coulomb friction. One
+// BodyPairContact per pair of bodies whose bounding boxes overlap; it lives as long as they do,
+// so its multipliers warm-start the next step. Touched only by the simulation thread.
+//
+// Index space: the pair's nodes are body a's nodes, then body b's (node k of b is a.nodeCount() +
+// k); triangles likewise (b's are offset by a's surface triangle count). Its SurfaceContactSet
+// holds the candidates in that space with the same constraint as self-contact: with the
+// triangle point's barycentric weights w, beta = (1, -w_a, -w_b, -w_c), relative velocity
+// u = sum_k beta_k v_k, linearised end-of-step gap g + dt n.u >= 0. Since sum_k beta_k = 0, an
+// impulse lambda on the node and -w_j lambda on the triangle's corners exchanges momentum exactly.
+// The island solve (island_contact.h) resolves them.
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+#include <memory>
+#include <vector>
+
+#include "torsion/contact/surface_contact_set.h"
+#include "torsion/contact/surface_tree.h"
+#include "torsion/fem/fem_model.h"
+#include "torsion/result.h"
+
+namespace torsion {
+
+/// Contact between FEM bodies, one setting for every pair of a world (FemSoftBodySolver).
+struct BodyContactSettings {
+  double friction = 0.3;  ///< Coulomb coefficient between two FEM bodies' surfaces
+  /// m: the end-of-step gap every contact is driven to within (no penetration beyond it).
+  /// 0: 1e-3 times the smaller of the two bodies' mean surface edges (rest mesh).
+  double gap_tolerance = 0;
+  /// Candidates: nodes within this fraction of the triangle body's mean surface edge of a
+  /// triangle at the start of the step, besides those whose predicted path crosses it.
+  double margin = 0.25;
+  /// A node this fraction of the triangle's shortest edge behind it is deep inside the other body
+  /// (on its far side), not through its surface: no candidate.
+  double max_depth = 0.25;
+  /// rho in units of the contact's effective mass (surface_contact_set.h), for the island's
+  /// joint solve; its Gauss-Seidel path uses a hundredth of it (island_contact.h).
+  double penalty_factor = 20;
+  /// Uzawa updates per step (each one linear solve of every body of the island).
+  int max_iterations = 60;
+
+  Status validate() const;
+};
+
+class BodyPairContact {
+ public:
+  BodyPairContact(std::shared_ptr<const FemModel> a, std::shared_ptr<const FemModel> b,
+                  const BodyContactSettings& settings);
+
+  /// Candidates for this step from both bodies' positions at the step's start and their
+  /// predicted motion x + s dt v, s in [0, 1] (the same tests as self-contact: within the margin
+  /// now, or crossing on the path, projection inside the triangle then). Last step's multipliers
+  /// become warm starts. Returns whether there are any.
+  bool detect(const Eigen::VectorXd& xa, const Eigen::VectorXd& va, const Eigen::VectorXd& xb,
+              const Eigen::VectorXd& vb, double dt);
+
+  int nodeCountA() const { return node_count_a_; }
+  /// m, the gap tolerance in use (settings or its default from the two meshes).
+  double gapTolerance() const { return gap_tolerance_; }
+  const BodyContactSettings& settings() const { return settings_; }
+  SurfaceContactSet& set() { return set_; }
+  const SurfaceContactSet& set() const { return set_; }
+  /// Live material edit of either body: same meshes, new masses (nothing here depends on them).
+  void replaceModels(std::shared_ptr<const FemModel> a, std::shared_ptr<const FemModel> b);
+
+ private:
+  // Surface nodes of `nodes_model` (offset `node_offset` in the pair) against the surface
+  // triangles of `tree` (corners offset by `triangle_node_offset`, indices by
+  // `triangle_offset`).
+  void addCandidates(const FemModel& nodes_model, int node_offset, const Eigen::VectorXd& xn,
+                     const Eigen::VectorXd& en, SurfaceTree& tree, int triangle_node_offset,
+                     int triangle_offset, const Eigen::VectorXd& xt, const Eigen::VectorXd& et,
+                     double margin);
+
+  std::shared_ptr<const FemModel> a_, b_;
+  BodyContactSettings settings_;
+  int node_count_a_ = 0;
+  int triangle_count_a_ = 0;
+  double mean_edge_a_ = 0, mean_edge_b_ = 0;
+  double gap_tolerance_ = 0;
+  SurfaceTree tree_a_, tree_b_;
+  SurfaceContactSet set_;
+  Eigen::VectorXd end_a_, end_b_;
+  std::vector<int> found_;
+};
+
+}  // namespace torsion

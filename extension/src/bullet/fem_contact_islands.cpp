@@ -1,0 +1,177 @@
+#include "torsion/bullet/fem_contact_islands.h"
+
+#include <algorithm>
+#include <numeric>
+#include <sstream>
+
+namespace torsion {
+
+namespace {
+
+int findRoot(std::vector<int>& parent, int i) {
+  while (parent[static_cast<size_t>(i)] != i) {
+    parent[static_cast<size_t>(i)] = parent[static_cast<size_t>(parent[static_cast<size_t>(i)])];
+    i = parent[static_cast<size_t>(i)];
+  }
+  return i;
+}
+
+}  // namespace
+
+void FemContactIslands::notePair(FemBody* a, FemBody* b) {
+  if (a != b) touching_.emplace_back(a, b);
+}
+
+void FemContactIslands::forget(const FemBody* body) {
+  for (auto it = pairs_.begin(); it != pairs_.end();) {
+    it = it->first.first == body || it->first.second == body ? pairs_.erase(it) : std::next(it);
+  }
+  touching_.erase(
+      std::remove_if(touching_.begin(), touching_.end(),
+                     [body](const auto& p) { return p.first == body || p.second == body; }),
+      touching_.end());
+}
+
+const BodyPairContact* FemContactIslands::pair(const FemBody* a, const FemBody* b) const {
+  for (const Key& key : {Key{a, b}, Key{b, a}}) {
+    const auto it = pairs_.find(key);
+    if (it != pairs_.end()) return it->second.get();
+  }
+  return nullptr;
+}
+
+std::vector<std::vector<FemBody*>> FemContactIslands::plan(const std::vector<FemBody*>& bodies,
+                                                           const StepContext& ctx) {
+  stats_ = FemContactStats{};
+  live_.clear();
+  // The broadphase's pairs by body index (Bullet's order is its own), each once.
+  std::map<const FemBody*, int> index;
+  for (size_t i = 0; i < bodies.size(); ++i)
+    index[bodies[i]] = static_cast<int>(i);
+  std::vector<std::pair<int, int>> pairs;
+  for (const auto& [a, b] : touching_) {
+    const auto ia = index.find(a), ib = index.find(b);
+    if (ia == index.end() || ib == index.end()) continue;
+    pairs.push_back(std::minmax(ia->second, ib->second));
+  }
+  std::sort(pairs.begin(), pairs.end());
+  pairs.erase(std::unique(pairs.begin(), pairs.end()), pairs.end());
+  stats_.touching_pairs = static_cast<int>(pairs.size());
+
+  // Pairs no longer touching lose their multipliers.
+  std::map<Key, std::unique_ptr<BodyPairContact>> kept;
+  std::vector<int> parent(bodies.size());
+  std::iota(parent.begin(), parent.end(), 0);
+  for (const auto& [i, j] : pairs) {
+    FemBody* a = bodies[static_cast<size_t>(i)];
+    FemBody* b = bodies[static_cast<size_t>(j)];
+    const Key key{a, b};
+    auto found = pairs_.find(key);
+    std::unique_ptr<BodyPairContact> contact =
+        found != pairs_.end()
+            ? std::move(found->second)
+            : std::make_unique<BodyPairContact>(a->modelPointer(), b->modelPointer(), settings_);
+    const bool candidates = contact->detect(a->state().positions, a->state().velocities,
+                                            b->state().positions, b->state().velocities, ctx.dt);
+    if (candidates) {
+      live_.emplace_back(key, contact.get());
+      parent[static_cast<size_t>(findRoot(parent, i))] = findRoot(parent, j);
+    }
+    kept.emplace(key, std::move(contact));
+  }
+  pairs_ = std::move(kept);
+
+  // Groups in the order of their first body, bodies in order within each.
+  std::vector<std::vector<FemBody*>> groups;
+  std::map<int, size_t> group_of_root;
+  for (size_t i = 0; i < bodies.size(); ++i) {
+    const int root = findRoot(parent, static_cast<int>(i));
+    auto [it, added] = group_of_root.emplace(root, groups.size());
+    if (added) groups.emplace_back();
+    groups[it->second].push_back(bodies[i]);
+  }
+  return groups;
+}
+
+void FemContactIslands::advance(const std::vector<FemBody*>& group, const StepContext& ctx) {
+  if (group.size() == 1) {
+    group.front()->advance(ctx);
+    return;
+  }
+  group_ = group;
+  const size_t n = group.size();
+  slots_.assign(n, IslandContactSolve::Body{});
+  terms_.assign(n, PairContactTerm{});
+  advanced_.assign(n, 0);
+  island_pairs_.clear();
+  auto slot = [&](const FemBody* body) {
+    return static_cast<int>(std::find(group.begin(), group.end(), body) - group.begin());
+  };
+  for (const auto& [key, contact] : live_) {
+    const int first = slot(key.first), second = slot(key.second);
+    if (first == static_cast<int>(n) || second == static_cast<int>(n)) continue;
+    island_pairs_.push_back({contact, first, second});
+    const int na = contact->nodeCountA();
+    terms_[static_cast<size_t>(first)].addSide({&contact->set(), 0, na});
+    terms_[static_cast<size_t>(second)].addSide(
+        {&contact->set(), na, key.second->model().nodeCount()});
+  }
+  solved_ = false;
+  island_stats_ = IslandContactStats{};
+  advanceFrom(0, ctx);
+  // A body that stopped before its solve broke the chain: the rest step alone.
+  for (size_t k = 0; k < n; ++k) {
+    if (!advanced_[k]) group[k]->advance(ctx);
+  }
+
+  ++stats_.islands;
+  stats_.candidates += island_stats_.candidates;
+  stats_.active += island_stats_.active;
+  stats_.sticking += island_stats_.sticking;
+  stats_.iterations = std::max(stats_.iterations, island_stats_.iterations);
+  stats_.normal_impulse += island_stats_.normal_impulse;
+  stats_.max_end_penetration =
+      std::max(stats_.max_end_penetration, island_stats_.max_end_penetration);
+  if (solved_ && !island_stats_.converged) {
+    // Reported per step, never accepted silently (a warning: the step is usable).
+    stats_.converged = false;
+    std::ostringstream s;
+    s << "contact between FEM bodies did not converge in " << island_stats_.iterations
+      << " updates (end penetration " << island_stats_.max_end_penetration << " m, tolerance "
+      << island_stats_.gap_tolerance << " m)";
+    for (size_t k = 0; k < n; ++k) {
+      if (slots_[k].present && !isFatal(group[k]->lastReport().health))
+        group[k]->noteContactNotConverged(s.str());
+    }
+  }
+}
+
+void FemContactIslands::advanceFrom(size_t k, const StepContext& ctx) {
+  FemBody* body = group_[k];
+  body->setIslandSolve(
+      [this, k, &ctx](const SystemOperator& op, const NodeConstraints& constraints,
+                      const Eigen::VectorXd& b, const SolverSettings& settings, Eigen::VectorXd& v,
+                      const ImplicitStepper::LinearSolveHook& own) {
+        IslandContactSolve::Body& s = slots_[k];
+        s.op = &op;
+        s.constraints = &constraints;
+        s.b = &b;
+        s.settings = &settings;
+        s.v = &v;
+        s.solve = own;
+        s.term = &terms_[k];
+        s.present = true;
+        // The next body steps up to its own solve (and so on); the last one solves the island.
+        if (k + 1 < group_.size()) advanceFrom(k + 1, ctx);
+        if (!solved_) {
+          solved_ = true;
+          island_stats_ = solver_.solve(slots_, island_pairs_, ctx.dt);
+        }
+        return slots_[k].report;
+      },
+      &terms_[k]);
+  body->advance(ctx);
+  advanced_[k] = 1;
+}
+
+}  // namespace torsion

@@ -1,0 +1,156 @@
+#include "torsion/contact/body_pair_contact.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "torsion/format_number.h"
+
+namespace torsion {
+
+namespace {
+
+// A projection within this of a triangle's edge (barycentric units) still counts as inside: a
+// node passing exactly over an edge is caught by both triangles (as for self-contact).
+constexpr double kInsideTolerance = 0.05;
+
+// Barycentric coordinates of p's projection onto the plane of (a, b, c).
+Eigen::Vector3d barycentric(const Eigen::Vector3d& p, const Eigen::Vector3d& a,
+                            const Eigen::Vector3d& b, const Eigen::Vector3d& c) {
+  const Eigen::Vector3d e0 = b - a, e1 = c - a, d = p - a;
+  const double d00 = e0.dot(e0), d01 = e0.dot(e1), d11 = e1.dot(e1);
+  const double d20 = d.dot(e0), d21 = d.dot(e1);
+  const double det = d00 * d11 - d01 * d01;
+  const double v = (d11 * d20 - d01 * d21) / det;
+  const double w = (d00 * d21 - d01 * d20) / det;
+  return {1.0 - v - w, v, w};
+}
+
+double meanSurfaceEdge(const TetMesh& mesh) {
+  const std::vector<Triangle>& triangles = mesh.surfaceTriangles();
+  if (triangles.empty()) return 0;
+  double sum = 0;
+  for (const Triangle& t : triangles) {
+    for (size_t k = 0; k < 3; ++k)
+      sum += (mesh.restPositions()[static_cast<size_t>(t[k])] -
+              mesh.restPositions()[static_cast<size_t>(t[(k + 1) % 3])])
+                 .norm();
+  }
+  return sum / (3.0 * static_cast<double>(triangles.size()));
+}
+
+}  // namespace
+
+Status BodyContactSettings::validate() const {
+  if (!(std::isfinite(friction) && friction >= 0))
+    return Error{"fem_contact: friction = " + formatNumber(friction) + ": must be >= 0"};
+  if (!(std::isfinite(gap_tolerance) && gap_tolerance >= 0))
+    return Error{"fem_contact: gap_tolerance = " + formatNumber(gap_tolerance) +
+                 ": must be >= 0 m (0: from the meshes)"};
+  if (!(std::isfinite(margin) && margin >= 0 && margin <= 1))
+    return Error{"fem_contact: margin = " + formatNumber(margin) + ": must be in [0, 1]"};
+  if (!(std::isfinite(max_depth) && max_depth > 0 && max_depth <= 0.5))
+    return Error{"fem_contact: max_depth = " + formatNumber(max_depth) + ": must be in (0, 0.5]"};
+  if (!(std::isfinite(penalty_factor) && penalty_factor > 0))
+    return Error{"fem_contact: penalty_factor = " + formatNumber(penalty_factor) + ": must be > 0"};
+  if (max_iterations < 1)
+    return Error{"fem_contact: max_iterations = " + std::to_string(max_iterations) +
+                 ": must be >= 1"};
+  return Ok{};
+}
+
+BodyPairContact::BodyPairContact(std::shared_ptr<const FemModel> a,
+                                 std::shared_ptr<const FemModel> b,
+                                 const BodyContactSettings& settings)
+    : a_(std::move(a)),
+      b_(std::move(b)),
+      settings_(settings),
+      node_count_a_(a_->nodeCount()),
+      triangle_count_a_(static_cast<int>(a_->mesh().surfaceTriangles().size())),
+      mean_edge_a_(meanSurfaceEdge(a_->mesh())),
+      mean_edge_b_(meanSurfaceEdge(b_->mesh())),
+      tree_a_(a_->mesh().surfaceTriangles()),
+      tree_b_(b_->mesh().surfaceTriangles()) {
+  gap_tolerance_ = settings_.gap_tolerance > 0 ? settings_.gap_tolerance
+                                               : 1e-3 * std::min(mean_edge_a_, mean_edge_b_);
+}
+
+void BodyPairContact::replaceModels(std::shared_ptr<const FemModel> a,
+                                    std::shared_ptr<const FemModel> b) {
+  a_ = std::move(a);
+  b_ = std::move(b);
+}
+
+bool BodyPairContact::detect(const Eigen::VectorXd& xa, const Eigen::VectorXd& va,
+                             const Eigen::VectorXd& xb, const Eigen::VectorXd& vb, double dt) {
+  set_.beginStep();
+  end_a_ = xa + dt * va;
+  end_b_ = xb + dt * vb;
+  // a's nodes against b's triangles, then b's nodes against a's: a fixed order, so the candidates
+  // (and the solve) are the same for any thread count.
+  addCandidates(*a_, 0, xa, end_a_, tree_b_, node_count_a_, triangle_count_a_, xb, end_b_,
+                settings_.margin * mean_edge_b_);
+  addCandidates(*b_, node_count_a_, xb, end_b_, tree_a_, 0, 0, xa, end_a_,
+                settings_.margin * mean_edge_a_);
+  return !set_.empty();
+}
+
+void BodyPairContact::addCandidates(const FemModel& nodes_model, int node_offset,
+                                    const Eigen::VectorXd& xn, const Eigen::VectorXd& en,
+                                    SurfaceTree& tree, int triangle_node_offset,
+                                    int triangle_offset, const Eigen::VectorXd& xt,
+                                    const Eigen::VectorXd& et, double margin) {
+  tree.refit(xt, et, margin);
+  const std::vector<Triangle>& triangles = tree.triangles();
+  for (int p : nodes_model.mesh().surfaceNodes()) {
+    const Eigen::Vector3d xp = xn.segment<3>(3 * p), ep = en.segment<3>(3 * p);
+    tree.query(xp.cwiseMin(ep), xp.cwiseMax(ep), found_);
+    for (int t : found_) {
+      const Triangle& tri = triangles[static_cast<size_t>(t)];
+      const Eigen::Vector3d a0 = xt.segment<3>(3 * tri[0]), b0 = xt.segment<3>(3 * tri[1]),
+                            c0 = xt.segment<3>(3 * tri[2]);
+      Eigen::Vector3d n0 = (b0 - a0).cross(c0 - a0);
+      if (!(n0.norm() > 0)) continue;  // degenerate: no plane to stay out of
+      n0.normalize();
+      const double g0 = n0.dot(xp - a0);
+      const double shortest = std::min({(b0 - a0).norm(), (c0 - b0).norm(), (a0 - c0).norm()});
+      if (g0 < -settings_.max_depth * shortest) continue;  // deep inside: the far side
+      const int pair_node = node_offset + p;
+      const int pair_triangle = triangle_offset + t;
+      // Behind the plane beyond the tolerance: only a contact held last step is still one (it
+      // sank within its tolerance); a new pair there is a node past the other body's rim.
+      if (g0 < -2 * gap_tolerance_ && !set_.wasActive(pair_node, pair_triangle)) continue;
+      const Eigen::Vector3d a1 = et.segment<3>(3 * tri[0]), b1 = et.segment<3>(3 * tri[1]),
+                            c1 = et.segment<3>(3 * tri[2]);
+      Eigen::Vector3d n1 = (b1 - a1).cross(c1 - a1);
+      if (!(n1.norm() > 0)) n1 = n0;
+      const double g1 = n1.normalized().dot(ep - a1);
+      // When on the path the node meets the plane: now if within the margin, at the crossing if
+      // it passes through, at the end if it ends within the margin.
+      double s;
+      if (g0 <= margin) {
+        s = 0;
+      } else if (g1 < 0) {
+        s = g0 / (g0 - g1);
+      } else if (g1 <= margin) {
+        s = 1;
+      } else {
+        continue;
+      }
+      const Eigen::Vector3d w = barycentric(xp + s * (ep - xp), a0 + s * (a1 - a0),
+                                            b0 + s * (b1 - b0), c0 + s * (c1 - c0));
+      if (!w.allFinite() || w.minCoeff() < -kInsideTolerance) continue;
+      const Eigen::Vector3d wc = w.cwiseMax(0.0) / w.cwiseMax(0.0).sum();
+      SurfaceContact c;
+      c.nodes = {pair_node, triangle_node_offset + tri[0], triangle_node_offset + tri[1],
+                 triangle_node_offset + tri[2]};
+      c.beta = {1.0, -wc[0], -wc[1], -wc[2]};
+      c.triangle = pair_triangle;
+      c.normal = n0;
+      c.gap = g0;
+      c.friction = settings_.friction;
+      set_.add(c);
+    }
+  }
+}
+
+}  // namespace torsion

@@ -1,0 +1,212 @@
+// Contact between two FEM bodies (docs/contact.md, "Contact between FEM bodies"): each body's
+// surface nodes against the other's surface triangles, solved with both bodies' velocities in
+// one island solve. Forces, momentum, penetration and friction against their analytic values.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+#include <vector>
+
+#include "torsion/bullet/fem_body.h"
+#include "torsion/bullet/fem_world.h"
+#include "torsion/mesh/ball_mesh.h"
+#include "torsion/mesh/box_mesh.h"
+
+namespace torsion {
+namespace {
+
+std::vector<int> nodesWhere(const FemBody& body, double z_below) {
+  std::vector<int> nodes;
+  for (int i = 0; i < body.model().nodeCount(); ++i)
+    if (body.state().position(i).z() < z_below) nodes.push_back(i);
+  return nodes;
+}
+
+Eigen::Vector3d momentum(const FemBody& body) {
+  Eigen::Vector3d p = Eigen::Vector3d::Zero();
+  for (int i = 0; i < body.model().nodeCount(); ++i)
+    p += body.model().nodeMasses()[static_cast<size_t>(i)] * body.state().velocity(i);
+  return p;
+}
+
+Eigen::Vector3d centre(const FemBody& body) {
+  Eigen::Vector3d c = Eigen::Vector3d::Zero();
+  for (int i = 0; i < body.model().nodeCount(); ++i)
+    c += body.model().nodeMasses()[static_cast<size_t>(i)] * body.state().position(i);
+  return c / body.model().totalMass();
+}
+
+// N: the force the pair's contacts put on `body` during the last step (impulses over dt).
+Eigen::Vector3d contactForceOn(const FemWorld& world, const FemBody& body, const FemBody& other,
+                               double dt) {
+  const BodyPairContact* pair = world.femSolver().femContact()->pair(&body, &other);
+  if (pair == nullptr) return Eigen::Vector3d::Zero();
+  // The pair's first body is the one added first.
+  const bool body_first = &body == world.bodies().front().get() ||
+                          (&other != world.bodies().front().get() && &body < &other);
+  const int na = pair->nodeCountA();
+  Eigen::Vector3d impulse = Eigen::Vector3d::Zero();
+  for (const SurfaceContact& c : pair->set().contacts()) {
+    if (c.determined || c.state == SurfaceContact::State::kInactive) continue;
+    for (size_t k = 0; k < 4; ++k)
+      if ((c.nodes[k] < na) == body_first) impulse += c.beta[k] * c.multiplier;
+  }
+  return impulse / dt;
+}
+
+Material soft(double youngs_modulus) {
+  Material m;
+  m.youngs_modulus = youngs_modulus;
+  m.poisson_ratio = 0.3;
+  m.density = 1000;
+  m.mass_damping = 2;
+  return m;
+}
+
+TEST(BodyContact, ASoftBallRestsOnASoftSlabCarriedByTheTotalContactForceMg) {
+  WorldSettings settings;
+  settings.solver.time_step = 0.005;
+  FemWorld world(settings);
+  FemBody* slab =
+      world
+          .addBody("slab", makeBoxTetMesh({-0.3, -0.3, 0}, {0.3, 0.3, 0.1}, 6, 6, 2).value(),
+                   soft(2e5))
+          .value();
+  slab->carryNodes(
+      "base", nodesWhere(*slab, 1e-9), [](double) { return Frame{}; }, 0.0);
+  FemBody* ball =
+      world.addBody("ball", makeBallTetMesh({0.013, 0.021, 0.201}, 0.1, 3).value(), soft(5e4))
+          .value();
+  const double g = 9.81, mass = ball->model().totalMass();
+  double worst_penetration = 0, tolerance = 0;
+  int unconverged = 0;
+  Eigen::Vector3d force = Eigen::Vector3d::Zero();
+  const int steps = 400, averaged = 40;  // 2 s, the last 0.2 s averaged
+  for (int k = 0; k < steps; ++k) {
+    const WorldStepReport r = world.step();
+    ASSERT_TRUE(r.ok) << r.message;
+    const FemContactStats& s = world.femSolver().femContact()->stats();
+    if (!s.converged) ++unconverged;
+    worst_penetration = std::max(worst_penetration, s.max_end_penetration);
+    if (k >= steps - averaged) force += contactForceOn(world, *ball, *slab, 0.005) / averaged;
+  }
+  tolerance = world.femSolver().femContact()->pair(slab, ball)->gapTolerance();
+  const FemContactStats& s = world.femSolver().femContact()->stats();
+  std::printf(
+      "[figures] ball on slab: m g = %.4f N, contact force z = %.4f N (x %.2e, y %.2e), "
+      "active %d, worst end penetration %.2e m (tolerance %.2e m), unconverged steps %d, "
+      "last iterations %d, centre z %.5f\n",
+      mass * g, force.z(), force.x(), force.y(), s.active, worst_penetration, tolerance,
+      unconverged, s.iterations, centre(*ball).z());
+  EXPECT_GT(s.active, 0);
+  EXPECT_NEAR(force.z(), mass * g, 0.02 * mass * g);
+  EXPECT_LT(std::hypot(force.x(), force.y()), 0.02 * mass * g);
+  EXPECT_LE(worst_penetration, tolerance);
+  EXPECT_EQ(unconverged, 0);
+  // Resting on the slab's top (z = 0.1), a little sunk in by both bodies' deformation.
+  EXPECT_NEAR(centre(*ball).z(), 0.2, 0.02);
+}
+
+TEST(BodyContact, ASoftBlockThrownAtAnotherKeepsTheLinearMomentumAndDoesNotPassThrough) {
+  WorldSettings settings;
+  settings.gravity.setZero();
+  settings.solver.time_step = 1e-3;
+  FemWorld world(settings);
+  Material material = soft(1e6);
+  material.mass_damping = 0;
+  material.stiffness_damping = 1e-3;
+  FemBody* struck =
+      world.addBody("struck", makeBoxTetMesh({0, 0, 0}, {0.1, 0.1, 0.1}, 3, 3, 3).value(), material)
+          .value();
+  FemBody* thrown =
+      world
+          .addBody("thrown",
+                   makeBoxTetMesh({0.12, 0.03, 0.01}, {0.22, 0.13, 0.11}, 3, 3, 3).value(),
+                   material)
+          .value();
+  thrown->setVelocity(Eigen::Vector3d(-4, 0, 0));
+  const Eigen::Vector3d before = momentum(*struck) + momentum(*thrown);
+  double worst = 0, deepest = 0;
+  int unconverged = 0, contact_steps = 0;
+  for (int k = 0; k < 150; ++k) {
+    const WorldStepReport r = world.step();
+    ASSERT_TRUE(r.ok) << r.message;
+    const Eigen::Vector3d now = momentum(*struck) + momentum(*thrown);
+    worst = std::max(worst, (now - before).norm() / before.norm());
+    const FemContactStats& s = world.femSolver().femContact()->stats();
+    if (s.active > 0) ++contact_steps;
+    if (!s.converged) ++unconverged;
+    deepest = std::max(deepest, s.max_end_penetration);
+    // No tunnelling: no linearised end gap deeper than a millimetre (a tenth of a cell), and the
+    // thrown block's centre stays a block's width right of the struck one's.
+    ASSERT_LT(s.max_end_penetration, 1e-3) << "step " << k;
+    ASSERT_GT(centre(*thrown).x() - centre(*struck).x(), 0.095) << "step " << k;
+  }
+  const double p_struck = momentum(*struck).x(), p_thrown = momentum(*thrown).x();
+  std::printf(
+      "[figures] thrown block: momentum %.5f -> %.5f N s (worst relative drift %.2e), "
+      "struck %.4f, thrown %.4f N s, contact steps %d, unconverged %d, deepest end "
+      "penetration %.2e m\n",
+      before.x(), p_struck + p_thrown, worst, p_struck, p_thrown, contact_steps, unconverged,
+      deepest);
+  EXPECT_LT(worst, 0.01);
+  EXPECT_GT(contact_steps, 0);
+  EXPECT_LT(p_struck, 0.5 * before.x()) << "the struck block took a good share of the momentum";
+  EXPECT_GT(centre(*thrown).x() - centre(*struck).x(), 0.1);
+}
+
+// Two blocks, the lower one's base fixed, the upper one (`element`) pressed down by 5 N spread
+// over its top nodes, no gravity: at rest the contact carries the load.
+void pressBlocks(ElementKind element) {
+  WorldSettings settings;
+  settings.gravity.setZero();
+  settings.solver.time_step = 0.005;
+  FemWorld world(settings);
+  FemBody* lower =
+      world.addBody("lower", makeBoxTetMesh({0, 0, 0}, {0.1, 0.1, 0.1}, 3, 3, 3).value(), soft(2e5))
+          .value();
+  lower->carryNodes(
+      "base", nodesWhere(*lower, 1e-9), [](double) { return Frame{}; }, 0.0);
+  FemBody* upper =
+      world
+          .addBody("upper",
+                   makeBoxTetMesh({0.02, 0.01, 0.1005}, {0.08, 0.09, 0.1605}, 2, 2, 2).value(),
+                   soft(2e5), Frame{}, element)
+          .value();
+  // 5 N down, spread over the upper block's top nodes.
+  const double load = 5;
+  std::vector<int> top;
+  for (int i = 0; i < upper->model().nodeCount(); ++i)
+    if (upper->state().position(i).z() > 0.16) top.push_back(i);
+  for (int i : top)
+    ASSERT_TRUE(
+        upper->setNodeForce(i, Eigen::Vector3d(0, 0, -load / static_cast<double>(top.size())))
+            .ok());
+  Eigen::Vector3d force = Eigen::Vector3d::Zero();
+  const int steps = 300, averaged = 40;
+  for (int k = 0; k < steps; ++k) {
+    const WorldStepReport r = world.step();
+    ASSERT_TRUE(r.ok) << r.message;
+    if (k >= steps - averaged) force += contactForceOn(world, *upper, *lower, 0.005) / averaged;
+  }
+  const FemContactStats& s = world.femSolver().femContact()->stats();
+  std::printf(
+      "[figures] pressed blocks (upper %s): load %.3f N, contact force on the upper block %.4f N "
+      "(lateral %.2e), active %d, end penetration %.2e m, upper block speed %.2e m/s\n",
+      element == ElementKind::kTet10 ? "tet10" : "tet4", load, force.z(),
+      std::hypot(force.x(), force.y()), s.active, s.max_end_penetration,
+      momentum(*upper).norm() / upper->model().totalMass());
+  EXPECT_NEAR(force.z(), load, 0.03 * load);
+  EXPECT_TRUE(s.converged);
+}
+
+TEST(BodyContact, TwoBlocksPressedTogetherCarryTheAppliedLoadThroughTheirContact) {
+  pressBlocks(ElementKind::kTet4);
+}
+
+TEST(BodyContact, AQuadraticBlockPressedOnALinearOneCarriesTheLoadThroughItsSplitSurface) {
+  pressBlocks(ElementKind::kTet10);
+}
+
+}  // namespace
+}  // namespace torsion
