@@ -1,10 +1,13 @@
 # Warnings and sanitizers, applied per target so consumers of the installed package inherit none.
+# Third-party headers (Eigen, Bullet, pybind11, GoogleTest, nlohmann_json) come in through
+# imported targets, whose include directories are SYSTEM: these flags judge our own code only.
 
 function(torsion_apply_warnings target)
   if(CMAKE_CXX_COMPILER_ID MATCHES "GNU|Clang")
     target_compile_options(${target} PRIVATE -Wall -Wextra -Wpedantic -Wshadow -Wnon-virtual-dtor
                                              -Wold-style-cast -Wcast-align -Woverloaded-virtual
-                                             -Wdouble-promotion -Wformat=2)
+                                             -Wdouble-promotion -Wformat=2 -Wconversion
+                                             -Wsign-conversion)
     if(TORSION_WARNINGS_AS_ERRORS)
       target_compile_options(${target} PRIVATE -Werror)
     endif()
