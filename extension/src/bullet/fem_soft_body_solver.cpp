@@ -214,14 +214,6 @@ void FemSoftBodySolver::predictMotion(btScalar solver_dt) {
 
 void FemSoftBodySolver::solveConstraints(btScalar solver_dt) {
   bullet_solver_.solveConstraints(solver_dt);
-  stepFemBodies(solver_dt);
-}
-
-void FemSoftBodySolver::stepWithoutSoftBodies(btScalar solver_dt) {
-  stepFemBodies(solver_dt);
-}
-
-void FemSoftBodySolver::stepFemBodies(btScalar solver_dt) {
   // A substep without FEM bodies is still a step of the FEM clock (stepCount() counts substeps).
   if (!status_.ok || !(solver_dt > 0)) return;
 

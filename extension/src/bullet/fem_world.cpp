@@ -119,10 +119,7 @@ WorldStepReport FemWorld::step() {
   WorldStepReport report;
   if (soft_solver_->status().ok) {
     // One variable step: Bullet makes exactly one internal substep of dt, the FEM step.
-    const auto dt = static_cast<btScalar>(settings_.solver.time_step);
-    world_->stepSimulation(dt, 0);
-    // Bullet calls its soft-body solver only while the world holds a soft body.
-    if (world_->getSoftBodyArray().size() == 0) soft_solver_->stepWithoutSoftBodies(dt);
+    world_->stepSimulation(static_cast<btScalar>(settings_.solver.time_step), 0);
   }
   report.step = stepCount();
   const FemSolverStatus& status = soft_solver_->status();

@@ -119,11 +119,6 @@ class FemSoftBodySolver : public btSoftBodySolver {
   std::int64_t stepCount() const { return steps_; }
   /// s, length of the last FEM step (0 before the first).
   double lastTimeStep() const { return last_dt_; }
-  /// One FEM step of `solver_dt` for a world that holds no soft body at all, which Bullet steps
-  /// without calling its soft-body solver: the clock moves on and the step listeners hear of the
-  /// step, as from solveConstraints. Call it after such a world's substep to keep the FEM clock
-  /// with Bullet's (FemWorld::step does).
-  void stepWithoutSoftBodies(btScalar solver_dt);
 
   // ---- checkpoints ----
   /// Clock, health and every FEM body's state and warm starts now (hands: Hand::checkpoint;
@@ -168,8 +163,6 @@ class FemSoftBodySolver : public btSoftBodySolver {
   void unsupportedPair(const btSoftBody* a, const btSoftBody* b);
   std::string describe(const btSoftBody* soft) const;
   void fail(std::string message);
-  // The FEM part of a substep: listeners, every FEM body's step, the clock.
-  void stepFemBodies(btScalar solver_dt);
 
   SolverSettings settings_;
   Parallel parallel_;
