@@ -31,7 +31,7 @@ TEST(RemoveBody, TheWorldForgetsTheBodyItsMemoryIsFreedAndTheOthersStepOn) {
   FemBody* right =
       user.fem.addBody("right", box, Material{}, Frame{{3, 0, 0}, Eigen::Quaterniond::Identity()})
           .value();
-  const btScalar dt(0.01);
+  const auto dt = static_cast<btScalar>(0.01);
   for (int k = 0; k < 10; ++k)
     user.world.stepSimulation(dt, 0);
   ASSERT_TRUE(user.fem.status().ok) << user.fem.status().message;
