@@ -1,10 +1,20 @@
 # Warnings and sanitizers, applied per target so consumers of the installed package inherit none.
+# Third-party headers (Eigen, Bullet, pybind11, GoogleTest, nlohmann_json) come in through
+# imported targets, whose include directories are SYSTEM: these flags judge our own code only.
 
 function(torsion_apply_warnings target)
   if(CMAKE_CXX_COMPILER_ID MATCHES "GNU|Clang")
     target_compile_options(${target} PRIVATE -Wall -Wextra -Wpedantic -Wshadow -Wnon-virtual-dtor
                                              -Wold-style-cast -Wcast-align -Woverloaded-virtual
                                              -Wdouble-promotion -Wformat=2)
+    # Implicit narrowing and sign changes are mistakes in our code: say so with a cast. Not yet
+    # in tests/ on float Bullet, whose tests still pass double literals straight to Bullet
+    # (btVector3(0.1, ...) and the like); everywhere else, both precisions.
+    get_target_property(_source_dir ${target} SOURCE_DIR)
+    string(FIND "${_source_dir}/" "${PROJECT_SOURCE_DIR}/tests/" _in_tests)
+    if(NOT (TORSION_BULLET_PRECISION STREQUAL "float" AND _in_tests EQUAL 0))
+      target_compile_options(${target} PRIVATE -Wconversion -Wsign-conversion)
+    endif()
     if(TORSION_WARNINGS_AS_ERRORS)
       target_compile_options(${target} PRIVATE -Werror)
     endif()

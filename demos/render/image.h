@@ -15,9 +15,13 @@ struct Image {
   int height = 0;
   std::vector<std::uint8_t> rgb;  ///< width * height * 3, row 0 at the top
 
-  std::uint8_t* pixel(int x, int y) { return &rgb[3 * (static_cast<size_t>(y) * width + x)]; }
-  const std::uint8_t* pixel(int x, int y) const {
-    return &rgb[3 * (static_cast<size_t>(y) * width + x)];
+  std::uint8_t* pixel(int x, int y) { return &rgb[offset(x, y)]; }
+  const std::uint8_t* pixel(int x, int y) const { return &rgb[offset(x, y)]; }
+
+ private:
+  // x, y inside the image, hence not negative.
+  size_t offset(int x, int y) const {
+    return 3 * (static_cast<size_t>(y) * static_cast<size_t>(width) + static_cast<size_t>(x));
   }
 };
 

@@ -25,8 +25,8 @@ Status checkStiffnessRatio(const Material& material, const TetMesh& mesh, double
   double shortest_sq = std::numeric_limits<double>::infinity();
   const std::vector<Eigen::Vector3d>& x = mesh.restPositions();
   for (const auto& tet : mesh.tets()) {
-    for (int a = 0; a < 4; ++a) {
-      for (int b = a + 1; b < 4; ++b) {
+    for (size_t a = 0; a < tet.size(); ++a) {
+      for (size_t b = a + 1; b < tet.size(); ++b) {
         shortest_sq = std::min(
             shortest_sq,
             (x[static_cast<size_t>(tet[a])] - x[static_cast<size_t>(tet[b])]).squaredNorm());

@@ -9,7 +9,7 @@
 #include "rigid_body_builder.h"
 #include "scene_spec.h"
 #include "torsion/bullet/fem_world.h"
-#include "torsion/constraints/hand.h"
+#include "torsion/bullet/hand.h"
 #include "torsion/result.h"
 
 namespace torsion::scene {

@@ -20,7 +20,7 @@
 #include <vector>
 
 #include "torsion/bullet/fem_world.h"
-#include "torsion/constraints/hand.h"
+#include "torsion/bullet/hand.h"
 #include "torsion/device/scripted_device.h"
 #include "torsion/haptics/haptic_runtime.h"
 #include "torsion/mesh/mesh_io.h"

@@ -2,7 +2,7 @@
 #include <gtest/gtest.h>
 
 #include "torsion/bullet/fem_world.h"
-#include "torsion/constraints/hand.h"
+#include "torsion/bullet/hand.h"
 #include "torsion/mesh/box_mesh.h"
 
 namespace torsion {

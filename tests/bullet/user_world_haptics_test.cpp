@@ -1,7 +1,7 @@
 // A haptic device driving a hand on an FEM body in a world the user steps with substeps.
 #include <gtest/gtest.h>
 
-#include "torsion/constraints/hand.h"
+#include "torsion/bullet/hand.h"
 #include "torsion/device/scripted_device.h"
 #include "torsion/haptics/haptic_runtime.h"
 #include "torsion/mesh/box_mesh.h"

@@ -28,7 +28,7 @@ file(WRITE "${WORK_DIR}/readme_snippet.cpp" "${snippet}")
 run(${CMAKE_COMMAND} --install "${BUILD_DIR}" --prefix "${WORK_DIR}/prefix")
 run(${CMAKE_COMMAND} -S "${PROJECT_DIR}/examples" -B "${WORK_DIR}/build" -G "${GENERATOR}"
     "-DCMAKE_PREFIX_PATH=${WORK_DIR}/prefix" -DCMAKE_BUILD_TYPE=Release
-    "-DREADME_SNIPPET=${WORK_DIR}/readme_snippet.cpp")
+    "-DREADME_SNIPPET=${WORK_DIR}/readme_snippet.cpp" -DTORSION_EXAMPLES_STRICT=ON)
 run(${CMAKE_COMMAND} --build "${WORK_DIR}/build")
 
 get_filename_component(mesh_base "${MESH}" NAME_WE)

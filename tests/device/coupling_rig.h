@@ -7,7 +7,7 @@
 #include <string>
 
 #include "torsion/bullet/fem_world.h"
-#include "torsion/constraints/hand.h"
+#include "torsion/bullet/hand.h"
 #include "torsion/device/pose_math.h"
 #include "torsion/haptics/hand_coupling.h"
 #include "torsion/mesh/mesh_io.h"

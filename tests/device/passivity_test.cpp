@@ -71,7 +71,8 @@ Trace run(const Scenario& sc) {
   Trace trace;
   for (int k = 0; k * kDt <= sc.duration + 1e-9; ++k) {
     const double now = k * kDt;
-    while (!in_flight.empty() && in_flight.front().step * 0.01 + sc.delay <= now + 1e-9) {
+    while (!in_flight.empty() &&
+           static_cast<double>(in_flight.front().step) * 0.01 + sc.delay <= now + 1e-9) {
       loop.wrenches().write(in_flight.front());
       in_flight.pop_front();
     }

@@ -19,7 +19,7 @@
 #include "torsion/analysis/deformation_metrics.h"
 #include "torsion/bullet/fem_body.h"
 #include "torsion/bullet/fem_world.h"
-#include "torsion/constraints/hand.h"
+#include "torsion/bullet/hand.h"
 #include "torsion/mesh/mesh_io.h"
 #include "validation_output.h"
 

@@ -11,7 +11,7 @@
 
 #include "torsion/analysis/twist_profile.h"
 #include "torsion/bullet/fem_world.h"
-#include "torsion/constraints/hand.h"
+#include "torsion/bullet/hand.h"
 #include "torsion/mesh/mesh_io.h"
 #include "validation_output.h"
 

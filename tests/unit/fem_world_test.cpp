@@ -103,6 +103,64 @@ TEST(FemWorld, InstabilityStopsWithBodyAndStep) {
   EXPECT_NE(r.message.find("blow-up"), std::string::npos) << r.message;
 }
 
+TEST(FemWorld, AWorldWithoutBodiesStillCountsItsSteps) {
+  WorldSettings settings;
+  FemWorld world(settings);
+  for (int k = 1; k <= 3; ++k) {
+    const WorldStepReport r = world.step();
+    ASSERT_TRUE(r.ok) << r.message;
+    EXPECT_EQ(r.step, k);
+  }
+  EXPECT_EQ(world.stepCount(), 3);
+  const double dt = static_cast<double>(static_cast<btScalar>(settings.solver.time_step));
+  EXPECT_NEAR(world.time(), 3 * dt, 1e-12);
+  // A body added now starts at the world's clock and the count goes on from there.
+  world.addBody("late", beam(), Material{}).value();
+  ASSERT_TRUE(world.step().ok);
+  EXPECT_EQ(world.stepCount(), 4);
+  EXPECT_NEAR(world.time(), 4 * dt, 1e-12);
+}
+
+TEST(FemWorld, AFailedStepIsCountedFreezesTheWorldAndIsUndoneByRestoringACheckpoint) {
+  WorldSettings settings;
+  settings.solver.max_speed = 5;  // gravity alone exceeds it after ~0.5 s of free fall
+  FemWorld world(settings);
+  FemBody* body = world.addBody("faller", beam(), Material{}).value();
+  WorldCheckpoint before_failure = world.checkpoint();
+  Eigen::VectorXd positions_before_failure = body->state().positions;
+  WorldStepReport r;
+  for (int k = 0; k < 200; ++k) {
+    before_failure = world.checkpoint();
+    positions_before_failure = body->state().positions;
+    r = world.step();
+    if (!r.ok) break;
+  }
+  ASSERT_FALSE(r.ok);
+  // The failed step counts on the clock, and the body keeps what that step computed.
+  EXPECT_EQ(world.stepCount(), r.step);
+  EXPECT_NE(body->state().positions, positions_before_failure);
+
+  // Later steps move nothing and report the same failure.
+  const Eigen::VectorXd positions_after_failure = body->state().positions;
+  const double time_after_failure = world.time();
+  const WorldStepReport again = world.step();
+  EXPECT_FALSE(again.ok);
+  EXPECT_EQ(again.step, r.step);
+  EXPECT_EQ(again.message, r.message);
+  EXPECT_EQ(world.stepCount(), r.step);
+  EXPECT_EQ(world.time(), time_after_failure);
+  EXPECT_EQ(body->state().positions, positions_after_failure);
+
+  // The checkpoint from before the failed step brings back the bodies, the clock and the health.
+  ASSERT_TRUE(world.restore(before_failure).ok());
+  EXPECT_EQ(world.stepCount(), r.step - 1);
+  EXPECT_EQ(body->state().positions, positions_before_failure);
+  const WorldStepReport retried = world.step();
+  EXPECT_FALSE(retried.ok);  // the same step, taken again, fails the same way
+  EXPECT_EQ(retried.step, r.step);
+  EXPECT_EQ(world.stepCount(), r.step);
+}
+
 TEST(FemWorld, ScriptedRotationCarriesNodesExactly) {
   WorldSettings settings;
   settings.gravity.setZero();

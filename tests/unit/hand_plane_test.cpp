@@ -14,7 +14,7 @@
 #include <string>
 
 #include "torsion/bullet/fem_world.h"
-#include "torsion/constraints/hand.h"
+#include "torsion/bullet/hand.h"
 #include "torsion/mesh/box_mesh.h"
 #include "torsion/mesh/mesh_io.h"
 

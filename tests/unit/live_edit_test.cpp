@@ -6,7 +6,7 @@
 
 #include "torsion/bt_conversions.h"
 #include "torsion/bullet/fem_world.h"
-#include "torsion/constraints/hand.h"
+#include "torsion/bullet/hand.h"
 #include "torsion/mesh/box_mesh.h"
 
 namespace torsion {

@@ -13,7 +13,7 @@
 #include "device_parser.h"
 #include "scene_builder.h"
 #include "torsion/bullet/fem_world.h"
-#include "torsion/constraints/hand.h"
+#include "torsion/bullet/hand.h"
 #include "torsion/result.h"
 
 namespace torsion::python {

@@ -250,7 +250,7 @@ void FemBody::restore(const FemBodyCheckpoint& c) {
     model_ = c.model;
     stepper_.replaceModel(model_);
     for (int i = 0; i < model_->nodeCount(); ++i)
-      soft_body_->m_nodes[i].m_im = 1 / model_->nodeMasses()[static_cast<size_t>(i)];
+      soft_body_->m_nodes[i].m_im = toBtScalar(1 / model_->nodeMasses()[static_cast<size_t>(i)]);
   }
   state_ = c.state;
   external_forces_ = c.external_forces;

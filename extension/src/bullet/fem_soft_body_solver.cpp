@@ -228,7 +228,8 @@ void FemSoftBodySolver::predictMotion(btScalar solver_dt) {
 
 void FemSoftBodySolver::solveConstraints(btScalar solver_dt) {
   bullet_solver_.solveConstraints(solver_dt);
-  if (!status_.ok || bodies_.empty() || !(solver_dt > 0)) return;
+  // A substep without FEM bodies is still a step of the FEM clock (stepCount() counts substeps).
+  if (!status_.ok || !(solver_dt > 0)) return;
 
   StepContext ctx;
   ctx.time = time_;

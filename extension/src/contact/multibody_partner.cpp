@@ -70,7 +70,7 @@ Eigen::VectorXd multibodyResponse(const btMultiBody& body, const Eigen::VectorXd
   in.resize(columns);
   out.resize(columns);
   for (int c = 0; c < columns; ++c)
-    in[c] = impulse[c];
+    in[c] = toBtScalar(impulse[c]);
   body.calcAccelerationDeltasMultiDof(&in[0], &out[0], scratch_r, scratch_v);
   Eigen::VectorXd dv(columns);
   for (int c = 0; c < columns; ++c)
@@ -165,11 +165,11 @@ void MultibodyLinks::applyImpulse(const LinkImpulse& l, double dt) {
   btAlignedObjectArray<btScalar> delta;
   delta.resize(static_cast<int>(dv.size()));
   for (int c = 0; c < dv.size(); ++c)
-    delta[c] = dv[c];
+    delta[c] = toBtScalar(dv[c]);
   body.applyDeltaVeeMultiDof(&delta[0], 1);
   // Bullet integrated the positions with the velocities before the impulse; take the step with
   // them (symplectic Euler with the contact impulse inside the step, as for rigid bodies).
-  body.stepPositionsMultiDof(dt, nullptr, &delta[0]);
+  body.stepPositionsMultiDof(toBtScalar(dt), nullptr, &delta[0]);
   btAlignedObjectArray<btQuaternion> world_to_local;
   btAlignedObjectArray<btVector3> local_origin;
   world_to_local.resize(body.getNumLinks() + 1);

@@ -2,6 +2,8 @@
 
 #include <Eigen/Geometry>
 
+#include "torsion/bullet/fem_body.h"
+
 namespace torsion::haptics {
 
 namespace {
@@ -23,10 +25,7 @@ Matrix6d PatchStiffness::compute(FemBody& body, int group, const Eigen::Vector3d
 
 bool PatchStiffness::advance(FemBody& body, int group, const Eigen::Vector3d& point,
                              double tolerance, int columns) {
-  if (next_column_ == 0) {
-    partial_.setZero();
-    partial_iterations_ = 0;
-  }
+  if (next_column_ == 0) partial_.setZero();
   for (int k = 0; k < columns && next_column_ < 6; ++k, ++next_column_)
     partial_.col(next_column_) = column(body, group, point, tolerance, next_column_);
   if (next_column_ < 6) return false;
@@ -39,7 +38,6 @@ bool PatchStiffness::advance(FemBody& body, int group, const Eigen::Vector3d& po
     partial_.bottomRightCorner<3, 3>() += skew(forces.segment<3>(3 * node)) * skew(r);
   }
   matrix_ = partial_;
-  iterations_ = partial_iterations_;
   return true;
 }
 
@@ -71,8 +69,7 @@ Eigen::Matrix<double, 6, 1> PatchStiffness::column(FemBody& body, int group,
     constraints.prescribeVelocity(node, v);
   }
   Eigen::VectorXd& dv = warm_[static_cast<size_t>(c)];
-  const LinearSolveReport report = cg_.solve(system, constraints, zero_rhs_, settings, dv);
-  partial_iterations_ += report.iterations;
+  cg_.solve(system, constraints, zero_rhs_, settings, dv);
   system.multiplyStiffness(dv, stiffness_times_);
   Eigen::Matrix<double, 6, 1> out = Eigen::Matrix<double, 6, 1>::Zero();
   for (int node : grabbed) {

@@ -16,7 +16,7 @@
 #include <vector>
 
 #include "torsion/bullet/fem_world.h"
-#include "torsion/constraints/hand.h"
+#include "torsion/bullet/hand.h"
 #include "torsion/result.h"
 
 namespace torsion {

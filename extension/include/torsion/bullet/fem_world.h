@@ -75,9 +75,15 @@ class FemWorld {
   /// removed from the world nor deleted by this FemWorld; its owner must keep it alive as long.
   void trackRigidBody(btRigidBody* body);
 
-  /// One step of settings().solver.time_step. Not ok when an FEM step failed (the FEM bodies then
-  /// stay where they were and every later step reports the same failure) or a rigid body became
-  /// non-finite or overflowed (bullet/rigid_health.h).
+  /// One step of settings().solver.time_step (also with no bodies: the clock moves on). Not ok
+  /// when a rigid body became non-finite or overflowed (bullet/rigid_health.h) or an FEM step
+  /// failed. A failed FEM step is not undone (that would cost every step a checkpoint): the
+  /// bodies before the failing one in bodies() took the step; the failing one's state() holds
+  /// what its step computed (often non-finite: that is how the failure was found) while its
+  /// btSoftBody keeps the last good step; those after it did not step; the rigid bodies took the
+  /// step and the clock counts it. From then on step() moves nothing and reports the same
+  /// failure. To go back, restore() a checkpoint taken before the failed step (it clears the
+  /// failure too).
   WorldStepReport step();
 
   /// Live edit between steps (the viewer's dt and solver keys): the next steps use `solver`

@@ -30,7 +30,7 @@
 #include <limits>
 #include <string>
 
-#include "torsion/constraints/hand.h"
+#include "torsion/bullet/hand.h"
 #include "torsion/device/device_types.h"
 #include "torsion/haptics/device_mapping.h"
 #include "torsion/haptics/patch_stiffness.h"

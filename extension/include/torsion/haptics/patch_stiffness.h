@@ -14,9 +14,12 @@
 #include <Eigen/Core>
 #include <vector>
 
-#include "torsion/bullet/fem_body.h"
 #include "torsion/haptics/device_mapping.h"
 #include "torsion/solve/projected_cg.h"
+
+namespace torsion {
+class FemBody;  // torsion/bullet/fem_body.h
+}  // namespace torsion
 
 namespace torsion::haptics {
 
@@ -34,8 +37,6 @@ class PatchStiffness {
   /// Abandons a refresh under way (the grabbed patch changed).
   void reset() { next_column_ = 0; }
   const Matrix6d& matrix() const { return matrix_; }
-  /// Total CG iterations of the last complete refresh.
-  int lastIterations() const { return iterations_; }
 
  private:
   Eigen::Matrix<double, 6, 1> column(FemBody& body, int group, const Eigen::Vector3d& point,
@@ -44,7 +45,6 @@ class PatchStiffness {
   ProjectedCg cg_;
   std::vector<Eigen::VectorXd> warm_;  // last solution per column
   Eigen::VectorXd zero_rhs_, stiffness_times_;
-  int iterations_ = 0, partial_iterations_ = 0;
   int next_column_ = 0;  // 0: no refresh under way
   Matrix6d partial_ = Matrix6d::Zero(), matrix_ = Matrix6d::Zero();
 };

@@ -9,6 +9,7 @@
 #include <tbb/task_arena.h>
 
 #include <atomic>
+#include <cstddef>
 #include <cstdint>
 #include <memory>
 
@@ -32,7 +33,7 @@ class Parallel {
     }
     split_calls_.fetch_add(1, std::memory_order_relaxed);
     arena_->execute([&] {
-      tbb::parallel_for(tbb::blocked_range<int>(0, n, grain),
+      tbb::parallel_for(tbb::blocked_range<int>(0, n, static_cast<std::size_t>(grain)),
                         [&](const tbb::blocked_range<int>& r) { fn(r.begin(), r.end()); });
     });
   }

@@ -1,4 +1,4 @@
-#include "torsion/constraints/hand.h"
+#include "torsion/bullet/hand.h"
 
 #include <algorithm>
 #include <cassert>

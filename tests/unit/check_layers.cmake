@@ -1,0 +1,70 @@
+# Fails when a file of extension/ includes from its own layer's peers or from a layer above it.
+# The order is docs/architecture.md's (its line "layers: mesh < fem < ..."), so the page and the
+# code cannot drift apart. Usage:
+#   cmake -DROOT=<source dir> [-DDOC=<page with the layers line>] -P check_layers.cmake
+# ROOT holds extension/include/torsion and/or extension/src; each file's module is the folder
+# under those. Only "torsion/<module>/..." includes are checked: `torsion/*.h` (result.h,
+# format_number.h, bt_conversions.h) and the device target (torsion/device/) sit below everything.
+if(NOT DEFINED ROOT)
+  message(FATAL_ERROR "check_layers: pass -DROOT=<source dir>")
+endif()
+if(NOT DEFINED DOC)
+  set(DOC "${ROOT}/docs/architecture.md")
+endif()
+
+file(STRINGS "${DOC}" order_lines REGEX "^layers: ")
+list(LENGTH order_lines n)
+if(NOT n EQUAL 1)
+  message(FATAL_ERROR "check_layers: ${DOC} must have exactly one line \"layers: a < b, c < ...\"")
+endif()
+string(REGEX REPLACE "^layers: " "" order "${order_lines}")
+string(REPLACE " " "" order "${order}")
+string(REPLACE "<" ";" layers "${order}")
+set(level 1)
+foreach(layer IN LISTS layers)
+  string(REPLACE "," ";" peers "${layer}")
+  foreach(module IN LISTS peers)
+    set(level_of_${module} ${level})
+  endforeach()
+  math(EXPR level "${level} + 1")
+endforeach()
+set(level_of_device 0)
+
+file(GLOB_RECURSE files LIST_DIRECTORIES false
+     "${ROOT}/extension/include/torsion/*.h" "${ROOT}/extension/src/*.h"
+     "${ROOT}/extension/src/*.cpp")
+set(violations "")
+foreach(file IN LISTS files)
+  file(RELATIVE_PATH rel "${ROOT}" "${file}")
+  if(NOT rel MATCHES "^extension/(include/torsion|src)/([a-z_0-9]+)/")
+    set(module "")  # torsion/*.h: the bottom, includes no module
+    set(level 0)
+  else()
+    set(module "${CMAKE_MATCH_2}")
+    if(NOT DEFINED level_of_${module})
+      list(APPEND violations "${rel}: module '${module}' is not in the layers line of ${DOC}")
+      continue()
+    endif()
+    set(level ${level_of_${module}})
+  endif()
+  file(STRINGS "${file}" includes REGEX "^[ \t]*#[ \t]*include[ \t]*[<\"]torsion/[a-z_0-9]+/")
+  foreach(line IN LISTS includes)
+    string(REGEX MATCH "torsion/([a-z_0-9]+)/" _ "${line}")
+    set(target "${CMAKE_MATCH_1}")
+    if(target STREQUAL module)
+      continue()
+    endif()
+    if(NOT DEFINED level_of_${target})
+      list(APPEND violations "${rel}: includes module '${target}', which is not in the layers line")
+    elseif(NOT level_of_${target} LESS level)
+      list(APPEND violations "${rel}: '${module}' includes from '${target}', not below it: ${line}")
+    endif()
+  endforeach()
+endforeach()
+
+list(LENGTH files checked)
+if(violations)
+  list(JOIN violations "\n  " text)
+  message(FATAL_ERROR "check_layers: includes against the layer order (${order}):\n  ${text}")
+endif()
+message(STATUS "check_layers: ${checked} files follow ${order}")
