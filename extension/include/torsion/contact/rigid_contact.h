@@ -177,25 +177,54 @@ class RigidContactSolver {
   void restoreCarriedContacts(const CarriedContacts& carried);
 
  private:
+  // detect's stages (rigid_contact_detection.cpp).
+  void rememberActiveContacts();
+  void forgetLastStep(double dt);
+  void findContacts(const FemState& state, const NodeConstraints& constraints, double dt);
+  void addNodeContact(const FemState& state, const NodeConstraints& constraints,
+                      const btCollisionObject& object, const btTransform& transform, int node,
+                      double reach, double dt);
+  void addAnchorContacts(const FemState& state, const NodeConstraints& constraints);
+  void dropUntouchedPartners();
+  void warmStartActiveSet();
+  void recordDetectionStats();
   int partnerIndex(const btCollisionObject* object);
   void chooseSupportPlane(const btCollisionShape& shape, const btTransform& transform,
                           const Eigen::Vector3d& x, const Eigen::Vector3d& node_velocity,
                           const Eigen::Vector3d& into_surface, double dt, NodeContact& c) const;
   btTransform startPoseOf(const btCollisionObject& object) const;
   void recordAnchorStartPoses();  // node_anchors.cpp
-  void addAnchorContacts(const FemState& state, const NodeConstraints& constraints);
+
+  // solve's stages (rigid_contact.cpp; the reduced system in rigid_contact_reduced_system.cpp).
+  void numberRigidUnknowns();
+  void warmStart(const Eigen::VectorXd& v);
+  void setFacePenalties(const SystemOperator& op);
+  void markDeterminedFaces();
+  void assembleRightHandSide(const SystemOperator& op, const Eigen::VectorXd& b);
+  void projectWarmStart();
+  void buildPreconditioner(const SystemOperator& op);
+  LinearSolveReport conjugateGradient(const SystemOperator& op, const Eigen::VectorXd& reduced_rhs,
+                                      const SolverSettings& settings, Eigen::VectorXd& q);
+  void accumulate(const LinearSolveReport& r, LinearSolveReport& total);
+  /// v, the rigid velocities and the node constraints' impulses (product_) from the solution q_.
+  void recoverSolution(const SystemOperator& op, Eigen::VectorXd& v);
+  /// Node and face contact states after a solve; whether any changed (another solve is needed).
+  bool updateContactStates(const Eigen::VectorXd& v);
+  void collectImpulses();
+  void solveHeld(const Eigen::VectorXd& v, double dt);  // rigid_contact_held.cpp
+  void measureEndGaps(const Eigen::VectorXd& v);
+
+  // The reduced system q = (u, V) (rigid_contact_reduced_system.cpp).
   void expand(const Eigen::VectorXd& q, Eigen::VectorXd& v) const;
   void contract(const Eigen::VectorXd& y, const Eigen::VectorXd& rigid_part,
                 Eigen::VectorXd& q) const;
   void applyOperator(const SystemOperator& op, const Eigen::VectorXd& q, Eigen::VectorXd& out);
-  void buildPreconditioner(const SystemOperator& op);
   void precondition(const Eigen::VectorXd& r, Eigen::VectorXd& z) const;
-  LinearSolveReport conjugateGradient(const SystemOperator& op, const Eigen::VectorXd& reduced_rhs,
-                                      const SolverSettings& settings, Eigen::VectorXd& q);
+
+  // The active set (rigid_contact_active_set.cpp).
   /// `p`: the node constraints' impulses (Coulomb's bounds: each scaled by its partner's
   /// friction_share).
   bool updateActiveSet(const Eigen::VectorXd& v, const Eigen::VectorXd& p, double dt);
-  void solveHeld(const Eigen::VectorXd& v, double dt);
   /// Each partner's friction_share from the solve just done (node impulses in product_).
   void measureFrictionShares();
 
@@ -221,6 +250,8 @@ class RigidContactSolver {
   std::vector<Eigen::Matrix3d> block_inverse_;
   std::vector<Eigen::Matrix<double, 6, 6>> rigid_inverse_;
   Eigen::VectorXd v_c_, scratch_, product_, r_, reduced_rhs_, q_, rigid_scratch_, b_solve_;
+  Eigen::VectorXd b_friction_;  // b plus the sliding node contacts' friction impulses
+  Eigen::VectorXd rigid_rhs_;   // the rigid unknowns' part of the right-hand side
   PcgScratch cg_;
 };
 

@@ -1,0 +1,153 @@
+// The active set of the FEM-rigid node contacts (docs/contact.md, "Active set and Coulomb
+// friction"): release, activation and the stick/slide switches by Coulomb's law, with the
+// anti-cycling bounds, and each rigid body's friction share.
+
+#include <algorithm>
+#include <cmath>
+
+#include "torsion/contact/rigid_contact.h"
+
+namespace torsion {
+
+namespace {
+
+constexpr int kMaxSlipsPerStep = 2;
+constexpr int kMaxFrictionRefinements = 8;
+
+}  // namespace
+
+bool RigidContactSolver::updateActiveSet(const Eigen::VectorXd& v, const Eigen::VectorXd& p,
+                                         double dt) {
+  bool changed = false;
+  const std::vector<double>& mass = model_->nodeMasses();
+  // Impulses below this are CG noise: a part in 1e4 of the largest one, or a micrometre per
+  // second of the node's own momentum.
+  double largest = 0;
+  for (const NodeContact& c : contacts_) {
+    if (!c.held && c.state != NodeContact::State::kInactive)
+      largest = std::max(largest, std::abs(c.normal.dot(p.segment<3>(3 * c.node))));
+  }
+  for (NodeContact& c : contacts_) {
+    if (c.held || c.anchored) continue;  // an anchor sticks for good
+    const RigidPartner& k = partners_[static_cast<size_t>(c.partner)];
+    const Eigen::Vector3d vi = v.segment<3>(3 * c.node);
+    const Eigen::Vector3d pi = p.segment<3>(3 * c.node);
+    const double noise = std::max(1e-4 * largest, 1e-6 * mass[static_cast<size_t>(c.node)]);
+    const Eigen::Vector3d rigid_v = pointVelocity(k.velocity, c.lever);
+    switch (c.state) {
+      case NodeContact::State::kInactive: {
+        const double gap_end = c.gap + dt * c.normal.dot(vi - rigid_v);
+        if (gap_end < -settings_.activation_tolerance) {
+          // A node the rigid body sweeps over (held by the supporting plane, chooseSupportPlane)
+          // starts sliding when it slips; its friction follows from the next solve's normal
+          // impulse. Starting it stuck stopped a sliding body at each node row (docs/contact.md,
+          // "Sliding over nodes"). Other contacts start stuck: a landing body's contacts slip
+          // too (Poisson), and starting those sliding kept a box on a tet10 slab from settling.
+          Eigen::Vector3d slip = vi - rigid_v;
+          slip -= c.normal * c.normal.dot(slip);
+          const bool slipping = c.swept && dt * slip.norm() > settings_.activation_tolerance;
+          c.state =
+              c.friction > 0 && !slipping ? NodeContact::State::kStick : NodeContact::State::kSlide;
+          c.friction_impulse.setZero();
+          changed = true;
+        }
+        break;
+      }
+      case NodeContact::State::kStick: {
+        const double lambda = c.normal.dot(pi);
+        const Eigen::Vector3d pt = pi - c.normal * lambda;
+        if (lambda < -noise && c.releases == 0) {
+          c.state = NodeContact::State::kInactive;
+          ++c.releases;
+          changed = true;
+        } else if (pt.norm() > k.friction_share * c.friction * std::max(lambda, 0.0) + noise &&
+                   c.slips < kMaxSlipsPerStep) {
+          // Anti-cycling, as for releases: in a body pressed between two surfaces the nodes'
+          // tangential and normal impulses are coupled through the body, and per-node stick/slide
+          // switching can cycle. After kMaxSlipsPerStep slips in a step a contact stays stuck for
+          // the rest of the step (its friction may then exceed mu lambda for that step; it is
+          // re-examined from the next step on). Letting it slide instead (sticking bounded)
+          // let a block below the friction angle creep 12 mm in 1 s.
+          ++c.slips;
+          c.state = NodeContact::State::kSlide;
+          c.friction_impulse =
+              k.friction_share * c.friction * std::max(lambda, 0.0) * pt.normalized();
+          changed = true;
+        }
+        break;
+      }
+      case NodeContact::State::kSlide: {
+        const double lambda = c.normal.dot(pi);
+        if (lambda < -noise && c.releases == 0) {
+          c.state = NodeContact::State::kInactive;
+          ++c.releases;
+          c.friction_impulse.setZero();
+          changed = true;
+          break;
+        }
+        if (c.friction <= 0) break;
+        Eigen::Vector3d slip = vi - rigid_v;
+        slip -= c.normal * c.normal.dot(slip);
+        const double speed = slip.norm();
+        const double bound = k.friction_share * c.friction * std::max(c.normal.dot(pi), 0.0);
+        if (speed < 1e-9 || (c.friction_impulse.norm() > 0 && slip.dot(c.friction_impulse) > 0)) {
+          // The slip stopped or turned along the friction: the friction was too strong. If it
+          // exceeds mu lambda of this very solve it was stale (set from an earlier, larger
+          // normal impulse: pressing a soft body, its normal and tangential impulses are coupled
+          // by the Poisson effect): bring it down to mu lambda and solve again. Sticking on a
+          // stale friction and sliding again on the stick's tangential impulse was the cycle of
+          // the kinematic press (docs/contact.md). Friction within its bound that stops the
+          // slip: stick.
+          const double magnitude = c.friction_impulse.norm();
+          if (magnitude > bound + noise) {
+            c.friction_impulse *= bound / magnitude;
+            changed = true;
+            break;
+          }
+          c.state = NodeContact::State::kStick;
+          c.friction_impulse.setZero();
+          changed = true;
+          break;
+        }
+        // Under-relaxed: lambda itself depends on the friction (coupled through the body), and
+        // the plain fixed point f = mu lambda(f) can oscillate; half steps converge.
+        const Eigen::Vector3d target = -bound * slip / speed;
+        const Eigen::Vector3d f = c.friction_impulse.norm() > 0
+                                      ? Eigen::Vector3d(0.5 * (target + c.friction_impulse))
+                                      : target;
+        // Each refinement is a CG solve; after kMaxFrictionRefinements a slip that keeps its
+        // state no longer holds the loop open (the friction still follows mu lambda).
+        if ((target - c.friction_impulse).norm() > 1e-2 * (target.norm() + noise) &&
+            c.friction_refinements++ < kMaxFrictionRefinements)
+          changed = true;
+        c.friction_impulse = f;
+        break;
+      }
+    }
+  }
+  return changed;
+}
+
+void RigidContactSolver::measureFrictionShares() {
+  // The split of a body's load between a face contact and the node contacts at its corners is
+  // not unique where both hold the same motion: on a stiff slab they share it as a push and a
+  // pull, and Coulomb bounds taken per contact from the pushes alone gave the body far more
+  // friction than mu times its net normal impulse (docs/contact.md, "Sliding over nodes").
+  std::vector<double> push(partners_.size(), 0.0), net(partners_.size(), 0.0);
+  for (const NodeContact& c : contacts_) {
+    if (c.held || c.state == NodeContact::State::kInactive) continue;
+    const double lambda = c.normal.dot(product_.segment<3>(3 * c.node));
+    push[static_cast<size_t>(c.partner)] += std::max(lambda, 0.0);
+    net[static_cast<size_t>(c.partner)] += lambda;
+  }
+  for (const FaceContact& c : faces_.contacts()) {
+    if (c.state == FaceContact::State::kInactive || c.determined) continue;
+    const double lambda = c.normal.dot(c.impulse);
+    push[static_cast<size_t>(c.partner)] += std::max(lambda, 0.0);
+    net[static_cast<size_t>(c.partner)] += lambda;
+  }
+  for (size_t k = 0; k < partners_.size(); ++k)
+    partners_[k].friction_share = push[k] > 0 ? std::clamp(net[k] / push[k], 0.0, 1.0) : 1.0;
+}
+
+}  // namespace torsion

@@ -1,0 +1,293 @@
+// Narrow phase of the FEM-rigid contact (docs/contact.md, "Narrow phase"): the candidate objects
+// of Bullet's broadphase against the body's node tree and surface triangles, each touched object
+// made a partner of the solve, and the warm active set carried over from the last step.
+
+#include <BulletCollision/BroadphaseCollision/btDbvt.h>
+#include <BulletCollision/BroadphaseCollision/btDispatcher.h>
+#include <BulletCollision/NarrowPhaseCollision/btPersistentManifold.h>
+#include <LinearMath/btTransformUtil.h>
+
+#include <Eigen/Dense>
+#include <algorithm>
+#include <cmath>
+
+#include "torsion/bt_conversions.h"
+#include "torsion/contact/rigid_contact.h"
+#include "torsion/contact/shape_distance.h"
+
+namespace torsion {
+
+namespace {
+
+// m: a supporting plane replaces the nearest feature's only if it leaves a larger predicted end
+// gap by more than round-off (at rest the two agree).
+constexpr double kPlaneChoiceMargin = 1e-9;
+
+// Collects the soft body's nodes whose tree leaves overlap a volume.
+struct NodeCollector : btDbvt::ICollide {
+  explicit NodeCollector(const btSoftBody& sb) : first(&sb.m_nodes[0]) {}
+  void Process(const btDbvtNode* leaf) override {
+    nodes.push_back(static_cast<int>(static_cast<const btSoftBody::Node*>(leaf->data) - first));
+  }
+  const btSoftBody::Node* first;
+  std::vector<int> nodes;
+};
+
+// The object's pose at the start of the step. Bullet has already moved dynamic bodies by their
+// velocity (stage 3) and kinematic ones to their scripted end pose (saveKinematicState); both
+// moved by exactly integrateTransform(start, v, omega, dt), which we invert.
+btTransform startPose(const btCollisionObject& object, double dt) {
+  const btRigidBody* body = btRigidBody::upcast(&object);
+  // Kinematic first: a mass-0 body made kinematic (Bullet's own recipe) keeps CF_STATIC_OBJECT
+  // too, yet Bullet has moved it to its end pose. Taking that pose as the start pose shifted the
+  // plate by one step's motion: nodes lagged a step behind a pressing plate and, when it stopped,
+  // were taken as separating and dropped (docs/contact.md, the kinematic press).
+  if (body == nullptr || (!body->isKinematicObject() && body->isStaticObject()))
+    return object.getWorldTransform();
+  btTransform start;
+  btTransformUtil::integrateTransform(object.getWorldTransform(), -body->getLinearVelocity(),
+                                      -body->getAngularVelocity(), toBtScalar(dt), start);
+  return start;
+}
+
+// Whether Bullet's contact manifolds hold `body` against a static or kinematic object.
+bool touchesStaticOrKinematic(const btRigidBody& body, btSoftBody& soft) {
+  btDispatcher* dispatcher = soft.getWorldInfo()->m_dispatcher;
+  if (dispatcher == nullptr) return false;
+  for (int m = 0; m < dispatcher->getNumManifolds(); ++m) {
+    const btPersistentManifold* manifold = dispatcher->getManifoldByIndexInternal(m);
+    const btCollisionObject* other = nullptr;
+    if (manifold->getBody0() == &body) other = manifold->getBody1();
+    if (manifold->getBody1() == &body) other = manifold->getBody0();
+    if (other == nullptr || !other->isStaticOrKinematicObject()) continue;
+    for (int c = 0; c < manifold->getNumContacts(); ++c) {
+      if (manifold->getContactPoint(c).getDistance() <= manifold->getContactProcessingThreshold())
+        return true;
+    }
+  }
+  return false;
+}
+
+}  // namespace
+
+btTransform RigidContactSolver::startPoseOf(const btCollisionObject& object) const {
+  if (std::optional<btTransform> pose = links_.startPose(object)) return *pose;
+  return startPose(object, dt_);
+}
+
+int RigidContactSolver::partnerIndex(const btCollisionObject* object) {
+  for (size_t k = 0; k < partners_.size(); ++k) {
+    if (partners_[k].object == object) return static_cast<int>(k);
+  }
+  RigidPartner p;
+  p.object = object;
+  p.body = const_cast<btRigidBody*>(btRigidBody::upcast(object));
+  if (p.body != nullptr) {
+    p.entry_velocity << toEigen(p.body->getLinearVelocity()), toEigen(p.body->getAngularVelocity());
+    p.dynamic = !p.body->isStaticOrKinematicObject() && p.body->getInvMass() > 0;
+  }
+  p.com = toEigen(startPoseOf(*object).getOrigin());
+  links_.describe(object, p);
+  if (p.dynamic && p.body != nullptr) {
+    p.mass = 1.0 / toDouble(p.body->getInvMass());
+    p.inverse_inertia = toEigen(p.body->getInvInertiaTensorWorld());
+    // A zero inverse inertia component (locked rotation) has no inverse: keep it rigid.
+    Eigen::Matrix3d regular = p.inverse_inertia;
+    regular.diagonal().array() += 1e-12 * std::max(1.0, regular.norm());
+    p.inertia = regular.inverse();
+    p.mass_matrix.setZero();
+    p.mass_matrix.topLeftCorner<3, 3>() = p.mass * Eigen::Matrix3d::Identity();
+    p.mass_matrix.bottomRightCorner<3, 3>() = p.inertia;
+    p.inverse_mass_matrix.setZero();
+    p.inverse_mass_matrix.topLeftCorner<3, 3>() = Eigen::Matrix3d::Identity() / p.mass;
+    p.inverse_mass_matrix.bottomRightCorner<3, 3>() = p.inverse_inertia;
+    if (touchesStaticOrKinematic(*p.body, *soft_body_)) {
+      p.dynamic = false;
+      p.supported = true;
+    }
+  }
+  p.velocity = p.entry_velocity;
+  partners_.push_back(p);
+  return static_cast<int>(partners_.size()) - 1;
+}
+
+void RigidContactSolver::chooseSupportPlane(const btCollisionShape& shape,
+                                            const btTransform& transform, const Eigen::Vector3d& x,
+                                            const Eigen::Vector3d& node_velocity,
+                                            const Eigen::Vector3d& into_surface, double dt,
+                                            NodeContact& c) const {
+  // The contact is linearised on one supporting plane of the (convex) rigid shape: the node must
+  // end the step outside it. The nearest feature's plane is exact at the start of the step but
+  // not over it: a node on a flat surface just ahead of a sliding box sees the box's front face
+  // (a horizontal normal), and the linearised end gap along it, d - v dt, stops the box at the
+  // node as at a wall, although the box's bottom edge would pass over it (docs/contact.md,
+  // "Sliding over nodes"). The supporting plane facing the soft surface (normal minus the node's
+  // surface normal: the bottom face's plane for a box on a slab) is as valid a bound. Of the two,
+  // the one the predicted motion (the node's velocity, the rigid body's velocity after Bullet's
+  // integration) leaves the larger end gap is taken. At rest they agree or the nearest wins: a
+  // supporting plane never measures more than the distance.
+  const RigidPartner& k = partners_[static_cast<size_t>(c.partner)];
+  if (into_surface.squaredNorm() == 0) return;
+  const std::optional<SurfacePoint> plane = supportPlaneDistance(shape, transform, x, into_surface);
+  if (!plane) return;
+  // Where the node would touch the plane: its foot on the plane, moved onto the shape.
+  const Eigen::Vector3d foot = x - plane->distance * plane->normal;
+  const std::optional<SurfacePoint> onto = signedDistance(shape, transform, foot, 0);
+  const Eigen::Vector3d contact_point =
+      onto ? Eigen::Vector3d(foot - onto->distance * onto->normal) : foot;
+  const Eigen::Vector3d lever = contact_point - k.com;
+  // Only the motion along the plane predicts which side the node ends on: across it, the rigid
+  // body's predicted velocity carries the step's gravity, which the contacts under it cancel.
+  Eigen::Vector3d slip = node_velocity - pointVelocity(k.entry_velocity, c.lever);
+  slip -= plane->normal * plane->normal.dot(slip);
+  const double end_nearest = c.gap + dt * c.normal.dot(slip);
+  const double end_plane = plane->distance;
+  if (end_plane <= end_nearest + kPlaneChoiceMargin) return;
+  c.normal = plane->normal;
+  c.gap = plane->distance;
+  c.lever = lever;
+  c.swept = true;
+}
+
+void RigidContactSolver::rememberActiveContacts() {
+  // Last step's active contacts start this step active (warm active set).
+  previous_active_.clear();
+  previous_state_.clear();
+  for (const NodeContact& c : contacts_) {
+    if (c.state != NodeContact::State::kInactive && !c.held) {
+      previous_active_.emplace_back(c.node, partners_[static_cast<size_t>(c.partner)].object);
+      previous_state_.push_back(c.state);
+    }
+  }
+}
+
+void RigidContactSolver::forgetLastStep(double dt) {
+  for (const NodeContact& c : contacts_) {
+    if (c.node >= 0 && !c.held) node_contact_[static_cast<size_t>(c.node)] = -1;
+  }
+  faces_.beginStep(partners_);
+  contacts_.clear();
+  partners_.clear();
+  stats_ = ContactStepStats{};
+  dt_ = dt;
+  dynamic_count_ = 0;
+}
+
+void RigidContactSolver::findContacts(const FemState& state, const NodeConstraints& constraints,
+                                      double dt) {
+  const btSoftBody& sb = *soft_body_;
+  const double margin = sb.getCollisionShape()->getMargin();
+  double max_node_speed = 0;
+  for (int i = 0; i < model_->nodeCount(); ++i)
+    max_node_speed = std::max(max_node_speed, state.velocity(i).norm());
+
+  // A triangle that overlaps an object's box has its nodes within the longest edge of it.
+  const double longest_edge = faces_.longestEdge(state);
+  for (const btCollisionObject* object : candidates_) {
+    const btCollisionShape* shape = object->getCollisionShape();
+    const btTransform transform = startPoseOf(*object);
+    const btRigidBody* body = btRigidBody::upcast(object);
+    double rigid_speed = 0;
+    btVector3 lo, hi;
+    shape->getAabb(transform, lo, hi);
+    if (body != nullptr) {
+      const double radius = 0.5 * toDouble((hi - lo).length());
+      rigid_speed = toDouble(body->getLinearVelocity().length()) +
+                    toDouble(body->getAngularVelocity().length()) * std::min(radius, 1e6);
+    } else {
+      rigid_speed = MultibodyLinks::speedBound(*object, 0.5 * toDouble((hi - lo).length()));
+    }
+    // Anything that can close the gap within the step, twice over, plus the soft margin.
+    const double reach = 2 * dt * (max_node_speed + rigid_speed) + 4 * margin;
+    const btVector3 pad = toBt(Eigen::Vector3d::Constant(reach));
+    const btVector3 face_pad = pad + toBt(Eigen::Vector3d::Constant(longest_edge));
+    NodeCollector collector(sb);
+    sb.m_ndbvt.collideTV(sb.m_ndbvt.m_root, btDbvtVolume::FromMM(lo - face_pad, hi + face_pad),
+                         collector);
+    const Eigen::Vector3d node_lo = toEigen(lo - pad), node_hi = toEigen(hi + pad);
+    for (int i : collector.nodes) {
+      if (!surface_[static_cast<size_t>(i)]) continue;
+      if (anchors_.anchored(i) && constraints.kind(i) != NodeConstraints::Kind::kFull) continue;
+      const Eigen::Vector3d x = state.position(i);
+      if ((x.array() < node_lo.array()).any() || (x.array() > node_hi.array()).any()) continue;
+      addNodeContact(state, constraints, *object, transform, i, reach, dt);
+    }
+    const int partner = partnerIndex(object);
+    faces_.detect(state, constraints, collector.nodes, *shape, transform, toEigen(lo), toEigen(hi),
+                  reach, dt, partner, partners_[static_cast<size_t>(partner)],
+                  settings_.friction * toDouble(object->getFriction()));
+  }
+}
+
+void RigidContactSolver::addNodeContact(const FemState& state, const NodeConstraints& constraints,
+                                        const btCollisionObject& object,
+                                        const btTransform& transform, int i, double reach,
+                                        double dt) {
+  const btSoftBody& sb = *soft_body_;
+  const btCollisionShape& shape = *object.getCollisionShape();
+  const Eigen::Vector3d x = state.position(i);
+  std::optional<SurfacePoint> sp =
+      signedDistance(shape, transform, x, reach, -toEigen(sb.m_nodes[i].m_n));
+  if (!sp) return;
+  const bool held = constraints.kind(i) == NodeConstraints::Kind::kFull;
+  // Every node within reach is a candidate, separating or not: the active set decides.
+  // Filtering by the start-of-step closing speed dropped nodes of a compressed body that were
+  // moving away but sprang back within the implicit step (the kinematic press).
+  NodeContact c;
+  c.node = i;
+  c.partner = partnerIndex(&object);
+  c.normal = sp->normal;
+  c.gap = sp->distance;
+  c.distance = sp->distance;
+  c.lever = x - sp->distance * sp->normal - partners_[static_cast<size_t>(c.partner)].com;
+  c.friction = settings_.friction * toDouble(object.getFriction());
+  c.held = held;
+  chooseSupportPlane(shape, transform, x, state.velocity(i), -toEigen(sb.m_nodes[i].m_n), dt, c);
+  // One contact per free node: the deepest.
+  if (!held) {
+    int& slot = node_contact_[static_cast<size_t>(i)];
+    if (slot >= 0) {
+      if (contacts_[static_cast<size_t>(slot)].distance <= c.distance) return;
+      contacts_[static_cast<size_t>(slot)] = c;
+      return;
+    }
+    slot = static_cast<int>(contacts_.size());
+  }
+  contacts_.push_back(c);
+}
+
+void RigidContactSolver::dropUntouchedPartners() {
+  // A candidate object that nothing touches keeps Bullet's velocity untouched: not an unknown.
+  std::vector<char> touched(partners_.size(), 0);
+  for (const NodeContact& c : contacts_)
+    touched[static_cast<size_t>(c.partner)] = 1;
+  for (const FaceContact& c : faces_.contacts())
+    touched[static_cast<size_t>(c.partner)] = 1;
+  for (size_t k = 0; k < partners_.size(); ++k) {
+    if (!touched[k]) partners_[k].dynamic = partners_[k].supported = false;
+  }
+}
+
+void RigidContactSolver::warmStartActiveSet() {
+  for (NodeContact& c : contacts_) {
+    if (c.held || c.anchored) continue;
+    for (size_t k = 0; k < previous_active_.size(); ++k) {
+      if (previous_active_[k].first == c.node &&
+          previous_active_[k].second == partners_[static_cast<size_t>(c.partner)].object) {
+        c.state = c.friction > 0 ? previous_state_[k] : NodeContact::State::kSlide;
+      }
+    }
+  }
+}
+
+void RigidContactSolver::recordDetectionStats() {
+  stats_.candidates = static_cast<int>(contacts_.size());
+  stats_.face_candidates = static_cast<int>(faces_.contacts().size());
+  for (const NodeContact& c : contacts_) {
+    if (!c.anchored) stats_.max_penetration = std::max(stats_.max_penetration, -c.distance);
+  }
+  for (const FaceContact& c : faces_.contacts())
+    stats_.max_penetration = std::max(stats_.max_penetration, -c.gap);
+}
+
+}  // namespace torsion
