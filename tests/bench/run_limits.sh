@@ -9,7 +9,9 @@
 #   BUILD        build directory with bench_twist, bench_bullet_demos, machine_probe, torsion [build]
 #   STEPS, RAMP  twist protocol: total steps and ramp steps [200, 100]
 #   BIG_TETS     tets of the generated large cylinder [125000]
+#   BIG_MESH_DIR where it is generated (kept between runs) [RESULTS_DIR]
 #   BULLET_BIG_STEPS  Bullet runs only the first steps of the protocol on the large mesh [20]
+#   BULLET_SLOW_STEPS  ...and on the 31558 mesh and at E = 1e7 (3-4 steps/s) [60]
 # Writes RESULTS_DIR/machine.txt (machine, load, commit, command), machine_probe.json,
 # raw.jsonl (one line per run), summary.md (the table).
 set -euo pipefail
@@ -21,6 +23,7 @@ STEPS=${STEPS:-200}
 RAMP=${RAMP:-100}
 BIG_TETS=${BIG_TETS:-125000}
 BULLET_BIG_STEPS=${BULLET_BIG_STEPS:-20}
+BULLET_SLOW_STEPS=${BULLET_SLOW_STEPS:-60}
 BT=$BUILD/tests/bench/bench_twist
 for exe in "$BT" "$BUILD/tests/bench/bench_bullet_demos" "$BUILD/tests/bench/machine_probe" \
            "$BUILD/demos/torsion"; do
@@ -41,7 +44,7 @@ RAW=$OUT/raw.jsonl
 "$BUILD/tests/bench/machine_probe" >"$OUT/machine_probe.json"
 
 # The large cylinder is generated, not committed (tetgen through the project's mesh tool).
-BIG=$OUT/cylinder_$BIG_TETS
+BIG=${BIG_MESH_DIR:-$OUT}/cylinder_$BIG_TETS
 if [[ ! -f $BIG.node ]]; then
   "$BUILD/demos/torsion" mesh cylinder --radius 1 --length 10 --tets "$BIG_TETS" -o "$BIG.node" \
       >"$OUT/mesh.log" 2>&1
@@ -63,7 +66,7 @@ M=$ROOT/assets/meshes
 run "tet4 8332, 1 thread" ours --solver torsion-cg --mesh $M/cylinder_8332 --threads 1 $P
 run "tet4 8332, 1 thread" bullet --solver bullet-implicit --mesh $M/cylinder_8332 $P
 run "tet4 31558, 2 threads" ours --solver torsion-cg --mesh $M/cylinder_31558 --threads 2 $P
-run "tet4 31558, 2 threads" bullet --solver bullet-implicit --mesh $M/cylinder_31558 $P
+run "tet4 31558, 2 threads" bullet --solver bullet-implicit --mesh $M/cylinder_31558 --steps "$BULLET_SLOW_STEPS" --ramp-steps $RAMP
 run "tet10 8332, 2 threads" ours --solver torsion-cg --element tet10 --mesh $M/cylinder_8332 --threads 2 $P
 run "tet10 8332, 2 threads" ours-two_level --solver torsion-cg --element tet10 --preconditioner two_level --mesh $M/cylinder_8332 --threads 2 $P
 run "tet10 8332, 2 threads" ours-1-thread --solver torsion-cg --element tet10 --mesh $M/cylinder_8332 --threads 1 $P
@@ -72,7 +75,7 @@ run "tet4 ${BIG_TETS}, 2 threads" bullet --solver bullet-implicit --mesh "$BIG" 
 for pc in block_jacobi lagged_cholesky incomplete_cholesky; do
   run "E 1e7 8332, 1 thread" "ours-$pc" --solver torsion-cg --preconditioner $pc --E 1e7 --mesh $M/cylinder_8332 --threads 1 $P
 done
-run "E 1e7 8332, 1 thread" bullet --solver bullet-implicit --E 1e7 --mesh $M/cylinder_8332 $P
+run "E 1e7 8332, 1 thread" bullet --solver bullet-implicit --E 1e7 --mesh $M/cylinder_8332 --steps "$BULLET_SLOW_STEPS" --ramp-steps $RAMP
 run "fast hand 8332 (+-45 deg at 2 Hz), 1 thread" ours --solver torsion-cg --mesh $M/cylinder_8332 --threads 1 --oscillate-hz 2 --amplitude 0.7853981633974483 --steps $STEPS
 run "fast hand 8332 (+-45 deg at 2 Hz), 1 thread" bullet --solver bullet-implicit --mesh $M/cylinder_8332 --oscillate-hz 2 --amplitude 0.7853981633974483 --steps $STEPS
 # Drop impact: a scene through both engines' worlds (contact with the ground on both sides).
