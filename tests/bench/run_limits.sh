@@ -33,7 +33,7 @@ mkdir -p "$OUT"
 RAW=$OUT/raw.jsonl
 : >"$RAW"
 {
-  echo "command: bash tests/bench/run_limits.sh $OUT (STEPS=$STEPS RAMP=$RAMP BIG_TETS=$BIG_TETS BULLET_BIG_STEPS=$BULLET_BIG_STEPS)"
+  echo "command: bash tests/bench/run_limits.sh $OUT (STEPS=$STEPS RAMP=$RAMP BIG_TETS=$BIG_TETS BULLET_BIG_STEPS=$BULLET_BIG_STEPS BULLET_SLOW_STEPS=$BULLET_SLOW_STEPS)"
   echo "date: $(date -u +%FT%TZ)"
   echo "commit: $(git -C "$ROOT" rev-parse --short HEAD)$(git -C "$ROOT" diff --quiet || echo ' (plus uncommitted changes)')"
   echo "cpu: $(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2 | xargs), nproc $(nproc), $(free -g | awk '/Mem:/ {print $2}') GiB"
