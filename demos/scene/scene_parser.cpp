@@ -88,9 +88,19 @@ SolverSettings readSolver(const JsonObject& s) {
     settings.preconditioner = PreconditionerKind::kJacobi;
   } else if (preconditioner == "block_jacobi") {
     settings.preconditioner = PreconditionerKind::kBlockJacobi;
+  } else if (preconditioner == "lagged_cholesky") {
+    settings.preconditioner = PreconditionerKind::kLaggedCholesky;
+  } else if (preconditioner == "incomplete_cholesky") {
+    settings.preconditioner = PreconditionerKind::kIncompleteCholesky;
+  } else if (preconditioner == "two_level") {
+    settings.preconditioner = PreconditionerKind::kTwoLevel;
   } else {
-    s.fail("preconditioner", "'" + preconditioner + "' is not one of: jacobi, block_jacobi");
+    s.fail("preconditioner", "'" + preconditioner +
+                                 "' is not one of: jacobi, block_jacobi, lagged_cholesky, "
+                                 "incomplete_cholesky, two_level");
   }
+  settings.refactor_interval = s.integer("refactor_interval", settings.refactor_interval);
+  settings.refactor_iterations = s.integer("refactor_iterations", settings.refactor_iterations);
   settings.tolerance = s.number("tolerance", settings.tolerance);
   settings.max_iterations = s.integer("max_iterations", settings.max_iterations);
   settings.threads = s.integer("threads", settings.threads);

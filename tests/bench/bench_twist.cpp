@@ -13,6 +13,7 @@
 #include <fstream>
 #include <iostream>
 #include <limits>
+#include <map>
 #include <nlohmann/json.hpp>
 #include <numeric>
 
@@ -60,6 +61,9 @@ int main(int argc, char** argv) {
   int substeps = 1;
   int max_iterations = 300;
   bool mass_preconditioner = false;
+  std::string element = "tet4";
+  std::string preconditioner = "block_jacobi";
+  torsion::bench::TorsionOptions torsion_options;
   app.add_option("--solver", solver,
                  "torsion-cg | torsion-cholmod | bullet-implicit | bullet-explicit")
       ->check(
@@ -93,6 +97,24 @@ int main(int argc, char** argv) {
                "bullet-implicit: initialise Bullet's mass preconditioner after the first step");
   app.add_option("--substeps", substeps, "bullet-explicit: stepSimulation calls per dt")
       ->capture_default_str();
+  app.add_option("--element", element, "ours: tet4 | tet10 (Bullet always runs the linear tets)")
+      ->check(CLI::IsMember({"tet4", "tet10"}));
+  app.add_option("--preconditioner", preconditioner, "ours, CG: its preconditioner")
+      ->check(CLI::IsMember(
+          {"jacobi", "block_jacobi", "lagged_cholesky", "incomplete_cholesky", "two_level"}));
+  app.add_option("--refactor-interval", torsion_options.refactor_interval,
+                 "ours, lagged preconditioners: refactorise after this many solves")
+      ->capture_default_str();
+  app.add_option("--refactor-iterations", torsion_options.refactor_iterations,
+                 "ours, lagged preconditioners: refactorise after a solve above this many "
+                 "iterations")
+      ->capture_default_str();
+  app.add_option("--oscillate-hz", protocol.oscillation_hz,
+                 "> 0: the driven end oscillates at this frequency, amplitude --amplitude")
+      ->capture_default_str();
+  app.add_option("--amplitude", protocol.final_angle,
+                 "rad: the final twist angle, or the oscillation's amplitude")
+      ->capture_default_str();
   app.add_option("--label", label, "free text copied into the JSON");
   app.add_option("--dump-positions", dump_path, "write final positions (x y z per line) here");
   CLI11_PARSE(app, argc, argv);
@@ -108,7 +130,15 @@ int main(int argc, char** argv) {
   TwistResult result;
   double reported_tolerance = tolerance;
   if (solver == "torsion-cg" || solver == "torsion-cholmod") {
-    torsion::bench::TorsionOptions options;
+    torsion::bench::TorsionOptions options = torsion_options;
+    options.tet10 = element == "tet10";
+    const std::map<std::string, torsion::PreconditionerKind> kinds = {
+        {"jacobi", torsion::PreconditionerKind::kJacobi},
+        {"block_jacobi", torsion::PreconditionerKind::kBlockJacobi},
+        {"lagged_cholesky", torsion::PreconditionerKind::kLaggedCholesky},
+        {"incomplete_cholesky", torsion::PreconditionerKind::kIncompleteCholesky},
+        {"two_level", torsion::PreconditionerKind::kTwoLevel}};
+    options.preconditioner = kinds.at(preconditioner);
     options.cholmod = solver == "torsion-cholmod";
     if (!std::isnan(tolerance)) options.tolerance = tolerance;
     options.threads = threads;
@@ -143,6 +173,8 @@ int main(int argc, char** argv) {
   j["mesh"] = mesh_path.filename().string();
   j["nodes"] = mesh->nodeCount();
   j["tets"] = mesh->tetCount();
+  j["element"] = solver.rfind("torsion", 0) == 0 ? element : std::string("tet4");
+  j["preconditioner"] = solver == "torsion-cg" ? preconditioner : std::string();
   j["E"] = protocol.youngs_modulus;
   j["nu"] = protocol.poisson_ratio;
   j["rho"] = protocol.density;

@@ -28,7 +28,8 @@ TwistResult runTorsionTwist(const TwistProtocol& protocol, std::shared_ptr<const
   material.density = protocol.density;
   material.mass_damping = 0;
   material.stiffness_damping = protocol.stiffness_damping;
-  auto created = FemModel::create(mesh, material);
+  auto created =
+      FemModel::create(mesh, material, options.tet10 ? ElementKind::kTet10 : ElementKind::kTet4);
   if (!created.ok()) {
     result.status = RunStatus::kSetupFailed;
     result.message = created.error().message;
@@ -41,6 +42,9 @@ TwistResult runTorsionTwist(const TwistProtocol& protocol, std::shared_ptr<const
   settings.linear_solver =
       options.cholmod ? LinearSolverKind::kCholmod : LinearSolverKind::kConjugateGradient;
   settings.tolerance = options.tolerance;
+  settings.preconditioner = options.preconditioner;
+  settings.refactor_interval = options.refactor_interval;
+  settings.refactor_iterations = options.refactor_iterations;
   settings.threads = options.threads;
   settings.max_speed = protocol.max_speed;
   if (Status valid = settings.validate(); !valid.ok()) {
@@ -54,14 +58,16 @@ TwistResult runTorsionTwist(const TwistProtocol& protocol, std::shared_ptr<const
   } else {
     detail << "cg " << toString(settings.preconditioner) << " tol " << settings.tolerance;
   }
-  detail << ", threads " << options.threads;
+  detail << (options.tet10 ? ", tet10" : "") << ", threads " << options.threads;
   result.solver_detail = detail.str();
 
   const Parallel parallel(options.threads);
   ImplicitStepper stepper(model, settings, parallel);
   FemState state = FemState::atRest(*model);
   const int n = model->nodeCount();
-  const TwistScene scene = classifyNodes(*mesh);
+  // tet10: the protocol's nodes are all P2 nodes (the model's mesh; the linear mesh for tet4).
+  const TetMesh& nodes_mesh = model->mesh();
+  const TwistScene scene = classifyNodes(nodes_mesh);
   std::vector<int> driven;
   NodeConstraints constraints(n);
   for (int i = 0; i < n; ++i) {
@@ -70,7 +76,7 @@ TwistResult runTorsionTwist(const TwistProtocol& protocol, std::shared_ptr<const
     if (role == NodeRole::kDriven) driven.push_back(i);
   }
   const Eigen::VectorXd external = Eigen::VectorXd::Zero(3 * n);
-  const std::vector<Eigen::Vector3d>& rest = mesh->restPositions();
+  const std::vector<Eigen::Vector3d>& rest = nodes_mesh.restPositions();
   const double dt = protocol.time_step;
   result.setup_seconds = std::chrono::duration<double>(Clock::now() - setup_start).count();
   result.setup_rss_kb = peakRssKb();
@@ -103,7 +109,7 @@ TwistResult runTorsionTwist(const TwistProtocol& protocol, std::shared_ptr<const
   result.loop_cpu_seconds = processCpuSeconds() - cpu_start;
   result.peak_rss_kb = peakRssKb();
   result.final_positions = state.positions;
-  measureTwist(protocol, *mesh, scene, state.positions, result);
+  measureTwist(protocol, nodes_mesh, scene, state.positions, result);
   return result;
 }
 

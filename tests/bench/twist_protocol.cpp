@@ -12,6 +12,7 @@
 namespace torsion::bench {
 
 double TwistProtocol::angle(double t) const {
+  if (oscillation_hz > 0) return final_angle * std::sin(2 * 3.141592653589793 * oscillation_hz * t);
   const double ramp = ramp_steps * time_step;
   return final_angle * std::min(t / ramp, 1.0);
 }

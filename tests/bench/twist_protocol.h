@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "torsion/mesh/tet_mesh.h"
+#include "torsion/solve/solver_settings.h"
 
 namespace torsion::bench {
 
@@ -27,6 +28,9 @@ struct TwistProtocol {
   int ramp_steps = 300;         ///< steps to reach final_angle
   int total_steps = 600;        ///< ramp + hold
   double final_angle = 1.5707963267948966;  ///< pi/2, rad
+  /// > 0: the driven end oscillates instead, angle(t) = final_angle sin(2 pi f t) (a fast hand:
+  /// final_angle = pi/4, f = 2 Hz); Hz. The end-of-run twist profile then means nothing.
+  double oscillation_hz = 0;
   /// Rayleigh stiffness damping beta, s (C = beta K). Ours: Material::stiffness_damping; Bullet's
   /// btDeformableLinearElasticityForce: damping_beta (same meaning, see bullet_twist_runner.cpp).
   double stiffness_damping = 0.01;
@@ -97,6 +101,10 @@ struct TorsionOptions {
   bool cholmod = false;
   double tolerance = 1e-4;  ///< CG relative residual
   int threads = 1;
+  bool tet10 = false;  ///< quadratic elements on the mesh (all P2 nodes take part in the protocol)
+  PreconditionerKind preconditioner = PreconditionerKind::kBlockJacobi;
+  int refactor_interval = SolverSettings{}.refactor_interval;
+  int refactor_iterations = SolverSettings{}.refactor_iterations;
 };
 TwistResult runTorsionTwist(const TwistProtocol& protocol, std::shared_ptr<const TetMesh> mesh,
                             const TorsionOptions& options);

@@ -201,6 +201,27 @@ TEST(SceneParserFaults, UnknownSolverName) {
   EXPECT_TRUE(failsWith(parse(text), {"solver.linear_solver: 'lu' is not one of: cg, cholmod"}));
 }
 
+TEST(SceneParser, ReadsALaggedPreconditionerAndItsRefactorisationPolicy) {
+  const std::string text = replaced(kValid, "\"tolerance\": 1e-6,",
+                                    "\"tolerance\": 1e-6, \"preconditioner\": \"two_level\", "
+                                    "\"refactor_interval\": 20, \"refactor_iterations\": 5,");
+  Result<SceneSpec> r = parse(text);
+  ASSERT_TRUE(r.ok()) << r.error().message;
+  EXPECT_EQ(r.value().world.solver.preconditioner, PreconditionerKind::kTwoLevel);
+  EXPECT_EQ(r.value().world.solver.refactor_interval, 20);
+  EXPECT_EQ(r.value().world.solver.refactor_iterations, 5);
+}
+
+TEST(SceneParserFaults, UnknownPreconditionerAndZeroRefactorInterval) {
+  EXPECT_TRUE(failsWith(parse(replaced(kValid, "\"tolerance\": 1e-6,",
+                                       "\"tolerance\": 1e-6, \"preconditioner\": \"ilu\",")),
+                        {"solver.preconditioner: 'ilu' is not one of: jacobi, block_jacobi, "
+                         "lagged_cholesky, incomplete_cholesky, two_level"}));
+  EXPECT_TRUE(failsWith(parse(replaced(kValid, "\"tolerance\": 1e-6,",
+                                       "\"tolerance\": 1e-6, \"refactor_interval\": 0,")),
+                        {"refactor_interval = 0: must be >= 1"}));
+}
+
 TEST(SceneParserFaults, NonFiniteNumbersAndZeroAxis) {
   std::string text = kValid;
   text.replace(text.find("\"axis\": [0, 0, 1]"), 17, "\"axis\": [0, 0, 0]");

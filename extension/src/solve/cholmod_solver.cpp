@@ -37,6 +37,59 @@ struct CholmodSolver::Impl {
   Eigen::VectorXd rhs, prescribed, q, solution;
 };
 
+#if TORSION_WITH_CHOLMOD
+namespace {
+// Eigen's wrapper keeps CHOLMOD's factor protected; its size is what a solve streams.
+class CholmodWithFactorSize
+    : public Eigen::CholmodDecomposition<Eigen::SparseMatrix<double>, Eigen::Lower> {
+ public:
+  const cholmod_factor* factorPtr() const { return this->m_cholmodFactor; }
+};
+}  // namespace
+#endif
+
+struct SparseCholesky::Impl {
+#if TORSION_WITH_CHOLMOD
+  CholmodWithFactorSize factor;
+#else
+  Eigen::SimplicialLLT<Eigen::SparseMatrix<double>, Eigen::Lower> factor;
+#endif
+  Eigen::Index rows = -1, entries = -1;  // the analysed pattern
+};
+
+SparseCholesky::SparseCholesky() : impl_(std::make_unique<Impl>()) {}
+SparseCholesky::~SparseCholesky() = default;
+
+bool SparseCholesky::factorize(const Eigen::SparseMatrix<double>& lower) {
+  Impl& m = *impl_;
+  valid_ = false;
+  if (!Eigen::Map<const Eigen::VectorXd>(lower.valuePtr(), lower.nonZeros()).allFinite())
+    return false;
+  if (m.rows != lower.rows() || m.entries != lower.nonZeros()) {
+    m.factor.analyzePattern(lower);
+    m.rows = lower.rows();
+    m.entries = lower.nonZeros();
+  }
+  m.factor.factorize(lower);
+  valid_ = m.factor.info() == Eigen::Success;
+  return valid_;
+}
+
+void SparseCholesky::solve(const Eigen::VectorXd& b, Eigen::VectorXd& x) const {
+  x = impl_->factor.solve(b);
+}
+
+long SparseCholesky::factorEntries() const {
+  if (!valid_) return 0;
+#if TORSION_WITH_CHOLMOD
+  // Eigen's wrapper does not expose the factor: read CHOLMOD's own count.
+  const cholmod_factor* L = impl_->factor.factorPtr();
+  return L ? static_cast<long>(L->is_super ? L->xsize : L->nzmax) : 0;
+#else
+  return static_cast<long>(impl_->factor.matrixL().nestedExpression().nonZeros());
+#endif
+}
+
 CholmodSolver::CholmodSolver() : impl_(std::make_unique<Impl>()) {}
 CholmodSolver::~CholmodSolver() = default;
 

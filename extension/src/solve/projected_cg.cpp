@@ -3,9 +3,21 @@
 #include <Eigen/LU>
 #include <cmath>
 
+#include "torsion/solve/lagged_factor_preconditioner.h"
 #include "torsion/solve/pcg_iterations.h"
+#include "torsion/solve/two_level_preconditioner.h"
 
 namespace torsion {
+
+ProjectedCg::ProjectedCg() = default;
+ProjectedCg::~ProjectedCg() = default;
+
+long ProjectedCg::factorisations() const {
+  long count = 0;
+  if (lagged_) count += lagged_->policy().factorisations();
+  if (two_level_) count += two_level_->policy().factorisations();
+  return count;
+}
 
 void ProjectedCg::precondition(const NodeConstraints& constraints, PreconditionerKind kind,
                                const Eigen::VectorXd& r, Eigen::VectorXd& z) const {
@@ -13,9 +25,9 @@ void ProjectedCg::precondition(const NodeConstraints& constraints, Preconditione
   z.resize(r.size());
   for (int i = 0; i < n; ++i) {
     const Eigen::Matrix3d& inv = block_inverse_[static_cast<size_t>(i)];
-    Eigen::Vector3d zi = kind == PreconditionerKind::kBlockJacobi
-                             ? Eigen::Vector3d(inv * r.segment<3>(3 * i))
-                             : Eigen::Vector3d(inv.diagonal().cwiseProduct(r.segment<3>(3 * i)));
+    Eigen::Vector3d zi = kind == PreconditionerKind::kJacobi
+                             ? Eigen::Vector3d(inv.diagonal().cwiseProduct(r.segment<3>(3 * i)))
+                             : Eigen::Vector3d(inv * r.segment<3>(3 * i));
     z.segment<3>(3 * i) = constraints.isConstrained(i) ? constraints.filterNode(i, zi) : zi;
   }
 }
@@ -25,11 +37,12 @@ LinearSolveReport ProjectedCg::solve(const SystemOperator& op, const NodeConstra
                                      Eigen::VectorXd& v) {
   const int n = constraints.nodeCount();
 
-  // Preconditioner: inverse diagonal (stored as a diagonal matrix) or inverse 3x3 node blocks.
+  // Inverse diagonal (stored as a diagonal matrix) or inverse 3x3 node blocks: the
+  // preconditioner, two_level's smoother, and the fallback of a failed factorisation.
   op.diagonalBlocks(block_inverse_);
   for (int i = 0; i < n; ++i) {
     Eigen::Matrix3d& block = block_inverse_[static_cast<size_t>(i)];
-    if (settings.preconditioner == PreconditionerKind::kBlockJacobi) {
+    if (settings.preconditioner != PreconditionerKind::kJacobi) {
       block = block.inverse().eval();
     } else {
       // Through a temporary: assigning a diagonal wrapper zeroes the target before reading it.
@@ -47,19 +60,50 @@ LinearSolveReport ProjectedCg::solve(const SystemOperator& op, const NodeConstra
   constraints.filter(r_);
   const double reference = r_.norm();
 
+  // Lagged preconditioners: refactorised when their policy says so; a failed factorisation
+  // falls back to block-Jacobi for this solve. two_level needs quadratic elements (on tet4 the
+  // corner nodes are all nodes: a lagged Cholesky of the whole system).
+  PreconditionerKind kind = settings.preconditioner;
+  if (kind == PreconditionerKind::kTwoLevel && op.model().elementKind() != ElementKind::kTet10)
+    kind = PreconditionerKind::kLaggedCholesky;
+  if (kind == PreconditionerKind::kLaggedCholesky ||
+      kind == PreconditionerKind::kIncompleteCholesky) {
+    if (!lagged_ || lagged_->kind() != kind)
+      lagged_ = std::make_unique<LaggedFactorPreconditioner>(kind);
+    if (!lagged_->prepare(op, constraints, settings)) kind = PreconditionerKind::kBlockJacobi;
+  } else if (kind == PreconditionerKind::kTwoLevel) {
+    if (!two_level_) two_level_ = std::make_unique<TwoLevelPreconditioner>();
+    if (!two_level_->prepare(op, constraints, settings, block_inverse_))
+      kind = PreconditionerKind::kBlockJacobi;
+  }
+
   constraints.impose(v);
   op.multiply(v, q_);
   r_ = b - q_;
   constraints.filter(r_);
-  return pcgIterations(
+  const LinearSolveReport report = pcgIterations(
       [&](const Eigen::VectorXd& in, Eigen::VectorXd& out) {
         op.multiply(in, out);
         constraints.filter(out);
       },
       [&](const Eigen::VectorXd& in, Eigen::VectorXd& out) {
-        precondition(constraints, settings.preconditioner, in, out);
+        if (kind == PreconditionerKind::kLaggedCholesky ||
+            kind == PreconditionerKind::kIncompleteCholesky) {
+          lagged_->apply(constraints, in, out);
+        } else if (kind == PreconditionerKind::kTwoLevel) {
+          two_level_->apply(op, constraints, block_inverse_, in, out);
+        } else {
+          precondition(constraints, kind, in, out);
+        }
       },
       reference, settings, v, r_, scratch_);
+  if (kind == PreconditionerKind::kLaggedCholesky ||
+      kind == PreconditionerKind::kIncompleteCholesky) {
+    lagged_->solved(report.iterations);
+  } else if (kind == PreconditionerKind::kTwoLevel) {
+    two_level_->solved(report.iterations);
+  }
+  return report;
 }
 
 }  // namespace torsion

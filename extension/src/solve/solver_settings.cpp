@@ -13,6 +13,12 @@ Status SolverSettings::validate() const {
     return Error{"solver: tolerance = " + formatNumber(tolerance) + ": must be in (0, 1)"};
   if (max_iterations < 1)
     return Error{"solver: max_iterations = " + std::to_string(max_iterations) + ": must be >= 1"};
+  if (refactor_interval < 1)
+    return Error{"solver: refactor_interval = " + std::to_string(refactor_interval) +
+                 ": must be >= 1"};
+  if (refactor_iterations < 0)
+    return Error{"solver: refactor_iterations = " + std::to_string(refactor_iterations) +
+                 ": must be >= 0"};
   if (threads < 0) return Error{"solver: threads = " + std::to_string(threads) + ": must be >= 0"};
   if (!(max_speed > 0)) return Error{"solver: max_speed must be > 0 m/s"};
   return Ok{};
@@ -34,6 +40,12 @@ const char* toString(PreconditionerKind kind) {
       return "jacobi";
     case PreconditionerKind::kBlockJacobi:
       return "block_jacobi";
+    case PreconditionerKind::kLaggedCholesky:
+      return "lagged_cholesky";
+    case PreconditionerKind::kIncompleteCholesky:
+      return "incomplete_cholesky";
+    case PreconditionerKind::kTwoLevel:
+      return "two_level";
   }
   return "?";
 }

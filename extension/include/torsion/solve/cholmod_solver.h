@@ -19,6 +19,31 @@
 
 namespace torsion {
 
+/// Cholesky factor of a symmetric positive definite sparse matrix given by its lower triangle
+/// (column-major), with the same backend as CholmodSolver. The symbolic analysis is kept while
+/// the pattern (size and number of stored entries) stays the same: refactorising a matrix of a
+/// fixed pattern is numeric only. For preconditioners that keep a factor across steps.
+class SparseCholesky {
+ public:
+  SparseCholesky();
+  ~SparseCholesky();
+  SparseCholesky(const SparseCholesky&) = delete;
+  SparseCholesky& operator=(const SparseCholesky&) = delete;
+
+  /// False if the matrix is not positive definite (or not finite); the old factor is then gone.
+  bool factorize(const Eigen::SparseMatrix<double>& lower);
+  bool valid() const { return valid_; }
+  /// x = A^-1 b with the last successful factor.
+  void solve(const Eigen::VectorXd& b, Eigen::VectorXd& x) const;
+  /// Entries of the factor L (supernodal storage counts its padding), for cost reports.
+  long factorEntries() const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+  bool valid_ = false;
+};
+
 class CholmodSolver {
  public:
   CholmodSolver();

@@ -3,6 +3,7 @@
 // 1998, "modified PCG"): prescribed velocity components never change, free ones are solved.
 
 #include <Eigen/Core>
+#include <memory>
 #include <vector>
 
 #include "torsion/solve/node_constraints.h"
@@ -10,6 +11,9 @@
 #include "torsion/solve/system_operator.h"
 
 namespace torsion {
+
+class LaggedFactorPreconditioner;
+class TwoLevelPreconditioner;
 
 struct PcgScratch {
   Eigen::VectorXd z, p, q;  ///< workspace of pcgIterations (pcg_iterations.h)
@@ -35,17 +39,29 @@ inline LinearSolveReport brokenDown(LinearSolveReport report, const char* reason
 }
 
 /// Solves A v = b for the free components of v. On entry v holds the warm start; prescribed
-/// components are imposed from `constraints` first. Workspace vectors are reused across calls.
+/// components are imposed from `constraints` first. Workspace vectors are reused across calls, and
+/// so are the lagged preconditioners' factorisations (SolverSettings::preconditioner): the solves
+/// of one ProjectedCg must be of one body.
 class ProjectedCg {
  public:
+  ProjectedCg();
+  ~ProjectedCg();
+  ProjectedCg(const ProjectedCg&) = delete;
+  ProjectedCg& operator=(const ProjectedCg&) = delete;
+
   LinearSolveReport solve(const SystemOperator& op, const NodeConstraints& constraints,
                           const Eigen::VectorXd& b, const SolverSettings& settings,
                           Eigen::VectorXd& v);
+
+  /// Factorisations the lagged preconditioner in use has done so far (0 for the Jacobi kinds).
+  long factorisations() const;
 
  private:
   void precondition(const NodeConstraints& constraints, PreconditionerKind kind,
                     const Eigen::VectorXd& r, Eigen::VectorXd& z) const;
 
+  std::unique_ptr<LaggedFactorPreconditioner> lagged_;
+  std::unique_ptr<TwoLevelPreconditioner> two_level_;
   std::vector<Eigen::Matrix3d> block_inverse_;
   Eigen::VectorXd r_, q_, prescribed_only_;
   PcgScratch scratch_;

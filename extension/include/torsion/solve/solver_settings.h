@@ -16,6 +16,15 @@ enum class LinearSolverKind {
 enum class PreconditionerKind {
   kJacobi,       ///< inverse diagonal of the system matrix
   kBlockJacobi,  ///< inverse 3x3 node blocks: captures each node's anisotropic stiffness
+  /// CHOLMOD factor of the whole system, kept across steps and refactorised by the policy of
+  /// SolverSettings::refactor_interval / refactor_iterations (the corotated K changes slowly).
+  kLaggedCholesky,
+  /// Eigen's IncompleteCholesky (limited fill, AMD order) of the system, lagged the same way.
+  kIncompleteCholesky,
+  /// tet10: a two-level (p-multigrid) cycle, block-Jacobi smoothing on all nodes and the Galerkin
+  /// system on the corner nodes (the tet4 problem) solved by a lagged CHOLMOD factor. On tet4 the
+  /// corner nodes are all nodes: the same as kLaggedCholesky.
+  kTwoLevel,
 };
 
 struct SolverSettings {
@@ -26,7 +35,12 @@ struct SolverSettings {
   /// constrained system relative to its right-hand side.
   double tolerance = 1e-4;
   int max_iterations = 300;  ///< CG iteration cap
-  int threads = 0;           ///< worker threads; 0: all cores
+  /// Lagged preconditioners (kLaggedCholesky, kIncompleteCholesky, kTwoLevel's coarse level) are
+  /// refactorised at the first solve, after this many solves with the same factor, and after a
+  /// solve that took more than refactor_iterations CG iterations.
+  int refactor_interval = 100;
+  int refactor_iterations = 8;
+  int threads = 0;  ///< worker threads; 0: all cores
   /// A node faster than this (m/s) means the simulation blew up; the run stops.
   double max_speed = 1e3;
 
