@@ -164,8 +164,17 @@ int SelfContactSolver::addCandidates(const Eigen::VectorXd& x, const Eigen::Vect
       stats_.max_penetration = std::max(stats_.max_penetration, -c.gap);
     }
   }
-  // Edges against edges, the same way.
+  // Edges against edges, the same way, after each edge's box over the motion.
   const int edge_blocks = (static_cast<int>(edges_.size()) + kSearchBlock - 1) / kSearchBlock;
+  edge_lo_.resize(edges_.size());
+  edge_hi_.resize(edges_.size());
+  for (size_t i = 0; i < edges_.size(); ++i) {
+    const std::array<int, 2>& e = edges_[i];
+    const Eigen::Vector3d p0 = x.segment<3>(3 * e[0]), q0 = x.segment<3>(3 * e[1]);
+    const Eigen::Vector3d p1 = end.segment<3>(3 * e[0]), q1 = end.segment<3>(3 * e[1]);
+    edge_lo_[i] = p0.cwiseMin(q0).cwiseMin(p1).cwiseMin(q1);
+    edge_hi_[i] = p0.cwiseMax(q0).cwiseMax(p1).cwiseMax(q1);
+  }
   parallel_->forRange(edge_blocks, 1, [&](int first, int last) {
     std::vector<int> scratch;
     for (int block = first; block < last; ++block) {
@@ -261,8 +270,7 @@ void SelfContactSolver::edgeCandidates(int i, const Eigen::VectorXd& x,
   const Eigen::Vector3d p0 = x.segment<3>(3 * e[0]), q0 = x.segment<3>(3 * e[1]);
   const Eigen::Vector3d p1 = end.segment<3>(3 * e[0]), q1 = end.segment<3>(3 * e[1]);
   std::vector<int>& triangles = scratch;
-  tree_.query(p0.cwiseMin(q0).cwiseMin(p1).cwiseMin(q1),
-              p0.cwiseMax(q0).cwiseMax(p1).cwiseMax(q1), triangles);
+  tree_.query(edge_lo_[static_cast<size_t>(i)], edge_hi_[static_cast<size_t>(i)], triangles);
   // The later edges of the triangles found, each once, ascending.
   std::vector<int> later;
   later.reserve(3 * triangles.size());
@@ -274,6 +282,12 @@ void SelfContactSolver::edgeCandidates(int i, const Eigen::VectorXd& x,
   for (int j : later) {
     const std::array<int, 2>& f = edges_[static_cast<size_t>(j)];
     if (f[0] == e[0] || f[0] == e[1] || f[1] == e[0] || f[1] == e[1]) continue;  // adjacent
+    // Boxes over the motion more than the margin apart: never within it, never crossing.
+    const Eigen::Vector3d& lo = edge_lo_[static_cast<size_t>(j)];
+    const Eigen::Vector3d& hi = edge_hi_[static_cast<size_t>(j)];
+    if (((lo.array() - margin) > edge_hi_[static_cast<size_t>(i)].array()).any() ||
+        ((hi.array() + margin) < edge_lo_[static_cast<size_t>(i)].array()).any())
+      continue;
     const std::uint64_t pair =
         (static_cast<std::uint64_t>(i) << 32) | static_cast<std::uint32_t>(j);
     if (edge_pairs_.count(pair) != 0) continue;  // this step has it already
