@@ -77,7 +77,7 @@ int main(int argc, char** argv) {
       "\"unconverged\": %d, \"max_active\": %d, \"worst_end_penetration_m\": %.3g, "
       "\"gap_tolerance_m\": %.3g, \"searches\": %d, \"crossing_checks\": %d, "
       "\"first_crossing_step\": %d}\n",
-      scene.spec.name.c_str(), steps, threads, steps / stepping, unconverged, max_active,
-      worst_end, body->selfContact()->gapTolerance(), searches, crossing_checks, crossing_first);
+      scene.spec.name.c_str(), steps, threads, steps / stepping, unconverged, max_active, worst_end,
+      body->selfContact()->gapTolerance(), searches, crossing_checks, crossing_first);
   return 0;
 }

@@ -138,8 +138,8 @@ int SelfContactSolver::addCandidates(const Eigen::VectorXd& x, const Eigen::Vect
   // alone would let the node cross the neighbour's plane).
   const std::vector<int>& nodes = model_->mesh().surfaceNodes();
   const int node_blocks = (static_cast<int>(nodes.size()) + kSearchBlock - 1) / kSearchBlock;
-  block_finds_.resize(static_cast<size_t>(std::max(
-      node_blocks, (static_cast<int>(edges_.size()) + kSearchBlock - 1) / kSearchBlock)));
+  block_finds_.resize(static_cast<size_t>(
+      std::max(node_blocks, (static_cast<int>(edges_.size()) + kSearchBlock - 1) / kSearchBlock)));
   parallel_->forRange(node_blocks, 1, [&](int first, int last) {
     std::vector<int> found;
     for (int block = first; block < last; ++block) {
@@ -236,8 +236,8 @@ std::optional<SurfaceContact> SelfContactSolver::nodeCandidate(int p, int t,
   } else {
     return std::nullopt;
   }
-  const Eigen::Vector3d w = barycentric(xp + s * (ep - xp), a0 + s * (a1 - a0),
-                                        b0 + s * (b1 - b0), c0 + s * (c1 - c0));
+  const Eigen::Vector3d w =
+      barycentric(xp + s * (ep - xp), a0 + s * (a1 - a0), b0 + s * (b1 - b0), c0 + s * (c1 - c0));
   if (!w.allFinite() || w.minCoeff() < -kInsideTolerance) return std::nullopt;
   const Eigen::Vector3d wc = w.cwiseMax(0.0) / w.cwiseMax(0.0).sum();
   SurfaceContact c;
@@ -262,8 +262,8 @@ Eigen::Vector3d SelfContactSolver::edgeNormal(const std::array<int, 2>& edge,
   return sum.normalized();
 }
 
-void SelfContactSolver::edgeCandidates(int i, const Eigen::VectorXd& x,
-                                       const Eigen::VectorXd& end, std::vector<int>& scratch,
+void SelfContactSolver::edgeCandidates(int i, const Eigen::VectorXd& x, const Eigen::VectorXd& end,
+                                       std::vector<int>& scratch,
                                        std::vector<SurfaceContact>& out) const {
   const double margin = settings_.margin * mean_edge_;
   const std::array<int, 2>& e = edges_[static_cast<size_t>(i)];

@@ -165,8 +165,8 @@ bool SurfaceContactSet::update(const Eigen::VectorXd& v, double dt, double activ
       c.tangential_stiffness = 0;
       c.multiplier = c.normal * ln;
     } else if (old_state == State::kStick) {
-      Eigen::Vector3d trial = c.multiplier - c.normal * c.normal.dot(c.multiplier) -
-                              c.penalty * slip;
+      Eigen::Vector3d trial =
+          c.multiplier - c.normal * c.normal.dot(c.multiplier) - c.penalty * slip;
       if (trial.norm() <= bound || !may_switch) {
         if (trial.norm() > bound) trial *= bound / trial.norm();
         c.multiplier = c.normal * ln + trial;

@@ -136,14 +136,14 @@ class SelfContactSolver {
   std::unique_ptr<Parallel> own_parallel_;  // serial, when no Parallel was given
   const Parallel* parallel_ = nullptr;
   SurfaceTree tree_;
-  std::vector<std::vector<int>> node_triangles_;  // surface triangles of each node
-  std::vector<std::vector<int>> node_contacts_;   // this step's contacts of each node
-  std::vector<int> touched_nodes_;                // nodes with an entry in node_contacts_
-  std::vector<std::array<int, 2>> edges_;         // surface edges, corners ascending
-  std::vector<std::vector<int>> triangle_edges_;  // the three edges of each surface triangle
+  std::vector<std::vector<int>> node_triangles_;    // surface triangles of each node
+  std::vector<std::vector<int>> node_contacts_;     // this step's contacts of each node
+  std::vector<int> touched_nodes_;                  // nodes with an entry in node_contacts_
+  std::vector<std::array<int, 2>> edges_;           // surface edges, corners ascending
+  std::vector<std::vector<int>> triangle_edges_;    // the three edges of each surface triangle
   std::vector<Eigen::Vector3d> edge_lo_, edge_hi_;  // each edge's box over the searched motion
   std::vector<std::vector<SurfaceContact>> block_finds_;  // per block of nodes (edges), in order
-  std::set<std::uint64_t> edge_pairs_;      // this step's edge pairs (i << 32 | j)
+  std::set<std::uint64_t> edge_pairs_;                    // this step's edge pairs (i << 32 | j)
   const Eigen::VectorXd* start_ = nullptr;  // positions at the step's start (the state's)
   const NodeConstraints* constraints_ = nullptr;
   SurfaceContactSet set_;

@@ -53,7 +53,7 @@ struct SurfaceContact {
   /// kg, sliding: k_t, the friction impulse being -k_t u_t (the tangential relative velocity);
   /// at most the penalty. Negative: the penalty (a warm-started contact's first solve).
   double tangential_stiffness = 0;
-  double end_gap = 0;       ///< m, the linearised end-of-step gap after the last solve
+  double end_gap = 0;  ///< m, the linearised end-of-step gap after the last solve
 };
 
 class SurfaceContactSet final : public AddedOperatorTerm {
