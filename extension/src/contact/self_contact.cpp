@@ -405,10 +405,13 @@ LinearSolveReport SelfContactSolver::solve(const SystemOperator& op,
     if (r.breakdown) break;
     const bool settled = set_.update(v, dt_, activation, gap_tolerance_);
     // Safeguard: where constraints contradict each other (crossed before, a crease) Uzawa can
-    // diverge. The best solve so far is kept; three worse ones in a row end the step with it
-    // (reported as not converged).
+    // diverge. The best solve so far is kept; three worse ones in a row, beyond the tolerance,
+    // end the step with it (reported as not converged).
+    // An update whose gaps are all within the tolerance is never "worse": it is kept and the
+    // loop goes on to settle states and friction (stopping there left most of the plectoneme's
+    // contact steps unconverged with their gaps already within the tolerance).
     const double error = set_.maxGapError();
-    if (round == 0 || error < best_error) {
+    if (round == 0 || error < best_error || error <= gap_tolerance_) {
       best_error = error;
       best_v_ = v;
       best_contacts_ = set_.contacts();
