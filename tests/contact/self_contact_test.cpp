@@ -135,5 +135,34 @@ TEST(SelfContact, ABodyAtRestFeelsNoSelfContact) {
   EXPECT_EQ((result[0] - result[1]).cwiseAbs().maxCoeff(), 0.0);
 }
 
+TEST(SelfContact, TheImpactEndsTheSameToTheLastBitOnOneAndOnTwoThreads) {
+  // The candidate search runs in fixed blocks on the world's threads and adds their finds in
+  // block order: the contacts, and so the motion, must not depend on the thread count.
+  int second = 0;
+  const TetMesh mesh = twoBlocks(0.02, 0.03, 3, second);
+  Eigen::VectorXd result[2];
+  int active = 0;
+  for (int run = 0; run < 2; ++run) {
+    WorldSettings settings;
+    settings.gravity.setZero();
+    settings.solver.time_step = 5e-4;
+    settings.solver.threads = run + 1;
+    FemWorld world(settings);
+    FemBody* body = world.addBody("blocks", mesh, Material{}).value();
+    ASSERT_TRUE(body->enableSelfContact(SelfContactSettings{}).ok());
+    FemBodyCheckpoint start = body->checkpoint();
+    for (int i = second; i < mesh.nodeCount(); ++i)
+      start.state.velocities.segment<3>(3 * i) = Eigen::Vector3d(-15, 0, 0);
+    body->restore(start);
+    for (int k = 0; k < 60; ++k) {
+      ASSERT_TRUE(world.step().ok);
+      active = std::max(active, body->selfContact()->stats().active);
+    }
+    result[run] = body->state().positions;
+  }
+  EXPECT_GT(active, 0);  // the blocks met: the search found and held contacts
+  EXPECT_EQ((result[0] - result[1]).cwiseAbs().maxCoeff(), 0.0);
+}
+
 }  // namespace
 }  // namespace torsion

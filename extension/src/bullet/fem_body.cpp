@@ -9,6 +9,7 @@ FemBody::FemBody(std::string name, std::shared_ptr<const FemModel> model,
     : name_(std::move(name)),
       model_(std::move(model)),
       state_(FemState::atRest(*model_)),
+      parallel_(parallel),
       stepper_(model_, settings, parallel),
       constraints_(model_->nodeCount()),
       external_forces_(Eigen::VectorXd::Zero(3 * model_->nodeCount())) {
@@ -218,7 +219,7 @@ void FemBody::noteContactNotConverged(const std::string& what) {
 Status FemBody::enableSelfContact(const SelfContactSettings& settings) {
   if (Status valid = settings.validate(); !valid)
     return Error{"body '" + name_ + "': " + valid.error().message};
-  self_contact_ = std::make_unique<SelfContactSolver>(model_, settings);
+  self_contact_ = std::make_unique<SelfContactSolver>(model_, settings, parallel_);
   return Ok{};
 }
 
@@ -261,7 +262,7 @@ void FemBody::restore(const FemBodyCheckpoint& c) {
   *contacts_ = *c.contacts;
   self_contact_.reset();
   if (c.self_contact) {
-    self_contact_ = std::make_unique<SelfContactSolver>(model_, c.self_contact_settings);
+    self_contact_ = std::make_unique<SelfContactSolver>(model_, c.self_contact_settings, parallel_);
     self_contact_->restoreWarmStarts(c.self_contact_warm_starts);
   }
   last_report_ = c.last_report;

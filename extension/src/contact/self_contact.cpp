@@ -14,6 +14,9 @@ namespace {
 constexpr double kInsideTolerance = 0.05;
 // Searches along the solved motion per step (each may add candidates and solves).
 constexpr int kMaxRedetections = 3;
+// Surface nodes (edges) per block of the parallel search: blocks are fixed, whatever the thread
+// count, and their finds are added in block order.
+constexpr int kSearchBlock = 64;
 
 // Barycentric coordinates of p's projection onto the plane of (a, b, c).
 Eigen::Vector3d barycentric(const Eigen::Vector3d& p, const Eigen::Vector3d& a,
@@ -25,6 +28,19 @@ Eigen::Vector3d barycentric(const Eigen::Vector3d& p, const Eigen::Vector3d& a,
   const double v = (d11 * d20 - d01 * d21) / det;
   const double w = (d00 * d21 - d01 * d20) / det;
   return {1.0 - v - w, v, w};
+}
+
+// Closest points of lines a + u (b - a) and c + v (d - c); false when (nearly) parallel.
+bool closestPoints(const Eigen::Vector3d& a, const Eigen::Vector3d& b, const Eigen::Vector3d& c,
+                   const Eigen::Vector3d& d, double& u, double& v, double& distance) {
+  const Eigen::Vector3d d1 = b - a, d2 = d - c, w = a - c;
+  const double aa = d1.dot(d1), bb = d1.dot(d2), cc = d2.dot(d2), dd = d1.dot(w), ee = d2.dot(w);
+  const double denominator = aa * cc - bb * bb;
+  if (!(denominator > 1e-12 * aa * cc)) return false;
+  u = (bb * ee - cc * dd) / denominator;
+  v = (aa * ee - bb * dd) / denominator;
+  distance = (a + u * d1 - c - v * d2).norm();
+  return true;
 }
 
 }  // namespace
@@ -50,7 +66,19 @@ Status SelfContactSettings::validate() const {
 
 SelfContactSolver::SelfContactSolver(std::shared_ptr<const FemModel> model,
                                      const SelfContactSettings& settings)
-    : model_(std::move(model)), settings_(settings), tree_(model_->mesh().surfaceTriangles()) {
+    : SelfContactSolver(std::move(model), settings, nullptr) {}
+
+SelfContactSolver::SelfContactSolver(std::shared_ptr<const FemModel> model,
+                                     const SelfContactSettings& settings, const Parallel& parallel)
+    : SelfContactSolver(std::move(model), settings, &parallel) {}
+
+SelfContactSolver::SelfContactSolver(std::shared_ptr<const FemModel> model,
+                                     const SelfContactSettings& settings, const Parallel* parallel)
+    : model_(std::move(model)),
+      settings_(settings),
+      own_parallel_(parallel != nullptr ? nullptr : std::make_unique<Parallel>(1)),
+      parallel_(parallel != nullptr ? parallel : own_parallel_.get()),
+      tree_(model_->mesh().surfaceTriangles()) {
   const TetMesh& mesh = model_->mesh();
   const std::vector<Triangle>& triangles = mesh.surfaceTriangles();
   node_triangles_.assign(static_cast<size_t>(mesh.nodeCount()), {});
@@ -65,7 +93,6 @@ SelfContactSolver::SelfContactSolver(std::shared_ptr<const FemModel> model,
   }
   mean_edge_ = triangles.empty() ? 0 : edges / (3.0 * static_cast<double>(triangles.size()));
   gap_tolerance_ = settings_.gap_tolerance > 0 ? settings_.gap_tolerance : 1e-3 * mean_edge_;
-  one_ring_mark_.assign(triangles.size(), 0);
   node_contacts_.assign(static_cast<size_t>(mesh.nodeCount()), {});
   // Surface edges, each once, and the three of every triangle.
   std::vector<std::pair<std::array<int, 2>, int>> halves;  // (sorted corners, triangle)
@@ -83,7 +110,6 @@ SelfContactSolver::SelfContactSolver(std::shared_ptr<const FemModel> model,
     triangle_edges_[static_cast<size_t>(halves[k].second)].push_back(
         static_cast<int>(edges_.size()) - 1);
   }
-  edge_mark_.assign(edges_.size(), 0);
 }
 
 bool SelfContactSolver::detect(const FemState& state, const NodeConstraints& constraints,
@@ -104,89 +130,124 @@ bool SelfContactSolver::detect(const FemState& state, const NodeConstraints& con
 }
 
 int SelfContactSolver::addCandidates(const Eigen::VectorXd& x, const Eigen::VectorXd& end) {
-  const double margin = settings_.margin * mean_edge_;
-  tree_.refit(x, end, margin);
-  const std::vector<Triangle>& triangles = tree_.triangles();
+  ++stats_.searches;
+  tree_.refit(x, end, settings_.margin * mean_edge_);
   const size_t before = set_.contacts().size();
-
-  struct Candidate {
-    SurfaceContact contact;
-  };
-  std::vector<Candidate> found;
-  for (int p : model_->mesh().surfaceNodes()) {
-    const Eigen::Vector3d xp = x.segment<3>(3 * p), ep = end.segment<3>(3 * p);
-    tree_.query(xp.cwiseMin(ep), xp.cwiseMax(ep), found_);
-    if (found_.empty()) continue;
-    std::vector<int>& kept = node_contacts_[static_cast<size_t>(p)];
-    for (int t : node_triangles_[static_cast<size_t>(p)])
-      one_ring_mark_[static_cast<size_t>(t)] = 1;
-    for (int k : kept)  // pairs this step has already
-      one_ring_mark_[static_cast<size_t>(set_.contacts()[static_cast<size_t>(k)].triangle)] = 1;
-    found.clear();
-    for (int t : found_) {
-      if (one_ring_mark_[static_cast<size_t>(t)]) continue;  // the node's own one-ring
-      const Triangle& tri = triangles[static_cast<size_t>(t)];
-      const Eigen::Vector3d a0 = x.segment<3>(3 * tri[0]), b0 = x.segment<3>(3 * tri[1]),
-                            c0 = x.segment<3>(3 * tri[2]);
-      Eigen::Vector3d n0 = (b0 - a0).cross(c0 - a0);
-      if (!(n0.norm() > 0)) continue;  // degenerate: no plane to stay out of
-      n0.normalize();
-      const double g0 = n0.dot(xp - a0);
-      const double shortest = std::min({(b0 - a0).norm(), (c0 - b0).norm(), (a0 - c0).norm()});
-      if (g0 < -settings_.max_depth * shortest) continue;  // the far side of the body
-      // Behind the plane beyond the tolerance: only a contact already held last step is still one
-      // (it sank within its tolerance); a new pair there is a node across a sharp convex crease
-      // (behind the plane, not through the surface), which a contact would throw out violently.
-      if (g0 < -2 * gap_tolerance_ && !set_.wasActive(p, t)) continue;
-      const Eigen::Vector3d a1 = end.segment<3>(3 * tri[0]), b1 = end.segment<3>(3 * tri[1]),
-                            c1 = end.segment<3>(3 * tri[2]);
-      Eigen::Vector3d n1 = (b1 - a1).cross(c1 - a1);
-      if (!(n1.norm() > 0)) n1 = n0;
-      const double g1 = n1.normalized().dot(ep - a1);
-      // When on the path the node meets the plane: now if it is within the margin, at the
-      // crossing if it passes through, at the end if it ends within the margin.
-      double s;
-      if (g0 <= margin) {
-        s = 0;
-      } else if (g1 < 0) {
-        s = g0 / (g0 - g1);
-      } else if (g1 <= margin) {
-        s = 1;
-      } else {
-        continue;
+  // Nodes against triangles: every triangle found is kept. A node passing over an edge or a
+  // corner gets a contact with each triangle there (redundant constraints share the impulse; one
+  // alone would let the node cross the neighbour's plane).
+  const std::vector<int>& nodes = model_->mesh().surfaceNodes();
+  const int node_blocks = (static_cast<int>(nodes.size()) + kSearchBlock - 1) / kSearchBlock;
+  block_finds_.resize(static_cast<size_t>(
+      std::max(node_blocks, (static_cast<int>(edges_.size()) + kSearchBlock - 1) / kSearchBlock)));
+  parallel_->forRange(node_blocks, 1, [&](int first, int last) {
+    std::vector<int> found;
+    for (int block = first; block < last; ++block) {
+      std::vector<SurfaceContact>& finds = block_finds_[static_cast<size_t>(block)];
+      finds.clear();
+      const size_t end_node = std::min(nodes.size(), static_cast<size_t>(block + 1) * kSearchBlock);
+      for (size_t k = static_cast<size_t>(block) * kSearchBlock; k < end_node; ++k) {
+        const int p = nodes[k];
+        const Eigen::Vector3d xp = x.segment<3>(3 * p), ep = end.segment<3>(3 * p);
+        tree_.query(xp.cwiseMin(ep), xp.cwiseMax(ep), found);
+        for (int t : found)
+          if (std::optional<SurfaceContact> c = nodeCandidate(p, t, x, end)) finds.push_back(*c);
       }
-      const Eigen::Vector3d w = barycentric(xp + s * (ep - xp), a0 + s * (a1 - a0),
-                                            b0 + s * (b1 - b0), c0 + s * (c1 - c0));
-      if (!w.allFinite() || w.minCoeff() < -kInsideTolerance) continue;
-      const Eigen::Vector3d wc = w.cwiseMax(0.0) / w.cwiseMax(0.0).sum();
-      Candidate c;
-      c.contact.nodes = {p, tri[0], tri[1], tri[2]};
-      c.contact.beta = {1.0, -wc[0], -wc[1], -wc[2]};
-      c.contact.triangle = t;
-      c.contact.normal = n0;
-      c.contact.gap = g0;  // to the triangle's plane, at the start of the step
-      c.contact.friction = settings_.friction;
-      found.push_back(c);
     }
-    for (int t : node_triangles_[static_cast<size_t>(p)])
-      one_ring_mark_[static_cast<size_t>(t)] = 0;
-    for (int k : kept)
-      one_ring_mark_[static_cast<size_t>(set_.contacts()[static_cast<size_t>(k)].triangle)] = 0;
-    // Every triangle found is kept: a node passing over an edge or a corner gets a contact with
-    // each triangle there (redundant constraints share the impulse; one alone would let the node
-    // cross the neighbour's plane).
-    for (const Candidate& c : found) {
-      if (kept.empty()) touched_nodes_.push_back(p);
+  });
+  for (int block = 0; block < node_blocks; ++block) {
+    for (const SurfaceContact& c : block_finds_[static_cast<size_t>(block)]) {
+      std::vector<int>& kept = node_contacts_[static_cast<size_t>(c.nodes[0])];
+      if (kept.empty()) touched_nodes_.push_back(c.nodes[0]);
       kept.push_back(static_cast<int>(set_.contacts().size()));
-      set_.add(c.contact);
-      stats_.max_penetration = std::max(stats_.max_penetration, -c.contact.gap);
+      set_.add(c);
+      stats_.max_penetration = std::max(stats_.max_penetration, -c.gap);
     }
   }
-  addEdgeCandidates(x, end);
+  // Edges against edges, the same way, after each edge's box over the motion.
+  const int edge_blocks = (static_cast<int>(edges_.size()) + kSearchBlock - 1) / kSearchBlock;
+  edge_lo_.resize(edges_.size());
+  edge_hi_.resize(edges_.size());
+  for (size_t i = 0; i < edges_.size(); ++i) {
+    const std::array<int, 2>& e = edges_[i];
+    const Eigen::Vector3d p0 = x.segment<3>(3 * e[0]), q0 = x.segment<3>(3 * e[1]);
+    const Eigen::Vector3d p1 = end.segment<3>(3 * e[0]), q1 = end.segment<3>(3 * e[1]);
+    edge_lo_[i] = p0.cwiseMin(q0).cwiseMin(p1).cwiseMin(q1);
+    edge_hi_[i] = p0.cwiseMax(q0).cwiseMax(p1).cwiseMax(q1);
+  }
+  parallel_->forRange(edge_blocks, 1, [&](int first, int last) {
+    std::vector<int> scratch;
+    for (int block = first; block < last; ++block) {
+      std::vector<SurfaceContact>& finds = block_finds_[static_cast<size_t>(block)];
+      finds.clear();
+      const int end_edge = std::min(static_cast<int>(edges_.size()), (block + 1) * kSearchBlock);
+      for (int i = block * kSearchBlock; i < end_edge; ++i)
+        edgeCandidates(i, x, end, scratch, finds);
+    }
+  });
+  for (int block = 0; block < edge_blocks; ++block) {
+    for (const SurfaceContact& c : block_finds_[static_cast<size_t>(block)]) {
+      edge_pairs_.insert((static_cast<std::uint64_t>(c.edge) << 32) |
+                         static_cast<std::uint32_t>(c.triangle));
+      set_.add(c);
+    }
+  }
   const NodeConstraints& constraints = *constraints_;
   set_.markDetermined(
       [&](int node) { return constraints.kind(node) == NodeConstraints::Kind::kFull; });
   return static_cast<int>(set_.contacts().size() - before);
+}
+
+std::optional<SurfaceContact> SelfContactSolver::nodeCandidate(int p, int t,
+                                                               const Eigen::VectorXd& x,
+                                                               const Eigen::VectorXd& end) const {
+  const Triangle& tri = tree_.triangles()[static_cast<size_t>(t)];
+  if (tri[0] == p || tri[1] == p || tri[2] == p) return std::nullopt;  // the node's own one-ring
+  for (int k : node_contacts_[static_cast<size_t>(p)])                 // a pair this step has
+    if (set_.contacts()[static_cast<size_t>(k)].triangle == t) return std::nullopt;
+  const double margin = settings_.margin * mean_edge_;
+  const Eigen::Vector3d xp = x.segment<3>(3 * p), ep = end.segment<3>(3 * p);
+  const Eigen::Vector3d a0 = x.segment<3>(3 * tri[0]), b0 = x.segment<3>(3 * tri[1]),
+                        c0 = x.segment<3>(3 * tri[2]);
+  Eigen::Vector3d n0 = (b0 - a0).cross(c0 - a0);
+  if (!(n0.norm() > 0)) return std::nullopt;  // degenerate: no plane to stay out of
+  n0.normalize();
+  const double g0 = n0.dot(xp - a0);
+  const double shortest = std::min({(b0 - a0).norm(), (c0 - b0).norm(), (a0 - c0).norm()});
+  if (g0 < -settings_.max_depth * shortest) return std::nullopt;  // the far side of the body
+  // Behind the plane beyond the tolerance: only a contact already held last step is still one
+  // (it sank within its tolerance); a new pair there is a node across a sharp convex crease
+  // (behind the plane, not through the surface), which a contact would throw out violently.
+  if (g0 < -2 * gap_tolerance_ && !set_.wasActive(p, t)) return std::nullopt;
+  const Eigen::Vector3d a1 = end.segment<3>(3 * tri[0]), b1 = end.segment<3>(3 * tri[1]),
+                        c1 = end.segment<3>(3 * tri[2]);
+  Eigen::Vector3d n1 = (b1 - a1).cross(c1 - a1);
+  if (!(n1.norm() > 0)) n1 = n0;
+  const double g1 = n1.normalized().dot(ep - a1);
+  // When on the path the node meets the plane: now if it is within the margin, at the
+  // crossing if it passes through, at the end if it ends within the margin.
+  double s;
+  if (g0 <= margin) {
+    s = 0;
+  } else if (g1 < 0) {
+    s = g0 / (g0 - g1);
+  } else if (g1 <= margin) {
+    s = 1;
+  } else {
+    return std::nullopt;
+  }
+  const Eigen::Vector3d w =
+      barycentric(xp + s * (ep - xp), a0 + s * (a1 - a0), b0 + s * (b1 - b0), c0 + s * (c1 - c0));
+  if (!w.allFinite() || w.minCoeff() < -kInsideTolerance) return std::nullopt;
+  const Eigen::Vector3d wc = w.cwiseMax(0.0) / w.cwiseMax(0.0).sum();
+  SurfaceContact c;
+  c.nodes = {p, tri[0], tri[1], tri[2]};
+  c.beta = {1.0, -wc[0], -wc[1], -wc[2]};
+  c.triangle = t;
+  c.normal = n0;
+  c.gap = g0;  // to the triangle's plane, at the start of the step
+  c.friction = settings_.friction;
+  return c;
 }
 
 Eigen::Vector3d SelfContactSolver::edgeNormal(const std::array<int, 2>& edge,
@@ -201,98 +262,106 @@ Eigen::Vector3d SelfContactSolver::edgeNormal(const std::array<int, 2>& edge,
   return sum.normalized();
 }
 
-void SelfContactSolver::addEdgeCandidates(const Eigen::VectorXd& x, const Eigen::VectorXd& end) {
+void SelfContactSolver::edgeCandidates(int i, const Eigen::VectorXd& x, const Eigen::VectorXd& end,
+                                       std::vector<int>& scratch,
+                                       std::vector<SurfaceContact>& out) const {
   const double margin = settings_.margin * mean_edge_;
-  for (size_t i = 0; i < edges_.size(); ++i) {
-    const std::array<int, 2>& e = edges_[i];
-    const Eigen::Vector3d p0 = x.segment<3>(3 * e[0]), q0 = x.segment<3>(3 * e[1]);
-    const Eigen::Vector3d p1 = end.segment<3>(3 * e[0]), q1 = end.segment<3>(3 * e[1]);
-    tree_.query(p0.cwiseMin(q0).cwiseMin(p1).cwiseMin(q1),
-                p0.cwiseMax(q0).cwiseMax(p1).cwiseMax(q1), found_);
-    ++edge_stamp_;
-    for (int t : found_) {
-      for (int j : triangle_edges_[static_cast<size_t>(t)]) {
-        if (static_cast<size_t>(j) <= i || edge_mark_[static_cast<size_t>(j)] == edge_stamp_)
-          continue;
-        edge_mark_[static_cast<size_t>(j)] = edge_stamp_;
-        const std::array<int, 2>& f = edges_[static_cast<size_t>(j)];
-        if (f[0] == e[0] || f[0] == e[1] || f[1] == e[0] || f[1] == e[1]) continue;  // adjacent
-        const std::uint64_t pair =
-            (static_cast<std::uint64_t>(i) << 32) | static_cast<std::uint32_t>(j);
-        if (edge_pairs_.count(pair) != 0) continue;  // this step has it already
-        const Eigen::Vector3d r0 = x.segment<3>(3 * f[0]), s0 = x.segment<3>(3 * f[1]);
-        const Eigen::Vector3d r1 = end.segment<3>(3 * f[0]), s1 = end.segment<3>(3 * f[1]);
-        // Normal: across both edges, pointing from edge f to edge e at the start.
-        Eigen::Vector3d n0 = (q0 - p0).cross(s0 - r0);
-        const double scale = (q0 - p0).norm() * (s0 - r0).norm();
-        if (!(n0.norm() > 1e-3 * scale)) continue;  // nearly parallel: nodes and faces hold them
-        n0.normalize();
-        double g0 = n0.dot(p0 - r0);
-        {
-          // Cheap rejection first: apart now and at the end of the path, on the same side.
-          const Eigen::Vector3d m1 = (q1 - p1).cross(s1 - r1);
-          const double h1 = m1.norm() > 0 ? m1.normalized().dot(p1 - r1) : g0;
-          if (std::abs(g0) > margin && std::abs(h1) > margin &&
-              (g0 > 0) == (m1.dot(n0) >= 0 ? h1 > 0 : h1 < 0))
-            continue;
-        }
-        SurfaceContact contact;
-        contact.triangle = j;
-        contact.edge = static_cast<int>(i);
-        // Oriented to separate them: as they are now, or, for a pair held last step (which may
-        // have crossed within the tolerance), as its impulse pushed.
-        // Oriented out of f's surface into e's (the sum of each edge's triangles' outward
-        // normals): the sign of the gap alone is arbitrary for edges lying in one plane, as those
-        // of two faces pressed together do, and a wrong sign pushes one face into the other. A
-        // pair held last step keeps the side its impulse pushed.
-        const Eigen::Vector3d* held = set_.warmStartOf(contact);
-        const Eigen::Vector3d outward = edgeNormal(f, x) - edgeNormal(e, x);
-        const double side = held != nullptr ? n0.dot(*held) : n0.dot(outward);
-        if (held == nullptr && std::abs(side) < 0.5 * outward.norm()) continue;  // not facing
-        if (side < 0) {
-          n0 = -n0;
-          g0 = -g0;
-        }
-        if (g0 < -2 * gap_tolerance_ && held == nullptr) continue;  // crossed before, or apart
-        if (g0 < -settings_.max_depth * (q0 - p0).norm()) continue;
-        Eigen::Vector3d n1 = (q1 - p1).cross(s1 - r1);
-        if (n1.dot(n0) < 0) n1 = -n1;
-        if (!(n1.norm() > 0)) n1 = n0;
-        const double g1 = n1.normalized().dot(p1 - r1);
-        double when;
-        if (g0 <= margin) {
-          when = 0;
-        } else if (g1 < 0) {
-          when = g0 / (g0 - g1);
-        } else if (g1 <= margin) {
-          when = 1;
-        } else {
-          continue;
-        }
-        // Closest points of the two lines at that moment; both must lie inside their edges.
-        const Eigen::Vector3d a = p0 + when * (p1 - p0), b = q0 + when * (q1 - q0);
-        const Eigen::Vector3d c = r0 + when * (r1 - r0), d = s0 + when * (s1 - s0);
-        const Eigen::Vector3d d1 = b - a, d2 = d - c, w = a - c;
-        const double aa = d1.dot(d1), bb = d1.dot(d2), cc = d2.dot(d2), dd = d1.dot(w),
-                     ee = d2.dot(w);
-        const double denominator = aa * cc - bb * bb;
-        if (!(denominator > 1e-12 * aa * cc)) continue;
-        const double u = (bb * ee - cc * dd) / denominator;
-        const double v = (aa * ee - bb * dd) / denominator;
-        if (!(u > 0 && u < 1 && v > 0 && v < 1)) continue;
-        // Closer at the start than the margin, or crossing on the path, but not closer than the
-        // points: a pair whose lines pass near while the edges stay apart is no contact.
-        const double distance = (a + u * d1 - c - v * d2).norm();
-        if (when == 0 && distance > margin) continue;
-        contact.nodes = {e[0], e[1], f[0], f[1]};
-        contact.beta = {1.0 - u, u, -(1.0 - v), -v};
-        contact.normal = n0;
-        contact.gap = g0;
-        contact.friction = settings_.friction;
-        edge_pairs_.insert(pair);
-        set_.add(contact);
-      }
+  const std::array<int, 2>& e = edges_[static_cast<size_t>(i)];
+  const Eigen::Vector3d p0 = x.segment<3>(3 * e[0]), q0 = x.segment<3>(3 * e[1]);
+  const Eigen::Vector3d p1 = end.segment<3>(3 * e[0]), q1 = end.segment<3>(3 * e[1]);
+  std::vector<int>& triangles = scratch;
+  tree_.query(edge_lo_[static_cast<size_t>(i)], edge_hi_[static_cast<size_t>(i)], triangles);
+  // The later edges of the triangles found, each once, ascending.
+  std::vector<int> later;
+  later.reserve(3 * triangles.size());
+  for (int t : triangles)
+    for (int j : triangle_edges_[static_cast<size_t>(t)])
+      if (j > i) later.push_back(j);
+  std::sort(later.begin(), later.end());
+  later.erase(std::unique(later.begin(), later.end()), later.end());
+  for (int j : later) {
+    const std::array<int, 2>& f = edges_[static_cast<size_t>(j)];
+    if (f[0] == e[0] || f[0] == e[1] || f[1] == e[0] || f[1] == e[1]) continue;  // adjacent
+    // Boxes over the motion more than the margin apart: never within it, never crossing.
+    const Eigen::Vector3d& lo = edge_lo_[static_cast<size_t>(j)];
+    const Eigen::Vector3d& hi = edge_hi_[static_cast<size_t>(j)];
+    if (((lo.array() - margin) > edge_hi_[static_cast<size_t>(i)].array()).any() ||
+        ((hi.array() + margin) < edge_lo_[static_cast<size_t>(i)].array()).any())
+      continue;
+    const std::uint64_t pair =
+        (static_cast<std::uint64_t>(i) << 32) | static_cast<std::uint32_t>(j);
+    if (edge_pairs_.count(pair) != 0) continue;  // this step has it already
+    const Eigen::Vector3d r0 = x.segment<3>(3 * f[0]), s0 = x.segment<3>(3 * f[1]);
+    const Eigen::Vector3d r1 = end.segment<3>(3 * f[0]), s1 = end.segment<3>(3 * f[1]);
+    // Normal: across both edges, pointing from edge f to edge e at the start.
+    Eigen::Vector3d n0 = (q0 - p0).cross(s0 - r0);
+    const double scale = (q0 - p0).norm() * (s0 - r0).norm();
+    if (!(n0.norm() > 1e-3 * scale)) continue;  // nearly parallel: nodes and faces hold them
+    n0.normalize();
+    double g0 = n0.dot(p0 - r0);
+    {
+      // Cheap rejection first: apart now and at the end of the path, on the same side.
+      const Eigen::Vector3d m1 = (q1 - p1).cross(s1 - r1);
+      const double h1 = m1.norm() > 0 ? m1.normalized().dot(p1 - r1) : g0;
+      if (std::abs(g0) > margin && std::abs(h1) > margin &&
+          (g0 > 0) == (m1.dot(n0) >= 0 ? h1 > 0 : h1 < 0))
+        continue;
     }
+    if (std::abs(g0) <= margin) {
+      // Within the margin now, whichever way the normal turns: the pair is judged at the start,
+      // so its closest points can rule it out before the (dearer) orientation. Neighbouring
+      // edges of one face lie in a plane and end here.
+      double u, v, distance;
+      if (!closestPoints(p0, q0, r0, s0, u, v, distance)) continue;
+      if (!(u > 0 && u < 1 && v > 0 && v < 1) || distance > margin) continue;
+    }
+    SurfaceContact contact;
+    contact.triangle = j;
+    contact.edge = i;
+    // Oriented out of f's surface into e's (the sum of each edge's triangles' outward
+    // normals): the sign of the gap alone is arbitrary for edges lying in one plane, as those
+    // of two faces pressed together do, and a wrong sign pushes one face into the other. A
+    // pair held last step (which may have crossed within the tolerance) keeps the side its
+    // impulse pushed.
+    const Eigen::Vector3d* held = set_.warmStartOf(contact);
+    const Eigen::Vector3d outward = edgeNormal(f, x) - edgeNormal(e, x);
+    const double side = held != nullptr ? n0.dot(*held) : n0.dot(outward);
+    if (held == nullptr && std::abs(side) < 0.5 * outward.norm()) continue;  // not facing
+    if (side < 0) {
+      n0 = -n0;
+      g0 = -g0;
+    }
+    if (g0 < -2 * gap_tolerance_ && held == nullptr) continue;  // crossed before, or apart
+    if (g0 < -settings_.max_depth * (q0 - p0).norm()) continue;
+    Eigen::Vector3d n1 = (q1 - p1).cross(s1 - r1);
+    if (n1.dot(n0) < 0) n1 = -n1;
+    if (!(n1.norm() > 0)) n1 = n0;
+    const double g1 = n1.normalized().dot(p1 - r1);
+    double when;
+    if (g0 <= margin) {
+      when = 0;
+    } else if (g1 < 0) {
+      when = g0 / (g0 - g1);
+    } else if (g1 <= margin) {
+      when = 1;
+    } else {
+      continue;
+    }
+    // Closest points of the two lines at that moment; both must lie inside their edges.
+    const Eigen::Vector3d a = p0 + when * (p1 - p0), b = q0 + when * (q1 - q0);
+    const Eigen::Vector3d c = r0 + when * (r1 - r0), d = s0 + when * (s1 - s0);
+    double u, v, distance;
+    if (!closestPoints(a, b, c, d, u, v, distance)) continue;
+    if (!(u > 0 && u < 1 && v > 0 && v < 1)) continue;
+    // Closer at the start than the margin, or crossing on the path, but not closer than the
+    // points: a pair whose lines pass near while the edges stay apart is no contact.
+    if (when == 0 && distance > margin) continue;
+    contact.nodes = {e[0], e[1], f[0], f[1]};
+    contact.beta = {1.0 - u, u, -(1.0 - v), -v};
+    contact.normal = n0;
+    contact.gap = g0;
+    contact.friction = settings_.friction;
+    out.push_back(contact);
   }
 }
 
@@ -300,11 +369,19 @@ LinearSolveReport SelfContactSolver::solve(const SystemOperator& op,
                                            const NodeConstraints& constraints,
                                            const Eigen::VectorXd& b, const SolverSettings& settings,
                                            Eigen::VectorXd& v, const InnerSolve& inner) {
-  // Penalties from the system without the term (the operator includes it otherwise).
-  set_.setSuspended(true);
-  op.diagonalBlocks(blocks_);
-  set_.setSuspended(false);
-  set_.setPenalties(blocks_, settings_.penalty_factor);
+  // Penalties from the system without the term (the operator includes it otherwise); its
+  // diagonal blocks are only taken once there are candidates.
+  penalties_ready_ = false;
+  const auto set_penalties = [&] {
+    if (!penalties_ready_) {
+      set_.setSuspended(true);
+      op.diagonalBlocks(blocks_);
+      set_.setSuspended(false);
+      penalties_ready_ = true;
+    }
+    set_.setPenalties(blocks_, settings_.penalty_factor);
+  };
+  if (!set_.empty()) set_penalties();
   // Activation below a tenth of the tolerance: a contact hovering at zero gap does not flip.
   const double activation = 0.1 * gap_tolerance_;
 
@@ -328,10 +405,13 @@ LinearSolveReport SelfContactSolver::solve(const SystemOperator& op,
     if (r.breakdown) break;
     const bool settled = set_.update(v, dt_, activation, gap_tolerance_);
     // Safeguard: where constraints contradict each other (crossed before, a crease) Uzawa can
-    // diverge. The best solve so far is kept; three worse ones in a row end the step with it
-    // (reported as not converged).
+    // diverge. The best solve so far is kept; three worse ones in a row, beyond the tolerance,
+    // end the step with it (reported as not converged).
+    // An update whose gaps are all within the tolerance is never "worse": it is kept and the
+    // loop goes on to settle states and friction (stopping there left most of the plectoneme's
+    // contact steps unconverged with their gaps already within the tolerance).
     const double error = set_.maxGapError();
-    if (round == 0 || error < best_error) {
+    if (round == 0 || error < best_error || error <= gap_tolerance_) {
       best_error = error;
       best_v_ = v;
       best_contacts_ = set_.contacts();
@@ -352,7 +432,7 @@ LinearSolveReport SelfContactSolver::solve(const SystemOperator& op,
     if (moved > 0.5 * margin / std::sqrt(3.0) && redetections < kMaxRedetections &&
         addCandidates(*start_, end_) > 0) {
       ++redetections;
-      set_.setPenalties(blocks_, settings_.penalty_factor);
+      set_penalties();
       set_.update(v, dt_, activation, gap_tolerance_);  // activates the new ones
       continue;
     }

@@ -5,6 +5,20 @@
 
 namespace torsion {
 
+namespace {
+
+// Stick/slide switches of one contact per step before it keeps its state (anti-cycling).
+constexpr int kMaxSwitches = 4;
+
+// The operator's block for a contact: rho I sticking, rho n n^T + k_t (I - n n^T) sliding.
+Eigen::Matrix3d contactBlock(const SurfaceContact& c) {
+  if (c.state == SurfaceContact::State::kStick) return c.penalty * Eigen::Matrix3d::Identity();
+  const Eigen::Matrix3d nn = c.normal * c.normal.transpose();
+  return c.penalty * nn + c.tangential_stiffness * (Eigen::Matrix3d::Identity() - nn);
+}
+
+}  // namespace
+
 SurfaceContactSet::WarmStarts SurfaceContactSet::warmStarts() const {
   WarmStarts warm;
   for (const SurfaceContact& c : contacts_) {
@@ -51,6 +65,8 @@ void SurfaceContactSet::add(SurfaceContact contact) {
       contact.state = contact.friction > 0 && tangential.norm() < bound
                           ? SurfaceContact::State::kStick
                           : SurfaceContact::State::kSlide;
+      // Sliding: its first solve holds it at the penalty; the slip it then shows sets k_t.
+      if (contact.friction > 0) contact.tangential_stiffness = -1;
     }
   }
   contacts_.push_back(contact);
@@ -65,6 +81,7 @@ void SurfaceContactSet::setPenalties(const std::vector<Eigen::Matrix3d>& diagona
       inverse_mass += c.beta[k] * c.beta[k] / m;
     }
     c.penalty = penalty_factor / inverse_mass;
+    if (c.tangential_stiffness < 0) c.tangential_stiffness = c.penalty;
   }
 }
 
@@ -79,7 +96,10 @@ Eigen::Vector3d SurfaceContactSet::relativeVelocity(const SurfaceContact& c,
 void SurfaceContactSet::addRightHandSide(double dt, Eigen::VectorXd& b) const {
   for (const SurfaceContact& c : contacts_) {
     if (!participates(c)) continue;
-    const Eigen::Vector3d r = c.multiplier - c.penalty * c.normal * (c.gap / dt);
+    const Eigen::Vector3d lambda = c.state == SurfaceContact::State::kStick
+                                       ? c.multiplier
+                                       : Eigen::Vector3d(c.normal * c.normal.dot(c.multiplier));
+    const Eigen::Vector3d r = lambda - c.penalty * c.normal * (c.gap / dt);
     for (size_t k = 0; k < 4; ++k)
       b.segment<3>(3 * c.nodes[k]) += c.beta[k] * r;
   }
@@ -88,10 +108,7 @@ void SurfaceContactSet::addRightHandSide(double dt, Eigen::VectorXd& b) const {
 void SurfaceContactSet::addProduct(const Eigen::VectorXd& y, Eigen::VectorXd& out) const {
   for (const SurfaceContact& c : contacts_) {
     if (!participates(c)) continue;
-    const Eigen::Vector3d u = relativeVelocity(c, y);
-    const Eigen::Vector3d f = c.state == SurfaceContact::State::kStick
-                                  ? Eigen::Vector3d(c.penalty * u)
-                                  : Eigen::Vector3d(c.penalty * c.normal * c.normal.dot(u));
+    const Eigen::Vector3d f = contactBlock(c) * relativeVelocity(c, y);
     for (size_t k = 0; k < 4; ++k)
       out.segment<3>(3 * c.nodes[k]) += c.beta[k] * f;
   }
@@ -100,23 +117,23 @@ void SurfaceContactSet::addProduct(const Eigen::VectorXd& y, Eigen::VectorXd& ou
 void SurfaceContactSet::addDiagonalBlocks(std::vector<Eigen::Matrix3d>& blocks) const {
   for (const SurfaceContact& c : contacts_) {
     if (!participates(c)) continue;
-    const Eigen::Matrix3d p = c.state == SurfaceContact::State::kStick
-                                  ? Eigen::Matrix3d::Identity()
-                                  : Eigen::Matrix3d(c.normal * c.normal.transpose());
+    const Eigen::Matrix3d p = contactBlock(c);
     for (size_t k = 0; k < 4; ++k)
-      blocks[static_cast<size_t>(c.nodes[k])] += c.penalty * c.beta[k] * c.beta[k] * p;
+      blocks[static_cast<size_t>(c.nodes[k])] += c.beta[k] * c.beta[k] * p;
   }
 }
 
 bool SurfaceContactSet::update(const Eigen::VectorXd& v, double dt, double activation_tolerance,
                                double gap_tolerance) {
+  using State = SurfaceContact::State;
   bool converged = true;
   for (SurfaceContact& c : contacts_) {
     if (c.determined) continue;
-    const Eigen::Vector3d h = relativeVelocity(c, v) + c.normal * (c.gap / dt);
-    const double hn = c.normal.dot(h);
+    const Eigen::Vector3d u = relativeVelocity(c, v);
+    const double un = c.normal.dot(u);
+    const double hn = un + c.gap / dt;
     c.end_gap = dt * hn;
-    if (c.state == SurfaceContact::State::kInactive) {
+    if (c.state == State::kInactive) {
       // A released contact comes back only if it penetrates beyond the tolerance (anti-cycling).
       const double threshold = c.releases > 0 ? gap_tolerance : activation_tolerance;
       if (c.end_gap >= -threshold) {
@@ -124,52 +141,58 @@ bool SurfaceContactSet::update(const Eigen::VectorXd& v, double dt, double activ
         continue;
       }
     }
-    const SurfaceContact::State old_state = c.state;
-    const Eigen::Vector3d old_multiplier = c.multiplier;
-    const Eigen::Vector3d trial = c.multiplier - c.penalty * h;
-    const double ln = c.normal.dot(trial);
+    const State old_state = c.state;
+    const double old_stiffness = c.tangential_stiffness;
+    const double ln = c.normal.dot(c.multiplier) - c.penalty * hn;
     if (ln <= 0) {
-      if (c.state != SurfaceContact::State::kInactive) {
+      if (c.state != State::kInactive) {
         ++c.releases;
         converged = false;
       }
-      c.state = SurfaceContact::State::kInactive;
+      c.state = State::kInactive;
       c.multiplier.setZero();
+      c.tangential_stiffness = 0;
       continue;
     }
-    const Eigen::Vector3d tangential = trial - c.normal * ln;
+    const Eigen::Vector3d slip = u - c.normal * un;  // tangential relative velocity
+    const double speed = slip.norm();
     const double bound = c.friction * ln;
-    const bool may_stick = old_state != SurfaceContact::State::kSlide || c.switches < 2;
-    if (c.friction > 0 && tangential.norm() <= bound && may_stick) {
-      c.state = SurfaceContact::State::kStick;
-      c.multiplier = trial;
-    } else {
-      // Sliding: Coulomb's friction opposes the slip, under-relaxed half way from the last value:
-      // taken from the trial alone, the friction and the slip it causes alternated between two
-      // states.
-      c.state = SurfaceContact::State::kSlide;
-      const Eigen::Vector3d slip = h - c.normal * hn;
-      const Eigen::Vector3d direction = slip.norm() > 0 ? Eigen::Vector3d(-slip.normalized())
-                                                        : Eigen::Vector3d(tangential.normalized());
-      Eigen::Vector3d friction = bound * direction;
-      if (old_state == SurfaceContact::State::kSlide) {
-        const Eigen::Vector3d old_t = old_multiplier - c.normal * c.normal.dot(old_multiplier);
-        friction = 0.5 * (friction + old_t);
-        if (friction.norm() > bound) friction *= bound / friction.norm();
+    const bool may_switch = c.switches < kMaxSwitches;
+    // k_t Coulomb's friction asks for at this slip, at most the penalty (then it sticks).
+    const double wanted = speed * c.penalty <= bound ? c.penalty : bound / speed;
+    if (c.friction <= 0) {
+      c.state = State::kSlide;
+      c.tangential_stiffness = 0;
+      c.multiplier = c.normal * ln;
+    } else if (old_state == State::kStick) {
+      Eigen::Vector3d trial =
+          c.multiplier - c.normal * c.normal.dot(c.multiplier) - c.penalty * slip;
+      if (trial.norm() <= bound || !may_switch) {
+        if (trial.norm() > bound) trial *= bound / trial.norm();
+        c.multiplier = c.normal * ln + trial;
+      } else {
+        c.state = State::kSlide;
+        c.tangential_stiffness = wanted;
+        c.multiplier = c.normal * ln - wanted * slip;
       }
-      if (!friction.allFinite()) friction.setZero();
-      c.multiplier = c.normal * ln + friction;
+    } else if (wanted >= c.penalty && (may_switch || old_state == State::kInactive)) {
+      // Slower than mu lambda_n / rho: sticks, from the friction impulse of this solve.
+      c.state = State::kStick;
+      const double used = old_state == State::kSlide ? std::max(0.0, old_stiffness) : 0.0;
+      c.multiplier = c.normal * ln - used * slip;
+    } else {
+      c.state = State::kSlide;
+      c.tangential_stiffness = wanted;
+      c.multiplier = c.normal * ln - wanted * slip;
     }
-    if (old_state != SurfaceContact::State::kInactive && c.state != old_state) ++c.switches;
+    if (!c.multiplier.allFinite()) c.multiplier = c.normal * ln;
+    if (old_state != State::kInactive && c.state != old_state) ++c.switches;
     if (c.state != old_state || std::abs(c.end_gap) > gap_tolerance) converged = false;
-    const Eigen::Vector3d slip = h - c.normal * hn;
-    if (c.state == SurfaceContact::State::kStick && dt * slip.norm() > gap_tolerance)
+    if (c.state == State::kStick && dt * speed > gap_tolerance) converged = false;
+    // Sliding friction settled: its impulse moved by less than 2 % of mu lambda_n.
+    if (c.state == State::kSlide && c.friction > 0 &&
+        std::abs(c.tangential_stiffness - old_stiffness) * speed > 2e-2 * bound)
       converged = false;
-    // Sliding friction follows the normal impulse: settled once it moves by less than 1 %.
-    if (c.state == SurfaceContact::State::kSlide) {
-      const Eigen::Vector3d change = c.multiplier - old_multiplier;
-      if ((change - c.normal * c.normal.dot(change)).norm() > 2e-2 * bound) converged = false;
-    }
   }
   return converged;
 }

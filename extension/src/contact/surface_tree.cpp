@@ -8,11 +8,18 @@ namespace torsion {
 
 namespace {
 
-// Collects leaf indices of a box query.
-struct Collector : btDbvt::ICollide {
-  std::vector<int>* out = nullptr;
-  void Process(const btDbvtNode* leaf) override { out->push_back(leaf->dataAsInt); }
-};
+// Leaf indices under `node` whose boxes overlap `box`. Recursive rather than btDbvt::collideTV,
+// which allocates its stack on every call: queries run per surface node and edge, from several
+// threads at once, and only read the tree.
+void collect(const btDbvtNode* node, const btDbvtVolume& box, std::vector<int>& out) {
+  if (!Intersect(node->volume, box)) return;
+  if (node->isleaf()) {
+    out.push_back(node->dataAsInt);
+    return;
+  }
+  collect(node->childs[0], box, out);
+  collect(node->childs[1], box, out);
+}
 
 btDbvtVolume boxOf(const Eigen::Vector3d& lo, const Eigen::Vector3d& hi) {
   // Float Bullet rounds the corners: widen by one float ulp of the extent so no overlap is lost.
@@ -56,9 +63,7 @@ void SurfaceTree::query(const Eigen::Vector3d& lo, const Eigen::Vector3d& hi,
                         std::vector<int>& out) const {
   out.clear();
   if (tree_.m_root == nullptr) return;
-  Collector collector;
-  collector.out = &out;
-  tree_.collideTV(tree_.m_root, boxOf(lo, hi), collector);
+  collect(tree_.m_root, boxOf(lo, hi), out);
   std::sort(out.begin(), out.end());
 }
 

@@ -141,6 +141,7 @@ class FemBody {
   std::string name_;
   std::shared_ptr<const FemModel> model_;
   FemState state_;
+  const Parallel& parallel_;  // the world's threads (self-contact searches on them)
   ImplicitStepper stepper_;
   NodeConstraints constraints_;
   Eigen::VectorXd external_forces_;  // N, 3n, the user's (setExternalForces)

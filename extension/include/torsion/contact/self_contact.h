@@ -26,6 +26,7 @@
 #include <cstdint>
 #include <functional>
 #include <memory>
+#include <optional>
 #include <set>
 #include <vector>
 
@@ -35,6 +36,7 @@
 #include "torsion/result.h"
 #include "torsion/solve/fem_state.h"
 #include "torsion/solve/node_constraints.h"
+#include "torsion/solve/parallel.h"
 #include "torsion/solve/projected_cg.h"
 #include "torsion/solve/solver_settings.h"
 #include "torsion/solve/system_operator.h"
@@ -65,6 +67,7 @@ struct SelfContactStats {
   int active = 0;      ///< pushing at the end of the step
   int sticking = 0;    ///< of which sticking
   int iterations = 0;  ///< Uzawa updates (CG solves) this step
+  int searches = 0;    ///< tree searches this step: 1, plus the re-searches along the solved motion
   bool converged = true;
   double normal_impulse = 0;       ///< N s, sum over active contacts
   double max_penetration = 0;      ///< m, deepest candidate node behind its triangle at the start
@@ -73,7 +76,12 @@ struct SelfContactStats {
 
 class SelfContactSolver {
  public:
+  /// Searches serially.
   SelfContactSolver(std::shared_ptr<const FemModel> model, const SelfContactSettings& settings);
+  /// Searches on `parallel`'s threads (it must outlive the solver); the candidates, and so every
+  /// result, are the same for any thread count.
+  SelfContactSolver(std::shared_ptr<const FemModel> model, const SelfContactSettings& settings,
+                    const Parallel& parallel);
 
   const SelfContactSettings& settings() const { return settings_; }
   /// The gap tolerance in use (m): settings().gap_tolerance or its default from the mesh.
@@ -105,11 +113,19 @@ class SelfContactSolver {
   void replaceModel(std::shared_ptr<const FemModel> model) { model_ = std::move(model); }
 
  private:
+  SelfContactSolver(std::shared_ptr<const FemModel> model, const SelfContactSettings& settings,
+                    const Parallel* parallel);
   // Adds the (node, triangle) pairs found along the motion from x to end that this step does not
-  // have yet; returns how many.
+  // have yet, then the edge pairs; returns how many. The tree queries run in fixed blocks of
+  // nodes (edges) on the threads, and the blocks' finds are added in block order.
   int addCandidates(const Eigen::VectorXd& x, const Eigen::VectorXd& end);
-  // Edge-against-edge pairs along the same motion (crossing edges that no node meets).
-  void addEdgeCandidates(const Eigen::VectorXd& x, const Eigen::VectorXd& end);
+  // The contact of node p with triangle t along the motion, if they are a candidate (reads only).
+  std::optional<SurfaceContact> nodeCandidate(int p, int t, const Eigen::VectorXd& x,
+                                              const Eigen::VectorXd& end) const;
+  // Edge-against-edge pairs (i, j > i) along the same motion: crossing edges that no node meets
+  // (reads only; appended to out in ascending j).
+  void edgeCandidates(int i, const Eigen::VectorXd& x, const Eigen::VectorXd& end,
+                      std::vector<int>& scratch, std::vector<SurfaceContact>& out) const;
   // Unit mean outward normal of the surface triangles on a surface edge, at positions x.
   Eigen::Vector3d edgeNormal(const std::array<int, 2>& edge, const Eigen::VectorXd& x) const;
 
@@ -117,16 +133,17 @@ class SelfContactSolver {
   SelfContactSettings settings_;
   double mean_edge_ = 0;
   double gap_tolerance_ = 0;
+  std::unique_ptr<Parallel> own_parallel_;  // serial, when no Parallel was given
+  const Parallel* parallel_ = nullptr;
   SurfaceTree tree_;
-  std::vector<char> one_ring_mark_;               // scratch: triangles incident to the current node
-  std::vector<std::vector<int>> node_triangles_;  // surface triangles of each node
-  std::vector<std::vector<int>> node_contacts_;   // this step's contacts of each node
-  std::vector<int> touched_nodes_;                // nodes with an entry in node_contacts_
-  std::vector<std::array<int, 2>> edges_;         // surface edges, corners ascending
-  std::vector<std::vector<int>> triangle_edges_;  // the three edges of each surface triangle
-  std::vector<int> edge_mark_;                    // scratch: edges seen by the current query
-  int edge_stamp_ = 0;
-  std::set<std::uint64_t> edge_pairs_;      // this step's edge pairs (i << 32 | j)
+  std::vector<std::vector<int>> node_triangles_;    // surface triangles of each node
+  std::vector<std::vector<int>> node_contacts_;     // this step's contacts of each node
+  std::vector<int> touched_nodes_;                  // nodes with an entry in node_contacts_
+  std::vector<std::array<int, 2>> edges_;           // surface edges, corners ascending
+  std::vector<std::vector<int>> triangle_edges_;    // the three edges of each surface triangle
+  std::vector<Eigen::Vector3d> edge_lo_, edge_hi_;  // each edge's box over the searched motion
+  std::vector<std::vector<SurfaceContact>> block_finds_;  // per block of nodes (edges), in order
+  std::set<std::uint64_t> edge_pairs_;                    // this step's edge pairs (i << 32 | j)
   const Eigen::VectorXd* start_ = nullptr;  // positions at the step's start (the state's)
   const NodeConstraints* constraints_ = nullptr;
   SurfaceContactSet set_;
@@ -136,7 +153,7 @@ class SelfContactSolver {
   std::vector<Eigen::Matrix3d> blocks_;
   Eigen::VectorXd end_, b_aug_, best_v_;
   std::vector<SurfaceContact> best_contacts_;
-  std::vector<int> found_;
+  bool penalties_ready_ = false;  // blocks_ hold this step's diagonal blocks
 };
 
 }  // namespace torsion

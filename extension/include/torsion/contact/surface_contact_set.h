@@ -11,14 +11,20 @@
 // triangle's corners, so the pair exchanges momentum exactly (sum beta_k = 0) and, the lever being
 // the same point, angular momentum up to the linearisation.
 //
-// Augmented Lagrangian (Alart & Curnier 1991; Uzawa's update): each linear solve takes the
-// impulse as lambda = Lambda - rho P h with h = u + n gap / dt, P = I (sticking) or n n^T
-// (sliding, the tangential part of Lambda being Coulomb's friction). That adds rho beta_k beta_l P
-// to the system (this class is the AddedOperatorTerm) and beta_k (Lambda - rho n gap / dt) to its
-// right-hand side. After each solve, update() projects Lambda - rho h onto Coulomb's cone:
-// lambda_n = max(0, .), sticking while |lambda_t| <= mu lambda_n, sliding at mu lambda_n along it
-// otherwise. rho is `penalty_factor` times the contact's effective mass from the system's 3x3
-// diagonal blocks.
+// Augmented Lagrangian (Alart & Curnier 1991; Uzawa's update) for the normal impulse, with
+// Coulomb's friction implicit in the tangential direction. Each linear solve takes the impulse as
+//   sticking: lambda = Lambda - rho h,                         h = u + n gap / dt,
+//   sliding:  lambda = n (n.Lambda - rho n.h) - k_t (I - n n^T) u,
+// which adds rho beta_k beta_l I (sticking) or beta_k beta_l (rho n n^T + k_t (I - n n^T))
+// (sliding) to the system (this class is the AddedOperatorTerm) and beta_k (Lambda - rho n gap /
+// dt) to its right-hand side (only Lambda's normal part when sliding). After each solve update()
+// projects on Coulomb's cone: lambda_n = max(0, n.Lambda - rho n.h); a sticking contact keeps
+// Lambda - rho h while its tangential part stays within mu lambda_n; a sliding one gets
+// k_t = mu lambda_n / |u_t| (at most rho: below the slip speed mu lambda_n / rho it sticks again),
+// so its friction impulse -k_t u_t is Coulomb's, opposes the slip of the same solve and can never
+// reverse it (a fixed point of lagged stiffnesses: Kacanov's iteration, not an explicit force).
+// rho is `penalty_factor` times the contact's effective mass from the system's 3x3 diagonal
+// blocks.
 
 #include <Eigen/Core>
 #include <array>
@@ -43,8 +49,11 @@ struct SurfaceContact {
   State state = State::kInactive;
   bool determined = false;  ///< all four nodes fully prescribed: sits the solves out
   int releases = 0;         ///< releases this step (anti-cycling: one)
-  int switches = 0;         ///< stick/slide switches this step (anti-cycling: then it slides)
-  double end_gap = 0;       ///< m, the linearised end-of-step gap after the last solve
+  int switches = 0;         ///< stick/slide switches this step (anti-cycling: then it stays)
+  /// kg, sliding: k_t, the friction impulse being -k_t u_t (the tangential relative velocity);
+  /// at most the penalty. Negative: the penalty (a warm-started contact's first solve).
+  double tangential_stiffness = 0;
+  double end_gap = 0;  ///< m, the linearised end-of-step gap after the last solve
 };
 
 class SurfaceContactSet final : public AddedOperatorTerm {
@@ -80,7 +89,8 @@ class SurfaceContactSet final : public AddedOperatorTerm {
   /// Uzawa's projection after a solve with velocities v (3n). Activates contacts whose end gap is
   /// below -activation_tolerance. Returns whether the set has converged: no contact changed
   /// state, every end gap within gap_tolerance (no penetration beyond it, no active contact
-  /// pushing across a gap beyond it) and no sticking contact slipping more than gap_tolerance.
+  /// pushing across a gap beyond it), no sticking contact slipping more than gap_tolerance and
+  /// every sliding contact's friction impulse within 2 % of mu lambda_n of the last solve's.
   bool update(const Eigen::VectorXd& v, double dt, double activation_tolerance,
               double gap_tolerance);
   /// m, the deepest linearised end-of-step penetration of any candidate (>= 0).
@@ -89,7 +99,7 @@ class SurfaceContactSet final : public AddedOperatorTerm {
   /// contact's end gap away from zero.
   double maxGapError() const;
 
-  // AddedOperatorTerm: rho beta_k beta_l P of the active contacts.
+  // AddedOperatorTerm: beta_k beta_l (rho I or rho n n^T + k_t (I - n n^T)) of the active contacts.
   void addProduct(const Eigen::VectorXd& y, Eigen::VectorXd& out) const override;
   void addDiagonalBlocks(std::vector<Eigen::Matrix3d>& blocks) const override;
   /// While suspended the term adds nothing (the penalties are taken from A alone).

@@ -22,7 +22,8 @@ class SurfaceTree {
 
   /// Each triangle's box covers it at `start` and at `end` (3n positions), grown by `pad` (m).
   void refit(const Eigen::VectorXd& start, const Eigen::VectorXd& end, double pad);
-  /// Indices of the triangles whose boxes overlap [lo, hi], ascending.
+  /// Indices of the triangles whose boxes overlap [lo, hi], ascending. Only reads the tree: any
+  /// number of threads may query at once (each with its own `out`), none while refit() runs.
   void query(const Eigen::Vector3d& lo, const Eigen::Vector3d& hi, std::vector<int>& out) const;
   const std::vector<Triangle>& triangles() const { return triangles_; }
 

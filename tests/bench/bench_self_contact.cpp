@@ -1,0 +1,88 @@
+// Self-contact over a whole scene (docs/performance.md, "Self-contact on the plectoneme rod";
+// docs/contact.md, "Self-contact"): steps/s, and per body with self-contact the steps whose
+// contact solve stopped unconverged, the most active contacts, the deepest linearised end-of-step
+// penetration, the tree searches, how many unconverged steps used every Uzawa update (the others
+// were stopped by the safeguard), and every `--check-every` steps whether any two surface
+// triangles cross. One JSON line on stdout.
+//
+//   bench_self_contact SCENE [--steps N] [--threads T] [--check-every K]
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <string>
+
+#include "../contact/surface_intersections.h"
+#include "scene_builder.h"
+#include "scene_haptics.h"
+#include "scene_parser.h"
+
+int main(int argc, char** argv) {
+  using namespace torsion;
+  using namespace torsion::scene;
+  if (argc < 2) {
+    std::fprintf(stderr, "usage: %s SCENE [--steps N] [--threads T] [--check-every K]\n", argv[0]);
+    return 1;
+  }
+  int steps = -1, threads = -1, check_every = 50;
+  for (int a = 2; a + 1 < argc; a += 2) {
+    if (!std::strcmp(argv[a], "--steps")) steps = std::atoi(argv[a + 1]);
+    if (!std::strcmp(argv[a], "--threads")) threads = std::atoi(argv[a + 1]);
+    if (!std::strcmp(argv[a], "--check-every")) check_every = std::atoi(argv[a + 1]);
+  }
+  Result<SceneSpec> spec = loadScene(argv[1]);
+  if (!spec) {
+    std::fprintf(stderr, "%s\n", spec.error().message.c_str());
+    return 1;
+  }
+  if (steps < 0) steps = spec.value().steps;
+  Result<std::unique_ptr<BuiltScene>> built = buildScene(std::move(spec.value()), threads);
+  if (!built) {
+    std::fprintf(stderr, "%s\n", built.error().message.c_str());
+    return 1;
+  }
+  BuiltScene& scene = *built.value();
+  FemBody* body = nullptr;
+  for (const auto& b : scene.world->bodies())
+    if (b->selfContact() != nullptr) body = b.get();
+  if (body == nullptr) {
+    std::fprintf(stderr, "no body with self-contact in %s\n", argv[1]);
+    return 1;
+  }
+  SurfaceTree tree(body->model().mesh().surfaceTriangles());
+  int unconverged = 0, at_cap = 0, max_active = 0, searches = 0, crossing_checks = 0,
+      crossing_first = -1;
+  double worst_end = 0, stepping = 0;
+  for (int k = 1; k <= steps; ++k) {
+    const auto t0 = std::chrono::steady_clock::now();
+    Result<WorldStepReport> report = stepScene(scene);
+    stepping += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    if (!report || !report.value().ok) {
+      std::fprintf(stderr, "step %d failed: %s\n", k,
+                   report ? report.value().message.c_str() : report.error().message.c_str());
+      return 2;
+    }
+    const SelfContactStats& s = body->selfContact()->stats();
+    unconverged += s.converged ? 0 : 1;
+    // Unconverged with every update used, rather than stopped early by the safeguard.
+    if (!s.converged && s.iterations >= body->selfContact()->settings().max_iterations) ++at_cap;
+    max_active = std::max(max_active, s.active);
+    worst_end = std::max(worst_end, s.max_end_penetration);
+    searches += s.searches;
+    if (check_every > 0 && k % check_every == 0 &&
+        countSurfaceIntersections(tree, body->state().positions) > 0) {
+      ++crossing_checks;
+      if (crossing_first < 0) crossing_first = k;
+    }
+  }
+  std::printf(
+      "{\"scene\": \"%s\", \"steps\": %d, \"threads\": %d, \"steps_per_s\": %.2f, "
+      "\"unconverged\": %d, \"unconverged_at_max_iterations\": %d, \"max_active\": %d, "
+      "\"worst_end_penetration_m\": %.3g, "
+      "\"gap_tolerance_m\": %.3g, \"searches\": %d, \"crossing_checks\": %d, "
+      "\"first_crossing_step\": %d}\n",
+      scene.spec.name.c_str(), steps, threads, steps / stepping, unconverged, at_cap, max_active,
+      worst_end, body->selfContact()->gapTolerance(), searches, crossing_checks, crossing_first);
+  return 0;
+}
