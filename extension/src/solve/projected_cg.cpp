@@ -11,6 +11,8 @@ namespace torsion {
 
 ProjectedCg::ProjectedCg() = default;
 ProjectedCg::~ProjectedCg() = default;
+ProjectedCg::ProjectedCg(ProjectedCg&&) noexcept = default;
+ProjectedCg& ProjectedCg::operator=(ProjectedCg&&) noexcept = default;
 
 long ProjectedCg::factorisations() const {
   long count = 0;

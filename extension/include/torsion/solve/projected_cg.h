@@ -48,6 +48,10 @@ class ProjectedCg {
   ~ProjectedCg();
   ProjectedCg(const ProjectedCg&) = delete;
   ProjectedCg& operator=(const ProjectedCg&) = delete;
+  // Movable, so solvers can be kept in a std::vector (one per body of an island); defined in the
+  // .cpp, where the preconditioners' types are complete.
+  ProjectedCg(ProjectedCg&&) noexcept;
+  ProjectedCg& operator=(ProjectedCg&&) noexcept;
 
   LinearSolveReport solve(const SystemOperator& op, const NodeConstraints& constraints,
                           const Eigen::VectorXd& b, const SolverSettings& settings,
