@@ -3,6 +3,8 @@
 // element's own force differential. (The tet10 blocks are checked against the element
 // differentials in quadratic_mesh_test.cpp.)
 
+#include "solve/system_operator_kernels.h"  // white box: extension/src
+
 #include <gtest/gtest.h>
 
 #include <Eigen/Geometry>
@@ -10,6 +12,7 @@
 #include <random>
 
 #include "torsion/fem/corotated_element.h"
+#include "torsion/fem/polar_rotation.h"
 #include "torsion/mesh/box_mesh.h"
 #include "torsion/solve/system_operator.h"
 
@@ -100,6 +103,72 @@ TEST(SystemOperatorKernels, Tet4ProductsMatchTheElementDifferentialsInEitherBuil
     Eigen::VectorXd Ky;
     op.multiplyStiffness(y, Ky);
     EXPECT_LT((Ky - reference).norm(), 1e-12 * reference.norm()) << op.kernelPath();
+  }
+}
+
+// The batched per-tet pass (F, rotation, forces, energy, four tets at a time) against the element
+// functions it replaces, in each build: random deformations, warm-started from a nearby rotation,
+// the batch cut short at the end, and inverted tets flagged for the SVD path, not computed.
+TEST(SystemOperatorKernels, BatchedTet4ForcePassMatchesTheElementFunctions) {
+  auto model = beam(ElementKind::kTet4);
+  const int tets = model->elementCount() - 1;  // a short last batch
+  std::mt19937 rng(5);
+  std::normal_distribution<double> n(0, 1);
+  const Eigen::Matrix3d Q = Eigen::Quaterniond(0.9, 0.3, -0.2, 0.4).normalized().toRotationMatrix();
+  std::vector<double> positions;
+  for (const Eigen::Vector3d& X : model->mesh().restPositions()) {
+    const Eigen::Vector3d x = Q * X + 0.02 * Eigen::Vector3d(n(rng), n(rng), n(rng));
+    positions.insert(positions.end(), x.data(), x.data() + 3);
+  }
+  std::vector<int> nodes = model->elementNodes();
+  std::swap(nodes[4 * 7 + 1], nodes[4 * 7 + 2]);  // tet 7 inverted
+  const double mu = model->material().mu(), lambda = model->material().lambda();
+  std::vector<system_kernels::KernelTable const*> builds = {&system_kernels::genericKernels()};
+  if (std::strcmp(SystemOperator::bestKernelPath(), "avx2+fma") == 0)
+    builds.push_back(system_kernels::avx2Kernels());
+  for (const system_kernels::KernelTable* build : builds) {
+    const Eigen::Quaterniond start(Eigen::AngleAxisd(0.1, Eigen::Vector3d::UnitX()) *
+                                   Eigen::Quaterniond(Q));
+    std::vector<Eigen::Quaterniond> q(static_cast<size_t>(tets), start);
+    std::vector<Eigen::Matrix3d> R(q.size());
+    std::vector<double> forces(12 * q.size()), energy(q.size()), strain(q.size());
+    std::vector<unsigned char> needs_svd(q.size(), 2);
+    system_kernels::Tet4ForceInput in;
+    in.positions = positions.data();
+    in.nodes = nodes.data();
+    in.rest = model->tetRestData().data()->rest_shape_inverse.data();
+    in.mu = mu;
+    in.lambda = lambda;
+    in.quaternions = q.data()->coeffs().data();
+    in.rotations = R.data()->data();
+    in.forces = forces.data();
+    in.energy = energy.data();
+    in.volumetric_strain = strain.data();
+    in.needs_svd = needs_svd.data();
+    build->tet4_forces(in, 0, tets);
+    for (size_t t = 0; t < q.size(); ++t) {
+      std::array<Eigen::Vector3d, 4> x;
+      for (size_t a = 0; a < 4; ++a)
+        x[a] = Eigen::Map<const Eigen::Vector3d>(positions.data() + 3 * nodes[4 * t + a]);
+      const TetRestData& rest = model->tetRestData()[t];
+      const Eigen::Matrix3d F = deformationGradient(x, rest.rest_shape_inverse);
+      ASSERT_EQ(needs_svd[t], F.determinant() > 0 ? 0 : 1) << t;
+      if (needs_svd[t]) continue;
+      Eigen::Quaterniond q_ref = start;
+      const Eigen::Matrix3d R_ref = extractRotation(F, q_ref);
+      EXPECT_LT((R[t] - R_ref).norm(), 1e-12) << build->name << " tet " << t;
+      const CorotatedResponse ref = corotatedResponse(F, R_ref, rest, mu, lambda);
+      const double scale = ref.forces[0].norm() + ref.forces[1].norm() + 1e-300;
+      for (size_t a = 0; a < 4; ++a)
+        EXPECT_LT(
+            (Eigen::Map<const Eigen::Vector3d>(forces.data() + 12 * t + 3 * a) - ref.forces[a])
+                .norm(),
+            1e-9 * scale)
+            << build->name << " tet " << t;
+      EXPECT_NEAR(energy[t], ref.energy, 1e-9 * ref.energy) << build->name;
+      EXPECT_NEAR(strain[t], (R_ref.transpose() * F).trace() - 3.0, 1e-12) << build->name;
+    }
+    EXPECT_EQ(needs_svd[7], 1);
   }
 }
 

@@ -52,11 +52,33 @@ struct ProductInput {
   double mass_scale = 0, stiffness_scale = 0;
 };
 
+/// The per-tet pass of a tet4 step (ImplicitStepper): F = Ds Bm, the rotation R = polar(F) by
+/// the warm-started quaternion iteration of fem/polar_rotation.h (extractRotation, with its
+/// arithmetic and stopping rule per tet), and the corotated forces and energy of
+/// fem/corotated_element.h. Four tets at a time, each stopping on its own, so a tet's result does
+/// not depend on which tets share its batch. Tets with det F <= 0 (inverted, or NaN) are only
+/// flagged (needs_svd = 1); the caller redoes them with the SVD path.
+struct Tet4ForceInput {
+  const double* positions = nullptr;  ///< 3 per node, m
+  const int* nodes = nullptr;         ///< 4 per tet
+  const double* rest = nullptr;       ///< per tet: Bm (9, column-major), then V; stride 10
+  double mu = 0, lambda = 0;
+  int max_iterations = 20;
+  double tolerance = 1e-6;              ///< rad
+  double* quaternions = nullptr;        ///< in/out: x, y, z, w per tet (the last step's rotation)
+  double* rotations = nullptr;          ///< out: R, 9 per tet, column-major
+  double* forces = nullptr;             ///< out: 12 per tet, N
+  double* energy = nullptr;             ///< out: per tet, J
+  double* volumetric_strain = nullptr;  ///< out if not null: tr(R^T F) - 3 per tet
+  unsigned char* needs_svd = nullptr;   ///< out: per tet
+};
+
 struct KernelTable {
   const char* name;  ///< "sse2" or "avx2+fma"
   void (*tet4_rows)(const AssemblyInput&, int row_begin, int row_end);
   void (*tet10_rows)(const AssemblyInput&, int row_begin, int row_end);
   void (*block_product)(const ProductInput&, int row_begin, int row_end);
+  void (*tet4_forces)(const Tet4ForceInput&, int tet_begin, int tet_end);
 };
 
 /// The baseline x86-64 (or other architecture's default) build.

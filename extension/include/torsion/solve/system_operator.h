@@ -108,6 +108,9 @@ class SystemOperator {
   /// Switches this operator to the baseline build (true) or back to the best one (false); the
   /// paths agree to rounding (tests compare them).
   void useBaselineKernels(bool baseline);
+  /// The chosen kernel build itself (src/solve/system_operator_kernels.h), for the implicit
+  /// stepper's per-tet force pass.
+  const system_kernels::KernelTable& kernels() const { return *kernels_; }
   double massCoefficient() const { return mass_coefficient_; }
   double stiffnessCoefficient() const { return stiffness_coefficient_; }
 
