@@ -19,8 +19,9 @@ namespace fs = std::filesystem;
 
 // summary.json keys that say how a result was obtained, not what it is: shown when they differ.
 const std::set<std::string> kNotedKeys = {
-    "schema_version", "torsion_version", "git_commit", "bullet_precision",  "threads",
-    "linear_solver",  "preconditioner",  "tolerance",  "solver_iterations", "final_state_hash"};
+    "schema_version",    "torsion_version",  "git_commit",     "bullet_precision",
+    "threads",           "linear_solver",    "preconditioner", "tolerance",
+    "solver_iterations", "final_state_hash", "kernel_path"};
 // Keys that differ between any two runs (timings) or name files: not shown.
 const std::set<std::string> kIgnoredKeys = {"ms_per_step", "outputs", "scene_file", "haptics",
                                             "haptic_warnings"};

@@ -15,6 +15,7 @@
 #include "torsion/bullet/rigid_health.h"
 #include "torsion/mesh/mesh_io.h"
 #include "torsion/mesh/vtk_format.h"
+#include "torsion/solve/system_operator.h"
 
 namespace torsion::scene {
 
@@ -395,6 +396,8 @@ class Run {
     summary["preconditioner"] = toString(world_.settings().solver.preconditioner);
     summary["tolerance"] = world_.settings().solver.tolerance;
     summary["threads"] = Parallel::usableThreads(world_.settings().solver.threads);  // used
+    // The system operator's kernel build that ran: "avx2+fma" or "sse2" (system_operator.h).
+    summary["kernel_path"] = SystemOperator::bestKernelPath();
     summary["ms_per_step"] = {{"median", percentile(step_ms_, 0.5)},
                               {"p95", percentile(step_ms_, 0.95)}};
     summary["solver_iterations"] = {

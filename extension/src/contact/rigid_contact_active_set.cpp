@@ -39,13 +39,25 @@ bool RigidContactSolver::updateActiveSet(const Eigen::VectorXd& v, const Eigen::
         const double gap_end = c.gap + dt * c.normal.dot(vi - rigid_v);
         if (gap_end < -settings_.activation_tolerance) {
           // A node the rigid body sweeps over (held by the supporting plane, chooseSupportPlane)
-          // starts sliding when it slips; its friction follows from the next solve's normal
-          // impulse. Starting it stuck stopped a sliding body at each node row (docs/contact.md,
-          // "Sliding over nodes"). Other contacts start stuck: a landing body's contacts slip
-          // too (Poisson), and starting those sliding kept a box on a tet10 slab from settling.
+          // starts sliding when it slips, and so does one that a body sliding over the surface
+          // (k.sliding: all its node contacts slid last step) slips over by more than the face
+          // gap tolerance; its friction follows from the next solve's normal impulse. Started
+          // stuck, such a node glued a box sliding over a stiff slab for a solve (its velocity
+          // fell to nothing), left Coulomb's cone, slipped, was released, came back stuck, ...
+          // until its slips ran out and the step ended on the glued solve: whether that happened
+          // hung on rounding, and the box's distance differed by 30 % between the two builds of
+          // the system operator (docs/contact.md, "Sliding over nodes"). Other contacts start
+          // stuck: a landing body's contacts slip too (its fall's speed along the surface,
+          // Poisson); starting those sliding let a box keep speed the impact's friction takes
+          // (16 % too far just above the friction angle), and kept a box on a tet10 slab from
+          // settling; starting them sliding under a body with some contact stuck let a box
+          // below the friction angle creep (7 mm in 1 s).
           Eigen::Vector3d slip = vi - rigid_v;
           slip -= c.normal * c.normal.dot(slip);
-          const bool slipping = c.swept && dt * slip.norm() > settings_.activation_tolerance;
+          const double slipped = dt * slip.norm();
+          const bool slipping = (c.swept && slipped > settings_.activation_tolerance) ||
+                                (k.sliding && slipped > std::max(settings_.activation_tolerance,
+                                                                 settings_.face_gap_tolerance));
           c.state =
               c.friction > 0 && !slipping ? NodeContact::State::kStick : NodeContact::State::kSlide;
           c.friction_impulse.setZero();

@@ -269,15 +269,22 @@ void RigidContactSolver::dropUntouchedPartners() {
 }
 
 void RigidContactSolver::warmStartActiveSet() {
+  std::vector<char> slid(partners_.size(), 0), stuck(partners_.size(), 0);
   for (NodeContact& c : contacts_) {
     if (c.held || c.anchored) continue;
     for (size_t k = 0; k < previous_active_.size(); ++k) {
       if (previous_active_[k].first == c.node &&
           previous_active_[k].second == partners_[static_cast<size_t>(c.partner)].object) {
         c.state = c.friction > 0 ? previous_state_[k] : NodeContact::State::kSlide;
+        if (c.friction > 0 && c.state == NodeContact::State::kSlide)
+          slid[static_cast<size_t>(c.partner)] = 1;
+        if (c.state == NodeContact::State::kStick) stuck[static_cast<size_t>(c.partner)] = 1;
       }
     }
   }
+  // A body all of whose carried contacts slide, none stuck, is sliding over the surface: a new
+  // contact it slips over joins the slide (updateActiveSet).
+  for (size_t k = 0; k < partners_.size(); ++k) partners_[k].sliding = slid[k] && !stuck[k];
 }
 
 void RigidContactSolver::recordDetectionStats() {

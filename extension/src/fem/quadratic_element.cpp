@@ -52,11 +52,33 @@ QuadraticRestData quadraticRestData(const Eigen::Matrix3d& corner_rest_shape_inv
       rest.gradients[q][4 + e] = 4 * (L[i] * gL[j] + L[j] * gL[i]);
     }
   }
+  rest.corner_gradients = gL;
   for (size_t e = 0; e < 6; ++e) {
     rest.centroid_edge_gradients[e] =
         gL[static_cast<size_t>(kTet10Edges[e][0])] + gL[static_cast<size_t>(kTet10Edges[e][1])];
   }
   return rest;
+}
+
+const Tet10GradientCoefficients& quadraticGradientCoefficients() {
+  static const Tet10GradientCoefficients coefficients = [] {
+    Tet10GradientCoefficients alpha{};  // zeros
+    for (size_t q = 0; q < kTet10QuadraturePoints; ++q) {
+      std::array<double, 4> L;
+      for (size_t c = 0; c < 4; ++c)
+        L[c] = c == q ? kA : kB;
+      for (size_t a = 0; a < 4; ++a)
+        alpha[q][a][a] = 4 * L[a] - 1;
+      for (size_t e = 0; e < 6; ++e) {
+        const size_t i = static_cast<size_t>(kTet10Edges[e][0]);
+        const size_t j = static_cast<size_t>(kTet10Edges[e][1]);
+        alpha[q][4 + e][j] = 4 * L[i];
+        alpha[q][4 + e][i] = 4 * L[j];
+      }
+    }
+    return alpha;
+  }();
+  return coefficients;
 }
 
 Eigen::Matrix3d quadraticDeformationGradient(const Tet10Vectors& x, const QuadraticRestData& rest,

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <sstream>
 
+#include "system_operator_kernels.h"
 #include "torsion/fem/corotated_element.h"
 #include "torsion/fem/nodal_pressure.h"
 #include "torsion/fem/polar_rotation.h"
@@ -60,9 +61,27 @@ double ImplicitStepper::computeElasticForces(FemState& state) {
     const bool nodal_pressure = model_->nodalPressure();
     const double element_lambda = nodal_pressure ? -2.0 * mu / 3.0 : lambda;
     tet_strain_.resize(nodal_pressure ? nodes.size() / 4 : 0);
+    // Four tets at a time in the operator's kernel build (system_operator_kernels.h); the tets it
+    // flags (det F <= 0) go through the SVD path here.
+    static_assert(sizeof(TetRestData) == 10 * sizeof(double), "Bm then V, no padding");
+    system_kernels::Tet4ForceInput in;
+    in.positions = state.positions.data();
+    in.nodes = nodes.data();
+    in.rest = model_->tetRestData().data()->rest_shape_inverse.data();
+    in.mu = mu;
+    in.lambda = element_lambda;
+    in.quaternions = state.element_rotations.data()->coeffs().data();
+    in.rotations = rotations.data()->data();
+    in.forces = element_forces_.data()->data();
+    in.energy = element_energy_.data();
+    in.volumetric_strain = nodal_pressure ? tet_strain_.data() : nullptr;
+    needs_svd_.resize(static_cast<size_t>(model_->elementCount()));
+    in.needs_svd = needs_svd_.data();
     parallel_.forRange(model_->elementCount(), kTetGrain, [&](int begin, int end) {
+      system_.kernels().tet4_forces(in, begin, end);
       for (int t = begin; t < end; ++t) {
         const size_t ti = static_cast<size_t>(t);
+        if (needs_svd_[ti] == 0) continue;
         const TetRestData& rest = model_->tetRestData()[ti];
         std::array<Eigen::Vector3d, 4> x;
         for (size_t a = 0; a < 4; ++a)

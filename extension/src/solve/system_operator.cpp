@@ -2,7 +2,11 @@
 
 #include <algorithm>
 #include <cassert>
+#include <cmath>
+#include <cstdlib>
+#include <cstring>
 
+#include "system_operator_kernels.h"
 #include "torsion/fem/nodal_pressure.h"
 
 namespace torsion {
@@ -16,6 +20,24 @@ std::array<Eigen::Vector3d, 4> shapeGradients(const Eigen::Matrix3d& B) {
   return {Eigen::Vector3d(-(B.row(0) + B.row(1) + B.row(2)).transpose()), B.row(0).transpose(),
           B.row(1).transpose(), B.row(2).transpose()};
 }
+
+bool cpuHasAvx2Fma() {
+#if defined(TORSION_HAVE_AVX2_KERNELS) && (defined(__GNUC__) || defined(__clang__))
+  __builtin_cpu_init();
+  return __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma");
+#else
+  return false;
+#endif
+}
+
+// The best kernel build for this CPU, unless TORSION_KERNELS=sse2 asks for the baseline.
+const system_kernels::KernelTable& bestKernels() {
+  const char* forced = std::getenv("TORSION_KERNELS");
+  const bool baseline = forced != nullptr && std::strcmp(forced, "sse2") == 0;
+  const system_kernels::KernelTable* avx2 = system_kernels::avx2Kernels();
+  if (!baseline && avx2 != nullptr && cpuHasAvx2Fma()) return *avx2;
+  return system_kernels::genericKernels();
+}
 }  // namespace
 
 SystemOperator::SystemOperator(std::shared_ptr<const FemModel> model, const Parallel& parallel)
@@ -24,10 +46,27 @@ SystemOperator::SystemOperator(std::shared_ptr<const FemModel> model, const Para
   const int n_per = model_->nodesPerElement();
   const std::vector<int>& element_nodes = model_->elementNodes();
   nodes_per_element_ = n_per;
+  kernels_ = &bestKernels();
   rotations_.assign(static_cast<size_t>(elements), Eigen::Matrix3d::Identity());
-  const int quadrature = model_->elementKind() == ElementKind::kTet10 ? kTet10QuadraturePoints : 1;
-  rotated_gradients_.resize(static_cast<size_t>(elements) *
-                            static_cast<size_t>(quadrature * n_per));
+  // Four rest-frame gradients per element: the shape gradients of a tet4, the corner gradients
+  // of a tet10 (its blocks are combinations of their products, buildTet10Terms()).
+  rest_gradients_.resize(4 * static_cast<size_t>(elements));
+  rotated_gradients_.resize(rest_gradients_.size());
+  element_volumes_.resize(static_cast<size_t>(elements));
+  for (size_t e = 0; e < static_cast<size_t>(elements); ++e) {
+    if (model_->elementKind() == ElementKind::kTet10) {
+      const QuadraticRestData& rest = model_->quadraticRestData()[e];
+      std::copy(rest.corner_gradients.begin(), rest.corner_gradients.end(),
+                rest_gradients_.begin() + static_cast<std::ptrdiff_t>(4 * e));
+      element_volumes_[e] = rest.volume;
+    } else {
+      const TetRestData& rest = model_->tetRestData()[e];
+      const std::array<Eigen::Vector3d, 4> g = shapeGradients(rest.rest_shape_inverse);
+      std::copy(g.begin(), g.end(), rest_gradients_.begin() + static_cast<std::ptrdiff_t>(4 * e));
+      element_volumes_[e] = rest.volume;
+    }
+  }
+  if (model_->elementKind() == ElementKind::kTet10) buildTet10Terms();
   // Node -> (element, local index), elements ascending per node.
   const int node_count = model_->nodeCount();
   node_offsets_.assign(static_cast<size_t>(node_count) + 1, 0);
@@ -42,6 +81,45 @@ SystemOperator::SystemOperator(std::shared_ptr<const FemModel> model, const Para
         static_cast<int>(entry);
   buildPattern();
   if (model_->elementKind() == ElementKind::kTet4) buildPatches();
+}
+
+SystemOperator::~SystemOperator() = default;
+
+const char* SystemOperator::kernelPath() const {
+  return kernels_->name;
+}
+
+const char* SystemOperator::bestKernelPath() {
+  return bestKernels().name;
+}
+
+void SystemOperator::useBaselineKernels(bool baseline) {
+  kernels_ = baseline ? &system_kernels::genericKernels() : &bestKernels();
+  assembled_ = false;  // K as the chosen build computes it
+}
+
+void SystemOperator::buildTet10Terms() {
+  // K_ab = V sum_q (1/4) [mu (g_qa . g_qb) I + ...] with g_qa = sum_c alpha[q][a][c] grad L_c,
+  // so every sum_q g_qa g_qb^T is sum over (c, d) of C_cd grad L_c grad L_d^T with
+  // C_cd = (1/4) sum_q alpha[q][a][c] alpha[q][b][d]: the same C for every element. The zero
+  // coefficients are exact (alpha is sparse), so they are left out.
+  const Tet10GradientCoefficients& alpha = quadraticGradientCoefficients();
+  term_offsets_.assign(1, 0);
+  terms_.clear();
+  for (size_t a = 0; a < 10; ++a) {
+    for (size_t b = 0; b < 10; ++b) {
+      for (int c = 0; c < 4; ++c) {
+        for (int d = 0; d < 4; ++d) {
+          double coefficient = 0;
+          for (size_t q = 0; q < kTet10QuadraturePoints; ++q)
+            coefficient +=
+                alpha[q][a][static_cast<size_t>(c)] * alpha[q][b][static_cast<size_t>(d)];
+          if (coefficient != 0.0) terms_.push_back({c, d, coefficient / kTet10QuadraturePoints});
+        }
+      }
+      term_offsets_.push_back(static_cast<int>(terms_.size()));
+    }
+  }
 }
 
 void SystemOperator::buildPattern() {
@@ -114,79 +192,40 @@ void SystemOperator::buildPattern() {
 
 void SystemOperator::assemble() const {
   if (assembled_) return;
-  if (model_->elementKind() == ElementKind::kTet10) {
-    assembleElements<10, kTet10QuadraturePoints>();
-  } else {
-    assembleElements<4, 1>();
-  }
-  assembled_ = true;
-}
-
-template <int N, int Q>
-void SystemOperator::assembleElements() const {
   const double mu = model_->material().mu();
   // With nodal pressure the blocks hold the deviatoric part only (nodal_pressure.h): the same
   // formula with lambda replaced by -2 mu / 3; the volumetric part is applied in factored form.
   const double lambda = model_->nodalPressure() ? -2.0 * mu / 3.0 : model_->material().lambda();
-  constexpr size_t kPerElement = static_cast<size_t>(N * Q);
-  // Pass 1, per element: the rotated shape gradients R g_a at each quadrature point.
+  // Pass 1, per element: the four rotated gradients.
   parallel_.forRange(model_->elementCount(), kTetGrain, [&](int begin, int end) {
-    for (int e = begin; e < end; ++e) {
-      const size_t ei = static_cast<size_t>(e);
-      Eigen::Vector3d* out = rotated_gradients_.data() + kPerElement * ei;
-      if constexpr (N == 4) {
-        const std::array<Eigen::Vector3d, 4> g =
-            shapeGradients(model_->tetRestData()[ei].rest_shape_inverse);
-        for (size_t a = 0; a < 4; ++a)
-          out[a] = rotations_[ei] * g[a];
-      } else {
-        const QuadraticRestData& rest = model_->quadraticRestData()[ei];
-        for (size_t q = 0; q < static_cast<size_t>(Q); ++q)
-          for (size_t a = 0; a < static_cast<size_t>(N); ++a)
-            out[static_cast<size_t>(N) * q + a] = rotations_[ei] * rest.gradients[q][a];
-      }
-    }
+    for (size_t e = static_cast<size_t>(begin); e < static_cast<size_t>(end); ++e)
+      for (size_t c = 0; c < 4; ++c)
+        rotated_gradients_[4 * e + c].noalias() = rotations_[e] * rest_gradients_[4 * e + c];
   });
-  // Pass 2, per block row: K_ab = sum_q w_q (mu (g_a . g_b) I + mu (R g_b)(R g_a)^T +
-  // lambda (R g_a)(R g_b)^T) for every element of the row's node a (rotating the rest-frame block
-  // R Ke_ab R^T); w is V for tet4 (one point), V / 4 for tet10.
+  // Pass 2, per block row: tet4 K_ab = V (mu (g_a . g_b) I + mu (R g_b)(R g_a)^T +
+  // lambda (R g_a)(R g_b)^T) for every element of the row's node a (the rest-frame block rotated,
+  // R Ke_ab R^T); tet10 the same integrated over the element (buildTet10Terms()).
+  system_kernels::AssemblyInput in;
+  in.row_offsets = row_offsets_.data();
+  in.node_offsets = node_offsets_.data();
+  in.node_entries = node_entries_.data();
+  in.entry_slots = entry_slots_.data();
+  in.rotated = rotated_gradients_.data()->data();
+  in.volumes = element_volumes_.data();
+  in.mu = mu;
+  in.lambda = lambda;
+  in.term_offsets = term_offsets_.data();
+  in.terms = terms_.data();
+  in.blocks = block_values_.data()->data();
+  const bool tet10 = model_->elementKind() == ElementKind::kTet10;
   parallel_.forRange(model_->nodeCount(), kNodeGrain, [&](int begin, int end) {
-    for (int row = begin; row < end; ++row) {
-      const size_t r = static_cast<size_t>(row);
-      for (int s = row_offsets_[r]; s < row_offsets_[r + 1]; ++s)
-        block_values_[static_cast<size_t>(s)].setZero();
-      for (int k = node_offsets_[r]; k < node_offsets_[r + 1]; ++k) {
-        const int entry = node_entries_[static_cast<size_t>(k)];
-        const size_t e = static_cast<size_t>(entry / N), a = static_cast<size_t>(entry % N);
-        double weight;
-        if constexpr (N == 4) {
-          weight = model_->tetRestData()[e].volume;
-        } else {
-          weight = model_->quadraticRestData()[e].volume / Q;
-        }
-        const Eigen::Vector3d* rg = rotated_gradients_.data() + kPerElement * e;
-        const double mu_v = mu * weight, lambda_v = lambda * weight;
-        for (size_t b = 0; b < static_cast<size_t>(N); ++b) {
-          const int slot = entry_slots_[static_cast<size_t>(N) * static_cast<size_t>(k) + b];
-          if (slot < 0) continue;  // left of the diagonal: stored by the other node's row
-          double* block = block_values_[static_cast<size_t>(slot)].data();  // column-major
-          for (size_t q = 0; q < static_cast<size_t>(Q); ++q) {
-            const Eigen::Vector3d& u = rg[static_cast<size_t>(N) * q + a];
-            const Eigen::Vector3d& w = rg[static_cast<size_t>(N) * q + b];
-            const Eigen::Vector3d p = mu_v * w;
-            const Eigen::Vector3d qv = lambda_v * u;
-            // g_a . g_b is rotation-invariant: take it from the rotated gradients.
-            const double diagonal = mu_v * u.dot(w);
-            for (int c = 0; c < 3; ++c) {
-              for (int i = 0; i < 3; ++i)
-                block[3 * c + i] += p[i] * u[c] + qv[i] * w[c];
-              block[4 * c] += diagonal;
-            }
-          }
-        }
-      }
+    if (tet10) {
+      kernels_->tet10_rows(in, begin, end);
+    } else {
+      kernels_->tet4_rows(in, begin, end);
     }
   });
+  assembled_ = true;
 }
 
 void SystemOperator::setCoefficients(double mass_coefficient, double stiffness_coefficient) {
@@ -223,32 +262,34 @@ void SystemOperator::nodalPressureIncrements(const Eigen::VectorXd& y) const {
 void SystemOperator::apply(const Eigen::VectorXd& y, Eigen::VectorXd& out, double mass_scale,
                            double stiffness_scale) const {
   assemble();
-  const std::vector<double>& mass = model_->nodeMasses();
   out.resize(y.size());
   const bool nodal_pressure = model_->nodalPressure();
   if (nodal_pressure) nodalPressureIncrements(y);
+  system_kernels::ProductInput in;
+  in.row_offsets = row_offsets_.data();
+  in.columns = block_columns_.data();
+  in.blocks = block_values_.data()->data();
+  in.lower_offsets = lower_offsets_.data();
+  in.lower_slots = lower_slots_.data();
+  in.lower_columns = lower_columns_.data();
+  in.mass = model_->nodeMasses().data();
+  in.y = y.data();
+  in.out = out.data();
+  in.mass_scale = mass_scale;
+  in.stiffness_scale = stiffness_scale;
   parallel_.forRange(model_->nodeCount(), kNodeGrain, [&](int begin, int end) {
+    kernels_->block_product(in, begin, end);
+    if (!nodal_pressure) return;
     for (int row = begin; row < end; ++row) {
+      // K_vol y at this node: sum over its tets of V_e dpbar_e R_e g_a
       const size_t r = static_cast<size_t>(row);
       Eigen::Vector3d sum = Eigen::Vector3d::Zero();
-      for (int s = row_offsets_[r]; s < row_offsets_[r + 1]; ++s) {
-        sum.noalias() += block_values_[static_cast<size_t>(s)] *
-                         y.segment<3>(3 * block_columns_[static_cast<size_t>(s)]);
+      for (int k = node_offsets_[r]; k < node_offsets_[r + 1]; ++k) {
+        const int entry = node_entries_[static_cast<size_t>(k)];
+        sum.noalias() += tet_scalars_[static_cast<size_t>(entry / 4)] *
+                         rotated_gradients_[static_cast<size_t>(entry)];
       }
-      for (int l = lower_offsets_[r]; l < lower_offsets_[r + 1]; ++l) {
-        sum.noalias() +=
-            block_values_[static_cast<size_t>(lower_slots_[static_cast<size_t>(l)])].transpose() *
-            y.segment<3>(3 * lower_columns_[static_cast<size_t>(l)]);
-      }
-      if (nodal_pressure) {  // K_vol y at this node: sum over its tets of V_e dpbar_e R_e g_a
-        for (int k = node_offsets_[r]; k < node_offsets_[r + 1]; ++k) {
-          const int entry = node_entries_[static_cast<size_t>(k)];
-          sum.noalias() += tet_scalars_[static_cast<size_t>(entry / 4)] *
-                           rotated_gradients_[static_cast<size_t>(entry)];
-        }
-      }
-      out.segment<3>(3 * row) =
-          stiffness_scale * sum + (mass_scale * mass[r]) * y.segment<3>(3 * row);
+      out.segment<3>(3 * row) += stiffness_scale * sum;
     }
   });
 }

@@ -42,6 +42,9 @@ struct RigidPartner {
   /// their friction together is mu times the net normal impulse (docs/contact.md, "Sliding over
   /// nodes").
   double friction_share = 1;
+  /// Its node contacts ended the last step sliding, none stuck (and start this one so): the body
+  /// slides over the surface, and a contact it slips over joins the slide (rigid_contact.cpp).
+  bool sliding = false;
 };
 
 /// M V: the partner's momentum (linear, angular about com) at velocity V (dynamic partners). A

@@ -43,12 +43,21 @@ struct QuadraticRestData {
   std::array<std::array<Eigen::Vector3d, 10>, kTet10QuadraturePoints> gradients;
   /// Gradients at the centroid of the mid-edge nodes (local 4..9); the corners' are zero, 1/m.
   std::array<Eigen::Vector3d, 6> centroid_edge_gradients;
+  /// The corner tet's barycentric gradients grad L_0..3 (the rows of Bm, and minus their sum), 1/m.
+  std::array<Eigen::Vector3d, 4> corner_gradients;
   double volume = 0;  ///< rest volume V, m^3 (each quadrature weight is V / 4)
 };
 
 /// Rest data from the corner tet's Bm = Dm^-1 and rest volume.
 QuadraticRestData quadraticRestData(const Eigen::Matrix3d& corner_rest_shape_inverse,
                                     double volume);
+
+/// The P2 gradients as combinations of the barycentric ones, the same for every element:
+/// gradients[q][a] = sum over c of coefficients[q][a][c] grad L_c. (The stiffness blocks are built
+/// from them: K_ab is a combination of the products (R grad L_c)(R grad L_d)^T.)
+using Tet10GradientCoefficients =
+    std::array<std::array<std::array<double, 4>, 10>, kTet10QuadraturePoints>;
+const Tet10GradientCoefficients& quadraticGradientCoefficients();
 
 using Tet10Vectors = std::array<Eigen::Vector3d, 10>;
 

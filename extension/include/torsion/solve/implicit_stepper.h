@@ -152,6 +152,8 @@ class ImplicitStepper {
   // Nodal pressure (fem/nodal_pressure.h): per-tet volumetric strain, then pressure; per-node
   // averaged strain.
   std::vector<double> tet_strain_, node_strain_;
+  // Per tet: 1 where the batched force pass saw det F <= 0 and the SVD path redid it.
+  std::vector<unsigned char> needs_svd_;
   bool internal_forces_valid_ = false;
   double last_dt_;  // s, dt of the last step (the internal forces' linearisation uses it)
 };

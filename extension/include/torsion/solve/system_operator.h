@@ -11,6 +11,12 @@
 // Assembly runs per block row over the row node's tets in ascending order, so K and every
 // product are identical for any thread count.
 //
+// The assembly and the product run in kernels on plain arrays
+// (src/solve/system_operator_kernels.h), built twice: for baseline x86-64 and for AVX2 + FMA,
+// chosen at run time (kernelPath()). tet10 blocks are combinations of the rotated corner-gradient
+// products (R gL_c)(R gL_d)^T (one term for a corner-corner block, four for an edge-edge block)
+// instead of one rank-2 update per quadrature point.
+//
 // Nodal pressure (tet4 with VolumetricStrain::kNodalAverage, fem/nodal_pressure.h): the blocks
 // hold the deviatoric stiffness, and the volumetric part sum_n kappa V_n b_n b_n^T, which couples
 // nodes two tets apart, is applied in its factored form in every product (three more passes:
@@ -27,9 +33,15 @@
 
 namespace torsion {
 
+namespace system_kernels {
+struct KernelTable;
+struct BlockTerm;
+}  // namespace system_kernels
+
 class SystemOperator {
  public:
   SystemOperator(std::shared_ptr<const FemModel> model, const Parallel& parallel);
+  ~SystemOperator();  // out of line: the kernel terms' type is private
 
   /// The rotation of every element for this step. Writing through mutableRotations() marks K stale;
   /// the next product or diagonalBlocks() call re-assembles it (products are not thread-safe
@@ -68,7 +80,14 @@ class SystemOperator {
   const std::vector<int>& blockRowOffsets() const { return row_offsets_; }
   const std::vector<int>& blockColumns() const { return block_columns_; }
   const std::vector<Eigen::Matrix3d>& stiffnessBlocks() const;
-  /// Nodal pressure (tet4) only: the volumetric stiffness is sum over nodes n of
+  /// The assembly and the product run in kernels on plain arrays
+  /// (src/solve/system_operator_kernels.h),
+  // built twice: for baseline x86-64 and for AVX2 + FMA, chosen at run time (kernelPath()).
+  // tet10 blocks are combinations of the rotated corner-gradient products (R gL_c)(R gL_d)^T
+  // (one term for a corner-corner block, four for an edge-edge block) instead of one rank-2 update
+  // per quadrature point.
+  //
+  // Nodal pressure (tet4) only: the volumetric stiffness is sum over nodes n of
   /// kappa / V_n w_n w_n^T, where w_n has one 3-vector per node a of n's patch (the nodes of n's
   /// tets), (w_n)_a = sum over n's tets e holding a of (V_e / 4) R_e g_a. Fills the patch's nodes
   /// (ascending) and w_n.
@@ -80,6 +99,18 @@ class SystemOperator {
   /// the block pattern and this step's rotations stay; K is re-assembled with the new material
   /// constants at the next product, and the masses are the new model's.
   void replaceModel(std::shared_ptr<const FemModel> model);
+  /// The kernel build this operator runs: "avx2+fma" on a CPU with AVX2 and FMA (where the
+  /// library was built for x86-64), else "sse2". The environment variable TORSION_KERNELS=sse2
+  /// forces the baseline build for every operator created after it is set.
+  const char* kernelPath() const;
+  /// The build a new operator would choose on this machine.
+  static const char* bestKernelPath();
+  /// Switches this operator to the baseline build (true) or back to the best one (false); the
+  /// paths agree to rounding (tests compare them).
+  void useBaselineKernels(bool baseline);
+  /// The chosen kernel build itself (src/solve/system_operator_kernels.h), for the implicit
+  /// stepper's per-tet force pass.
+  const system_kernels::KernelTable& kernels() const { return *kernels_; }
   double massCoefficient() const { return mass_coefficient_; }
   double stiffnessCoefficient() const { return stiffness_coefficient_; }
 
@@ -94,9 +125,8 @@ class SystemOperator {
   void buildPatches();
   // Fills block_values_ from this step's rotations (if stale).
   void assemble() const;
-  // The two passes of assemble() for N-node elements with Q quadrature points.
-  template <int N, int Q>
-  void assembleElements() const;
+  // tet10: the terms of every block (a, b) (system_kernels::BlockTerm), once per operator.
+  void buildTet10Terms();
 
   std::shared_ptr<const FemModel> model_;
   const Parallel& parallel_;
@@ -123,8 +153,14 @@ class SystemOperator {
   std::vector<int> lower_slots_;
   std::vector<int> lower_columns_;
   mutable std::vector<Eigen::Matrix3d> block_values_;
-  // R_e grad N_a at each quadrature point: index (Q e + q) N + a.
+  // Rest-frame gradients, four per element (tet4: grad N_a; tet10: the corner gradients grad L_c),
+  // their rotations R_e g for this step (same index 4 e + c), and the element volumes.
+  std::vector<Eigen::Vector3d> rest_gradients_;
   mutable std::vector<Eigen::Vector3d> rotated_gradients_;
+  std::vector<double> element_volumes_;
+  std::vector<int> term_offsets_;
+  std::vector<system_kernels::BlockTerm> terms_;
+  const system_kernels::KernelTable* kernels_ = nullptr;
   mutable bool assembled_ = false;
   // tet4 node patches (for the nodal-pressure diagonal): row n's patch, the nodes of its tets
   // sorted, is patch_nodes_[patch_offsets_[n] ..]; patch_slots_[4 k + b] is where local node b of

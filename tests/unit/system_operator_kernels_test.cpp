@@ -1,0 +1,176 @@
+// The system operator's two kernel builds (baseline and AVX2 + FMA, system_operator.h): the same
+// K and the same products to rounding, for tet4 and tet10; and the tet4 blocks against the
+// element's own force differential. (The tet10 blocks are checked against the element
+// differentials in quadratic_mesh_test.cpp.)
+
+#include "solve/system_operator_kernels.h"  // white box: extension/src
+
+#include <gtest/gtest.h>
+
+#include <Eigen/Geometry>
+#include <cstring>
+#include <random>
+
+#include "torsion/fem/corotated_element.h"
+#include "torsion/fem/polar_rotation.h"
+#include "torsion/mesh/box_mesh.h"
+#include "torsion/solve/system_operator.h"
+
+namespace torsion {
+namespace {
+
+std::shared_ptr<const FemModel> beam(ElementKind element) {
+  auto mesh = std::make_shared<const TetMesh>(
+      makeBoxTetMesh(Eigen::Vector3d::Zero(), {4, 1, 1}, 4, 2, 2).value());
+  return FemModel::create(mesh, Material{}, element).value();
+}
+
+void randomRotations(SystemOperator& op, std::mt19937& rng) {
+  std::normal_distribution<double> n(0, 1);
+  for (auto& R : op.mutableRotations())
+    R = Eigen::Quaterniond(n(rng), n(rng), n(rng), n(rng)).normalized().toRotationMatrix();
+}
+
+Eigen::VectorXd randomVector(int size, std::mt19937& rng) {
+  std::normal_distribution<double> n(0, 1);
+  Eigen::VectorXd y(size);
+  for (int i = 0; i < size; ++i)
+    y[i] = n(rng);
+  return y;
+}
+
+// Products and blocks of both builds for one model; on a CPU without AVX2 both runs are the
+// baseline build and agree exactly.
+void expectBuildsAgree(ElementKind element) {
+  auto model = beam(element);
+  Parallel parallel(1);
+  SystemOperator best(model, parallel), baseline(model, parallel);
+  baseline.useBaselineKernels(true);
+  EXPECT_STREQ(baseline.kernelPath(), "sse2");
+  EXPECT_STREQ(best.kernelPath(), SystemOperator::bestKernelPath());
+  std::mt19937 rng(3);
+  randomRotations(best, rng);
+  baseline.mutableRotations() = best.rotations();
+  best.setCoefficients(1.01, 1e-4);
+  baseline.setCoefficients(1.01, 1e-4);
+  const Eigen::VectorXd y = randomVector(3 * model->nodeCount(), rng);
+  Eigen::VectorXd a, b;
+  best.multiply(y, a);
+  baseline.multiply(y, b);
+  EXPECT_LT((a - b).norm(), 1e-13 * b.norm());
+  const auto& blocks_a = best.stiffnessBlocks();
+  const auto& blocks_b = baseline.stiffnessBlocks();
+  ASSERT_EQ(blocks_a.size(), blocks_b.size());
+  double largest = 0, difference = 0;
+  for (size_t s = 0; s < blocks_a.size(); ++s) {
+    largest = std::max(largest, blocks_b[s].cwiseAbs().maxCoeff());
+    difference = std::max(difference, (blocks_a[s] - blocks_b[s]).cwiseAbs().maxCoeff());
+  }
+  EXPECT_LE(difference, 1e-13 * largest);
+}
+
+TEST(SystemOperatorKernels, BothBuildsGiveTheSameTet4MatrixAndProducts) {
+  expectBuildsAgree(ElementKind::kTet4);
+}
+
+TEST(SystemOperatorKernels, BothBuildsGiveTheSameTet10MatrixAndProducts) {
+  expectBuildsAgree(ElementKind::kTet10);
+}
+
+// K y from the blocks equals minus the sum of the elements' force differentials, for each build.
+TEST(SystemOperatorKernels, Tet4ProductsMatchTheElementDifferentialsInEitherBuild) {
+  auto model = beam(ElementKind::kTet4);
+  Parallel parallel(2);
+  for (bool baseline : {false, true}) {
+    SystemOperator op(model, parallel);
+    op.useBaselineKernels(baseline);
+    std::mt19937 rng(11);
+    randomRotations(op, rng);
+    const Eigen::VectorXd y = randomVector(3 * model->nodeCount(), rng);
+    Eigen::VectorXd reference = Eigen::VectorXd::Zero(y.size());
+    const double mu = model->material().mu(), lambda = model->material().lambda();
+    for (int e = 0; e < model->elementCount(); ++e) {
+      const int* nodes = model->elementNodes().data() + 4 * e;
+      std::array<Eigen::Vector3d, 4> dx;
+      for (size_t a = 0; a < 4; ++a)
+        dx[a] = y.segment<3>(3 * nodes[a]);
+      const auto df =
+          corotatedForceDifferential(dx, op.rotations()[static_cast<size_t>(e)],
+                                     model->tetRestData()[static_cast<size_t>(e)], mu, lambda);
+      for (size_t a = 0; a < 4; ++a)
+        reference.segment<3>(3 * nodes[a]) -= df[a];
+    }
+    Eigen::VectorXd Ky;
+    op.multiplyStiffness(y, Ky);
+    EXPECT_LT((Ky - reference).norm(), 1e-12 * reference.norm()) << op.kernelPath();
+  }
+}
+
+// The batched per-tet pass (F, rotation, forces, energy, four tets at a time) against the element
+// functions it replaces, in each build: random deformations, warm-started from a nearby rotation,
+// the batch cut short at the end, and inverted tets flagged for the SVD path, not computed.
+TEST(SystemOperatorKernels, BatchedTet4ForcePassMatchesTheElementFunctions) {
+  auto model = beam(ElementKind::kTet4);
+  const int tets = model->elementCount() - 1;  // a short last batch
+  std::mt19937 rng(5);
+  std::normal_distribution<double> n(0, 1);
+  const Eigen::Matrix3d Q = Eigen::Quaterniond(0.9, 0.3, -0.2, 0.4).normalized().toRotationMatrix();
+  std::vector<double> positions;
+  for (const Eigen::Vector3d& X : model->mesh().restPositions()) {
+    const Eigen::Vector3d x = Q * X + 0.02 * Eigen::Vector3d(n(rng), n(rng), n(rng));
+    positions.insert(positions.end(), x.data(), x.data() + 3);
+  }
+  std::vector<int> nodes = model->elementNodes();
+  std::swap(nodes[4 * 7 + 1], nodes[4 * 7 + 2]);  // tet 7 inverted
+  const double mu = model->material().mu(), lambda = model->material().lambda();
+  std::vector<system_kernels::KernelTable const*> builds = {&system_kernels::genericKernels()};
+  if (std::strcmp(SystemOperator::bestKernelPath(), "avx2+fma") == 0)
+    builds.push_back(system_kernels::avx2Kernels());
+  for (const system_kernels::KernelTable* build : builds) {
+    const Eigen::Quaterniond start(Eigen::AngleAxisd(0.1, Eigen::Vector3d::UnitX()) *
+                                   Eigen::Quaterniond(Q));
+    std::vector<Eigen::Quaterniond> q(static_cast<size_t>(tets), start);
+    std::vector<Eigen::Matrix3d> R(q.size());
+    std::vector<double> forces(12 * q.size()), energy(q.size()), strain(q.size());
+    std::vector<unsigned char> needs_svd(q.size(), 2);
+    system_kernels::Tet4ForceInput in;
+    in.positions = positions.data();
+    in.nodes = nodes.data();
+    in.rest = model->tetRestData().data()->rest_shape_inverse.data();
+    in.mu = mu;
+    in.lambda = lambda;
+    in.quaternions = q.data()->coeffs().data();
+    in.rotations = R.data()->data();
+    in.forces = forces.data();
+    in.energy = energy.data();
+    in.volumetric_strain = strain.data();
+    in.needs_svd = needs_svd.data();
+    build->tet4_forces(in, 0, tets);
+    for (size_t t = 0; t < q.size(); ++t) {
+      std::array<Eigen::Vector3d, 4> x;
+      for (size_t a = 0; a < 4; ++a)
+        x[a] = Eigen::Map<const Eigen::Vector3d>(positions.data() + 3 * nodes[4 * t + a]);
+      const TetRestData& rest = model->tetRestData()[t];
+      const Eigen::Matrix3d F = deformationGradient(x, rest.rest_shape_inverse);
+      ASSERT_EQ(needs_svd[t], F.determinant() > 0 ? 0 : 1) << t;
+      if (needs_svd[t]) continue;
+      Eigen::Quaterniond q_ref = start;
+      const Eigen::Matrix3d R_ref = extractRotation(F, q_ref);
+      EXPECT_LT((R[t] - R_ref).norm(), 1e-12) << build->name << " tet " << t;
+      const CorotatedResponse ref = corotatedResponse(F, R_ref, rest, mu, lambda);
+      const double scale = ref.forces[0].norm() + ref.forces[1].norm() + 1e-300;
+      for (size_t a = 0; a < 4; ++a)
+        EXPECT_LT(
+            (Eigen::Map<const Eigen::Vector3d>(forces.data() + 12 * t + 3 * a) - ref.forces[a])
+                .norm(),
+            1e-9 * scale)
+            << build->name << " tet " << t;
+      EXPECT_NEAR(energy[t], ref.energy, 1e-9 * ref.energy) << build->name;
+      EXPECT_NEAR(strain[t], (R_ref.transpose() * F).trace() - 3.0, 1e-12) << build->name;
+    }
+    EXPECT_EQ(needs_svd[7], 1);
+  }
+}
+
+}  // namespace
+}  // namespace torsion
