@@ -24,6 +24,7 @@
 #include "scene_haptics.h"
 #include "scene_parser.h"
 #include "torsion/bt_conversions.h"
+#include "torsion/solve/system_operator.h"
 
 namespace torsion::scene {
 namespace {
@@ -79,6 +80,10 @@ std::string toolchain() {
   id += "-asan";
 #endif
   if (!torsion::kBulletIsDouble) id += "-bullet-float";  // another build of Bullet: another state
+  // The operator's kernels are chosen at run time by the CPU (AVX2+FMA or the baseline); they
+  // round differently, so each has its own states.
+  const std::string kernels = torsion::SystemOperator::bestKernelPath();
+  if (kernels != "avx2+fma") id += "-" + kernels;
   return id;
 }
 
