@@ -284,7 +284,8 @@ void RigidContactSolver::warmStartActiveSet() {
   }
   // A body all of whose carried contacts slide, none stuck, is sliding over the surface: a new
   // contact it slips over joins the slide (updateActiveSet).
-  for (size_t k = 0; k < partners_.size(); ++k) partners_[k].sliding = slid[k] && !stuck[k];
+  for (size_t k = 0; k < partners_.size(); ++k)
+    partners_[k].sliding = slid[k] && !stuck[k];
 }
 
 void RigidContactSolver::recordDetectionStats() {
