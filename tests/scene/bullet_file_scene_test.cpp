@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <string>
+#include <vector>
 
 #include "scene_builder.h"
 #include "scene_parser.h"
@@ -20,17 +21,28 @@ TEST(BulletFileScene, ImportedBoxesFallOntoTheFemSlabAndRestOnIt) {
   ASSERT_EQ(scene.rigid_bodies.size(), 4u);
   EXPECT_EQ(scene.rigid_bodies[1].name, "boxes_1");
   EXPECT_EQ(scene.world->bulletWorld().getGravity().z(), btScalar(-9.81)) << "the scene's gravity";
-  for (int k = 0; k < 250; ++k) {  // 2.5 s: the last box lands near 0.6 s and rocks a while
+  // 2.5 s: the last box lands near 0.6 s and rocks a while. Where each box is at 1.5 s, to see
+  // that it stays there.
+  std::vector<btVector3> settled;
+  for (int k = 0; k < 250; ++k) {
     ASSERT_TRUE(driveHands(scene).ok());
     const WorldStepReport r = scene.world->step();
     ASSERT_TRUE(r.ok) << r.message;
+    if (k == 149) {
+      for (size_t b = 1; b < 4; ++b)
+        settled.push_back(scene.rigid_bodies[b].body->getWorldTransform().getOrigin());
+    }
   }
   // Each box rests on the slab (top at z = 0.2 m): its centre 0.1 m above the sagging surface,
-  // within the sag of this soft slab (a few mm) and at rest.
+  // within the sag of this soft slab (a few mm), and it stays where it settled: less than 1 cm
+  // in the last second (a box sliding or tipping moves tens of cm). Its velocity at one instant
+  // is not the test: resting on this soft slab, a box's contact chatters with speeds up to
+  // 0.09 m/s, and the boxes creep 2-7 mm/s (measured; an open defect, docs/contact.md).
   for (size_t k = 1; k < 4; ++k) {
     const btRigidBody* box = scene.rigid_bodies[k].body;
     EXPECT_NEAR(box->getWorldTransform().getOrigin().z(), 0.3, 0.01) << "box " << k;
-    EXPECT_LT(box->getLinearVelocity().length(), 0.05) << "box " << k;
+    EXPECT_LT((box->getWorldTransform().getOrigin() - settled[k - 1]).length(), 0.01)
+        << "box " << k;
   }
 }
 
