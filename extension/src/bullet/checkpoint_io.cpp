@@ -590,9 +590,16 @@ Result<StoredCheckpoint> readCheckpoint(std::string_view bytes, FemWorld& world,
     const std::string name = r.str(), body = r.str();
     if (!r.ok()) return truncated;
     if (name != hands[h]->name() || body != hands[h]->body().name()) {
-      return Error{anotherWorld("its hand " + std::to_string(h) + " is '" + name + "' on body '" +
-                                body + "', here '" + hands[h]->name() + "' on body '" +
-                                hands[h]->body().name() + "'")};
+      std::string difference = "its hand " + std::to_string(h) + " is '";
+      difference += name;
+      difference += "' on body '";
+      difference += body;
+      difference += "', here '";
+      difference += hands[h]->name();
+      difference += "' on body '";
+      difference += hands[h]->body().name();
+      difference += "'";
+      return Error{anotherWorld(difference)};
     }
     stored.hands.push_back(readHand(r));
     const HandSelection& s = stored.hands.back().selection;

@@ -52,7 +52,7 @@ std::vector<std::vector<FemBody*>> FemContactIslands::plan(const std::vector<Fem
   for (const auto& [a, b] : touching_) {
     const auto ia = index.find(a), ib = index.find(b);
     if (ia == index.end() || ib == index.end()) continue;
-    pairs.push_back(std::minmax(ia->second, ib->second));
+    pairs.emplace_back(std::min(ia->second, ib->second), std::max(ia->second, ib->second));
   }
   std::sort(pairs.begin(), pairs.end());
   pairs.erase(std::unique(pairs.begin(), pairs.end()), pairs.end());
