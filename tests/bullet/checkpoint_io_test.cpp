@@ -41,7 +41,8 @@ class BlockRig {
   void step() {
     const double t = world_.time();
     if (t > 0.25 && !hand_->grabbed()) {
-      ASSERT_TRUE(hand_->grab(Frame{Eigen::Vector3d(0, 0, 0.3), {}}, t).ok());
+      ASSERT_TRUE(
+          hand_->grab(Frame{Eigen::Vector3d(0, 0, 0.3), Eigen::Quaterniond::Identity()}, t).ok());
     }
     if (hand_->grabbed()) {
       hand_->moveTo(Frame{Eigen::Vector3d(0, 0, 0.3), Eigen::Quaterniond(Eigen::AngleAxisd(

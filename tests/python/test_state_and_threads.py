@@ -194,7 +194,7 @@ def test_a_python_thread_runs_while_the_world_steps():
     time.sleep(0.05)
     before = counter[0]
     start = time.perf_counter()
-    world.step(150)
+    world.step(500)  # 0.3 s or more: long beside the 5 ms switch interval
     elapsed = time.perf_counter() - start
     during = counter[0] - before
     stop.set()
