@@ -11,6 +11,8 @@
 #include <limits>
 #include <utility>
 
+#include "constrained_blocks.h"
+
 namespace torsion {
 
 struct CholmodSolver::Impl {
@@ -237,38 +239,8 @@ const Eigen::SparseMatrix<double>& CholmodSolver::assemble(const SystemOperator&
               op.massCoefficient() * mass[static_cast<size_t>(i)] * Eigen::Matrix3d::Identity());
   }
 
-  // Constraints: A' = S A S + (I - S), block by block. S_i = I (free), 0 (full), I - n n^T.
-  if (constraints.constrainedCount() > 0) {
-    auto filter_matrix = [&](int node) {
-      Eigen::Matrix3d S;
-      for (int col = 0; col < 3; ++col)
-        S.col(col) = constraints.filterNode(node, Eigen::Vector3d::Unit(col));
-      return S;
-    };
-    for (size_t k = 0; k < m.blocks.size(); ++k) {
-      const auto [i, j] = m.blocks[k];
-      if (!constraints.isConstrained(i) && !constraints.isConstrained(j)) continue;
-      const std::array<int, 9>& idx = m.block_values[k];
-      Eigen::Matrix3d block;
-      for (int r = 0; r < 3; ++r) {
-        for (int col = 0; col < 3; ++col) {
-          // The upper triangle of a diagonal block is not stored: mirror it.
-          const int at = idx[static_cast<size_t>(3 * r + col)] >= 0
-                             ? idx[static_cast<size_t>(3 * r + col)]
-                             : idx[static_cast<size_t>(3 * col + r)];
-          block(r, col) = values[at];
-        }
-      }
-      Eigen::Matrix3d filtered = filter_matrix(i) * block * filter_matrix(j);
-      if (i == j) filtered += Eigen::Matrix3d::Identity() - filter_matrix(i);
-      for (int r = 0; r < 3; ++r) {
-        for (int col = 0; col < 3; ++col) {
-          const int at = idx[static_cast<size_t>(3 * r + col)];
-          if (at >= 0) values[at] = filtered(r, col);
-        }
-      }
-    }
-  }
+  // Constraints: A' = S A S + (I - S), block by block.
+  detail::applyConstraintsToBlocks(constraints, m.blocks, m.block_values, values);
   return m.matrix;
 }
 

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "constrained_blocks.h"
 #include "torsion/mesh/quadratic_tet_mesh.h"
 #include "torsion/solve/cholmod_solver.h"
 
@@ -158,35 +159,7 @@ void TwoLevelPreconditioner::assembleCoarse(const SystemOperator& op,
     }
   }
   // The corner nodes' constraints: S A S + (I - S), block by block.
-  if (constraints.constrainedCount() == 0) return;
-  auto filter_matrix = [&](int node) {
-    Eigen::Matrix3d S;
-    for (int col = 0; col < 3; ++col)
-      S.col(col) = constraints.filterNode(node, Eigen::Vector3d::Unit(col));
-    return S;
-  };
-  for (size_t k = 0; k < coarse_blocks_.size(); ++k) {
-    const auto [i, j] = coarse_blocks_[k];
-    if (!constraints.isConstrained(i) && !constraints.isConstrained(j)) continue;
-    const std::array<int, 9>& idx = coarse_values_[k];
-    Eigen::Matrix3d block;
-    for (int r = 0; r < 3; ++r) {
-      for (int col = 0; col < 3; ++col) {
-        const int at = idx[static_cast<size_t>(3 * r + col)] >= 0
-                           ? idx[static_cast<size_t>(3 * r + col)]
-                           : idx[static_cast<size_t>(3 * col + r)];
-        block(r, col) = values[at];
-      }
-    }
-    Eigen::Matrix3d filtered = filter_matrix(i) * block * filter_matrix(j);
-    if (i == j) filtered += Eigen::Matrix3d::Identity() - filter_matrix(i);
-    for (int r = 0; r < 3; ++r) {
-      for (int col = 0; col < 3; ++col) {
-        const int at = idx[static_cast<size_t>(3 * r + col)];
-        if (at >= 0) values[at] = filtered(r, col);
-      }
-    }
-  }
+  detail::applyConstraintsToBlocks(constraints, coarse_blocks_, coarse_values_, values);
 }
 
 void TwoLevelPreconditioner::smooth(const NodeConstraints& constraints,
