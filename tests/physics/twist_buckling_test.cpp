@@ -1,6 +1,6 @@
 // A slender rod clamped at both ends and twisted buckles sideways (Greenhill 1883; Timoshenko &
-// Gere, Theory of Elastic Stability, 2nd ed., section 2.18): docs/validation.md, "Twist buckling
-// (Greenhill)". With no axial force and both ends clamped, the straight twisted rod loses
+// Gere, Theory of Elastic Stability, 2nd ed., chapter 2): docs/validation.md, "Twist buckling
+// against Greenhill" (with the derivation for clamped ends). With no axial force and both ends clamped, the straight twisted rod loses
 // stability at the twisting moment
 //   M_cr = 8.9868 E I / L   (2 x 4.4934, 4.4934 the first root of tan x = x; 2.86 pi E I / L),
 // i.e. at the twist angle theta_cr = M_cr L / (G J) = 8.9868 (1 + nu) for a round (or regular
@@ -16,9 +16,9 @@
 // (the seed's projections on the two buckling modes of moments +M_c and -M_c). M_c is fitted to
 // the settled levels (a Southwell-type estimate from below the critical point); the critical twist
 // is the angle at which the settled torque-angle curve reaches M_c. Past the levels the twist goes
-// on through the critical point: the rod buckles and folds into a loop that presses on itself,
-// held off by self-contact, and after every step an exact test finds no two surface triangles of
-// the rod intersecting.
+// on through the critical point to 1.2 times it: the rod buckles into an open helix (its loop does
+// not close that soon), with self-contact on, and after every step an exact test finds no two
+// surface triangles of the rod intersecting.
 #include <gtest/gtest.h>
 
 #include <Eigen/Dense>
