@@ -1,7 +1,7 @@
 // A slender rod clamped at both ends and twisted buckles sideways (Greenhill 1883; Timoshenko &
 // Gere, Theory of Elastic Stability, 2nd ed., chapter 2): docs/validation.md, "Twist buckling
-// against Greenhill" (with the derivation for clamped ends). With no axial force and both ends clamped, the straight twisted rod loses
-// stability at the twisting moment
+// against Greenhill" (with the derivation for clamped ends). With no axial force and both ends
+// clamped, the straight twisted rod loses stability at the twisting moment
 //   M_cr = 8.9868 E I / L   (2 x 4.4934, 4.4934 the first root of tan x = x; 2.86 pi E I / L),
 // i.e. at the twist angle theta_cr = M_cr L / (G J) = 8.9868 (1 + nu) for a round (or regular
 // polygonal) section, whatever its slenderness. 11.68 rad = 1.86 turns at nu = 0.3.
@@ -66,7 +66,7 @@ struct BucklingSpec {
   double end_travel_limit = 0.75;
   double final_hold = 0.5;  ///< s
   double final_rate = 1.0;  ///< rad/s
-  double dt = 0.02;
+  double dt = 0.02;         ///< s
 };
 
 struct Level {
@@ -213,7 +213,8 @@ BucklingRun twistUntilBuckled(const BucklingSpec& spec) {
   }
   schedule.rampTo(spec.final_level * kCriticalTwist, spec.final_rate);
   schedule.hold(spec.final_hold);
-  // Knot times at which a hold ends: measure there.
+  // The steps that end the holds before the final one: measure there (one step early, so that
+  // rounding of the knot times never puts the measurement on the next ramp).
   std::vector<int> hold_ends;
   for (size_t k = 1; k < schedule.knots.size(); ++k)
     if (schedule.knots[k].second == schedule.knots[k - 1].second && k + 1 < schedule.knots.size())
@@ -222,7 +223,7 @@ BucklingRun twistUntilBuckled(const BucklingSpec& spec) {
 
   // The hand: turns by the schedule and slides along the axis so that the axial force stays zero
   // (a proportional step on the force the rod exerts, scaled by the axial stiffness E A / L),
-  // until the rod has buckled; then it holds its place.
+  // until the end has come in to end_travel_limit L; then it holds its place.
   auto end_z = std::make_shared<double>(kLength);
   body->carryNodes(
       "base", base, [](double) { return Frame{}; }, 0);
@@ -293,13 +294,10 @@ BucklingRun twistUntilBuckled(const BucklingSpec& spec) {
   run.final_deflection = history.empty() ? 0 : history.back();
   run.end_z = *end_z;
   run.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  // The levels below the critical twist (the last hold, past it, is the buckled rod).
-  std::vector<Level> below(run.levels.begin(),
-                           run.levels.begin() + std::min(static_cast<long>(spec.levels.size()) + 1,
-                                                         static_cast<long>(run.levels.size())));
-  if (below.size() < 3) return run;
-  run.fitted_moment = fitCriticalMoment(below);
-  run.critical_angle = angleAtMoment(below, run.fitted_moment);
+  // The held levels (the untwisted rod and spec.levels; the final hold is not one of them).
+  if (run.levels.size() < 3) return run;
+  run.fitted_moment = fitCriticalMoment(run.levels);
+  run.critical_angle = angleAtMoment(run.levels, run.fitted_moment);
   return run;
 }
 
