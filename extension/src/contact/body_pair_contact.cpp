@@ -83,6 +83,8 @@ void BodyPairContact::replaceModels(std::shared_ptr<const FemModel> a,
 bool BodyPairContact::detect(const Eigen::VectorXd& xa, const Eigen::VectorXd& va,
                              const Eigen::VectorXd& xb, const Eigen::VectorXd& vb, double dt) {
   set_.beginStep();
+  start_a_ = xa;
+  start_b_ = xb;
   end_a_ = xa + dt * va;
   end_b_ = xb + dt * vb;
   // a's nodes against b's triangles, then b's nodes against a's: a fixed order, so the candidates
@@ -151,6 +153,36 @@ void BodyPairContact::addCandidates(const FemModel& nodes_model, int node_offset
       set_.add(c);
     }
   }
+}
+
+int BodyPairContact::correctGaps(const Eigen::VectorXd& v, double dt, double tolerance) {
+  auto end = [&](int node) -> Eigen::Vector3d {
+    const Eigen::Vector3d x = node < node_count_a_ ? start_a_.segment<3>(3 * node)
+                                                   : start_b_.segment<3>(3 * (node - node_count_a_));
+    return x + dt * v.segment<3>(3 * node);
+  };
+  int shifted = 0;
+  for (SurfaceContact& c : set_.contacts()) {
+    if (c.determined || c.edge >= 0) continue;
+    const Eigen::Vector3d p = end(c.nodes[0]), a = end(c.nodes[1]), b = end(c.nodes[2]),
+                          t = end(c.nodes[3]);
+    Eigen::Vector3d n = (b - a).cross(t - a);
+    if (!(n.norm() > 0)) continue;
+    n.normalize();
+    const double true_gap = n.dot(p - a);
+    if (true_gap >= -tolerance) continue;
+    const Eigen::Vector3d w = barycentric(p, a, b, t);
+    if (!w.allFinite() || w.minCoeff() < -kInsideTolerance) continue;  // slid off: not this face
+    Eigen::Vector3d u = Eigen::Vector3d::Zero();
+    for (size_t k = 0; k < 4; ++k)
+      u += c.beta[k] * v.segment<3>(3 * c.nodes[k]);
+    const double linear_gap = c.gap + dt * c.normal.dot(u);
+    if (true_gap < linear_gap) {
+      c.gap += true_gap - linear_gap;
+      ++shifted;
+    }
+  }
+  return shifted;
 }
 
 }  // namespace torsion
