@@ -13,6 +13,7 @@
 
 #include "scene_builder.h"
 #include "scene_parser.h"
+#include "../contact/surface_depth.h"
 #include "torsion/bullet/fem_contact_islands.h"
 
 namespace torsion::scene {
@@ -40,72 +41,10 @@ double depthInBox(const Eigen::Vector3d& p, const btTransform& pose, const Eigen
   return (h - local).minCoeff();
 }
 
-// The closed surface of a body at positions x (3n).
-struct Surface {
-  const std::vector<Triangle>* triangles;
-  const Eigen::VectorXd* x;
-  Eigen::Vector3d corner(const Triangle& t, int k) const {
-    return x->segment<3>(3 * t[static_cast<size_t>(k)]);
-  }
-};
-
-// Generalised winding number of the surface around p (Van Oosterom & Strackee's solid angle of
-// each triangle, summed over 4 pi): 1 inside a closed outward-oriented surface, 0 outside, robust
-// to any shape (no ray to graze an edge).
-double windingNumber(const Surface& s, const Eigen::Vector3d& p) {
-  double sum = 0;
-  for (const Triangle& t : *s.triangles) {
-    const Eigen::Vector3d a = s.corner(t, 0) - p, b = s.corner(t, 1) - p, c = s.corner(t, 2) - p;
-    const double la = a.norm(), lb = b.norm(), lc = c.norm();
-    const double numerator = a.dot(b.cross(c));
-    const double denominator = la * lb * lc + a.dot(b) * lc + b.dot(c) * la + c.dot(a) * lb;
-    sum += 2 * std::atan2(numerator, denominator);
-  }
-  return sum / (4 * M_PI);
-}
-
-// Distance from p to the triangle (a, b, c) (Ericson, Real-Time Collision Detection 5.1.5).
-double distanceToTriangle(const Eigen::Vector3d& p, const Eigen::Vector3d& a,
-                          const Eigen::Vector3d& b, const Eigen::Vector3d& c) {
-  const Eigen::Vector3d ab = b - a, ac = c - a, ap = p - a;
-  const double d1 = ab.dot(ap), d2 = ac.dot(ap);
-  if (d1 <= 0 && d2 <= 0) return ap.norm();
-  const Eigen::Vector3d bp = p - b;
-  const double d3 = ab.dot(bp), d4 = ac.dot(bp);
-  if (d3 >= 0 && d4 <= d3) return bp.norm();
-  const double vc = d1 * d4 - d3 * d2;
-  if (vc <= 0 && d1 >= 0 && d3 <= 0) return (p - (a + d1 / (d1 - d3) * ab)).norm();
-  const Eigen::Vector3d cp = p - c;
-  const double d5 = ab.dot(cp), d6 = ac.dot(cp);
-  if (d6 >= 0 && d5 <= d6) return cp.norm();
-  const double vb = d5 * d2 - d1 * d6;
-  if (vb <= 0 && d2 >= 0 && d6 <= 0) return (p - (a + d2 / (d2 - d6) * ac)).norm();
-  const double va = d3 * d6 - d5 * d4;
-  if (va <= 0 && (d4 - d3) >= 0 && (d5 - d6) >= 0)
-    return (p - (b + (d4 - d3) / ((d4 - d3) + (d5 - d6)) * (c - b))).norm();
-  const double denominator = 1 / (va + vb + vc);
-  return (p - (a + ab * (vb * denominator) + ac * (vc * denominator))).norm();
-}
-
-// Depth of p inside the closed surface: its distance to the surface when the winding number says
-// inside, else 0.
-double depthInSurface(const Surface& s, const Eigen::Vector3d& p) {
-  if (windingNumber(s, p) < 0.5) return 0;
-  double nearest = std::numeric_limits<double>::infinity();
-  for (const Triangle& t : *s.triangles)
-    nearest = std::min(nearest, distanceToTriangle(p, s.corner(t, 0), s.corner(t, 1),
-                                                   s.corner(t, 2)));
-  return nearest;
-}
-
-// The deepest surface node of `nodes` inside `other`, both at positions given.
+// The deepest surface node of `nodes` inside `other`, both at the positions given.
 double deepestInside(const FemBody& nodes, const Eigen::VectorXd& xn, const FemBody& other,
                      const Eigen::VectorXd& xo) {
-  const Surface surface{&other.model().mesh().surfaceTriangles(), &xo};
-  double deepest = 0;
-  for (int p : nodes.model().mesh().surfaceNodes())
-    deepest = std::max(deepest, depthInSurface(surface, xn.segment<3>(3 * p)));
-  return deepest;
+  return deepestNodeInside(nodes.model().mesh(), xn, other.model().mesh(), xo);
 }
 
 Eigen::Vector3d linearMomentum(const FemBody& b) {

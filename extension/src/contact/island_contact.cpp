@@ -342,9 +342,13 @@ IslandContactStats IslandContactSolve::solve(std::vector<Body>& bodies,
       // Activation below a tenth of the tolerance: a contact hovering at zero gap does not flip.
       if (!pair->contact->set().update(pair_v_, dt, 0.1 * tolerance, tolerance)) settled = false;
     }
-    if (settled && corrections < kMaxGapCorrections) {
-      // Settled on the linearised gaps: measure them on the true end positions, and go on where
-      // a node would end behind the moved surface.
+    // Settled, or at least every linearised gap within its tolerance (sliding friction may take
+    // the rest of the updates to settle, or not settle): measure the gaps on the true end
+    // positions, and go on where a node would end behind the moved surface.
+    double gap_error = 0;
+    for (const Pair* pair : live)
+      gap_error = std::max(gap_error, pair->contact->set().maxGapError());
+    if ((settled || gap_error <= min_tolerance) && corrections < kMaxGapCorrections) {
       int shifted = 0;
       for (const Pair* pair : live) {
         pairVelocities(bodies, *pair, pair_v_);
