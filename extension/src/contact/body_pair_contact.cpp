@@ -141,7 +141,16 @@ void BodyPairContact::addCandidates(const FemModel& nodes_model, int node_offset
       const Eigen::Vector3d w = barycentric(xp + s * (ep - xp), a0 + s * (a1 - a0),
                                             b0 + s * (b1 - b0), c0 + s * (c1 - c0));
       if (!w.allFinite() || w.minCoeff() < -kInsideTolerance) continue;
-      const Eigen::Vector3d wc = w.cwiseMax(0.0) / w.cwiseMax(0.0).sum();
+      // The impulse's triangle point: the node's projection at the step's start, unclamped while
+      // within the slack. Node and point then differ only along the normal, so the pair of
+      // impulses has no moment about the start positions, where an implicit step's impulses act
+      // on the angular momentum (clamping to the triangle gave levers: 1.5 % of the angular
+      // momentum lost in bullet_collide_soft, 0.95 % without). A projection that enters the
+      // triangle only later on the path takes the crossing's weights, clamped.
+      const Eigen::Vector3d w_start = s > 0 ? barycentric(xp, a0, b0, c0) : w;
+      const Eigen::Vector3d wc = w_start.allFinite() && w_start.minCoeff() >= -kInsideTolerance
+                                     ? w_start
+                                     : Eigen::Vector3d(w.cwiseMax(0.0) / w.cwiseMax(0.0).sum());
       SurfaceContact c;
       c.nodes = {pair_node, triangle_node_offset + tri[0], triangle_node_offset + tri[1],
                  triangle_node_offset + tri[2]};
