@@ -195,13 +195,15 @@ TEST(BodyContact, ASoftBlockThrownAt15MetresPerSecondNeverEntersTheOther) {
     const Eigen::VectorXd ms = 0.5 * (xs + ys), mt = 0.5 * (xt + yt);
     const TetMesh& a = struck->model().mesh();
     const TetMesh& b = thrown->model().mesh();
-    const double depth = std::max({deepestNodeInside(a, ys, b, yt), deepestNodeInside(b, yt, a, ys),
-                                   deepestNodeInside(a, ms, b, mt), deepestNodeInside(b, mt, a, ms)});
+    const double depth =
+        std::max({deepestNodeInside(a, ys, b, yt), deepestNodeInside(b, yt, a, ys),
+                  deepestNodeInside(a, ms, b, mt), deepestNodeInside(b, mt, a, ms)});
     if (depth > deepest) {
       deepest = depth;
       deepest_step = k + 1;
     }
-    worst = std::max(worst, (momentum(*struck) + momentum(*thrown) - before).norm() / before.norm());
+    worst =
+        std::max(worst, (momentum(*struck) + momentum(*thrown) - before).norm() / before.norm());
     xs = ys;
     xt = yt;
   }

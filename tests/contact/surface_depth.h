@@ -44,7 +44,7 @@ inline double windingNumber(const ClosedSurface& s, const Eigen::Vector3d& p) {
 
 // Distance from p to the triangle (a, b, c) (Ericson, Real-Time Collision Detection 5.1.5).
 inline double distanceToTriangle(const Eigen::Vector3d& p, const Eigen::Vector3d& a,
-                          const Eigen::Vector3d& b, const Eigen::Vector3d& c) {
+                                 const Eigen::Vector3d& b, const Eigen::Vector3d& c) {
   const Eigen::Vector3d ab = b - a, ac = c - a, ap = p - a;
   const double d1 = ab.dot(ap), d2 = ac.dot(ap);
   if (d1 <= 0 && d2 <= 0) return ap.norm();
@@ -71,8 +71,8 @@ inline double depthInSurface(const ClosedSurface& s, const Eigen::Vector3d& p) {
   if (windingNumber(s, p) < 0.5) return 0;
   double nearest = std::numeric_limits<double>::infinity();
   for (const Triangle& t : *s.triangles)
-    nearest = std::min(nearest, distanceToTriangle(p, s.corner(t, 0), s.corner(t, 1),
-                                                   s.corner(t, 2)));
+    nearest =
+        std::min(nearest, distanceToTriangle(p, s.corner(t, 0), s.corner(t, 1), s.corner(t, 2)));
   return nearest;
 }
 

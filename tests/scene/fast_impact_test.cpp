@@ -11,9 +11,9 @@
 #include <cmath>
 #include <limits>
 
+#include "../contact/surface_depth.h"
 #include "scene_builder.h"
 #include "scene_parser.h"
-#include "../contact/surface_depth.h"
 #include "torsion/bullet/fem_contact_islands.h"
 
 namespace torsion::scene {
@@ -34,9 +34,8 @@ Eigen::Vector3d toEigen(const btVector3& v) {
 
 // Depth of p inside a box (half extents h, pose `pose`): > 0 inside, <= 0 outside.
 double depthInBox(const Eigen::Vector3d& p, const btTransform& pose, const Eigen::Vector3d& h) {
-  const btVector3 local_bt = pose.invXform(btVector3(static_cast<btScalar>(p.x()),
-                                                     static_cast<btScalar>(p.y()),
-                                                     static_cast<btScalar>(p.z())));
+  const btVector3 local_bt = pose.invXform(btVector3(
+      static_cast<btScalar>(p.x()), static_cast<btScalar>(p.y()), static_cast<btScalar>(p.z())));
   const Eigen::Vector3d local = toEigen(local_bt).cwiseAbs();
   return (h - local).minCoeff();
 }
@@ -92,14 +91,14 @@ void expectNoNodeInTheBox(const std::string& scene) {
   // cube's 1 m cells (a tunnelling node ends a whole step's travel, 0.5 m, inside).
   const double tolerance = 2e-3 * meanSurfaceEdge(cube);
   auto momentum = [&]() -> Eigen::Vector3d {
-    return linearMomentum(cube) + toEigen(box.getLinearVelocity()) /
-                                      static_cast<double>(box.getInvMass());
+    return linearMomentum(cube) +
+           toEigen(box.getLinearVelocity()) / static_cast<double>(box.getInvMass());
   };
   const Eigen::Vector3d p0 = momentum();
   // Measured against the larger of what each body brings.
-  const double scale = std::max(linearMomentum(cube).norm(),
-                                toEigen(box.getLinearVelocity()).norm() /
-                                    static_cast<double>(box.getInvMass()));
+  const double scale =
+      std::max(linearMomentum(cube).norm(),
+               toEigen(box.getLinearVelocity()).norm() / static_cast<double>(box.getInvMass()));
   double deepest = 0, worst_momentum = 0;
   int deepest_step = 0, unconverged = 0;
   Eigen::VectorXd before = cube.state().positions;
@@ -177,16 +176,15 @@ TEST(FastImpactContact, TwoSoftCubesAt15MetresPerSecondEachNeverInterpenetrateAn
     const Eigen::VectorXd& la = lower.state().positions;
     const Eigen::VectorXd& ua = upper.state().positions;
     const Eigen::VectorXd lm = 0.5 * (lower_before + la), um = 0.5 * (upper_before + ua);
-    const double depth = std::max({deepestInside(lower, la, upper, ua),
-                                   deepestInside(upper, ua, lower, la),
-                                   deepestInside(lower, lm, upper, um),
-                                   deepestInside(upper, um, lower, lm)});
+    const double depth =
+        std::max({deepestInside(lower, la, upper, ua), deepestInside(upper, ua, lower, la),
+                  deepestInside(lower, lm, upper, um), deepestInside(upper, um, lower, lm)});
     if (depth > deepest) {
       deepest = depth;
       deepest_step = k + 1;
     }
-    worst_p = std::max(
-        worst_p, (linearMomentum(lower) + linearMomentum(upper) - p0).norm() / p_scale);
+    worst_p =
+        std::max(worst_p, (linearMomentum(lower) + linearMomentum(upper) - p0).norm() / p_scale);
     worst_l = std::max(worst_l,
                        (angularMomentum(lower) + angularMomentum(upper) - l0).norm() / l0.norm());
     lower_before = la;
@@ -195,8 +193,8 @@ TEST(FastImpactContact, TwoSoftCubesAt15MetresPerSecondEachNeverInterpenetrateAn
   }
   std::cout << "[ measured ] deepest node inside the other cube " << deepest << " m (step "
             << deepest_step << ", tolerance " << tolerance << " m); linear momentum off by "
-            << worst_p << " of one body's, angular by " << worst_l << "; " << unconverged
-            << " of " << contact_steps << " contact steps unconverged\n";
+            << worst_p << " of one body's, angular by " << worst_l << "; " << unconverged << " of "
+            << contact_steps << " contact steps unconverged\n";
   EXPECT_GT(contact_steps, 0) << "the cubes met";
   EXPECT_LT(deepest, tolerance) << "a node went into the other cube at step " << deepest_step;
   EXPECT_LT(worst_p, 0.01);

@@ -37,12 +37,12 @@ TEST(SceneStartingVelocityKeys, BadValuesNameTheFileTheKeyAndTheFault) {
                               {"s.json: bodies[0].linear_velocity", "array of 3 numbers"}));
   EXPECT_TRUE(test::failsWith(parse(R"( "angular_velocity": [0, "1", 0],)"),
                               {"s.json: bodies[0].angular_velocity", "element 1", "number"}));
-  EXPECT_TRUE(test::failsWith(parse(R"( "linear_velocity": [2e6, 0, 0],)"),
-                              {"s.json: bodies[0].linear_velocity", "speed 2e+06 m/s",
-                               "above the bound 1e+06 m/s"}));
-  EXPECT_TRUE(test::failsWith(parse(R"( "angular_velocity": [0, 0, -3e7],)"),
-                              {"s.json: bodies[0].angular_velocity", "spin 3e+07 rad/s",
-                               "above the bound 1e+06 rad/s"}));
+  EXPECT_TRUE(test::failsWith(
+      parse(R"( "linear_velocity": [2e6, 0, 0],)"),
+      {"s.json: bodies[0].linear_velocity", "speed 2e+06 m/s", "above the bound 1e+06 m/s"}));
+  EXPECT_TRUE(test::failsWith(
+      parse(R"( "angular_velocity": [0, 0, -3e7],)"),
+      {"s.json: bodies[0].angular_velocity", "spin 3e+07 rad/s", "above the bound 1e+06 rad/s"}));
   EXPECT_TRUE(test::failsWith(parse(R"( "velocity": [1, 0, 0],)"),
                               {"s.json: bodies[0].velocity", "unknown"}));
 }

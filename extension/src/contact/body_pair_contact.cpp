@@ -166,8 +166,9 @@ void BodyPairContact::addCandidates(const FemModel& nodes_model, int node_offset
 
 int BodyPairContact::correctGaps(const Eigen::VectorXd& v, double dt, double tolerance) {
   auto end = [&](int node) -> Eigen::Vector3d {
-    const Eigen::Vector3d x = node < node_count_a_ ? start_a_.segment<3>(3 * node)
-                                                   : start_b_.segment<3>(3 * (node - node_count_a_));
+    const Eigen::Vector3d x = node < node_count_a_
+                                  ? start_a_.segment<3>(3 * node)
+                                  : start_b_.segment<3>(3 * (node - node_count_a_));
     return x + dt * v.segment<3>(3 * node);
   };
   int shifted = 0;
