@@ -20,6 +20,11 @@ inline constexpr double kMaxRigidLength = 1e6;
 /// from the origin: beyond it a unit-sized body's coordinates lose their digits (1e300 + 1 ==
 /// 1e300) and the first step returns inf or NaN.
 inline constexpr double kMaxPlacement = 1e6;
+/// An FEM body's starting speed (m/s) and spin (rad/s) above this are refused: a step moves a
+/// node by dt v, and products of such speeds with masses and lengths lose every digit of the
+/// body's size (1e6 m/s covers any impact a solid survives; sound in steel is 6e3 m/s).
+inline constexpr double kMaxInitialSpeed = 1e6;
+inline constexpr double kMaxInitialSpin = 1e6;
 /// A dynamic rigid body's mass, kg: Bullet divides by it and multiplies it by sizes squared; at
 /// 1e300 or 1e-300 a contact impulse overflows in the first step.
 inline constexpr double kMinRigidMass = 1e-9;

@@ -76,6 +76,9 @@ Result<std::unique_ptr<BuiltScene>> buildScene(SceneSpec spec, int threads_overr
     Result<FemBody*> added =
         world.addBody(body.name, mesh.value().mesh, body.material, body.pose, body.element);
     if (!added) return Error{entry + ": " + added.error().message};
+    if (body.linear_velocity != Eigen::Vector3d::Zero() ||
+        body.angular_velocity != Eigen::Vector3d::Zero())
+      added.value()->setRigidVelocity(body.linear_velocity, body.angular_velocity);
     if (body.self_contact) {
       if (Status on = added.value()->enableSelfContact(*body.self_contact); !on)
         return Error{entry + ": " + on.error().message};

@@ -299,6 +299,23 @@ void readWorld(const JsonObject& root, const std::string& file_name, SceneSpec& 
   if (root.has("fem_contact")) scene.fem_contact = readFemContact(root);
 }
 
+// "linear_velocity" (m/s) and "angular_velocity" (rad/s, about the centre of mass): the body's
+// rigid motion at the start, bounded so that the first step's arithmetic keeps its digits.
+void readStartingVelocity(const JsonObject& b, BodySpec& body) {
+  body.linear_velocity = b.vector3("linear_velocity", Eigen::Vector3d::Zero());
+  if (body.linear_velocity.norm() > kMaxInitialSpeed) {
+    b.fail("linear_velocity", "speed " + formatNumber(body.linear_velocity.norm()) +
+                                  " m/s is above the bound " + formatNumber(kMaxInitialSpeed) +
+                                  " m/s");
+  }
+  body.angular_velocity = b.vector3("angular_velocity", Eigen::Vector3d::Zero());
+  if (body.angular_velocity.norm() > kMaxInitialSpin) {
+    b.fail("angular_velocity", "spin " + formatNumber(body.angular_velocity.norm()) +
+                                   " rad/s is above the bound " + formatNumber(kMaxInitialSpin) +
+                                   " rad/s");
+  }
+}
+
 BodySpec readBody(const JsonObject& b, const SceneSpec& scene, const std::string& base_directory) {
   BodySpec body;
   body.name = b.name("name");
@@ -309,6 +326,7 @@ BodySpec readBody(const JsonObject& b, const SceneSpec& scene, const std::string
   body.mesh_path = resolved(mesh, base_directory);
   body.material = readMaterial(b.object("material"));
   body.pose = readPose(b, "pose");
+  readStartingVelocity(b, body);
   const std::string element = b.string("element", "tet4");
   if (auto kind = parseElementKind(element)) {
     body.element = *kind;

@@ -27,6 +27,11 @@ struct BodySpec {
   std::string mesh_path;  ///< resolved
   Material material;
   Frame pose;
+  /// m/s, the centre of mass's velocity at the start ("linear_velocity"); rad/s, a spin about the
+  /// centre of mass ("angular_velocity", axis times rate): every node starts at
+  /// linear + angular x (x_i - c) (FemBody::setRigidVelocity).
+  Eigen::Vector3d linear_velocity = Eigen::Vector3d::Zero();
+  Eigen::Vector3d angular_velocity = Eigen::Vector3d::Zero();
   ElementKind element = ElementKind::kTet4;  ///< "element": "tet4" | "tet10"
   /// "self_contact": {"friction", "gap_tolerance"}: on when present (docs/contact.md).
   std::optional<SelfContactSettings> self_contact;

@@ -617,6 +617,29 @@ assert c["normal_impulse_total_Ns"] > 0, c
 PY
     ;;
 
+  run_bullet_collide_soft)
+    # Two soft cubes thrown at each other at 15 m/s each (starting velocities from the scene):
+    # they meet, every contact step converges and the end gaps stay within the tolerance.
+    run "$torsion" run bullet_collide_soft --out out --threads 1
+    expect_rc 0
+    python3 - out/summary.json <<'PY' || fail "fem_contact figures"
+import json, sys
+c = json.load(open(sys.argv[1]))["contacts"]["fem_contact"]
+assert c["steps_in_contact"] > 0 and c["normal_impulse_total_Ns"] > 0, c
+assert c["unconverged_steps"] == 0 and c["max_end_penetration_m"] < 2.3e-3, c
+PY
+    ;;
+
+  run_bad_body_velocity)
+    # A starting speed beyond the bound: refused before any step, naming the file and the key.
+    sed "s|../../assets/meshes|$assets|; s|\"linear_velocity\": \[0, 0, -15\]|\"linear_velocity\": [0, 0, -2e6]|" \
+      "$scenes/bullet_collide_moving.json" > bad.json
+    run "$torsion" run bad.json --out out
+    expect_rc nonzero
+    expect_out "^error: bad.json: bodies\\[0\\].linear_velocity: speed 2e\\+06 m/s is above the bound"
+    [[ ! -e out/summary.json ]] || fail "no output may be written for a bad scene"
+    ;;
+
   run_bad_rigid_body)
     # A kinematic body with a mass: refused before any step, naming the key.
     sed "s|../../assets/meshes|$assets|; s|\"friction\": 0.8,|\"friction\": 0.8, \"mass\": 3,|" \

@@ -90,6 +90,18 @@ void FemBody::setVelocity(const Eigen::Vector3d& velocity) {
   writeBack();
 }
 
+void FemBody::setRigidVelocity(const Eigen::Vector3d& linear, const Eigen::Vector3d& angular) {
+  const std::vector<double>& masses = model_->nodeMasses();
+  Eigen::Vector3d centre = Eigen::Vector3d::Zero();
+  for (int i = 0; i < model_->nodeCount(); ++i)
+    centre += masses[static_cast<size_t>(i)] * state_.positions.segment<3>(3 * i);
+  centre /= model_->totalMass();
+  for (int i = 0; i < model_->nodeCount(); ++i)
+    state_.velocities.segment<3>(3 * i) =
+        linear + angular.cross(Eigen::Vector3d(state_.positions.segment<3>(3 * i)) - centre);
+  writeBack();
+}
+
 Status FemBody::setExternalForces(const Eigen::VectorXd& forces) {
   if (forces.size() != external_forces_.size()) {
     return Error{"body '" + name_ + "': external forces have " + std::to_string(forces.size()) +

@@ -83,6 +83,8 @@ void BodyPairContact::replaceModels(std::shared_ptr<const FemModel> a,
 bool BodyPairContact::detect(const Eigen::VectorXd& xa, const Eigen::VectorXd& va,
                              const Eigen::VectorXd& xb, const Eigen::VectorXd& vb, double dt) {
   set_.beginStep();
+  start_a_ = xa;
+  start_b_ = xb;
   end_a_ = xa + dt * va;
   end_b_ = xb + dt * vb;
   // a's nodes against b's triangles, then b's nodes against a's: a fixed order, so the candidates
@@ -139,7 +141,16 @@ void BodyPairContact::addCandidates(const FemModel& nodes_model, int node_offset
       const Eigen::Vector3d w = barycentric(xp + s * (ep - xp), a0 + s * (a1 - a0),
                                             b0 + s * (b1 - b0), c0 + s * (c1 - c0));
       if (!w.allFinite() || w.minCoeff() < -kInsideTolerance) continue;
-      const Eigen::Vector3d wc = w.cwiseMax(0.0) / w.cwiseMax(0.0).sum();
+      // The impulse's triangle point: the node's projection at the step's start, unclamped while
+      // within the slack. Node and point then differ only along the normal, so the pair of
+      // impulses has no moment about the start positions, where an implicit step's impulses act
+      // on the angular momentum (clamping to the triangle gave levers: 1.5 % of the angular
+      // momentum lost in bullet_collide_soft, 0.95 % without). A projection that enters the
+      // triangle only later on the path takes the crossing's weights, clamped.
+      const Eigen::Vector3d w_start = s > 0 ? barycentric(xp, a0, b0, c0) : w;
+      const Eigen::Vector3d wc = w_start.allFinite() && w_start.minCoeff() >= -kInsideTolerance
+                                     ? w_start
+                                     : Eigen::Vector3d(w.cwiseMax(0.0) / w.cwiseMax(0.0).sum());
       SurfaceContact c;
       c.nodes = {pair_node, triangle_node_offset + tri[0], triangle_node_offset + tri[1],
                  triangle_node_offset + tri[2]};
@@ -151,6 +162,37 @@ void BodyPairContact::addCandidates(const FemModel& nodes_model, int node_offset
       set_.add(c);
     }
   }
+}
+
+int BodyPairContact::correctGaps(const Eigen::VectorXd& v, double dt, double tolerance) {
+  auto end = [&](int node) -> Eigen::Vector3d {
+    const Eigen::Vector3d x = node < node_count_a_
+                                  ? start_a_.segment<3>(3 * node)
+                                  : start_b_.segment<3>(3 * (node - node_count_a_));
+    return x + dt * v.segment<3>(3 * node);
+  };
+  int shifted = 0;
+  for (SurfaceContact& c : set_.contacts()) {
+    if (c.determined || c.edge >= 0) continue;
+    const Eigen::Vector3d p = end(c.nodes[0]), a = end(c.nodes[1]), b = end(c.nodes[2]),
+                          t = end(c.nodes[3]);
+    Eigen::Vector3d n = (b - a).cross(t - a);
+    if (!(n.norm() > 0)) continue;
+    n.normalize();
+    const double true_gap = n.dot(p - a);
+    if (true_gap >= -tolerance) continue;
+    const Eigen::Vector3d w = barycentric(p, a, b, t);
+    if (!w.allFinite() || w.minCoeff() < -kInsideTolerance) continue;  // slid off: not this face
+    Eigen::Vector3d u = Eigen::Vector3d::Zero();
+    for (size_t k = 0; k < 4; ++k)
+      u += c.beta[k] * v.segment<3>(3 * c.nodes[k]);
+    const double linear_gap = c.gap + dt * c.normal.dot(u);
+    if (true_gap < linear_gap) {
+      c.gap += true_gap - linear_gap;
+      ++shifted;
+    }
+  }
+  return shifted;
 }
 
 }  // namespace torsion

@@ -16,6 +16,13 @@ namespace {
 // soft_stack scene 0.01 left 0.7 mm end penetration, 0.05 4.2 mm, 0.2 and 1 diverged).
 constexpr double kGaussSeidelPenaltyScale = 0.01;
 
+// Passes that move linearised gaps onto the true end-of-step surface (BodyPairContact::
+// correctGaps) before a step may settle. Each is a secant step of the gap function with the
+// detection's normal as its slope: on the soft cubes thrown at each other at 15 m/s
+// (bullet_collide_soft) the deepest node ends 1.1 mm inside the other cube instead of 9.6 mm
+// (docs/contact.md, "Fast impacts").
+constexpr int kMaxGapCorrections = 4;
+
 bool participates(const SurfaceContact& c) {
   return !c.determined && c.state != SurfaceContact::State::kInactive;
 }
@@ -315,7 +322,7 @@ IslandContactStats IslandContactSolve::solve(std::vector<Body>& bodies,
     min_tolerance = std::min(min_tolerance, pair->contact->gapTolerance());
   bool settled = false, broke = false;
   double best_error = 0;
-  int worse = 0;
+  int worse = 0, corrections = 0, first_round = 0;
   for (int round = 0; round < settings.max_iterations && !broke; ++round) {
     double moved = 0;
     if (joint) {
@@ -335,6 +342,25 @@ IslandContactStats IslandContactSolve::solve(std::vector<Body>& bodies,
       // Activation below a tenth of the tolerance: a contact hovering at zero gap does not flip.
       if (!pair->contact->set().update(pair_v_, dt, 0.1 * tolerance, tolerance)) settled = false;
     }
+    // Settled, or at least every linearised gap within its tolerance (sliding friction may take
+    // the rest of the updates to settle, or not settle): measure the gaps on the true end
+    // positions, and go on where a node would end behind the moved surface.
+    double gap_error = 0;
+    for (const Pair* pair : live)
+      gap_error = std::max(gap_error, pair->contact->set().maxGapError());
+    if ((settled || gap_error <= min_tolerance) && corrections < kMaxGapCorrections) {
+      int shifted = 0;
+      for (const Pair* pair : live) {
+        pairVelocities(bodies, *pair, pair_v_);
+        shifted += pair->contact->correctGaps(pair_v_, dt, pair->contact->gapTolerance());
+      }
+      if (shifted > 0) {
+        ++corrections;
+        settled = false;
+        first_round = round + 1;  // the safeguard starts over on the shifted gaps
+        continue;
+      }
+    }
     if (settled) break;
     // Safeguard (as for self-contact): where the sweeps and updates do not contract (contacts
     // contradicting each other, an inexact sweep against a stiff penalty) the best round so far is
@@ -342,7 +368,7 @@ IslandContactStats IslandContactSolve::solve(std::vector<Body>& bodies,
     double error = 0;
     for (const Pair* pair : live)
       error = std::max(error, pair->contact->set().maxGapError());
-    if (round == 0 || error < best_error) {
+    if (round == first_round || error < best_error) {
       best_error = error;
       best_v_.resize(bodies.size());
       best_contacts_.resize(live.size());

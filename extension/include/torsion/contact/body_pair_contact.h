@@ -57,6 +57,16 @@ class BodyPairContact {
   bool detect(const Eigen::VectorXd& xa, const Eigen::VectorXd& va, const Eigen::VectorXd& xb,
               const Eigen::VectorXd& vb, double dt);
 
+  /// The true end of the step after a solve with the pair's velocities v (a's, then b's; m/s):
+  /// a candidate whose node, moved to x + dt v, projects inside its moved triangle (same slack
+  /// as detection) and lies more than `tolerance` behind the moved triangle's plane has its gap
+  /// shifted by the difference between that true end gap and its linearised one
+  /// (gap + dt n.u), so the next solve aims at the surface where it really ends up, not where
+  /// the start-of-step plane put it (a triangle that tilts or stretches while nodes slide over
+  /// it). Normals and weights stay those of detection, so the impulses stay equal and opposite
+  /// with the same levers. Returns how many gaps were shifted (docs/contact.md, "Fast impacts").
+  int correctGaps(const Eigen::VectorXd& v, double dt, double tolerance);
+
   int nodeCountA() const { return node_count_a_; }
   /// m, the gap tolerance in use (settings or its default from the two meshes).
   double gapTolerance() const { return gap_tolerance_; }
@@ -83,6 +93,7 @@ class BodyPairContact {
   double gap_tolerance_ = 0;
   SurfaceTree tree_a_, tree_b_;
   SurfaceContactSet set_;
+  Eigen::VectorXd start_a_, start_b_;  // positions at the step's start (correctGaps)
   Eigen::VectorXd end_a_, end_b_;
   std::vector<int> found_;
 };
