@@ -25,6 +25,7 @@
 #include <vector>
 
 #include "torsion/contact/body_pair_contact.h"
+#include "torsion/contact/rigid_contact.h"
 #include "torsion/solve/added_operator_term.h"
 #include "torsion/solve/node_constraints.h"
 #include "torsion/solve/projected_cg.h"
@@ -80,6 +81,9 @@ class IslandContactSolve {
     const SolverSettings* settings = nullptr;
     Eigen::VectorXd* v = nullptr;  ///< warm start on entry, v' on return
     BodySolve solve;
+    /// Its node contacts with prescribed rigid partners (ground, kinematic bodies), when they
+    /// join the joint solve (RigidContactSolver::joinsIsland); then `solve` is empty. Not owned.
+    RigidContactSolver* rigid = nullptr;
     PairContactTerm* term = nullptr;  ///< in op's added term (not owned)
     LinearSolveReport report;         ///< out: the body's solves, summed
     bool present = false;             ///< reached its solve (else its pairs sit this step out)
@@ -111,11 +115,25 @@ class IslandContactSolve {
   // The pair terms' product over the joint vector (offsets: each body's first component).
   void addJointProduct(const std::vector<const Pair*>& live, const Eigen::VectorXd& y,
                        Eigen::VectorXd& out) const;
+  // The joint path with rigid contacts: each such body's constraints and right-hand side with its
+  // active node contacts (rebuilt before every joint solve).
+  void prepareRigidContacts(std::vector<Body>& bodies);
+  // Their active sets on the impulses of the last joint solve; whether any contact changed.
+  bool updateRigidContacts(std::vector<Body>& bodies);
+  const NodeConstraints& constraintsOf(const std::vector<Body>& bodies, size_t i) const {
+    return bodies[i].rigid != nullptr ? rigid_constraints_[i] : *bodies[i].constraints;
+  }
+  const Eigen::VectorXd& rightHandSideOf(const std::vector<Body>& bodies, size_t i) const {
+    return bodies[i].rigid != nullptr ? rigid_b_[i] : *bodies[i].b;
+  }
 
   std::vector<ProjectedCg> cg_;  // plain solves, one per body (their workspaces)
   std::vector<int> offsets_;     // joint path: each body's first component (-1: absent)
   std::vector<Eigen::Matrix3d> joint_inverse_;
   Eigen::VectorXd joint_b_, joint_v_, joint_r_, joint_q_, joint_c_;
+  Eigen::VectorXd joint_impulse_;  // A v - b of the last joint solve, unfiltered
+  std::vector<NodeConstraints> rigid_constraints_;  // per body with `rigid`
+  std::vector<Eigen::VectorXd> rigid_b_;
   PcgScratch joint_scratch_;
   std::vector<std::vector<Eigen::Matrix3d>> blocks_;
   std::vector<Eigen::Matrix3d> pair_blocks_;
