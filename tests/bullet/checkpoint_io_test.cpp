@@ -183,7 +183,8 @@ class TouchingBodiesRig {
     std::vector<int> base;
     for (int i = 0; i < slab_->model().nodeCount(); ++i)
       if (slab_->state().position(i).z() < 1e-9) base.push_back(i);
-    slab_->carryNodes("base", base, [](double) { return Frame{}; }, 0.0);
+    slab_->carryNodes(
+        "base", base, [](double) { return Frame{}; }, 0.0);
     block_ = world_
                  .addBody("block",
                           makeBoxTetMesh({-0.08, -0.05, 0.101}, {0.06, 0.07, 0.2}, 2, 2, 2).value(),

@@ -2,9 +2,8 @@
 // touching each other and the ground are solved in one island CG with the ground contacts as node
 // constraints, so the stack carries its weight down to the ground with every step converged and
 // no body sinking into another.
-#include <gtest/gtest.h>
-
 #include <BulletCollision/CollisionShapes/btStaticPlaneShape.h>
+#include <gtest/gtest.h>
 
 #include <algorithm>
 #include <cmath>
@@ -63,21 +62,20 @@ TEST(SoftStack, AStackOfSoftBodiesOnRigidGroundCarriesItsWeightWithEveryStepConv
   settings.solver.time_step = 0.01;
   settings.solver.tolerance = 1e-5;
   FemWorld world(settings);
-  btRigidBody* ground =
-      world.addRigidBody(std::make_unique<btStaticPlaneShape>(btVector3(0, 0, 1), 0), 0,
-                         btTransform::getIdentity());
+  btRigidBody* ground = world.addRigidBody(
+      std::make_unique<btStaticPlaneShape>(btVector3(0, 0, 1), 0), 0, btTransform::getIdentity());
   ground->setFriction(0.5);
   std::vector<FemBody*> blocks;
   const double offsets[3][2] = {{0, 0}, {0.01, 0}, {-0.01, 0.01}};
   for (int k = 0; k < 3; ++k) {
     const double x = offsets[k][0], y = offsets[k][1], z = 0.0005 + 0.201 * k;
-    blocks.push_back(world
-                         .addBody("block" + std::to_string(k),
-                                  makeBoxTetMesh({x - 0.1, y - 0.1, z}, {x + 0.1, y + 0.1, z + 0.2},
-                                                 3, 3, 3)
-                                      .value(),
-                                  soft(1e5, 500))
-                         .value());
+    blocks.push_back(
+        world
+            .addBody(
+                "block" + std::to_string(k),
+                makeBoxTetMesh({x - 0.1, y - 0.1, z}, {x + 0.1, y + 0.1, z + 0.2}, 3, 3, 3).value(),
+                soft(1e5, 500))
+            .value());
   }
   double mass = 0;
   for (const FemBody* block : blocks)
@@ -98,8 +96,8 @@ TEST(SoftStack, AStackOfSoftBodiesOnRigidGroundCarriesItsWeightWithEveryStepConv
     }
     if (!converged) ++unconverged;
     worst_end = std::max(worst_end, s.max_end_penetration);
-    worst_overlap = std::max({worst_overlap, overlap(*blocks[1], *blocks[0]),
-                              overlap(*blocks[2], *blocks[1])});
+    worst_overlap =
+        std::max({worst_overlap, overlap(*blocks[1], *blocks[0]), overlap(*blocks[2], *blocks[1])});
     if (k >= steps - averaged) ground_force += impulse / dt / averaged;
   }
   const double tolerance =

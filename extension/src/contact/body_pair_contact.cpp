@@ -126,9 +126,9 @@ bool BodyPairContact::detect(const Eigen::VectorXd& xa, const Eigen::VectorXd& v
 void BodyPairContact::addCandidates(const FemModel& nodes_model, int node_offset,
                                     const Eigen::VectorXd& xn, const Eigen::VectorXd& en,
                                     const Eigen::VectorXd& node_normals, SurfaceTree& tree,
-                                    int triangle_node_offset,
-                                    int triangle_offset, const Eigen::VectorXd& xt,
-                                    const Eigen::VectorXd& et, double margin) {
+                                    int triangle_node_offset, int triangle_offset,
+                                    const Eigen::VectorXd& xt, const Eigen::VectorXd& et,
+                                    double margin) {
   tree.refit(xt, et, margin);
   const std::vector<Triangle>& triangles = tree.triangles();
   for (int p : nodes_model.mesh().surfaceNodes()) {

@@ -13,9 +13,8 @@ namespace torsion {
 
 bool RigidContactSolver::joinsIsland() const {
   if (!faces_.empty()) return false;
-  return std::none_of(partners_.begin(), partners_.end(), [](const RigidPartner& k) {
-    return k.dynamic || k.link != nullptr;
-  });
+  return std::none_of(partners_.begin(), partners_.end(),
+                      [](const RigidPartner& k) { return k.dynamic || k.link != nullptr; });
 }
 
 void RigidContactSolver::beginIslandSolve(const NodeConstraints& base) {
@@ -37,7 +36,8 @@ void RigidContactSolver::islandConstraints(const Eigen::VectorXd& b, NodeConstra
     // End gap gap + dt n.(v_i - J_i V) = 0 along the normal.
     const double normal_speed = c.normal.dot(rigid) - c.gap / dt_;
     if (c.state == NodeContact::State::kStick) {
-      out.prescribeVelocity(c.node, rigid - c.normal * c.normal.dot(rigid) + c.normal * normal_speed);
+      out.prescribeVelocity(c.node,
+                            rigid - c.normal * c.normal.dot(rigid) + c.normal * normal_speed);
     } else {
       out.prescribeDirection(c.node, c.normal, normal_speed);
       b_friction.segment<3>(3 * c.node) += c.friction_impulse;

@@ -73,9 +73,8 @@ class BodyPairContact {
   // `triangle_offset`).
   void addCandidates(const FemModel& nodes_model, int node_offset, const Eigen::VectorXd& xn,
                      const Eigen::VectorXd& en, const Eigen::VectorXd& node_normals,
-                     SurfaceTree& tree, int triangle_node_offset,
-                     int triangle_offset, const Eigen::VectorXd& xt, const Eigen::VectorXd& et,
-                     double margin);
+                     SurfaceTree& tree, int triangle_node_offset, int triangle_offset,
+                     const Eigen::VectorXd& xt, const Eigen::VectorXd& et, double margin);
 
   std::shared_ptr<const FemModel> a_, b_;
   BodyContactSettings settings_;

@@ -131,7 +131,7 @@ class IslandContactSolve {
   std::vector<int> offsets_;     // joint path: each body's first component (-1: absent)
   std::vector<Eigen::Matrix3d> joint_inverse_;
   Eigen::VectorXd joint_b_, joint_v_, joint_r_, joint_q_, joint_c_;
-  Eigen::VectorXd joint_impulse_;  // A v - b of the last joint solve, unfiltered
+  Eigen::VectorXd joint_impulse_;                   // A v - b of the last joint solve, unfiltered
   std::vector<NodeConstraints> rigid_constraints_;  // per body with `rigid`
   std::vector<Eigen::VectorXd> rigid_b_;
   PcgScratch joint_scratch_;
