@@ -58,7 +58,9 @@ SlideResult slide(double degrees) {
   material.poisson_ratio = 0.3;
   material.density = 1000;
   material.mass_damping = 0;  // no drag on the sliding motion
-  material.stiffness_damping = 1e-3;
+  // As the scenes have it: with 1e-3 the stiff block chattered on its contacts while sliding
+  // (contacts lifting off and landing again), and each landing's friction braked it.
+  material.stiffness_damping = 0.01;
   FemBody* slab =
       world
           .addBody("slab", makeBoxTetMesh({-0.3, -0.2, 0}, {0.3, 0.2, 0.1}, 6, 4, 1).value(),
@@ -126,14 +128,14 @@ TEST(SoftIncline, ASoftBlockOnASoftInclineSticksTwoDegreesBelowTheFrictionAngle)
   EXPECT_LE(r.unconverged, 5);
 }
 
-TEST(SoftIncline, ASoftBlockOnASoftInclineSlidesTwoDegreesAboveTheFrictionAngleNoFartherThanCoulomb) {
+TEST(SoftIncline, ASoftBlockOnASoftInclineSlidesTwoDegreesAboveTheFrictionAngleAtCoulombsRate) {
   const SlideResult r = slide(kFrictionAngle + 2);
-  // Sliding, never farther than Coulomb's rigid block (the friction is mu lambda_n at least: it
-  // is bounded, not lost), and at least half as far. Measured 78 %: between jolts the block
-  // accelerates at Coulomb's rate within 3 % (mu 0.51-0.52), but in single steps where half its
-  // contacts drop out, and where its front edge reaches the slab's next node line, its speed
-  // halves (docs/contact.md, "Limits").
-  EXPECT_GT(r.distance, 0.5 * r.coulomb);
+  // Sliding at Coulomb's rate: the friction the block's acceleration over the second 0.25 s says
+  // is mu within 5 % (the friction angle within 0.8 degrees). How far it slid is less than
+  // Coulomb's rigid block (the elastic contact shears for a while before it slips) but never more
+  // (that would be friction below mu lambda_n).
+  EXPECT_NEAR(r.effective_friction, kFriction, 0.05 * kFriction);
+  EXPECT_GT(r.distance, 0.4 * r.coulomb);
   EXPECT_LT(r.distance, 1.02 * r.coulomb);
   EXPECT_LE(r.worst_penetration, r.tolerance);
   EXPECT_LE(r.unconverged, 5);

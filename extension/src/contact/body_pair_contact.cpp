@@ -120,6 +120,23 @@ bool BodyPairContact::detect(const Eigen::VectorXd& xa, const Eigen::VectorXd& v
                 end_b_, settings_.margin * mean_edge_b_);
   addCandidates(*b_, node_count_a_, xb, end_b_, normals_b_, tree_a_, 0, 0, xa, end_a_,
                 settings_.margin * mean_edge_a_);
+  // A contact that slid last step starts its first solve with the k_t its friction and the slip
+  // at the step's start give, not held at the penalty (SurfaceContactSet's default; the island
+  // caps it at the penalty): held, its first solve's slip came out small, the update took it for
+  // sticking, and a soft block sliding down a soft slab lost half its speed in that step.
+  for (SurfaceContact& c : set_.contacts()) {
+    if (c.state != SurfaceContact::State::kSlide || c.friction <= 0) continue;
+    Eigen::Vector3d u = Eigen::Vector3d::Zero();
+    for (size_t k = 0; k < 4; ++k) {
+      const int node = c.nodes[k];
+      u += c.beta[k] * (node < node_count_a_ ? va.segment<3>(3 * node)
+                                             : vb.segment<3>(3 * (node - node_count_a_)));
+    }
+    const Eigen::Vector3d slip = u - c.normal * c.normal.dot(u);
+    const Eigen::Vector3d friction = c.multiplier - c.normal * c.normal.dot(c.multiplier);
+    if (slip.norm() > 0 && friction.norm() > 0)
+      c.tangential_stiffness = friction.norm() / slip.norm();
+  }
   return !set_.empty();
 }
 

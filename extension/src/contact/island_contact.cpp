@@ -348,6 +348,9 @@ IslandContactStats IslandContactSolve::solve(std::vector<Body>& bodies,
     pair_blocks_.insert(pair_blocks_.end(), bb.begin(), bb.end());
     pair->contact->set().setPenalties(
         pair_blocks_, settings.penalty_factor * (joint ? 1.0 : kGaussSeidelPenaltyScale));
+    // A sliding contact's starting k_t (BodyPairContact::detect) at most its penalty.
+    for (SurfaceContact& c : pair->contact->set().contacts())
+      c.tangential_stiffness = std::min(c.tangential_stiffness, c.penalty);
   }
 
   double min_tolerance = std::numeric_limits<double>::infinity();
