@@ -23,6 +23,7 @@ declare -A STEPS=(
   [press]=100                  # the plate down 6 cm and holding (it lifts at 1.1 s)
   [haptic_cylinder]=700        # device at 70 s of Figure 6.7 (speed 10): turned 0.5 rad about z
   [haptic_dragon]=350          # neck turned 90 degrees and held; button 2 releases it at 4 s
+  [soft_grasp]=150             # the block lifted 0.3 m between the fingers
 )
 
 scenes=("$@")

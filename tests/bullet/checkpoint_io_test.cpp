@@ -5,8 +5,10 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cstdint>
 #include <random>
+#include <vector>
 
 #include "torsion/mesh/box_mesh.h"
 
@@ -159,6 +161,78 @@ TEST(CheckpointIo, AnotherWorldIsNamedAsSuch) {
   EXPECT_NE(read.error().message.find("saved from another world: body 'block' has another mesh"),
             std::string::npos)
       << read.error().message;
+}
+
+}  // namespace
+}  // namespace torsion
+
+namespace torsion {
+namespace {
+
+// A soft block resting on a soft slab (base fixed): contact between FEM bodies, whose multipliers
+// warm-start every step.
+class TouchingBodiesRig {
+ public:
+  TouchingBodiesRig() : world_(BlockRig::settings()) {
+    Material material;
+    material.youngs_modulus = 5e4;
+    slab_ = world_
+                .addBody("slab", makeBoxTetMesh({-0.2, -0.2, 0}, {0.2, 0.2, 0.1}, 2, 2, 1).value(),
+                         material)
+                .value();
+    std::vector<int> base;
+    for (int i = 0; i < slab_->model().nodeCount(); ++i)
+      if (slab_->state().position(i).z() < 1e-9) base.push_back(i);
+    slab_->carryNodes(
+        "base", base, [](double) { return Frame{}; }, 0.0);
+    block_ = world_
+                 .addBody("block",
+                          makeBoxTetMesh({-0.08, -0.05, 0.101}, {0.06, 0.07, 0.2}, 2, 2, 2).value(),
+                          material)
+                 .value();
+  }
+
+  std::string save() { return writeCheckpoint(world_, world_.checkpoint(), {}, {}, ""); }
+  Status load(const std::string& bytes) {
+    Result<StoredCheckpoint> stored = readCheckpoint(bytes, world_, {});
+    if (!stored) return stored.error();
+    return world_.restore(stored.value().world);
+  }
+  void steps(int n) {
+    for (int k = 0; k < n; ++k) {
+      const WorldStepReport r = world_.step();
+      ASSERT_TRUE(r.ok) << r.message;
+    }
+  }
+  double difference(const TouchingBodiesRig& other) const {
+    return std::max(
+        (block_->state().positions - other.block_->state().positions).cwiseAbs().maxCoeff(),
+        (slab_->state().velocities - other.slab_->state().velocities).cwiseAbs().maxCoeff());
+  }
+
+  FemWorld world_;
+  FemBody* slab_;
+  FemBody* block_;
+};
+
+TEST(CheckpointIo, BytesTakenWhileTwoFemBodiesTouchContinueBitForBitWithTheirPairMultipliers) {
+  TouchingBodiesRig rig;
+  rig.steps(30);
+  const BodyPairContact* pair = rig.world_.femSolver().femContact()->pair(rig.slab_, rig.block_);
+  ASSERT_NE(pair, nullptr);
+  ASSERT_FALSE(pair->set().warmStarts().empty()) << "the block must rest on the slab";
+  const std::string bytes = rig.save();
+  rig.steps(15);
+
+  TouchingBodiesRig fresh;  // built the same way, never stepped
+  ASSERT_TRUE(fresh.load(bytes).ok());
+  fresh.steps(15);
+  EXPECT_EQ(fresh.difference(rig), 0.0);
+
+  // The same world, back to the bytes after stepping on: the pairs it kept since are replaced.
+  ASSERT_TRUE(rig.load(bytes).ok());
+  rig.steps(15);
+  EXPECT_EQ(fresh.difference(rig), 0.0);
 }
 
 }  // namespace

@@ -15,7 +15,8 @@ static_assert(__BYTE_ORDER__ == __ORDER_LITTLE_ENDIAN__, "checkpoint bytes are l
 #endif
 
 constexpr char kMagic[8] = {'T', 'R', 'S', 'N', 'C', 'K', 'P', 'T'};
-constexpr std::uint32_t kVersion = 1;
+// 2: the pair multipliers of contact between FEM bodies.
+constexpr std::uint32_t kVersion = 2;
 constexpr size_t kHeaderSize = sizeof(kMagic) + 4 + 8 + 8;
 
 std::uint64_t fnv1a(std::string_view bytes) {
@@ -534,6 +535,17 @@ std::string writeCheckpoint(FemWorld& world, const WorldCheckpoint& checkpoint,
   for (const auto& [body, saved] : fem.bodies)
     writeBody(w, world, *body, saved, hands, hand_checkpoints);
 
+  w.u32(fem.fem_pairs.size());
+  for (const FemPairCheckpoint& pair : fem.fem_pairs) {
+    w.str(pair.a->name());
+    w.str(pair.b->name());
+    w.u32(pair.warm_starts.size());
+    for (const auto& [key, lambda] : pair.warm_starts) {
+      w.raw(key);
+      w.vec3(lambda);
+    }
+  }
+
   w.u32(checkpoint.rigid.size());
   for (const WorldCheckpoint::RigidState& r : checkpoint.rigid) {
     for (int row = 0; row < 3; ++row) {
@@ -627,6 +639,25 @@ Result<StoredCheckpoint> readCheckpoint(std::string_view bytes, FemWorld& world,
     Result<FemBodyCheckpoint> saved = readBody(r, world, *body, hands, stored.hands);
     if (!saved) return saved.error();
     fem.bodies.emplace_back(body, std::move(saved).value());
+  }
+
+  const size_t pair_count = r.count(16);
+  if (!r.ok()) return truncated;
+  for (size_t p = 0; p < pair_count; ++p) {
+    FemPairCheckpoint pair;
+    const std::string a = r.str(), b = r.str();
+    if (!r.ok()) return truncated;
+    pair.a = world.body(a);
+    pair.b = world.body(b);
+    if (pair.a == nullptr || pair.b == nullptr)
+      return Error{anotherWorld("this world has no body '" + (pair.a == nullptr ? a : b) + "'")};
+    pair.warm_starts.resize(r.count(32));
+    for (auto& [key, lambda] : pair.warm_starts) {
+      key = r.raw<std::uint64_t>();
+      lambda = r.vec3();
+    }
+    if (!r.ok()) return truncated;
+    fem.fem_pairs.push_back(std::move(pair));
   }
 
   // A hand's group indexes its body's groups (its wrench reads it).

@@ -32,6 +32,27 @@ void FemContactIslands::forget(const FemBody* body) {
       touching_.end());
 }
 
+std::vector<FemPairCheckpoint> FemContactIslands::checkpoint() const {
+  std::vector<FemPairCheckpoint> saved;
+  for (const auto& [key, contact] : pairs_)
+    saved.push_back({key.first, key.second, contact->set().warmStarts()});
+  return saved;
+}
+
+void FemContactIslands::restore(const std::vector<FemPairCheckpoint>& pairs) {
+  // A pair's candidates are found afresh each step (its tree's queries come back sorted), so the
+  // multipliers are all a pair carries from one step to the next.
+  pairs_.clear();
+  live_.clear();
+  touching_.clear();
+  for (const FemPairCheckpoint& saved : pairs) {
+    auto contact = std::make_unique<BodyPairContact>(saved.a->modelPointer(),
+                                                     saved.b->modelPointer(), settings_);
+    contact->set().setWarmStarts(saved.warm_starts);
+    pairs_.emplace(Key{saved.a, saved.b}, std::move(contact));
+  }
+}
+
 const BodyPairContact* FemContactIslands::pair(const FemBody* a, const FemBody* b) const {
   for (const Key& key : {Key{a, b}, Key{b, a}}) {
     const auto it = pairs_.find(key);
@@ -158,7 +179,14 @@ void FemContactIslands::advanceFrom(size_t k, const StepContext& ctx) {
         s.b = &b;
         s.settings = &settings;
         s.v = &v;
+        // Node contacts with prescribed rigid partners (the ground) join the island's joint
+        // solve; a body with self-contact or a dynamic rigid partner keeps its own solve.
+        s.rigid = nullptr;
         s.solve = own;
+        if (own && group_[k]->selfContact() == nullptr && group_[k]->contacts().joinsIsland()) {
+          s.rigid = &group_[k]->contacts();
+          s.solve = nullptr;
+        }
         s.term = &terms_[k];
         s.present = true;
         // The next body steps up to its own solve (and so on); the last one solves the island.

@@ -146,6 +146,7 @@ FemCheckpoint FemSoftBodySolver::checkpoint() {
   c.status = status_;
   for (const auto& body : bodies_)
     c.bodies.emplace_back(body.get(), body->checkpoint());
+  if (fem_contact_) c.fem_pairs = fem_contact_->checkpoint();
   return c;
 }
 
@@ -157,6 +158,7 @@ Status FemSoftBodySolver::restore(const FemCheckpoint& c) {
   }
   for (const auto& [body, saved] : c.bodies)
     const_cast<FemBody*>(body)->restore(saved);
+  if (fem_contact_) fem_contact_->restore(c.fem_pairs);
   time_ = c.time;
   steps_ = c.steps;
   last_dt_ = c.last_dt;

@@ -31,9 +31,12 @@ bool onSide(int node, int first, int count) {
   return node >= first && node < first + count;
 }
 
-// P: the identity while sticking, n n^T while sliding (friction is then in Lambda).
-Eigen::Vector3d project(const SurfaceContact& c, const Eigen::Vector3d& u) {
-  return c.state == SurfaceContact::State::kStick ? u : Eigen::Vector3d(c.normal * c.normal.dot(u));
+// The contact's operator block: rho I sticking, rho n n^T + k_t (I - n n^T) sliding, so that
+// sliding friction is implicit (surface_contact_set.h): -k_t u_t of the same solve's slip, never
+// an impulse carried over from the last one (that explicit friction threw a block off a coarse
+// slab: docs/contact.md, "Friction between FEM bodies").
+Eigen::Matrix3d block(const SurfaceContact& c) {
+  return SurfaceContactSet::operatorBlock(c);
 }
 
 }  // namespace
@@ -51,7 +54,7 @@ void PairContactTerm::addProduct(const Eigen::VectorXd& y, Eigen::VectorXd& out)
         touches = true;
       }
       if (!touches) continue;
-      const Eigen::Vector3d f = c.penalty * project(c, u);
+      const Eigen::Vector3d f = block(c) * u;
       for (size_t k = 0; k < 4; ++k) {
         if (onSide(c.nodes[k], side.first, side.count))
           out.segment<3>(3 * (c.nodes[k] - side.first)) += c.beta[k] * f;
@@ -65,13 +68,10 @@ void PairContactTerm::addDiagonalBlocks(std::vector<Eigen::Matrix3d>& blocks) co
   for (const Side& side : sides_) {
     for (const SurfaceContact& c : side.set->contacts()) {
       if (!participates(c)) continue;
-      const Eigen::Matrix3d p = c.state == SurfaceContact::State::kStick
-                                    ? Eigen::Matrix3d::Identity()
-                                    : Eigen::Matrix3d(c.normal * c.normal.transpose());
+      const Eigen::Matrix3d p = block(c);
       for (size_t k = 0; k < 4; ++k) {
         if (onSide(c.nodes[k], side.first, side.count))
-          blocks[static_cast<size_t>(c.nodes[k] - side.first)] +=
-              c.penalty * c.beta[k] * c.beta[k] * p;
+          blocks[static_cast<size_t>(c.nodes[k] - side.first)] += c.beta[k] * c.beta[k] * p;
       }
     }
   }
@@ -100,7 +100,8 @@ void IslandContactSolve::addRightHandSide(const std::vector<Body>& bodies,
     const int other_first = is_first ? na : 0;
     for (const SurfaceContact& c : pair.contact->set().contacts()) {
       if (!participates(c)) continue;
-      Eigen::Vector3d r = c.multiplier;
+      // Closing: the impulse fixed at Lambda (its friction included); else as in the joint solve.
+      Eigen::Vector3d r = closing ? c.multiplier : SurfaceContactSet::rightHandSideImpulse(c, dt);
       if (!closing) {
         // The other body's share of the relative velocity, from its latest solve.
         Eigen::Vector3d u_other = Eigen::Vector3d::Zero();
@@ -108,7 +109,7 @@ void IslandContactSolve::addRightHandSide(const std::vector<Body>& bodies,
           if (!onSide(c.nodes[k], first, count))
             u_other += c.beta[k] * other.v->segment<3>(3 * (c.nodes[k] - other_first));
         }
-        r -= c.penalty * (c.normal * (c.gap / dt) + project(c, u_other));
+        r -= block(c) * u_other;
       }
       for (size_t k = 0; k < 4; ++k) {
         if (onSide(c.nodes[k], first, count))
@@ -159,7 +160,7 @@ void IslandContactSolve::addJointProduct(const std::vector<const Pair*>& live,
         at[k] = c.nodes[k] < na ? oa + 3 * c.nodes[k] : ob + 3 * (c.nodes[k] - na);
         u += c.beta[k] * y.segment<3>(at[k]);
       }
-      const Eigen::Vector3d f = c.penalty * project(c, u);
+      const Eigen::Vector3d f = block(c) * u;
       for (size_t k = 0; k < 4; ++k)
         out.segment<3>(at[k]) += c.beta[k] * f;
     }
@@ -186,11 +187,12 @@ void IslandContactSolve::jointSolve(std::vector<Body>& bodies, const std::vector
   for (size_t i = 0; i < bodies.size(); ++i) {
     if (!bodies[i].present) continue;
     const int o = offsets_[i], m = static_cast<int>(bodies[i].v->size());
-    bodies[i].constraints->impose(*bodies[i].v);
+    const NodeConstraints& constraints = constraintsOf(bodies, i);
+    constraints.impose(*bodies[i].v);
     joint_v_.segment(o, m) = *bodies[i].v;
-    joint_b_.segment(o, m) = *bodies[i].b;
+    joint_b_.segment(o, m) = rightHandSideOf(bodies, i);
     Eigen::VectorXd prescribed = Eigen::VectorXd::Zero(m);
-    bodies[i].constraints->impose(prescribed);
+    constraints.impose(prescribed);
     joint_c_.segment(o, m) = prescribed;
     bodies[i].op->diagonalBlocks(blocks_[i]);
     joint_inverse_.insert(joint_inverse_.end(), blocks_[i].begin(), blocks_[i].end());
@@ -202,14 +204,12 @@ void IslandContactSolve::jointSolve(std::vector<Body>& bodies, const std::vector
     const int ob = offsets_[static_cast<size_t>(pair->second)];
     for (const SurfaceContact& c : pair->contact->set().contacts()) {
       if (!participates(c)) continue;
-      const Eigen::Vector3d r = c.multiplier - c.penalty * c.normal * (c.gap / dt);
-      const Eigen::Matrix3d p = c.state == SurfaceContact::State::kStick
-                                    ? Eigen::Matrix3d::Identity()
-                                    : Eigen::Matrix3d(c.normal * c.normal.transpose());
+      const Eigen::Vector3d r = SurfaceContactSet::rightHandSideImpulse(c, dt);
+      const Eigen::Matrix3d p = block(c);
       for (size_t k = 0; k < 4; ++k) {
         const int at = c.nodes[k] < na ? oa + 3 * c.nodes[k] : ob + 3 * (c.nodes[k] - na);
         joint_b_.segment<3>(at) += c.beta[k] * r;
-        joint_inverse_[static_cast<size_t>(at / 3)] += c.penalty * c.beta[k] * c.beta[k] * p;
+        joint_inverse_[static_cast<size_t>(at / 3)] += c.beta[k] * c.beta[k] * p;
       }
     }
   }
@@ -220,7 +220,7 @@ void IslandContactSolve::jointSolve(std::vector<Body>& bodies, const std::vector
   auto filter = [&](Eigen::VectorXd& x) {
     for (size_t i = 0; i < bodies.size(); ++i) {
       if (!bodies[i].present) continue;
-      const NodeConstraints& constraints = *bodies[i].constraints;
+      const NodeConstraints& constraints = constraintsOf(bodies, i);
       for (int node = 0; node < constraints.nodeCount(); ++node) {
         if (!constraints.isConstrained(node)) continue;
         const int at = offsets_[i] + 3 * node;
@@ -228,7 +228,7 @@ void IslandContactSolve::jointSolve(std::vector<Body>& bodies, const std::vector
       }
     }
   };
-  auto apply = [&](const Eigen::VectorXd& y, Eigen::VectorXd& out) {
+  auto applyUnfiltered = [&](const Eigen::VectorXd& y, Eigen::VectorXd& out) {
     out.resize(y.size());
     for (size_t i = 0; i < bodies.size(); ++i) {
       if (!bodies[i].present) continue;
@@ -238,6 +238,9 @@ void IslandContactSolve::jointSolve(std::vector<Body>& bodies, const std::vector
       out.segment(o, m) = previous_v_;
     }
     addJointProduct(live, y, out);
+  };
+  auto apply = [&](const Eigen::VectorXd& y, Eigen::VectorXd& out) {
+    applyUnfiltered(y, out);
     filter(out);
   };
   auto precondition = [&](const Eigen::VectorXd& in, Eigen::VectorXd& out) {
@@ -256,6 +259,15 @@ void IslandContactSolve::jointSolve(std::vector<Body>& bodies, const std::vector
   filter(joint_r_);
   const LinearSolveReport r =
       pcgIterations(apply, precondition, reference, *settings, joint_v_, joint_r_, joint_scratch_);
+  // The impulses the constraints leave on their nodes (rigid node contacts' active sets): the
+  // system's residual, which the projected CG drives to zero on the free components only.
+  bool rigid = false;
+  for (const Body& body : bodies)
+    rigid = rigid || (body.present && body.rigid != nullptr);
+  if (rigid) {
+    applyUnfiltered(joint_v_, joint_impulse_);
+    joint_impulse_ -= joint_b_;
+  }
   for (size_t i = 0; i < bodies.size(); ++i) {
     if (!bodies[i].present) continue;
     *bodies[i].v = joint_v_.segment(offsets_[i], static_cast<int>(bodies[i].v->size()));
@@ -269,6 +281,30 @@ void IslandContactSolve::jointSolve(std::vector<Body>& bodies, const std::vector
     }
   }
   if (r.breakdown) broke = true;
+}
+
+void IslandContactSolve::prepareRigidContacts(std::vector<Body>& bodies) {
+  rigid_constraints_.resize(bodies.size());
+  rigid_b_.resize(bodies.size());
+  for (size_t i = 0; i < bodies.size(); ++i) {
+    const Body& body = bodies[i];
+    if (body.present && body.rigid != nullptr)
+      body.rigid->islandConstraints(*body.b, rigid_constraints_[i], rigid_b_[i]);
+  }
+}
+
+bool IslandContactSolve::updateRigidContacts(std::vector<Body>& bodies) {
+  bool changed = false;
+  for (size_t i = 0; i < bodies.size(); ++i) {
+    Body& body = bodies[i];
+    if (!body.present || body.rigid == nullptr) continue;
+    const Eigen::Index m = body.v->size();
+    // The pair contacts' impulses are in the joint residual's right-hand side (b) and product
+    // alike, so what is left on a node is its rigid contact's impulse (and its hand's, if held).
+    rhs_ = joint_impulse_.segment(offsets_[i], m);
+    if (body.rigid->updateIslandActiveSet(*body.v, rhs_)) changed = true;
+  }
+  return changed;
 }
 
 IslandContactStats IslandContactSolve::solve(std::vector<Body>& bodies,
@@ -295,7 +331,11 @@ IslandContactStats IslandContactSolve::solve(std::vector<Body>& bodies,
                        : b.constraints->kind(node - na) == NodeConstraints::Kind::kFull;
     });
   }
-  // One joint solve when no body brings a solve of its own (rigid contacts, self-contact).
+  for (Body& body : bodies) {
+    if (body.present && body.rigid != nullptr) body.rigid->beginIslandSolve(*body.constraints);
+  }
+  // One joint solve when no body brings a solve of its own (rigid contacts with a dynamic
+  // partner, self-contact); node contacts with prescribed rigid partners join it.
   bool joint = true;
   for (const Body& body : bodies)
     if (body.present && body.solve) joint = false;
@@ -315,18 +355,25 @@ IslandContactStats IslandContactSolve::solve(std::vector<Body>& bodies,
     pair_blocks_.insert(pair_blocks_.end(), bb.begin(), bb.end());
     pair->contact->set().setPenalties(
         pair_blocks_, settings.penalty_factor * (joint ? 1.0 : kGaussSeidelPenaltyScale));
+    // A sliding contact's starting k_t (BodyPairContact::detect) at most its penalty.
+    for (SurfaceContact& c : pair->contact->set().contacts())
+      c.tangential_stiffness = std::min(c.tangential_stiffness, c.penalty);
   }
 
   double min_tolerance = std::numeric_limits<double>::infinity();
   for (const Pair* pair : live)
     min_tolerance = std::min(min_tolerance, pair->contact->gapTolerance());
-  bool settled = false, broke = false;
+  bool settled = false, broke = false, rigid_settled = true;
   double best_error = 0;
   int worse = 0, corrections = 0, first_round = 0;
   for (int round = 0; round < settings.max_iterations && !broke; ++round) {
     double moved = 0;
+    bool rigid_changed = false;
     if (joint) {
+      prepareRigidContacts(bodies);
       jointSolve(bodies, live, dt, broke);
+      if (!broke) rigid_changed = updateRigidContacts(bodies);
+      rigid_settled = !rigid_changed;
     } else {
       sweep(bodies, pairs, dt, broke, moved);
     }
@@ -334,8 +381,9 @@ IslandContactStats IslandContactSolve::solve(std::vector<Body>& bodies,
     if (broke) break;
     // A Gauss-Seidel sweep saw the others' velocities of their previous solve: settled only once
     // no velocity moves a node by more than the tolerance over the step from one sweep to the
-    // next (the joint solve sees them all at once).
-    settled = joint || (round > 0 && moved <= min_tolerance);
+    // next (the joint solve sees them all at once, but settles only with the rigid contacts'
+    // active sets).
+    settled = joint ? !rigid_changed : (round > 0 && moved <= min_tolerance);
     for (const Pair* pair : live) {
       pairVelocities(bodies, *pair, pair_v_);
       const double tolerance = pair->contact->gapTolerance();
@@ -396,6 +444,11 @@ IslandContactStats IslandContactSolve::solve(std::vector<Body>& bodies,
     addRightHandSide(bodies, pairs, i, dt, true, rhs_);
     if (solveBody(body, i, rhs_).breakdown) broke = true;
     body.term->setSuspended(false);
+  }
+
+  // The rigid node contacts' impulses and end gaps, as their own solve ends.
+  for (Body& body : bodies) {
+    if (body.present && body.rigid != nullptr) body.rigid->endIslandSolve(*body.v, rigid_settled);
   }
 
   // The end gaps on the velocities the bodies keep.

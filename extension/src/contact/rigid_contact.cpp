@@ -120,7 +120,13 @@ bool RigidContactSolver::updateContactStates(const Eigen::VectorXd& v) {
 }
 
 void RigidContactSolver::collectImpulses() {
-  // Impulses, statistics, and what the rigid bodies receive.
+  // Impulses, statistics, and what the rigid bodies receive, from this solve alone: a step may
+  // solve several times (inside self-contact's loop, an island's sweeps), and only its last
+  // solve's impulses are the step's (summed, they counted the contacts once per solve).
+  stats_.active = stats_.face_active = stats_.sticking = 0;
+  stats_.normal_impulse = 0;
+  for (RigidPartner& k : partners_)
+    k.impulse.setZero();
   for (NodeContact& c : contacts_) {
     if (c.held) continue;
     if (c.state == NodeContact::State::kInactive) {
@@ -151,6 +157,7 @@ void RigidContactSolver::collectImpulses() {
 
 void RigidContactSolver::measureEndGaps(const Eigen::VectorXd& v) {
   // The linearised end-of-step gap of every contact, with the final velocities.
+  stats_.max_end_penetration = 0;
   for (const NodeContact& c : contacts_) {
     const Eigen::Vector3d rigid =
         pointVelocity(partners_[static_cast<size_t>(c.partner)].velocity, c.lever);

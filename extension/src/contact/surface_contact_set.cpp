@@ -10,14 +10,24 @@ namespace {
 // Stick/slide switches of one contact per step before it keeps its state (anti-cycling).
 constexpr int kMaxSwitches = 4;
 
-// The operator's block for a contact: rho I sticking, rho n n^T + k_t (I - n n^T) sliding.
 Eigen::Matrix3d contactBlock(const SurfaceContact& c) {
+  return SurfaceContactSet::operatorBlock(c);
+}
+
+}  // namespace
+
+Eigen::Matrix3d SurfaceContactSet::operatorBlock(const SurfaceContact& c) {
   if (c.state == SurfaceContact::State::kStick) return c.penalty * Eigen::Matrix3d::Identity();
   const Eigen::Matrix3d nn = c.normal * c.normal.transpose();
   return c.penalty * nn + c.tangential_stiffness * (Eigen::Matrix3d::Identity() - nn);
 }
 
-}  // namespace
+Eigen::Vector3d SurfaceContactSet::rightHandSideImpulse(const SurfaceContact& c, double dt) {
+  const Eigen::Vector3d lambda = c.state == SurfaceContact::State::kStick
+                                     ? c.multiplier
+                                     : Eigen::Vector3d(c.normal * c.normal.dot(c.multiplier));
+  return lambda - c.penalty * c.normal * (c.gap / dt);
+}
 
 SurfaceContactSet::WarmStarts SurfaceContactSet::warmStarts() const {
   WarmStarts warm;
@@ -96,10 +106,7 @@ Eigen::Vector3d SurfaceContactSet::relativeVelocity(const SurfaceContact& c,
 void SurfaceContactSet::addRightHandSide(double dt, Eigen::VectorXd& b) const {
   for (const SurfaceContact& c : contacts_) {
     if (!participates(c)) continue;
-    const Eigen::Vector3d lambda = c.state == SurfaceContact::State::kStick
-                                       ? c.multiplier
-                                       : Eigen::Vector3d(c.normal * c.normal.dot(c.multiplier));
-    const Eigen::Vector3d r = lambda - c.penalty * c.normal * (c.gap / dt);
+    const Eigen::Vector3d r = rightHandSideImpulse(c, dt);
     for (size_t k = 0; k < 4; ++k)
       b.segment<3>(3 * c.nodes[k]) += c.beta[k] * r;
   }
@@ -182,8 +189,14 @@ bool SurfaceContactSet::update(const Eigen::VectorXd& v, double dt, double activ
       c.multiplier = c.normal * ln - used * slip;
     } else {
       c.state = State::kSlide;
-      c.tangential_stiffness = wanted;
-      c.multiplier = c.normal * ln - wanted * slip;
+      // Still sliding: Kacanov's k_t may swing about its fixed point (the slip's speed falls as
+      // k_t rises); relaxed, it settles (friction_relaxation_, setFrictionRelaxation).
+      const double relaxed =
+          old_state == State::kSlide && old_stiffness > 0
+              ? friction_relaxation_ * wanted + (1 - friction_relaxation_) * old_stiffness
+              : wanted;
+      c.tangential_stiffness = relaxed;
+      c.multiplier = c.normal * ln - relaxed * slip;
     }
     if (!c.multiplier.allFinite()) c.multiplier = c.normal * ln;
     if (old_state != State::kInactive && c.state != old_state) ++c.switches;

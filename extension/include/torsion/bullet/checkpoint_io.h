@@ -7,7 +7,8 @@
 // Layout: "TRSNCKPT", u32 version, u64 payload length, u64 FNV-1a hash of the payload, payload.
 // Numbers are little-endian; btScalar values are stored as double. What leaves memory: FEM bodies
 // (state, warm starts, node groups, material, rigid-contact and self-contact warm starts, last
-// step's report), the clock and health, the rigid bodies' poses and velocities, the hands. Not in
+// step's report), the multipliers of FEM bodies touching each other (their pairs by the bodies'
+// names), the clock and health, the rigid bodies' poses and velocities, the hands. Not in
 // it, as in a checkpoint in memory: Bullet's manifolds between rigid bodies, and the statistics
 // of the last contact step.
 

@@ -41,6 +41,13 @@ struct FemContactStats {
   double max_end_penetration = 0;  ///< m, deepest linearised end gap
 };
 
+/// One touching pair's multipliers, the warm starts its next step starts from (checkpoints).
+struct FemPairCheckpoint {
+  const FemBody* a = nullptr;  ///< the pair's first body (the earlier in the solver's order)
+  const FemBody* b = nullptr;
+  SurfaceContactSet::WarmStarts warm_starts;
+};
+
 class FemContactIslands {
  public:
   explicit FemContactIslands(const BodyContactSettings& settings) : settings_(settings) {}
@@ -62,6 +69,11 @@ class FemContactIslands {
   void advance(const std::vector<FemBody*>& group, const StepContext& ctx);
 
   const FemContactStats& stats() const { return stats_; }
+  /// Every pair's multipliers now, in key order: what the next step takes over from the last.
+  std::vector<FemPairCheckpoint> checkpoint() const;
+  /// Back to `pairs` (from checkpoint()): the pairs now kept are dropped, those saved come back
+  /// with their multipliers, so the next step is bit for bit the one that followed the save.
+  void restore(const std::vector<FemPairCheckpoint>& pairs);
   /// The pair contact of two bodies (either order), or nullptr when they are not touching.
   const BodyPairContact* pair(const FemBody* a, const FemBody* b) const;
 

@@ -80,6 +80,8 @@ struct FemCheckpoint {
   double last_dt = 0;
   FemSolverStatus status;
   std::vector<std::pair<const FemBody*, FemBodyCheckpoint>> bodies;
+  /// Contact between FEM bodies: every pair's multipliers (empty while it is off).
+  std::vector<FemPairCheckpoint> fem_pairs;
 };
 
 /// What to do when an FEM body touches a body it has no contact with (one of Bullet's soft bodies,

@@ -52,7 +52,8 @@ class BodyPairContact {
 
   /// Candidates for this step from both bodies' positions at the step's start and their
   /// predicted motion x + s dt v, s in [0, 1] (the same tests as self-contact: within the margin
-  /// now, or crossing on the path, projection inside the triangle then). Last step's multipliers
+  /// now, or crossing on the path, projection inside the triangle then; only where the node's
+  /// surface faces the triangle, its normal against the triangle's). Last step's multipliers
   /// become warm starts. Returns whether there are any.
   bool detect(const Eigen::VectorXd& xa, const Eigen::VectorXd& va, const Eigen::VectorXd& xb,
               const Eigen::VectorXd& vb, double dt);
@@ -81,9 +82,9 @@ class BodyPairContact {
   // triangles of `tree` (corners offset by `triangle_node_offset`, indices by
   // `triangle_offset`).
   void addCandidates(const FemModel& nodes_model, int node_offset, const Eigen::VectorXd& xn,
-                     const Eigen::VectorXd& en, SurfaceTree& tree, int triangle_node_offset,
-                     int triangle_offset, const Eigen::VectorXd& xt, const Eigen::VectorXd& et,
-                     double margin);
+                     const Eigen::VectorXd& en, const Eigen::VectorXd& node_normals,
+                     SurfaceTree& tree, int triangle_node_offset, int triangle_offset,
+                     const Eigen::VectorXd& xt, const Eigen::VectorXd& et, double margin);
 
   std::shared_ptr<const FemModel> a_, b_;
   BodyContactSettings settings_;
@@ -95,6 +96,7 @@ class BodyPairContact {
   SurfaceContactSet set_;
   Eigen::VectorXd start_a_, start_b_;  // positions at the step's start (correctGaps)
   Eigen::VectorXd end_a_, end_b_;
+  Eigen::VectorXd normals_a_, normals_b_;  // surface node normals at the step's start
   std::vector<int> found_;
 };
 

@@ -4,20 +4,25 @@
 // or its rigid-contact / self-contact solve), coupled by the pairs' augmented Lagrangian
 // (docs/contact.md, "Contact between FEM bodies"). Touched only by the simulation thread.
 //
-// Per step, with the multipliers Lambda of every pair contact (warm-started from the last step):
-//   sweep       bodies in island order: body i solves its system plus the contacts' penalty on
-//               its own nodes, rho beta_k beta_l P for k, l on i (PairContactTerm, added to its
-//               SystemOperator), with right-hand side b_i + beta_k (Lambda - rho n g/dt
-//               - rho P u_other), u_other from the other bodies' latest velocities (block
-//               Gauss-Seidel on the island's augmented system, which is symmetric positive
-//               definite, so the sweeps converge)
-//   update      Uzawa's projection of Lambda - rho h on Coulomb's cone for every contact
-//               (SurfaceContactSet::update); repeated until no contact changes state and every end
-//               gap is within the tolerance, or max_iterations (reported)
-//   closing     every body solves once more with the penalty off and the contact impulses fixed
-//               at Lambda: body and partner get exactly opposite impulses, so the island's
-//               momentum is exchanged exactly (to the linear solves' tolerance); the end gaps are
-//               measured on these velocities.
+// Per step, with the multipliers Lambda of every pair contact (warm-started from the last step),
+// and B = rho I (sticking) or rho n n^T + k_t (I - n n^T) (sliding: friction implicit,
+// SurfaceContactSet::operatorBlock), one of two paths:
+//   joint       (no body brings a solve of its own) every body's velocities are one vector, the
+//               pairs' whole term beta_k beta_l B couples them, one projected CG per update.
+//               A body's node contacts with prescribed rigid partners (the ground) join it as
+//               node constraints (RigidContactSolver::islandConstraints), their active set run
+//               after each solve on the impulses the joint system leaves on them
+//   sweep       (a body with self-contact, or rigid contacts needing the rigid solver's reduced
+//               system) bodies in island order: body i solves its system plus the contacts'
+//               penalty on its own nodes (PairContactTerm), with right-hand side b_i +
+//               beta_k (Lambda - rho n g/dt - B u_other), u_other from the other bodies' latest
+//               velocities (block Gauss-Seidel on the island's augmented system); then a closing
+//               solve per body with the penalty off and the impulses fixed at Lambda, so that
+//               body and partner get exactly opposite impulses
+//   update      after each solve: Uzawa's projection of Lambda - rho h on Coulomb's cone for
+//               every contact (SurfaceContactSet::update); repeated until no contact (pair or
+//               rigid) changes state and every end gap is within the tolerance, or max_iterations
+//               (reported). The end gaps are measured on the velocities the bodies keep.
 // Everything runs serially in island order: the result is the same for any thread count.
 
 #include <Eigen/Core>
@@ -25,6 +30,7 @@
 #include <vector>
 
 #include "torsion/contact/body_pair_contact.h"
+#include "torsion/contact/rigid_contact.h"
 #include "torsion/solve/added_operator_term.h"
 #include "torsion/solve/node_constraints.h"
 #include "torsion/solve/projected_cg.h"
@@ -33,7 +39,7 @@
 
 namespace torsion {
 
-/// The pair contacts' penalty on one body's own nodes, rho beta_k beta_l P for the contacts'
+/// The pair contacts' penalty on one body's own nodes, beta_k beta_l B for the contacts'
 /// nodes k, l on this body (the rest of each constraint enters the right-hand side).
 class PairContactTerm final : public AddedOperatorTerm {
  public:
@@ -80,6 +86,9 @@ class IslandContactSolve {
     const SolverSettings* settings = nullptr;
     Eigen::VectorXd* v = nullptr;  ///< warm start on entry, v' on return
     BodySolve solve;
+    /// Its node contacts with prescribed rigid partners (ground, kinematic bodies), when they
+    /// join the joint solve (RigidContactSolver::joinsIsland); then `solve` is empty. Not owned.
+    RigidContactSolver* rigid = nullptr;
     PairContactTerm* term = nullptr;  ///< in op's added term (not owned)
     LinearSolveReport report;         ///< out: the body's solves, summed
     bool present = false;             ///< reached its solve (else its pairs sit this step out)
@@ -111,11 +120,25 @@ class IslandContactSolve {
   // The pair terms' product over the joint vector (offsets: each body's first component).
   void addJointProduct(const std::vector<const Pair*>& live, const Eigen::VectorXd& y,
                        Eigen::VectorXd& out) const;
+  // The joint path with rigid contacts: each such body's constraints and right-hand side with its
+  // active node contacts (rebuilt before every joint solve).
+  void prepareRigidContacts(std::vector<Body>& bodies);
+  // Their active sets on the impulses of the last joint solve; whether any contact changed.
+  bool updateRigidContacts(std::vector<Body>& bodies);
+  const NodeConstraints& constraintsOf(const std::vector<Body>& bodies, size_t i) const {
+    return bodies[i].rigid != nullptr ? rigid_constraints_[i] : *bodies[i].constraints;
+  }
+  const Eigen::VectorXd& rightHandSideOf(const std::vector<Body>& bodies, size_t i) const {
+    return bodies[i].rigid != nullptr ? rigid_b_[i] : *bodies[i].b;
+  }
 
   std::vector<ProjectedCg> cg_;  // plain solves, one per body (their workspaces)
   std::vector<int> offsets_;     // joint path: each body's first component (-1: absent)
   std::vector<Eigen::Matrix3d> joint_inverse_;
   Eigen::VectorXd joint_b_, joint_v_, joint_r_, joint_q_, joint_c_;
+  Eigen::VectorXd joint_impulse_;                   // A v - b of the last joint solve, unfiltered
+  std::vector<NodeConstraints> rigid_constraints_;  // per body with `rigid`
+  std::vector<Eigen::VectorXd> rigid_b_;
   PcgScratch joint_scratch_;
   std::vector<std::vector<Eigen::Matrix3d>> blocks_;
   std::vector<Eigen::Matrix3d> pair_blocks_;

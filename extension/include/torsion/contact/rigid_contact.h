@@ -157,6 +157,28 @@ class RigidContactSolver {
   /// multibodies.
   void finish();
 
+  // ---- in an island of touching FEM bodies (contact/island_contact.h) ----
+  // A body whose rigid partners are all prescribed (static, kinematic, or supported by Bullet's
+  // ground) has node contacts that are plain node constraints of its system: the island's joint
+  // CG takes them (rigid_contact_island.cpp), and the active set runs between its solves.
+  /// Whether this step's contacts can join an island's joint solve: no dynamic partner, no
+  /// multibody link, no face contact (those need this solver's reduced system).
+  bool joinsIsland() const;
+  /// Before the island's first solve: `base` holds the body's own prescriptions (kept by address
+  /// until endIslandSolve).
+  void beginIslandSolve(const NodeConstraints& base);
+  /// The active node contacts as prescriptions on top of base's, into `out` (stick: the rigid
+  /// surface's velocity; slide: its normal speed), and `b` plus the sliding contacts' friction
+  /// impulses into `b_friction`.
+  void islandConstraints(const Eigen::VectorXd& b, NodeConstraints& out,
+                         Eigen::VectorXd& b_friction) const;
+  /// After an island solve: `v` the body's velocities, `impulses` (3n) the constraint impulses on
+  /// its nodes (A v - b_friction less the pair contacts' impulses). Runs the active set; returns
+  /// whether any contact changed (another solve is needed).
+  bool updateIslandActiveSet(const Eigen::VectorXd& v, const Eigen::VectorXd& impulses);
+  /// After the island's last solve: impulses, statistics and end gaps, as solve() ends.
+  void endIslandSolve(const Eigen::VectorXd& v, bool active_set_converged);
+
   /// Anchors `nodes` (at their positions in `state`) to `object` (node_anchors.h). Returns the
   /// anchor's id.
   int addAnchor(const btCollisionObject* object, std::vector<int> nodes, const FemState& state) {

@@ -73,8 +73,19 @@ class SurfaceContactSet final : public AddedOperatorTerm {
   const std::vector<SurfaceContact>& contacts() const { return contacts_; }
   bool empty() const { return contacts_.empty(); }
 
+  /// A sliding contact that keeps sliding takes this fraction of the k_t its slip asks for and
+  /// keeps the rest of its last one (1, the default: all of it). Below 1 damps the two-cycle
+  /// Kacanov's iteration can fall into when k_t and the slip's speed trade places from one
+  /// update to the next (measured between FEM bodies: body_pair_contact.h uses 0.5).
+  void setFrictionRelaxation(double fraction) { friction_relaxation_ = fraction; }
   /// rho of every contact from the system's diagonal blocks (without this term).
   void setPenalties(const std::vector<Eigen::Matrix3d>& diagonal_blocks, double penalty_factor);
+  /// The contact's block of the operator: rho I sticking, rho n n^T + k_t (I - n n^T) sliding
+  /// (its impulse on the relative velocity u is -block u beyond the right-hand side's).
+  static Eigen::Matrix3d operatorBlock(const SurfaceContact& c);
+  /// N s: what the contact puts on the right-hand side (times beta_k on its nodes): Lambda
+  /// (sliding: its normal part; the friction is in the operator) less rho n gap / dt.
+  static Eigen::Vector3d rightHandSideImpulse(const SurfaceContact& c, double dt);
   /// Marks contacts whose nodes the solve cannot move (is_fixed(node) for all four).
   template <typename IsFixed>
   void markDetermined(IsFixed is_fixed) {
@@ -132,6 +143,7 @@ class SurfaceContactSet final : public AddedOperatorTerm {
   std::vector<SurfaceContact> contacts_;
   WarmStarts warm_;  // the last step's, looked up by add()
   bool suspended_ = false;
+  double friction_relaxation_ = 1;
   bool restored_ = false;  // warm_ was set by setWarmStarts: beginStep keeps it
 };
 
