@@ -36,7 +36,8 @@ struct Cylinder {
   std::unique_ptr<haptics::HandCoupling> coupling;
 };
 
-Cylinder makeCylinder(int tets, haptics::Rendering rendering, int threads, int kh_columns = 1) {
+Cylinder makeCylinder(int tets, haptics::Rendering rendering, int threads, int kh_columns = 1,
+                      int kh_refresh = 10) {
   Result<LoadedMesh> mesh =
       readMesh(std::string(TORSION_ASSETS_DIR) + "/cylinder_" + std::to_string(tets) + ".node");
   if (!mesh) {
@@ -65,6 +66,7 @@ Cylinder makeCylinder(int tets, haptics::Rendering rendering, int threads, int k
   haptics::CouplingSettings settings;
   settings.rendering = rendering;
   settings.stiffness_columns_per_step = kh_columns;
+  settings.stiffness_refresh_steps = kh_refresh;
   c.coupling = std::make_unique<haptics::HandCoupling>(*c.hand, mapping, settings);
   return c;
 }
@@ -84,26 +86,50 @@ double percentile(std::vector<double> v, double p) {
   return v[static_cast<size_t>(p * static_cast<double>(v.size() - 1))];
 }
 
-int threaded(int tets, double seconds, const char* log_path, int priority, int kh_columns) {
-  Cylinder c = makeCylinder(tets, haptics::Rendering::kInternalForce, 1, kh_columns);
+struct ThreadedOptions {
+  int priority = device::HapticLoopSettings{}.realtime_priority;
+  int kh_columns = 1;
+  int kh_refresh = 10;
+  int solver_threads = 1;
+  bool real_time = false;
+};
+
+int threaded(int tets, double seconds, const char* log_path, const ThreadedOptions& o) {
+  Cylinder c = makeCylinder(tets, haptics::Rendering::kInternalForce, o.solver_threads,
+                            o.kh_columns, o.kh_refresh);
   device::ScriptedDevice scripted(figure67(), device::defaultDeviceLimits(), "figure_6_7");
   device::HapticLoopSettings settings;
   settings.log_capacity = static_cast<size_t>(seconds * 1000 * 1.2) + 1000;
-  settings.realtime_priority = priority;
+  settings.realtime_priority = o.priority;
   device::HapticLoop loop(scripted, settings);
   haptics::HapticRuntime runtime(*c.world, {{c.coupling.get(), &loop, 1000}});
-  const auto start = std::chrono::steady_clock::now();
+  // The step alone is timed (the pacing's wait, when real time, is not part of it).
   int steps = 0;
-  std::vector<double> step_ms;
-  auto previous = start;
-  runtime.runThreaded(1 << 30, false, [&](const WorldStepReport&) {
+  std::vector<double> step_ms, step_iterations;
+  runtime.startThreads();
+  const auto start = std::chrono::steady_clock::now();
+  while (std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count() <
+         seconds) {
+    if (o.real_time) runtime.pace();
+    const auto t0 = std::chrono::steady_clock::now();
+    const WorldStepReport report = runtime.step();
+    step_ms.push_back(
+        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
+    step_iterations.push_back(static_cast<double>(c.body->lastReport().solve.iterations));
     ++steps;
-    const auto now = std::chrono::steady_clock::now();
-    if (steps > 1)
-      step_ms.push_back(std::chrono::duration<double, std::milli>(now - previous).count());
-    previous = now;
-    return std::chrono::duration<double>(now - start).count() < seconds;
-  });
+    if (!report.ok) {
+      std::fprintf(stderr, "unstable: %s\n", report.message.c_str());
+      break;
+    }
+  }
+  runtime.stopThreads();
+  if (const char* dump = std::getenv("TORSION_BENCH_STEP_TIMES")) {
+    if (FILE* f = std::fopen(dump, "w")) {
+      for (size_t k = 0; k < step_ms.size(); ++k)
+        std::fprintf(f, "%.4f %g\n", step_ms[k], step_iterations[k]);
+      std::fclose(f);
+    }
+  }
   const double wall =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   std::vector<double> period_error, period, age, information_age;
@@ -123,14 +149,18 @@ int threaded(int tets, double seconds, const char* log_path, int priority, int k
       "\"overruns\": %llu, \"wrench_age_ms\": {\"p50\": "
       "%.2f, \"p99\": %.2f, \"max\": %.2f}, \"information_age_ms\": {\"p50\": %.2f, \"p99\": "
       "%.2f, \"max\": %.2f}, \"sim_steps_per_s\": %.1f, \"sim_step_ms\": {\"p50\": "
-      "%.2f, \"p99\": %.2f, \"max\": %.2f}, \"kh_columns_per_step\": %d, \"realtime\": %s}\n",
+      "%.2f, \"p99\": %.2f, \"max\": %.2f}, \"cg_iterations_per_step\": {\"p50\": %.0f, \"p99\": %.0f}, \"solver_threads\": %d, "
+      "\"real_time\": %s, \"kh_columns_per_step\": %d, \"kh_refresh_steps\": %d, "
+      "\"realtime\": %s}\n",
       tets, wall, span > 0 ? static_cast<double>(log.size() - 1) / span : 0.0,
       percentile(period_error, 0.5), percentile(period_error, 0.99), percentile(period_error, 1.0),
       percentile(period, 0.5), percentile(period, 0.99),
       static_cast<unsigned long long>(loop.stats().overruns.load()), percentile(age, 0.5),
       percentile(age, 0.99), percentile(age, 1.0), percentile(information_age, 0.5),
       percentile(information_age, 0.99), percentile(information_age, 1.0), steps / wall,
-      percentile(step_ms, 0.5), percentile(step_ms, 0.99), percentile(step_ms, 1.0), kh_columns,
+      percentile(step_ms, 0.5), percentile(step_ms, 0.99), percentile(step_ms, 1.0), percentile(step_iterations, 0.5),
+      percentile(step_iterations, 0.99), o.solver_threads, o.real_time ? "true" : "false",
+      o.kh_columns, o.kh_refresh,
       loop.stats().realtime ? "true" : "false");
   if (log_path && !loop.writeLog(log_path)) return 1;
   return 0;
@@ -165,18 +195,24 @@ int main(int argc, char** argv) {
   const std::string mode = argc > 1 ? argv[1] : "";
   if (mode == "threaded" && argc >= 4) {
     const char* log = nullptr;
-    int priority = device::HapticLoopSettings{}.realtime_priority, kh_columns = 1;
+    ThreadedOptions options;
     for (int k = 4; k < argc; ++k) {
       const std::string a = argv[k];
       if (a == "--priority" && k + 1 < argc) {
-        priority = std::atoi(argv[++k]);
+        options.priority = std::atoi(argv[++k]);
       } else if (a == "--kh-columns" && k + 1 < argc) {
-        kh_columns = std::atoi(argv[++k]);
+        options.kh_columns = std::atoi(argv[++k]);
+      } else if (a == "--kh-refresh" && k + 1 < argc) {
+        options.kh_refresh = std::atoi(argv[++k]);
+      } else if (a == "--threads" && k + 1 < argc) {
+        options.solver_threads = std::atoi(argv[++k]);
+      } else if (a == "--real-time") {
+        options.real_time = true;
       } else {
         log = argv[k];
       }
     }
-    return threaded(std::atoi(argv[2]), std::atof(argv[3]), log, priority, kh_columns);
+    return threaded(std::atoi(argv[2]), std::atof(argv[3]), log, options);
   }
   if (mode == "figure67" && argc >= 4) {
     return figure(argv[2], argv[3], argc > 4 ? std::atoi(argv[4]) : 2430);
