@@ -15,7 +15,7 @@
 //
 // Controller (impedance causality: the twist comes in, the wrench goes out). Two kinds.
 //
-// Rate-limited energy reserve (the default, `rate_limited`). The wrench written to the device
+// Rate-limited energy reserve (`rate_limited: true`). The wrench written to the device
 // changes by at most the safety filter's rate limit per tick (r_f N/s, r_t N m/s), damping
 // included, so the controller cannot take a large amount of energy back in one tick: it must
 // never hand out more of the reserve -E_obs than it could still stop. For a wrench W = (f, tau)
@@ -38,7 +38,7 @@
 // the output small and then damps, at the rate limit, until it is repaid. A slow, quasi-static
 // motion into a spring keeps a reserve of the spring's stored energy and is left alone.
 //
-// Dead-beat damper (Hannaford & Ryu, `rate_limited: false`). At tick n, for W_plan,
+// Dead-beat damper (Hannaford & Ryu; the default, `rate_limited: false`). At tick n, for W_plan,
 //     E_pre = E_obs(n-1) + W_plan . v(n) dt;
 //     E_pre > 0 and |v|_w > min_speed:  alpha = E_pre / (|v|_w^2 dt),
 //                                        W = W_plan - alpha (v_lin, l^2 v_ang)
@@ -63,9 +63,9 @@ namespace torsion::device {
 
 struct PassivitySettings {
   bool enabled = true;        ///< the controller; the observer always runs
-  /// The energy-reserve controller whose output respects the rate limit (above); false: the
-  /// dead-beat damper added after the rate limit.
-  bool rate_limited = true;
+  /// The energy-reserve controller whose output respects the rate limit (above); false (the
+  /// default): the dead-beat damper added after the rate limit (docs/haptics.md compares them).
+  bool rate_limited = false;
   /// s, rate-limited controller: how long the speed bound holds a peak speed (it decays as
   /// exp(-t / speed_hold_time)); about an oscillation period of the hand on the device.
   double speed_hold_time = 0.1;
