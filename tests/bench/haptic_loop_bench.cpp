@@ -1,13 +1,19 @@
 // Haptic loop benchmark and headless Figure 6.7 runs. Not a test: it measures.
 //
 //   bench_haptic_loop threaded MESH_TETS SECONDS [LOG.csv] [--priority P] [--kh-columns N]
+//                     [--kh-refresh N] [--threads N] [--free-running] [--steps N]
 //       The 1 kHz loop on its own thread (scripted Figure 6.7 device) while the simulation thread
-//       steps the cylinder as fast as it can; prints loop rate, period jitter p50/p99/max,
+//       steps the cylinder on 2 solver threads, paced to the clock as an interactive run is
+//       (--free-running: as fast as it can); prints loop rate, period jitter p50/p99/max,
 //       overruns, wrench age (since the simulation's wrench arrived) and information age (of the
 //       newest information in the rendered wrench: the device pose the K_h prediction used, or
-//       without K_h the pose the step used), simulation step time p50/p99/max and steps per second,
-//       and whether the loop got SCHED_FIFO. --priority 0 keeps the default scheduling (default:
-//       the loop's 80); --kh-columns 6 refreshes K_h in one step (default 1 column per step).
+//       without K_h the pose the step used), simulation step time p50/p99/max (the step alone,
+//       not the pacing's wait; its CPU time on the stepping thread, which the machine's load
+//       does not inflate as much), CG iterations per step, steps per second, the 1-minute load
+//       average, and whether the loop got SCHED_FIFO. --priority 0 keeps the default
+//       scheduling (default: the loop's 80); --kh-columns 6 refreshes K_h in one step (default 1
+//       column per step); --kh-refresh 0 publishes no K_h; --steps N stops after N steps.
+//       TORSION_BENCH_STEP_TIMES=FILE writes each step's milliseconds and CG iterations.
 //   bench_haptic_loop figure67 internal_force|frame_difference LOG.csv [MESH_TETS]
 //       The Figure 6.7 sequence on a simulated clock (lockstep, deterministic), loop log to CSV
 //       for docs/haptics.md (tests/bench/plot_haptics.py draws it).
@@ -16,6 +22,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <ctime>
 #include <string>
 #include <vector>
 
@@ -80,6 +87,23 @@ device::Trajectory figure67() {
   return *t.value;
 }
 
+// CPU seconds of the calling thread (a step's own work on it, whatever the machine's load).
+double threadCpuSeconds() {
+  timespec ts{};
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+  return static_cast<double>(ts.tv_sec) + 1e-9 * static_cast<double>(ts.tv_nsec);
+}
+
+// The 1-minute load average (state it with any wall-clock figure on a shared machine).
+double loadAverage() {
+  double load = -1;
+  if (FILE* f = std::fopen("/proc/loadavg", "r")) {
+    if (std::fscanf(f, "%lf", &load) != 1) load = -1;
+    std::fclose(f);
+  }
+  return load;
+}
+
 double percentile(std::vector<double> v, double p) {
   if (v.empty()) return 0;
   std::sort(v.begin(), v.end());
@@ -90,8 +114,9 @@ struct ThreadedOptions {
   int priority = device::HapticLoopSettings{}.realtime_priority;
   int kh_columns = 1;
   int kh_refresh = 10;
-  int solver_threads = 1;
-  bool real_time = false;
+  int solver_threads = 2;  // as the plain twist benchmark's 2-thread rows
+  bool real_time = true;   // paced to the clock, as an interactive run (torsion run --haptics)
+  int steps = 0;  // > 0: stop after this many steps (instruction counts per step), not SECONDS
 };
 
 int threaded(int tets, double seconds, const char* log_path, const ThreadedOptions& o) {
@@ -105,14 +130,17 @@ int threaded(int tets, double seconds, const char* log_path, const ThreadedOptio
   haptics::HapticRuntime runtime(*c.world, {{c.coupling.get(), &loop, 1000}});
   // The step alone is timed (the pacing's wait, when real time, is not part of it).
   int steps = 0;
-  std::vector<double> step_ms, step_iterations;
+  std::vector<double> step_ms, step_cpu_ms, step_iterations;
   runtime.startThreads();
   const auto start = std::chrono::steady_clock::now();
-  while (std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count() <
-         seconds) {
+  while (o.steps > 0 ? steps < o.steps
+                    : std::chrono::duration<double>(std::chrono::steady_clock::now() - start)
+                              .count() < seconds) {
     if (o.real_time) runtime.pace();
     const auto t0 = std::chrono::steady_clock::now();
+    const double cpu0 = threadCpuSeconds();
     const WorldStepReport report = runtime.step();
+    step_cpu_ms.push_back(1e3 * (threadCpuSeconds() - cpu0));
     step_ms.push_back(
         std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
     step_iterations.push_back(static_cast<double>(c.body->lastReport().solve.iterations));
@@ -149,7 +177,8 @@ int threaded(int tets, double seconds, const char* log_path, const ThreadedOptio
       "\"overruns\": %llu, \"wrench_age_ms\": {\"p50\": "
       "%.2f, \"p99\": %.2f, \"max\": %.2f}, \"information_age_ms\": {\"p50\": %.2f, \"p99\": "
       "%.2f, \"max\": %.2f}, \"sim_steps_per_s\": %.1f, \"sim_step_ms\": {\"p50\": "
-      "%.2f, \"p99\": %.2f, \"max\": %.2f}, \"cg_iterations_per_step\": {\"p50\": %.0f, \"p99\": %.0f}, \"solver_threads\": %d, "
+      "%.2f, \"p99\": %.2f, \"max\": %.2f}, \"sim_step_cpu_ms_this_thread\": {\"p50\": %.2f, "
+      "\"p99\": %.2f}, \"load_1min\": %.2f, \"cg_iterations_per_step\": {\"p50\": %.0f, \"p99\": %.0f}, \"solver_threads\": %d, "
       "\"real_time\": %s, \"kh_columns_per_step\": %d, \"kh_refresh_steps\": %d, "
       "\"realtime\": %s}\n",
       tets, wall, span > 0 ? static_cast<double>(log.size() - 1) / span : 0.0,
@@ -158,7 +187,8 @@ int threaded(int tets, double seconds, const char* log_path, const ThreadedOptio
       static_cast<unsigned long long>(loop.stats().overruns.load()), percentile(age, 0.5),
       percentile(age, 0.99), percentile(age, 1.0), percentile(information_age, 0.5),
       percentile(information_age, 0.99), percentile(information_age, 1.0), steps / wall,
-      percentile(step_ms, 0.5), percentile(step_ms, 0.99), percentile(step_ms, 1.0), percentile(step_iterations, 0.5),
+      percentile(step_ms, 0.5), percentile(step_ms, 0.99), percentile(step_ms, 1.0), percentile(step_cpu_ms, 0.5),
+      percentile(step_cpu_ms, 0.99), loadAverage(), percentile(step_iterations, 0.5),
       percentile(step_iterations, 0.99), o.solver_threads, o.real_time ? "true" : "false",
       o.kh_columns, o.kh_refresh,
       loop.stats().realtime ? "true" : "false");
@@ -206,8 +236,10 @@ int main(int argc, char** argv) {
         options.kh_refresh = std::atoi(argv[++k]);
       } else if (a == "--threads" && k + 1 < argc) {
         options.solver_threads = std::atoi(argv[++k]);
-      } else if (a == "--real-time") {
-        options.real_time = true;
+      } else if (a == "--steps" && k + 1 < argc) {
+        options.steps = std::atoi(argv[++k]);
+      } else if (a == "--free-running") {
+        options.real_time = false;
       } else {
         log = argv[k];
       }
@@ -220,6 +252,7 @@ int main(int argc, char** argv) {
   std::fprintf(
       stderr,
       "usage: bench_haptic_loop threaded TETS SECONDS [LOG.csv] [--priority P] [--kh-columns N]\n"
+      "                         [--kh-refresh N] [--threads N] [--free-running] [--steps N]\n"
       "       bench_haptic_loop figure67 internal_force|frame_difference LOG.csv [TETS]\n");
   return 2;
 }
