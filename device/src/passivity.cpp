@@ -14,6 +14,8 @@ std::string PassivitySettings::validate() const {
   if (!(min_speed > 0 && std::isfinite(min_speed)))
     return "passivity.min_speed must be positive (m/s)";
   if (!(max_alpha > 0)) return "passivity.max_alpha must be positive (N s/m)";
+  if (!(energy_tolerance >= 0 && std::isfinite(energy_tolerance)))
+    return "passivity.energy_tolerance must be non-negative (J)";
   if (!(speed_hold_time > 0 && std::isfinite(speed_hold_time)))
     return "passivity.speed_hold_time must be positive (s)";
   if (!(speed_margin >= 1 && std::isfinite(speed_margin)))
@@ -75,7 +77,7 @@ Vec3 brakePart(const Vec3& from, const Vec3& v, double dt, double speed, double 
 double PassivityController::reserveNeed(const Wrench& w, const double v[6], double dt,
                                         double force_rate, double torque_rate) const {
   const double m = settings_.speed_margin;
-  return energy_ + partNeed(w.force, {v[0], v[1], v[2]}, dt, m * speed_bound_[0], force_rate) +
+  return energy_ - settings_.energy_tolerance + partNeed(w.force, {v[0], v[1], v[2]}, dt, m * speed_bound_[0], force_rate) +
          partNeed(w.torque, {v[3], v[4], v[5]}, dt, m * speed_bound_[1], torque_rate);
 }
 
@@ -135,7 +137,7 @@ Wrench PassivityController::damping(const Wrench& planned, const double v[6], do
   const double l2 = settings_.length_scale * settings_.length_scale;
   const double speed2 =
       v[0] * v[0] + v[1] * v[1] + v[2] * v[2] + l2 * (v[3] * v[3] + v[4] * v[4] + v[5] * v[5]);
-  const double predicted = energy_ + power(planned, v) * dt;
+  const double predicted = energy_ - settings_.energy_tolerance + power(planned, v) * dt;
   if (!(predicted > 0) || !(speed2 > settings_.min_speed * settings_.min_speed)) return Wrench{};
   alpha_ = std::min(predicted / (speed2 * dt), settings_.max_alpha);
   if (!std::isfinite(alpha_)) {

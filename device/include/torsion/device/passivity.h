@@ -20,7 +20,8 @@
 // included, so the controller cannot take a large amount of energy back in one tick: it must
 // never hand out more of the reserve -E_obs than it could still stop. For a wrench W = (f, tau)
 // the reserve need is
-//     N(W) = E_obs(n) + W . v(n) dt + |f|^2 s_f / (2 r_f) + |tau|^2 s_t / (2 r_t)     (J)
+//     N(W) = E_obs(n) - energy_tolerance + W . v(n) dt + |f|^2 s_f / (2 r_f)
+//            + |tau|^2 s_t / (2 r_t)     (J)
 // the energy already given, the work of W over the coming tick, and the most that ramping f and
 // tau down to zero at the rate limit (|f| / r_f, |tau| / r_t seconds) can give out while the
 // hand moves at up to s_f m/s and s_t rad/s. The speed bounds s are the peak speeds of about the
@@ -39,12 +40,13 @@
 // motion into a spring keeps a reserve of the spring's stored energy and is left alone.
 //
 // Dead-beat damper (Hannaford & Ryu; the default, `rate_limited: false`). At tick n, for W_plan,
-//     E_pre = E_obs(n-1) + W_plan . v(n) dt;
+//     E_pre = E_obs(n-1) - energy_tolerance + W_plan . v(n) dt;
 //     E_pre > 0 and |v|_w > min_speed:  alpha = E_pre / (|v|_w^2 dt),
 //                                        W = W_plan - alpha (v_lin, l^2 v_ang)
 // with |v|_w^2 = |v_lin|^2 + l^2 |v_ang|^2 and l = `length_scale` (the one damping coefficient
 // alpha, N s/m, acts on rotation as alpha l^2, N m s/rad). Then W . v dt = E_pre - alpha |v|_w^2
-// dt brings E_obs(n) to exactly 0 in one tick; the damping is added after the rate limit, so the
+// dt brings E_obs(n) to exactly energy_tolerance (0 by default) in one tick; the damping is
+// added after the rate limit, so the
 // written wrench may step (about 1 N m in a tick where the limit allows 0.03 N m).
 //
 // Either way the observer books the wrench actually written, so what saturation holds back is
@@ -73,6 +75,12 @@ struct PassivitySettings {
   /// accelerating the hand meanwhile, so the speed while braking exceeds the one measured.
   double speed_margin = 2;
   double length_scale = 0.1;  ///< m, l above: rotational damping alpha l^2 for linear alpha
+  /// J the port may hold above 0 before either controller acts (E_obs <= energy_tolerance is
+  /// its target instead of 0). A stiff sampled rendering's own excess can be a few microjoules;
+  /// acting on it makes the controller chatter and soften what the hand feels, while a
+  /// tolerance lets a larger misprediction through on a delayed one (docs/haptics.md,
+  /// "Passivity", measures both). 0: the strict controller.
+  double energy_tolerance = 0;
   double min_speed = 1e-6;    ///< m/s of |v|_w below which no damping is added (alpha -> inf)
   /// Dead-beat damper: N s/m, largest alpha (rotation: alpha l^2); infinity: none. A bound
   /// leaves some generated energy for the following ticks instead of a damping spike.
