@@ -2,6 +2,7 @@
 //
 //   bench_haptic_loop threaded MESH_TETS SECONDS [LOG.csv] [--priority P] [--kh-columns N]
 //                     [--kh-refresh N] [--threads N] [--free-running] [--steps N]
+//                     [--sim-priority P]
 //       The 1 kHz loop on its own thread (scripted Figure 6.7 device) while the simulation thread
 //       steps the cylinder on 2 solver threads, paced to the clock as an interactive run is
 //       (--free-running: as fast as it can); prints loop rate, period jitter p50/p99/max,
@@ -11,7 +12,9 @@
 //       not the pacing's wait; its CPU time on the stepping thread, which the machine's load
 //       does not inflate as much), CG iterations per step, steps per second, the 1-minute load
 //       average, and whether the loop got SCHED_FIFO. --priority 0 keeps the default
-//       scheduling (default: the loop's 80); --kh-columns 6 refreshes K_h in one step (default 1
+//       scheduling (default: the loop's 80); --sim-priority P the stepping thread's SCHED_FIFO
+//       priority (default 50, HapticRuntime::setSimulationPriority; 0: the default policy);
+//       --kh-columns 6 refreshes K_h in one step (default 1
 //       column per step); --kh-refresh 0 publishes no K_h; --steps N stops after N steps.
 //       TORSION_BENCH_STEP_TIMES=FILE writes each step's milliseconds and CG iterations.
 //   bench_haptic_loop figure67 internal_force|frame_difference LOG.csv [MESH_TETS]
@@ -116,6 +119,7 @@ struct ThreadedOptions {
   int kh_refresh = 10;
   int solver_threads = 2;  // as the plain twist benchmark's 2-thread rows
   bool real_time = true;   // paced to the clock, as an interactive run (torsion run --haptics)
+  int sim_priority = 50;   // SCHED_FIFO priority of the stepping thread (0: the default policy)
   int steps = 0;  // > 0: stop after this many steps (instruction counts per step), not SECONDS
 };
 
@@ -131,7 +135,9 @@ int threaded(int tets, double seconds, const char* log_path, const ThreadedOptio
   // The step alone is timed (the pacing's wait, when real time, is not part of it).
   int steps = 0;
   std::vector<double> step_ms, step_cpu_ms, step_iterations;
+  runtime.setSimulationPriority(o.sim_priority);
   runtime.startThreads();
+  const bool sim_realtime = runtime.simulationRealtime();
   const auto start = std::chrono::steady_clock::now();
   while (o.steps > 0 ? steps < o.steps
                     : std::chrono::duration<double>(std::chrono::steady_clock::now() - start)
@@ -180,7 +186,7 @@ int threaded(int tets, double seconds, const char* log_path, const ThreadedOptio
       "%.2f, \"p99\": %.2f, \"max\": %.2f}, \"sim_step_cpu_ms_this_thread\": {\"p50\": %.2f, "
       "\"p99\": %.2f}, \"load_1min\": %.2f, \"cg_iterations_per_step\": {\"p50\": %.0f, \"p99\": %.0f}, \"solver_threads\": %d, "
       "\"real_time\": %s, \"kh_columns_per_step\": %d, \"kh_refresh_steps\": %d, "
-      "\"realtime\": %s}\n",
+      "\"realtime\": %s, \"sim_priority\": %d, \"sim_realtime\": %s}\n",
       tets, wall, span > 0 ? static_cast<double>(log.size() - 1) / span : 0.0,
       percentile(period_error, 0.5), percentile(period_error, 0.99), percentile(period_error, 1.0),
       percentile(period, 0.5), percentile(period, 0.99),
@@ -191,7 +197,7 @@ int threaded(int tets, double seconds, const char* log_path, const ThreadedOptio
       percentile(step_cpu_ms, 0.99), loadAverage(), percentile(step_iterations, 0.5),
       percentile(step_iterations, 0.99), o.solver_threads, o.real_time ? "true" : "false",
       o.kh_columns, o.kh_refresh,
-      loop.stats().realtime ? "true" : "false");
+      loop.stats().realtime ? "true" : "false", o.sim_priority, sim_realtime ? "true" : "false");
   if (log_path && !loop.writeLog(log_path)) return 1;
   return 0;
 }
@@ -238,6 +244,8 @@ int main(int argc, char** argv) {
         options.solver_threads = std::atoi(argv[++k]);
       } else if (a == "--steps" && k + 1 < argc) {
         options.steps = std::atoi(argv[++k]);
+      } else if (a == "--sim-priority" && k + 1 < argc) {
+        options.sim_priority = std::atoi(argv[++k]);
       } else if (a == "--free-running") {
         options.real_time = false;
       } else {
@@ -253,6 +261,7 @@ int main(int argc, char** argv) {
       stderr,
       "usage: bench_haptic_loop threaded TETS SECONDS [LOG.csv] [--priority P] [--kh-columns N]\n"
       "                         [--kh-refresh N] [--threads N] [--free-running] [--steps N]\n"
+      "                         [--sim-priority P]\n"
       "       bench_haptic_loop figure67 internal_force|frame_difference LOG.csv [TETS]\n");
   return 2;
 }
