@@ -77,7 +77,7 @@ class HapticRuntime : public StepListener {
   /// Refused silently without the privilege (simulationRealtime() says). 0 (default): keep the
   /// thread's policy.
   void setSimulationPriority(int priority) { simulation_priority_ = priority; }
-  /// The stepping thread got SCHED_FIFO at startThreads().
+  /// The stepping thread runs under SCHED_FIFO (from startThreads() until stopThreads()).
   bool simulationRealtime() const { return simulation_realtime_; }
   WorldStepReport stepPaced(bool real_time);
   /// The wait of stepPaced(true) alone: returns when the coming step is due.
