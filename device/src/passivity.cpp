@@ -61,8 +61,7 @@ double partNeed(const Vec3& w, const Vec3& v, double dt, double speed, double ra
 
 // The wrench part within `step` of `from` with the least partNeed: toward its minimiser
 // -v dt rate / speed (straight against v when the speed bound is zero).
-Vec3 brakePart(const Vec3& from, const Vec3& v, double dt, double speed, double rate,
-               double step) {
+Vec3 brakePart(const Vec3& from, const Vec3& v, double dt, double speed, double rate, double step) {
   if (speed > 0 && rate > 0) {
     const double s = dt * rate / speed;
     return approach(from, {-s * v.x, -s * v.y, -s * v.z}, step);
@@ -77,7 +76,8 @@ Vec3 brakePart(const Vec3& from, const Vec3& v, double dt, double speed, double 
 double PassivityController::reserveNeed(const Wrench& w, const double v[6], double dt,
                                         double force_rate, double torque_rate) const {
   const double m = settings_.speed_margin;
-  return energy_ - settings_.energy_tolerance + partNeed(w.force, {v[0], v[1], v[2]}, dt, m * speed_bound_[0], force_rate) +
+  return energy_ - settings_.energy_tolerance +
+         partNeed(w.force, {v[0], v[1], v[2]}, dt, m * speed_bound_[0], force_rate) +
          partNeed(w.torque, {v[3], v[4], v[5]}, dt, m * speed_bound_[1], torque_rate);
 }
 
@@ -91,13 +91,12 @@ Wrench PassivityController::limit(const Wrench& previous, const Wrench& planned,
   // The brake: the wrench within the rate limit of the last one written with the least need.
   // Saturation projects onto the limit balls, which keeps it within the rate limit of
   // `previous` (itself within the limits).
-  const Wrench brake{
-      clampNorm(brakePart(previous.force, {v[0], v[1], v[2]}, dt, speed_bound_[0], force_rate,
-                          force_step),
-                limits.max_force),
-      clampNorm(brakePart(previous.torque, {v[3], v[4], v[5]}, dt, speed_bound_[1], torque_rate,
-                          torque_step),
-                limits.max_torque)};
+  const Wrench brake{clampNorm(brakePart(previous.force, {v[0], v[1], v[2]}, dt, speed_bound_[0],
+                                         force_rate, force_step),
+                               limits.max_force),
+                     clampNorm(brakePart(previous.torque, {v[3], v[4], v[5]}, dt, speed_bound_[1],
+                                         torque_rate, torque_step),
+                               limits.max_torque)};
   // The least change from the plan toward the brake that covers the need (the need is convex
   // along the segment; the brake's end when even the brake does not).
   auto at = [&](double u) {

@@ -139,9 +139,10 @@ int threaded(int tets, double seconds, const char* log_path, const ThreadedOptio
   runtime.startThreads();
   const bool sim_realtime = runtime.simulationRealtime();
   const auto start = std::chrono::steady_clock::now();
-  while (o.steps > 0 ? steps < o.steps
-                    : std::chrono::duration<double>(std::chrono::steady_clock::now() - start)
-                              .count() < seconds) {
+  while (o.steps > 0
+             ? steps < o.steps
+             : std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count() <
+                   seconds) {
     if (o.real_time) runtime.pace();
     const auto t0 = std::chrono::steady_clock::now();
     const double cpu0 = threadCpuSeconds();
@@ -184,7 +185,8 @@ int threaded(int tets, double seconds, const char* log_path, const ThreadedOptio
       "%.2f, \"p99\": %.2f, \"max\": %.2f}, \"information_age_ms\": {\"p50\": %.2f, \"p99\": "
       "%.2f, \"max\": %.2f}, \"sim_steps_per_s\": %.1f, \"sim_step_ms\": {\"p50\": "
       "%.2f, \"p99\": %.2f, \"max\": %.2f}, \"sim_step_cpu_ms_this_thread\": {\"p50\": %.2f, "
-      "\"p99\": %.2f}, \"load_1min\": %.2f, \"cg_iterations_per_step\": {\"p50\": %.0f, \"p99\": %.0f}, \"solver_threads\": %d, "
+      "\"p99\": %.2f}, \"load_1min\": %.2f, \"cg_iterations_per_step\": {\"p50\": %.0f, \"p99\": "
+      "%.0f}, \"solver_threads\": %d, "
       "\"real_time\": %s, \"kh_columns_per_step\": %d, \"kh_refresh_steps\": %d, "
       "\"realtime\": %s, \"sim_priority\": %d, \"sim_realtime\": %s}\n",
       tets, wall, span > 0 ? static_cast<double>(log.size() - 1) / span : 0.0,
@@ -193,10 +195,10 @@ int threaded(int tets, double seconds, const char* log_path, const ThreadedOptio
       static_cast<unsigned long long>(loop.stats().overruns.load()), percentile(age, 0.5),
       percentile(age, 0.99), percentile(age, 1.0), percentile(information_age, 0.5),
       percentile(information_age, 0.99), percentile(information_age, 1.0), steps / wall,
-      percentile(step_ms, 0.5), percentile(step_ms, 0.99), percentile(step_ms, 1.0), percentile(step_cpu_ms, 0.5),
-      percentile(step_cpu_ms, 0.99), loadAverage(), percentile(step_iterations, 0.5),
-      percentile(step_iterations, 0.99), o.solver_threads, o.real_time ? "true" : "false",
-      o.kh_columns, o.kh_refresh,
+      percentile(step_ms, 0.5), percentile(step_ms, 0.99), percentile(step_ms, 1.0),
+      percentile(step_cpu_ms, 0.5), percentile(step_cpu_ms, 0.99), loadAverage(),
+      percentile(step_iterations, 0.5), percentile(step_iterations, 0.99), o.solver_threads,
+      o.real_time ? "true" : "false", o.kh_columns, o.kh_refresh,
       loop.stats().realtime ? "true" : "false", o.sim_priority, sim_realtime ? "true" : "false");
   if (log_path && !loop.writeLog(log_path)) return 1;
   return 0;

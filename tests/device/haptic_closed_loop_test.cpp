@@ -20,7 +20,7 @@ namespace {
 struct ClosedLoop {
   double delay = 0.02;  // s from a step's end to its wrench reaching the loop
   bool passivity = true;
-  double energy_tolerance = 0;  // J, passivity.energy_tolerance
+  double energy_tolerance = 0;   // J, passivity.energy_tolerance
   bool local_stiffness = false;  // publish K_h
   double twist = 0.05;           // rad the operator means to turn
   double twist_time = 0.05;
@@ -192,9 +192,7 @@ TEST(HapticClosedLoop, WithAFirmGripOnTheTiltASlowTwistFeelsTheBodysStaticStiffn
   const ClosedTrace loose = runClosedLoop(c);
   c.tilt_damping = 10;
   const ClosedTrace firm = runClosedLoop(c);
-  auto felt = [](const ClosedTrace& t) {
-    return t.mean(t.torque, 2, 3) / t.mean(t.angle, 2, 3);
-  };
+  auto felt = [](const ClosedTrace& t) { return t.mean(t.torque, 2, 3) / t.mean(t.angle, 2, 3); };
   auto simulated = [](const ClosedTrace& t) {
     return t.mean(t.simulated, 2, 3) / t.mean(t.angle, 2, 3);
   };

@@ -39,7 +39,8 @@ struct Trace {
   double max_energy = 0;
   double dissipated = 0;
   std::uint64_t active = 0;
-  double max_torque_step = 0;  // N m, largest change of the written torque from one tick to the next
+  double max_torque_step =
+      0;  // N m, largest change of the written torque from one tick to the next
   // Peak-to-peak of the device angle over [from, to).
   double swing(double from, double to) const {
     double lo = 1e300, hi = -1e300;
@@ -96,8 +97,8 @@ Trace run(const Scenario& sc) {
   const LoopLogRow* previous = nullptr;
   for (const LoopLogRow& r : loop.log()) {
     if (previous != nullptr)
-      trace.max_torque_step = std::max(trace.max_torque_step,
-                                       norm(r.output.torque - previous->output.torque));
+      trace.max_torque_step =
+          std::max(trace.max_torque_step, norm(r.output.torque - previous->output.torque));
     previous = &r;
     trace.time.push_back(r.time);
     trace.angle.push_back(toRotationVector(r.pose.orientation).z);

@@ -149,8 +149,8 @@ void SimulatedArm::advance(double dt) {
     const double force = motor_[i] + s.arm_stiffness * (intended_position[i] - state_.position[i]) -
                          s.arm_damping * state_.velocity[i];
     // About x and y the whole grip resists tilting the handle; about z the fingers twist it.
-    const double damping = i < 2 && s.wrist_tilt_damping >= 0 ? s.wrist_tilt_damping
-                                                               : s.wrist_damping;
+    const double damping =
+        i < 2 && s.wrist_tilt_damping >= 0 ? s.wrist_tilt_damping : s.wrist_damping;
     const double torque =
         motor_[3 + i] + s.wrist_stiffness * error[i] - damping * state_.angular_velocity[i];
     state_.velocity[i] += dt * force / mass;

@@ -64,7 +64,7 @@
 namespace torsion::device {
 
 struct PassivitySettings {
-  bool enabled = true;        ///< the controller; the observer always runs
+  bool enabled = true;  ///< the controller; the observer always runs
   /// The energy-reserve controller whose output respects the rate limit (above); false (the
   /// default): the dead-beat damper added after the rate limit (docs/haptics.md compares them).
   bool rate_limited = false;
@@ -81,7 +81,7 @@ struct PassivitySettings {
   /// tolerance lets a larger misprediction through on a delayed one (docs/haptics.md,
   /// "Passivity", measures both). 0: the strict controller.
   double energy_tolerance = 0;
-  double min_speed = 1e-6;    ///< m/s of |v|_w below which no damping is added (alpha -> inf)
+  double min_speed = 1e-6;  ///< m/s of |v|_w below which no damping is added (alpha -> inf)
   /// Dead-beat damper: N s/m, largest alpha (rotation: alpha l^2); infinity: none. A bound
   /// leaves some generated energy for the following ticks instead of a damping spike.
   double max_alpha = std::numeric_limits<double>::infinity();
@@ -115,10 +115,10 @@ class PassivityController {
   /// The wrench actually written this tick; observe() books it at the next tick.
   void written(const Wrench& wrench) { held_ = wrench; }
 
-  double portEnergy() const { return energy_; }                ///< J, E_obs (<= 0 when passive)
-  double maxPortEnergy() const { return max_energy_; }         ///< J, largest E_obs seen
-  double alpha() const { return alpha_; }  ///< N s/m, this tick's damping (equivalent)
-  double dissipated() const { return dissipated_; }  ///< J, power taken out of W_plan, summed
+  double portEnergy() const { return energy_; }         ///< J, E_obs (<= 0 when passive)
+  double maxPortEnergy() const { return max_energy_; }  ///< J, largest E_obs seen
+  double alpha() const { return alpha_; }               ///< N s/m, this tick's damping (equivalent)
+  double dissipated() const { return dissipated_; }     ///< J, power taken out of W_plan, summed
   std::uint64_t activeTicks() const { return active_ticks_; }  ///< ticks with alpha > 0
   const PassivitySettings& settings() const { return settings_; }
 
@@ -140,6 +140,5 @@ class PassivityController {
 
 /// Power W . v (W) of a wrench on a twist (linear m/s, angular rad/s).
 double power(const Wrench& w, const double v[6]);
-
 
 }  // namespace torsion::device

@@ -103,7 +103,7 @@ class HapticRuntime : public StepListener {
   std::uint64_t lockstep_ticks_ = 0;
   int simulation_priority_ = 0;
   bool simulation_realtime_ = false;
-  int saved_policy_ = 0;        // the stepping thread's policy before startThreads()
+  int saved_policy_ = 0;  // the stepping thread's policy before startThreads()
   int saved_priority_ = 0;
 };
 
