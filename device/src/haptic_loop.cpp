@@ -121,14 +121,21 @@ void HapticLoop::tick(double now, double deadline) {
   inputs.device_alive = sample.alive;
   inputs.simulation_fresh = published && now - last_fresh_time_ <= settings_.safety.stale_after;
   inputs.grabbed = force_enabled_ && simulated_.grabbed;
+  const Wrench previous_output = safety_.output();
   Wrench output = safety_.apply(desired, inputs, dt);
-  // The passivity controller's damping goes on after the rate limiter, within the device's
-  // limits: it only ever opposes the motion, and a damper held back by the rate limit could not
-  // take back the generated energy in time. Only while healthy and holding: a fading output
-  // fades alone.
+  // The passivity controller (passivity.h) takes the generated energy back; only while healthy
+  // and holding: a fading output fades alone. The rate-limited kind keeps the written wrench
+  // within the safety filter's rate limit of the last one, and the filter then starts its next
+  // step from what was written. The dead-beat kind adds its damping after the rate limit.
   const bool holding = inputs.grabbed && inputs.device_alive && inputs.simulation_fresh;
   passivity_.observe(port_twist, dt, holding);
-  if (holding) output = saturate(output + passivity_.damping(output, port_twist, dt), limits_);
+  if (holding) {
+    const double step_dt = std::clamp(dt, 0.0, settings_.safety.fade_time);
+    output = passivity_.control(previous_output, output, port_twist, dt,
+                                settings_.safety.max_force_rate * step_dt,
+                                settings_.safety.max_torque_rate * step_dt, limits_);
+    if (settings_.passivity.rate_limited) safety_.follow(output);
+  }
   device_.write(output);
   passivity_.written(output);
   if (passivity_.alpha() > 0) {

@@ -1,13 +1,22 @@
 // Haptic loop benchmark and headless Figure 6.7 runs. Not a test: it measures.
 //
 //   bench_haptic_loop threaded MESH_TETS SECONDS [LOG.csv] [--priority P] [--kh-columns N]
+//                     [--kh-refresh N] [--threads N] [--free-running] [--steps N]
+//                     [--sim-priority P]
 //       The 1 kHz loop on its own thread (scripted Figure 6.7 device) while the simulation thread
-//       steps the cylinder as fast as it can; prints loop rate, period jitter p50/p99/max,
+//       steps the cylinder on 2 solver threads, paced to the clock as an interactive run is
+//       (--free-running: as fast as it can); prints loop rate, period jitter p50/p99/max,
 //       overruns, wrench age (since the simulation's wrench arrived) and information age (of the
 //       newest information in the rendered wrench: the device pose the K_h prediction used, or
-//       without K_h the pose the step used), simulation step time p50/p99/max and steps per second,
-//       and whether the loop got SCHED_FIFO. --priority 0 keeps the default scheduling (default:
-//       the loop's 80); --kh-columns 6 refreshes K_h in one step (default 1 column per step).
+//       without K_h the pose the step used), simulation step time p50/p99/max (the step alone,
+//       not the pacing's wait; its CPU time on the stepping thread, which the machine's load
+//       does not inflate as much), CG iterations per step, steps per second, the 1-minute load
+//       average, and whether the loop got SCHED_FIFO. --priority 0 keeps the default
+//       scheduling (default: the loop's 80); --sim-priority P the stepping thread's SCHED_FIFO
+//       priority (default 50, HapticRuntime::setSimulationPriority; 0: the default policy);
+//       --kh-columns 6 refreshes K_h in one step (default 1
+//       column per step); --kh-refresh 0 publishes no K_h; --steps N stops after N steps.
+//       TORSION_BENCH_STEP_TIMES=FILE writes each step's milliseconds and CG iterations.
 //   bench_haptic_loop figure67 internal_force|frame_difference LOG.csv [MESH_TETS]
 //       The Figure 6.7 sequence on a simulated clock (lockstep, deterministic), loop log to CSV
 //       for docs/haptics.md (tests/bench/plot_haptics.py draws it).
@@ -16,6 +25,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <ctime>
 #include <string>
 #include <vector>
 
@@ -36,7 +46,8 @@ struct Cylinder {
   std::unique_ptr<haptics::HandCoupling> coupling;
 };
 
-Cylinder makeCylinder(int tets, haptics::Rendering rendering, int threads, int kh_columns = 1) {
+Cylinder makeCylinder(int tets, haptics::Rendering rendering, int threads, int kh_columns = 1,
+                      int kh_refresh = 10) {
   Result<LoadedMesh> mesh =
       readMesh(std::string(TORSION_ASSETS_DIR) + "/cylinder_" + std::to_string(tets) + ".node");
   if (!mesh) {
@@ -65,6 +76,7 @@ Cylinder makeCylinder(int tets, haptics::Rendering rendering, int threads, int k
   haptics::CouplingSettings settings;
   settings.rendering = rendering;
   settings.stiffness_columns_per_step = kh_columns;
+  settings.stiffness_refresh_steps = kh_refresh;
   c.coupling = std::make_unique<haptics::HandCoupling>(*c.hand, mapping, settings);
   return c;
 }
@@ -78,32 +90,81 @@ device::Trajectory figure67() {
   return *t.value;
 }
 
+// CPU seconds of the calling thread (a step's own work on it, whatever the machine's load).
+double threadCpuSeconds() {
+  timespec ts{};
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+  return static_cast<double>(ts.tv_sec) + 1e-9 * static_cast<double>(ts.tv_nsec);
+}
+
+// The 1-minute load average (state it with any wall-clock figure on a shared machine).
+double loadAverage() {
+  double load = -1;
+  if (FILE* f = std::fopen("/proc/loadavg", "r")) {
+    if (std::fscanf(f, "%lf", &load) != 1) load = -1;
+    std::fclose(f);
+  }
+  return load;
+}
+
 double percentile(std::vector<double> v, double p) {
   if (v.empty()) return 0;
   std::sort(v.begin(), v.end());
   return v[static_cast<size_t>(p * static_cast<double>(v.size() - 1))];
 }
 
-int threaded(int tets, double seconds, const char* log_path, int priority, int kh_columns) {
-  Cylinder c = makeCylinder(tets, haptics::Rendering::kInternalForce, 1, kh_columns);
+struct ThreadedOptions {
+  int priority = device::HapticLoopSettings{}.realtime_priority;
+  int kh_columns = 1;
+  int kh_refresh = 10;
+  int solver_threads = 2;  // as the plain twist benchmark's 2-thread rows
+  bool real_time = true;   // paced to the clock, as an interactive run (torsion run --haptics)
+  int sim_priority = 50;   // SCHED_FIFO priority of the stepping thread (0: the default policy)
+  int steps = 0;  // > 0: stop after this many steps (instruction counts per step), not SECONDS
+};
+
+int threaded(int tets, double seconds, const char* log_path, const ThreadedOptions& o) {
+  Cylinder c = makeCylinder(tets, haptics::Rendering::kInternalForce, o.solver_threads,
+                            o.kh_columns, o.kh_refresh);
   device::ScriptedDevice scripted(figure67(), device::defaultDeviceLimits(), "figure_6_7");
   device::HapticLoopSettings settings;
   settings.log_capacity = static_cast<size_t>(seconds * 1000 * 1.2) + 1000;
-  settings.realtime_priority = priority;
+  settings.realtime_priority = o.priority;
   device::HapticLoop loop(scripted, settings);
   haptics::HapticRuntime runtime(*c.world, {{c.coupling.get(), &loop, 1000}});
-  const auto start = std::chrono::steady_clock::now();
+  // The step alone is timed (the pacing's wait, when real time, is not part of it).
   int steps = 0;
-  std::vector<double> step_ms;
-  auto previous = start;
-  runtime.runThreaded(1 << 30, false, [&](const WorldStepReport&) {
+  std::vector<double> step_ms, step_cpu_ms, step_iterations;
+  runtime.setSimulationPriority(o.sim_priority);
+  runtime.startThreads();
+  const bool sim_realtime = runtime.simulationRealtime();
+  const auto start = std::chrono::steady_clock::now();
+  while (o.steps > 0
+             ? steps < o.steps
+             : std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count() <
+                   seconds) {
+    if (o.real_time) runtime.pace();
+    const auto t0 = std::chrono::steady_clock::now();
+    const double cpu0 = threadCpuSeconds();
+    const WorldStepReport report = runtime.step();
+    step_cpu_ms.push_back(1e3 * (threadCpuSeconds() - cpu0));
+    step_ms.push_back(
+        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
+    step_iterations.push_back(static_cast<double>(c.body->lastReport().solve.iterations));
     ++steps;
-    const auto now = std::chrono::steady_clock::now();
-    if (steps > 1)
-      step_ms.push_back(std::chrono::duration<double, std::milli>(now - previous).count());
-    previous = now;
-    return std::chrono::duration<double>(now - start).count() < seconds;
-  });
+    if (!report.ok) {
+      std::fprintf(stderr, "unstable: %s\n", report.message.c_str());
+      break;
+    }
+  }
+  runtime.stopThreads();
+  if (const char* dump = std::getenv("TORSION_BENCH_STEP_TIMES")) {
+    if (FILE* f = std::fopen(dump, "w")) {
+      for (size_t k = 0; k < step_ms.size(); ++k)
+        std::fprintf(f, "%.4f %g\n", step_ms[k], step_iterations[k]);
+      std::fclose(f);
+    }
+  }
   const double wall =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   std::vector<double> period_error, period, age, information_age;
@@ -123,15 +184,22 @@ int threaded(int tets, double seconds, const char* log_path, int priority, int k
       "\"overruns\": %llu, \"wrench_age_ms\": {\"p50\": "
       "%.2f, \"p99\": %.2f, \"max\": %.2f}, \"information_age_ms\": {\"p50\": %.2f, \"p99\": "
       "%.2f, \"max\": %.2f}, \"sim_steps_per_s\": %.1f, \"sim_step_ms\": {\"p50\": "
-      "%.2f, \"p99\": %.2f, \"max\": %.2f}, \"kh_columns_per_step\": %d, \"realtime\": %s}\n",
+      "%.2f, \"p99\": %.2f, \"max\": %.2f}, \"sim_step_cpu_ms_this_thread\": {\"p50\": %.2f, "
+      "\"p99\": %.2f}, \"load_1min\": %.2f, \"cg_iterations_per_step\": {\"p50\": %.0f, \"p99\": "
+      "%.0f}, \"solver_threads\": %d, "
+      "\"real_time\": %s, \"kh_columns_per_step\": %d, \"kh_refresh_steps\": %d, "
+      "\"realtime\": %s, \"sim_priority\": %d, \"sim_realtime\": %s}\n",
       tets, wall, span > 0 ? static_cast<double>(log.size() - 1) / span : 0.0,
       percentile(period_error, 0.5), percentile(period_error, 0.99), percentile(period_error, 1.0),
       percentile(period, 0.5), percentile(period, 0.99),
       static_cast<unsigned long long>(loop.stats().overruns.load()), percentile(age, 0.5),
       percentile(age, 0.99), percentile(age, 1.0), percentile(information_age, 0.5),
       percentile(information_age, 0.99), percentile(information_age, 1.0), steps / wall,
-      percentile(step_ms, 0.5), percentile(step_ms, 0.99), percentile(step_ms, 1.0), kh_columns,
-      loop.stats().realtime ? "true" : "false");
+      percentile(step_ms, 0.5), percentile(step_ms, 0.99), percentile(step_ms, 1.0),
+      percentile(step_cpu_ms, 0.5), percentile(step_cpu_ms, 0.99), loadAverage(),
+      percentile(step_iterations, 0.5), percentile(step_iterations, 0.99), o.solver_threads,
+      o.real_time ? "true" : "false", o.kh_columns, o.kh_refresh,
+      loop.stats().realtime ? "true" : "false", o.sim_priority, sim_realtime ? "true" : "false");
   if (log_path && !loop.writeLog(log_path)) return 1;
   return 0;
 }
@@ -165,18 +233,28 @@ int main(int argc, char** argv) {
   const std::string mode = argc > 1 ? argv[1] : "";
   if (mode == "threaded" && argc >= 4) {
     const char* log = nullptr;
-    int priority = device::HapticLoopSettings{}.realtime_priority, kh_columns = 1;
+    ThreadedOptions options;
     for (int k = 4; k < argc; ++k) {
       const std::string a = argv[k];
       if (a == "--priority" && k + 1 < argc) {
-        priority = std::atoi(argv[++k]);
+        options.priority = std::atoi(argv[++k]);
       } else if (a == "--kh-columns" && k + 1 < argc) {
-        kh_columns = std::atoi(argv[++k]);
+        options.kh_columns = std::atoi(argv[++k]);
+      } else if (a == "--kh-refresh" && k + 1 < argc) {
+        options.kh_refresh = std::atoi(argv[++k]);
+      } else if (a == "--threads" && k + 1 < argc) {
+        options.solver_threads = std::atoi(argv[++k]);
+      } else if (a == "--steps" && k + 1 < argc) {
+        options.steps = std::atoi(argv[++k]);
+      } else if (a == "--sim-priority" && k + 1 < argc) {
+        options.sim_priority = std::atoi(argv[++k]);
+      } else if (a == "--free-running") {
+        options.real_time = false;
       } else {
         log = argv[k];
       }
     }
-    return threaded(std::atoi(argv[2]), std::atof(argv[3]), log, priority, kh_columns);
+    return threaded(std::atoi(argv[2]), std::atof(argv[3]), log, options);
   }
   if (mode == "figure67" && argc >= 4) {
     return figure(argv[2], argv[3], argc > 4 ? std::atoi(argv[4]) : 2430);
@@ -184,6 +262,8 @@ int main(int argc, char** argv) {
   std::fprintf(
       stderr,
       "usage: bench_haptic_loop threaded TETS SECONDS [LOG.csv] [--priority P] [--kh-columns N]\n"
+      "                         [--kh-refresh N] [--threads N] [--free-running] [--steps N]\n"
+      "                         [--sim-priority P]\n"
       "       bench_haptic_loop figure67 internal_force|frame_difference LOG.csv [TETS]\n");
   return 2;
 }

@@ -1,5 +1,7 @@
 // A haptic device driving a hand on an FEM body in a world the user steps with substeps.
 #include <gtest/gtest.h>
+#include <pthread.h>
+#include <sched.h>
 
 #include "torsion/bullet/hand.h"
 #include "torsion/device/scripted_device.h"
@@ -81,6 +83,46 @@ TEST(UserWorldHaptics, ThreadedLoopRunsBesideTheUsersSteppingLoop) {
   EXPECT_GT(loop.stats().ticks, 0u);
   EXPECT_TRUE(hand.grabbed()) << "the button pressed on the loop's thread reached the hand";
   EXPECT_EQ(user.fem.stepCount(), 80);
+}
+
+TEST(UserWorldHaptics, TheSteppingThreadIsRealTimeOnlyWhileTheLoopsRun) {
+  // setSimulationPriority: SCHED_FIFO at startThreads() when the process may have it (the
+  // result says which), and the thread's own policy back at stopThreads() either way.
+  UserWorld user(btVector3(0, 0, 0));
+  Material material;
+  FemBody* bar =
+      user.fem.addBody("bar", makeBoxTetMesh({0, 0, 0}, {0.4, 0.4, 2}, 1, 1, 4).value(), material)
+          .value();
+  Hand hand(*bar);
+  haptics::DeviceMapping mapping;
+  mapping.anchor.origin = Eigen::Vector3d(0.2, 0.2, 1.9);
+  haptics::HandCoupling coupling(hand, mapping, haptics::CouplingSettings{});
+  const device::Trajectory hold({{0, device::Pose{}}, {10, device::Pose{}}}, {{0, 1u}});
+  device::ScriptedDevice scripted(hold, device::defaultDeviceLimits(), "hold");
+  device::HapticLoop loop(scripted, device::HapticLoopSettings{});
+  haptics::HapticRuntime runtime(user.fem, {{&coupling, &loop, 1000}});
+  int policy_before = -1, policy = -1;
+  sched_param before{}, during{};
+  ASSERT_EQ(pthread_getschedparam(pthread_self(), &policy_before, &before), 0);
+  runtime.setSimulationPriority(40);
+  runtime.startThreads();
+  ASSERT_EQ(pthread_getschedparam(pthread_self(), &policy, &during), 0);
+  if (runtime.simulationRealtime()) {
+    EXPECT_EQ(policy, SCHED_FIFO);
+    EXPECT_EQ(during.sched_priority, 40);
+  } else {
+    EXPECT_EQ(policy, policy_before);  // refused: unchanged
+  }
+  for (int call = 0; call < 5; ++call) {
+    user.world.stepSimulation(btScalar(1 / 60.), 10, btScalar(1 / 240.));
+    ASSERT_TRUE(user.fem.status().ok) << user.fem.status().message;
+  }
+  runtime.stopThreads();
+  sched_param after{};
+  ASSERT_EQ(pthread_getschedparam(pthread_self(), &policy, &after), 0);
+  EXPECT_EQ(policy, policy_before);
+  EXPECT_EQ(after.sched_priority, before.sched_priority);
+  EXPECT_FALSE(runtime.simulationRealtime());
 }
 
 }  // namespace

@@ -88,6 +88,7 @@ std::string SimulatedArmSettings::parse(const std::string& config) {
                                                       {"arm_damping", &arm_damping},
                                                       {"wrist_stiffness", &wrist_stiffness},
                                                       {"wrist_damping", &wrist_damping},
+                                                      {"wrist_tilt_damping", &wrist_tilt_damping},
                                                       {"intent_rate", &intent_rate},
                                                       {"intent_start", &intent_start},
                                                       {"intent_time", &intent_time},
@@ -147,8 +148,11 @@ void SimulatedArm::advance(double dt) {
   for (int i = 0; i < 3; ++i) {
     const double force = motor_[i] + s.arm_stiffness * (intended_position[i] - state_.position[i]) -
                          s.arm_damping * state_.velocity[i];
+    // About x and y the whole grip resists tilting the handle; about z the fingers twist it.
+    const double damping =
+        i < 2 && s.wrist_tilt_damping >= 0 ? s.wrist_tilt_damping : s.wrist_damping;
     const double torque =
-        motor_[3 + i] + s.wrist_stiffness * error[i] - s.wrist_damping * state_.angular_velocity[i];
+        motor_[3 + i] + s.wrist_stiffness * error[i] - damping * state_.angular_velocity[i];
     state_.velocity[i] += dt * force / mass;
     state_.angular_velocity[i] += dt * torque / inertia;
     state_.position[i] += dt * state_.velocity[i];

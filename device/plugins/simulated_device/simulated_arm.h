@@ -31,6 +31,8 @@ struct SimulatedArmSettings {
   double arm_damping = 8;      ///< N s/m
   double wrist_stiffness = 3;  ///< N m/rad toward the intended orientation
   double wrist_damping = 0.1;  ///< N m s/rad
+  /// N m s/rad about x and y (tilting the handle); negative: wrist_damping about all three axes
+  double wrist_tilt_damping = -1;
   // intent
   enum class Intent { kHold, kTwist, kPush } intent = Intent::kTwist;
   double intent_rate = 0.5;   ///< rad/s (twist about z) or m/s (push along x)

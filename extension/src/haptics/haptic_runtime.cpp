@@ -1,5 +1,8 @@
 #include "torsion/haptics/haptic_runtime.h"
 
+#include <pthread.h>
+#include <sched.h>
+
 #include <cassert>
 #include <chrono>
 #include <cmath>
@@ -62,6 +65,15 @@ WorldStepReport HapticRuntime::stepLockstep() {
 }
 
 void HapticRuntime::startThreads() {
+  if (simulation_priority_ > 0 && !simulation_realtime_) {
+    sched_param saved{};
+    if (pthread_getschedparam(pthread_self(), &saved_policy_, &saved) == 0) {
+      saved_priority_ = saved.sched_priority;
+      sched_param param{};
+      param.sched_priority = simulation_priority_;
+      simulation_realtime_ = pthread_setschedparam(pthread_self(), SCHED_FIFO, &param) == 0;
+    }
+  }
   for (HapticBinding& b : bindings_)
     b.loop->start();
   // Give the loops a first tick so the first step sees the device.
@@ -91,6 +103,12 @@ WorldStepReport HapticRuntime::stepPaced(bool real_time) {
 void HapticRuntime::stopThreads() {
   for (HapticBinding& b : bindings_)
     b.loop->stop();
+  if (simulation_realtime_) {
+    sched_param saved{};
+    saved.sched_priority = saved_priority_;
+    pthread_setschedparam(pthread_self(), saved_policy_, &saved);
+    simulation_realtime_ = false;
+  }
 }
 
 WorldStepReport HapticRuntime::runThreaded(

@@ -7,8 +7,10 @@
 //   3. hand the simulation a HandCommand (lock-free, commands());
 //   4. take the newest SimulationWrench (lock-free, wrenches()) and render the local model
 //      W_sim + K_h dpose - B twist (local_wrench_model.h);
-//   5. add the passivity controller's damping (passivity.h), pass the wrench through the
-//      SafetyFilter, write it to the device and book its energy at the port;
+//   5. pass the wrench through the SafetyFilter, let the passivity controller (passivity.h) take
+//      back the generated energy (the dead-beat damper on top of the filter's output, or the
+//      rate-limited controller within the filter's rate limit, the filter then following what
+//      was written), write it to the device and book its energy at the port;
 //   6. append a row to the in-memory log (no I/O on this thread; writeLog after stop()).
 //
 // Threads: tick() runs on the loop thread (or on a test's thread with a fake clock, never both);

@@ -13,18 +13,45 @@
 // -E_obs = K x^2 / 2 and returns it). E_obs > 0 is energy the coupling generated (delay, sample
 // and hold, a stale simulation wrench), the source of the growing buzz of an unstable coupling.
 //
-// Controller (impedance causality: the twist comes in, the wrench goes out). At tick n, for the
-// wrench W_plan the loop is about to send,
-//     E_pre = E_obs(n-1) + W_plan . v(n) dt;
+// Controller (impedance causality: the twist comes in, the wrench goes out). Two kinds.
+//
+// Rate-limited energy reserve (`rate_limited: true`). The wrench written to the device
+// changes by at most the safety filter's rate limit per tick (r_f N/s, r_t N m/s), damping
+// included, so the controller cannot take a large amount of energy back in one tick: it must
+// never hand out more of the reserve -E_obs than it could still stop. For a wrench W = (f, tau)
+// the reserve need is
+//     N(W) = E_obs(n) - energy_tolerance + W . v(n) dt + |f|^2 s_f / (2 r_f)
+//            + |tau|^2 s_t / (2 r_t)     (J)
+// the energy already given, the work of W over the coming tick, and the most that ramping f and
+// tau down to zero at the rate limit (|f| / r_f, |tau| / r_t seconds) can give out while the
+// hand moves at up to s_f m/s and s_t rad/s. The speed bounds s are the peak speeds of about the
+// last `speed_hold_time` (decaying; an oscillation's speed passes through zero at each turning
+// point, its amplitude does not) times `speed_margin` (the wrench being ramped down keeps
+// accelerating the hand). Each tick, with W_prev the wrench written at the last tick and W_plan
+// the safety filter's rate-limited step from it toward the rendering:
+//   - N(W_plan) <= 0: W = W_plan, the controller does nothing;
+//   - else the brake, W_brake = the wrench within the rate limit of W_prev with the least N
+//     (toward N's minimiser -v dt r / s, i.e. toward zero, then against the motion); W = the
+//     point of the segment W_plan -> W_brake nearest W_plan with N <= 0 (W_brake when none).
+// Both ends lie in the rate-limit ball around W_prev, so every point between does: the output
+// never steps by more than the rate limit, and the energy is taken back over several ticks. An
+// energy debt (E_obs > 0, after a motion faster than the bounds) keeps N > 0, so the brake holds
+// the output small and then damps, at the rate limit, until it is repaid. A slow, quasi-static
+// motion into a spring keeps a reserve of the spring's stored energy and is left alone.
+//
+// Dead-beat damper (Hannaford & Ryu; the default, `rate_limited: false`). At tick n, for W_plan,
+//     E_pre = E_obs(n-1) - energy_tolerance + W_plan . v(n) dt;
 //     E_pre > 0 and |v|_w > min_speed:  alpha = E_pre / (|v|_w^2 dt),
 //                                        W = W_plan - alpha (v_lin, l^2 v_ang)
 // with |v|_w^2 = |v_lin|^2 + l^2 |v_ang|^2 and l = `length_scale` (the one damping coefficient
 // alpha, N s/m, acts on rotation as alpha l^2, N m s/rad). Then W . v dt = E_pre - alpha |v|_w^2
-// dt brings E_obs(n) to exactly 0: the controller removes the energy generated and no more, so
-// it stays off (alpha = 0) for a passive rendering and does not change what a slow, quasi-static
-// motion feels. The haptic loop adds the damping after the safety filter's rate limit (it only
-// ever opposes the motion) and saturates the sum at the device's limits; the observer books the
-// wrench actually written, so what saturation holds back is caught at the next tick.
+// dt brings E_obs(n) to exactly energy_tolerance (0 by default) in one tick; the damping is
+// added after the rate limit, so the
+// written wrench may step (about 1 N m in a tick where the limit allows 0.03 N m).
+//
+// Either way the observer books the wrench actually written, so what saturation holds back is
+// caught at the next tick, and alpha() reports the damping as an equivalent coefficient: the
+// power taken out of W_plan over |v|_w^2 (N s/m).
 //
 // The port energy restarts at 0 whenever the hand holds nothing (a new grab is a new contact).
 
@@ -37,11 +64,26 @@
 namespace torsion::device {
 
 struct PassivitySettings {
-  bool enabled = true;        ///< the controller; the observer always runs
+  bool enabled = true;  ///< the controller; the observer always runs
+  /// The energy-reserve controller whose output respects the rate limit (above); false (the
+  /// default): the dead-beat damper added after the rate limit (docs/haptics.md compares them).
+  bool rate_limited = false;
+  /// s, rate-limited controller: how long the speed bound holds a peak speed (it decays as
+  /// exp(-t / speed_hold_time)); about an oscillation period of the hand on the device.
+  double speed_hold_time = 0.1;
+  /// Rate-limited controller: the speed bound's factor. The wrench being ramped down keeps
+  /// accelerating the hand meanwhile, so the speed while braking exceeds the one measured.
+  double speed_margin = 2;
   double length_scale = 0.1;  ///< m, l above: rotational damping alpha l^2 for linear alpha
-  double min_speed = 1e-6;    ///< m/s of |v|_w below which no damping is added (alpha -> inf)
-  /// N s/m, largest alpha (rotation: alpha l^2); infinity: none. A bound leaves some generated
-  /// energy for the following ticks instead of a damping spike at small speeds.
+  /// J the port may hold above 0 before either controller acts (E_obs <= energy_tolerance is
+  /// its target instead of 0). A stiff sampled rendering's own excess can be a few microjoules;
+  /// acting on it makes the controller chatter and soften what the hand feels, while a
+  /// tolerance lets a larger misprediction through on a delayed one (docs/haptics.md,
+  /// "Passivity", measures both). 0: the strict controller.
+  double energy_tolerance = 0;
+  double min_speed = 1e-6;  ///< m/s of |v|_w below which no damping is added (alpha -> inf)
+  /// Dead-beat damper: N s/m, largest alpha (rotation: alpha l^2); infinity: none. A bound
+  /// leaves some generated energy for the following ticks instead of a damping spike.
   double max_alpha = std::numeric_limits<double>::infinity();
 
   /// Empty when valid, else the message naming the field.
@@ -52,9 +94,20 @@ class PassivityController {
  public:
   explicit PassivityController(const PassivitySettings& settings = {}) : settings_(settings) {}
 
-  /// The damping wrench to add to `planned` (the wrench about to be written) for twist `v`
-  /// (linear m/s, angular rad/s) over `dt`; zero when the controller is off or not needed.
+  /// Dead-beat damper: the damping wrench to add to `planned` (the wrench about to be written)
+  /// for twist `v` (linear m/s, angular rad/s) over `dt`; zero when the controller is off or
+  /// not needed.
   Wrench damping(const Wrench& planned, const double v[6], double dt);
+  /// Rate-limited energy reserve: the wrench to write this tick. `previous`: the wrench written
+  /// at the last tick; `planned`: the rate-limited step from it toward the rendering (within
+  /// `force_step` N and `torque_step` N m of `previous`); the result is too, and within
+  /// `limits`. `planned` itself when the controller is off or not needed.
+  Wrench limit(const Wrench& previous, const Wrench& planned, const double v[6], double dt,
+               double force_step, double torque_step, const DeviceLimits& limits);
+  /// The loop's choice: limit() when settings().rate_limited, else planned + damping(),
+  /// saturated.
+  Wrench control(const Wrench& previous, const Wrench& planned, const double v[6], double dt,
+                 double force_step, double torque_step, const DeviceLimits& limits);
   /// Books the work of the wrench written at the previous tick (held by the device since) over
   /// the motion `v` dt that just happened. `holding`: a patch is grabbed with force on (else the
   /// port energy restarts at 0 and the held wrench is forgotten).
@@ -62,15 +115,21 @@ class PassivityController {
   /// The wrench actually written this tick; observe() books it at the next tick.
   void written(const Wrench& wrench) { held_ = wrench; }
 
-  double portEnergy() const { return energy_; }                ///< J, E_obs (<= 0 when passive)
-  double maxPortEnergy() const { return max_energy_; }         ///< J, largest E_obs seen
-  double alpha() const { return alpha_; }                      ///< N s/m, this tick's damping
-  double dissipated() const { return dissipated_; }            ///< J, sum alpha |v|_w^2 dt so far
+  double portEnergy() const { return energy_; }         ///< J, E_obs (<= 0 when passive)
+  double maxPortEnergy() const { return max_energy_; }  ///< J, largest E_obs seen
+  double alpha() const { return alpha_; }               ///< N s/m, this tick's damping (equivalent)
+  double dissipated() const { return dissipated_; }     ///< J, power taken out of W_plan, summed
   std::uint64_t activeTicks() const { return active_ticks_; }  ///< ticks with alpha > 0
   const PassivitySettings& settings() const { return settings_; }
 
  private:
+  /// J: E_obs plus the work of `w` over the coming tick plus what ramping it to zero at the
+  /// rates (N/s, N m/s) could give out at the speed bounds; > 0: not covered by the reserve.
+  double reserveNeed(const Wrench& w, const double v[6], double dt, double force_rate,
+                     double torque_rate) const;
+
   PassivitySettings settings_;
+  double speed_bound_[2] = {0, 0};  // m/s, rad/s: peak speeds, decaying
   Wrench held_;
   double energy_ = 0;
   double max_energy_ = 0;

@@ -46,6 +46,10 @@ class SafetyFilter {
   /// `dt`: s since the previous tick (clamped to [0, fade_time]).
   Wrench apply(const Wrench& desired, const SafetyInputs& inputs, double dt);
   const Wrench& output() const { return output_; }
+  /// The wrench actually written this tick, when a later stage (the passivity controller)
+  /// changed the filter's output within the rate limit: the next tick's rate limit and fade
+  /// start from what the device holds, so the written wrench never steps.
+  void follow(const Wrench& written) { output_ = written; }
   double gain() const { return gain_; }
 
  private:

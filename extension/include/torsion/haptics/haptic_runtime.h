@@ -67,6 +67,18 @@ class HapticRuntime : public StepListener {
   /// startThreads() has caught up with simulated time when `real_time`; stopThreads() stops them
   /// (zero wrench written).
   void startThreads();
+  /// SCHED_FIFO priority (1-99) the thread that calls startThreads() asks for until
+  /// stopThreads(), so that on a loaded machine the steps run at the speed of an idle one and
+  /// the wrench the loop renders stays young (docs/performance.md: wrench age p99 10 ms at
+  /// 31558 tets under load 13, against 100 ms without). Keep it below the loops' (80) so that
+  /// they still preempt the simulation. The solver's worker threads inherit it when the thread
+  /// starts them (their first parallel step). Linux caps real-time threads at 95 % of the CPU
+  /// (sched_rt_runtime_us), so a simulation slower than real time cannot lock the machine.
+  /// Refused silently without the privilege (simulationRealtime() says). 0 (default): keep the
+  /// thread's policy.
+  void setSimulationPriority(int priority) { simulation_priority_ = priority; }
+  /// The stepping thread runs under SCHED_FIFO (from startThreads() until stopThreads()).
+  bool simulationRealtime() const { return simulation_realtime_; }
   WorldStepReport stepPaced(bool real_time);
   /// The wait of stepPaced(true) alone: returns when the coming step is due.
   void pace();
@@ -89,6 +101,10 @@ class HapticRuntime : public StepListener {
   std::chrono::steady_clock::time_point threads_origin_;
   double threads_start_time_ = 0;  // FEM time at startThreads()
   std::uint64_t lockstep_ticks_ = 0;
+  int simulation_priority_ = 0;
+  bool simulation_realtime_ = false;
+  int saved_policy_ = 0;  // the stepping thread's policy before startThreads()
+  int saved_priority_ = 0;
 };
 
 }  // namespace torsion::haptics
