@@ -6,10 +6,12 @@
 // triangles cross. One JSON line on stdout.
 //
 //   bench_self_contact SCENE [--steps N] [--threads T] [--check-every K]
-//                            [--save-at K FILE] [--resume FILE]
+//                            [--save-at K FILE] [--resume FILE] [--self-contact off]
 //
 // --save-at writes a checkpoint (checkpoint_io.h) after step K; --resume starts from one, so that
-// the contact phase (the plectoneme's last ~350 steps) can be profiled alone.
+// the contact phase (the plectoneme's last ~350 steps) can be profiled alone. `--self-contact off`
+// runs the same scene with the body's self-contact turned off (the cost of having it on).
+// search_ms_per_step is the wall time of self-contact's tree searches (SelfContactStats).
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
@@ -32,17 +34,20 @@ int main(int argc, char** argv) {
   if (argc < 2) {
     std::fprintf(stderr,
                  "usage: %s SCENE [--steps N] [--threads T] [--check-every K] [--save-at K FILE] "
-                 "[--resume FILE]\n",
+                 "[--resume FILE] [--self-contact off]\n",
                  argv[0]);
     return 1;
   }
   int steps = -1, threads = -1, check_every = 50, save_at = -1;
   std::string save_file, resume_file;
+  bool self_contact = true;
   for (int a = 2; a + 1 < argc; a += 2) {
     if (!std::strcmp(argv[a], "--steps")) steps = std::atoi(argv[a + 1]);
     if (!std::strcmp(argv[a], "--threads")) threads = std::atoi(argv[a + 1]);
     if (!std::strcmp(argv[a], "--check-every")) check_every = std::atoi(argv[a + 1]);
     if (!std::strcmp(argv[a], "--resume")) resume_file = argv[a + 1];
+    if (!std::strcmp(argv[a], "--self-contact"))
+      self_contact = std::strcmp(argv[a + 1], "off") != 0;
     if (!std::strcmp(argv[a], "--save-at") && a + 2 < argc) {
       save_at = std::atoi(argv[a + 1]);
       save_file = argv[++a + 1];
@@ -67,6 +72,8 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "no body with self-contact in %s\n", argv[1]);
     return 1;
   }
+  const double gap_tolerance = body->selfContact()->gapTolerance();
+  const int max_iterations = body->selfContact()->settings().max_iterations;
   std::vector<Hand*> hands;
   for (SceneHand& h : scene.hands)
     hands.push_back(h.hand.get());
@@ -85,11 +92,13 @@ int main(int argc, char** argv) {
     for (size_t h = 0; h < hands.size(); ++h)
       hands[h]->restore(stored.value().hands[h]);
   }
+  // After a checkpoint's restore, which brings self-contact back as it was saved.
+  if (!self_contact) body->disableSelfContact();
   SurfaceTree tree(body->model().mesh().surfaceTriangles());
   int unconverged = 0, at_cap = 0, max_active = 0, searches = 0, crossing_checks = 0,
       crossing_first = -1;
   long updates = 0;
-  double worst_end = 0, stepping = 0;
+  double worst_end = 0, stepping = 0, searching = 0;
   const std::clock_t cpu0 = std::clock();
   for (int k = 1; k <= steps; ++k) {
     const auto t0 = std::chrono::steady_clock::now();
@@ -107,14 +116,17 @@ int main(int argc, char** argv) {
       std::ofstream(save_file, std::ios::binary)
           << writeCheckpoint(*scene.world, scene.world->checkpoint(), hands, hand_checkpoints, "");
     }
-    const SelfContactStats& s = body->selfContact()->stats();
-    unconverged += s.converged ? 0 : 1;
-    updates += s.iterations;
-    // Unconverged with every update used, rather than stopped early by the safeguard.
-    if (!s.converged && s.iterations >= body->selfContact()->settings().max_iterations) ++at_cap;
-    max_active = std::max(max_active, s.active);
-    worst_end = std::max(worst_end, s.max_end_penetration);
-    searches += s.searches;
+    if (body->selfContact() != nullptr) {
+      const SelfContactStats& s = body->selfContact()->stats();
+      unconverged += s.converged ? 0 : 1;
+      updates += s.iterations;
+      // Unconverged with every update used, rather than stopped early by the safeguard.
+      if (!s.converged && s.iterations >= max_iterations) ++at_cap;
+      max_active = std::max(max_active, s.active);
+      worst_end = std::max(worst_end, s.max_end_penetration);
+      searches += s.searches;
+      searching += s.search_seconds;
+    }
     if (check_every > 0 && k % check_every == 0 &&
         countSurfaceIntersections(tree, body->state().positions) > 0) {
       ++crossing_checks;
@@ -124,13 +136,14 @@ int main(int argc, char** argv) {
   const double cpu = static_cast<double>(std::clock() - cpu0) / CLOCKS_PER_SEC;
   std::printf(
       "{\"scene\": \"%s\", \"steps\": %d, \"threads\": %d, \"steps_per_s\": %.2f, "
-      "\"cpu_s_per_step\": %.4g, \"uzawa_updates\": %ld, "
+      "\"cpu_s_per_step\": %.4g, \"search_ms_per_step\": %.3g, \"self_contact\": %s, "
+      "\"uzawa_updates\": %ld, "
       "\"unconverged\": %d, \"unconverged_at_max_iterations\": %d, \"max_active\": %d, "
       "\"worst_end_penetration_m\": %.3g, "
       "\"gap_tolerance_m\": %.3g, \"searches\": %d, \"crossing_checks\": %d, "
       "\"first_crossing_step\": %d}\n",
-      scene.spec.name.c_str(), steps, threads, steps / stepping, cpu / steps, updates, unconverged,
-      at_cap, max_active, worst_end, body->selfContact()->gapTolerance(), searches, crossing_checks,
-      crossing_first);
+      scene.spec.name.c_str(), steps, threads, steps / stepping, cpu / steps,
+      1e3 * searching / steps, self_contact ? "true" : "false", updates, unconverged, at_cap,
+      max_active, worst_end, gap_tolerance, searches, crossing_checks, crossing_first);
   return 0;
 }

@@ -1,6 +1,7 @@
 #include "torsion/contact/self_contact.h"
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 
 #include "torsion/format_number.h"
@@ -136,6 +137,7 @@ bool SelfContactSolver::detect(const FemState& state, const NodeConstraints& con
 
 int SelfContactSolver::addCandidates(const Eigen::VectorXd& x, const Eigen::VectorXd& end) {
   ++stats_.searches;
+  const auto started = std::chrono::steady_clock::now();
   tree_.refit(x, end, settings_.margin * mean_edge_);
   const size_t before = set_.contacts().size();
   // Nodes against triangles: every triangle found is kept. A node passing over an edge or a
@@ -200,6 +202,8 @@ int SelfContactSolver::addCandidates(const Eigen::VectorXd& x, const Eigen::Vect
   const NodeConstraints& constraints = *constraints_;
   set_.markDetermined(
       [&](int node) { return constraints.kind(node) == NodeConstraints::Kind::kFull; });
+  stats_.search_seconds +=
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
   return static_cast<int>(set_.contacts().size() - before);
 }
 
