@@ -56,8 +56,8 @@ struct SelfContactSettings {
   double max_depth = 0.25;
   /// rho in units of the contact's effective mass (surface_contact_set.h). Stiffer converges the
   /// normal gap in fewer updates but each CG solve takes longer and friction settles worse: on
-  /// the plectoneme's contact phase 8 took 40 % fewer CG iterations per step than 20 (and 60
-  /// slower still); below 4 steps stopped unconverged (docs/contact.md).
+  /// six steps of the plectoneme's contact phase 8 took half the CPU time of 20 (60: a quarter
+  /// more than 20); 2 left steps unconverged (docs/contact.md).
   double penalty_factor = 8;
   /// Uzawa updates (each one warm-started CG solve) per step.
   int max_iterations = 40;
