@@ -6,30 +6,52 @@
 // triangles cross. One JSON line on stdout.
 //
 //   bench_self_contact SCENE [--steps N] [--threads T] [--check-every K]
+//                            [--save-at K FILE] [--resume FILE] [--self-contact off]
+//
+// --save-at writes a checkpoint (checkpoint_io.h) after step K; --resume starts from one, so that
+// the contact phase (the plectoneme's last ~350 steps) can be profiled alone. `--self-contact off`
+// runs the same scene with the body's self-contact turned off (the cost of having it on).
+// search_ms_per_step is the wall time of self-contact's tree searches (SelfContactStats).
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <ctime>
+#include <fstream>
+#include <iterator>
 #include <string>
 
 #include "../contact/surface_intersections.h"
 #include "scene_builder.h"
 #include "scene_haptics.h"
 #include "scene_parser.h"
+#include "torsion/bullet/checkpoint_io.h"
 
 int main(int argc, char** argv) {
   using namespace torsion;
   using namespace torsion::scene;
   if (argc < 2) {
-    std::fprintf(stderr, "usage: %s SCENE [--steps N] [--threads T] [--check-every K]\n", argv[0]);
+    std::fprintf(stderr,
+                 "usage: %s SCENE [--steps N] [--threads T] [--check-every K] [--save-at K FILE] "
+                 "[--resume FILE] [--self-contact off]\n",
+                 argv[0]);
     return 1;
   }
-  int steps = -1, threads = -1, check_every = 50;
+  int steps = -1, threads = -1, check_every = 50, save_at = -1;
+  std::string save_file, resume_file;
+  bool self_contact = true;
   for (int a = 2; a + 1 < argc; a += 2) {
     if (!std::strcmp(argv[a], "--steps")) steps = std::atoi(argv[a + 1]);
     if (!std::strcmp(argv[a], "--threads")) threads = std::atoi(argv[a + 1]);
     if (!std::strcmp(argv[a], "--check-every")) check_every = std::atoi(argv[a + 1]);
+    if (!std::strcmp(argv[a], "--resume")) resume_file = argv[a + 1];
+    if (!std::strcmp(argv[a], "--self-contact"))
+      self_contact = std::strcmp(argv[a + 1], "off") != 0;
+    if (!std::strcmp(argv[a], "--save-at") && a + 2 < argc) {
+      save_at = std::atoi(argv[a + 1]);
+      save_file = argv[++a + 1];
+    }
   }
   Result<SceneSpec> spec = loadScene(argv[1]);
   if (!spec) {
@@ -50,10 +72,34 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "no body with self-contact in %s\n", argv[1]);
     return 1;
   }
+  const double gap_tolerance = body->selfContact()->gapTolerance();
+  const int max_iterations = body->selfContact()->settings().max_iterations;
+  std::vector<Hand*> hands;
+  for (SceneHand& h : scene.hands)
+    hands.push_back(h.hand.get());
+  if (!resume_file.empty()) {
+    std::ifstream in(resume_file, std::ios::binary);
+    const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    Result<StoredCheckpoint> stored = readCheckpoint(bytes, *scene.world, hands);
+    if (!stored) {
+      std::fprintf(stderr, "%s: %s\n", resume_file.c_str(), stored.error().message.c_str());
+      return 1;
+    }
+    if (Status restored = scene.world->restore(stored.value().world); !restored) {
+      std::fprintf(stderr, "%s: %s\n", resume_file.c_str(), restored.error().message.c_str());
+      return 1;
+    }
+    for (size_t h = 0; h < hands.size(); ++h)
+      hands[h]->restore(stored.value().hands[h]);
+  }
+  // After a checkpoint's restore, which brings self-contact back as it was saved.
+  if (!self_contact) body->disableSelfContact();
   SurfaceTree tree(body->model().mesh().surfaceTriangles());
   int unconverged = 0, at_cap = 0, max_active = 0, searches = 0, crossing_checks = 0,
       crossing_first = -1;
-  double worst_end = 0, stepping = 0;
+  long updates = 0;
+  double worst_end = 0, stepping = 0, searching = 0;
+  const std::clock_t cpu0 = std::clock();
   for (int k = 1; k <= steps; ++k) {
     const auto t0 = std::chrono::steady_clock::now();
     Result<WorldStepReport> report = stepScene(scene);
@@ -63,26 +109,41 @@ int main(int argc, char** argv) {
                    report ? report.value().message.c_str() : report.error().message.c_str());
       return 2;
     }
-    const SelfContactStats& s = body->selfContact()->stats();
-    unconverged += s.converged ? 0 : 1;
-    // Unconverged with every update used, rather than stopped early by the safeguard.
-    if (!s.converged && s.iterations >= body->selfContact()->settings().max_iterations) ++at_cap;
-    max_active = std::max(max_active, s.active);
-    worst_end = std::max(worst_end, s.max_end_penetration);
-    searches += s.searches;
+    if (k == save_at) {
+      std::vector<HandCheckpoint> hand_checkpoints;
+      for (Hand* h : hands)
+        hand_checkpoints.push_back(h->checkpoint());
+      std::ofstream(save_file, std::ios::binary)
+          << writeCheckpoint(*scene.world, scene.world->checkpoint(), hands, hand_checkpoints, "");
+    }
+    if (body->selfContact() != nullptr) {
+      const SelfContactStats& s = body->selfContact()->stats();
+      unconverged += s.converged ? 0 : 1;
+      updates += s.iterations;
+      // Unconverged with every update used, rather than stopped early by the safeguard.
+      if (!s.converged && s.iterations >= max_iterations) ++at_cap;
+      max_active = std::max(max_active, s.active);
+      worst_end = std::max(worst_end, s.max_end_penetration);
+      searches += s.searches;
+      searching += s.search_seconds;
+    }
     if (check_every > 0 && k % check_every == 0 &&
         countSurfaceIntersections(tree, body->state().positions) > 0) {
       ++crossing_checks;
       if (crossing_first < 0) crossing_first = k;
     }
   }
+  const double cpu = static_cast<double>(std::clock() - cpu0) / CLOCKS_PER_SEC;
   std::printf(
       "{\"scene\": \"%s\", \"steps\": %d, \"threads\": %d, \"steps_per_s\": %.2f, "
+      "\"cpu_s_per_step\": %.4g, \"search_ms_per_step\": %.3g, \"self_contact\": %s, "
+      "\"uzawa_updates\": %ld, "
       "\"unconverged\": %d, \"unconverged_at_max_iterations\": %d, \"max_active\": %d, "
       "\"worst_end_penetration_m\": %.3g, "
       "\"gap_tolerance_m\": %.3g, \"searches\": %d, \"crossing_checks\": %d, "
       "\"first_crossing_step\": %d}\n",
-      scene.spec.name.c_str(), steps, threads, steps / stepping, unconverged, at_cap, max_active,
-      worst_end, body->selfContact()->gapTolerance(), searches, crossing_checks, crossing_first);
+      scene.spec.name.c_str(), steps, threads, steps / stepping, cpu / steps,
+      1e3 * searching / steps, self_contact ? "true" : "false", updates, unconverged, at_cap,
+      max_active, worst_end, gap_tolerance, searches, crossing_checks, crossing_first);
   return 0;
 }

@@ -84,6 +84,7 @@ void SurfaceContactSet::add(SurfaceContact contact) {
 
 void SurfaceContactSet::setPenalties(const std::vector<Eigen::Matrix3d>& diagonal_blocks,
                                      double penalty_factor) {
+  penalty_factor_ = penalty_factor;
   for (SurfaceContact& c : contacts_) {
     double inverse_mass = 0;
     for (size_t k = 0; k < 4; ++k) {
@@ -130,6 +131,12 @@ void SurfaceContactSet::addDiagonalBlocks(std::vector<Eigen::Matrix3d>& blocks) 
   }
 }
 
+bool SurfaceContactSet::beyondTolerance(const SurfaceContact& c, double impulse, double dt,
+                                        double gap_tolerance) const {
+  // The contact's effective mass is its penalty over penalty_factor (setPenalties).
+  return dt * impulse * penalty_factor_ > gap_tolerance * c.penalty;
+}
+
 bool SurfaceContactSet::update(const Eigen::VectorXd& v, double dt, double activation_tolerance,
                                double gap_tolerance) {
   using State = SurfaceContact::State;
@@ -154,7 +161,8 @@ bool SurfaceContactSet::update(const Eigen::VectorXd& v, double dt, double activ
     if (ln <= 0) {
       if (c.state != State::kInactive) {
         ++c.releases;
-        converged = false;
+        // The solve pulled with -ln: within the tolerance when that moved it less than it.
+        if (!within_tolerance_ || beyondTolerance(c, -ln, dt, gap_tolerance)) converged = false;
       }
       c.state = State::kInactive;
       c.multiplier.setZero();
@@ -165,6 +173,7 @@ bool SurfaceContactSet::update(const Eigen::VectorXd& v, double dt, double activ
     const double speed = slip.norm();
     const double bound = c.friction * ln;
     const bool may_switch = c.switches < kMaxSwitches;
+    double outside_cone = 0;  // N s, the part of the solve's friction impulse beyond Coulomb's
     // k_t Coulomb's friction asks for at this slip, at most the penalty (then it sticks).
     const double wanted = speed * c.penalty <= bound ? c.penalty : bound / speed;
     if (c.friction <= 0) {
@@ -178,6 +187,7 @@ bool SurfaceContactSet::update(const Eigen::VectorXd& v, double dt, double activ
         if (trial.norm() > bound) trial *= bound / trial.norm();
         c.multiplier = c.normal * ln + trial;
       } else {
+        outside_cone = trial.norm() - bound;
         c.state = State::kSlide;
         c.tangential_stiffness = wanted;
         c.multiplier = c.normal * ln - wanted * slip;
@@ -200,12 +210,21 @@ bool SurfaceContactSet::update(const Eigen::VectorXd& v, double dt, double activ
     }
     if (!c.multiplier.allFinite()) c.multiplier = c.normal * ln;
     if (old_state != State::kInactive && c.state != old_state) ++c.switches;
-    if (c.state != old_state || std::abs(c.end_gap) > gap_tolerance) converged = false;
-    if (c.state == State::kStick && dt * speed > gap_tolerance) converged = false;
-    // Sliding friction settled: its impulse moved by less than 2 % of mu lambda_n.
-    if (c.state == State::kSlide && c.friction > 0 &&
-        std::abs(c.tangential_stiffness - old_stiffness) * speed > 2e-2 * bound)
+    // Judged within the tolerance, a switch counts through the impulse it corrects and an
+    // activation through its end gap.
+    if (within_tolerance_ ? beyondTolerance(c, outside_cone, dt, gap_tolerance)
+                          : c.state != old_state)
       converged = false;
+    if (std::abs(c.end_gap) > gap_tolerance) converged = false;
+    if (c.state == State::kStick && dt * speed > gap_tolerance) converged = false;
+    // Sliding friction settled: its impulse moved by less than 2 % of mu lambda_n (or, judged
+    // within the tolerance, by less than moves the contact by it).
+    if (c.state == State::kSlide && c.friction > 0) {
+      const double moved = std::abs(c.tangential_stiffness - old_stiffness) * speed;
+      if (moved > 2e-2 * bound &&
+          !(within_tolerance_ && !beyondTolerance(c, moved, dt, gap_tolerance)))
+        converged = false;
+    }
   }
   return converged;
 }

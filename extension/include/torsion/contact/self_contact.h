@@ -54,8 +54,11 @@ struct SelfContactSettings {
   /// A node this fraction of the triangle's shortest edge behind it is on the far side of the
   /// body, not through the surface: no candidate (see docs/contact.md for why 0.25).
   double max_depth = 0.25;
-  /// rho in units of the contact's effective mass (surface_contact_set.h).
-  double penalty_factor = 20;
+  /// rho in units of the contact's effective mass (surface_contact_set.h). Stiffer converges the
+  /// normal gap in fewer updates but each CG solve takes longer and friction settles worse: on
+  /// six steps of the plectoneme's contact phase 8 took half the CPU time of 20 (60: a quarter
+  /// more than 20); 2 left steps unconverged (docs/contact.md).
+  double penalty_factor = 8;
   /// Uzawa updates (each one warm-started CG solve) per step.
   int max_iterations = 40;
 
@@ -68,6 +71,7 @@ struct SelfContactStats {
   int sticking = 0;    ///< of which sticking
   int iterations = 0;  ///< Uzawa updates (CG solves) this step
   int searches = 0;    ///< tree searches this step: 1, plus the re-searches along the solved motion
+  double search_seconds = 0;  ///< s, wall time of those searches (refit, queries, candidates)
   bool converged = true;
   double normal_impulse = 0;       ///< N s, sum over active contacts
   double max_penetration = 0;      ///< m, deepest candidate node behind its triangle at the start

@@ -104,6 +104,16 @@ class SurfaceContactSet final : public AddedOperatorTerm {
   /// every sliding contact's friction impulse within 2 % of mu lambda_n of the last solve's.
   bool update(const Eigen::VectorXd& v, double dt, double activation_tolerance,
               double gap_tolerance);
+  /// Whether update() judges convergence by what the last solve's motion is off by, rather than
+  /// by the states settling: the solve's impulse minus the one Uzawa's projection gives (a pull
+  /// that releases a contact, friction beyond Coulomb's cone that makes it slide, a sliding
+  /// friction impulse that changes), over the contact's effective mass (its penalty over
+  /// penalty_factor), times dt, must be at most gap_tolerance: the same geometric accuracy as
+  /// the end gaps and a sticking contact's slip. A state change alone (an activation within the
+  /// tolerance, a switch with a negligible impulse) then no longer keeps the loop going, nor
+  /// does a sliding impulse still moving by more than 2 % of mu lambda_n with no effect on the
+  /// motion. Off by default (the changes of state count).
+  void setConvergedWithinTolerance(bool on) { within_tolerance_ = on; }
   /// m, the deepest linearised end-of-step penetration of any candidate (>= 0).
   double maxEndPenetration() const;
   /// m, the largest gap error after the last update: penetration of any candidate, or an active
@@ -139,12 +149,17 @@ class SurfaceContactSet final : public AddedOperatorTerm {
     return !suspended_ && !c.determined && c.state != SurfaceContact::State::kInactive;
   }
   Eigen::Vector3d relativeVelocity(const SurfaceContact& c, const Eigen::VectorXd& v) const;
+  // Whether `impulse` (N s) on c moves it by more than gap_tolerance over the step.
+  bool beyondTolerance(const SurfaceContact& c, double impulse, double dt,
+                       double gap_tolerance) const;
 
   std::vector<SurfaceContact> contacts_;
   WarmStarts warm_;  // the last step's, looked up by add()
   bool suspended_ = false;
   double friction_relaxation_ = 1;
-  bool restored_ = false;  // warm_ was set by setWarmStarts: beginStep keeps it
+  bool within_tolerance_ = false;
+  double penalty_factor_ = 1;  // the last setPenalties' (rho over the effective mass)
+  bool restored_ = false;      // warm_ was set by setWarmStarts: beginStep keeps it
 };
 
 }  // namespace torsion
