@@ -18,6 +18,7 @@
 #include <numeric>
 
 #include "torsion/mesh/mesh_io.h"
+#include "torsion/mesh/node_ordering.h"
 #include "twist_protocol.h"
 
 #ifndef TORSION_ASSETS_DIR
@@ -117,6 +118,12 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   app.add_option("--label", label, "free text copied into the JSON");
   app.add_option("--dump-positions", dump_path, "write final positions (x y z per line) here");
+  std::string node_order = "file";
+  app.add_option("--node-order", node_order,
+                 "file (the mesh file's numbering) | rcm (renumbered by reverse Cuthill-McKee, as "
+                 "`torsion mesh` writes new meshes; the twist's node sets are chosen by position)")
+      ->check(CLI::IsMember({"file", "rcm"}))
+      ->capture_default_str();
   CLI11_PARSE(app, argc, argv);
 
   const std::filesystem::path mesh_path = resolveMesh(mesh_name);
@@ -125,7 +132,9 @@ int main(int argc, char** argv) {
     std::cerr << "bench_twist: " << loaded.error().message << "\n";
     return 2;
   }
-  auto mesh = std::make_shared<const torsion::TetMesh>(std::move(loaded.value().mesh));
+  auto mesh = std::make_shared<const torsion::TetMesh>(
+      node_order == "rcm" ? torsion::inCacheFriendlyOrder(loaded.value().mesh)
+                          : std::move(loaded.value().mesh));
 
   TwistResult result;
   double reported_tolerance = tolerance;
@@ -171,6 +180,7 @@ int main(int argc, char** argv) {
   j["label"] = label;
   j["detail"] = result.solver_detail;
   j["mesh"] = mesh_path.filename().string();
+  j["node_order"] = node_order;
   j["nodes"] = mesh->nodeCount();
   j["tets"] = mesh->tetCount();
   j["element"] = solver.rfind("torsion", 0) == 0 ? element : std::string("tet4");

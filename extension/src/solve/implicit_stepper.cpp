@@ -53,9 +53,12 @@ double ImplicitStepper::computeElasticForces(FemState& state) {
   const double mu = model_->material().mu();
   const double lambda = model_->material().lambda();
   const std::vector<int>& nodes = model_->elementNodes();
-  std::vector<Eigen::Matrix3d>& rotations = system_.mutableRotations();
   double nodal_energy = 0;
   if (model_->elementKind() == ElementKind::kTet4) {
+    // The force pass also writes the rotated gradients K is assembled from (one pass over the
+    // tets instead of two).
+    const SystemOperator::RotationOutputs outputs = system_.mutableRotationsAndGradients();
+    std::vector<Eigen::Matrix3d>& rotations = outputs.rotations;
     // Nodal pressure (fem/nodal_pressure.h): the tets carry the deviatoric stress (lambda ->
     // -2 mu / 3) and report their volumetric strain; the pressure comes from the node averages.
     const bool nodal_pressure = model_->nodalPressure();
@@ -64,6 +67,7 @@ double ImplicitStepper::computeElasticForces(FemState& state) {
     // Four tets at a time in the operator's kernel build (system_operator_kernels.h); the tets it
     // flags (det F <= 0) go through the SVD path here.
     static_assert(sizeof(TetRestData) == 10 * sizeof(double), "Bm then V, no padding");
+    static_assert(sizeof(Eigen::Vector3d) == 3 * sizeof(double), "12 doubles per tet");
     system_kernels::Tet4ForceInput in;
     in.positions = state.positions.data();
     in.nodes = nodes.data();
@@ -75,6 +79,7 @@ double ImplicitStepper::computeElasticForces(FemState& state) {
     in.forces = element_forces_.data()->data();
     in.energy = element_energy_.data();
     in.volumetric_strain = nodal_pressure ? tet_strain_.data() : nullptr;
+    in.rotated_gradients = outputs.rotated_gradients.data()->data();
     needs_svd_.resize(static_cast<size_t>(model_->elementCount()));
     in.needs_svd = needs_svd_.data();
     parallel_.forRange(model_->elementCount(), kTetGrain, [&](int begin, int end) {
@@ -93,11 +98,13 @@ double ImplicitStepper::computeElasticForces(FemState& state) {
         std::copy(response.forces.begin(), response.forces.end(), element_forces_.begin() + 4 * t);
         element_energy_[ti] = response.energy;
         if (nodal_pressure) tet_strain_[ti] = (rotations[ti].transpose() * F).trace() - 3.0;
+        system_.rotateGradients(t);
       }
     });
     if (nodal_pressure) nodal_energy = addNodalPressureForces();
   } else {
     // One rotation per element, from its mean deformation gradient (quadratic_element.h).
+    std::vector<Eigen::Matrix3d>& rotations = system_.mutableRotations();
     parallel_.forRange(model_->elementCount(), kTetGrain / 4, [&](int begin, int end) {
       for (int e = begin; e < end; ++e) {
         const size_t ei = static_cast<size_t>(e);

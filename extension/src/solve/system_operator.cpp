@@ -196,12 +196,15 @@ void SystemOperator::assemble() const {
   // With nodal pressure the blocks hold the deviatoric part only (nodal_pressure.h): the same
   // formula with lambda replaced by -2 mu / 3; the volumetric part is applied in factored form.
   const double lambda = model_->nodalPressure() ? -2.0 * mu / 3.0 : model_->material().lambda();
-  // Pass 1, per element: the four rotated gradients.
-  parallel_.forRange(model_->elementCount(), kTetGrain, [&](int begin, int end) {
-    for (size_t e = static_cast<size_t>(begin); e < static_cast<size_t>(end); ++e)
-      for (size_t c = 0; c < 4; ++c)
-        rotated_gradients_[4 * e + c].noalias() = rotations_[e] * rest_gradients_[4 * e + c];
-  });
+  // Pass 1, per element: the four rotated gradients (unless the force pass wrote them).
+  if (!gradients_current_) {
+    parallel_.forRange(model_->elementCount(), kTetGrain, [&](int begin, int end) {
+      for (size_t e = static_cast<size_t>(begin); e < static_cast<size_t>(end); ++e)
+        for (size_t c = 0; c < 4; ++c)
+          rotated_gradients_[4 * e + c].noalias() = rotations_[e] * rest_gradients_[4 * e + c];
+    });
+    gradients_current_ = true;
+  }
   // Pass 2, per block row: tet4 K_ab = V (mu (g_a . g_b) I + mu (R g_b)(R g_a)^T +
   // lambda (R g_a)(R g_b)^T) for every element of the row's node a (the rest-frame block rotated,
   // R Ke_ab R^T); tet10 the same integrated over the element (buildTet10Terms()).
@@ -226,6 +229,12 @@ void SystemOperator::assemble() const {
     }
   });
   assembled_ = true;
+}
+
+void SystemOperator::rotateGradients(int element) {
+  const size_t e = static_cast<size_t>(element);
+  for (size_t c = 0; c < 4; ++c)
+    rotated_gradients_[4 * e + c].noalias() = rotations_[e] * rest_gradients_[4 * e + c];
 }
 
 void SystemOperator::setCoefficients(double mass_coefficient, double stiffness_coefficient) {
@@ -312,6 +321,48 @@ void SystemOperator::gather(const std::vector<Eigen::Vector3d>& element_values, 
 void SystemOperator::multiply(const Eigen::VectorXd& y, Eigen::VectorXd& out) const {
   apply(y, out, mass_coefficient_, stiffness_coefficient_);
   if (added_term_ != nullptr) added_term_->addProduct(y, out);
+}
+
+void SystemOperator::multiplyFromNodes(const Eigen::VectorXd& y, const std::vector<int>& nodes,
+                                       Eigen::VectorXd& out) const {
+  if (model_->nodalPressure() || added_term_ != nullptr) {
+    multiply(y, out);  // both couple rows beyond the block pattern
+    return;
+  }
+  assemble();
+  // A row with no coupled node in `nodes` sums +0 products only: +0, as in the full product.
+  out.setZero(y.size());
+  const int n = model_->nodeCount();
+  row_marks_.resize(static_cast<size_t>(n), 0);
+  std::vector<int> rows;
+  auto mark = [&](int row) {
+    if (row_marks_[static_cast<size_t>(row)] != 0) return;
+    row_marks_[static_cast<size_t>(row)] = 1;
+    rows.push_back(row);
+  };
+  for (int node : nodes) {
+    const size_t r = static_cast<size_t>(node);
+    for (int s = row_offsets_[r]; s < row_offsets_[r + 1]; ++s)  // includes the node itself
+      mark(block_columns_[static_cast<size_t>(s)]);
+    for (int l = lower_offsets_[r]; l < lower_offsets_[r + 1]; ++l)
+      mark(lower_columns_[static_cast<size_t>(l)]);
+  }
+  system_kernels::ProductInput in;
+  in.row_offsets = row_offsets_.data();
+  in.columns = block_columns_.data();
+  in.blocks = block_values_.data()->data();
+  in.lower_offsets = lower_offsets_.data();
+  in.lower_slots = lower_slots_.data();
+  in.lower_columns = lower_columns_.data();
+  in.mass = model_->nodeMasses().data();
+  in.y = y.data();
+  in.out = out.data();
+  in.mass_scale = mass_coefficient_;
+  in.stiffness_scale = stiffness_coefficient_;
+  for (int row : rows) {
+    kernels_->block_product(in, row, row + 1);  // the same kernel, row by row: the same bits
+    row_marks_[static_cast<size_t>(row)] = 0;
+  }
 }
 
 void SystemOperator::multiplyStiffness(const Eigen::VectorXd& y, Eigen::VectorXd& out) const {

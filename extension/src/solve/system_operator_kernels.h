@@ -70,7 +70,13 @@ struct Tet4ForceInput {
   double* forces = nullptr;             ///< out: 12 per tet, N
   double* energy = nullptr;             ///< out: per tet, J
   double* volumetric_strain = nullptr;  ///< out if not null: tr(R^T F) - 3 per tet
-  unsigned char* needs_svd = nullptr;   ///< out: per tet
+  /// out if not null: R g_a for the tet's four shape gradients g_a (g_1..3 the rows of Bm, g_0
+  /// minus their sum), 12 per tet: what the assembly of K reads (AssemblyInput::rotated), written
+  /// here while R is at hand instead of by a second pass over the tets. Bit for bit what
+  /// SystemOperator's own pass computes (Eigen's 3x3 product: rows 0 and 1 summed left to right,
+  /// row 2 as p0 + (p1 + p2)).
+  double* rotated_gradients = nullptr;
+  unsigned char* needs_svd = nullptr;  ///< out: per tet
 };
 
 struct KernelTable {

@@ -68,6 +68,7 @@ class ProjectedCg {
   std::unique_ptr<TwoLevelPreconditioner> two_level_;
   std::vector<Eigen::Matrix3d> block_inverse_;
   Eigen::VectorXd r_, q_, prescribed_only_;
+  std::vector<int> constrained_nodes_;  // the reference residual's nonzero nodes
   PcgScratch scratch_;
 };
 

@@ -49,8 +49,26 @@ class SystemOperator {
   const std::vector<Eigen::Matrix3d>& rotations() const { return rotations_; }
   std::vector<Eigen::Matrix3d>& mutableRotations() {
     assembled_ = false;
+    gradients_current_ = false;
     return rotations_;
   }
+  /// For a pass that computes the rotations itself (the tet4 force pass of ImplicitStepper) and
+  /// can write the rotated gradients the assembly reads in the same pass: the rotations and the
+  /// rotated gradients, 4 per element (index 4 e + a), rotated_gradients[4 e + a] = R_e g_a with
+  /// g_a the element's rest gradients (tet4: the shape gradients, g_0 = -(sum of Bm's rows)).
+  /// Marks K stale; the assembly then skips its own pass over the elements. The caller fills
+  /// both for every element before the next product (rotateGradients() does one element).
+  struct RotationOutputs {
+    std::vector<Eigen::Matrix3d>& rotations;
+    std::vector<Eigen::Vector3d>& rotated_gradients;
+  };
+  RotationOutputs mutableRotationsAndGradients() {
+    assembled_ = false;
+    gradients_current_ = true;
+    return {rotations_, rotated_gradients_};
+  }
+  /// rotated_gradients[4 e + a] = rotations()[e] g_a for one element e.
+  void rotateGradients(int element);
   /// The system coefficients: A = mass_coefficient M + stiffness_coefficient K.
   void setCoefficients(double mass_coefficient, double stiffness_coefficient);
 
@@ -61,6 +79,12 @@ class SystemOperator {
 
   /// out = A y (plus the added term, if any).
   void multiply(const Eigen::VectorXd& y, Eigen::VectorXd& out) const;
+  /// out = A y for a y that is zero outside `nodes`: only the block rows coupled to those nodes
+  /// are multiplied, the others are zero; bit for bit what multiply() gives (with nodal pressure
+  /// or an added term it is multiply()). The projected CG's reference residual, where y holds
+  /// the prescribed velocities alone, costs a few rows instead of a product.
+  void multiplyFromNodes(const Eigen::VectorXd& y, const std::vector<int>& nodes,
+                         Eigen::VectorXd& out) const;
   /// out = K y.
   void multiplyStiffness(const Eigen::VectorXd& y, Eigen::VectorXd& out) const;
   /// out_i = scale * sum of the per-element values of node i (element_values[N e + a] belongs to
@@ -162,12 +186,16 @@ class SystemOperator {
   std::vector<system_kernels::BlockTerm> terms_;
   const system_kernels::KernelTable* kernels_ = nullptr;
   mutable bool assembled_ = false;
+  // The rotated gradients match rotations_ (the assembly's first pass is not needed).
+  mutable bool gradients_current_ = false;
   // tet4 node patches (for the nodal-pressure diagonal): row n's patch, the nodes of its tets
   // sorted, is patch_nodes_[patch_offsets_[n] ..]; patch_slots_[4 k + b] is where local node b of
   // node entry k's tet sits in its row's patch.
   std::vector<int> patch_offsets_, patch_nodes_, patch_slots_;
   // Nodal pressure scratch: per tet and per node scalars of one product.
   mutable std::vector<double> tet_scalars_, node_scalars_;
+  // multiplyFromNodes() scratch: 1 for the rows it multiplies (all 0 between calls).
+  mutable std::vector<unsigned char> row_marks_;
 };
 
 }  // namespace torsion
