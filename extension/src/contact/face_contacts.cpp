@@ -313,11 +313,19 @@ bool FaceContactSet::update(const Eigen::VectorXd& v, const std::vector<RigidPar
       // micrometre, releasing it the next solve, and the nodes' friction following each time,
       // was most of the active-set iterations of rigid_mix.
       if (end_gap < -std::max(activation_tolerance, gap_tolerance)) {
-        // Starts stuck, even under a body sliding over it: starting slipping faces sliding (as
-        // slipping nodes the body sweeps over do, rigid_contact.cpp) brings a box sliding over a
-        // soft slab to Coulomb's distance within 27 % instead of 71 %, but made rigid_mix's
-        // twisting rod blow up (docs/contact.md, "Sliding over nodes", open).
-        c.state = c.friction > 0 ? FaceContact::State::kStick : FaceContact::State::kSlide;
+        // A face that a body sliding over the surface (RigidPartner::sliding) slips over by more
+        // than the gap tolerance this step starts sliding, as node contacts do
+        // (rigid_contact_active_set.cpp); its friction follows from the next update. Started
+        // stuck, its penalty glued a box sliding over a soft slab to each new triangle for a
+        // solve, the face then pulled, was released and added again, and the loop cycled to its
+        // cap on those two sets, ending the step on a glued solve (docs/contact.md, "Sliding over
+        // nodes"). Other faces start stuck: a landing or resting body's (Poisson's slips).
+        const Eigen::Vector3d slip = h - c.normal * c.normal.dot(h);
+        const bool slipping =
+            partners[static_cast<size_t>(c.partner)].sliding &&
+            dt * slip.norm() > std::max(activation_tolerance, gap_tolerance);
+        c.state =
+            c.friction > 0 && !slipping ? FaceContact::State::kStick : FaceContact::State::kSlide;
         c.multiplier.setZero();
         again = true;
       }

@@ -282,8 +282,16 @@ void RigidContactSolver::warmStartActiveSet() {
       }
     }
   }
+  // Face contacts carried over (FaceContactSet::detect) count as the nodes do: under a box on a
+  // soft slab whole steps pass with only face contacts active, and counting nodes alone took the
+  // box for not sliding the step after, so new contacts started stuck and glued it.
+  for (const FaceContact& f : faces_.contacts()) {
+    if (f.friction > 0 && f.state == FaceContact::State::kSlide)
+      slid[static_cast<size_t>(f.partner)] = 1;
+    if (f.state == FaceContact::State::kStick) stuck[static_cast<size_t>(f.partner)] = 1;
+  }
   // A body all of whose carried contacts slide, none stuck, is sliding over the surface: a new
-  // contact it slips over joins the slide (updateActiveSet).
+  // contact it slips over joins the slide (updateActiveSet, FaceContactSet::update).
   for (size_t k = 0; k < partners_.size(); ++k)
     partners_[k].sliding = slid[k] && !stuck[k];
 }
