@@ -320,10 +320,13 @@ bool FaceContactSet::update(const Eigen::VectorXd& v, const std::vector<RigidPar
         // solve, the face then pulled, was released and added again, and the loop cycled to its
         // cap on those two sets, ending the step on a glued solve (docs/contact.md, "Sliding over
         // nodes"). Other faces start stuck: a landing or resting body's (Poisson's slips).
-        const Eigen::Vector3d slip = h - c.normal * c.normal.dot(h);
+        // The slip with this solve's velocities or the body's before the step (as for nodes).
+        const RigidPartner& k = partners[static_cast<size_t>(c.partner)];
+        const Eigen::Vector3d entry_h = relativeVelocity(c, v, pointVelocity(k.entry_velocity, c.lever));
+        const double slip = std::max((h - c.normal * c.normal.dot(h)).norm(),
+                                     (entry_h - c.normal * c.normal.dot(entry_h)).norm());
         const bool slipping =
-            partners[static_cast<size_t>(c.partner)].sliding &&
-            dt * slip.norm() > std::max(activation_tolerance, gap_tolerance);
+            k.sliding && dt * slip > std::max(activation_tolerance, gap_tolerance);
         c.state =
             c.friction > 0 && !slipping ? FaceContact::State::kStick : FaceContact::State::kSlide;
         c.multiplier.setZero();
@@ -354,7 +357,34 @@ bool FaceContactSet::update(const Eigen::VectorXd& v, const std::vector<RigidPar
     const double bound =
         partners[static_cast<size_t>(c.partner)].friction_share * c.friction * lambda;
     const FaceContact::State before = c.state;
-    const double applied_friction = (c.multiplier - c.normal * c.normal.dot(c.multiplier)).norm();
+    const Eigen::Vector3d applied = c.multiplier - c.normal * c.normal.dot(c.multiplier);
+    const double applied_friction = applied.norm();
+    const Eigen::Vector3d slip = h - c.normal * c.normal.dot(h);
+    if (before == FaceContact::State::kSlide && c.friction > 0 && applied_friction > 0 &&
+        slip.dot(applied) > 0) {
+      // The slip turned along the friction the solve applied: that friction was more than enough
+      // to stop it within the step (a light face under a heavy sliding body: the friction carries
+      // its nodes past the body). Projected onto the cone along the new slip, the friction would
+      // flip back and forth with each solve, and the step could end on either sign (a box
+      // sliding over a soft slab was pushed downhill, 1 deg below the friction angle it crept
+      // 3 cm in 1 s). Instead it sticks, from the applied friction within this solve's cone;
+      // past the switch budget it keeps its friction (direction and magnitude), brought within
+      // this solve's cone: a fixed friction bounded by mu lambda. (Uzawa's update along the
+      // direction, less rho times the slip along it, took the friction to zero, and the next
+      // solve back onto the cone: the same cycle.)
+      const Eigen::Vector3d d = applied / applied_friction;
+      const double magnitude = std::min(applied_friction, bound);
+      c.multiplier = c.normal * lambda + magnitude * d;
+      if (c.switches < kMaxSwitches) {
+        c.state = FaceContact::State::kStick;
+        ++c.switches;
+      } else if (applied_friction - magnitude > 1e-2 * bound &&
+                 c.friction_refinements++ < kMaxFrictionRefinements) {
+        again = true;
+      }
+      if (c.state != before || violation > gap_tolerance) again = true;
+      continue;
+    }
     if (c.friction > 0 && tangential.norm() <= bound) {
       // Within the cone: sticks, or, after kMaxSwitches slide-to-stick switches this step (they
       // can cycle: neighbouring contacts' tangential impulses are coupled through the body),

@@ -153,11 +153,28 @@ void RigidContactSolver::rememberActiveContacts() {
   // Last step's active contacts start this step active (warm active set).
   previous_active_.clear();
   previous_state_.clear();
+  std::vector<char> slid(partners_.size(), 0), stuck(partners_.size(), 0);
   for (const NodeContact& c : contacts_) {
     if (c.state != NodeContact::State::kInactive && !c.held) {
       previous_active_.emplace_back(c.node, partners_[static_cast<size_t>(c.partner)].object);
       previous_state_.push_back(c.state);
+      (c.state == NodeContact::State::kSlide ? slid : stuck)[static_cast<size_t>(c.partner)] = 1;
     }
+  }
+  for (const FaceContact& f : faces_.contacts()) {
+    if (f.state == FaceContact::State::kInactive) continue;
+    (f.state == FaceContact::State::kSlide ? slid : stuck)[static_cast<size_t>(f.partner)] = 1;
+  }
+  // A body whose contacts (node and face) all ended the last step sliding is sliding over the
+  // surface: a new contact it slips over joins the slide (updateActiveSet,
+  // FaceContactSet::update). Taken from the end of the last step, not from the contacts that
+  // survive into this one: a box sliding at 2 m/s leaves its contacts of the last step behind,
+  // and counting the survivors took it for not sliding, so its new contacts started stuck and
+  // took 1.3 m/s off it in one step. Face contacts count as nodes do: under a box on a soft slab
+  // whole steps pass with face contacts alone.
+  previous_sliding_.clear();
+  for (size_t k = 0; k < partners_.size(); ++k) {
+    if (slid[k] && !stuck[k]) previous_sliding_.push_back(partners_[k].object);
   }
 }
 
@@ -269,31 +286,18 @@ void RigidContactSolver::dropUntouchedPartners() {
 }
 
 void RigidContactSolver::warmStartActiveSet() {
-  std::vector<char> slid(partners_.size(), 0), stuck(partners_.size(), 0);
   for (NodeContact& c : contacts_) {
     if (c.held || c.anchored) continue;
     for (size_t k = 0; k < previous_active_.size(); ++k) {
       if (previous_active_[k].first == c.node &&
           previous_active_[k].second == partners_[static_cast<size_t>(c.partner)].object) {
         c.state = c.friction > 0 ? previous_state_[k] : NodeContact::State::kSlide;
-        if (c.friction > 0 && c.state == NodeContact::State::kSlide)
-          slid[static_cast<size_t>(c.partner)] = 1;
-        if (c.state == NodeContact::State::kStick) stuck[static_cast<size_t>(c.partner)] = 1;
       }
     }
   }
-  // Face contacts carried over (FaceContactSet::detect) count as the nodes do: under a box on a
-  // soft slab whole steps pass with only face contacts active, and counting nodes alone took the
-  // box for not sliding the step after, so new contacts started stuck and glued it.
-  for (const FaceContact& f : faces_.contacts()) {
-    if (f.friction > 0 && f.state == FaceContact::State::kSlide)
-      slid[static_cast<size_t>(f.partner)] = 1;
-    if (f.state == FaceContact::State::kStick) stuck[static_cast<size_t>(f.partner)] = 1;
-  }
-  // A body all of whose carried contacts slide, none stuck, is sliding over the surface: a new
-  // contact it slips over joins the slide (updateActiveSet, FaceContactSet::update).
-  for (size_t k = 0; k < partners_.size(); ++k)
-    partners_[k].sliding = slid[k] && !stuck[k];
+  for (RigidPartner& k : partners_)
+    k.sliding = std::find(previous_sliding_.begin(), previous_sliding_.end(), k.object) !=
+                previous_sliding_.end();
 }
 
 void RigidContactSolver::recordDetectionStats() {

@@ -97,6 +97,14 @@ struct NodeContact {
   double normal_impulse = 0;                          ///< N s, impulse . normal
 };
 
+/// The tangential velocity (m/s) of node velocity `node_velocity` relative to the rigid surface
+/// point of contact `c` when its body moves at `rigid_velocity`.
+inline Eigen::Vector3d tangentialSlip(const NodeContact& c, const Eigen::Vector3d& node_velocity,
+                                      const Vector6d& rigid_velocity) {
+  const Eigen::Vector3d relative = node_velocity - pointVelocity(rigid_velocity, c.lever);
+  return relative - c.normal * c.normal.dot(relative);
+}
+
 struct ContactStepStats {
   int candidates = 0;             ///< surface nodes within the detection margin
   int face_candidates = 0;        ///< surface triangles (or edges) with a face contact candidate
@@ -241,6 +249,7 @@ class RigidContactSolver {
   std::vector<int> node_contact_;  // per node: index into contacts_ (free nodes only) or -1
   std::vector<std::pair<int, const btCollisionObject*>> previous_active_;  // (node, object)
   std::vector<NodeContact::State> previous_state_;
+  std::vector<const btCollisionObject*> previous_sliding_;  // bodies sliding at the last step's end
   const NodeConstraints* base_ = nullptr;
   double dt_ = 0;
   int dynamic_count_ = 0;
