@@ -202,6 +202,19 @@ void FaceContactSet::detect(const FemState& state, const NodeConstraints& held,
   }
 }
 
+std::vector<FaceContact::State> FaceContactSet::states() const {
+  std::vector<FaceContact::State> states;
+  states.reserve(contacts_.size());
+  for (const FaceContact& c : contacts_)
+    states.push_back(c.state);
+  return states;
+}
+
+void FaceContactSet::restoreStates(const std::vector<FaceContact::State>& states) {
+  for (size_t c = 0; c < contacts_.size() && c < states.size(); ++c)
+    contacts_[c].state = states[c];
+}
+
 void FaceContactSet::setPenalties(const std::vector<Eigen::Matrix3d>& diagonal_blocks,
                                   double scale) {
   for (FaceContact& c : contacts_) {

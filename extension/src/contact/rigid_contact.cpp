@@ -72,12 +72,17 @@ LinearSolveReport RigidContactSolver::solve(const SystemOperator& op,
     recoverSolution(op, v);
     if (r.breakdown) break;
     measureFrictionShares();
+    rememberSolvedStates();
     if (!updateContactStates(v)) {
       converged_set = true;
       break;
     }
   }
   stats_.active_set_converged = converged_set;
+  // At the iteration cap the states were updated after the last solve: the impulses are those
+  // of the states that solve used (a contact released in that last update had its impulse
+  // applied, and a slide's friction was the one before the update).
+  if (!converged_set && !total.breakdown) restoreSolvedStates();
   collectImpulses();
   solveHeld(v, dt_);
   measureEndGaps(v);
@@ -117,6 +122,21 @@ bool RigidContactSolver::updateContactStates(const Eigen::VectorXd& v) {
   const bool faces_changed = faces_.update(v, partners_, dt_, settings_.activation_tolerance,
                                            settings_.face_gap_tolerance);
   return nodes_changed || faces_changed;
+}
+
+void RigidContactSolver::rememberSolvedStates() {
+  solved_states_.resize(contacts_.size());
+  for (size_t c = 0; c < contacts_.size(); ++c)
+    solved_states_[c] = {contacts_[c].state, contacts_[c].friction_impulse};
+  solved_face_states_ = faces_.states();
+}
+
+void RigidContactSolver::restoreSolvedStates() {
+  for (size_t c = 0; c < contacts_.size() && c < solved_states_.size(); ++c) {
+    contacts_[c].state = solved_states_[c].first;
+    contacts_[c].friction_impulse = solved_states_[c].second;
+  }
+  faces_.restoreStates(solved_face_states_);
 }
 
 void RigidContactSolver::collectImpulses() {

@@ -50,19 +50,36 @@ btTransform startPose(const btCollisionObject& object, double dt) {
   return start;
 }
 
-// Whether Bullet's contact manifolds hold `body` against a static or kinematic object.
+// Whether Bullet's contact manifolds hold `body` up against a static or kinematic object: a
+// contact whose push on the body opposes the body's gravity (within 60 deg; any contact when it
+// has no gravity). A kinematic plate pushing a box sideways across a soft slab does not hold it
+// up: taken as support, the box was prescribed in the solve with the step's gravity in its
+// velocity, the slab's reaction (a hundred times its weight) came back as an explicit impulse,
+// and the box was thrown off the slab.
 bool touchesStaticOrKinematic(const btRigidBody& body, btSoftBody& soft) {
   btDispatcher* dispatcher = soft.getWorldInfo()->m_dispatcher;
   if (dispatcher == nullptr) return false;
+  const Eigen::Vector3d gravity = toEigen(body.getGravity());
+  const Eigen::Vector3d up =
+      gravity.squaredNorm() > 0 ? Eigen::Vector3d(-gravity.normalized()) : Eigen::Vector3d::Zero();
   for (int m = 0; m < dispatcher->getNumManifolds(); ++m) {
     const btPersistentManifold* manifold = dispatcher->getManifoldByIndexInternal(m);
     const btCollisionObject* other = nullptr;
-    if (manifold->getBody0() == &body) other = manifold->getBody1();
-    if (manifold->getBody1() == &body) other = manifold->getBody0();
+    double side = 0;  // the push on the body is side * normalWorldOnB
+    if (manifold->getBody0() == &body) {
+      other = manifold->getBody1();
+      side = 1;
+    }
+    if (manifold->getBody1() == &body) {
+      other = manifold->getBody0();
+      side = -1;
+    }
     if (other == nullptr || !other->isStaticOrKinematicObject()) continue;
     for (int c = 0; c < manifold->getNumContacts(); ++c) {
-      if (manifold->getContactPoint(c).getDistance() <= manifold->getContactProcessingThreshold())
-        return true;
+      const btManifoldPoint& point = manifold->getContactPoint(c);
+      if (point.getDistance() > manifold->getContactProcessingThreshold()) continue;
+      const Eigen::Vector3d push = side * toEigen(point.m_normalWorldOnB);
+      if (up.squaredNorm() == 0 || push.dot(up) > 0.5) return true;
     }
   }
   return false;
