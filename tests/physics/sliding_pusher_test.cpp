@@ -7,8 +7,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdio>
-#include <cstdlib>
 #include <iostream>
 #include <memory>
 #include <vector>
@@ -25,7 +23,7 @@ constexpr double kDt = 0.01;
 constexpr double kRamp = 0.3;  ///< s, the pusher's speed ramps up over this
 
 struct PushedBox {
-  double slab_friction_n = 0;  ///< N, mean tangential force of the slab's contacts on the box
+  double slab_friction_n = 0;  ///< N, mean friction between the slab and the box, along the push
   double pusher_force_n = 0;   ///< N, mean normal force of Bullet's pusher-box contact
   double box_speed = 0;        ///< m/s, mean over the measured window
   int steps_failed = 0;
@@ -80,8 +78,7 @@ PushedBox pushBox(double mu, double E, double speed, double seconds) {
   const double plate_half = 0.01;
   btTransform plate_pose;
   plate_pose.setIdentity();
-  plate_pose.setOrigin(btVector3(box_x - 0.1 - plate_half, 0,
-                                 thickness + half_height + 1e-4));
+  plate_pose.setOrigin(btVector3(box_x - 0.1 - plate_half, 0, thickness + half_height + 1e-4));
   btRigidBody* pusher = world.addRigidBody(
       std::make_unique<btBoxShape>(btVector3(plate_half, 0.12, 0.03)), 0, plate_pose);
   pusher->setCollisionFlags(pusher->getCollisionFlags() | btCollisionObject::CF_KINEMATIC_OBJECT);
@@ -102,8 +99,9 @@ PushedBox pushBox(double mu, double E, double speed, double seconds) {
       ADD_FAILURE() << "step " << k << ": " << r.message;
       break;
     }
-    if (k < settle_steps + push_steps / 2 && !std::getenv("PUSH_TRACE")) continue;
-    // The slab's friction on the box: minus the impulses the box gave the slab's nodes and faces.
+    if (k < settle_steps + push_steps / 2) continue;
+    // The slab's friction on the box, measured as its reaction: the impulses the box gave the
+    // slab's nodes and faces, along the push.
     const RigidContactSolver& contacts = slab->contacts();
     Eigen::Vector3d on_slab = Eigen::Vector3d::Zero();
     for (const NodeContact& c : contacts.contacts()) {
@@ -129,16 +127,6 @@ PushedBox pushBox(double mu, double E, double speed, double seconds) {
         pushed += static_cast<double>(manifold->getContactPoint(p).getAppliedImpulse());
     }
     out.pusher_force_n += pushed / kDt;
-    if (std::getenv("PUSH_TRACE")) {
-      int st = 0, sl = 0;
-      for (const NodeContact& c : contacts.contacts()) {
-        if (c.state == NodeContact::State::kStick) ++st;
-        if (c.state == NodeContact::State::kSlide) ++sl;
-      }
-      std::printf("PUSH %d fx %.3f fz %.3f push %.3f v %.4f nodes %d/%d it %d conv %d sup %d dyn %d sliding %d\n", k, on_slab.x() / kDt, on_slab.z() / kDt, pushed / kDt,
-                  static_cast<double>(box->getLinearVelocity().x()), st, sl, contacts.stats().active_set_iterations, contacts.stats().active_set_converged,
-                  int(contacts.partners()[0].supported), int(contacts.partners()[0].dynamic), int(contacts.partners()[0].sliding));
-    }
     out.box_speed += static_cast<double>(box->getLinearVelocity().x());
     ++measured;
   }

@@ -21,6 +21,8 @@ constexpr int kMaxStalls = 3;
 constexpr double kDuplicateMargin = 1e-3;
 constexpr int kMaxSwitches = 1;
 constexpr int kMaxFrictionRefinements = 8;
+// m/s: a sliding face carried past the body faster than this by its friction sticks at once.
+constexpr double kCarriedPastSpeed = 0.01;
 // m: round-off between the nearest pair's and a supporting plane's predicted end gaps.
 constexpr double kPlaneChoiceMargin = 1e-9;
 
@@ -335,7 +337,8 @@ bool FaceContactSet::update(const Eigen::VectorXd& v, const std::vector<RigidPar
         // nodes"). Other faces start stuck: a landing or resting body's (Poisson's slips).
         // The slip with this solve's velocities or the body's before the step (as for nodes).
         const RigidPartner& k = partners[static_cast<size_t>(c.partner)];
-        const Eigen::Vector3d entry_h = relativeVelocity(c, v, pointVelocity(k.entry_velocity, c.lever));
+        const Eigen::Vector3d entry_h =
+            relativeVelocity(c, v, pointVelocity(k.entry_velocity, c.lever));
         const double slip = std::max((h - c.normal * c.normal.dot(h)).norm(),
                                      (entry_h - c.normal * c.normal.dot(entry_h)).norm());
         const bool slipping =
@@ -373,18 +376,24 @@ bool FaceContactSet::update(const Eigen::VectorXd& v, const std::vector<RigidPar
     const Eigen::Vector3d applied = c.multiplier - c.normal * c.normal.dot(c.multiplier);
     const double applied_friction = applied.norm();
     const Eigen::Vector3d slip = h - c.normal * c.normal.dot(h);
-    if (before == FaceContact::State::kSlide && c.friction > 0 && applied_friction > 0 &&
-        slip.dot(applied) > 0) {
+    const bool overshot = before == FaceContact::State::kSlide && c.friction > 0 &&
+                          applied_friction > 0 && slip.dot(applied) > 0;
+    const bool carried_past = slip.norm() > kCarriedPastSpeed;
+    if (overshot && ((carried_past && c.switches < kMaxSwitches) ||
+                     (c.switches >= kMaxSwitches && tangential.norm() > bound))) {
       // The slip turned along the friction the solve applied: that friction was more than enough
       // to stop it within the step (a light face under a heavy sliding body: the friction carries
       // its nodes past the body). Projected onto the cone along the new slip, the friction would
       // flip back and forth with each solve, and the step could end on either sign (a box
       // sliding over a soft slab was pushed downhill, 1 deg below the friction angle it crept
-      // 3 cm in 1 s). Instead it sticks, from the applied friction within this solve's cone;
-      // past the switch budget it keeps its friction (direction and magnitude), brought within
-      // this solve's cone: a fixed friction bounded by mu lambda. (Uzawa's update along the
-      // direction, less rho times the slip along it, took the friction to zero, and the next
-      // solve back onto the cone: the same cycle.)
+      // 3 cm in 1 s). Instead, when the face was carried past the body faster than
+      // kCarriedPastSpeed, it sticks, from the applied friction within this solve's cone (for
+      // every overshoot, a box dropped onto a slope below the friction angle crept 7 mm in 1 s);
+      // past the switch budget, where Uzawa's trial would leave the cone on the other side, it
+      // keeps its friction (direction and magnitude), brought within this solve's cone: a fixed
+      // friction bounded by mu lambda. (Uzawa's update along the direction, less rho times the
+      // slip along it, took the friction to zero, and the next solve back onto the cone: the same
+      // cycle.) A trial within the cone is taken as before (below).
       const Eigen::Vector3d d = applied / applied_friction;
       const double magnitude = std::min(applied_friction, bound);
       c.multiplier = c.normal * lambda + magnitude * d;

@@ -52,15 +52,16 @@ bool RigidContactSolver::updateActiveSet(const Eigen::VectorXd& v, const Eigen::
           // (16 % too far just above the friction angle), and kept a box on a tet10 slab from
           // settling; starting them sliding under a body with some contact stuck let a box
           // below the friction angle creep (7 mm in 1 s).
-          // The slip with this solve's velocities, or with the body's velocity before the step:
-          // within a solve that other contacts glued (the loop's iterate), a node the body is
-          // sliding over may seem to move with it.
-          const double slipped =
-              dt * std::max(tangentialSlip(c, vi, k.velocity).norm(),
-                            tangentialSlip(c, vi, k.entry_velocity).norm());
-          const bool slipping = (c.swept && slipped > settings_.activation_tolerance) ||
-                                (k.sliding && slipped > std::max(settings_.activation_tolerance,
-                                                                 settings_.face_gap_tolerance));
+          // Under a sliding body, the slip with this solve's velocities or with the body's
+          // velocity before the step: within a solve that other contacts glued (the loop's
+          // iterate), a node the body is sliding over may seem to move with it.
+          const double slipped = dt * tangentialSlip(c, vi, k.velocity).norm();
+          const double slipped_under_slider =
+              std::max(slipped, dt * tangentialSlip(c, vi, k.entry_velocity).norm());
+          const bool slipping =
+              (c.swept && slipped > settings_.activation_tolerance) ||
+              (k.sliding && slipped_under_slider > std::max(settings_.activation_tolerance,
+                                                            settings_.face_gap_tolerance));
           c.state =
               c.friction > 0 && !slipping ? NodeContact::State::kStick : NodeContact::State::kSlide;
           c.friction_impulse.setZero();

@@ -182,13 +182,12 @@ void RigidContactSolver::rememberActiveContacts() {
     if (f.state == FaceContact::State::kInactive) continue;
     (f.state == FaceContact::State::kSlide ? slid : stuck)[static_cast<size_t>(f.partner)] = 1;
   }
-  // A body whose contacts (node and face) all ended the last step sliding is sliding over the
-  // surface: a new contact it slips over joins the slide (updateActiveSet,
-  // FaceContactSet::update). Taken from the end of the last step, not from the contacts that
-  // survive into this one: a box sliding at 2 m/s leaves its contacts of the last step behind,
-  // and counting the survivors took it for not sliding, so its new contacts started stuck and
-  // took 1.3 m/s off it in one step. Face contacts count as nodes do: under a box on a soft slab
-  // whole steps pass with face contacts alone.
+  // A body whose contacts (node and face) all ended the last step sliding may be sliding over the
+  // surface (RigidContactSolver::detect decides by its speed). Taken from the end of the last step,
+  // not from the contacts that survive into this one: a box sliding at 2 m/s leaves its contacts of
+  // the last step behind, and counting the survivors took it for not sliding, so its new
+  // contacts started stuck and took 1.3 m/s off it in one step. Face contacts count as nodes do:
+  // under a box on a soft slab whole steps pass with face contacts alone.
   previous_sliding_.clear();
   for (size_t k = 0; k < partners_.size(); ++k) {
     if (slid[k] && !stuck[k]) previous_sliding_.push_back(partners_[k].object);
