@@ -10,7 +10,9 @@
 #include <cmath>
 #include <iostream>
 #include <memory>
+#include <string>
 #include <utility>
+#include <vector>
 
 #include "torsion/bt_conversions.h"
 #include "torsion/bullet/fem_world.h"
@@ -21,6 +23,9 @@ namespace torsion::test {
 namespace {
 
 constexpr double kGravity = 9.81;
+constexpr double kSettleSeconds = 0.2;  ///< s on the slab before the slope's pull starts
+// Slopes (deg) and friction coefficients of the table: 0.30 to 1.18 m in 1 s, on the slab.
+constexpr std::pair<double, double> kSlopes[] = {{20, 0.3}, {20, 0.2}, {25, 0.3}, {25, 0.2}};
 
 struct Slope {
   double degrees = 20;
@@ -28,6 +33,9 @@ struct Slope {
   double youngs_modulus = 1e5;  ///< Pa
   int cells_along = 20;         ///< along the 2 m slope: node rows 2 / cells_along apart
   ElementKind element = ElementKind::kTet4;
+  /// The box settles on the slab under the slope's normal gravity before the pull along the slope
+  /// starts (t = 0 at rest, as Coulomb's distance assumes); else it is dropped onto the slope.
+  bool settle = true;
 };
 
 double coulombDistance(const Slope& s, double t) {
@@ -35,9 +43,10 @@ double coulombDistance(const Slope& s, double t) {
   return std::max(0.0, 0.5 * kGravity * (std::sin(a) - s.mu * std::cos(a)) * t * t);
 }
 
-// Distance (m) the box's centre moves down the slope in `seconds`. The slab is 2 x 0.6 x 0.1 m;
-// the box 0.2 x 0.3 x 0.1 m, 2 kg, starts 0.1 mm above it with its edges on node rows (across the
-// slope, rows are 0.1 m apart and the box's sides lie between them).
+// Distance (m) the box's centre moves down the slope in `seconds` from rest. The slab is
+// 2 x 0.6 x 0.1 m; the box 0.2 x 0.3 x 0.1 m, 2 kg, dropped from 0.1 mm above it with its edges on
+// node rows (across the slope, rows are 0.1 m apart and the box's sides lie between them), settles
+// for kSettleSeconds first.
 double slideDistance(const Slope& s, double seconds) {
   const double a = s.degrees * M_PI / 180;
   WorldSettings settings;
@@ -45,7 +54,13 @@ double slideDistance(const Slope& s, double seconds) {
   settings.solver.threads = 1;
   settings.solver.tolerance = 1e-6;
   settings.solver.max_iterations = 1000;
-  settings.gravity = kGravity * Eigen::Vector3d(std::sin(a), 0, -std::cos(a));
+  // The box first settles under the slope's normal gravity alone; the slope's pull along it starts
+  // at t = 0, with the box at rest on the slab, as Coulomb's distance assumes. (Dropped 0.1 mm
+  // onto the slope instead, it falls freely along it for 5 ms, and the landing's friction takes
+  // only part of that speed back: 0.02 m/s more at the end, +8 % of the distance at 20 deg with
+  // mu = 0.3.)
+  const Eigen::Vector3d slope_gravity = kGravity * Eigen::Vector3d(std::sin(a), 0, -std::cos(a));
+  settings.gravity = s.settle ? Eigen::Vector3d(0, 0, slope_gravity.z()) : slope_gravity;
   FemWorld world(settings);
   Material m;
   m.youngs_modulus = s.youngs_modulus;
@@ -71,13 +86,22 @@ double slideDistance(const Slope& s, double seconds) {
   }
   slab->carryNodes(
       "base", base, [](double) { return Frame{}; }, 0.0);
-  const double half_height = 0.05, x0 = -0.6;
+  const double half_height = 0.05, start_x = -0.6;
   btTransform start;
   start.setIdentity();
-  start.setOrigin(btVector3(x0, 0, thickness + half_height + 1e-4));
+  start.setOrigin(btVector3(start_x, 0, thickness + half_height + 1e-4));
   btRigidBody* box = world.addRigidBody(
       std::make_unique<btBoxShape>(btVector3(0.1, 0.15, half_height)), 2.0, start);
   box->setFriction(s.mu);
+  const int settle_steps =
+      s.settle ? static_cast<int>(std::lround(kSettleSeconds / settings.solver.time_step)) : 0;
+  for (int k = 0; k < settle_steps; ++k) {
+    const WorldStepReport r = world.step();
+    EXPECT_TRUE(r.ok) << "settling step " << k << ": " << r.message;
+    if (!r.ok) return std::nan("");
+  }
+  world.bulletWorld().setGravity(toBt(slope_gravity));
+  const double x0 = static_cast<double>(box->getCenterOfMassPosition().x());
   const int steps = static_cast<int>(std::lround(seconds / settings.solver.time_step));
   for (int k = 0; k < steps; ++k) {
     const WorldStepReport r = world.step();
@@ -136,13 +160,11 @@ TEST(Sliding, FrictionlessBoxSlidesOverACoarseTet10Slab) {
 }
 
 // With friction, on a stiff slab, the box feels Coulomb's friction of its net normal force. Before
-// the fix it moved 66 % of Coulomb's distance at 20 deg with mu = 0.3: face contacts at its edges
-// ended steps stuck beyond Coulomb's cone or pulling, and a face and the node contacts at its
+// the fixes it moved 66 % of Coulomb's distance at 20 deg with mu = 0.3: face contacts at its
+// edges ended steps stuck beyond Coulomb's cone or pulling, and a face and the node contacts at its
 // corners split the load as a push and a pull whose push alone bounded the friction
 // (docs/contact.md, "Sliding over nodes"). The distance magnifies a friction error by
-// mu cos a / (sin a - mu cos a): 4.5 at 20 deg with mu = 0.3. Steeper slopes and mu = 0.1 at
-// 20 deg are still short, and on a soft slab the box moves 31 % of Coulomb's distance
-// (docs/validation.md, open); those are not asserted.
+// mu cos a / (sin a - mu cos a): 4.5 at 20 deg with mu = 0.3.
 TEST(Sliding, BoxWithFrictionSlidesAsCoulombSaysOnAStiffSlab) {
   const std::pair<double, double> cases[] = {{10, 0.1}, {20, 0.3}};
   for (const auto& [degrees, mu] : cases) {
@@ -156,9 +178,12 @@ TEST(Sliding, BoxWithFrictionSlidesAsCoulombSaysOnAStiffSlab) {
 
 // The stick/slip threshold tan(a) = mu (16.7 deg for mu = 0.3), on a stiff slab: 1 deg below the
 // box stays (creep within 2 mm in 1 s), 1 deg above it slides as Coulomb says (8.9 cm in 1 s).
+// The box is dropped onto the slope, as before the settled start; settled first it holds too
+// (printed), and on the soft slab it creeps (printed; docs/validation.md, open).
 TEST(Sliding, StiffSlabHoldsTheBoxBelowTheFrictionAngleAndLetsItSlideAbove) {
   Slope s;
   s.youngs_modulus = 1e8;
+  s.settle = false;
   const double friction_angle = std::atan(s.mu) * 180 / M_PI;
   s.degrees = friction_angle - 1;
   const double below = slideDistance(s, 1.0);
@@ -170,6 +195,64 @@ TEST(Sliding, StiffSlabHoldsTheBoxBelowTheFrictionAngleAndLetsItSlideAbove) {
             << " m (Coulomb " << coulomb << " m)\n";
   EXPECT_LT(std::abs(below), 2e-3);
   EXPECT_NEAR(above, coulomb, 0.15 * coulomb);
+  // Settled first, then pulled along the slope (open, printed only).
+  s.settle = true;
+  s.degrees = friction_angle - 1;
+  const double settled_below = slideDistance(s, 1.0);
+  s.youngs_modulus = 1e5;
+  const double soft_below = slideDistance(s, 1.0);
+  s.degrees = friction_angle + 1;
+  const double soft_above = slideDistance(s, 1.0);
+  std::cout << "[figures] sliding threshold, settled first (open, not asserted): stiff "
+            << friction_angle - 1 << " deg moved " << settled_below << " m; soft "
+            << friction_angle - 1 << " deg moved " << soft_below << " m, " << friction_angle + 1
+            << " deg moved " << soft_above << " m (Coulomb " << coulomb << " m)\n";
+}
+
+// Coulomb's distance whatever the slab: soft (E = 1e5 Pa) and stiff (1e8), node rows 0.2 m (the
+// box's length), 0.1 m and 0.05 m apart, tet4 and tet10, two slopes by two coefficients
+// (docs/validation.md, "Sliding over an FEM slab"). Before the sliding-body rules
+// (docs/contact.md, "Sliding over nodes") the soft slab gave -64 % at 20 deg with mu = 0.3. Two
+// kinds of case are still off and only printed (open): node rows as long as the box at 20 deg with
+// mu = 0.3 (soft +6.4 %, stiff +5.0 %), and the stiff coarse tet10 slab at 25 deg with mu = 0.2,
+// where the box, at 2 m/s, stops dead at a node row (-15 %).
+TEST(Sliding, BoxWithFrictionSlidesAsCoulombSaysOverSoftStiffCoarseFineTet4AndTet10Slabs) {
+  struct Case {
+    double degrees, mu, youngs_modulus;
+    int cells;
+    ElementKind element;
+    bool asserted;
+  };
+  std::vector<Case> cases;
+  for (double E : {1e5, 1e8}) {
+    const bool soft = E < 1e6;
+    for (const auto& [degrees, mu] : kSlopes)
+      cases.push_back({degrees, mu, E, 20, ElementKind::kTet4, true});
+    for (int cells : {10, 40}) {
+      cases.push_back({20, 0.3, E, cells, ElementKind::kTet4, cells != 10});
+      cases.push_back({25, 0.2, E, cells, ElementKind::kTet4, true});
+    }
+    cases.push_back({20, 0.3, E, 10, ElementKind::kTet10, true});
+    cases.push_back({20, 0.2, E, 10, ElementKind::kTet10, true});
+    cases.push_back({25, 0.2, E, 10, ElementKind::kTet10, soft});
+  }
+  for (const Case& c : cases) {
+    Slope s;
+    s.degrees = c.degrees;
+    s.mu = c.mu;
+    s.youngs_modulus = c.youngs_modulus;
+    s.cells_along = c.cells;
+    s.element = c.element;
+    if (c.asserted) {
+      expectCoulomb(s, 0.05, "friction_table");
+      continue;
+    }
+    const double moved = slideDistance(s, 1.0), coulomb = coulombDistance(s, 1.0);
+    std::cout << "[figures] sliding (open, not asserted): " << c.degrees << " deg, mu " << c.mu
+              << ", E " << c.youngs_modulus << ", " << c.cells << " cells, "
+              << (c.element == ElementKind::kTet10 ? "tet10" : "tet4") << ": moved " << moved
+              << " m, Coulomb " << coulomb << " m (" << 100 * (moved / coulomb - 1) << " %)\n";
+  }
 }
 
 }  // namespace

@@ -21,6 +21,8 @@ constexpr int kMaxStalls = 3;
 constexpr double kDuplicateMargin = 1e-3;
 constexpr int kMaxSwitches = 1;
 constexpr int kMaxFrictionRefinements = 8;
+// m/s: a sliding face carried past the body faster than this by its friction sticks at once.
+constexpr double kCarriedPastSpeed = 0.01;
 // m: round-off between the nearest pair's and a supporting plane's predicted end gaps.
 constexpr double kPlaneChoiceMargin = 1e-9;
 
@@ -202,6 +204,19 @@ void FaceContactSet::detect(const FemState& state, const NodeConstraints& held,
   }
 }
 
+std::vector<FaceContact::State> FaceContactSet::states() const {
+  std::vector<FaceContact::State> states;
+  states.reserve(contacts_.size());
+  for (const FaceContact& c : contacts_)
+    states.push_back(c.state);
+  return states;
+}
+
+void FaceContactSet::restoreStates(const std::vector<FaceContact::State>& states) {
+  for (size_t c = 0; c < contacts_.size() && c < states.size(); ++c)
+    contacts_[c].state = states[c];
+}
+
 void FaceContactSet::setPenalties(const std::vector<Eigen::Matrix3d>& diagonal_blocks,
                                   double scale) {
   for (FaceContact& c : contacts_) {
@@ -313,11 +328,23 @@ bool FaceContactSet::update(const Eigen::VectorXd& v, const std::vector<RigidPar
       // micrometre, releasing it the next solve, and the nodes' friction following each time,
       // was most of the active-set iterations of rigid_mix.
       if (end_gap < -std::max(activation_tolerance, gap_tolerance)) {
-        // Starts stuck, even under a body sliding over it: starting slipping faces sliding (as
-        // slipping nodes the body sweeps over do, rigid_contact.cpp) brings a box sliding over a
-        // soft slab to Coulomb's distance within 27 % instead of 71 %, but made rigid_mix's
-        // twisting rod blow up (docs/contact.md, "Sliding over nodes", open).
-        c.state = c.friction > 0 ? FaceContact::State::kStick : FaceContact::State::kSlide;
+        // A face that a body sliding over the surface (RigidPartner::sliding) slips over by more
+        // than the gap tolerance this step starts sliding, as node contacts do
+        // (rigid_contact_active_set.cpp); its friction follows from the next update. Started
+        // stuck, its penalty glued a box sliding over a soft slab to each new triangle for a
+        // solve, the face then pulled, was released and added again, and the loop cycled to its
+        // cap on those two sets, ending the step on a glued solve (docs/contact.md, "Sliding over
+        // nodes"). Other faces start stuck: a landing or resting body's (Poisson's slips).
+        // The slip with this solve's velocities or the body's before the step (as for nodes).
+        const RigidPartner& k = partners[static_cast<size_t>(c.partner)];
+        const Eigen::Vector3d entry_h =
+            relativeVelocity(c, v, pointVelocity(k.entry_velocity, c.lever));
+        const double slip = std::max((h - c.normal * c.normal.dot(h)).norm(),
+                                     (entry_h - c.normal * c.normal.dot(entry_h)).norm());
+        const bool slipping =
+            k.sliding && dt * slip > std::max(activation_tolerance, gap_tolerance);
+        c.state =
+            c.friction > 0 && !slipping ? FaceContact::State::kStick : FaceContact::State::kSlide;
         c.multiplier.setZero();
         again = true;
       }
@@ -346,7 +373,40 @@ bool FaceContactSet::update(const Eigen::VectorXd& v, const std::vector<RigidPar
     const double bound =
         partners[static_cast<size_t>(c.partner)].friction_share * c.friction * lambda;
     const FaceContact::State before = c.state;
-    const double applied_friction = (c.multiplier - c.normal * c.normal.dot(c.multiplier)).norm();
+    const Eigen::Vector3d applied = c.multiplier - c.normal * c.normal.dot(c.multiplier);
+    const double applied_friction = applied.norm();
+    const Eigen::Vector3d slip = h - c.normal * c.normal.dot(h);
+    const bool overshot = before == FaceContact::State::kSlide && c.friction > 0 &&
+                          applied_friction > 0 && slip.dot(applied) > 0;
+    const bool carried_past = slip.norm() > kCarriedPastSpeed;
+    if (overshot && ((carried_past && c.switches < kMaxSwitches) ||
+                     (c.switches >= kMaxSwitches && tangential.norm() > bound))) {
+      // The slip turned along the friction the solve applied: that friction was more than enough
+      // to stop it within the step (a light face under a heavy sliding body: the friction carries
+      // its nodes past the body). Projected onto the cone along the new slip, the friction would
+      // flip back and forth with each solve, and the step could end on either sign (a box
+      // sliding over a soft slab was pushed downhill, 1 deg below the friction angle it crept
+      // 3 cm in 1 s). Instead, when the face was carried past the body faster than
+      // kCarriedPastSpeed, it sticks, from the applied friction within this solve's cone (for
+      // every overshoot, a box dropped onto a slope below the friction angle crept 7 mm in 1 s);
+      // past the switch budget, where Uzawa's trial would leave the cone on the other side, it
+      // keeps its friction (direction and magnitude), brought within this solve's cone: a fixed
+      // friction bounded by mu lambda. (Uzawa's update along the direction, less rho times the
+      // slip along it, took the friction to zero, and the next solve back onto the cone: the same
+      // cycle.) A trial within the cone is taken as before (below).
+      const Eigen::Vector3d d = applied / applied_friction;
+      const double magnitude = std::min(applied_friction, bound);
+      c.multiplier = c.normal * lambda + magnitude * d;
+      if (c.switches < kMaxSwitches) {
+        c.state = FaceContact::State::kStick;
+        ++c.switches;
+      } else if (applied_friction - magnitude > 1e-2 * bound &&
+                 c.friction_refinements++ < kMaxFrictionRefinements) {
+        again = true;
+      }
+      if (c.state != before || violation > gap_tolerance) again = true;
+      continue;
+    }
     if (c.friction > 0 && tangential.norm() <= bound) {
       // Within the cone: sticks, or, after kMaxSwitches slide-to-stick switches this step (they
       // can cycle: neighbouring contacts' tangential impulses are coupled through the body),

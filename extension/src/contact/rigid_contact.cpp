@@ -15,6 +15,34 @@
 
 namespace torsion {
 
+namespace {
+
+// m/s: a body whose contacts all slid in the last step is sliding over the surface if it slips
+// faster than this over the nodes it reaches.
+constexpr double kSlidingSpeed = 0.01;
+
+// Clears RigidPartner::sliding of the bodies that slip slower than kSlidingSpeed over the surface
+// nodes they reach this step, at their velocity at the end of the last step (Bullet's, less this
+// step's gravity; `state` at the start of the step). A body landing on a slope or resting on it
+// slips by Poisson's effect and partial slip at its edges: taken as sliding, its new contacts
+// started sliding and it crept (7 mm in 1 s 1 deg below the friction angle on a stiff slab).
+void keepFastSliders(const std::vector<NodeContact>& contacts, const FemState& state, double dt,
+                     std::vector<RigidPartner>& partners) {
+  std::vector<double> fastest(partners.size(), 0.0);
+  for (const NodeContact& c : contacts) {
+    if (c.held) continue;
+    const RigidPartner& k = partners[static_cast<size_t>(c.partner)];
+    Vector6d last = k.entry_velocity;
+    if (k.body != nullptr) last.head<3>() -= dt * toEigen(k.body->getGravity());
+    double& f = fastest[static_cast<size_t>(c.partner)];
+    f = std::max(f, tangentialSlip(c, state.velocity(c.node), last).norm());
+  }
+  for (size_t k = 0; k < partners.size(); ++k)
+    partners[k].sliding = partners[k].sliding && fastest[k] > kSlidingSpeed;
+}
+
+}  // namespace
+
 RigidContactSolver::RigidContactSolver(std::shared_ptr<const FemModel> model, btSoftBody* soft_body)
     : model_(std::move(model)), soft_body_(soft_body), faces_(model_->mesh()) {
   const int n = model_->nodeCount();
@@ -48,6 +76,7 @@ bool RigidContactSolver::detect(const FemState& state, const NodeConstraints& co
   addAnchorContacts(state, constraints);
   dropUntouchedPartners();
   warmStartActiveSet();
+  keepFastSliders(contacts_, state, dt_, partners_);
   recordDetectionStats();
   return !contacts_.empty() || !faces_.empty();
 }
@@ -72,12 +101,17 @@ LinearSolveReport RigidContactSolver::solve(const SystemOperator& op,
     recoverSolution(op, v);
     if (r.breakdown) break;
     measureFrictionShares();
+    rememberSolvedStates();
     if (!updateContactStates(v)) {
       converged_set = true;
       break;
     }
   }
   stats_.active_set_converged = converged_set;
+  // At the iteration cap the states were updated after the last solve: the impulses are those
+  // of the states that solve used (a contact released in that last update had its impulse
+  // applied, and a slide's friction was the one before the update).
+  if (!converged_set && !total.breakdown) restoreSolvedStates();
   collectImpulses();
   solveHeld(v, dt_);
   measureEndGaps(v);
@@ -117,6 +151,21 @@ bool RigidContactSolver::updateContactStates(const Eigen::VectorXd& v) {
   const bool faces_changed = faces_.update(v, partners_, dt_, settings_.activation_tolerance,
                                            settings_.face_gap_tolerance);
   return nodes_changed || faces_changed;
+}
+
+void RigidContactSolver::rememberSolvedStates() {
+  solved_states_.resize(contacts_.size());
+  for (size_t c = 0; c < contacts_.size(); ++c)
+    solved_states_[c] = {contacts_[c].state, contacts_[c].friction_impulse};
+  solved_face_states_ = faces_.states();
+}
+
+void RigidContactSolver::restoreSolvedStates() {
+  for (size_t c = 0; c < contacts_.size() && c < solved_states_.size(); ++c) {
+    contacts_[c].state = solved_states_[c].first;
+    contacts_[c].friction_impulse = solved_states_[c].second;
+  }
+  faces_.restoreStates(solved_face_states_);
 }
 
 void RigidContactSolver::collectImpulses() {

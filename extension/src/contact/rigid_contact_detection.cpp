@@ -50,19 +50,36 @@ btTransform startPose(const btCollisionObject& object, double dt) {
   return start;
 }
 
-// Whether Bullet's contact manifolds hold `body` against a static or kinematic object.
+// Whether Bullet's contact manifolds hold `body` up against a static or kinematic object: a
+// contact whose push on the body opposes the body's gravity (within 60 deg; any contact when it
+// has no gravity). A kinematic plate pushing a box sideways across a soft slab does not hold it
+// up: taken as support, the box was prescribed in the solve with the step's gravity in its
+// velocity, the slab's reaction (a hundred times its weight) came back as an explicit impulse,
+// and the box was thrown off the slab.
 bool touchesStaticOrKinematic(const btRigidBody& body, btSoftBody& soft) {
   btDispatcher* dispatcher = soft.getWorldInfo()->m_dispatcher;
   if (dispatcher == nullptr) return false;
+  const Eigen::Vector3d gravity = toEigen(body.getGravity());
+  const Eigen::Vector3d up =
+      gravity.squaredNorm() > 0 ? Eigen::Vector3d(-gravity.normalized()) : Eigen::Vector3d::Zero();
   for (int m = 0; m < dispatcher->getNumManifolds(); ++m) {
     const btPersistentManifold* manifold = dispatcher->getManifoldByIndexInternal(m);
     const btCollisionObject* other = nullptr;
-    if (manifold->getBody0() == &body) other = manifold->getBody1();
-    if (manifold->getBody1() == &body) other = manifold->getBody0();
+    double side = 0;  // the push on the body is side * normalWorldOnB
+    if (manifold->getBody0() == &body) {
+      other = manifold->getBody1();
+      side = 1;
+    }
+    if (manifold->getBody1() == &body) {
+      other = manifold->getBody0();
+      side = -1;
+    }
     if (other == nullptr || !other->isStaticOrKinematicObject()) continue;
     for (int c = 0; c < manifold->getNumContacts(); ++c) {
-      if (manifold->getContactPoint(c).getDistance() <= manifold->getContactProcessingThreshold())
-        return true;
+      const btManifoldPoint& point = manifold->getContactPoint(c);
+      if (point.getDistance() > manifold->getContactProcessingThreshold()) continue;
+      const Eigen::Vector3d push = side * toEigen(point.m_normalWorldOnB);
+      if (up.squaredNorm() == 0 || push.dot(up) > 0.5) return true;
     }
   }
   return false;
@@ -153,11 +170,27 @@ void RigidContactSolver::rememberActiveContacts() {
   // Last step's active contacts start this step active (warm active set).
   previous_active_.clear();
   previous_state_.clear();
+  std::vector<char> slid(partners_.size(), 0), stuck(partners_.size(), 0);
   for (const NodeContact& c : contacts_) {
     if (c.state != NodeContact::State::kInactive && !c.held) {
       previous_active_.emplace_back(c.node, partners_[static_cast<size_t>(c.partner)].object);
       previous_state_.push_back(c.state);
+      (c.state == NodeContact::State::kSlide ? slid : stuck)[static_cast<size_t>(c.partner)] = 1;
     }
+  }
+  for (const FaceContact& f : faces_.contacts()) {
+    if (f.state == FaceContact::State::kInactive) continue;
+    (f.state == FaceContact::State::kSlide ? slid : stuck)[static_cast<size_t>(f.partner)] = 1;
+  }
+  // A body whose contacts (node and face) all ended the last step sliding may be sliding over the
+  // surface (RigidContactSolver::detect decides by its speed). Taken from the end of the last step,
+  // not from the contacts that survive into this one: a box sliding at 2 m/s leaves its contacts of
+  // the last step behind, and counting the survivors took it for not sliding, so its new
+  // contacts started stuck and took 1.3 m/s off it in one step. Face contacts count as nodes do:
+  // under a box on a soft slab whole steps pass with face contacts alone.
+  previous_sliding_.clear();
+  for (size_t k = 0; k < partners_.size(); ++k) {
+    if (slid[k] && !stuck[k]) previous_sliding_.push_back(partners_[k].object);
   }
 }
 
@@ -269,23 +302,18 @@ void RigidContactSolver::dropUntouchedPartners() {
 }
 
 void RigidContactSolver::warmStartActiveSet() {
-  std::vector<char> slid(partners_.size(), 0), stuck(partners_.size(), 0);
   for (NodeContact& c : contacts_) {
     if (c.held || c.anchored) continue;
     for (size_t k = 0; k < previous_active_.size(); ++k) {
       if (previous_active_[k].first == c.node &&
           previous_active_[k].second == partners_[static_cast<size_t>(c.partner)].object) {
         c.state = c.friction > 0 ? previous_state_[k] : NodeContact::State::kSlide;
-        if (c.friction > 0 && c.state == NodeContact::State::kSlide)
-          slid[static_cast<size_t>(c.partner)] = 1;
-        if (c.state == NodeContact::State::kStick) stuck[static_cast<size_t>(c.partner)] = 1;
       }
     }
   }
-  // A body all of whose carried contacts slide, none stuck, is sliding over the surface: a new
-  // contact it slips over joins the slide (updateActiveSet).
-  for (size_t k = 0; k < partners_.size(); ++k)
-    partners_[k].sliding = slid[k] && !stuck[k];
+  for (RigidPartner& k : partners_)
+    k.sliding = std::find(previous_sliding_.begin(), previous_sliding_.end(), k.object) !=
+                previous_sliding_.end();
 }
 
 void RigidContactSolver::recordDetectionStats() {

@@ -91,6 +91,10 @@ class FaceContactSet {
     index_.clear();
   }
   bool empty() const { return contacts_.empty(); }
+  /// Each contact's state, in contacts() order; restoreStates() sets them back (the solve's
+  /// impulses are those of the states it used, FaceContactSet::update changes them after).
+  std::vector<FaceContact::State> states() const;
+  void restoreStates(const std::vector<FaceContact::State>& states);
 
   // ---- terms of the reduced solve (rigid_contact.cpp) ----
   /// Before each solve: marks the contacts whose every weighted node `prescribed_along(node, n)`.

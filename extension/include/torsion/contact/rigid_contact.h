@@ -97,6 +97,14 @@ struct NodeContact {
   double normal_impulse = 0;                          ///< N s, impulse . normal
 };
 
+/// The tangential velocity (m/s) of node velocity `node_velocity` relative to the rigid surface
+/// point of contact `c` when its body moves at `rigid_velocity`.
+inline Eigen::Vector3d tangentialSlip(const NodeContact& c, const Eigen::Vector3d& node_velocity,
+                                      const Vector6d& rigid_velocity) {
+  const Eigen::Vector3d relative = node_velocity - pointVelocity(rigid_velocity, c.lever);
+  return relative - c.normal * c.normal.dot(relative);
+}
+
 struct ContactStepStats {
   int candidates = 0;             ///< surface nodes within the detection margin
   int face_candidates = 0;        ///< surface triangles (or edges) with a face contact candidate
@@ -232,6 +240,10 @@ class RigidContactSolver {
   void recoverSolution(const SystemOperator& op, Eigen::VectorXd& v);
   /// Node and face contact states after a solve; whether any changed (another solve is needed).
   bool updateContactStates(const Eigen::VectorXd& v);
+  /// The node and face contact states (and sliding frictions) the solve just done used, before
+  /// updateContactStates changes them; restoreSolvedStates() brings them back.
+  void rememberSolvedStates();
+  void restoreSolvedStates();
   void collectImpulses();
   void solveHeld(const Eigen::VectorXd& v, double dt);  // rigid_contact_held.cpp
   void measureEndGaps(const Eigen::VectorXd& v);
@@ -263,6 +275,9 @@ class RigidContactSolver {
   std::vector<int> node_contact_;  // per node: index into contacts_ (free nodes only) or -1
   std::vector<std::pair<int, const btCollisionObject*>> previous_active_;  // (node, object)
   std::vector<NodeContact::State> previous_state_;
+  std::vector<std::pair<NodeContact::State, Eigen::Vector3d>> solved_states_;
+  std::vector<FaceContact::State> solved_face_states_;
+  std::vector<const btCollisionObject*> previous_sliding_;  // bodies sliding at the last step's end
   const NodeConstraints* base_ = nullptr;
   double dt_ = 0;
   int dynamic_count_ = 0;

@@ -42,8 +42,9 @@ struct RigidPartner {
   /// their friction together is mu times the net normal impulse (docs/contact.md, "Sliding over
   /// nodes").
   double friction_share = 1;
-  /// Its node contacts ended the last step sliding, none stuck (and start this one so): the body
-  /// slides over the surface, and a contact it slips over joins the slide (rigid_contact.cpp).
+  /// All its contacts (node and face) ended the last step sliding: the body slides over the
+  /// surface, and a node or face contact it slips over starts sliding
+  /// (rigid_contact_active_set.cpp, face_contacts.cpp).
   bool sliding = false;
 };
 
