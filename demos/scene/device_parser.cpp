@@ -98,6 +98,10 @@ void readLoop(const JsonObject& d, DeviceSpec& spec) {
     device::PassivitySettings& p = l.passivity;
     p.enabled = o.boolean("enabled", p.enabled);
     p.length_scale = positive(o, "length_scale", p.length_scale, " m");
+    p.rate_limited = o.boolean("rate_limited", p.rate_limited);
+    p.speed_hold_time = positive(o, "speed_hold_time", p.speed_hold_time, " s");
+    p.speed_margin = positive(o, "speed_margin", p.speed_margin, "");
+    p.energy_tolerance = nonNegative(o, "energy_tolerance", p.energy_tolerance, " J");
     o.finish();
   }
   if (d.has("safety")) {

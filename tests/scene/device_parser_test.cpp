@@ -32,6 +32,8 @@ TEST(DeviceParser, ReadsAScriptedDeviceWithEverySetting) {
       "coupling": {"force_coefficient": 0.2, "torque_coefficient": 0.04, "stiffness_refresh_steps": 5},
       "limits": {"max_force": 12, "max_torque": 1.5}, "rate_hz": 500,
       "damper": {"linear": 2, "angular": 0.1},
+      "passivity": {"enabled": true, "length_scale": 0.05, "rate_limited": true,
+                    "speed_hold_time": 0.2, "speed_margin": 3, "energy_tolerance": 1e-5},
       "safety": {"max_force_rate": 100, "max_torque_rate": 10, "stale_after": 0.05, "fade_time": 0.3}})"));
   ASSERT_TRUE(r.ok()) << r.error().message;
   const HandSpec& h = r.value().hands.at(0);
@@ -50,6 +52,11 @@ TEST(DeviceParser, ReadsAScriptedDeviceWithEverySetting) {
   EXPECT_EQ(d.max_torque, 1.5);
   EXPECT_EQ(d.loop.rate_hz, 500);
   EXPECT_EQ(d.loop.damper.linear, 2);
+  EXPECT_EQ(d.loop.passivity.length_scale, 0.05);
+  EXPECT_TRUE(d.loop.passivity.rate_limited);
+  EXPECT_EQ(d.loop.passivity.speed_hold_time, 0.2);
+  EXPECT_EQ(d.loop.passivity.speed_margin, 3);
+  EXPECT_EQ(d.loop.passivity.energy_tolerance, 1e-5);
   EXPECT_EQ(d.loop.safety.fade_time, 0.3);
   EXPECT_EQ(h.initial.origin.z(), 9.9);  // the device's anchor
 }
@@ -94,6 +101,13 @@ TEST(DeviceParser, BadInputNamesTheKey) {
   EXPECT_TRUE(
       failsWith(parse(sceneWith(R"({"type": "replay", "log": "a", "limits": {"max_force": -1}})")),
                 {"hands[0].device.limits.max_force: must be >= 0"}));
+  EXPECT_TRUE(failsWith(
+      parse(
+          sceneWith(R"({"type": "replay", "log": "a", "passivity": {"energy_tolerance": -1e-5}})")),
+      {"hands[0].device.passivity.energy_tolerance: must be >= 0 J"}));
+  EXPECT_TRUE(failsWith(
+      parse(sceneWith(R"({"type": "replay", "log": "a", "passivity": {"rate_limited": 1}})")),
+      {"hands[0].device.passivity.rate_limited: expected"}));
   EXPECT_TRUE(failsWith(parse(sceneWith(R"({"type": "spacemouse", "limits": {"max_force": 1}})")),
                         {"hands[0].device.limits: unknown key"}));  // no motors, no force limits
   EXPECT_TRUE(failsWith(parse(sceneWith(R"({"type": "replay", "log": "a", "speed": 0})")),
