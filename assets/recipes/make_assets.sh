@@ -78,8 +78,10 @@ fi
   --keep-surface --min-dihedral 10 --max-volume 0
 
 # ---- Contact scenes: a small rod (tetgen), structured boxes and a ball (no tetgen) ----
-echo "== rod_1200, slab_768, block_162, paddle_108, ball_384"
+echo "== rod_1200, rod_slender_7951, slab_768, block_162, paddle_108, ball_384"
 "$torsion" mesh cylinder --radius 0.15 --length 1.2 --tets 1200 -o "$meshes/rod_1200.node"
+# The plectoneme's slender rod (demos/scenes/plectoneme.json): 40 radii long.
+"$torsion" mesh cylinder --radius 0.01 --length 0.4 --tets 7951 -o "$meshes/rod_slender_7951.node"
 "$torsion" mesh box --min -0.5 -0.5 0 --max 0.5 0.5 0.2 --cells 8 8 2 -o "$meshes/slab_768.node"
 "$torsion" mesh box --min -0.1 -0.1 0 --max 0.1 0.1 0.2 --cells 3 3 3 -o "$meshes/block_162.node"
 "$torsion" mesh box --min -0.3 -0.04 0 --max 0.3 0.04 0.3 --cells 6 1 3 \
@@ -93,7 +95,7 @@ echo "== cube_384, sheet_1536"
 
 echo "== torsion mesh info"
 for f in "$meshes"/cylinder_2430.node "$meshes"/cylinder_4323.node "$meshes"/cylinder_8332.node \
-  "$meshes"/cylinder_31558.node "$meshes"/dragon_4300.node "$meshes"/rod_1200.node \
+  "$meshes"/cylinder_31558.node "$meshes"/dragon_4300.node "$meshes"/rod_1200.node "$meshes"/rod_slender_7951.node \
   "$meshes"/slab_768.node "$meshes"/block_162.node "$meshes"/paddle_108.node \
   "$meshes"/ball_384.node "$meshes"/cube_384.node \
   "$meshes"/sheet_1536.node; do
