@@ -215,6 +215,32 @@ case $case_name in
     cmp c.ele cylinder_2430.ele || fail "ele file differs after .node -> .msh -> .vtk -> .node"
     ;;
 
+  convert_reorder)
+    # Renumbering keeps the body (counts, volume, bounds) and brings the node numbers of each tet
+    # together: the committed cylinder is in that order already, a scattered copy is not.
+    cp "$assets/cylinder_2430.node" "$assets/cylinder_2430.ele" .
+    run "$torsion" mesh convert --reorder cylinder_2430.node r.node
+    expect_rc 0
+    expect_out "^node order +reverse Cuthill-McKee: mean index span per tet [0-9.]+ -> [0-9.]+$"
+    for field in nodes tets volume "bounds min" "bounds max" "surface triangles"; do
+      [[ $(info_field "$field" r.node) == $(info_field "$field" cylinder_2430.node) ]] ||
+        fail "$field changed by --reorder"
+    done
+    # Scatter the nodes (node i -> i * 263 mod 661) and reorder: the span must shrink 4-fold.
+    { head -n 1 cylinder_2430.node
+      awk 'NR > 1 && NF >= 4 && $1 ~ /^[0-9]+$/ { $1 = ($1 * 263) % 661; print }' \
+        cylinder_2430.node | sort -n -k1,1; } >s.node
+    awk 'NR == 1 { print; next } NF >= 5 && $1 ~ /^[0-9]+$/ {
+           for (i = 2; i <= 5; ++i) $i = ($i * 263) % 661 } { print }' cylinder_2430.ele >s.ele
+    run "$torsion" mesh convert --reorder s.node t.node
+    expect_rc 0
+    read -r before after < <(sed -nE 's/^node order .* per tet ([0-9.]+) -> ([0-9.]+)$/\1 \2/p' <<<"$out")
+    awk -v b="$before" -v a="$after" 'BEGIN { exit !(b > 4 * a) }' ||
+      fail "mean index span $before -> $after: not brought 4-fold closer"
+    [[ $(info_field tets t.node) == 2408 && $(info_field volume t.node) == $(info_field volume cylinder_2430.node) ]] ||
+      fail "the scattered and reordered mesh is not the same body"
+    ;;
+
   cylinder_small)
     need_tetgen
     run "$torsion" mesh cylinder --radius 0.5 --length 2 --tets 500 -o small.vtk
