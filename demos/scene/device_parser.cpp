@@ -297,6 +297,13 @@ Status applyDeviceOverrides(SceneSpec& scene, const DeviceOverrides& overrides) 
     if (!mode) return mode.error();
     scene.haptics_mode = mode.value();
   }
+  // Below the loops' own priority (80), so that they still preempt the simulation.
+  if (overrides.simulation_priority < 0 || overrides.simulation_priority > 79) {
+    return Error{"--sim-priority: " + std::to_string(overrides.simulation_priority) +
+                 " is not in [0, 79] (the haptic loops run at 80 and must preempt the "
+                 "simulation)"};
+  }
+  scene.simulation_priority = overrides.simulation_priority;
   if (!overrides.allow_remote_devices) {
     for (size_t h = 0; h < scene.hands.size(); ++h) {
       const HandSpec& hand = scene.hands[h];

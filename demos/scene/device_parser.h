@@ -29,6 +29,9 @@ struct DeviceOverrides {
   std::string haptics;               ///< `--haptics lockstep|threaded`; empty: the default
   /// `--allow-remote-device`: a network device may listen on an address other than loopback.
   bool allow_remote_devices = false;
+  /// `--sim-priority N`: SCHED_FIFO priority (1-79) of the stepping thread while threaded loops
+  /// run; 0: the thread's own policy.
+  int simulation_priority = 0;
 };
 
 /// Applies every --device (applyDeviceOverride), then --haptics, to `scene`; the first fault

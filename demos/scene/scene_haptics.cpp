@@ -95,6 +95,9 @@ Result<std::unique_ptr<SceneHaptics>> SceneHaptics::attach(BuiltScene& scene) {
     h->channels_.push_back(std::move(c));
   }
   h->runtime_ = std::make_unique<haptics::HapticRuntime>(*scene.world, std::move(bindings));
+  if (h->mode_ == HapticsMode::kThreaded)
+    h->runtime_->setSimulationPriority(scene.spec.simulation_priority);
+  h->simulation_priority_ = scene.spec.simulation_priority;
   h->prepareRun(scene.spec.steps);
   return h;
 }
@@ -116,8 +119,19 @@ void SceneHaptics::pace() {
   if (!threads_started_) {
     runtime_->startThreads();
     threads_started_ = true;
+    simulation_real_time_ = runtime_->simulationRealtime();
   }
   runtime_->pace();
+}
+
+std::vector<std::string> SceneHaptics::warnings() const {
+  std::vector<std::string> all = runtime_->warnings();
+  if (threads_started_ && simulation_priority_ > 0 && !simulation_real_time_) {
+    all.push_back("--sim-priority " + std::to_string(simulation_priority_) +
+                  ": real-time priority refused (needs root or CAP_SYS_NICE); the simulation "
+                  "ran at its normal priority");
+  }
+  return all;
 }
 
 WorldStepReport SceneHaptics::step() {
@@ -157,6 +171,8 @@ nlohmann::json SceneHaptics::statistics(const Channel& c) const {
       {"nonfinite", st.nonfinite.load()},
       {"log_dropped", st.log_dropped.load()},
       {"poses_rejected", c.coupling->rejectedPoses()},
+      {"simulation_priority",
+       {{"asked", simulation_priority_}, {"real_time", simulation_real_time_}}},
       {"passivity",
        {{"controller", c.loop->passivityEnabled()},
         {"max_port_energy_J", st.max_port_energy.load()},

@@ -46,7 +46,8 @@ class SceneHaptics {
 
   /// One line per device hand: "hand 'h': device scripted(f.json), lockstep at 1000 Hz".
   std::vector<std::string> describe() const;
-  const std::vector<std::string>& warnings() const { return runtime_->warnings(); }
+  /// The runtime's warnings, and a refused --sim-priority.
+  std::vector<std::string> warnings() const;
 
  private:
   struct Channel {
@@ -63,6 +64,8 @@ class SceneHaptics {
   double dt_ = 0.01;
   std::vector<Channel> channels_;
   std::unique_ptr<haptics::HapticRuntime> runtime_;
+  int simulation_priority_ = 0;        // asked for (--sim-priority)
+  bool simulation_real_time_ = false;  // granted when the threads started (stop restores it)
   bool threads_started_ = false;
   bool finished_ = false;
 };

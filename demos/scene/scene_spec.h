@@ -137,6 +137,9 @@ struct SceneSpec {
   /// "friction", "gap_tolerance"}; nullopt: off.
   std::optional<BodyContactSettings> fem_contact = BodyContactSettings{};
   HapticsMode haptics_mode = HapticsMode::kAuto;  ///< not in the file: the CLI's --haptics
+  /// Not in the file: the CLI's --sim-priority, the SCHED_FIFO priority of the stepping thread
+  /// while threaded haptic loops run (HapticRuntime::setSimulationPriority); 0: unchanged.
+  int simulation_priority = 0;
 };
 
 }  // namespace torsion::scene

@@ -531,6 +531,27 @@ EOF
       exit !(m > 1 && d <= 1e-4 * m) }' || fail "replayed torque $b differs from recorded $a"
     ;;
 
+  run_haptic_sim_priority)
+    # --sim-priority asks real-time priority for the stepping thread under threaded haptics: the
+    # summary says what was asked and whether it was granted, and a refusal (no privilege) is a
+    # warning, not a failure. Out of range (the loops run at 80) is an error before any step.
+    sed "s|../../assets/meshes|$assets|" "$scenes/twist_cylinder_2430.json" > twist.json
+    write_short_turn turn.json
+    run "$torsion" run twist.json --device hand=scripted:turn.json --haptics threaded \
+      --sim-priority 40 --out rt --steps 60 --threads 1
+    expect_rc 0
+    tr -d ' \n' < rt/summary.json > flat.json
+    grep -q '"simulation_priority":{"asked":40,"real_time":true}' flat.json ||
+      { grep -q '"simulation_priority":{"asked":40,"real_time":false}' flat.json &&
+        grep -q "sim-priority 40: real-time priority refused" <<<"$out"; } ||
+      fail "summary lacks the priority asked and granted (or the refusal's warning)"
+    run "$torsion" run twist.json --device hand=scripted:turn.json --haptics threaded \
+      --sim-priority 80 --out bad --steps 5
+    expect_rc nonzero
+    expect_out "--sim-priority: 80 is not in \[0, 79\]"
+    [[ ! -e bad/summary.json ]] || fail "a refused option may not leave a summary"
+    ;;
+
   run_haptic_network)
     # The reference peer plays a trajectory over UDP loopback; torsion drives the hand with it
     # (threaded haptics: the loop at 1 kHz on its own thread, the simulation paced to the clock).
