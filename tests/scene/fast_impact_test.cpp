@@ -1,9 +1,10 @@
 // Fast impacts without tunnelling (docs/contact.md, "Fast impacts"): Bullet's Collide demo as
 // Bullet sets it up (a soft cube and a rigid box thrown at each other at 15 m/s each,
 // bullet_collide_moving), as seen from the cube (the box at 30 m/s, bullet_collide) and with two
-// soft cubes (bullet_collide_soft), run as `torsion run` runs them. After every step, and at the middle of every step's straight path, no node of one body is
-// inside the other beyond a small tolerance; in free space the two soft cubes keep their linear
-// and angular momentum. Label "physics" (seconds in Release).
+// soft cubes (bullet_collide_soft), run as `torsion run` runs them. After every step, and at the
+// middle of every step's straight path, no node of one body is inside the other beyond a small
+// tolerance; in free space the two soft cubes keep their linear and angular momentum. Label
+// "physics" (seconds in Release).
 
 #include <gtest/gtest.h>
 

@@ -268,12 +268,9 @@ void SystemOperator::nodalPressureIncrements(const Eigen::VectorXd& y) const {
   });
 }
 
-void SystemOperator::apply(const Eigen::VectorXd& y, Eigen::VectorXd& out, double mass_scale,
-                           double stiffness_scale) const {
-  assemble();
-  out.resize(y.size());
-  const bool nodal_pressure = model_->nodalPressure();
-  if (nodal_pressure) nodalPressureIncrements(y);
+system_kernels::ProductInput SystemOperator::productInput(const Eigen::VectorXd& y,
+                                                          Eigen::VectorXd& out, double mass_scale,
+                                                          double stiffness_scale) const {
   system_kernels::ProductInput in;
   in.row_offsets = row_offsets_.data();
   in.columns = block_columns_.data();
@@ -286,6 +283,16 @@ void SystemOperator::apply(const Eigen::VectorXd& y, Eigen::VectorXd& out, doubl
   in.out = out.data();
   in.mass_scale = mass_scale;
   in.stiffness_scale = stiffness_scale;
+  return in;
+}
+
+void SystemOperator::apply(const Eigen::VectorXd& y, Eigen::VectorXd& out, double mass_scale,
+                           double stiffness_scale) const {
+  assemble();
+  out.resize(y.size());
+  const bool nodal_pressure = model_->nodalPressure();
+  if (nodal_pressure) nodalPressureIncrements(y);
+  const system_kernels::ProductInput in = productInput(y, out, mass_scale, stiffness_scale);
   parallel_.forRange(model_->nodeCount(), kNodeGrain, [&](int begin, int end) {
     kernels_->block_product(in, begin, end);
     if (!nodal_pressure) return;
@@ -334,11 +341,11 @@ void SystemOperator::multiplyFromNodes(const Eigen::VectorXd& y, const std::vect
   out.setZero(y.size());
   const int n = model_->nodeCount();
   row_marks_.resize(static_cast<size_t>(n), 0);
-  std::vector<int> rows;
+  marked_rows_.clear();
   auto mark = [&](int row) {
     if (row_marks_[static_cast<size_t>(row)] != 0) return;
     row_marks_[static_cast<size_t>(row)] = 1;
-    rows.push_back(row);
+    marked_rows_.push_back(row);
   };
   for (int node : nodes) {
     const size_t r = static_cast<size_t>(node);
@@ -347,19 +354,9 @@ void SystemOperator::multiplyFromNodes(const Eigen::VectorXd& y, const std::vect
     for (int l = lower_offsets_[r]; l < lower_offsets_[r + 1]; ++l)
       mark(lower_columns_[static_cast<size_t>(l)]);
   }
-  system_kernels::ProductInput in;
-  in.row_offsets = row_offsets_.data();
-  in.columns = block_columns_.data();
-  in.blocks = block_values_.data()->data();
-  in.lower_offsets = lower_offsets_.data();
-  in.lower_slots = lower_slots_.data();
-  in.lower_columns = lower_columns_.data();
-  in.mass = model_->nodeMasses().data();
-  in.y = y.data();
-  in.out = out.data();
-  in.mass_scale = mass_coefficient_;
-  in.stiffness_scale = stiffness_coefficient_;
-  for (int row : rows) {
+  const system_kernels::ProductInput in =
+      productInput(y, out, mass_coefficient_, stiffness_coefficient_);
+  for (int row : marked_rows_) {
     kernels_->block_product(in, row, row + 1);  // the same kernel, row by row: the same bits
     row_marks_[static_cast<size_t>(row)] = 0;
   }

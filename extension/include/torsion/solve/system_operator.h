@@ -36,6 +36,7 @@ namespace torsion {
 namespace system_kernels {
 struct KernelTable;
 struct BlockTerm;
+struct ProductInput;
 }  // namespace system_kernels
 
 class SystemOperator {
@@ -142,6 +143,9 @@ class SystemOperator {
   // out_i = mass_scale m_i y_i + stiffness_scale (K y)_i
   void apply(const Eigen::VectorXd& y, Eigen::VectorXd& out, double mass_scale,
              double stiffness_scale) const;
+  // The block product kernel's input over the stored pattern, for y into out (sized).
+  system_kernels::ProductInput productInput(const Eigen::VectorXd& y, Eigen::VectorXd& out,
+                                            double mass_scale, double stiffness_scale) const;
   void buildPattern();
   // tet_scalars_[e] = V_e dpbar_e(y), the volumetric stiffness's tet pressures for y.
   void nodalPressureIncrements(const Eigen::VectorXd& y) const;
@@ -194,8 +198,9 @@ class SystemOperator {
   std::vector<int> patch_offsets_, patch_nodes_, patch_slots_;
   // Nodal pressure scratch: per tet and per node scalars of one product.
   mutable std::vector<double> tet_scalars_, node_scalars_;
-  // multiplyFromNodes() scratch: 1 for the rows it multiplies (all 0 between calls).
+  // multiplyFromNodes() scratch: 1 for the rows it multiplies (all 0 between calls), and them.
   mutable std::vector<unsigned char> row_marks_;
+  mutable std::vector<int> marked_rows_;
 };
 
 }  // namespace torsion
