@@ -3,7 +3,7 @@
 // contact solve stopped unconverged, the most active contacts, the deepest linearised end-of-step
 // penetration, the tree searches, how many unconverged steps used every Uzawa update (the others
 // were stopped by the safeguard), and every `--check-every` steps whether any two surface
-// triangles cross. One JSON line on stdout.
+// triangles intersect (analysis/surface_intersections.h, exact). One JSON line on stdout.
 //
 //   bench_self_contact SCENE [--steps N] [--threads T] [--check-every K]
 //                            [--save-at K FILE] [--resume FILE] [--self-contact off]
@@ -22,10 +22,10 @@
 #include <iterator>
 #include <string>
 
-#include "../contact/surface_intersections.h"
 #include "scene_builder.h"
 #include "scene_haptics.h"
 #include "scene_parser.h"
+#include "torsion/analysis/surface_intersections.h"
 #include "torsion/bullet/checkpoint_io.h"
 
 int main(int argc, char** argv) {
@@ -94,7 +94,7 @@ int main(int argc, char** argv) {
   }
   // After a checkpoint's restore, which brings self-contact back as it was saved.
   if (!self_contact) body->disableSelfContact();
-  SurfaceTree tree(body->model().mesh().surfaceTriangles());
+  const std::vector<Triangle>& surface = body->model().mesh().surfaceTriangles();
   int unconverged = 0, at_cap = 0, max_active = 0, searches = 0, crossing_checks = 0,
       crossing_first = -1;
   long updates = 0;
@@ -128,7 +128,7 @@ int main(int argc, char** argv) {
       searching += s.search_seconds;
     }
     if (check_every > 0 && k % check_every == 0 &&
-        countSurfaceIntersections(tree, body->state().positions) > 0) {
+        !findSurfaceIntersections(surface, body->state().positions).empty()) {
       ++crossing_checks;
       if (crossing_first < 0) crossing_first = k;
     }

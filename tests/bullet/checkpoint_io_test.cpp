@@ -10,6 +10,7 @@
 #include <random>
 #include <vector>
 
+#include "checkpoint_rigs.h"
 #include "torsion/mesh/box_mesh.h"
 
 namespace torsion {
@@ -19,7 +20,7 @@ namespace {
 // hand after the world was built and turned about z.
 class BlockRig {
  public:
-  BlockRig() : world_(settings()) {
+  BlockRig() : world_(test::checkpointWorldSettings()) {
     Material material;
     material.youngs_modulus = 2e4;
     body_ =
@@ -32,12 +33,6 @@ class BlockRig {
     slab.setOrigin(btVector3(0, 0, btScalar(-0.5)));
     world_.addRigidBody(std::make_unique<btBoxShape>(btVector3(2, 2, btScalar(0.5))), 0.0, slab);
     hand_ = std::make_unique<Hand>(*body_);
-  }
-
-  static WorldSettings settings() {
-    WorldSettings s;
-    s.solver.time_step = 0.01;
-    return s;
   }
 
   void step() {
@@ -54,17 +49,8 @@ class BlockRig {
     ASSERT_TRUE(r.ok) << r.message;
   }
 
-  std::string save() {
-    return writeCheckpoint(world_, world_.checkpoint(), {hand_.get()}, {hand_->checkpoint()}, "x");
-  }
-
-  Status load(const std::string& bytes) {
-    Result<StoredCheckpoint> stored = readCheckpoint(bytes, world_, {hand_.get()});
-    if (!stored) return stored.error();
-    if (Status s = world_.restore(stored.value().world); !s) return s;
-    hand_->restore(stored.value().hands[0]);
-    return Ok{};
-  }
+  std::string save() { return test::saveBytes(world_, {hand_.get()}, "x"); }
+  Status load(const std::string& bytes) { return test::loadBytes(bytes, world_, {hand_.get()}); }
 
   FemWorld world_;
   FemBody* body_;
@@ -149,7 +135,7 @@ TEST(CheckpointIo, AnotherWorldIsNamedAsSuch) {
   BlockRig rig;
   rig.step();
   const std::string bytes = rig.save();
-  FemWorld other(BlockRig::settings());
+  FemWorld other(test::checkpointWorldSettings());
   FemBody* body =
       other
           .addBody("block", makeBoxTetMesh({-0.2, -0.2, 0.02}, {0.2, 0.2, 0.42}, 3, 3, 3).value(),
@@ -173,18 +159,14 @@ namespace {
 // warm-start every step.
 class TouchingBodiesRig {
  public:
-  TouchingBodiesRig() : world_(BlockRig::settings()) {
+  TouchingBodiesRig() : world_(test::checkpointWorldSettings()) {
     Material material;
     material.youngs_modulus = 5e4;
     slab_ = world_
                 .addBody("slab", makeBoxTetMesh({-0.2, -0.2, 0}, {0.2, 0.2, 0.1}, 2, 2, 1).value(),
                          material)
                 .value();
-    std::vector<int> base;
-    for (int i = 0; i < slab_->model().nodeCount(); ++i)
-      if (slab_->state().position(i).z() < 1e-9) base.push_back(i);
-    slab_->carryNodes(
-        "base", base, [](double) { return Frame{}; }, 0.0);
+    test::holdBase(*slab_);
     block_ = world_
                  .addBody("block",
                           makeBoxTetMesh({-0.08, -0.05, 0.101}, {0.06, 0.07, 0.2}, 2, 2, 2).value(),
@@ -192,12 +174,8 @@ class TouchingBodiesRig {
                  .value();
   }
 
-  std::string save() { return writeCheckpoint(world_, world_.checkpoint(), {}, {}, ""); }
-  Status load(const std::string& bytes) {
-    Result<StoredCheckpoint> stored = readCheckpoint(bytes, world_, {});
-    if (!stored) return stored.error();
-    return world_.restore(stored.value().world);
-  }
+  std::string save() { return test::saveBytes(world_, {}); }
+  Status load(const std::string& bytes) { return test::loadBytes(bytes, world_, {}); }
   void steps(int n) {
     for (int k = 0; k < n; ++k) {
       const WorldStepReport r = world_.step();

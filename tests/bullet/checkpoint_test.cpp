@@ -1,8 +1,7 @@
 // Checkpoints: going back to a moment and going on gives, bit for bit, what followed it.
 #include <gtest/gtest.h>
 
-#include "torsion/bullet/fem_world.h"
-#include "torsion/bullet/hand.h"
+#include "checkpoint_rigs.h"
 #include "torsion/mesh/box_mesh.h"
 
 namespace torsion {
@@ -16,30 +15,18 @@ struct Recorded {
 
 class TwistRig {
  public:
-  TwistRig() : world_(settings()) {
+  TwistRig() : world_(test::checkpointWorldSettings()) {
     Material material;
     material.youngs_modulus = 1e5;
     body_ =
         world_.addBody("bar", makeBoxTetMesh({0, 0, 0}, {0.4, 0.4, 2}, 2, 2, 8).value(), material)
             .value();
-    std::vector<int> base;
-    for (int i = 0; i < body_->model().nodeCount(); ++i) {
-      if (body_->model().mesh().restPositions()[static_cast<size_t>(i)].z() < 1e-9)
-        base.push_back(i);
-    }
-    body_->carryNodes(
-        "base", base, [](double) { return Frame{}; }, 0.0);
+    test::holdBase(*body_);
     hand_ = std::make_unique<Hand>(*body_);
     btTransform pose;
     pose.setIdentity();
     pose.setOrigin(btVector3(3, 0, 5));  // a rigid ball falling beside the bar
     rigid_ = world_.addRigidBody(std::make_unique<btSphereShape>(btScalar(0.2)), 1.0, pose);
-  }
-
-  static WorldSettings settings() {
-    WorldSettings s;
-    s.solver.time_step = 0.01;
-    return s;
   }
 
   // The hand grabs the top at step 0 and turns it about z at 1 rad/s.

@@ -109,24 +109,39 @@ TEST(BodyContact, ASoftBallRestsOnASoftSlabCarriedByTheTotalContactForceMg) {
   EXPECT_NEAR(centre(*ball).z(), 0.2, 0.02);
 }
 
+// Two 0.1 m cubes (3 x 3 x 3 cells, E = 1 MPa, no mass damping), no gravity, dt = 1 ms: `struck`
+// at rest at the origin, `thrown` 2 cm to its right (shifted 3 cm in y, 1 cm in z) moving towards
+// it along -x at `speed` (m/s).
+struct ThrownBlocks {
+  static WorldSettings settings() {
+    WorldSettings s;
+    s.gravity.setZero();
+    s.solver.time_step = 1e-3;
+    return s;
+  }
+  explicit ThrownBlocks(double speed) : world(settings()) {
+    Material material = soft(1e6);
+    material.mass_damping = 0;
+    material.stiffness_damping = 1e-3;
+    struck = world
+                 .addBody("struck", makeBoxTetMesh({0, 0, 0}, {0.1, 0.1, 0.1}, 3, 3, 3).value(),
+                          material)
+                 .value();
+    thrown = world
+                 .addBody("thrown",
+                          makeBoxTetMesh({0.12, 0.03, 0.01}, {0.22, 0.13, 0.11}, 3, 3, 3).value(),
+                          material)
+                 .value();
+    thrown->setVelocity(Eigen::Vector3d(-speed, 0, 0));
+  }
+  FemWorld world;
+  FemBody* struck = nullptr;
+  FemBody* thrown = nullptr;
+};
+
 TEST(BodyContact, ASoftBlockThrownAtAnotherKeepsTheLinearMomentumAndDoesNotPassThrough) {
-  WorldSettings settings;
-  settings.gravity.setZero();
-  settings.solver.time_step = 1e-3;
-  FemWorld world(settings);
-  Material material = soft(1e6);
-  material.mass_damping = 0;
-  material.stiffness_damping = 1e-3;
-  FemBody* struck =
-      world.addBody("struck", makeBoxTetMesh({0, 0, 0}, {0.1, 0.1, 0.1}, 3, 3, 3).value(), material)
-          .value();
-  FemBody* thrown =
-      world
-          .addBody("thrown",
-                   makeBoxTetMesh({0.12, 0.03, 0.01}, {0.22, 0.13, 0.11}, 3, 3, 3).value(),
-                   material)
-          .value();
-  thrown->setVelocity(Eigen::Vector3d(-4, 0, 0));
+  ThrownBlocks blocks(4);
+  auto& [world, struck, thrown] = blocks;
   const Eigen::Vector3d before = momentum(*struck) + momentum(*thrown);
   double worst = 0, deepest = 0;
   int unconverged = 0, contact_steps = 0;
@@ -162,23 +177,8 @@ TEST(BodyContact, ASoftBlockThrownAtAnotherKeepsTheLinearMomentumAndDoesNotPassT
 // of either block is inside the other beyond twice the contact's gap tolerance (a tunnelling node
 // would end a step's travel inside), and the momentum holds.
 TEST(BodyContact, ASoftBlockThrownAt15MetresPerSecondNeverEntersTheOther) {
-  WorldSettings settings;
-  settings.gravity.setZero();
-  settings.solver.time_step = 1e-3;
-  FemWorld world(settings);
-  Material material = soft(1e6);
-  material.mass_damping = 0;
-  material.stiffness_damping = 1e-3;
-  FemBody* struck =
-      world.addBody("struck", makeBoxTetMesh({0, 0, 0}, {0.1, 0.1, 0.1}, 3, 3, 3).value(), material)
-          .value();
-  FemBody* thrown =
-      world
-          .addBody("thrown",
-                   makeBoxTetMesh({0.12, 0.03, 0.01}, {0.22, 0.13, 0.11}, 3, 3, 3).value(),
-                   material)
-          .value();
-  thrown->setVelocity(Eigen::Vector3d(-15, 0, 0));
+  ThrownBlocks blocks(15);
+  auto& [world, struck, thrown] = blocks;
   const Eigen::Vector3d before = momentum(*struck) + momentum(*thrown);
   const double limit = 2e-3 * (0.1 / 3);  // 2e-3 of a cell: about twice the gap tolerance
   double worst = 0, deepest = 0;

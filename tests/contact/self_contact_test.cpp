@@ -9,7 +9,7 @@
 #include <cstdio>
 #include <vector>
 
-#include "surface_intersections.h"
+#include "torsion/analysis/surface_intersections.h"
 #include "torsion/bullet/fem_body.h"
 #include "torsion/bullet/fem_world.h"
 #include "torsion/mesh/box_mesh.h"
@@ -75,7 +75,6 @@ TEST(SelfContact, ABlockThrownAtAnotherAt15MetresPerSecondHandsItsMomentumOverEx
   body->restore(start);
 
   const Momenta before = momenta(*body);
-  SurfaceTree tree(mesh.surfaceTriangles());
   int crossing_steps = 0, unconverged = 0, max_active = 0;
   double worst_linear = 0, worst_angular = 0;
   for (int k = 0; k < 200; ++k) {
@@ -84,7 +83,8 @@ TEST(SelfContact, ABlockThrownAtAnotherAt15MetresPerSecondHandsItsMomentumOverEx
     const SelfContactStats& s = body->selfContact()->stats();
     if (!s.converged) ++unconverged;
     max_active = std::max(max_active, s.active);
-    if (countSurfaceIntersections(tree, body->state().positions) > 0) ++crossing_steps;
+    if (!findSurfaceIntersections(mesh.surfaceTriangles(), body->state().positions).empty())
+      ++crossing_steps;
     const Momenta now = momenta(*body);
     worst_linear = std::max(worst_linear, (now.linear - before.linear).norm());
     worst_angular = std::max(worst_angular, (now.angular - before.angular).norm());

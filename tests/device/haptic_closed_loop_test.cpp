@@ -12,6 +12,7 @@
 
 #include "arm_device.h"
 #include "coupling_rig.h"
+#include "stand_in_simulation.h"
 #include "torsion/device/haptic_loop.h"
 
 namespace torsion::haptics {
@@ -33,15 +34,7 @@ struct ClosedTrace {
   std::vector<double> time, angle, torque, simulated;
   double max_energy = 0, dissipated = 0;
   std::uint64_t active = 0;
-  double swing(double from, double to) const {
-    double lo = 1e300, hi = -1e300;
-    for (size_t k = 0; k < time.size(); ++k) {
-      if (time[k] < from || time[k] >= to) continue;
-      lo = std::min(lo, angle[k]);
-      hi = std::max(hi, angle[k]);
-    }
-    return hi - lo;
-  }
+  double swing(double from, double to) const { return device::peakToPeak(time, angle, from, to); }
   // Mean of `v` over [from, to).
   double mean(const std::vector<double>& v, double from, double to) const {
     double sum = 0;
@@ -64,15 +57,8 @@ ClosedTrace runClosedLoop(const ClosedLoop& c) {
   mapping.torque_scale = 1e-4;
   CouplingRig rig(2430, solver, coupling, 0.0, ElementKind::kTet4, 1e7, &mapping);
 
-  simulated::SimulatedArmSettings arm;
-  arm.intent = simulated::SimulatedArmSettings::Intent::kTwist;
-  arm.intent_start = 0.1;
-  arm.intent_time = c.twist_time;
-  arm.intent_rate = c.twist / c.twist_time;
-  arm.grab_time = 0.01;
-  arm.max_torque = 3;
+  simulated::SimulatedArmSettings arm = device::twistingArm(c.twist, c.twist_time, c.wrist_damping);
   arm.max_force = 30;
-  arm.wrist_damping = c.wrist_damping;
   arm.wrist_tilt_damping = c.tilt_damping;
   device::ArmDevice device(arm);
   device::HapticLoopSettings settings;

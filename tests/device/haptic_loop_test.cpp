@@ -6,6 +6,7 @@
 #include <cstdio>
 #include <thread>
 
+#include "stand_in_simulation.h"
 #include "torsion/device/pose_math.h"
 #include "torsion/device/scripted_device.h"
 
@@ -23,12 +24,8 @@ struct SpringSimulation {
   void answer(HapticLoop& loop) {
     HandCommand c;
     loop.commands().read(c);
-    SimulationWrench w;
-    w.step = ++step;
-    w.command_tick = c.tick;
+    SimulationWrench w = answerTo(c, ++step);
     w.command_time = c.time;
-    w.grabbed = c.grab_requests > c.release_requests;
-    w.pose = c.pose;
     w.wrench.force = -stiffness * c.pose.position;
     for (int k = 0; k < 3 && with_stiffness; ++k)
       w.stiffness[7 * k] = -stiffness;

@@ -9,6 +9,7 @@
 #include <string>
 
 #include "arm_device.h"
+#include "stand_in_simulation.h"
 #include "torsion/device/haptic_loop.h"
 #include "torsion/device/pose_math.h"
 
@@ -42,27 +43,11 @@ struct Trace {
   double max_torque_step =
       0;  // N m, largest change of the written torque from one tick to the next
   // Peak-to-peak of the device angle over [from, to).
-  double swing(double from, double to) const {
-    double lo = 1e300, hi = -1e300;
-    for (size_t k = 0; k < time.size(); ++k) {
-      if (time[k] < from || time[k] >= to) continue;
-      lo = std::min(lo, angle[k]);
-      hi = std::max(hi, angle[k]);
-    }
-    return hi - lo;
-  }
+  double swing(double from, double to) const { return peakToPeak(time, angle, from, to); }
 };
 
 Trace run(const Scenario& sc) {
-  simulated::SimulatedArmSettings arm;
-  arm.intent = simulated::SimulatedArmSettings::Intent::kTwist;
-  arm.intent_start = 0.1;
-  arm.intent_time = sc.twist_time;
-  arm.intent_rate = sc.twist / sc.twist_time;
-  arm.grab_time = 0.01;
-  arm.max_torque = 3;
-  arm.wrist_damping = sc.wrist_damping;
-  ArmDevice device(arm);
+  ArmDevice device(twistingArm(sc.twist, sc.twist_time, sc.wrist_damping));
   HapticLoopSettings settings;
   settings.passivity.enabled = sc.passivity;
   settings.passivity.rate_limited = sc.rate_limited;
@@ -84,11 +69,7 @@ Trace run(const Scenario& sc) {
     if (k % 10 == 0) {  // a 100 Hz simulation step on the newest command
       HandCommand c;
       loop.commands().read(c);
-      SimulationWrench w;
-      w.step = ++step;
-      w.command_tick = c.tick;
-      w.grabbed = c.grab_requests > c.release_requests;
-      w.pose = c.pose;
+      SimulationWrench w = answerTo(c, ++step);
       w.wrench.torque.z = -sc.stiffness * toRotationVector(c.pose.orientation).z;
       if (sc.give_stiffness) w.stiffness[35] = -sc.stiffness;
       in_flight.push_back(w);

@@ -5,6 +5,7 @@
 #include <chrono>
 #include <cmath>
 
+#include "stand_in_simulation.h"
 #include "torsion/device/haptic_loop.h"
 #include "torsion/device/pose_math.h"
 
@@ -23,11 +24,7 @@ struct TorsionSpring {
   void answer(HapticLoop& loop) {
     HandCommand c;
     loop.commands().read(c);
-    SimulationWrench w;
-    w.step = ++step;
-    w.command_tick = c.tick;
-    w.grabbed = c.grab_requests > c.release_requests;
-    w.pose = c.pose;
+    SimulationWrench w = answerTo(c, ++step);
     w.wrench.torque.z = -stiffness * toRotationVector(c.pose.orientation).z;
     w.stiffness[35] = -stiffness;
     loop.wrenches().write(w);
@@ -40,11 +37,7 @@ struct ConstantPush {
   void answer(HapticLoop& loop) {
     HandCommand c;
     loop.commands().read(c);
-    SimulationWrench w;
-    w.step = ++step;
-    w.command_tick = c.tick;
-    w.grabbed = c.grab_requests > c.release_requests;
-    w.pose = c.pose;
+    SimulationWrench w = answerTo(c, ++step);
     w.wrench.force.x = 5;
     loop.wrenches().write(w);
   }

@@ -11,20 +11,10 @@
 #include <functional>
 #include <limits>
 
-#include "scene_builder.h"
-#include "scene_parser.h"
+#include "demo_scenes.h"
 
 namespace torsion::scene {
 namespace {
-
-std::unique_ptr<BuiltScene> build(const std::string& name) {
-  Result<SceneSpec> spec = loadScene(std::string(TORSION_SCENES_DIR) + "/" + name + ".json");
-  EXPECT_TRUE(spec) << (spec ? "" : spec.error().message);
-  if (!spec) return nullptr;
-  auto built = buildScene(std::move(spec).value(), 1);
-  EXPECT_TRUE(built) << (built ? "" : built.error().message);
-  return built ? std::move(built).value() : nullptr;
-}
 
 // Runs the scene's steps, calling `each` after every step; fails on an unstable step.
 void run(BuiltScene& s, const std::function<void(int step)>& each = {}) {
@@ -114,7 +104,7 @@ Eigen::Vector3d rigidPosition(const BuiltScene& s, const std::string& name) {
 }
 
 TEST(BulletDemoScenes, PinchLiftsTheCubeOffTheGroundAndCarriesItBetweenTheFingers) {
-  auto s = build("bullet_pinch");
+  auto s = buildDemoScene("bullet_pinch");
   ASSERT_TRUE(s);
   double lowest_when_squeezed = 0;
   run(*s, [&](int step) {
@@ -134,7 +124,7 @@ TEST(BulletDemoScenes, PinchLiftsTheCubeOffTheGroundAndCarriesItBetweenTheFinger
 }
 
 TEST(BulletDemoScenes, CollideKnocksTheCubeAwayAndKeepsTheMomentum) {
-  auto s = build("bullet_collide");
+  auto s = buildDemoScene("bullet_collide");
   ASSERT_TRUE(s);
   run(*s);
   // Box 0.5 kg at 30 m/s, cube 0.5 kg at rest, no gravity, no friction: the total momentum
@@ -152,7 +142,7 @@ TEST(BulletDemoScenes, CollideKnocksTheCubeAwayAndKeepsTheMomentum) {
 }
 
 TEST(BulletDemoScenes, VolumetricCubeHitByFallingBoxesComesToRestOnTheGroundInsideTheWalls) {
-  auto s = build("bullet_volumetric_deformable");
+  auto s = buildDemoScene("bullet_volumetric_deformable");
   ASSERT_TRUE(s);
   run(*s);
   const FemBody& cube = soft(*s);
@@ -172,7 +162,7 @@ TEST(BulletDemoScenes, VolumetricCubeHitByFallingBoxesComesToRestOnTheGroundInsi
 }
 
 TEST(BulletDemoScenes, LargeDeformationCubeSqueezedToAThirdReturnsToItsRestShape) {
-  auto s = build("bullet_large_deformation");
+  auto s = buildDemoScene("bullet_large_deformation");
   ASSERT_TRUE(s);
   double squeezed_height = 0, smallest_ratio = std::numeric_limits<double>::infinity();
   run(*s, [&](int step) {

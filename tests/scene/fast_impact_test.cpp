@@ -13,25 +13,12 @@
 #include <limits>
 
 #include "../contact/surface_depth.h"
-#include "scene_builder.h"
-#include "scene_parser.h"
+#include "demo_scenes.h"
+#include "torsion/bt_conversions.h"
 #include "torsion/bullet/fem_contact_islands.h"
 
 namespace torsion::scene {
 namespace {
-
-std::unique_ptr<BuiltScene> build(const std::string& name) {
-  Result<SceneSpec> spec = loadScene(std::string(TORSION_SCENES_DIR) + "/" + name + ".json");
-  EXPECT_TRUE(spec) << (spec ? "" : spec.error().message);
-  if (!spec) return nullptr;
-  auto built = buildScene(std::move(spec).value(), 1);
-  EXPECT_TRUE(built) << (built ? "" : built.error().message);
-  return built ? std::move(built).value() : nullptr;
-}
-
-Eigen::Vector3d toEigen(const btVector3& v) {
-  return {static_cast<double>(v.x()), static_cast<double>(v.y()), static_cast<double>(v.z())};
-}
 
 // Depth of p inside a box (half extents h, pose `pose`): > 0 inside, <= 0 outside.
 double depthInBox(const Eigen::Vector3d& p, const btTransform& pose, const Eigen::Vector3d& h) {
@@ -83,7 +70,7 @@ double meanSurfaceEdge(const FemBody& b) {
 
 // Runs a soft-cube-against-rigid-box scene; checks every step's end and path midpoint.
 void expectNoNodeInTheBox(const std::string& scene) {
-  auto s = build(scene);
+  auto s = buildDemoScene(scene);
   ASSERT_TRUE(s);
   const FemBody& cube = *s->world->bodies().front();
   const btRigidBody& box = *s->rigid_bodies.front().body;
@@ -150,7 +137,7 @@ TEST(FastImpactContact, RigidBoxAt30MetresPerSecondIntoASoftCubeAtRestNeverInter
 }
 
 TEST(FastImpactContact, TwoSoftCubesAt15MetresPerSecondEachNeverInterpenetrateAndKeepMomentum) {
-  auto s = build("bullet_collide_soft");
+  auto s = buildDemoScene("bullet_collide_soft");
   ASSERT_TRUE(s);
   const FemBody& lower = *s->world->bodies()[0];
   const FemBody& upper = *s->world->bodies()[1];

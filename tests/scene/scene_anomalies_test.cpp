@@ -8,24 +8,15 @@
 #include <fstream>
 #include <nlohmann/json.hpp>
 
-#include "scene_builder.h"
-#include "scene_parser.h"
+#include "demo_scenes.h"
 #include "scene_runner.h"
 
 namespace torsion::scene {
 namespace {
 
 nlohmann::json runAndReadSummary(const std::string& name, int steps) {
-  Result<SceneSpec> spec = loadScene(std::string(TORSION_SCENES_DIR) + "/" + name + ".json");
-  if (!spec.ok()) {
-    ADD_FAILURE() << spec.error().message;
-    return {};
-  }
-  auto built = buildScene(std::move(spec).value(), 1);
-  if (!built.ok()) {
-    ADD_FAILURE() << built.error().message;
-    return {};
-  }
+  std::unique_ptr<BuiltScene> built = buildDemoScene(name);
+  if (!built) return {};
   const std::filesystem::path out =
       std::filesystem::temp_directory_path() /
       ("torsion_scene_anomalies_test_" + name + "_" + std::to_string(::getpid()));
@@ -33,7 +24,7 @@ nlohmann::json runAndReadSummary(const std::string& name, int steps) {
   options.output_directory = out.string();
   options.steps = steps;
   options.stop_on_anomaly = true;
-  Result<RunOutcome> outcome = runScene(*built.value(), options);
+  Result<RunOutcome> outcome = runScene(*built, options);
   if (!outcome.ok()) {
     ADD_FAILURE() << outcome.error().message;
     return {};
