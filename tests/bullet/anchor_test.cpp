@@ -82,6 +82,16 @@ FemBody* addBar(FemSoftBodySolver& fem) {
       .value();
 }
 
+// The pendulums' block: a 0.1 m cube 0.5 to 0.6 m below the origin (their pivot).
+FemBody* addHangingBlock(FemSoftBodySolver& fem) {
+  Material material;
+  material.youngs_modulus = 1e5;
+  return fem
+      .addBody("block", makeBoxTetMesh({-0.05, -0.05, -0.6}, {0.05, 0.05, -0.5}, 3, 3, 3).value(),
+               material)
+      .value();
+}
+
 TEST(Anchors, ALightFreeBodyPulledByASoftBarConservesMomentumAndStaysStable) {
   MultibodyWorld user(btVector3(0, 0, 0));  // no external force
   solveTightly(user.fem);
@@ -117,14 +127,7 @@ TEST(Anchors, ALightFreeBodyPulledByASoftBarConservesMomentumAndStaysStable) {
 // are inside the solve: the next test's bob is twenty times lighter).
 TEST(Anchors, ASoftBlockOnARigidPendulumSwingsWithoutGainingEnergy) {
   MultibodyWorld user(btVector3(0, 0, 0));
-  Material material;
-  material.youngs_modulus = 1e5;
-  FemBody* block =
-      user.fem
-          .addBody("block",
-                   makeBoxTetMesh({-0.05, -0.05, -0.6}, {0.05, 0.05, -0.5}, 3, 3, 3).value(),
-                   material)
-          .value();  // 1 kg
+  FemBody* block = addHangingBlock(user.fem);  // 1 kg
   const double mass = 1.0;
   btRigidBody* bob = user.addRigid(std::make_unique<btBoxShape>(btVector3(0.05, 0.05, 0.025)), mass,
                                    btVector3(0, 0, -0.475));
@@ -163,14 +166,7 @@ TEST(Anchors, ASoftBlockOnARigidPendulumSwingsWithoutGainingEnergy) {
 
 TEST(Anchors, ASoftBlockOnALightMultibodyPendulumSwingsWithoutGainingEnergy) {
   MultibodyWorld user(btVector3(0, 0, 0));
-  Material material;
-  material.youngs_modulus = 1e5;
-  FemBody* block =
-      user.fem
-          .addBody("block",
-                   makeBoxTetMesh({-0.05, -0.05, -0.6}, {0.05, 0.05, -0.5}, 3, 3, 3).value(),
-                   material)
-          .value();  // 1 kg
+  FemBody* block = addHangingBlock(user.fem);  // 1 kg
   // A revolute joint about y at the origin; the bob, twenty times lighter than the block, 0.475 m
   // below it.
   const double mass = 0.05;

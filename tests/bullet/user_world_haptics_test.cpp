@@ -57,72 +57,69 @@ TEST(UserWorldHaptics, LockstepLoopTicksThroughEverySubstepAndFeelsThePush) {
   EXPECT_LT(scripted.lastWritten().force.x, -0.1);  // N: the bar resists the push along x
 }
 
+// A bar (0.4 x 0.4 x 2 m, 1 x 1 x 4 cells, E = 1e5 Pa) free in a user's world without gravity,
+// its hand coupled to a scripted device that holds still with button 1 pressed, behind a haptic
+// loop at 1 kHz: the threaded runtime's rig.
+struct HeldBar {
+  static haptics::DeviceMapping atTheTop() {
+    haptics::DeviceMapping mapping;
+    mapping.anchor.origin = Eigen::Vector3d(0.2, 0.2, 1.9);
+    return mapping;
+  }
+  UserWorld user{btVector3(0, 0, 0)};
+  FemBody* bar =
+      user.fem.addBody("bar", makeBoxTetMesh({0, 0, 0}, {0.4, 0.4, 2}, 1, 1, 4).value(), Material{})
+          .value();
+  Hand hand{*bar};
+  haptics::HandCoupling coupling{hand, atTheTop(), haptics::CouplingSettings{}};
+  device::ScriptedDevice scripted{
+      device::Trajectory({{0, device::Pose{}}, {10, device::Pose{}}}, {{0, 1u}}),
+      device::defaultDeviceLimits(), "hold"};
+  device::HapticLoop loop{scripted, device::HapticLoopSettings{}};
+  haptics::HapticRuntime runtime{user.fem, {{&coupling, &loop, 1000}}};
+};
+
 TEST(UserWorldHaptics, ThreadedLoopRunsBesideTheUsersSteppingLoop) {
   // The haptic loop on its own thread, the user's stepSimulation on this one: they meet only in
   // the lock-free buffers (the ThreadSanitizer build runs this test).
-  UserWorld user(btVector3(0, 0, 0));
-  Material material;
-  material.youngs_modulus = 1e5;
-  FemBody* bar =
-      user.fem.addBody("bar", makeBoxTetMesh({0, 0, 0}, {0.4, 0.4, 2}, 1, 1, 4).value(), material)
-          .value();
-  Hand hand(*bar);
-  haptics::DeviceMapping mapping;
-  mapping.anchor.origin = Eigen::Vector3d(0.2, 0.2, 1.9);
-  haptics::HandCoupling coupling(hand, mapping, haptics::CouplingSettings{});
-  const device::Trajectory hold({{0, device::Pose{}}, {10, device::Pose{}}}, {{0, 1u}});
-  device::ScriptedDevice scripted(hold, device::defaultDeviceLimits(), "hold");
-  device::HapticLoop loop(scripted, device::HapticLoopSettings{});
-  haptics::HapticRuntime runtime(user.fem, {{&coupling, &loop, 1000}});
-  runtime.startThreads();
+  HeldBar rig;
+  rig.runtime.startThreads();
   for (int call = 0; call < 20; ++call) {
-    user.world.stepSimulation(btScalar(1 / 60.), 10, btScalar(1 / 240.));
-    ASSERT_TRUE(user.fem.status().ok) << user.fem.status().message;
+    rig.user.world.stepSimulation(btScalar(1 / 60.), 10, btScalar(1 / 240.));
+    ASSERT_TRUE(rig.user.fem.status().ok) << rig.user.fem.status().message;
   }
-  runtime.stopThreads();
-  EXPECT_GT(loop.stats().ticks, 0u);
-  EXPECT_TRUE(hand.grabbed()) << "the button pressed on the loop's thread reached the hand";
-  EXPECT_EQ(user.fem.stepCount(), 80);
+  rig.runtime.stopThreads();
+  EXPECT_GT(rig.loop.stats().ticks, 0u);
+  EXPECT_TRUE(rig.hand.grabbed()) << "the button pressed on the loop's thread reached the hand";
+  EXPECT_EQ(rig.user.fem.stepCount(), 80);
 }
 
 TEST(UserWorldHaptics, TheSteppingThreadIsRealTimeOnlyWhileTheLoopsRun) {
   // setSimulationPriority: SCHED_FIFO at startThreads() when the process may have it (the
   // result says which), and the thread's own policy back at stopThreads() either way.
-  UserWorld user(btVector3(0, 0, 0));
-  Material material;
-  FemBody* bar =
-      user.fem.addBody("bar", makeBoxTetMesh({0, 0, 0}, {0.4, 0.4, 2}, 1, 1, 4).value(), material)
-          .value();
-  Hand hand(*bar);
-  haptics::DeviceMapping mapping;
-  mapping.anchor.origin = Eigen::Vector3d(0.2, 0.2, 1.9);
-  haptics::HandCoupling coupling(hand, mapping, haptics::CouplingSettings{});
-  const device::Trajectory hold({{0, device::Pose{}}, {10, device::Pose{}}}, {{0, 1u}});
-  device::ScriptedDevice scripted(hold, device::defaultDeviceLimits(), "hold");
-  device::HapticLoop loop(scripted, device::HapticLoopSettings{});
-  haptics::HapticRuntime runtime(user.fem, {{&coupling, &loop, 1000}});
+  HeldBar rig;
   int policy_before = -1, policy = -1;
   sched_param before{}, during{};
   ASSERT_EQ(pthread_getschedparam(pthread_self(), &policy_before, &before), 0);
-  runtime.setSimulationPriority(40);
-  runtime.startThreads();
+  rig.runtime.setSimulationPriority(40);
+  rig.runtime.startThreads();
   ASSERT_EQ(pthread_getschedparam(pthread_self(), &policy, &during), 0);
-  if (runtime.simulationRealtime()) {
+  if (rig.runtime.simulationRealtime()) {
     EXPECT_EQ(policy, SCHED_FIFO);
     EXPECT_EQ(during.sched_priority, 40);
   } else {
     EXPECT_EQ(policy, policy_before);  // refused: unchanged
   }
   for (int call = 0; call < 5; ++call) {
-    user.world.stepSimulation(btScalar(1 / 60.), 10, btScalar(1 / 240.));
-    ASSERT_TRUE(user.fem.status().ok) << user.fem.status().message;
+    rig.user.world.stepSimulation(btScalar(1 / 60.), 10, btScalar(1 / 240.));
+    ASSERT_TRUE(rig.user.fem.status().ok) << rig.user.fem.status().message;
   }
-  runtime.stopThreads();
+  rig.runtime.stopThreads();
   sched_param after{};
   ASSERT_EQ(pthread_getschedparam(pthread_self(), &policy, &after), 0);
   EXPECT_EQ(policy, policy_before);
   EXPECT_EQ(after.sched_priority, before.sched_priority);
-  EXPECT_FALSE(runtime.simulationRealtime());
+  EXPECT_FALSE(rig.runtime.simulationRealtime());
 }
 
 }  // namespace
