@@ -10,27 +10,11 @@ torsion=$2
 assets=$3
 scenes=$(cd "$(dirname "$0")/../../demos/scenes" && pwd)
 
-work=$(mktemp -d "${TMPDIR:-/tmp}/torsion-check-test-XXXXXX")
-trap 'rm -rf "$work"' EXIT
-cd "$work" || exit 1
-
-fail() {
-  echo "FAIL: $*" >&2
-  exit 1
-}
-
-run() {  # keeps the exit code in $rc and stdout+stderr in $out
-  out=$("$@" 2>&1)
-  rc=$?
-  printf '%s\n' "$out"
-}
+work_name=torsion-check-test
+source "$(dirname "$0")/case_helpers.sh"
 
 expect_rc() {
   [[ $rc -eq $1 ]] || fail "exit code $rc, expected $1"
-}
-
-expect_out() {
-  grep -Eq -- "$1" <<<"$out" || fail "output does not match: $1"
 }
 
 # twist RUN_DIR [THREADS] [SED]: 20 steps of the 2430-tet cylinder twisted by its hand.

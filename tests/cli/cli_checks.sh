@@ -13,29 +13,12 @@ peer=${4:-}
 plugin=${5:-}
 scenes=$(cd "$(dirname "$0")/../../demos/scenes" && pwd)
 
-work=$(mktemp -d "${TMPDIR:-/tmp}/torsion-cli-test-XXXXXX")
-trap 'rm -rf "$work"' EXIT
-cd "$work" || exit 1
-
-fail() {
-  echo "FAIL: $*" >&2
-  exit 1
-}
-
-# run CMD...: runs it, keeping its exit code in $rc and its stdout+stderr in $out.
-run() {
-  out=$("$@" 2>&1)
-  rc=$?
-  printf '%s\n' "$out"
-}
+work_name=torsion-cli-test
+source "$(dirname "$0")/case_helpers.sh"
 
 expect_rc() {  # expect_rc 0|nonzero
   if [[ $1 == 0 && $rc -ne 0 ]]; then fail "exit code $rc, expected 0"; fi
   if [[ $1 == nonzero && $rc -eq 0 ]]; then fail "exit code 0, expected non-zero"; fi
-}
-
-expect_out() {  # expect_out REGEX (extended, matched against the whole output)
-  grep -Eq -- "$1" <<<"$out" || fail "output does not match: $1"
 }
 
 # Value of one `torsion mesh info` field, e.g. info_field tets FILE.
@@ -44,10 +27,8 @@ info_field() {
 }
 
 need_tetgen() {
-  if ! command -v tetgen >/dev/null 2>&1; then
-    echo "SKIP: the 'tetgen' command is not on PATH (Debian package 'tetgen')"
-    exit 77
-  fi
+  command -v tetgen >/dev/null 2>&1 ||
+    skip "the 'tetgen' command is not on PATH (Debian package 'tetgen')"
 }
 
 # A closed cube [0,2]^3 in each surface format (outward triangles).
@@ -149,15 +130,6 @@ check_cube_mesh() {  # check_cube_mesh MESH: a valid mesh of volume exactly 8
   [[ -n $tets && $tets -ge 6 ]] || fail "expected at least 6 tets in $1, got '$tets'"
   [[ $volume == 8 ]] || fail "expected volume 8 for the cube in $1, got '$volume'"
   echo "ok: $1: $tets tets, volume $volume"
-}
-
-# A short device trajectory: button 1 at 0 s grabs, a turn about z at 0.5 rad/s for 0.6 s, a
-# hold, button 2 at 0.8 s releases; the peer holds the end for 0.5 s more.
-write_short_turn() {
-  cat >"$1" <<'EOF'
-{"segments": [{"duration": 0.6, "angular_velocity": [0, 0, 0.5]}, {"duration": 0.4}],
- "buttons": [{"time": 0, "held": [1]}, {"time": 0.8, "held": [2]}]}
-EOF
 }
 
 # check_haptic_outputs DIR MODE: the haptic log and stats exist; the wrench written to the device

@@ -6,17 +6,11 @@ set -uo pipefail
 
 case_name=$1
 torsion=$2
-work=$(mktemp -d "${TMPDIR:-/tmp}/torsion-mesh-test-XXXXXX")
-trap 'rm -rf "$work"' EXIT
-cd "$work" || exit 1
-
-fail() {
-  echo "FAIL: $*" >&2
-  exit 1
-}
+work_name=torsion-mesh-test
+source "$(dirname "$0")/case_helpers.sh"
 
 need() {
-  command -v "$1" >/dev/null 2>&1 || { echo "SKIP: the '$1' command is not on PATH"; exit 77; }
+  command -v "$1" >/dev/null 2>&1 || skip "the '$1' command is not on PATH"
 }
 
 field() {  # field NAME MESH: one value of `torsion mesh info`

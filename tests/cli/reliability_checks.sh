@@ -12,30 +12,11 @@ shim=${4:-}
 peer=${5:-}
 scenes=$(cd "$(dirname "$0")/../../demos/scenes" && pwd)
 
-work=$(mktemp -d "${TMPDIR:-/tmp}/torsion-reliability-XXXXXX")
-trap 'rm -rf "$work"' EXIT
-cd "$work" || exit 1
+work_name=torsion-reliability
+source "$(dirname "$0")/case_helpers.sh"
 
-fail() {
-  echo "FAIL: $*" >&2
-  exit 1
-}
-skip() {
-  echo "SKIP: $*"
-  exit 77
-}
-
-# run CMD...: runs it, keeping its exit code in $rc and its stdout+stderr in $out.
-run() {
-  out=$("$@" 2>&1)
-  rc=$?
-  printf '%s\n' "$out"
-}
 expect_rc() {  # expect_rc N
   [[ $rc -eq $1 ]] || fail "exit code $rc, expected $1"
-}
-expect_out() {  # expect_out REGEX (extended, matched against each line of the output)
-  grep -Eq -- "$1" <<<"$out" || fail "output does not match: $1"
 }
 # json_field FILE KEY: a top-level value of a JSON file, as Python prints it.
 json_field() {
@@ -103,13 +84,6 @@ stop_with() {
   "$torsion" mesh info out/cylinder.vtk >/dev/null || fail "the final mesh does not read back"
   [[ -s out/haptic_hand.csv ]] || fail "the haptic log was not written"
   no_temporaries out
-}
-
-write_short_turn() {
-  cat >"$1" <<'JSON'
-{"segments": [{"duration": 0.6, "angular_velocity": [0, 0, 0.5]}, {"duration": 0.4}],
- "buttons": [{"time": 0, "held": [1]}, {"time": 0.8, "held": [2]}]}
-JSON
 }
 
 # with_full_disk PATTERN AFTER CMD...: runs CMD with writes to files matching PATTERN failing
