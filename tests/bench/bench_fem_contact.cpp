@@ -17,10 +17,11 @@
 // time); the step itself is timed without it.
 //
 //   bench_fem_contact SCENE.json... [--steps N] [--tolerance M] [--bullet-margin M]
-//                     [--bullet-substeps K] [--bullet-ground-box] [--bullet-only]
+//                     [--bullet-substeps K] [--bullet-ground-box] [--only RUN]...
 // --tolerance: interpenetration allowed (default 1 % of the smallest body); --bullet-margin:
 // Bullet's soft body margin (default 0.01 m); --bullet-substeps: Bullet steps per scene step;
-// --bullet-ground-box: Bullet's ground a big box, as in its demos, instead of the scene's plane.
+// --bullet-ground-box: Bullet's ground a big box, as in its demos, instead of the scene's plane;
+// --only: just these runs (torsion, torsion_no_fem_contact, bullet), e.g. one per callgrind run.
 
 #include <time.h>
 
@@ -208,6 +209,13 @@ double sum(const std::vector<double>& v) {
   return s;
 }
 
+// The q-quantile of the step times (q = 0.5: median, 1: the slowest step).
+double quantile(std::vector<double> v, double q) {
+  if (v.empty()) return 0;
+  std::sort(v.begin(), v.end());
+  return v[static_cast<size_t>(q * static_cast<double>(v.size() - 1) + 0.5)];
+}
+
 nlohmann::json row(const scene::SceneSpec& spec, const std::vector<TetMesh>& rest,
                    const std::vector<std::vector<double>>& masses, const bench::Motion& start,
                    const std::string& engine, Run& run, double tolerance) {
@@ -227,6 +235,8 @@ nlohmann::json row(const scene::SceneSpec& spec, const std::vector<TetMesh>& res
       {"steps_per_cpu_second", sum(run.cpu_ms) > 0 ? 1000.0 * n / sum(run.cpu_ms) : 0},
       {"steps_per_wall_second", sum(run.wall_ms) > 0 ? 1000.0 * n / sum(run.wall_ms) : 0},
       {"cpu_ms_per_step", perStep(run.cpu_ms)},
+      {"cpu_ms_median_step", quantile(run.cpu_ms, 0.5)},
+      {"cpu_ms_slowest_step", quantile(run.cpu_ms, 1)},
       {"detect_cpu_ms_per_step", perStep(run.detect_cpu_ms)},
       {"max_node_speed", run.end.max_node_speed},
       {"exploded", demo.exploded},
@@ -254,7 +264,7 @@ int main(int argc, char** argv) {
   int steps = -1;
   double tolerance = -1;
   bench::MixOptions bullet_options;
-  bool bullet_only = false;
+  std::vector<std::string> only;
   for (int a = 1; a < argc; ++a) {
     if (std::strcmp(argv[a], "--bullet-margin") == 0 && a + 1 < argc) {
       bullet_options.margin = std::atof(argv[++a]);
@@ -262,8 +272,8 @@ int main(int argc, char** argv) {
       bullet_options.substeps = std::atoi(argv[++a]);
     } else if (std::strcmp(argv[a], "--bullet-ground-box") == 0) {
       bullet_options.ground_as_box = true;
-    } else if (std::strcmp(argv[a], "--bullet-only") == 0) {
-      bullet_only = true;
+    } else if (std::strcmp(argv[a], "--only") == 0 && a + 1 < argc) {
+      only.emplace_back(argv[++a]);
     } else if (std::strcmp(argv[a], "--steps") == 0 && a + 1 < argc) {
       steps = std::atoi(argv[++a]);
     } else if (std::strcmp(argv[a], "--tolerance") == 0 && a + 1 < argc) {
@@ -276,6 +286,9 @@ int main(int argc, char** argv) {
     std::cerr << "usage: bench_fem_contact SCENE.json... [--steps N] [--tolerance M]\n";
     return 1;
   }
+  auto wanted = [&](const std::string& run) {
+    return only.empty() || std::find(only.begin(), only.end(), run) != only.end();
+  };
   for (const std::string& path : paths) {
     Result<scene::SceneSpec> loaded = scene::loadScene(path);
     if (!loaded) {
@@ -311,11 +324,11 @@ int main(int argc, char** argv) {
     const bench::Motion start =
         bench::motionOf(masses, x0, bench::initialVelocities(spec, rest, masses));
 
-    if (!bullet_only) {
+    if (wanted("torsion")) {
       Run torsion = runTorsion(spec, n, rest, tol);
       std::cout << row(spec, rest, masses, start, "torsion", torsion, tol).dump() << std::endl;
     }
-    if (!bullet_only && spec.fem_contact && spec.bodies.size() >= 2) {
+    if (wanted("torsion_no_fem_contact") && spec.fem_contact && spec.bodies.size() >= 2) {
       scene::SceneSpec off = spec;
       off.fem_contact.reset();
       Run apart = runTorsion(off, n, rest, tol);
@@ -324,6 +337,7 @@ int main(int argc, char** argv) {
     }
     const bool tet10 = std::any_of(spec.bodies.begin(), spec.bodies.end(),
                                    [](const auto& b) { return b.element != ElementKind::kTet4; });
+    if (!wanted("bullet")) continue;
     if (!spec.hands.empty() || tet10) {
       std::cout << nlohmann::json{{"scene", spec.name},
                                   {"engine", "bullet"},
