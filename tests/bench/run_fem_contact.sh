@@ -4,8 +4,9 @@
 # instruction counts (callgrind: exact, whatever the machine's load) of each run's step and of
 # its contact detection.
 #
-#   tests/bench/run_fem_contact.sh [--instructions] [SCENE...]   (from the repository root,
-#                                                                 after building bench_fem_contact)
+#   tests/bench/run_fem_contact.sh [--instructions [--instruction-steps N]] [SCENE...]
+#   (from the repository root, after building bench_fem_contact; N: steps per callgrind run,
+#   default 60, the collide scenes' whole run and soft_stack's ball impact, ~1-3 min each)
 #
 # Bullet runs twice: with the runner's settings (margin 0.01 m, one Bullet step per scene step)
 # and with its contact demos' (margin 0.1 m on the 4 m cubes as Collide, 0.025 m on the 0.2 m
@@ -15,12 +16,15 @@ set -euo pipefail
 
 bench=build/tests/bench/bench_fem_contact
 instructions=0
+instruction_steps=60
 scenes=()
-for arg in "$@"; do
-  case "$arg" in
+while [ $# -gt 0 ]; do
+  case "$1" in
     --instructions) instructions=1 ;;
-    *) scenes+=("$arg") ;;
+    --instruction-steps) instruction_steps=$2; shift ;;
+    *) scenes+=("$1") ;;
   esac
+  shift
 done
 if [ ${#scenes[@]} -eq 0 ]; then
   scenes=(bullet_collide_soft bullet_collide_moving soft_stack soft_grasp)
@@ -46,14 +50,16 @@ echo "# load after: $(cut -d' ' -f1-3 /proc/loadavg)"
 # Inclusive instructions of the named functions, per run (callgrind_annotate's names).
 count() {  # out-file function-pattern
   callgrind_annotate --inclusive=yes --threshold=100 "$1" 2>/dev/null |
-    awk -v pattern="$2" 'index($0, pattern) { gsub(",", "", $1); sum += $1 } END { print sum + 0 }'
+    awk -v pattern="$2" 'index($0, pattern) { gsub(",", "", $1); sum += $1 } END { printf "%.0f\n", sum }'
 }
 out=$(mktemp -d)
 for scene in "${scenes[@]}"; do
   file=demos/scenes/$scene.json
   for run in torsion torsion_no_fem_contact bullet; do
     valgrind --tool=callgrind --callgrind-out-file="$out/$scene.$run" "$bench" "$file" \
-      --only "$run" --bullet-ground-box > "$out/$scene.$run.json" 2> /dev/null
+      --only "$run" --bullet-ground-box --steps "$instruction_steps" > "$out/$scene.$run.json" \
+      2> "$out/$scene.$run.err" ||
+      { echo "# $scene $run: failed: $(tail -n 1 "$out/$scene.$run.err")"; continue; }
     [ -s "$out/$scene.$run.json" ] || continue
     steps=$(/usr/bin/python3 -c "import json,sys; print(json.loads(open(sys.argv[1]).readline()).get('steps', 0))" "$out/$scene.$run.json")
     [ "$steps" -gt 0 ] || continue
