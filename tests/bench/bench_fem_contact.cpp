@@ -17,11 +17,12 @@
 // time); the step itself is timed without it.
 //
 //   bench_fem_contact SCENE.json... [--steps N] [--tolerance M] [--bullet-margin M]
-//                     [--bullet-substeps K] [--bullet-ground-box] [--only RUN]...
+//                     [--bullet-substeps K] [--bullet-ground-box] [--only RUN]... [--per-step]
 // --tolerance: interpenetration allowed (default 1 % of the smallest body); --bullet-margin:
 // Bullet's soft body margin (default 0.01 m); --bullet-substeps: Bullet steps per scene step;
 // --bullet-ground-box: Bullet's ground a big box, as in its demos, instead of the scene's plane;
-// --only: just these runs (torsion, torsion_no_fem_contact, bullet), e.g. one per callgrind run.
+// --only: just these runs (torsion, torsion_no_fem_contact, bullet), e.g. one per callgrind run;
+// --per-step: each step's CPU ms, detection ms (and Torsion's Uzawa updates, converged) too.
 
 #include <time.h>
 
@@ -63,6 +64,9 @@ struct Run {
   int fem_candidates_max = 0;  // Torsion: node-triangle candidates, most in a step
   int fem_iterations_max = 0;  // Torsion: Uzawa updates, most in a step
   int fem_unconverged = 0;     // Torsion: steps whose FEM pair contact did not converge
+  // Torsion, per step: Uzawa updates and whether FEM pair contact converged (--per-step).
+  std::vector<int> fem_iterations;
+  std::vector<bool> fem_converged;
 };
 
 // Tracks the deepest interpenetration over the steps.
@@ -156,6 +160,8 @@ Run runTorsion(const scene::SceneSpec& spec, int steps, const std::vector<TetMes
       run.fem_candidates_max = std::max(run.fem_candidates_max, stats.candidates);
       run.fem_iterations_max = std::max(run.fem_iterations_max, stats.iterations);
       if (!stats.converged) ++run.fem_unconverged;
+      run.fem_iterations.push_back(stats.iterations);
+      run.fem_converged.push_back(stats.converged);
     }
     if (!r.ok) {
       run.error = r.message;
@@ -218,7 +224,7 @@ double quantile(std::vector<double> v, double q) {
 
 nlohmann::json row(const scene::SceneSpec& spec, const std::vector<TetMesh>& rest,
                    const std::vector<std::vector<double>>& masses, const bench::Motion& start,
-                   const std::string& engine, Run& run, double tolerance) {
+                   const std::string& engine, Run& run, double tolerance, bool per_step) {
   const double n = static_cast<double>(run.cpu_ms.size());
   run.contact.finite = run.end.finite;
   run.contact.nodes = run.end.nodes;
@@ -253,6 +259,21 @@ nlohmann::json row(const scene::SceneSpec& spec, const std::vector<TetMesh>& res
     j["fem_iterations_max"] = run.fem_iterations_max;
     j["fem_unconverged_steps"] = run.fem_unconverged;
   }
+  if (per_step) {
+    // [CPU ms, detection CPU ms, Uzawa updates, converged] per step (updates and converged for
+    // Torsion with FEM contact only).
+    nlohmann::json steps = nlohmann::json::array();
+    for (size_t k = 0; k < run.cpu_ms.size(); ++k) {
+      nlohmann::json step = {run.cpu_ms[k],
+                             k < run.detect_cpu_ms.size() ? run.detect_cpu_ms[k] : 0};
+      if (k < run.fem_iterations.size()) {
+        step.push_back(run.fem_iterations[k]);
+        step.push_back(run.fem_converged[k]);
+      }
+      steps.push_back(step);
+    }
+    j["per_step"] = steps;
+  }
   if (!run.error.empty()) j["error"] = run.error;
   return j;
 }
@@ -265,6 +286,7 @@ int main(int argc, char** argv) {
   double tolerance = -1;
   bench::MixOptions bullet_options;
   std::vector<std::string> only;
+  bool per_step = false;
   for (int a = 1; a < argc; ++a) {
     if (std::strcmp(argv[a], "--bullet-margin") == 0 && a + 1 < argc) {
       bullet_options.margin = std::atof(argv[++a]);
@@ -272,6 +294,8 @@ int main(int argc, char** argv) {
       bullet_options.substeps = std::atoi(argv[++a]);
     } else if (std::strcmp(argv[a], "--bullet-ground-box") == 0) {
       bullet_options.ground_as_box = true;
+    } else if (std::strcmp(argv[a], "--per-step") == 0) {
+      per_step = true;
     } else if (std::strcmp(argv[a], "--only") == 0 && a + 1 < argc) {
       only.emplace_back(argv[++a]);
     } else if (std::strcmp(argv[a], "--steps") == 0 && a + 1 < argc) {
@@ -326,14 +350,16 @@ int main(int argc, char** argv) {
 
     if (wanted("torsion")) {
       Run torsion = runTorsion(spec, n, rest, tol);
-      std::cout << row(spec, rest, masses, start, "torsion", torsion, tol).dump() << std::endl;
+      std::cout << row(spec, rest, masses, start, "torsion", torsion, tol, per_step).dump()
+                << std::endl;
     }
     if (wanted("torsion_no_fem_contact") && spec.fem_contact && spec.bodies.size() >= 2) {
       scene::SceneSpec off = spec;
       off.fem_contact.reset();
       Run apart = runTorsion(off, n, rest, tol);
-      std::cout << row(off, rest, masses, start, "torsion_no_fem_contact", apart, tol).dump()
-                << std::endl;
+      std::cout
+          << row(off, rest, masses, start, "torsion_no_fem_contact", apart, tol, per_step).dump()
+          << std::endl;
     }
     const bool tet10 = std::any_of(spec.bodies.begin(), spec.bodies.end(),
                                    [](const auto& b) { return b.element != ElementKind::kTet4; });
@@ -347,7 +373,7 @@ int main(int argc, char** argv) {
       continue;
     }
     Run bullet = runBullet(spec, n, rest, tol, bullet_options);
-    nlohmann::json j = row(spec, rest, masses, start, "bullet", bullet, tol);
+    nlohmann::json j = row(spec, rest, masses, start, "bullet", bullet, tol, per_step);
     j["bullet_margin"] = bullet_options.margin;
     j["bullet_substeps"] = bullet_options.substeps;
     j["bullet_ground_box"] = bullet_options.ground_as_box;
