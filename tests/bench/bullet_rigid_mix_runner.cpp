@@ -323,7 +323,8 @@ MixRun runBulletMix(const scene::SceneSpec& spec, int steps, const MixOptions& o
     const double cpu0 = processCpuMs();
     const Clock::time_point t0 = Clock::now();
     for (int sub = 0; sub < substeps; ++sub) {
-      const double t_next = k * dt + (sub + 1) * h;
+      const double t_next =
+          (k + static_cast<double>(sub + 1) / substeps) * dt;  // (k + 1) dt for one
       next_time = t_next;
       for (const DrivenNode& d : driven) {
         btSoftBody::Node& node = d.body->m_nodes[d.node];
