@@ -139,6 +139,15 @@ Verdict judge(const scene::SceneSpec& spec, const std::vector<TetMesh>& rest, co
     ok = box.origin.z() + 2 < c.z() && std::abs(travelled - expected) < 0.05 * expected;
     d << "; box z " << box.origin.z() << "; centre of mass moved " << travelled
       << " m (momentum: " << expected << ")";
+  } else if (spec.name == "bullet_collide_moving") {
+    // The same pair thrown at each other at 15 m/s each: no momentum, so the centre of mass of
+    // box + cube (equal masses) stays at (7 - 2) / 2 = 2.5 m; 0.75 m allowed as above (5 % of
+    // the 15 m each body would travel), and the box stays below the cube.
+    const Frame& box = end.rigid[static_cast<size_t>(rigidIndex(spec, "box"))];
+    const double travelled = (box.origin.z() + c.z()) / 2 - 2.5;
+    ok = box.origin.z() + 2 < c.z() && std::abs(travelled) < 0.75;
+    d << "; box z " << box.origin.z() << "; centre of mass moved " << travelled
+      << " m (momentum: 0)";
   } else if (spec.name == "bullet_volumetric_deformable") {
     // The cube came to rest on the ground inside the four walls, under the boxes that fell on it.
     ok = lowestZ(cube) > -tolerance && c.z() > 1 && c.z() < 3;
