@@ -116,7 +116,7 @@ void HapticLoop::tick(double now, double deadline) {
       Wrench jump;
       if (fresh && previous_step.step > 0 && previous_step.grabbed)
         jump = desired + (-1.0) * renderLocalModel(previous_step, sample.pose, twist,
-                                                    settings_.damper, &limits_);
+                                                   settings_.damper, &limits_);
       blend_.update(jump, dt);
       desired = desired + blend_.offset();
     }
