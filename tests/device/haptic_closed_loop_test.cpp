@@ -292,14 +292,14 @@ TEST(HapticClosedLoop, ADelayedSlowTwistStaysPassiveAndFeelsTheUndelayedTorqueUn
     const ClosedTrace controlled = runClosedLoop(c);
     std::printf(
         "slow twist, delay %.0f ms (blend 5 Hz): uncontrolled E_obs %.3g J at 1 s, %.3g J at 3 "
-        "s, off the undelayed twist by %.3g rad in 0.1-0.3 s, %.3g in 2.5-3 s; rate-limited: max "
-        "E_obs %.3g J, largest "
-        "step %.3g N m, swing %.3g -> %.3g rad, torque %.4f N m (undelayed uncontrolled %.4f, "
-        "%+.2f %%), %llu active ticks\n",
+        "s, off the undelayed twist by %.3g rad in 0.1-0.3 s, %.3g in 2.5-3 s; rate-limited: "
+        "max E_obs %.3g J, largest step %.3g N m, swing %.3g -> %.3g rad, torque %.4f N m at "
+        "%.5f rad (undelayed uncontrolled %.4f at %.5f, %+.2f %%), %llu active ticks\n",
         1e3 * delay, free.energyAt(1), free.energyAt(3), free.deviation(reference, 0.1, 0.3),
         free.deviation(reference, 2.5, 3), controlled.max_energy, controlled.max_torque_step,
         controlled.swing(1, 1.5), controlled.swing(2.5, 3),
-        controlled.mean(controlled.torque, 2, 3), torque,
+        controlled.mean(controlled.torque, 2, 3), controlled.mean(controlled.angle, 2, 3), torque,
+        reference.mean(reference.angle, 2, 3),
         100 * (controlled.mean(controlled.torque, 2, 3) / torque - 1),
         static_cast<unsigned long long>(controlled.active));
     // Uncontrolled: the port gains energy, far beyond the 0.14 mJ the twisted body holds at the
