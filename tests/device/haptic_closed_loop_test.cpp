@@ -30,6 +30,7 @@ struct ClosedLoop {
   double tilt_damping = -1;  // N m s/rad about x and y (the grip); negative: wrist_damping
   double duration = 2;
   double step_blend_hz = 0;  // HapticLoopSettings::step_blend_hz
+  Rendering rendering = Rendering::kInternalForce;
 };
 
 struct ClosedTrace {
@@ -79,6 +80,7 @@ ClosedTrace runClosedLoop(const ClosedLoop& c) {
   SolverSettings solver;  // dt = 0.01, CG, as the twist scenes
   CouplingSettings coupling;
   coupling.stiffness_refresh_steps = c.local_stiffness ? 10 : 0;
+  coupling.rendering = c.rendering;
   DeviceMapping mapping;
   mapping.force_scale = 1e-4;  // G J / L = 6e5 N m/rad in the world: 60 N m/rad at the device
   mapping.torque_scale = 1e-4;
@@ -355,6 +357,40 @@ TEST(HapticClosedLoop, TheRateLimitedControllerKeepsAFastTurnPassiveButTheHandSi
     EXPECT_LE(reserve.max_torque_step, rate_step * (1 + 1e-9));
     EXPECT_LE(reserve.max_energy, 1.4e-6);
     EXPECT_GT(reserve.mean(reserve.angle, 1.5, 2), 5 * dead_beat.mean(dead_beat.angle, 1.5, 2));
+  }
+}
+
+// The report's frame-difference rendering through the same loop, under the default controller
+// and under the rate-limited one: a spring of E c_t = 1e7 * 0.05 m^3, 50 N m/rad at the device,
+// to the grab pose. The slow twist (firm grip, no delay) is felt as that spring.
+TEST(HapticClosedLoop, TheFrameDifferenceRenderingIsFeltAsItsSpringUnderEitherController) {
+  // Its K_h = diag(-E c_f, -E c_t) is exact, so the local model is the spring of the current
+  // pose and bridges the delay: passive, and felt as the spring, at 0 and at 50 ms.
+  ClosedLoop c;
+  c.local_stiffness = true;
+  c.rendering = Rendering::kFrameDifference;
+  c.twist_time = 1.5;
+  c.wrist_damping = 1.0;
+  c.tilt_damping = 10;
+  c.duration = 3;
+  const double spring = 1e7 * CouplingSettings{}.torque_coefficient * 1e-4;  // N m/rad
+  for (double delay : {0.0, 0.05}) {
+    for (bool rate_limited : {false, true}) {
+      SCOPED_TRACE(delay);
+      SCOPED_TRACE(rate_limited);
+      c.delay = delay;
+      c.rate_limited = rate_limited;
+      const ClosedTrace t = runClosedLoop(c);
+      const double felt = -t.mean(t.torque, 2, 3) / t.mean(t.angle, 2, 3);
+      std::printf(
+          "frame difference, delay %.0f ms, %s: felt %.2f N m/rad (spring %.1f), max E_obs %.3g "
+          "J, %llu active ticks, largest step %.3g N m\n",
+          1e3 * delay, rate_limited ? "rate-limited" : "dead-beat", felt, spring, t.max_energy,
+          static_cast<unsigned long long>(t.active), t.max_torque_step);
+      EXPECT_NEAR(felt, spring, 0.02 * spring);
+      EXPECT_LE(t.max_energy, 1e-6);
+      EXPECT_LT(t.swing(2.5, 3), 1e-3);
+    }
   }
 }
 
