@@ -6,7 +6,8 @@
 //      enabled; button 2 pressed -> a release request and force disabled;
 //   3. hand the simulation a HandCommand (lock-free, commands());
 //   4. take the newest SimulationWrench (lock-free, wrenches()) and render the local model
-//      W_sim + K_h dpose - B twist (local_wrench_model.h);
+//      W_sim + K_h dpose - B twist (local_wrench_model.h), a new step's change blended in when
+//      step_blend_hz is set (step_blend.h);
 //   5. pass the wrench through the SafetyFilter, let the passivity controller (passivity.h) take
 //      back the generated energy (the dead-beat damper on top of the filter's output, or the
 //      rate-limited controller within the filter's rate limit, the filter then following what
