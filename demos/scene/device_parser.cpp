@@ -87,6 +87,7 @@ void readLoop(const JsonObject& d, DeviceSpec& spec) {
   device::HapticLoopSettings& l = spec.loop;
   l.rate_hz = d.number("rate_hz", l.rate_hz);
   if (!(l.rate_hz > 0 && l.rate_hz <= 20000)) d.fail("rate_hz", "must be in (0, 20000] Hz");
+  l.step_blend_hz = nonNegative(d, "step_blend_hz", l.step_blend_hz, " Hz");
   if (d.has("damper")) {
     const JsonObject o = d.object("damper");
     l.damper.linear = nonNegative(o, "linear", l.damper.linear, " N s/m");

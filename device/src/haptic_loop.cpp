@@ -43,6 +43,8 @@ std::string HapticLoopSettings::validate() const {
   if (!(rate_hz > 0 && rate_hz <= 20000)) return "rate_hz must be in (0, 20000]";
   if (!(damper.linear >= 0) || !(damper.angular >= 0)) return "damper must be non-negative";
   if (!(twist_cutoff_hz > 0)) return "twist_cutoff_hz must be positive";
+  if (!(step_blend_hz >= 0 && std::isfinite(step_blend_hz)))
+    return "step_blend_hz must be non-negative (Hz)";
   if (realtime_priority < 0 || realtime_priority > 99)
     return "realtime_priority must be in [0, 99]";
   if (std::string bad = passivity.validate(); !bad.empty()) return bad;
@@ -55,7 +57,8 @@ HapticLoop::HapticLoop(HapticDevice& device, const HapticLoopSettings& settings)
       limits_(device.limits()),
       safety_(settings.safety, limits_),
       twist_(settings.twist_cutoff_hz),
-      passivity_(settings.passivity) {
+      passivity_(settings.passivity),
+      blend_(settings.step_blend_hz) {
   log_.reserve(settings.log_capacity);
 }
 
@@ -100,12 +103,25 @@ void HapticLoop::tick(double now, double deadline) {
   commands_.write(command);
 
   // 4. newest simulation wrench and the local model around it
+  const SimulationWrench previous_step = simulated_;
   const bool fresh = wrenches_.read(simulated_);
   if (fresh) last_fresh_time_ = now;
   const bool published = simulated_.step > 0;
   Wrench desired;
   if (published && simulated_.grabbed) {
     desired = renderLocalModel(simulated_, sample.pose, twist, settings_.damper, &limits_);
+    if (blend_.enabled()) {
+      // A new step of the same grab comes in through the blend (step_blend.h); a new grab
+      // starts from the model.
+      Wrench jump;
+      if (fresh && previous_step.step > 0 && previous_step.grabbed)
+        jump = desired + (-1.0) * renderLocalModel(previous_step, sample.pose, twist,
+                                                   settings_.damper, &limits_);
+      blend_.update(jump, dt);
+      desired = desired + blend_.offset();
+    }
+  } else {
+    blend_.reset();
   }
   if (!isFinite(desired)) {
     ++stats_.nonfinite;

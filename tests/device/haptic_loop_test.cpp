@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <thread>
 
@@ -72,6 +73,33 @@ TEST(HapticLoop, LocalModelAndDamperBetweenSteps) {
   const double moving[6] = {0.5, 0, 0, 0, 0, 0};
   const Wrench d = renderLocalModel(sim, sim.pose, moving, CouplingDamper{3, 0});
   EXPECT_NEAR(d.force.x, -2 - 1.5, 1e-12);  // the damper opposes the velocity
+}
+
+TEST(StepBlend, ANewStepComesInThroughAFirstOrderLowPassAndTheStaticWrenchIsTheModels) {
+  // The model at the hand's pose jumps by 1 N m (a new step); rendered, model + offset rises
+  // from the old value to the new one as 1 - exp(-t / tau), tau = 1 / (2 pi 5 Hz) = 31.8 ms.
+  StepBlend blend(5);
+  const double tau = 1 / (2 * M_PI * 5);
+  blend.update(Wrench{{}, {0, 0, 1}}, kDt);
+  EXPECT_NEAR(blend.offset().torque.z, -std::exp(-kDt / tau), 1e-12);  // one tick's worth in
+  for (int k = 1; k < 32; ++k)
+    blend.update(Wrench{}, kDt);
+  EXPECT_NEAR(1 + blend.offset().torque.z, 1 - std::exp(-0.032 / tau), 1e-12);  // 63 % in
+  for (int k = 0; k < 1000; ++k)
+    blend.update(Wrench{}, kDt);
+  EXPECT_LT(std::abs(blend.offset().torque.z), 1e-12);  // at rest: the model's wrench exactly
+  blend.update(Wrench{{0, 0, std::nan("")}, {}}, kDt);  // never NaN
+  EXPECT_EQ(blend.offset().force.z, 0.0);
+  blend.update(Wrench{{2, 0, 0}, {}}, kDt);
+  blend.reset();  // a new grab starts from the model
+  EXPECT_EQ(blend.offset().force.x, 0.0);
+  StepBlend off;  // 0 Hz: off
+  off.update(Wrench{{2, 0, 0}, {}}, kDt);
+  EXPECT_FALSE(off.enabled());
+  EXPECT_EQ(off.offset().force.x, 0.0);
+  HapticLoopSettings settings;
+  settings.step_blend_hz = -1;
+  EXPECT_EQ(settings.validate(), "step_blend_hz must be non-negative (Hz)");
 }
 
 TEST(HapticLoop, ThePredictionFromTheLocalStiffnessIsBoundedByTheDeviceLimits) {

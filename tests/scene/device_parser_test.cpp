@@ -30,7 +30,7 @@ TEST(DeviceParser, ReadsAScriptedDeviceWithEverySetting) {
       "speed": 10, "mapping": {"position_scale": 10, "force_scale": 0.1, "torque_scale": 0.01},
       "rendering": "frame_difference",
       "coupling": {"force_coefficient": 0.2, "torque_coefficient": 0.04, "stiffness_refresh_steps": 5},
-      "limits": {"max_force": 12, "max_torque": 1.5}, "rate_hz": 500,
+      "limits": {"max_force": 12, "max_torque": 1.5}, "rate_hz": 500, "step_blend_hz": 5,
       "damper": {"linear": 2, "angular": 0.1},
       "passivity": {"enabled": true, "length_scale": 0.05, "rate_limited": true,
                     "speed_hold_time": 0.2, "speed_margin": 3, "energy_tolerance": 1e-5},
@@ -51,6 +51,7 @@ TEST(DeviceParser, ReadsAScriptedDeviceWithEverySetting) {
   EXPECT_EQ(d.max_force, 12);
   EXPECT_EQ(d.max_torque, 1.5);
   EXPECT_EQ(d.loop.rate_hz, 500);
+  EXPECT_EQ(d.loop.step_blend_hz, 5);
   EXPECT_EQ(d.loop.damper.linear, 2);
   EXPECT_EQ(d.loop.passivity.length_scale, 0.05);
   EXPECT_TRUE(d.loop.passivity.rate_limited);
