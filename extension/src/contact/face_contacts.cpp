@@ -458,7 +458,7 @@ void FaceContactSet::setSlipResistance(const Eigen::VectorXd& v,
   // indents them, so each face's slip, and with it the next solve's friction, turned by up to
   // 45 deg from step to step: the frictions' sum along the slope fell to 0.28 of the normal
   // impulse (mu = 0.3), and a box 1 deg below the friction angle kept sliding. The friction's
-  // linearisation in the slip, d f / d s = -(|f| / |s|)(P_t - d d^T) (d the friction's direction),
+  // linearisation in the slip, d f / d s = -(|f| / |s|)(P_t - d d^T) (d the slip's direction),
   // goes into the next solve: a slip across the friction meets the friction it would turn, and
   // the friction's direction follows the slip inside the solve. It is bounded by the penalty of a
   // stuck face (a slip slower than |f| / rho would have the face stick).
