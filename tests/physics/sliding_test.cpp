@@ -178,8 +178,7 @@ TEST(Sliding, BoxWithFrictionSlidesAsCoulombSaysOnAStiffSlab) {
 
 // The stick/slip threshold tan(a) = mu (16.7 deg for mu = 0.3), on a stiff slab: 1 deg below the
 // box stays (creep within 2 mm in 1 s), 1 deg above it slides as Coulomb says (8.9 cm in 1 s).
-// The box is dropped onto the slope, as before the settled start; settled first it holds too
-// (printed), and on the soft slab it creeps (printed; docs/validation.md, open).
+// The box is dropped onto the slope (settled first: the next test).
 TEST(Sliding, StiffSlabHoldsTheBoxBelowTheFrictionAngleAndLetsItSlideAbove) {
   Slope s;
   s.youngs_modulus = 1e8;
@@ -195,46 +194,75 @@ TEST(Sliding, StiffSlabHoldsTheBoxBelowTheFrictionAngleAndLetsItSlideAbove) {
             << " m (Coulomb " << coulomb << " m)\n";
   EXPECT_LT(std::abs(below), 2e-3);
   EXPECT_NEAR(above, coulomb, 0.15 * coulomb);
-  // Settled first, then pulled along the slope (open, printed only).
-  s.settle = true;
-  s.degrees = friction_angle - 1;
-  const double settled_below = slideDistance(s, 1.0);
-  s.youngs_modulus = 1e5;
-  const double soft_below = slideDistance(s, 1.0);
-  s.degrees = friction_angle + 1;
-  const double soft_above = slideDistance(s, 1.0);
-  std::cout << "[figures] sliding threshold, settled first (open, not asserted): stiff "
-            << friction_angle - 1 << " deg moved " << settled_below << " m; soft "
-            << friction_angle - 1 << " deg moved " << soft_below << " m, " << friction_angle + 1
-            << " deg moved " << soft_above << " m (Coulomb " << coulomb << " m)\n";
+}
+
+// The stick/slip threshold tan(a) = mu (16.7 deg for mu = 0.3) on soft and stiff, tet4 and tet10
+// slabs, the box settled first and then pulled along the slope. 1 deg below it the box should
+// stay: the slab's elastic shear under the pull (88 Pa over the box's 0.06 m2 in a 0.1 m layer)
+// moves it 0.23 mm on the soft slab (shear modulus 3.8e4 Pa) and 0.23 um on the stiff one. 1 deg
+// above it slides as Coulomb says (8.9 cm in 1 s). The stiff slabs hold within 0.1 mm and slide
+// within 5 %. The soft slabs still creep 3 mm in 1 s (13 times the elastic shear) and slide 9 to
+// 10 % too far (docs/validation.md, open); their bounds (5 mm, 12 %) hold what the friction's slip
+// resistance gained (docs/contact.md, "The friction's direction inside the solve"): before it the
+// box crept 3.1 cm below and went 25 % too far above.
+TEST(Sliding, BoxHoldsOneDegreeBelowTheFrictionAngleAndSlidesOneDegreeAboveOnEverySlab) {
+  struct Case {
+    double youngs_modulus;
+    int cells;
+    ElementKind element;
+    double held_bound;       ///< m in 1 s, 1 deg below
+    double above_tolerance;  ///< of Coulomb's distance, 1 deg above
+  };
+  const Case cases[] = {{1e5, 20, ElementKind::kTet4, 5e-3, 0.12},
+                        {1e8, 20, ElementKind::kTet4, 1e-4, 0.05},
+                        {1e5, 10, ElementKind::kTet10, 5e-3, 0.12},
+                        {1e8, 10, ElementKind::kTet10, 1e-4, 0.05}};
+  for (const Case& c : cases) {
+    Slope s;
+    s.youngs_modulus = c.youngs_modulus;
+    s.cells_along = c.cells;
+    s.element = c.element;
+    const double friction_angle = std::atan(s.mu) * 180 / M_PI;
+    s.degrees = friction_angle - 1;
+    const double below = slideDistance(s, 1.0);
+    s.degrees = friction_angle + 1;
+    const double above = slideDistance(s, 1.0);
+    const double coulomb = coulombDistance(s, 1.0);
+    const char* element = c.element == ElementKind::kTet10 ? "tet10" : "tet4";
+    std::cout << "[figures] sliding threshold (settled, mu 0.3), E " << c.youngs_modulus << ", "
+              << element << ": " << friction_angle - 1 << " deg moved " << below << " m; "
+              << friction_angle + 1 << " deg moved " << above << " m (Coulomb " << coulomb << " m, "
+              << 100 * (above / coulomb - 1) << " %)\n";
+    EXPECT_LT(std::abs(below), c.held_bound) << c.youngs_modulus << " Pa, " << element;
+    EXPECT_NEAR(above, coulomb, c.above_tolerance * coulomb)
+        << c.youngs_modulus << " Pa, " << element;
+  }
 }
 
 // Coulomb's distance whatever the slab: soft (E = 1e5 Pa) and stiff (1e8), node rows 0.2 m (the
 // box's length), 0.1 m and 0.05 m apart, tet4 and tet10, two slopes by two coefficients
 // (docs/validation.md, "Sliding over an FEM slab"). Before the sliding-body rules
-// (docs/contact.md, "Sliding over nodes") the soft slab gave -64 % at 20 deg with mu = 0.3. Two
-// kinds of case are still off and only printed (open): node rows as long as the box at 20 deg with
-// mu = 0.3 (soft +6.4 %, stiff +5.0 %), and the stiff coarse tet10 slab at 25 deg with mu = 0.2,
-// where the box, at 2 m/s, stops dead at a node row (-15 %).
+// (docs/contact.md, "Sliding over nodes") the soft slab gave -64 % at 20 deg with mu = 0.3; before
+// the friction's slip resistance node rows as long as the box gave +6.4 % (soft) and +5.0 %
+// (stiff) at 20 deg with mu = 0.3, and the box on the stiff coarse tet10 slab at 25 deg with
+// mu = 0.2 stopped dead at a node row at 2 m/s (-15 %).
 TEST(Sliding, BoxWithFrictionSlidesAsCoulombSaysOverSoftStiffCoarseFineTet4AndTet10Slabs) {
   struct Case {
     double degrees, mu, youngs_modulus;
     int cells;
     ElementKind element;
-    bool asserted;
   };
   std::vector<Case> cases;
   for (double E : {1e5, 1e8}) {
-    const bool soft = E < 1e6;
     for (const auto& [degrees, mu] : kSlopes)
-      cases.push_back({degrees, mu, E, 20, ElementKind::kTet4, true});
+      cases.push_back({degrees, mu, E, 20, ElementKind::kTet4});
     for (int cells : {10, 40}) {
-      cases.push_back({20, 0.3, E, cells, ElementKind::kTet4, cells != 10});
-      cases.push_back({25, 0.2, E, cells, ElementKind::kTet4, true});
+      cases.push_back({20, 0.3, E, cells, ElementKind::kTet4});
+      cases.push_back({25, 0.2, E, cells, ElementKind::kTet4});
     }
-    cases.push_back({20, 0.3, E, 10, ElementKind::kTet10, true});
-    cases.push_back({20, 0.2, E, 10, ElementKind::kTet10, true});
-    cases.push_back({25, 0.2, E, 10, ElementKind::kTet10, soft});
+    cases.push_back({20, 0.3, E, 10, ElementKind::kTet10});
+    cases.push_back({20, 0.2, E, 10, ElementKind::kTet10});
+    cases.push_back({25, 0.2, E, 10, ElementKind::kTet10});
   }
   for (const Case& c : cases) {
     Slope s;
@@ -243,15 +271,7 @@ TEST(Sliding, BoxWithFrictionSlidesAsCoulombSaysOverSoftStiffCoarseFineTet4AndTe
     s.youngs_modulus = c.youngs_modulus;
     s.cells_along = c.cells;
     s.element = c.element;
-    if (c.asserted) {
-      expectCoulomb(s, 0.05, "friction_table");
-      continue;
-    }
-    const double moved = slideDistance(s, 1.0), coulomb = coulombDistance(s, 1.0);
-    std::cout << "[figures] sliding (open, not asserted): " << c.degrees << " deg, mu " << c.mu
-              << ", E " << c.youngs_modulus << ", " << c.cells << " cells, "
-              << (c.element == ElementKind::kTet10 ? "tet10" : "tet4") << ": moved " << moved
-              << " m, Coulomb " << coulomb << " m (" << 100 * (moved / coulomb - 1) << " %)\n";
+    expectCoulomb(s, 0.05, "friction_table");
   }
 }
 

@@ -148,6 +148,7 @@ void RigidContactSolver::accumulate(const LinearSolveReport& r, LinearSolveRepor
 bool RigidContactSolver::updateContactStates(const Eigen::VectorXd& v) {
   // Both sets are updated, whatever the other's answer.
   const bool nodes_changed = updateActiveSet(v, product_, dt_);
+  setSlipResistances(v);
   const bool faces_changed = faces_.update(v, partners_, dt_, settings_.activation_tolerance,
                                            settings_.face_gap_tolerance);
   return nodes_changed || faces_changed;
@@ -184,10 +185,10 @@ void RigidContactSolver::collectImpulses() {
       continue;
     }
     const Eigen::Vector3d pi = product_.segment<3>(3 * c.node);
+    // A sliding node's constraint impulse is along the normal, but for its friction's resistance
+    // to a slip across the friction (slip_resistance), which the solve put into pi.
     c.impulse =
-        (c.state == NodeContact::State::kStick ? pi
-                                               : Eigen::Vector3d(c.normal * c.normal.dot(pi))) +
-        (c.state == NodeContact::State::kSlide ? c.friction_impulse : Eigen::Vector3d::Zero());
+        pi + (c.state == NodeContact::State::kSlide ? c.friction_impulse : Eigen::Vector3d::Zero());
     c.normal_impulse = c.normal.dot(c.impulse);
     RigidPartner& k = partners_[static_cast<size_t>(c.partner)];
     k.impulse -= pointWrench(c.impulse, c.lever);

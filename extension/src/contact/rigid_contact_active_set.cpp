@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "torsion/bt_conversions.h"
 #include "torsion/contact/rigid_contact.h"
 
 namespace torsion {
@@ -27,6 +28,16 @@ bool RigidContactSolver::updateActiveSet(const Eigen::VectorXd& v, const Eigen::
     if (!c.held && c.state != NodeContact::State::kInactive)
       largest = std::max(largest, std::abs(c.normal.dot(p.segment<3>(3 * c.node))));
   }
+  // A contact on a side of the rigid body (its normal along the soft surface at the node, as a
+  // box's rear face over the nodes it leaves behind) does not hold the body up: it is released
+  // whenever it pulls, and not added again after its second release. Kept pulling after the one
+  // release the anti-cycling allows, the rear face of a box sliding at 1.2 m/s over a stiff slab
+  // pulled it back by 2.6 N s in one step. Contacts under the body keep the single release
+  // (released every time, a box on a stiff slab lost its support and tipped).
+  const auto sideContact = [&](const NodeContact& c) {
+    const Eigen::Vector3d surface = toEigen(soft_body_->m_nodes[c.node].m_n);
+    return std::abs(c.normal.dot(surface)) < 0.5 * surface.norm();
+  };
   for (NodeContact& c : contacts_) {
     if (c.held || c.anchored) continue;  // an anchor sticks for good
     const RigidPartner& k = partners_[static_cast<size_t>(c.partner)];
@@ -37,7 +48,7 @@ bool RigidContactSolver::updateActiveSet(const Eigen::VectorXd& v, const Eigen::
     switch (c.state) {
       case NodeContact::State::kInactive: {
         const double gap_end = c.gap + dt * c.normal.dot(vi - rigid_v);
-        if (gap_end < -settings_.activation_tolerance) {
+        if (gap_end < -settings_.activation_tolerance && c.releases < 2) {
           // A node the rigid body sweeps over (held by the supporting plane, chooseSupportPlane)
           // starts sliding when it slips, and so does one that a body sliding over the surface
           // (k.sliding: all its node contacts slid last step) slips over by more than the face
@@ -72,7 +83,7 @@ bool RigidContactSolver::updateActiveSet(const Eigen::VectorXd& v, const Eigen::
       case NodeContact::State::kStick: {
         const double lambda = c.normal.dot(pi);
         const Eigen::Vector3d pt = pi - c.normal * lambda;
-        if (lambda < -noise && c.releases == 0) {
+        if (lambda < -noise && (c.releases == 0 || sideContact(c))) {
           c.state = NodeContact::State::kInactive;
           ++c.releases;
           changed = true;
@@ -96,7 +107,7 @@ bool RigidContactSolver::updateActiveSet(const Eigen::VectorXd& v, const Eigen::
       }
       case NodeContact::State::kSlide: {
         const double lambda = c.normal.dot(pi);
-        if (lambda < -noise && c.releases == 0) {
+        if (lambda < -noise && (c.releases == 0 || sideContact(c))) {
           c.state = NodeContact::State::kInactive;
           ++c.releases;
           c.friction_impulse.setZero();
@@ -144,6 +155,37 @@ bool RigidContactSolver::updateActiveSet(const Eigen::VectorXd& v, const Eigen::
     }
   }
   return changed;
+}
+
+void RigidContactSolver::setSlipResistances(const Eigen::VectorXd& v) {
+  // As for face contacts (FaceContactSet::setSlipResistance): each solve applies a sliding node's
+  // friction fixed beforehand, along the slip of the solve before, and where that slip turns
+  // from solve to solve (a box's corners yaw it over a stiff slab, light nodes under a soft one
+  // are moved sideways) the frictions' sum fell short of mu times the normal impulse and a box
+  // below the friction angle kept sliding. The friction's linearisation in the slip,
+  // d f / d s = -(|f| / |s|)(P_t - s s^T / |s|^2), joins the next solve. It is a linearisation,
+  // valid near the slip it was taken at: it is bounded by the effective mass of the node's motion
+  // relative to the body (node and dynamic partner in series), at which it would stop a slip across
+  // the friction within the solve, as a stick would, and no more. Unbounded (|f| over a slip of a
+  // few micrometres per second), a node whose slip had turned held a box at 1.2 m/s over a stiff
+  // slab like a wall, and its rear face's contacts then pulled it back (-33 % of Coulomb's
+  // distance).
+  for (NodeContact& c : contacts_) {
+    c.slip_resistance.setZero();
+    if (c.held || c.anchored || c.state != NodeContact::State::kSlide || c.friction <= 0) continue;
+    const double magnitude = c.friction_impulse.norm();
+    if (magnitude <= 0) continue;
+    const RigidPartner& k = partners_[static_cast<size_t>(c.partner)];
+    const Eigen::Vector3d slip = tangentialSlip(c, v.segment<3>(3 * c.node), k.velocity);
+    const double speed = slip.norm();
+    if (speed <= 0) continue;
+    const Eigen::Vector3d d = slip / speed;
+    const double node_mass = model_->nodeMasses()[static_cast<size_t>(c.node)];
+    const double relative_mass = k.dynamic ? node_mass * k.mass / (node_mass + k.mass) : node_mass;
+    const double resistance = speed * relative_mass > magnitude ? magnitude / speed : relative_mass;
+    c.slip_resistance = resistance * (Eigen::Matrix3d::Identity() -
+                                      c.normal * c.normal.transpose() - d * d.transpose());
+  }
 }
 
 void RigidContactSolver::measureFrictionShares() {

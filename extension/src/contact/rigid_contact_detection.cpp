@@ -179,7 +179,8 @@ void RigidContactSolver::rememberActiveContacts() {
     }
   }
   for (const FaceContact& f : faces_.contacts()) {
-    if (f.state == FaceContact::State::kInactive) continue;
+    // A face that sat the last solve out (its nodes decided) kept the state it started with.
+    if (f.state == FaceContact::State::kInactive || f.determined) continue;
     (f.state == FaceContact::State::kSlide ? slid : stuck)[static_cast<size_t>(f.partner)] = 1;
   }
   // A body whose contacts (node and face) all ended the last step sliding may be sliding over the

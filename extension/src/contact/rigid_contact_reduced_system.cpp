@@ -88,7 +88,26 @@ void RigidContactSolver::applyOperator(const SystemOperator& op, const Eigen::Ve
     rigid_scratch_.segment<6>(o) = partnerMomentum(k, q.segment<6>(k.unknown));
   }
   faces_.addProduct(scratch_, q, partners_, 3 * model_->nodeCount(), product_, rigid_scratch_);
+  addSlipResistance(q, scratch_, product_, rigid_scratch_);
   contract(product_, rigid_scratch_, out);
+}
+
+void RigidContactSolver::addSlipResistance(const Eigen::VectorXd& q, const Eigen::VectorXd& v,
+                                           Eigen::VectorXd& node_out,
+                                           Eigen::VectorXd& rigid_out) const {
+  // R (v_i - J_i V) on a sliding node (its friction's resistance to a slip across it), and the
+  // opposite wrench on a dynamic partner. A static or kinematic partner's given velocity is on the
+  // right-hand side (assembleRightHandSide).
+  const int n = model_->nodeCount();
+  for (const NodeContact& c : contacts_) {
+    if (c.held || c.state != NodeContact::State::kSlide || c.slip_resistance.isZero(0)) continue;
+    const RigidPartner& k = partners_[static_cast<size_t>(c.partner)];
+    Eigen::Vector3d slip = v.segment<3>(3 * c.node);
+    if (k.dynamic) slip -= pointVelocity(q.segment<6>(k.unknown), c.lever);
+    const Eigen::Vector3d y = c.slip_resistance * slip;
+    node_out.segment<3>(3 * c.node) += y;
+    if (k.dynamic) rigid_out.segment<6>(k.unknown - 3 * n) -= pointWrench(y, c.lever);
+  }
 }
 
 void RigidContactSolver::buildPreconditioner(const SystemOperator& op) {
@@ -116,6 +135,12 @@ void RigidContactSolver::buildPreconditioner(const SystemOperator& op) {
     if (c.state == NodeContact::State::kSlide) G = c.normal * (c.normal.transpose() * J);
     rigid_inverse_[static_cast<size_t>(c.partner)] +=
         G.transpose() * block_inverse_[static_cast<size_t>(i)] * G;
+    if (c.state == NodeContact::State::kSlide)
+      rigid_inverse_[static_cast<size_t>(c.partner)] += J.transpose() * c.slip_resistance * J;
+  }
+  for (const NodeContact& c : contacts_) {
+    if (!c.held && c.state == NodeContact::State::kSlide && !base_->isConstrained(c.node))
+      block_inverse_[static_cast<size_t>(c.node)] += c.slip_resistance;
   }
   for (auto& block : block_inverse_)
     block = block.inverse().eval();
@@ -209,6 +234,9 @@ void RigidContactSolver::assembleRightHandSide(const SystemOperator& op, const E
     v_c_.segment<3>(3 * c.node) = vc;
     if (c.state == NodeContact::State::kSlide) {
       b_friction_.segment<3>(3 * c.node) += c.friction_impulse;
+      if (!k.dynamic)
+        b_friction_.segment<3>(3 * c.node) +=
+            c.slip_resistance * pointVelocity(k.entry_velocity, c.lever);
       if (k.dynamic)
         rigid_rhs_.segment<6>(k.unknown - 3 * n) -= pointWrench(c.friction_impulse, c.lever);
     }

@@ -61,6 +61,9 @@ struct FaceContact {
   int stalls = 0;                ///< updates this step that did not reduce the violation
   int switches = 0;              ///< stick/slide switches this step
   int friction_refinements = 0;  ///< solves this step reopened to bring the friction to mu lambda
+  /// kg, sliding: the friction's resistance to a slip across its direction in the next solve
+  /// (its linearisation in the slip; FaceContactSet::update).
+  Eigen::Matrix3d slip_resistance = Eigen::Matrix3d::Zero();
 };
 
 class FaceContactSet {
@@ -142,6 +145,8 @@ class FaceContactSet {
                 const std::vector<RigidPartner>& partners, double dt) const;
 
  private:
+  /// After update: each sliding face's slip_resistance from the slip of the solve just done.
+  void setSlipResistance(const Eigen::VectorXd& v, const std::vector<RigidPartner>& partners);
   Eigen::Vector3d relativeVelocity(const FaceContact& c, const Eigen::VectorXd& v,
                                    const Eigen::Vector3d& rigid) const;
 

@@ -89,10 +89,13 @@ struct NodeContact {
   bool swept = false;
   bool anchored = false;  ///< an anchor (node_anchors.h): sticks for good, gap = -drift
   State state = State::kInactive;
-  int releases = 0;              ///< times released this step (anti-cycling: never twice)
-  int slips = 0;                 ///< stick-to-slide switches this step (anti-cycling: at most two)
+  int releases = 0;  ///< times released this step (anti-cycling: once; a side contact twice)
+  int slips = 0;     ///< stick-to-slide switches this step (anti-cycling: at most two)
   int friction_refinements = 0;  ///< sliding friction updates this step that reopened the loop
   Eigen::Vector3d friction_impulse = Eigen::Vector3d::Zero();  ///< N s on the node (sliding)
+  /// kg, sliding: the friction's resistance to a slip across its direction in the next solve
+  /// (its linearisation in the slip; RigidContactSolver::setSlipResistances).
+  Eigen::Matrix3d slip_resistance = Eigen::Matrix3d::Zero();
   Eigen::Vector3d impulse = Eigen::Vector3d::Zero();  ///< N s, total the rigid body gave the node
   double normal_impulse = 0;                          ///< N s, impulse . normal
 };
@@ -253,6 +256,10 @@ class RigidContactSolver {
   void contract(const Eigen::VectorXd& y, const Eigen::VectorXd& rigid_part,
                 Eigen::VectorXd& q) const;
   void applyOperator(const SystemOperator& op, const Eigen::VectorXd& q, Eigen::VectorXd& out);
+  /// The sliding node contacts' slip_resistance terms of the operator, for reduced unknowns `q`
+  /// and their node velocities `v` (expand(q)).
+  void addSlipResistance(const Eigen::VectorXd& q, const Eigen::VectorXd& v,
+                         Eigen::VectorXd& node_out, Eigen::VectorXd& rigid_out) const;
   void precondition(const Eigen::VectorXd& r, Eigen::VectorXd& z) const;
 
   // The active set (rigid_contact_active_set.cpp).
@@ -261,6 +268,9 @@ class RigidContactSolver {
   bool updateActiveSet(const Eigen::VectorXd& v, const Eigen::VectorXd& p, double dt);
   /// Each partner's friction_share from the solve just done (node impulses in product_).
   void measureFrictionShares();
+  /// After the active set's update: each sliding node contact's slip_resistance from the slip of
+  /// the solve just done.
+  void setSlipResistances(const Eigen::VectorXd& v);
 
   std::shared_ptr<const FemModel> model_;
   btSoftBody* soft_body_;
