@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <limits>
 
 #include "torsion/format_number.h"
 
@@ -59,6 +60,9 @@ Status SelfContactSettings::validate() const {
   if (!(std::isfinite(penalty_factor) && penalty_factor > 0))
     return Error{"self_contact: penalty_factor = " + formatNumber(penalty_factor) +
                  ": must be > 0"};
+  if (!(std::isfinite(rough_tolerance_factor) && rough_tolerance_factor >= 1))
+    return Error{"self_contact: rough_tolerance_factor = " + formatNumber(rough_tolerance_factor) +
+                 ": must be >= 1"};
   if (max_iterations < 1)
     return Error{"self_contact: max_iterations = " + std::to_string(max_iterations) +
                  ": must be >= 1"};
@@ -398,13 +402,33 @@ LinearSolveReport SelfContactSolver::solve(const SystemOperator& op,
   stats_.converged = false;
   const int rounds = inner ? 1 : settings_.max_iterations;
   int redetections = 0;
-  double best_error = 0;
+  double best_error = std::numeric_limits<double>::infinity();  // no accurate round yet
   int worse = 0;
+  // Rough rounds first: while the active set and the multipliers are still far from settled,
+  // each CG solve stops at rough_tolerance_factor times the tolerance (its motion only steers
+  // the next Uzawa update). Once a rough round settles, or three rough rounds in a row did
+  // worse, or a quarter of the rounds has passed, the rounds are accurate for the rest of the
+  // step: the step only ends on an accurate solve, judged by the same criteria as before. A
+  // round with no contact pushing is accurate (a step with candidates but no contact solves as
+  // it did without the rough rounds, to the bit).
+  SolverSettings rough = settings;
+  rough.tolerance = settings_.rough_tolerance_factor * settings.tolerance;
+  bool rough_over = inner || !(settings_.rough_tolerance_factor > 1);
+  double rough_best = -1;  // the smallest gap error of the rough rounds (-1: none yet)
+  const auto any_pushing = [this] {
+    for (const SurfaceContact& c : set_.contacts())
+      if (!c.determined && c.state != SurfaceContact::State::kInactive) return true;
+    return false;
+  };
   for (int round = 0; round < rounds; ++round) {
+    // Where the rough rounds cycle, the accurate ones still have three quarters to settle in.
+    if (round == rounds - 1 || 4 * round >= rounds) rough_over = true;
+    const bool accurate = rough_over || !any_pushing();
     b_aug_ = b;
     set_.addRightHandSide(dt_, b_aug_);
+    const SolverSettings& round_settings = accurate ? settings : rough;
     const LinearSolveReport r = inner ? inner(op, constraints, b_aug_, settings, v)
-                                      : cg_.solve(op, constraints, b_aug_, settings, v);
+                                      : cg_.solve(op, constraints, b_aug_, round_settings, v);
     total.iterations += r.iterations;
     total.relative_residual = r.relative_residual;
     total.converged = r.converged;
@@ -413,6 +437,24 @@ LinearSolveReport SelfContactSolver::solve(const SystemOperator& op,
     ++stats_.iterations;
     if (r.breakdown) break;
     const bool settled = set_.update(v, dt_, activation, gap_tolerance_);
+    if (!accurate) {
+      // Rough: no best kept, nothing judged; worse rounds end the rough phase instead.
+      const double error = set_.maxGapError();
+      const bool first_rough = rough_best < 0;
+      if (settled ||
+          (!first_rough && error >= rough_best && error > gap_tolerance_ && ++worse >= 3)) {
+        rough_over = true;
+      } else if (first_rough || error < rough_best) {
+        worse = 0;
+      }
+      rough_best = first_rough ? error : std::min(rough_best, error);
+      if (rough_over) {
+        // The accurate rounds start their own safeguard: the first is the best so far.
+        worse = 0;
+        best_error = std::numeric_limits<double>::infinity();
+      }
+      continue;
+    }
     // Safeguard: where constraints contradict each other (crossed before, a crease) Uzawa can
     // diverge. The best solve so far is kept; three worse ones in a row, beyond the tolerance,
     // end the step with it (reported as not converged).
