@@ -23,6 +23,7 @@
 #include "torsion/bullet/fem_body.h"
 #include "torsion/bullet/fem_world.h"
 #include "torsion/mesh/mesh_io.h"
+#include "crossing_kinds.h"
 
 using namespace torsion;
 
@@ -90,6 +91,8 @@ int main(int argc, char** argv) {
   const int steps = static_cast<int>(std::ceil(max_angle / rate / dt)) + hold;
   const auto start = std::chrono::steady_clock::now();
   int crossing_steps = 0, first_crossing = -1, unconverged = 0, checked = 0;
+  // Over the steps with crossings: pairs by kind (crossing_kinds.h), summed.
+  CrossingKinds kinds_total;
   double peak_elastic = 0;
   for (int k = 1; k <= steps; ++k) {
     if (!world.step().ok) {
@@ -109,7 +112,24 @@ int main(int argc, char** argv) {
       const std::vector<TrianglePair> pairs =
           findSurfaceIntersections(mesh.surfaceTriangles(), body->state().positions);
       crossings = static_cast<int>(pairs.size());
-      if (!pairs.empty()) ++crossing_steps;
+      if (!pairs.empty()) {
+        ++crossing_steps;
+        const CrossingKinds kinds = classifyCrossings(
+            pairs, mesh.surfaceTriangles(), body->state().positions,
+            contact != nullptr ? contact->contacts() : std::vector<SurfaceContact>{},
+            contact != nullptr ? contact->settings().max_depth : 0.25);
+        kinds_total.node_in_face += kinds.node_in_face;
+        kinds_total.node_in_face_deep += kinds.node_in_face_deep;
+        kinds_total.edge_edge += kinds.edge_edge;
+        kinds_total.with_candidate += kinds.with_candidate;
+        kinds_total.edge_edge_with_candidate += kinds.edge_edge_with_candidate;
+        if (first_crossing < 0 || k % print_every == 0)
+          std::printf(
+              "step %d: %d crossing pairs: %d node in face (%d deep), %d edge-edge; %d with a "
+              "candidate (%d edge-edge)\n",
+              k, crossings, kinds.node_in_face, kinds.node_in_face_deep, kinds.edge_edge,
+              kinds.with_candidate, kinds.edge_edge_with_candidate);
+      }
       if (!pairs.empty() && first_crossing < 0) {
         first_crossing = k;
         const std::vector<Triangle>& triangles = mesh.surfaceTriangles();
@@ -123,6 +143,26 @@ int main(int argc, char** argv) {
               "step %d: triangles %d and %d cross; rest centroids (%.2f %.2f %.2f) and "
               "(%.2f %.2f %.2f), %.3f m apart\n",
               k, p.first, p.second, a.x(), a.y(), a.z(), b.x(), b.y(), b.z(), (a - b).norm());
+          // The contacts this step had on the pair: why did they not hold it?
+          const Triangle& tp = triangles[static_cast<size_t>(p.first)];
+          const Triangle& tq = triangles[static_cast<size_t>(p.second)];
+          auto in = [](const Triangle& t, int n) { return t[0] == n || t[1] == n || t[2] == n; };
+          for (const SurfaceContact& c : contact != nullptr ? contact->contacts()
+                                                            : std::vector<SurfaceContact>{}) {
+            const bool covers =
+                c.edge < 0
+                    ? (c.triangle == p.second && in(tp, c.nodes[0])) ||
+                          (c.triangle == p.first && in(tq, c.nodes[0]))
+                    : (in(tp, c.nodes[0]) && in(tp, c.nodes[1]) && in(tq, c.nodes[2]) &&
+                       in(tq, c.nodes[3])) ||
+                          (in(tq, c.nodes[0]) && in(tq, c.nodes[1]) && in(tp, c.nodes[2]) &&
+                           in(tp, c.nodes[3]));
+            if (!covers) continue;
+            std::printf("  %s contact: gap %.3g m, linearised end gap %.3g m, state %d, "
+                        "normal impulse %.3g N s\n",
+                        c.edge < 0 ? "node-triangle" : "edge-edge", c.gap, c.end_gap,
+                        static_cast<int>(c.state), c.normal.dot(c.multiplier));
+          }
         }
       }
     }
@@ -139,9 +179,13 @@ int main(int argc, char** argv) {
   const Wrench w = body->groupWrench(hand, Eigen::Vector3d(0, 0, length));
   std::printf(
       "end: hand torque %.5g N m, elastic %.5g J (peak %.5g J), steps with crossing triangles %d "
-      "of %d checked (first %d), unconverged contact solves %d, %.1f s\n",
+      "of %d checked (first %d), unconverged contact solves %d, %.1f s\n"
+      "crossing pairs summed over those steps: %d node in face (%d deep), %d edge-edge; %d with "
+      "a candidate (%d edge-edge)\n",
       std::abs(w.torque.z()), body->lastReport().elastic_energy, peak_elastic, crossing_steps,
       checked, first_crossing, unconverged,
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(),
+      kinds_total.node_in_face, kinds_total.node_in_face_deep, kinds_total.edge_edge,
+      kinds_total.with_candidate, kinds_total.edge_edge_with_candidate);
   return 0;
 }

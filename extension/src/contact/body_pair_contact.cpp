@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "torsion/contact/surface_candidates.h"
 #include "torsion/format_number.h"
 
 namespace torsion {
@@ -152,59 +153,44 @@ void BodyPairContact::addCandidates(const FemModel& nodes_model, int node_offset
                                     double margin) {
   tree.refit(xt, et, margin);
   const std::vector<Triangle>& triangles = tree.triangles();
+  CandidateRules rules;
+  rules.margin = margin;
+  rules.max_depth = settings_.max_depth;
+  rules.crease_depth = 2 * gap_tolerance_;
+  auto at = [](const Eigen::VectorXd& positions, int node) -> Eigen::Vector3d {
+    return positions.segment<3>(3 * node);
+  };
+  Eigen::Vector3d node_normal = Eigen::Vector3d::Zero();
+  // Not facing the triangle while already touching its plane (resting or sliding along it, not
+  // arriving): no contact, unless it held last step (no sudden release). A node still arriving is
+  // paired whatever its normal: an edge or corner striking a face obliquely in a fast impact faces
+  // it at any angle (filtered, two soft cubes at 15 m/s interpenetrated by 4 cm).
+  const ExclusionRule not_facing = [&](const Eigen::Vector3d& normal, double gap) {
+    return gap <= kFacingBand * gap_tolerance_ && node_normal.dot(normal) > -kFacing;
+  };
   for (int p : nodes_model.mesh().surfaceNodes()) {
     const Eigen::Vector3d xp = xn.segment<3>(3 * p), ep = en.segment<3>(3 * p);
+    node_normal = node_normals.segment<3>(3 * p);
     tree.query(xp.cwiseMin(ep), xp.cwiseMax(ep), found_);
     for (int t : found_) {
       const Triangle& tri = triangles[static_cast<size_t>(t)];
-      const Eigen::Vector3d a0 = xt.segment<3>(3 * tri[0]), b0 = xt.segment<3>(3 * tri[1]),
-                            c0 = xt.segment<3>(3 * tri[2]);
-      Eigen::Vector3d n0 = (b0 - a0).cross(c0 - a0);
-      if (!(n0.norm() > 0)) continue;  // degenerate: no plane to stay out of
-      n0.normalize();
-      const double g0 = n0.dot(xp - a0);
-      const double shortest = std::min({(b0 - a0).norm(), (c0 - b0).norm(), (a0 - c0).norm()});
-      if (g0 < -settings_.max_depth * shortest) continue;  // deep inside: the far side
       const int pair_node = node_offset + p;
       const int pair_triangle = triangle_offset + t;
-      // Behind the plane beyond the tolerance: only a contact held last step is still one (it
+      // Behind the plane beyond the crease depth: only a contact held last step is still one (it
       // sank within its tolerance); a new pair there is a node past the other body's rim.
-      if (g0 < -2 * gap_tolerance_ && !set_.wasActive(pair_node, pair_triangle)) continue;
-      // Not facing the triangle while already touching its plane (resting or sliding along it,
-      // not arriving): no contact, unless it held last step (no sudden release). A node still
-      // arriving is paired whatever its normal: an edge or corner striking a face obliquely in a
-      // fast impact faces it at any angle (filtered, two soft cubes at 15 m/s interpenetrated
-      // by 4 cm).
-      if (g0 <= kFacingBand * gap_tolerance_ && node_normals.segment<3>(3 * p).dot(n0) > -kFacing &&
-          !set_.wasActive(pair_node, pair_triangle))
-        continue;
-      const Eigen::Vector3d a1 = et.segment<3>(3 * tri[0]), b1 = et.segment<3>(3 * tri[1]),
-                            c1 = et.segment<3>(3 * tri[2]);
-      Eigen::Vector3d n1 = (b1 - a1).cross(c1 - a1);
-      if (!(n1.norm() > 0)) n1 = n0;
-      const double g1 = n1.normalized().dot(ep - a1);
-      // When on the path the node meets the plane: now if within the margin, at the crossing if
-      // it passes through, at the end if it ends within the margin.
-      double s;
-      if (g0 <= margin) {
-        s = 0;
-      } else if (g1 < 0) {
-        s = g0 / (g0 - g1);
-      } else if (g1 <= margin) {
-        s = 1;
-      } else {
-        continue;
-      }
-      const Eigen::Vector3d w = barycentric(xp + s * (ep - xp), a0 + s * (a1 - a0),
-                                            b0 + s * (b1 - b0), c0 + s * (c1 - c0));
-      if (!w.allFinite() || w.minCoeff() < -kInsideTolerance) continue;
+      const std::array<Eigen::Vector3d, 3> t0 = {at(xt, tri[0]), at(xt, tri[1]), at(xt, tri[2])};
+      const std::optional<NodeTriangleHit> hit = nodeTriangleCandidate(
+          {xp, ep}, t0, {at(et, tri[0]), at(et, tri[1]), at(et, tri[2])}, rules,
+          set_.wasActive(pair_node, pair_triangle), not_facing);
+      if (!hit) continue;
+      const Eigen::Vector3d& w = hit->weights;
       // The impulse's triangle point: the node's projection at the step's start, unclamped while
       // within the slack. Node and point then differ only along the normal, so the pair of
       // impulses has no moment about the start positions, where an implicit step's impulses act
       // on the angular momentum (clamping to the triangle gave levers: 1.5 % of the angular
       // momentum lost in bullet_collide_soft, 0.95 % without). A projection that enters the
       // triangle only later on the path takes the crossing's weights, clamped.
-      const Eigen::Vector3d w_start = s > 0 ? barycentric(xp, a0, b0, c0) : w;
+      const Eigen::Vector3d w_start = hit->when > 0 ? barycentric(xp, t0[0], t0[1], t0[2]) : w;
       const Eigen::Vector3d wc = w_start.allFinite() && w_start.minCoeff() >= -kInsideTolerance
                                      ? w_start
                                      : Eigen::Vector3d(w.cwiseMax(0.0) / w.cwiseMax(0.0).sum());
@@ -213,8 +199,8 @@ void BodyPairContact::addCandidates(const FemModel& nodes_model, int node_offset
                  triangle_node_offset + tri[2]};
       c.beta = {1.0, -wc[0], -wc[1], -wc[2]};
       c.triangle = pair_triangle;
-      c.normal = n0;
-      c.gap = g0;
+      c.normal = hit->normal;
+      c.gap = hit->gap;
       c.friction = settings_.friction;
       set_.add(c);
     }
