@@ -96,7 +96,9 @@ BodyPairContact::BodyPairContact(std::shared_ptr<const FemModel> a,
       mean_edge_a_(meanSurfaceEdge(a_->mesh())),
       mean_edge_b_(meanSurfaceEdge(b_->mesh())),
       tree_a_(a_->mesh().surfaceTriangles()),
-      tree_b_(b_->mesh().surfaceTriangles()) {
+      tree_b_(b_->mesh().surfaceTriangles()),
+      edges_a_(a_->mesh().surfaceTriangles()),
+      edges_b_(b_->mesh().surfaceTriangles()) {
   gap_tolerance_ = settings_.gap_tolerance > 0 ? settings_.gap_tolerance
                                                : 1e-3 * std::min(mean_edge_a_, mean_edge_b_);
   // Half steps of sliding friction: a stack on the ground had contacts whose k_t swung by 6 %
@@ -123,6 +125,8 @@ bool BodyPairContact::detect(const Eigen::VectorXd& xa, const Eigen::VectorXd& v
   nodeNormals(b_->mesh(), xb, normals_b_);
   addCandidates(*a_, 0, xa, end_a_, normals_a_, tree_b_, node_count_a_, triangle_count_a_, xb,
                 end_b_, settings_.margin * mean_edge_b_);
+  // a's edges against b's, with b's tree still refitted to b's motion.
+  addEdgeCandidates(xa, end_a_, xb, end_b_, settings_.margin * mean_edge_b_);
   addCandidates(*b_, node_count_a_, xb, end_b_, normals_b_, tree_a_, 0, 0, xa, end_a_,
                 settings_.margin * mean_edge_a_);
   // A contact that slid last step starts its first solve with the k_t its friction and the slip
@@ -199,6 +203,77 @@ void BodyPairContact::addCandidates(const FemModel& nodes_model, int node_offset
                  triangle_node_offset + tri[2]};
       c.beta = {1.0, -wc[0], -wc[1], -wc[2]};
       c.triangle = pair_triangle;
+      c.normal = hit->normal;
+      c.gap = hit->gap;
+      c.friction = settings_.friction;
+      set_.add(c);
+    }
+  }
+}
+
+void BodyPairContact::addEdgeCandidates(const Eigen::VectorXd& xa, const Eigen::VectorXd& ea,
+                                        const Eigen::VectorXd& xb, const Eigen::VectorXd& eb,
+                                        double margin) {
+  CandidateRules rules;
+  rules.margin = margin;
+  rules.max_depth = settings_.max_depth;
+  rules.crease_depth = 2 * gap_tolerance_;
+  auto at = [](const Eigen::VectorXd& positions, int node) -> Eigen::Vector3d {
+    return positions.segment<3>(3 * node);
+  };
+  // Each edge's box over the motion.
+  auto box = [&](const std::array<int, 2>& e, const Eigen::VectorXd& x, const Eigen::VectorXd& end,
+                 Eigen::Vector3d& lo, Eigen::Vector3d& hi) {
+    lo = at(x, e[0]).cwiseMin(at(x, e[1])).cwiseMin(at(end, e[0])).cwiseMin(at(end, e[1]));
+    hi = at(x, e[0]).cwiseMax(at(x, e[1])).cwiseMax(at(end, e[0])).cwiseMax(at(end, e[1]));
+  };
+  const std::vector<Triangle>& triangles_a = tree_a_.triangles();
+  const std::vector<Triangle>& triangles_b = tree_b_.triangles();
+  SurfaceContact contact;
+  const std::function<const Eigen::Vector3d*()> held = [&] { return set_.warmStartOf(contact); };
+  const std::function<Eigen::Vector3d()> outward = [&]() -> Eigen::Vector3d {
+    return edges_b_.outwardNormal(contact.triangle, triangles_b, xb) -
+           edges_a_.outwardNormal(contact.edge, triangles_a, xa);
+  };
+  // Only arriving edges make new pairs: two faces resting or sliding on each other have edges
+  // crossing in one plane everywhere, which their node contacts hold already; as edge pairs with
+  // friction they caught a soft block sliding down a soft slab (as nodes ahead of its leading
+  // edge did, docs/contact.md, "Friction between FEM bodies"). A pair held last step stays.
+  const ExclusionRule touching = [&](const Eigen::Vector3d&, double gap) {
+    return gap <= kFacingBand * gap_tolerance_;
+  };
+  std::vector<int> later;
+  for (size_t i = 0; i < edges_a_.edges.size(); ++i) {
+    const std::array<int, 2>& e = edges_a_.edges[i];
+    Eigen::Vector3d lo_e, hi_e;
+    box(e, xa, ea, lo_e, hi_e);
+    tree_b_.query(lo_e, hi_e, found_);
+    // The edges of b's triangles found, each once, ascending.
+    later.clear();
+    for (int t : found_)
+      for (int j : edges_b_.triangle_edges[static_cast<size_t>(t)])
+        later.push_back(j);
+    std::sort(later.begin(), later.end());
+    later.erase(std::unique(later.begin(), later.end()), later.end());
+    const std::array<std::array<Eigen::Vector3d, 2>, 2> edge_e = {
+        {{at(xa, e[0]), at(xa, e[1])}, {at(ea, e[0]), at(ea, e[1])}}};
+    contact.edge = static_cast<int>(i);
+    for (int j : later) {
+      const std::array<int, 2>& f = edges_b_.edges[static_cast<size_t>(j)];
+      // Boxes over the motion more than the margin apart: never within it, never crossing.
+      Eigen::Vector3d lo_f, hi_f;
+      box(f, xb, eb, lo_f, hi_f);
+      if (((lo_f.array() - margin) > hi_e.array()).any() ||
+          ((hi_f.array() + margin) < lo_e.array()).any())
+        continue;
+      contact.triangle = j;
+      const std::optional<EdgeEdgeHit> hit = edgeEdgeCandidate(
+          edge_e, {{{at(xb, f[0]), at(xb, f[1])}, {at(eb, f[0]), at(eb, f[1])}}}, rules, held,
+          outward, touching);
+      if (!hit) continue;
+      SurfaceContact c = contact;
+      c.nodes = {e[0], e[1], node_count_a_ + f[0], node_count_a_ + f[1]};
+      c.beta = {1.0 - hit->u, hit->u, -(1.0 - hit->v), -hit->v};
       c.normal = hit->normal;
       c.gap = hit->gap;
       c.friction = settings_.friction;

@@ -234,7 +234,7 @@ void SelfContactSolver::edgeCandidates(int i, const Eigen::VectorXd& x, const Ei
     contact.triangle = j;
     const std::optional<EdgeEdgeHit> hit = edgeEdgeCandidate(
         edge_e, {{{at(x, f[0]), at(x, f[1])}, {at(end, f[0]), at(end, f[1])}}}, rules(), held,
-        outward);
+        outward, {});
     if (!hit) continue;
     SurfaceContact c = contact;
     c.nodes = {e[0], e[1], f[0], f[1]};

@@ -121,7 +121,7 @@ std::optional<EdgeEdgeHit> edgeEdgeCandidate(
     const std::array<std::array<Eigen::Vector3d, 2>, 2>& e,
     const std::array<std::array<Eigen::Vector3d, 2>, 2>& f, const CandidateRules& rules,
     const std::function<const Eigen::Vector3d*()>& held_multiplier,
-    const std::function<Eigen::Vector3d()>& outward) {
+    const std::function<Eigen::Vector3d()>& outward, const ExclusionRule& excluded) {
   const double margin = rules.margin;
   const Eigen::Vector3d &p0 = e[0][0], &q0 = e[0][1], &p1 = e[1][0], &q1 = e[1][1];
   const Eigen::Vector3d &r0 = f[0][0], &s0 = f[0][1], &r1 = f[1][0], &s1 = f[1][1];
@@ -161,6 +161,7 @@ std::optional<EdgeEdgeHit> edgeEdgeCandidate(
   }
   if (g0 < -rules.crease_depth && held == nullptr) return std::nullopt;  // crossed, or apart
   if (g0 < -rules.max_depth * (q0 - p0).norm()) return std::nullopt;
+  if (excluded && held == nullptr && excluded(n0, g0)) return std::nullopt;
   Eigen::Vector3d n1 = (q1 - p1).cross(s1 - r1);
   if (n1.dot(n0) < 0) n1 = -n1;
   if (!(n1.norm() > 0)) n1 = n0;

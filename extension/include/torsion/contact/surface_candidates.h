@@ -86,13 +86,14 @@ struct EdgeEdgeHit {
 /// closest points lie inside both edges at the moment of the path where they meet (now if within
 /// the margin, at the crossing, or at the end if within the margin), their surfaces face each
 /// other (`outward()`: f's triangles' mean outward normal minus e's; asked only then), not
-/// behind by more than crease_depth unless held, nor max_depth of e's length. `held()`: the
-/// multiplier the pair ended last step with (nullptr: not held); its direction then orients the
-/// normal instead.
+/// behind by more than crease_depth unless held, nor max_depth of e's length, nor refused by
+/// `excluded` (oriented normal and gap; unless held; empty: no rule). `held()`: the multiplier
+/// the pair ended last step with (nullptr: not held); its direction then orients the normal
+/// instead.
 std::optional<EdgeEdgeHit> edgeEdgeCandidate(
     const std::array<std::array<Eigen::Vector3d, 2>, 2>& e,
     const std::array<std::array<Eigen::Vector3d, 2>, 2>& f, const CandidateRules& rules,
     const std::function<const Eigen::Vector3d*()>& held,
-    const std::function<Eigen::Vector3d()>& outward);
+    const std::function<Eigen::Vector3d()>& outward, const ExclusionRule& excluded);
 
 }  // namespace torsion
