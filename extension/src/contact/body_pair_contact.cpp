@@ -23,6 +23,8 @@ constexpr double kInsideTolerance = 0.05;
 constexpr double kFacing = 0.25;
 // ... and only for a node already touching it: within this many gap tolerances of its plane.
 constexpr double kFacingBand = 4;
+// An edge whose two triangles' normals are within 20 degrees lies on a flat part of its surface.
+const double kFlatFold = std::cos(20.0 * M_PI / 180.0);
 
 // 3n: each surface node's unit outward normal at positions x (zero off the surface): the sum of
 // its surface triangles' area-weighted normals.
@@ -126,7 +128,7 @@ bool BodyPairContact::detect(const Eigen::VectorXd& xa, const Eigen::VectorXd& v
   addCandidates(*a_, 0, xa, end_a_, normals_a_, tree_b_, node_count_a_, triangle_count_a_, xb,
                 end_b_, settings_.margin * mean_edge_b_);
   // a's edges against b's, with b's tree still refitted to b's motion.
-  addEdgeCandidates(xa, end_a_, xb, end_b_, settings_.margin * mean_edge_b_);
+  if (settings_.edge_edge) addEdgeCandidates(xa, end_a_, xb, end_b_, settings_.margin * mean_edge_b_);
   addCandidates(*b_, node_count_a_, xb, end_b_, normals_b_, tree_a_, 0, 0, xa, end_a_,
                 settings_.margin * mean_edge_a_);
   // A contact that slid last step starts its first solve with the k_t its friction and the slip
@@ -235,12 +237,16 @@ void BodyPairContact::addEdgeCandidates(const Eigen::VectorXd& xa, const Eigen::
     return edges_b_.outwardNormal(contact.triangle, triangles_b, xb) -
            edges_a_.outwardNormal(contact.edge, triangles_a, xa);
   };
-  // Only arriving edges make new pairs: two faces resting or sliding on each other have edges
-  // crossing in one plane everywhere, which their node contacts hold already; as edge pairs with
-  // friction they caught a soft block sliding down a soft slab (as nodes ahead of its leading
-  // edge did, docs/contact.md, "Friction between FEM bodies"). A pair held last step stays.
-  const ExclusionRule touching = [&](const Eigen::Vector3d&, double gap) {
-    return gap <= kFacingBand * gap_tolerance_;
+  // Where one of the edges lies on a flat part of its surface (its two triangles within 20
+  // degrees of each other), only an arriving pair is new: two faces resting or sliding on each
+  // other have edges crossing in one plane everywhere, which their node contacts hold already;
+  // as edge pairs with friction they caught a soft block sliding down a soft slab (as nodes
+  // ahead of its leading edge did, docs/contact.md, "Friction between FEM bodies"). Ridge
+  // against ridge, which no node contact sees, is kept touching; a pair held last step stays.
+  const ExclusionRule resting_on_flat = [&](const Eigen::Vector3d&, double gap) {
+    return gap <= kFacingBand * gap_tolerance_ &&
+           (edges_a_.foldCosine(contact.edge, triangles_a, xa) > kFlatFold ||
+            edges_b_.foldCosine(contact.triangle, triangles_b, xb) > kFlatFold);
   };
   std::vector<int> later;
   for (size_t i = 0; i < edges_a_.edges.size(); ++i) {
@@ -269,7 +275,7 @@ void BodyPairContact::addEdgeCandidates(const Eigen::VectorXd& xa, const Eigen::
       contact.triangle = j;
       const std::optional<EdgeEdgeHit> hit = edgeEdgeCandidate(
           edge_e, {{{at(xb, f[0]), at(xb, f[1])}, {at(eb, f[0]), at(eb, f[1])}}}, rules, held,
-          outward, touching);
+          outward, resting_on_flat);
       if (!hit) continue;
       SurfaceContact c = contact;
       c.nodes = {e[0], e[1], node_count_a_ + f[0], node_count_a_ + f[1]};

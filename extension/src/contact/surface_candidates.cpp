@@ -69,6 +69,19 @@ Eigen::Vector3d SurfaceEdges::outwardNormal(int edge, const std::vector<Triangle
   return sum.normalized();
 }
 
+double SurfaceEdges::foldCosine(int edge, const std::vector<Triangle>& triangles,
+                                const Eigen::VectorXd& x) const {
+  const std::array<int, 2>& on = edge_triangles[static_cast<size_t>(edge)];
+  if (on[1] < 0) return -1;
+  Eigen::Vector3d n[2];
+  for (size_t k = 0; k < 2; ++k) {
+    const Triangle& tri = triangles[static_cast<size_t>(on[k])];
+    const Eigen::Vector3d a = x.segment<3>(3 * tri[0]);
+    n[k] = (x.segment<3>(3 * tri[1]) - a).cross(x.segment<3>(3 * tri[2]) - a).normalized();
+  }
+  return n[0].dot(n[1]);
+}
+
 std::optional<NodeTriangleHit> nodeTriangleCandidate(
     const std::array<Eigen::Vector3d, 2>& p, const std::array<Eigen::Vector3d, 3>& triangle0,
     const std::array<Eigen::Vector3d, 3>& triangle1, const CandidateRules& rules, bool held,

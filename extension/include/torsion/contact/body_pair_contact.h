@@ -42,6 +42,9 @@ struct BodyContactSettings {
   double penalty_factor = 20;
   /// Uzawa updates per step (each one linear solve of every body of the island).
   int max_iterations = 60;
+  /// Edge-against-edge candidates besides node-against-triangle ones: two edges crossing where
+  /// no node meets a face (an edge across an edge). Off: node-triangle only.
+  bool edge_edge = true;
 
   Status validate() const;
 };

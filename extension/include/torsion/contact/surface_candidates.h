@@ -30,6 +30,10 @@ struct SurfaceEdges {
   /// Unit mean outward normal of the triangles on edge `edge` at positions x (3n), zero if none.
   Eigen::Vector3d outwardNormal(int edge, const std::vector<Triangle>& triangles,
                                 const Eigen::VectorXd& x) const;
+  /// Cosine of the angle between the unit normals of the two triangles on edge `edge` at x: 1
+  /// on a flat surface, 0 at a right-angled ridge or valley; -1 for an edge of one triangle.
+  double foldCosine(int edge, const std::vector<Triangle>& triangles,
+                    const Eigen::VectorXd& x) const;
 };
 
 /// Distances and tolerances that decide a candidate.
