@@ -144,12 +144,14 @@ int main(int argc, char** argv) {
             pairs, triangles, body->state().positions,
             body->selfContact() != nullptr ? body->selfContact()->contacts()
                                            : std::vector<SurfaceContact>{},
-            0.25);
+            0.25, gap_tolerance);
         kinds.node_in_face += found.node_in_face;
         kinds.node_in_face_deep += found.node_in_face_deep;
         kinds.edge_edge += found.edge_edge;
         kinds.with_candidate += found.with_candidate;
         kinds.edge_edge_with_candidate += found.edge_edge_with_candidate;
+        kinds.within_tolerance += found.within_tolerance;
+        kinds.deepest = std::max(kinds.deepest, found.deepest);
       }
     }
   }
@@ -164,11 +166,13 @@ int main(int argc, char** argv) {
       "\"first_crossing_step\": %d, \"exact_crossing_checks\": %d, "
       "\"crossing_pairs_node_in_face\": %d, \"crossing_pairs_node_in_face_deep\": %d, "
       "\"crossing_pairs_edge_edge\": %d, \"crossing_pairs_with_candidate\": %d, "
-      "\"crossing_pairs_edge_edge_with_candidate\": %d}\n",
+      "\"crossing_pairs_edge_edge_with_candidate\": %d, "
+      "\"crossing_pairs_within_gap_tolerance\": %d, \"deepest_crossing_m\": %.3g}\n",
       scene.spec.name.c_str(), steps, threads, steps / stepping, cpu / steps,
       1e3 * searching / steps, self_contact ? "true" : "false", updates, unconverged, at_cap,
       max_active, worst_end, gap_tolerance, searches, crossing_checks, crossing_first,
       exact_crossing_checks, kinds.node_in_face, kinds.node_in_face_deep, kinds.edge_edge,
-      kinds.with_candidate, kinds.edge_edge_with_candidate);
+      kinds.with_candidate, kinds.edge_edge_with_candidate, kinds.within_tolerance,
+      kinds.deepest);
   return 0;
 }

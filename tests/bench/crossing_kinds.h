@@ -10,6 +10,11 @@
 //                 triangle's shortest edge behind (detection's far-side rule refuses it).
 //   edge-edge:    no corner projects inside the other triangle from behind: the triangles cross
 //                 through their edges, and only an edge-edge constraint can see it.
+// Depth (a proxy for how far apart the pair must move): the inside corner's depth behind the
+// other triangle (the shallower side), or for an edge-edge crossing the smallest distance between
+// an edge of one and an edge of the other whose closest points lie on both. Pairs no deeper than
+// the contact's gap tolerance are counted apart: the solve accepts them (it drives end gaps to
+// zero within the tolerance, and the exact checker counts touching as intersecting).
 // Candidate: this step's contacts include a node-triangle pair of a corner of one with the other,
 // or an edge pair with an edge of each.
 #include <Eigen/Core>
@@ -28,6 +33,8 @@ struct CrossingKinds {
   int edge_edge = 0;          ///< no corner inside: edges through each other
   int with_candidate = 0;     ///< pairs this step's contacts cover
   int edge_edge_with_candidate = 0;
+  int within_tolerance = 0;  ///< pairs no deeper than the gap tolerance
+  double deepest = 0;        ///< m, the deepest pair's depth
 };
 
 namespace crossing_kinds_detail {
@@ -55,6 +62,26 @@ inline double cornerInside(const Triangle& p, const Triangle& t, const Eigen::Ve
   return deepest;
 }
 
+// Smallest distance between an edge of p and an edge of q whose closest points lie on both.
+inline double edgeEdgeDepth(const Triangle& p, const Triangle& q, const Eigen::VectorXd& x) {
+  double smallest = 1e300;
+  for (size_t i = 0; i < 3; ++i) {
+    for (size_t j = 0; j < 3; ++j) {
+      const Eigen::Vector3d a = corner(x, p[i]), b = corner(x, p[(i + 1) % 3]);
+      const Eigen::Vector3d c = corner(x, q[j]), d = corner(x, q[(j + 1) % 3]);
+      const Eigen::Vector3d d1 = b - a, d2 = d - c, w = a - c;
+      const double aa = d1.dot(d1), bb = d1.dot(d2), cc = d2.dot(d2);
+      const double den = aa * cc - bb * bb;
+      if (!(den > 1e-12 * aa * cc)) continue;
+      const double u = (bb * d2.dot(w) - cc * d1.dot(w)) / den;
+      const double v = (aa * d2.dot(w) - bb * d1.dot(w)) / den;
+      if (u < -0.01 || u > 1.01 || v < -0.01 || v > 1.01) continue;
+      smallest = std::min(smallest, (a + u * d1 - c - v * d2).norm());
+    }
+  }
+  return smallest;
+}
+
 inline bool hasCorner(const Triangle& t, int node) {
   return t[0] == node || t[1] == node || t[2] == node;
 }
@@ -65,7 +92,7 @@ inline CrossingKinds classifyCrossings(const std::vector<TrianglePair>& pairs,
                                        const std::vector<Triangle>& triangles,
                                        const Eigen::VectorXd& x,
                                        const std::vector<SurfaceContact>& contacts,
-                                       double max_depth) {
+                                       double max_depth, double tolerance) {
   using namespace crossing_kinds_detail;
   CrossingKinds kinds;
   for (const TrianglePair& pair : pairs) {
@@ -73,6 +100,10 @@ inline CrossingKinds classifyCrossings(const std::vector<TrianglePair>& pairs,
     const Triangle& q = triangles[static_cast<size_t>(pair.second)];
     const double pq = cornerInside(p, q, x), qp = cornerInside(q, p, x);
     const bool edge_edge = pq < 0 && qp < 0;
+    const double depth = edge_edge ? edgeEdgeDepth(p, q, x)
+                                   : std::min(pq < 0 ? 1e300 : pq, qp < 0 ? 1e300 : qp);
+    if (depth <= tolerance) ++kinds.within_tolerance;
+    if (depth < 1e300) kinds.deepest = std::max(kinds.deepest, depth);
     if (edge_edge) {
       ++kinds.edge_edge;
     } else {
