@@ -39,7 +39,9 @@ struct CrossingKinds {
 
 namespace crossing_kinds_detail {
 
-inline Eigen::Vector3d corner(const Eigen::VectorXd& x, int node) { return x.segment<3>(3 * node); }
+inline Eigen::Vector3d corner(const Eigen::VectorXd& x, int node) {
+  return x.segment<3>(3 * node);
+}
 
 // Deepest corner of `p` behind triangle `t` that projects inside it (depth >= 0), or -1.
 inline double cornerInside(const Triangle& p, const Triangle& t, const Eigen::VectorXd& x) {
@@ -100,8 +102,8 @@ inline CrossingKinds classifyCrossings(const std::vector<TrianglePair>& pairs,
     const Triangle& q = triangles[static_cast<size_t>(pair.second)];
     const double pq = cornerInside(p, q, x), qp = cornerInside(q, p, x);
     const bool edge_edge = pq < 0 && qp < 0;
-    const double depth = edge_edge ? edgeEdgeDepth(p, q, x)
-                                   : std::min(pq < 0 ? 1e300 : pq, qp < 0 ? 1e300 : qp);
+    const double depth =
+        edge_edge ? edgeEdgeDepth(p, q, x) : std::min(pq < 0 ? 1e300 : pq, qp < 0 ? 1e300 : qp);
     if (depth <= tolerance) ++kinds.within_tolerance;
     if (depth < 1e300) kinds.deepest = std::max(kinds.deepest, depth);
     if (edge_edge) {

@@ -1,11 +1,11 @@
 // The shared narrow phase of FEM surface contact (contact/surface_candidates.h): closest points of
 // two edges, the edge-edge candidate's normal, gap and weights, the node-triangle candidate with
 // its exclusion rule, and the surface edges' folds. Inline geometry, one quirk per test.
+#include "torsion/contact/surface_candidates.h"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
-
-#include "torsion/contact/surface_candidates.h"
 
 namespace torsion {
 namespace {
@@ -32,11 +32,14 @@ CandidateRules rules() {
 }
 
 // e's surface faces down (-z), f's up (+z): f's outward minus e's is +z.
-Eigen::Vector3d facingUp() { return Eigen::Vector3d(0, 0, 2); }
+Eigen::Vector3d facingUp() {
+  return Eigen::Vector3d(0, 0, 2);
+}
 
 TEST(SurfaceCandidates, TheClosestPointsOfTwoCrossingEdgesAreTheirMiddlesAtTheirDistance) {
   double u = -1, v = -1, distance = -1;
-  ASSERT_TRUE(closestPointsOfLines({-1, 0, 0.3}, {1, 0, 0.3}, {0, -1, 0}, {0, 3, 0}, u, v, distance));
+  ASSERT_TRUE(
+      closestPointsOfLines({-1, 0, 0.3}, {1, 0, 0.3}, {0, -1, 0}, {0, 3, 0}, u, v, distance));
   EXPECT_NEAR(u, 0.5, 1e-15);
   EXPECT_NEAR(v, 0.25, 1e-15);
   EXPECT_NEAR(distance, 0.3, 1e-15);
@@ -70,7 +73,8 @@ TEST(SurfaceCandidates, TheEdgePairsNormalFollowsTheSurfacesNotTheOrderOfTheCorn
   std::swap(swapped[1][0], swapped[1][1]);
   const std::optional<EdgeEdgeHit> a =
       edgeEdgeCandidate(alongX(0.02, 0.02), alongY(), rules(), {}, facingUp, {});
-  const std::optional<EdgeEdgeHit> b = edgeEdgeCandidate(swapped, alongY(), rules(), {}, facingUp, {});
+  const std::optional<EdgeEdgeHit> b =
+      edgeEdgeCandidate(swapped, alongY(), rules(), {}, facingUp, {});
   ASSERT_TRUE(a && b);
   EXPECT_NEAR(a->normal.z(), 1, 1e-15);
   EXPECT_NEAR(b->normal.z(), 1, 1e-15);
@@ -98,8 +102,7 @@ TEST(SurfaceCandidates, ParallelDegenerateDistantAndAvertedEdgePairsAreNoCandida
                         {Eigen::Vector3d(2, 0, 0.01), Eigen::Vector3d(3, 0, 0.01)}}};
   EXPECT_TRUE(none(beside, alongY(), facingUp));
   // Surfaces not facing each other (outward normals along the edges' plane).
-  EXPECT_TRUE(none(alongX(0.01, 0.01), alongY(),
-                   [] { return Eigen::Vector3d(2, 0, 0); }));
+  EXPECT_TRUE(none(alongX(0.01, 0.01), alongY(), [] { return Eigen::Vector3d(2, 0, 0); }));
 }
 
 TEST(SurfaceCandidates, ACrossedEdgePairIsRefusedUnlessHeldAndThenKeepsItsSide) {
@@ -118,8 +121,8 @@ TEST(SurfaceCandidates, TheCallersExclusionRuleRefusesOnlyNewPairs) {
   const ExclusionRule all = [](const Eigen::Vector3d&, double) { return true; };
   EXPECT_FALSE(edgeEdgeCandidate(alongX(0.01, 0.01), alongY(), rules(), {}, facingUp, all));
   const Eigen::Vector3d pushed_up(0, 0, 0.3);
-  EXPECT_TRUE(edgeEdgeCandidate(alongX(0.01, 0.01), alongY(), rules(), [&] { return &pushed_up; },
-                                facingUp, all));
+  EXPECT_TRUE(edgeEdgeCandidate(
+      alongX(0.01, 0.01), alongY(), rules(), [&] { return &pushed_up; }, facingUp, all));
   // Node against triangle, the same way.
   const std::array<Eigen::Vector3d, 3> triangle = {
       Eigen::Vector3d(0, 0, 0), Eigen::Vector3d(1, 0, 0), Eigen::Vector3d(0, 1, 0)};
@@ -133,9 +136,9 @@ TEST(SurfaceCandidates, ANodeCrossingATriangleIsJudgedWhereItMeetsThePlane) {
   const std::array<Eigen::Vector3d, 3> triangle = {
       Eigen::Vector3d(0, 0, 0), Eigen::Vector3d(1, 0, 0), Eigen::Vector3d(0, 1, 0)};
   // From (0.9, 0.3, 0.3) to (-0.1, 0.3, -0.1): meets the plane at s = 0.75, at (0.15, 0.3, 0).
-  const std::optional<NodeTriangleHit> hit = nodeTriangleCandidate(
-      {Eigen::Vector3d(0.9, 0.3, 0.3), Eigen::Vector3d(-0.1, 0.3, -0.1)}, triangle, triangle,
-      rules(), false, {});
+  const std::optional<NodeTriangleHit> hit =
+      nodeTriangleCandidate({Eigen::Vector3d(0.9, 0.3, 0.3), Eigen::Vector3d(-0.1, 0.3, -0.1)},
+                            triangle, triangle, rules(), false, {});
   ASSERT_TRUE(hit);
   EXPECT_NEAR(hit->when, 0.75, 1e-15);
   EXPECT_NEAR(hit->gap, 0.3, 1e-15);
@@ -143,8 +146,9 @@ TEST(SurfaceCandidates, ANodeCrossingATriangleIsJudgedWhereItMeetsThePlane) {
   EXPECT_NEAR(hit->weights[2], 0.3, 1e-12);
   // At the start over (0.9, 0.3): outside; only the crossing's projection counts.
   // A node that ends beside the triangle, never over it: none.
-  EXPECT_FALSE(nodeTriangleCandidate({Eigen::Vector3d(1.5, 0.3, 0.3), Eigen::Vector3d(1.2, 0.3, -0.1)},
-                                     triangle, triangle, rules(), false, {}));
+  EXPECT_FALSE(
+      nodeTriangleCandidate({Eigen::Vector3d(1.5, 0.3, 0.3), Eigen::Vector3d(1.2, 0.3, -0.1)},
+                            triangle, triangle, rules(), false, {}));
 }
 
 TEST(SurfaceCandidates, SurfaceEdgesKnowTheirTrianglesAndHowFarTheyFold) {

@@ -52,8 +52,8 @@ SurfaceEdges::SurfaceEdges(const std::vector<Triangle>& triangles) {
     } else if (edge_triangles.back()[1] < 0) {
       edge_triangles.back()[1] = halves[k].second;
     }
-    triangle_edges[static_cast<size_t>(halves[k].second)].push_back(
-        static_cast<int>(edges.size()) - 1);
+    triangle_edges[static_cast<size_t>(halves[k].second)].push_back(static_cast<int>(edges.size()) -
+                                                                    1);
   }
 }
 

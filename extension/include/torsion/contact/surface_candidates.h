@@ -22,9 +22,10 @@ namespace torsion {
 
 /// Surface edges of a triangle list, each once, and the edges of every triangle.
 struct SurfaceEdges {
-  std::vector<std::array<int, 2>> edges;          ///< corners ascending, sorted
-  std::vector<std::vector<int>> triangle_edges;   ///< the three edges of each triangle
-  std::vector<std::array<int, 2>> edge_triangles; ///< the (up to) two triangles on each edge, -1 none
+  std::vector<std::array<int, 2>> edges;         ///< corners ascending, sorted
+  std::vector<std::vector<int>> triangle_edges;  ///< the three edges of each triangle
+  /// The (up to) two triangles on each edge, -1 for none.
+  std::vector<std::array<int, 2>> edge_triangles;
 
   explicit SurfaceEdges(const std::vector<Triangle>& triangles);
   /// Unit mean outward normal of the triangles on edge `edge` at positions x (3n), zero if none.
@@ -50,10 +51,10 @@ struct CandidateRules {
 /// A node-triangle candidate: the constraint's normal and gap at the step's start, when on the
 /// path it was judged, and the node's projection there.
 struct NodeTriangleHit {
-  Eigen::Vector3d normal;  ///< unit, the triangle's (right-handed) normal at the start
-  double gap = 0;          ///< m, the node's signed distance along it at the start
-  double when = 0;         ///< s in [0, 1] where the node meets the plane (0: within the margin)
-  Eigen::Vector3d weights; ///< barycentric coordinates of the projection at `when` (unclamped)
+  Eigen::Vector3d normal;   ///< unit, the triangle's (right-handed) normal at the start
+  double gap = 0;           ///< m, the node's signed distance along it at the start
+  double when = 0;          ///< s in [0, 1] where the node meets the plane (0: within the margin)
+  Eigen::Vector3d weights;  ///< barycentric coordinates of the projection at `when` (unclamped)
 };
 
 /// A pair's own exclusion rule, asked after the geometric tests of a pair not held last step,
@@ -94,10 +95,11 @@ struct EdgeEdgeHit {
 /// `excluded` (oriented normal and gap; unless held; empty: no rule). `held()`: the multiplier
 /// the pair ended last step with (nullptr: not held); its direction then orients the normal
 /// instead.
-std::optional<EdgeEdgeHit> edgeEdgeCandidate(
-    const std::array<std::array<Eigen::Vector3d, 2>, 2>& e,
-    const std::array<std::array<Eigen::Vector3d, 2>, 2>& f, const CandidateRules& rules,
-    const std::function<const Eigen::Vector3d*()>& held,
-    const std::function<Eigen::Vector3d()>& outward, const ExclusionRule& excluded);
+std::optional<EdgeEdgeHit> edgeEdgeCandidate(const std::array<std::array<Eigen::Vector3d, 2>, 2>& e,
+                                             const std::array<std::array<Eigen::Vector3d, 2>, 2>& f,
+                                             const CandidateRules& rules,
+                                             const std::function<const Eigen::Vector3d*()>& held,
+                                             const std::function<Eigen::Vector3d()>& outward,
+                                             const ExclusionRule& excluded);
 
 }  // namespace torsion
