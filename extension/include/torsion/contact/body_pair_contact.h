@@ -43,8 +43,10 @@ struct BodyContactSettings {
   /// Uzawa updates per step (each one linear solve of every body of the island).
   int max_iterations = 60;
   /// Edge-against-edge candidates besides node-against-triangle ones: two edges crossing where
-  /// no node meets a face (an edge across an edge). Off: node-triangle only.
-  bool edge_edge = true;
+  /// no node meets a face (an edge across an edge). Off by default while its effect on the
+  /// contact scenes (soft_grasp's hand torque, soft_stack, bullet_collide_soft) is not judged
+  /// (docs/contact.md, "Edge against edge between bodies").
+  bool edge_edge = false;
 
   Status validate() const;
 };
