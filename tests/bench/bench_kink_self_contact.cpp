@@ -8,7 +8,9 @@
 // energy, active contacts, contact iterations.
 //
 //   bench_kink_self_contact [--friction MU] [--dt S] [--rate RAD_PER_S] [--hold STEPS]
-//                           [--check-from STEP] [--print STEPS] [--no-self-contact]
+//                           [--check-from STEP] [--print STEPS] [--detail STEP]
+//                           [--no-self-contact]
+// --detail prints that step's crossing pairs and the contacts on them, as for the first one.
 #include <Eigen/Geometry>
 #include <chrono>
 #include <cmath>
@@ -23,12 +25,13 @@
 #include "torsion/bullet/fem_body.h"
 #include "torsion/bullet/fem_world.h"
 #include "torsion/mesh/mesh_io.h"
+#include "crossing_kinds.h"
 
 using namespace torsion;
 
 int main(int argc, char** argv) {
   double friction = 0.3, dt = 0.01, rate = 0.5;
-  int hold = 300, check_from = 0, print_every = 100;
+  int hold = 300, check_from = 0, print_every = 100, detail_step = -1;
   bool self_contact = true;
   for (int i = 1; i < argc; ++i) {
     const std::string arg = argv[i];
@@ -45,6 +48,8 @@ int main(int argc, char** argv) {
       check_from = static_cast<int>(value());
     else if (arg == "--print")
       print_every = std::max(1, static_cast<int>(value()));
+    else if (arg == "--detail")
+      detail_step = static_cast<int>(value());
     else if (arg == "--no-self-contact")
       self_contact = false;
     else {
@@ -90,6 +95,9 @@ int main(int argc, char** argv) {
   const int steps = static_cast<int>(std::ceil(max_angle / rate / dt)) + hold;
   const auto start = std::chrono::steady_clock::now();
   int crossing_steps = 0, first_crossing = -1, unconverged = 0, checked = 0;
+  // Over the steps with crossings: pairs by kind (crossing_kinds.h), summed.
+  CrossingKinds kinds_total;
+  int deep_crossing_steps = 0;  // steps with a pair deeper than the gap tolerance
   double peak_elastic = 0;
   for (int k = 1; k <= steps; ++k) {
     if (!world.step().ok) {
@@ -109,9 +117,36 @@ int main(int argc, char** argv) {
       const std::vector<TrianglePair> pairs =
           findSurfaceIntersections(mesh.surfaceTriangles(), body->state().positions);
       crossings = static_cast<int>(pairs.size());
-      if (!pairs.empty()) ++crossing_steps;
-      if (!pairs.empty() && first_crossing < 0) {
-        first_crossing = k;
+      if (!pairs.empty()) {
+        ++crossing_steps;
+        const CrossingKinds kinds = classifyCrossings(
+            pairs, mesh.surfaceTriangles(), body->state().positions,
+            contact != nullptr ? contact->contacts() : std::vector<SurfaceContact>{},
+            contact != nullptr ? contact->settings().max_depth : 0.25,
+            contact != nullptr ? contact->gapTolerance() : 0.0);
+        kinds_total.node_in_face += kinds.node_in_face;
+        kinds_total.node_in_face_deep += kinds.node_in_face_deep;
+        kinds_total.edge_edge += kinds.edge_edge;
+        kinds_total.with_candidate += kinds.with_candidate;
+        kinds_total.edge_edge_with_candidate += kinds.edge_edge_with_candidate;
+        kinds_total.within_tolerance += kinds.within_tolerance;
+        kinds_total.deepest = std::max(kinds_total.deepest, kinds.deepest);
+        if (kinds.within_tolerance < crossings && deep_crossing_steps++ == 0)
+          std::printf("step %d: first pair deeper than the gap tolerance (%.3g m): %d of %d pairs "
+                      "(%d edge-edge), deepest %.3g m, active contacts %d\n",
+                      k, contact != nullptr ? contact->gapTolerance() : 0.0,
+                      crossings - kinds.within_tolerance, crossings, kinds.edge_edge,
+                      kinds.deepest, contact != nullptr ? contact->stats().active : 0);
+        if (first_crossing < 0 || k % print_every == 0)
+          std::printf(
+              "step %d: %d crossing pairs: %d node in face (%d deep), %d edge-edge; %d with a "
+              "candidate (%d edge-edge); %d within the gap tolerance, deepest %.3g m\n",
+              k, crossings, kinds.node_in_face, kinds.node_in_face_deep, kinds.edge_edge,
+              kinds.with_candidate, kinds.edge_edge_with_candidate, kinds.within_tolerance,
+              kinds.deepest);
+      }
+      if (!pairs.empty() && (first_crossing < 0 || k == detail_step)) {
+        if (first_crossing < 0) first_crossing = k;
         const std::vector<Triangle>& triangles = mesh.surfaceTriangles();
         for (const TrianglePair& p : pairs) {
           Eigen::Vector3d a = Eigen::Vector3d::Zero(), b = Eigen::Vector3d::Zero();
@@ -123,6 +158,26 @@ int main(int argc, char** argv) {
               "step %d: triangles %d and %d cross; rest centroids (%.2f %.2f %.2f) and "
               "(%.2f %.2f %.2f), %.3f m apart\n",
               k, p.first, p.second, a.x(), a.y(), a.z(), b.x(), b.y(), b.z(), (a - b).norm());
+          // The contacts this step had on the pair: why did they not hold it?
+          const Triangle& tp = triangles[static_cast<size_t>(p.first)];
+          const Triangle& tq = triangles[static_cast<size_t>(p.second)];
+          auto in = [](const Triangle& t, int n) { return t[0] == n || t[1] == n || t[2] == n; };
+          for (const SurfaceContact& c : contact != nullptr ? contact->contacts()
+                                                            : std::vector<SurfaceContact>{}) {
+            const bool covers =
+                c.edge < 0
+                    ? (c.triangle == p.second && in(tp, c.nodes[0])) ||
+                          (c.triangle == p.first && in(tq, c.nodes[0]))
+                    : (in(tp, c.nodes[0]) && in(tp, c.nodes[1]) && in(tq, c.nodes[2]) &&
+                       in(tq, c.nodes[3])) ||
+                          (in(tq, c.nodes[0]) && in(tq, c.nodes[1]) && in(tp, c.nodes[2]) &&
+                           in(tp, c.nodes[3]));
+            if (!covers) continue;
+            std::printf("  %s contact: gap %.3g m, linearised end gap %.3g m, state %d, "
+                        "normal impulse %.3g N s\n",
+                        c.edge < 0 ? "node-triangle" : "edge-edge", c.gap, c.end_gap,
+                        static_cast<int>(c.state), c.normal.dot(c.multiplier));
+          }
         }
       }
     }
@@ -139,9 +194,15 @@ int main(int argc, char** argv) {
   const Wrench w = body->groupWrench(hand, Eigen::Vector3d(0, 0, length));
   std::printf(
       "end: hand torque %.5g N m, elastic %.5g J (peak %.5g J), steps with crossing triangles %d "
-      "of %d checked (first %d), unconverged contact solves %d, %.1f s\n",
+      "of %d checked (first %d), unconverged contact solves %d, %.1f s\n"
+      "crossing pairs summed over those steps: %d node in face (%d deep), %d edge-edge; %d with "
+      "a candidate (%d edge-edge); %d within the gap tolerance, deepest %.3g m; steps with a "
+      "pair deeper than the tolerance %d\n",
       std::abs(w.torque.z()), body->lastReport().elastic_energy, peak_elastic, crossing_steps,
       checked, first_crossing, unconverged,
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(),
+      kinds_total.node_in_face, kinds_total.node_in_face_deep, kinds_total.edge_edge,
+      kinds_total.with_candidate, kinds_total.edge_edge_with_candidate,
+      kinds_total.within_tolerance, kinds_total.deepest, deep_crossing_steps);
   return 0;
 }

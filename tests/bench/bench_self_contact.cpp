@@ -22,6 +22,7 @@
 #include <iterator>
 #include <string>
 
+#include "crossing_kinds.h"
 #include "scene_builder.h"
 #include "scene_haptics.h"
 #include "scene_parser.h"
@@ -96,7 +97,8 @@ int main(int argc, char** argv) {
   if (!self_contact) body->disableSelfContact();
   const std::vector<Triangle>& surface = body->model().mesh().surfaceTriangles();
   int unconverged = 0, at_cap = 0, max_active = 0, searches = 0, crossing_checks = 0,
-      crossing_first = -1;
+      crossing_first = -1, exact_crossing_checks = 0;
+  CrossingKinds kinds;  // the exact checker's pairs at the checks, summed (crossing_kinds.h)
   long updates = 0;
   double worst_end = 0, stepping = 0, searching = 0;
   const std::clock_t cpu0 = std::clock();
@@ -127,10 +129,27 @@ int main(int argc, char** argv) {
       searches += s.searches;
       searching += s.search_seconds;
     }
-    if (check_every > 0 && k % check_every == 0 &&
-        !findSurfaceIntersections(surface, body->state().positions).empty()) {
-      ++crossing_checks;
-      if (crossing_first < 0) crossing_first = k;
+    if (check_every > 0 && k % check_every == 0) {
+      const std::vector<Triangle>& triangles = surface;
+      const std::vector<TrianglePair> pairs =
+          findSurfaceIntersections(triangles, body->state().positions);
+      if (!pairs.empty()) {
+        ++crossing_checks;
+        if (crossing_first < 0) crossing_first = k;
+        ++exact_crossing_checks;
+        const CrossingKinds found = classifyCrossings(
+            pairs, triangles, body->state().positions,
+            body->selfContact() != nullptr ? body->selfContact()->contacts()
+                                           : std::vector<SurfaceContact>{},
+            0.25, gap_tolerance);
+        kinds.node_in_face += found.node_in_face;
+        kinds.node_in_face_deep += found.node_in_face_deep;
+        kinds.edge_edge += found.edge_edge;
+        kinds.with_candidate += found.with_candidate;
+        kinds.edge_edge_with_candidate += found.edge_edge_with_candidate;
+        kinds.within_tolerance += found.within_tolerance;
+        kinds.deepest = std::max(kinds.deepest, found.deepest);
+      }
     }
   }
   const double cpu = static_cast<double>(std::clock() - cpu0) / CLOCKS_PER_SEC;
@@ -141,9 +160,16 @@ int main(int argc, char** argv) {
       "\"unconverged\": %d, \"unconverged_at_max_iterations\": %d, \"max_active\": %d, "
       "\"worst_end_penetration_m\": %.3g, "
       "\"gap_tolerance_m\": %.3g, \"searches\": %d, \"crossing_checks\": %d, "
-      "\"first_crossing_step\": %d}\n",
+      "\"first_crossing_step\": %d, \"exact_crossing_checks\": %d, "
+      "\"crossing_pairs_node_in_face\": %d, \"crossing_pairs_node_in_face_deep\": %d, "
+      "\"crossing_pairs_edge_edge\": %d, \"crossing_pairs_with_candidate\": %d, "
+      "\"crossing_pairs_edge_edge_with_candidate\": %d, "
+      "\"crossing_pairs_within_gap_tolerance\": %d, \"deepest_crossing_m\": %.3g}\n",
       scene.spec.name.c_str(), steps, threads, steps / stepping, cpu / steps,
       1e3 * searching / steps, self_contact ? "true" : "false", updates, unconverged, at_cap,
-      max_active, worst_end, gap_tolerance, searches, crossing_checks, crossing_first);
+      max_active, worst_end, gap_tolerance, searches, crossing_checks, crossing_first,
+      exact_crossing_checks, kinds.node_in_face, kinds.node_in_face_deep, kinds.edge_edge,
+      kinds.with_candidate, kinds.edge_edge_with_candidate, kinds.within_tolerance,
+      kinds.deepest);
   return 0;
 }

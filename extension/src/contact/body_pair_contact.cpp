@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "torsion/contact/surface_candidates.h"
 #include "torsion/format_number.h"
 
 namespace torsion {
@@ -22,6 +23,8 @@ constexpr double kInsideTolerance = 0.05;
 constexpr double kFacing = 0.25;
 // ... and only for a node already touching it: within this many gap tolerances of its plane.
 constexpr double kFacingBand = 4;
+// An edge whose two triangles' normals are within 20 degrees lies on a flat part of its surface.
+const double kFlatFold = std::cos(20.0 * M_PI / 180.0);
 
 // 3n: each surface node's unit outward normal at positions x (zero off the surface): the sum of
 // its surface triangles' area-weighted normals.
@@ -95,7 +98,9 @@ BodyPairContact::BodyPairContact(std::shared_ptr<const FemModel> a,
       mean_edge_a_(meanSurfaceEdge(a_->mesh())),
       mean_edge_b_(meanSurfaceEdge(b_->mesh())),
       tree_a_(a_->mesh().surfaceTriangles()),
-      tree_b_(b_->mesh().surfaceTriangles()) {
+      tree_b_(b_->mesh().surfaceTriangles()),
+      edges_a_(a_->mesh().surfaceTriangles()),
+      edges_b_(b_->mesh().surfaceTriangles()) {
   gap_tolerance_ = settings_.gap_tolerance > 0 ? settings_.gap_tolerance
                                                : 1e-3 * std::min(mean_edge_a_, mean_edge_b_);
   // Half steps of sliding friction: a stack on the ground had contacts whose k_t swung by 6 %
@@ -122,6 +127,8 @@ bool BodyPairContact::detect(const Eigen::VectorXd& xa, const Eigen::VectorXd& v
   nodeNormals(b_->mesh(), xb, normals_b_);
   addCandidates(*a_, 0, xa, end_a_, normals_a_, tree_b_, node_count_a_, triangle_count_a_, xb,
                 end_b_, settings_.margin * mean_edge_b_);
+  // a's edges against b's, with b's tree still refitted to b's motion.
+  if (settings_.edge_edge) addEdgeCandidates(xa, end_a_, xb, end_b_, settings_.margin * mean_edge_b_);
   addCandidates(*b_, node_count_a_, xb, end_b_, normals_b_, tree_a_, 0, 0, xa, end_a_,
                 settings_.margin * mean_edge_a_);
   // A contact that slid last step starts its first solve with the k_t its friction and the slip
@@ -152,59 +159,44 @@ void BodyPairContact::addCandidates(const FemModel& nodes_model, int node_offset
                                     double margin) {
   tree.refit(xt, et, margin);
   const std::vector<Triangle>& triangles = tree.triangles();
+  CandidateRules rules;
+  rules.margin = margin;
+  rules.max_depth = settings_.max_depth;
+  rules.crease_depth = 2 * gap_tolerance_;
+  auto at = [](const Eigen::VectorXd& positions, int node) -> Eigen::Vector3d {
+    return positions.segment<3>(3 * node);
+  };
+  Eigen::Vector3d node_normal = Eigen::Vector3d::Zero();
+  // Not facing the triangle while already touching its plane (resting or sliding along it, not
+  // arriving): no contact, unless it held last step (no sudden release). A node still arriving is
+  // paired whatever its normal: an edge or corner striking a face obliquely in a fast impact faces
+  // it at any angle (filtered, two soft cubes at 15 m/s interpenetrated by 4 cm).
+  const ExclusionRule not_facing = [&](const Eigen::Vector3d& normal, double gap) {
+    return gap <= kFacingBand * gap_tolerance_ && node_normal.dot(normal) > -kFacing;
+  };
   for (int p : nodes_model.mesh().surfaceNodes()) {
     const Eigen::Vector3d xp = xn.segment<3>(3 * p), ep = en.segment<3>(3 * p);
+    node_normal = node_normals.segment<3>(3 * p);
     tree.query(xp.cwiseMin(ep), xp.cwiseMax(ep), found_);
     for (int t : found_) {
       const Triangle& tri = triangles[static_cast<size_t>(t)];
-      const Eigen::Vector3d a0 = xt.segment<3>(3 * tri[0]), b0 = xt.segment<3>(3 * tri[1]),
-                            c0 = xt.segment<3>(3 * tri[2]);
-      Eigen::Vector3d n0 = (b0 - a0).cross(c0 - a0);
-      if (!(n0.norm() > 0)) continue;  // degenerate: no plane to stay out of
-      n0.normalize();
-      const double g0 = n0.dot(xp - a0);
-      const double shortest = std::min({(b0 - a0).norm(), (c0 - b0).norm(), (a0 - c0).norm()});
-      if (g0 < -settings_.max_depth * shortest) continue;  // deep inside: the far side
       const int pair_node = node_offset + p;
       const int pair_triangle = triangle_offset + t;
-      // Behind the plane beyond the tolerance: only a contact held last step is still one (it
+      // Behind the plane beyond the crease depth: only a contact held last step is still one (it
       // sank within its tolerance); a new pair there is a node past the other body's rim.
-      if (g0 < -2 * gap_tolerance_ && !set_.wasActive(pair_node, pair_triangle)) continue;
-      // Not facing the triangle while already touching its plane (resting or sliding along it,
-      // not arriving): no contact, unless it held last step (no sudden release). A node still
-      // arriving is paired whatever its normal: an edge or corner striking a face obliquely in a
-      // fast impact faces it at any angle (filtered, two soft cubes at 15 m/s interpenetrated
-      // by 4 cm).
-      if (g0 <= kFacingBand * gap_tolerance_ && node_normals.segment<3>(3 * p).dot(n0) > -kFacing &&
-          !set_.wasActive(pair_node, pair_triangle))
-        continue;
-      const Eigen::Vector3d a1 = et.segment<3>(3 * tri[0]), b1 = et.segment<3>(3 * tri[1]),
-                            c1 = et.segment<3>(3 * tri[2]);
-      Eigen::Vector3d n1 = (b1 - a1).cross(c1 - a1);
-      if (!(n1.norm() > 0)) n1 = n0;
-      const double g1 = n1.normalized().dot(ep - a1);
-      // When on the path the node meets the plane: now if within the margin, at the crossing if
-      // it passes through, at the end if it ends within the margin.
-      double s;
-      if (g0 <= margin) {
-        s = 0;
-      } else if (g1 < 0) {
-        s = g0 / (g0 - g1);
-      } else if (g1 <= margin) {
-        s = 1;
-      } else {
-        continue;
-      }
-      const Eigen::Vector3d w = barycentric(xp + s * (ep - xp), a0 + s * (a1 - a0),
-                                            b0 + s * (b1 - b0), c0 + s * (c1 - c0));
-      if (!w.allFinite() || w.minCoeff() < -kInsideTolerance) continue;
+      const std::array<Eigen::Vector3d, 3> t0 = {at(xt, tri[0]), at(xt, tri[1]), at(xt, tri[2])};
+      const std::optional<NodeTriangleHit> hit = nodeTriangleCandidate(
+          {xp, ep}, t0, {at(et, tri[0]), at(et, tri[1]), at(et, tri[2])}, rules,
+          set_.wasActive(pair_node, pair_triangle), not_facing);
+      if (!hit) continue;
+      const Eigen::Vector3d& w = hit->weights;
       // The impulse's triangle point: the node's projection at the step's start, unclamped while
       // within the slack. Node and point then differ only along the normal, so the pair of
       // impulses has no moment about the start positions, where an implicit step's impulses act
       // on the angular momentum (clamping to the triangle gave levers: 1.5 % of the angular
       // momentum lost in bullet_collide_soft, 0.95 % without). A projection that enters the
       // triangle only later on the path takes the crossing's weights, clamped.
-      const Eigen::Vector3d w_start = s > 0 ? barycentric(xp, a0, b0, c0) : w;
+      const Eigen::Vector3d w_start = hit->when > 0 ? barycentric(xp, t0[0], t0[1], t0[2]) : w;
       const Eigen::Vector3d wc = w_start.allFinite() && w_start.minCoeff() >= -kInsideTolerance
                                      ? w_start
                                      : Eigen::Vector3d(w.cwiseMax(0.0) / w.cwiseMax(0.0).sum());
@@ -213,8 +205,83 @@ void BodyPairContact::addCandidates(const FemModel& nodes_model, int node_offset
                  triangle_node_offset + tri[2]};
       c.beta = {1.0, -wc[0], -wc[1], -wc[2]};
       c.triangle = pair_triangle;
-      c.normal = n0;
-      c.gap = g0;
+      c.normal = hit->normal;
+      c.gap = hit->gap;
+      c.friction = settings_.friction;
+      set_.add(c);
+    }
+  }
+}
+
+void BodyPairContact::addEdgeCandidates(const Eigen::VectorXd& xa, const Eigen::VectorXd& ea,
+                                        const Eigen::VectorXd& xb, const Eigen::VectorXd& eb,
+                                        double margin) {
+  CandidateRules rules;
+  rules.margin = margin;
+  rules.max_depth = settings_.max_depth;
+  rules.crease_depth = 2 * gap_tolerance_;
+  auto at = [](const Eigen::VectorXd& positions, int node) -> Eigen::Vector3d {
+    return positions.segment<3>(3 * node);
+  };
+  // Each edge's box over the motion.
+  auto box = [&](const std::array<int, 2>& e, const Eigen::VectorXd& x, const Eigen::VectorXd& end,
+                 Eigen::Vector3d& lo, Eigen::Vector3d& hi) {
+    lo = at(x, e[0]).cwiseMin(at(x, e[1])).cwiseMin(at(end, e[0])).cwiseMin(at(end, e[1]));
+    hi = at(x, e[0]).cwiseMax(at(x, e[1])).cwiseMax(at(end, e[0])).cwiseMax(at(end, e[1]));
+  };
+  const std::vector<Triangle>& triangles_a = tree_a_.triangles();
+  const std::vector<Triangle>& triangles_b = tree_b_.triangles();
+  SurfaceContact contact;
+  const std::function<const Eigen::Vector3d*()> held = [&] { return set_.warmStartOf(contact); };
+  const std::function<Eigen::Vector3d()> outward = [&]() -> Eigen::Vector3d {
+    return edges_b_.outwardNormal(contact.triangle, triangles_b, xb) -
+           edges_a_.outwardNormal(contact.edge, triangles_a, xa);
+  };
+  // Where one of the edges lies on a flat part of its surface (its two triangles within 20
+  // degrees of each other), only an arriving pair is new: two faces resting or sliding on each
+  // other have edges crossing in one plane everywhere, which their node contacts hold already;
+  // as edge pairs with friction they caught a soft block sliding down a soft slab (as nodes
+  // ahead of its leading edge did, docs/contact.md, "Friction between FEM bodies"). Ridge
+  // against ridge, which no node contact sees, is kept touching; a pair held last step stays.
+  const ExclusionRule resting_on_flat = [&](const Eigen::Vector3d&, double gap) {
+    return gap <= kFacingBand * gap_tolerance_ &&
+           (edges_a_.foldCosine(contact.edge, triangles_a, xa) > kFlatFold ||
+            edges_b_.foldCosine(contact.triangle, triangles_b, xb) > kFlatFold);
+  };
+  std::vector<int> later;
+  for (size_t i = 0; i < edges_a_.edges.size(); ++i) {
+    const std::array<int, 2>& e = edges_a_.edges[i];
+    Eigen::Vector3d lo_e, hi_e;
+    box(e, xa, ea, lo_e, hi_e);
+    tree_b_.query(lo_e, hi_e, found_);
+    // The edges of b's triangles found, each once, ascending.
+    later.clear();
+    for (int t : found_)
+      for (int j : edges_b_.triangle_edges[static_cast<size_t>(t)])
+        later.push_back(j);
+    std::sort(later.begin(), later.end());
+    later.erase(std::unique(later.begin(), later.end()), later.end());
+    const std::array<std::array<Eigen::Vector3d, 2>, 2> edge_e = {
+        {{at(xa, e[0]), at(xa, e[1])}, {at(ea, e[0]), at(ea, e[1])}}};
+    contact.edge = static_cast<int>(i);
+    for (int j : later) {
+      const std::array<int, 2>& f = edges_b_.edges[static_cast<size_t>(j)];
+      // Boxes over the motion more than the margin apart: never within it, never crossing.
+      Eigen::Vector3d lo_f, hi_f;
+      box(f, xb, eb, lo_f, hi_f);
+      if (((lo_f.array() - margin) > hi_e.array()).any() ||
+          ((hi_f.array() + margin) < lo_e.array()).any())
+        continue;
+      contact.triangle = j;
+      const std::optional<EdgeEdgeHit> hit = edgeEdgeCandidate(
+          edge_e, {{{at(xb, f[0]), at(xb, f[1])}, {at(eb, f[0]), at(eb, f[1])}}}, rules, held,
+          outward, resting_on_flat);
+      if (!hit) continue;
+      SurfaceContact c = contact;
+      c.nodes = {e[0], e[1], node_count_a_ + f[0], node_count_a_ + f[1]};
+      c.beta = {1.0 - hit->u, hit->u, -(1.0 - hit->v), -hit->v};
+      c.normal = hit->normal;
+      c.gap = hit->gap;
       c.friction = settings_.friction;
       set_.add(c);
     }

@@ -17,6 +17,7 @@
 #include <memory>
 #include <vector>
 
+#include "torsion/contact/surface_candidates.h"
 #include "torsion/contact/surface_contact_set.h"
 #include "torsion/contact/surface_tree.h"
 #include "torsion/fem/fem_model.h"
@@ -41,6 +42,11 @@ struct BodyContactSettings {
   double penalty_factor = 20;
   /// Uzawa updates per step (each one linear solve of every body of the island).
   int max_iterations = 60;
+  /// Edge-against-edge candidates besides node-against-triangle ones: two edges crossing where
+  /// no node meets a face (an edge across an edge). Off by default while its effect on the
+  /// contact scenes (soft_grasp's hand torque, soft_stack, bullet_collide_soft) is not judged
+  /// (docs/contact.md, "Edge against edge between bodies").
+  bool edge_edge = false;
 
   Status validate() const;
 };
@@ -86,6 +92,11 @@ class BodyPairContact {
                      SurfaceTree& tree, int triangle_node_offset, int triangle_offset,
                      const Eigen::VectorXd& xt, const Eigen::VectorXd& et, double margin);
 
+  // a's surface edges against b's (b's tree refitted to b's motion): the crossings of two edges
+  // that no node meets, as in self-contact; keyed (a's edge, b's edge).
+  void addEdgeCandidates(const Eigen::VectorXd& xa, const Eigen::VectorXd& ea,
+                         const Eigen::VectorXd& xb, const Eigen::VectorXd& eb, double margin);
+
   std::shared_ptr<const FemModel> a_, b_;
   BodyContactSettings settings_;
   int node_count_a_ = 0;
@@ -93,6 +104,7 @@ class BodyPairContact {
   double mean_edge_a_ = 0, mean_edge_b_ = 0;
   double gap_tolerance_ = 0;
   SurfaceTree tree_a_, tree_b_;
+  SurfaceEdges edges_a_, edges_b_;
   SurfaceContactSet set_;
   Eigen::VectorXd start_a_, start_b_;  // positions at the step's start (correctGaps)
   Eigen::VectorXd end_a_, end_b_;

@@ -30,6 +30,7 @@
 #include <set>
 #include <vector>
 
+#include "torsion/contact/surface_candidates.h"
 #include "torsion/contact/surface_contact_set.h"
 #include "torsion/contact/surface_tree.h"
 #include "torsion/fem/fem_model.h"
@@ -136,8 +137,8 @@ class SelfContactSolver {
   // (reads only; appended to out in ascending j).
   void edgeCandidates(int i, const Eigen::VectorXd& x, const Eigen::VectorXd& end,
                       std::vector<int>& scratch, std::vector<SurfaceContact>& out) const;
-  // Unit mean outward normal of the surface triangles on a surface edge, at positions x.
-  Eigen::Vector3d edgeNormal(const std::array<int, 2>& edge, const Eigen::VectorXd& x) const;
+  // Margin, depth and crease rule of the shared candidate tests (surface_candidates.h).
+  CandidateRules rules() const;
 
   std::shared_ptr<const FemModel> model_;
   SelfContactSettings settings_;
@@ -149,8 +150,7 @@ class SelfContactSolver {
   std::vector<std::vector<int>> node_triangles_;    // surface triangles of each node
   std::vector<std::vector<int>> node_contacts_;     // this step's contacts of each node
   std::vector<int> touched_nodes_;                  // nodes with an entry in node_contacts_
-  std::vector<std::array<int, 2>> edges_;           // surface edges, corners ascending
-  std::vector<std::vector<int>> triangle_edges_;    // the three edges of each surface triangle
+  SurfaceEdges surface_edges_;                      // surface edges and each triangle's three
   std::vector<Eigen::Vector3d> edge_lo_, edge_hi_;  // each edge's box over the searched motion
   std::vector<std::vector<SurfaceContact>> block_finds_;  // per block of nodes (edges), in order
   std::set<std::uint64_t> edge_pairs_;                    // this step's edge pairs (i << 32 | j)
