@@ -20,12 +20,12 @@
 #include <string>
 #include <vector>
 
+#include "crossing_kinds.h"
 #include "torsion/analysis/step_anomalies.h"
 #include "torsion/analysis/surface_intersections.h"
 #include "torsion/bullet/fem_body.h"
 #include "torsion/bullet/fem_world.h"
 #include "torsion/mesh/mesh_io.h"
-#include "crossing_kinds.h"
 
 using namespace torsion;
 
@@ -132,11 +132,12 @@ int main(int argc, char** argv) {
         kinds_total.within_tolerance += kinds.within_tolerance;
         kinds_total.deepest = std::max(kinds_total.deepest, kinds.deepest);
         if (kinds.within_tolerance < crossings && deep_crossing_steps++ == 0)
-          std::printf("step %d: first pair deeper than the gap tolerance (%.3g m): %d of %d pairs "
-                      "(%d edge-edge), deepest %.3g m, active contacts %d\n",
-                      k, contact != nullptr ? contact->gapTolerance() : 0.0,
-                      crossings - kinds.within_tolerance, crossings, kinds.edge_edge,
-                      kinds.deepest, contact != nullptr ? contact->stats().active : 0);
+          std::printf(
+              "step %d: first pair deeper than the gap tolerance (%.3g m): %d of %d pairs "
+              "(%d edge-edge), deepest %.3g m, active contacts %d\n",
+              k, contact != nullptr ? contact->gapTolerance() : 0.0,
+              crossings - kinds.within_tolerance, crossings, kinds.edge_edge, kinds.deepest,
+              contact != nullptr ? contact->stats().active : 0);
         if (first_crossing < 0 || k % print_every == 0)
           std::printf(
               "step %d: %d crossing pairs: %d node in face (%d deep), %d edge-edge; %d with a "
@@ -162,21 +163,20 @@ int main(int argc, char** argv) {
           const Triangle& tp = triangles[static_cast<size_t>(p.first)];
           const Triangle& tq = triangles[static_cast<size_t>(p.second)];
           auto in = [](const Triangle& t, int n) { return t[0] == n || t[1] == n || t[2] == n; };
-          for (const SurfaceContact& c : contact != nullptr ? contact->contacts()
-                                                            : std::vector<SurfaceContact>{}) {
-            const bool covers =
-                c.edge < 0
-                    ? (c.triangle == p.second && in(tp, c.nodes[0])) ||
-                          (c.triangle == p.first && in(tq, c.nodes[0]))
-                    : (in(tp, c.nodes[0]) && in(tp, c.nodes[1]) && in(tq, c.nodes[2]) &&
-                       in(tq, c.nodes[3])) ||
-                          (in(tq, c.nodes[0]) && in(tq, c.nodes[1]) && in(tp, c.nodes[2]) &&
-                           in(tp, c.nodes[3]));
+          for (const SurfaceContact& c :
+               contact != nullptr ? contact->contacts() : std::vector<SurfaceContact>{}) {
+            const bool covers = c.edge < 0 ? (c.triangle == p.second && in(tp, c.nodes[0])) ||
+                                                 (c.triangle == p.first && in(tq, c.nodes[0]))
+                                           : (in(tp, c.nodes[0]) && in(tp, c.nodes[1]) &&
+                                              in(tq, c.nodes[2]) && in(tq, c.nodes[3])) ||
+                                                 (in(tq, c.nodes[0]) && in(tq, c.nodes[1]) &&
+                                                  in(tp, c.nodes[2]) && in(tp, c.nodes[3]));
             if (!covers) continue;
-            std::printf("  %s contact: gap %.3g m, linearised end gap %.3g m, state %d, "
-                        "normal impulse %.3g N s\n",
-                        c.edge < 0 ? "node-triangle" : "edge-edge", c.gap, c.end_gap,
-                        static_cast<int>(c.state), c.normal.dot(c.multiplier));
+            std::printf(
+                "  %s contact: gap %.3g m, linearised end gap %.3g m, state %d, "
+                "normal impulse %.3g N s\n",
+                c.edge < 0 ? "node-triangle" : "edge-edge", c.gap, c.end_gap,
+                static_cast<int>(c.state), c.normal.dot(c.multiplier));
           }
         }
       }

@@ -137,11 +137,11 @@ int main(int argc, char** argv) {
         ++crossing_checks;
         if (crossing_first < 0) crossing_first = k;
         ++exact_crossing_checks;
-        const CrossingKinds found = classifyCrossings(
-            pairs, triangles, body->state().positions,
-            body->selfContact() != nullptr ? body->selfContact()->contacts()
-                                           : std::vector<SurfaceContact>{},
-            0.25, gap_tolerance);
+        const CrossingKinds found =
+            classifyCrossings(pairs, triangles, body->state().positions,
+                              body->selfContact() != nullptr ? body->selfContact()->contacts()
+                                                             : std::vector<SurfaceContact>{},
+                              0.25, gap_tolerance);
         kinds.node_in_face += found.node_in_face;
         kinds.node_in_face_deep += found.node_in_face_deep;
         kinds.edge_edge += found.edge_edge;
@@ -169,7 +169,6 @@ int main(int argc, char** argv) {
       1e3 * searching / steps, self_contact ? "true" : "false", updates, unconverged, at_cap,
       max_active, worst_end, gap_tolerance, searches, crossing_checks, crossing_first,
       exact_crossing_checks, kinds.node_in_face, kinds.node_in_face_deep, kinds.edge_edge,
-      kinds.with_candidate, kinds.edge_edge_with_candidate, kinds.within_tolerance,
-      kinds.deepest);
+      kinds.with_candidate, kinds.edge_edge_with_candidate, kinds.within_tolerance, kinds.deepest);
   return 0;
 }

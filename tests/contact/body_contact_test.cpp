@@ -312,10 +312,9 @@ CrossedBars dropRidgeOnRidge(bool edge_edge) {
   for (int k = 0; k < 60; ++k) {
     const WorldStepReport r = world.step();
     EXPECT_TRUE(r.ok) << r.message;
-    if (!findSurfaceIntersections(below->model().mesh().surfaceTriangles(),
-                                  below->state().positions,
-                                  above->model().mesh().surfaceTriangles(),
-                                  above->state().positions)
+    if (!findSurfaceIntersections(
+             below->model().mesh().surfaceTriangles(), below->state().positions,
+             above->model().mesh().surfaceTriangles(), above->state().positions)
              .empty())
       ++result.crossing_steps;
     if (const BodyPairContact* pair = world.femSolver().femContact()->pair(below, above)) {
@@ -339,11 +338,12 @@ TEST(BodyContact, ARidgeDroppedAcrossAnotherRidgeIsStoppedByItsEdgeWhereNoNodeMe
   const CrossedBars without = dropRidgeOnRidge(false);
   const CrossedBars with = dropRidgeOnRidge(true);
   const double ridge = 0.05 * std::sqrt(2.0);
-  std::printf("[figures] ridge on ridge: node-triangle only: %d of 60 steps crossing, lowest "
-              "point %.4f m; with edge pairs: %d crossing, lowest point %.4f m, up to %d edge "
-              "pairs (the held ridge at %.4f m)\n",
-              without.crossing_steps, without.top_ridge_z, with.crossing_steps, with.top_ridge_z,
-              with.edge_contacts, ridge);
+  std::printf(
+      "[figures] ridge on ridge: node-triangle only: %d of 60 steps crossing, lowest "
+      "point %.4f m; with edge pairs: %d crossing, lowest point %.4f m, up to %d edge "
+      "pairs (the held ridge at %.4f m)\n",
+      without.crossing_steps, without.top_ridge_z, with.crossing_steps, with.top_ridge_z,
+      with.edge_contacts, ridge);
   EXPECT_GT(without.crossing_steps, 0);  // the case edge pairs are for
   EXPECT_EQ(with.crossing_steps, 0);
   EXPECT_GT(with.edge_contacts, 0);

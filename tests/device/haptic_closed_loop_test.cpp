@@ -334,10 +334,10 @@ TEST(HapticClosedLoop, TheRateLimitedControllerKeepsAFastTurnPassiveButTheHandSi
         "m, max E_obs %.3g J); rate-limited with the blend %.4f rad with %.4f N m against %.4f "
         "simulated (largest step %.3g N m, max E_obs %.3g J, swing 1.5-2 s %.3g rad)\n",
         1e3 * delay, dead_beat.mean(dead_beat.angle, 1.5, 2),
-        dead_beat.mean(dead_beat.torque, 1.5, 2), dead_beat.max_torque_step,
-        dead_beat.max_energy, reserve.mean(reserve.angle, 1.5, 2),
-        reserve.mean(reserve.torque, 1.5, 2), reserve.mean(reserve.simulated, 1.5, 2),
-        reserve.max_torque_step, reserve.max_energy, reserve.swing(1.5, 2));
+        dead_beat.mean(dead_beat.torque, 1.5, 2), dead_beat.max_torque_step, dead_beat.max_energy,
+        reserve.mean(reserve.angle, 1.5, 2), reserve.mean(reserve.torque, 1.5, 2),
+        reserve.mean(reserve.simulated, 1.5, 2), reserve.max_torque_step, reserve.max_energy,
+        reserve.swing(1.5, 2));
     EXPECT_GT(dead_beat.max_torque_step, 10 * rate_step);
     EXPECT_LT(dead_beat.mean(dead_beat.angle, 1.5, 2), 0.005);
     EXPECT_LE(reserve.max_torque_step, rate_step * (1 + 1e-9));

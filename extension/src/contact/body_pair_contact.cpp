@@ -42,18 +42,6 @@ void nodeNormals(const TetMesh& mesh, const Eigen::VectorXd& x, Eigen::VectorXd&
   }
 }
 
-// Barycentric coordinates of p's projection onto the plane of (a, b, c).
-Eigen::Vector3d barycentric(const Eigen::Vector3d& p, const Eigen::Vector3d& a,
-                            const Eigen::Vector3d& b, const Eigen::Vector3d& c) {
-  const Eigen::Vector3d e0 = b - a, e1 = c - a, d = p - a;
-  const double d00 = e0.dot(e0), d01 = e0.dot(e1), d11 = e1.dot(e1);
-  const double d20 = d.dot(e0), d21 = d.dot(e1);
-  const double det = d00 * d11 - d01 * d01;
-  const double v = (d11 * d20 - d01 * d21) / det;
-  const double w = (d00 * d21 - d01 * d20) / det;
-  return {1.0 - v - w, v, w};
-}
-
 double meanSurfaceEdge(const TetMesh& mesh) {
   const std::vector<Triangle>& triangles = mesh.surfaceTriangles();
   if (triangles.empty()) return 0;
@@ -85,6 +73,16 @@ Status BodyContactSettings::validate() const {
     return Error{"fem_contact: max_iterations = " + std::to_string(max_iterations) +
                  ": must be >= 1"};
   return Ok{};
+}
+
+// The candidate tests' rules for this pair: the search margin, the depth limit and the crease
+// rule's depth (twice the gap tolerance, as self-contact's).
+CandidateRules BodyPairContact::candidateRules(double margin) const {
+  CandidateRules rules;
+  rules.margin = margin;
+  rules.max_depth = settings_.max_depth;
+  rules.crease_depth = 2 * gap_tolerance_;
+  return rules;
 }
 
 BodyPairContact::BodyPairContact(std::shared_ptr<const FemModel> a,
@@ -128,7 +126,8 @@ bool BodyPairContact::detect(const Eigen::VectorXd& xa, const Eigen::VectorXd& v
   addCandidates(*a_, 0, xa, end_a_, normals_a_, tree_b_, node_count_a_, triangle_count_a_, xb,
                 end_b_, settings_.margin * mean_edge_b_);
   // a's edges against b's, with b's tree still refitted to b's motion.
-  if (settings_.edge_edge) addEdgeCandidates(xa, end_a_, xb, end_b_, settings_.margin * mean_edge_b_);
+  if (settings_.edge_edge)
+    addEdgeCandidates(xa, end_a_, xb, end_b_, settings_.margin * mean_edge_b_);
   addCandidates(*b_, node_count_a_, xb, end_b_, normals_b_, tree_a_, 0, 0, xa, end_a_,
                 settings_.margin * mean_edge_a_);
   // A contact that slid last step starts its first solve with the k_t its friction and the slip
@@ -159,10 +158,7 @@ void BodyPairContact::addCandidates(const FemModel& nodes_model, int node_offset
                                     double margin) {
   tree.refit(xt, et, margin);
   const std::vector<Triangle>& triangles = tree.triangles();
-  CandidateRules rules;
-  rules.margin = margin;
-  rules.max_depth = settings_.max_depth;
-  rules.crease_depth = 2 * gap_tolerance_;
+  const CandidateRules rules = candidateRules(margin);
   auto at = [](const Eigen::VectorXd& positions, int node) -> Eigen::Vector3d {
     return positions.segment<3>(3 * node);
   };
@@ -185,9 +181,9 @@ void BodyPairContact::addCandidates(const FemModel& nodes_model, int node_offset
       // Behind the plane beyond the crease depth: only a contact held last step is still one (it
       // sank within its tolerance); a new pair there is a node past the other body's rim.
       const std::array<Eigen::Vector3d, 3> t0 = {at(xt, tri[0]), at(xt, tri[1]), at(xt, tri[2])};
-      const std::optional<NodeTriangleHit> hit = nodeTriangleCandidate(
-          {xp, ep}, t0, {at(et, tri[0]), at(et, tri[1]), at(et, tri[2])}, rules,
-          set_.wasActive(pair_node, pair_triangle), not_facing);
+      const std::optional<NodeTriangleHit> hit =
+          nodeTriangleCandidate({xp, ep}, t0, {at(et, tri[0]), at(et, tri[1]), at(et, tri[2])},
+                                rules, set_.wasActive(pair_node, pair_triangle), not_facing);
       if (!hit) continue;
       const Eigen::Vector3d& w = hit->weights;
       // The impulse's triangle point: the node's projection at the step's start, unclamped while
@@ -196,7 +192,8 @@ void BodyPairContact::addCandidates(const FemModel& nodes_model, int node_offset
       // on the angular momentum (clamping to the triangle gave levers: 1.5 % of the angular
       // momentum lost in bullet_collide_soft, 0.95 % without). A projection that enters the
       // triangle only later on the path takes the crossing's weights, clamped.
-      const Eigen::Vector3d w_start = hit->when > 0 ? barycentric(xp, t0[0], t0[1], t0[2]) : w;
+      const Eigen::Vector3d w_start =
+          hit->when > 0 ? projectionWeights(xp, t0[0], t0[1], t0[2]) : w;
       const Eigen::Vector3d wc = w_start.allFinite() && w_start.minCoeff() >= -kInsideTolerance
                                      ? w_start
                                      : Eigen::Vector3d(w.cwiseMax(0.0) / w.cwiseMax(0.0).sum());
@@ -216,10 +213,7 @@ void BodyPairContact::addCandidates(const FemModel& nodes_model, int node_offset
 void BodyPairContact::addEdgeCandidates(const Eigen::VectorXd& xa, const Eigen::VectorXd& ea,
                                         const Eigen::VectorXd& xb, const Eigen::VectorXd& eb,
                                         double margin) {
-  CandidateRules rules;
-  rules.margin = margin;
-  rules.max_depth = settings_.max_depth;
-  rules.crease_depth = 2 * gap_tolerance_;
+  const CandidateRules rules = candidateRules(margin);
   auto at = [](const Eigen::VectorXd& positions, int node) -> Eigen::Vector3d {
     return positions.segment<3>(3 * node);
   };
@@ -273,9 +267,9 @@ void BodyPairContact::addEdgeCandidates(const Eigen::VectorXd& xa, const Eigen::
           ((hi_f.array() + margin) < lo_e.array()).any())
         continue;
       contact.triangle = j;
-      const std::optional<EdgeEdgeHit> hit = edgeEdgeCandidate(
-          edge_e, {{{at(xb, f[0]), at(xb, f[1])}, {at(eb, f[0]), at(eb, f[1])}}}, rules, held,
-          outward, resting_on_flat);
+      const std::optional<EdgeEdgeHit> hit =
+          edgeEdgeCandidate(edge_e, {{{at(xb, f[0]), at(xb, f[1])}, {at(eb, f[0]), at(eb, f[1])}}},
+                            rules, held, outward, resting_on_flat);
       if (!hit) continue;
       SurfaceContact c = contact;
       c.nodes = {e[0], e[1], node_count_a_ + f[0], node_count_a_ + f[1]};
@@ -305,7 +299,7 @@ int BodyPairContact::correctGaps(const Eigen::VectorXd& v, double dt, double tol
     n.normalize();
     const double true_gap = n.dot(p - a);
     if (true_gap >= -tolerance) continue;
-    const Eigen::Vector3d w = barycentric(p, a, b, t);
+    const Eigen::Vector3d w = projectionWeights(p, a, b, t);
     if (!w.allFinite() || w.minCoeff() < -kInsideTolerance) continue;  // slid off: not this face
     Eigen::Vector3d u = Eigen::Vector3d::Zero();
     for (size_t k = 0; k < 4; ++k)

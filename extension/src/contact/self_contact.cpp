@@ -108,7 +108,8 @@ int SelfContactSolver::addCandidates(const Eigen::VectorXd& x, const Eigen::Vect
   const std::vector<int>& nodes = model_->mesh().surfaceNodes();
   const int node_blocks = (static_cast<int>(nodes.size()) + kSearchBlock - 1) / kSearchBlock;
   block_finds_.resize(static_cast<size_t>(
-      std::max(node_blocks, (static_cast<int>(surface_edges_.edges.size()) + kSearchBlock - 1) / kSearchBlock)));
+      std::max(node_blocks,
+               (static_cast<int>(surface_edges_.edges.size()) + kSearchBlock - 1) / kSearchBlock)));
   parallel_->forRange(node_blocks, 1, [&](int first, int last) {
     std::vector<int> found;
     for (int block = first; block < last; ++block) {
@@ -134,7 +135,8 @@ int SelfContactSolver::addCandidates(const Eigen::VectorXd& x, const Eigen::Vect
     }
   }
   // Edges against edges, the same way, after each edge's box over the motion.
-  const int edge_blocks = (static_cast<int>(surface_edges_.edges.size()) + kSearchBlock - 1) / kSearchBlock;
+  const int edge_blocks =
+      (static_cast<int>(surface_edges_.edges.size()) + kSearchBlock - 1) / kSearchBlock;
   edge_lo_.resize(surface_edges_.edges.size());
   edge_hi_.resize(surface_edges_.edges.size());
   for (size_t i = 0; i < surface_edges_.edges.size(); ++i) {
@@ -149,7 +151,8 @@ int SelfContactSolver::addCandidates(const Eigen::VectorXd& x, const Eigen::Vect
     for (int block = first; block < last; ++block) {
       std::vector<SurfaceContact>& finds = block_finds_[static_cast<size_t>(block)];
       finds.clear();
-      const int end_edge = std::min(static_cast<int>(surface_edges_.edges.size()), (block + 1) * kSearchBlock);
+      const int end_edge =
+          std::min(static_cast<int>(surface_edges_.edges.size()), (block + 1) * kSearchBlock);
       for (int i = block * kSearchBlock; i < end_edge; ++i)
         edgeCandidates(i, x, end, scratch, finds);
     }
@@ -236,9 +239,9 @@ void SelfContactSolver::edgeCandidates(int i, const Eigen::VectorXd& x, const Ei
         (static_cast<std::uint64_t>(i) << 32) | static_cast<std::uint32_t>(j);
     if (edge_pairs_.count(pair) != 0) continue;  // this step has it already
     contact.triangle = j;
-    const std::optional<EdgeEdgeHit> hit = edgeEdgeCandidate(
-        edge_e, {{{at(x, f[0]), at(x, f[1])}, {at(end, f[0]), at(end, f[1])}}}, rules(), held,
-        outward, {});
+    const std::optional<EdgeEdgeHit> hit =
+        edgeEdgeCandidate(edge_e, {{{at(x, f[0]), at(x, f[1])}, {at(end, f[0]), at(end, f[1])}}},
+                          rules(), held, outward, {});
     if (!hit) continue;
     SurfaceContact c = contact;
     c.nodes = {e[0], e[1], f[0], f[1]};

@@ -11,18 +11,6 @@ namespace {
 // a node passing exactly over an edge is caught by both triangles (one is kept).
 constexpr double kInsideTolerance = 0.05;
 
-// Barycentric coordinates of p's projection onto the plane of (a, b, c).
-Eigen::Vector3d barycentric(const Eigen::Vector3d& p, const Eigen::Vector3d& a,
-                            const Eigen::Vector3d& b, const Eigen::Vector3d& c) {
-  const Eigen::Vector3d e0 = b - a, e1 = c - a, d = p - a;
-  const double d00 = e0.dot(e0), d01 = e0.dot(e1), d11 = e1.dot(e1);
-  const double d20 = d.dot(e0), d21 = d.dot(e1);
-  const double det = d00 * d11 - d01 * d01;
-  const double v = (d11 * d20 - d01 * d21) / det;
-  const double w = (d00 * d21 - d01 * d20) / det;
-  return {1.0 - v - w, v, w};
-}
-
 // When on the path a gap of g0 at the start and g1 at the end reaches the margin: now, at the
 // crossing, at the end; none if apart all along.
 std::optional<double> meetingTime(double g0, double g1, double margin) {
@@ -82,6 +70,17 @@ double SurfaceEdges::foldCosine(int edge, const std::vector<Triangle>& triangles
   return n[0].dot(n[1]);
 }
 
+Eigen::Vector3d projectionWeights(const Eigen::Vector3d& p, const Eigen::Vector3d& a,
+                                  const Eigen::Vector3d& b, const Eigen::Vector3d& c) {
+  const Eigen::Vector3d e0 = b - a, e1 = c - a, d = p - a;
+  const double d00 = e0.dot(e0), d01 = e0.dot(e1), d11 = e1.dot(e1);
+  const double d20 = d.dot(e0), d21 = d.dot(e1);
+  const double det = d00 * d11 - d01 * d01;
+  const double v = (d11 * d20 - d01 * d21) / det;
+  const double w = (d00 * d21 - d01 * d20) / det;
+  return {1.0 - v - w, v, w};
+}
+
 std::optional<NodeTriangleHit> nodeTriangleCandidate(
     const std::array<Eigen::Vector3d, 2>& p, const std::array<Eigen::Vector3d, 3>& triangle0,
     const std::array<Eigen::Vector3d, 3>& triangle1, const CandidateRules& rules, bool held,
@@ -106,8 +105,8 @@ std::optional<NodeTriangleHit> nodeTriangleCandidate(
   const std::optional<double> s = meetingTime(g0, g1, rules.margin);
   if (!s) return std::nullopt;
   const double when = *s;
-  const Eigen::Vector3d w = barycentric(xp + when * (ep - xp), a0 + when * (a1 - a0),
-                                        b0 + when * (b1 - b0), c0 + when * (c1 - c0));
+  const Eigen::Vector3d w = projectionWeights(xp + when * (ep - xp), a0 + when * (a1 - a0),
+                                              b0 + when * (b1 - b0), c0 + when * (c1 - c0));
   if (!w.allFinite() || w.minCoeff() < -kInsideTolerance) return std::nullopt;
   NodeTriangleHit hit;
   hit.normal = n0;

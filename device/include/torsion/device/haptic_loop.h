@@ -36,8 +36,8 @@ struct HapticLoopSettings {
   double rate_hz = 1000;  ///< ticks per second
   SafetySettings safety;
   CouplingDamper damper;
-  PassivitySettings passivity;   ///< time-domain passivity observer and controller (on)
-  double twist_cutoff_hz = 50;   ///< low-pass of the velocity the damper sees
+  PassivitySettings passivity;  ///< time-domain passivity observer and controller (on)
+  double twist_cutoff_hz = 50;  ///< low-pass of the velocity the damper sees
   /// Hz: each new simulation step's change of the local model is blended in through a
   /// first-order low-pass of this cutoff instead of stepping (step_blend.h); 0: off (the
   /// default). For a stiff body under delay with the rate-limited controller, docs/haptics.md.

@@ -94,6 +94,7 @@ class BodyPairContact {
 
   // a's surface edges against b's (b's tree refitted to b's motion): the crossings of two edges
   // that no node meets, as in self-contact; keyed (a's edge, b's edge).
+  CandidateRules candidateRules(double margin) const;
   void addEdgeCandidates(const Eigen::VectorXd& xa, const Eigen::VectorXd& ea,
                          const Eigen::VectorXd& xb, const Eigen::VectorXd& eb, double margin);
 

@@ -48,6 +48,10 @@ struct CandidateRules {
   double crease_depth = 0;
 };
 
+/// Barycentric coordinates of p's projection onto the plane of (a, b, c) (unclamped).
+Eigen::Vector3d projectionWeights(const Eigen::Vector3d& p, const Eigen::Vector3d& a,
+                                  const Eigen::Vector3d& b, const Eigen::Vector3d& c);
+
 /// A node-triangle candidate: the constraint's normal and gap at the step's start, when on the
 /// path it was judged, and the node's projection there.
 struct NodeTriangleHit {
