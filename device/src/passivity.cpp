@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
+#include <cstdlib>
 
 #include "torsion/device/pose_math.h"
 #include "torsion/device/wrench_safety.h"
@@ -20,6 +22,8 @@ std::string PassivitySettings::validate() const {
     return "passivity.speed_hold_time must be positive (s)";
   if (!(speed_margin >= 1 && std::isfinite(speed_margin)))
     return "passivity.speed_margin must be at least 1";
+  if (!(misprediction_margin >= 0 && std::isfinite(misprediction_margin)))
+    return "passivity.misprediction_margin must be non-negative";
   return {};
 }
 
@@ -130,6 +134,19 @@ Wrench PassivityController::control(const Wrench& previous, const Wrench& planne
   return saturate(planned + damping(planned, v, dt), limits);
 }
 
+PassivityController::~PassivityController() {  // DEBUG
+  if (std::getenv("PC_DEBUG"))
+    std::fprintf(stderr, "PCDBG reserve %llu plain %llu none %llu\n",
+                 static_cast<unsigned long long>(stat_reserve_), static_cast<unsigned long long>(stat_plain_),
+                 static_cast<unsigned long long>(stat_none_));
+}
+
+double PassivityController::worstNextEnergy(const Wrench& w, const double v[6], double dt) const {
+  const double m = settings_.misprediction_margin;
+  return energy_ - settings_.energy_tolerance + power(w, v) * dt +
+         m * dt * (change_bound_[0] * norm3(w.force) + change_bound_[1] * norm3(w.torque));
+}
+
 Wrench PassivityController::damping(const Wrench& planned, const double v[6], double dt) {
   alpha_ = 0;
   if (!settings_.enabled || !(dt > 0)) return Wrench{};
@@ -137,16 +154,66 @@ Wrench PassivityController::damping(const Wrench& planned, const double v[6], do
   const double speed2 =
       v[0] * v[0] + v[1] * v[1] + v[2] * v[2] + l2 * (v[3] * v[3] + v[4] * v[4] + v[5] * v[5]);
   const double predicted = energy_ - settings_.energy_tolerance + power(planned, v) * dt;
-  if (!(predicted > 0) || !(speed2 > settings_.min_speed * settings_.min_speed)) return Wrench{};
-  alpha_ = std::min(predicted / (speed2 * dt), settings_.max_alpha);
-  if (!std::isfinite(alpha_)) {
+  const double worst = worstNextEnergy(planned, v, dt);
+  if (!(worst > 0) || !(speed2 > settings_.min_speed * settings_.min_speed)) return Wrench{};
+  // The wrench nearest the plan (metric |df|^2 + |dtau|^2 / l^2) whose worst next energy is
+  // <= 0: for a multiplier mu, each part is the plan with a damping -mu/2 (v, l^2 omega),
+  // shrunk toward zero by mu/2 times its change bound (the KKT point of the projection onto
+  // the convex set worstNextEnergy <= 0); mu by bisection (the worst energy falls with mu).
+  const double m = settings_.misprediction_margin;
+  auto part = [&](const Vec3& p, const Vec3& u, double scale, double bound, double mu) {
+    const Vec3 y{p.x - 0.5 * mu * scale * u.x, p.y - 0.5 * mu * scale * u.y,
+                 p.z - 0.5 * mu * scale * u.z};
+    const double n = norm3(y), cut = 0.5 * mu * scale * m * bound;
+    if (!(n > cut)) return Vec3{};
+    const double keep = 1 - cut / n;
+    return Vec3{keep * y.x, keep * y.y, keep * y.z};
+  };
+  auto at = [&](double mu) {
+    return Wrench{part(planned.force, {v[0], v[1], v[2]}, 1.0, change_bound_[0], mu),
+                  part(planned.torque, {v[3], v[4], v[5]}, l2, change_bound_[1], mu)};
+  };
+  Wrench out;
+  if (m == 0) {
+    const double a = predicted / (speed2 * dt);
+    out = Wrench{{planned.force.x - a * v[0], planned.force.y - a * v[1], planned.force.z - a * v[2]},
+                 {planned.torque.x - a * l2 * v[3], planned.torque.y - a * l2 * v[4],
+                  planned.torque.z - a * l2 * v[5]}};
+    ++stat_plain_;
+  } else {
+    double hi = 2 * worst / (speed2 * dt);
+    int k = 0;
+    for (; k < 200 && worstNextEnergy(at(hi), v, dt) > 0; ++k)
+      hi *= 2;
+    if (k == 200) {
+      // Even the wrench cut to zero leaves a debt (E_obs > 0 after a motion beyond the bounds):
+      // the plain dead-beat damping of it.
+      const double debt = std::max(energy_ - settings_.energy_tolerance, 0.0);
+      const double a = debt / (speed2 * dt);
+      out = Wrench{{-a * v[0], -a * v[1], -a * v[2]}, {-a * l2 * v[3], -a * l2 * v[4], -a * l2 * v[5]}};
+      ++stat_plain_;
+    } else {
+      double lo = 0;
+      for (int j = 0; j < 60; ++j) {
+        const double mid = 0.5 * (lo + hi);
+        (worstNextEnergy(at(mid), v, dt) > 0 ? lo : hi) = mid;
+      }
+      out = at(hi);
+      ++stat_reserve_;
+    }
+  }
+  const Wrench change = out + (-1.0) * planned;
+  const double removed = -power(change, v);
+  double alpha = removed > 0 ? removed / speed2 : 0.0;
+  if (removed <= 0) ++stat_none_;
+  alpha_ = alpha;
+  if (!isFinite(change)) {
     alpha_ = 0;
     return Wrench{};
   }
-  dissipated_ += alpha_ * speed2 * dt;
+  dissipated_ += std::max(removed, 0.0) * dt;
   ++active_ticks_;
-  return {{-alpha_ * v[0], -alpha_ * v[1], -alpha_ * v[2]},
-          {-alpha_ * l2 * v[3], -alpha_ * l2 * v[4], -alpha_ * l2 * v[5]}};
+  return change;
 }
 
 void PassivityController::observe(const double v[6], double dt, bool holding) {
@@ -154,6 +221,8 @@ void PassivityController::observe(const double v[6], double dt, bool holding) {
     energy_ = 0;
     held_ = Wrench{};
     speed_bound_[0] = speed_bound_[1] = 0;
+    change_bound_[0] = change_bound_[1] = 0;
+    have_v_ = false;
     return;
   }
   // The speed bounds: the peak speeds of the last speed_hold_time or so (an oscillation's
@@ -163,6 +232,19 @@ void PassivityController::observe(const double v[6], double dt, bool holding) {
   const double ang = std::sqrt(v[3] * v[3] + v[4] * v[4] + v[5] * v[5]);
   if (std::isfinite(lin)) speed_bound_[0] = std::max(lin, decay * speed_bound_[0]);
   if (std::isfinite(ang)) speed_bound_[1] = std::max(ang, decay * speed_bound_[1]);
+  if (have_v_) {
+    const double dl = std::sqrt((v[0] - last_v_[0]) * (v[0] - last_v_[0]) +
+                                (v[1] - last_v_[1]) * (v[1] - last_v_[1]) +
+                                (v[2] - last_v_[2]) * (v[2] - last_v_[2]));
+    const double da = std::sqrt((v[3] - last_v_[3]) * (v[3] - last_v_[3]) +
+                                (v[4] - last_v_[4]) * (v[4] - last_v_[4]) +
+                                (v[5] - last_v_[5]) * (v[5] - last_v_[5]));
+    if (std::isfinite(dl)) change_bound_[0] = std::max(dl, decay * change_bound_[0]);
+    if (std::isfinite(da)) change_bound_[1] = std::max(da, decay * change_bound_[1]);
+  }
+  for (int k = 0; k < 6; ++k)
+    last_v_[k] = std::isfinite(v[k]) ? v[k] : 0.0;
+  have_v_ = true;
   const double delta = power(held_, v) * dt;
   if (std::isfinite(delta)) energy_ += delta;
   if (energy_ > max_energy_) max_energy_ = energy_;

@@ -85,6 +85,10 @@ struct PassivitySettings {
   /// Dead-beat damper: N s/m, largest alpha (rotation: alpha l^2); infinity: none. A bound
   /// leaves some generated energy for the following ticks instead of a damping spike.
   double max_alpha = std::numeric_limits<double>::infinity();
+  /// Dead-beat damper: the reserve it keeps against the next tick's misprediction of the hand's
+  /// motion, as a factor on the largest change of the hand's velocity in one tick over about the
+  /// last speed_hold_time. 0: the plain dead-beat damper (E_obs exceeds 0 by a misprediction).
+  double misprediction_margin = 2;
 
   /// Empty when valid, else the message naming the field.
   std::string validate() const;
@@ -121,15 +125,23 @@ class PassivityController {
   double dissipated() const { return dissipated_; }     ///< J, power taken out of W_plan, summed
   std::uint64_t activeTicks() const { return active_ticks_; }  ///< ticks with alpha > 0
   const PassivitySettings& settings() const { return settings_; }
+  std::uint64_t stat_reserve_ = 0, stat_plain_ = 0, stat_none_ = 0;  // DEBUG
+  ~PassivityController();  // DEBUG
 
  private:
   /// J: E_obs plus the work of `w` over the coming tick plus what ramping it to zero at the
   /// rates (N/s, N m/s) could give out at the speed bounds; > 0: not covered by the reserve.
   double reserveNeed(const Wrench& w, const double v[6], double dt, double force_rate,
                      double torque_rate) const;
+  /// J: E_obs after the coming tick with `w` held, at the worst velocity within the change
+  /// bounds (times misprediction_margin) of `v`.
+  double worstNextEnergy(const Wrench& w, const double v[6], double dt) const;
 
   PassivitySettings settings_;
   double speed_bound_[2] = {0, 0};  // m/s, rad/s: peak speeds, decaying
+  double change_bound_[2] = {0, 0};  // m/s, rad/s: peak velocity changes in one tick, decaying
+  double last_v_[6] = {};
+  bool have_v_ = false;
   Wrench held_;
   double energy_ = 0;
   double max_energy_ = 0;
