@@ -142,7 +142,7 @@ void HapticLoop::tick(double now, double deadline) {
   // The passivity controller (passivity.h) takes the generated energy back; only while healthy
   // and holding: a fading output fades alone. The rate-limited kind keeps the written wrench
   // within the safety filter's rate limit of the last one, and the filter then starts its next
-  // step from what was written. The dead-beat kind adds its damping after the rate limit.
+  // step from what was written. The dead-beat kind adds its correction after the rate limit.
   const bool holding = inputs.grabbed && inputs.device_alive && inputs.simulation_fresh;
   passivity_.observe(port_twist, dt, holding);
   if (holding) {
@@ -154,7 +154,7 @@ void HapticLoop::tick(double now, double deadline) {
   }
   device_.write(output);
   passivity_.written(output);
-  if (passivity_.alpha() > 0) {
+  if (passivity_.activeTicks() != stats_.pc_active.load(std::memory_order_relaxed)) {
     stats_.pc_active.store(passivity_.activeTicks(), std::memory_order_relaxed);
     stats_.pc_dissipated.store(passivity_.dissipated(), std::memory_order_relaxed);
   }

@@ -2,8 +2,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdio>
-#include <cstdlib>
 
 #include "torsion/device/pose_math.h"
 #include "torsion/device/wrench_safety.h"
@@ -131,90 +129,90 @@ Wrench PassivityController::control(const Wrench& previous, const Wrench& planne
                                     double torque_step, const DeviceLimits& limits) {
   if (settings_.rate_limited)
     return limit(previous, planned, v, dt, force_step, torque_step, limits);
-  return saturate(planned + damping(planned, v, dt), limits);
-}
-
-PassivityController::~PassivityController() {  // DEBUG
-  if (std::getenv("PC_DEBUG"))
-    std::fprintf(stderr, "PCDBG reserve %llu plain %llu none %llu\n",
-                 static_cast<unsigned long long>(stat_reserve_), static_cast<unsigned long long>(stat_plain_),
-                 static_cast<unsigned long long>(stat_none_));
+  return saturate(planned + correction(planned, v, dt), limits);
 }
 
 double PassivityController::worstNextEnergy(const Wrench& w, const double v[6], double dt) const {
-  const double m = settings_.misprediction_margin;
   return energy_ - settings_.energy_tolerance + power(w, v) * dt +
-         m * dt * (change_bound_[0] * norm3(w.force) + change_bound_[1] * norm3(w.torque));
+         settings_.misprediction_margin * dt *
+             (change_bound_[0] * norm3(w.force) + change_bound_[1] * norm3(w.torque));
 }
 
-Wrench PassivityController::damping(const Wrench& planned, const double v[6], double dt) {
+Wrench PassivityController::correction(const Wrench& planned, const double v[6], double dt) {
   alpha_ = 0;
   if (!settings_.enabled || !(dt > 0)) return Wrench{};
   const double l2 = settings_.length_scale * settings_.length_scale;
-  const double speed2 =
-      v[0] * v[0] + v[1] * v[1] + v[2] * v[2] + l2 * (v[3] * v[3] + v[4] * v[4] + v[5] * v[5]);
-  const double predicted = energy_ - settings_.energy_tolerance + power(planned, v) * dt;
-  const double worst = worstNextEnergy(planned, v, dt);
-  if (!(worst > 0) || !(speed2 > settings_.min_speed * settings_.min_speed)) return Wrench{};
-  // The wrench nearest the plan (metric |df|^2 + |dtau|^2 / l^2) whose worst next energy is
-  // <= 0: for a multiplier mu, each part is the plan with a damping -mu/2 (v, l^2 omega),
-  // shrunk toward zero by mu/2 times its change bound (the KKT point of the projection onto
-  // the convex set worstNextEnergy <= 0); mu by bisection (the worst energy falls with mu).
   const double m = settings_.misprediction_margin;
-  auto part = [&](const Vec3& p, const Vec3& u, double scale, double bound, double mu) {
-    const Vec3 y{p.x - 0.5 * mu * scale * u.x, p.y - 0.5 * mu * scale * u.y,
-                 p.z - 0.5 * mu * scale * u.z};
-    const double n = norm3(y), cut = 0.5 * mu * scale * m * bound;
-    if (!(n > cut)) return Vec3{};
-    const double keep = 1 - cut / n;
-    return Vec3{keep * y.x, keep * y.y, keep * y.z};
-  };
-  auto at = [&](double mu) {
-    return Wrench{part(planned.force, {v[0], v[1], v[2]}, 1.0, change_bound_[0], mu),
-                  part(planned.torque, {v[3], v[4], v[5]}, l2, change_bound_[1], mu)};
-  };
+  // The coming tick's twist: the last one (plain dead-beat), or the last one plus the last
+  // change (the reserve: the hand's acceleration goes on; the bound covers its change).
+  double u[6];
+  for (int k = 0; k < 6; ++k)
+    u[k] = m > 0 && have_v_ >= 2 ? 2 * v[k] - prev_v_[k] : v[k];
+  const double speed2 =
+      u[0] * u[0] + u[1] * u[1] + u[2] * u[2] + l2 * (u[3] * u[3] + u[4] * u[4] + u[5] * u[5]);
+  const double worst = worstNextEnergy(planned, u, dt);
+  if (!(worst > 0)) return Wrench{};
   Wrench out;
   if (m == 0) {
-    const double a = predicted / (speed2 * dt);
-    out = Wrench{{planned.force.x - a * v[0], planned.force.y - a * v[1], planned.force.z - a * v[2]},
-                 {planned.torque.x - a * l2 * v[3], planned.torque.y - a * l2 * v[4],
-                  planned.torque.z - a * l2 * v[5]}};
-    ++stat_plain_;
+    // The plain dead-beat damper.
+    if (!(speed2 > settings_.min_speed * settings_.min_speed)) return Wrench{};
+    const double a = std::min(worst / (speed2 * dt), settings_.max_alpha);
+    out = planned + Wrench{{-a * u[0], -a * u[1], -a * u[2]},
+                           {-a * l2 * u[3], -a * l2 * u[4], -a * l2 * u[5]}};
   } else {
-    double hi = 2 * worst / (speed2 * dt);
-    int k = 0;
-    for (; k < 200 && worstNextEnergy(at(hi), v, dt) > 0; ++k)
+    // The wrench nearest the plan (metric |df|^2 + |dtau|^2 / l^2) with worstNextEnergy <= 0, a
+    // convex set that holds W = 0 while E_obs <= 0. Its KKT point for a multiplier mu: each
+    // part is the plan with a damping of the predicted motion, mu/2 (u, l^2 omega), then
+    // shrunk toward zero by mu/2 times its share of the reserve (m times the change bound);
+    // the worst energy falls as mu grows, so mu by bisection.
+    auto part = [&](const Vec3& p, const double* w, double scale, double bound, double mu) {
+      const double d = 0.5 * mu * scale;
+      const Vec3 y{p.x - d * w[0], p.y - d * w[1], p.z - d * w[2]};
+      const double n = norm3(y), cut = d * m * bound;
+      if (!(n > cut)) return Vec3{};
+      const double keep = 1 - cut / n;
+      return Vec3{keep * y.x, keep * y.y, keep * y.z};
+    };
+    auto at = [&](double mu) {
+      return Wrench{part(planned.force, u, 1.0, change_bound_[0], mu),
+                    part(planned.torque, u + 3, l2, change_bound_[1], mu)};
+    };
+    double hi = speed2 > 0 ? 2 * worst / (speed2 * dt) : 1.0;
+    int doublings = 0;
+    for (; doublings < 400 && worstNextEnergy(at(hi), u, dt) > 0; ++doublings)
       hi *= 2;
-    if (k == 200) {
-      // Even the wrench cut to zero leaves a debt (E_obs > 0 after a motion beyond the bounds):
-      // the plain dead-beat damping of it.
-      const double debt = std::max(energy_ - settings_.energy_tolerance, 0.0);
-      const double a = debt / (speed2 * dt);
-      out = Wrench{{-a * v[0], -a * v[1], -a * v[2]}, {-a * l2 * v[3], -a * l2 * v[4], -a * l2 * v[5]}};
-      ++stat_plain_;
-    } else {
+    if (doublings < 400) {
       double lo = 0;
-      for (int j = 0; j < 60; ++j) {
+      for (int k = 0; k < 64; ++k) {
         const double mid = 0.5 * (lo + hi);
-        (worstNextEnergy(at(mid), v, dt) > 0 ? lo : hi) = mid;
+        (worstNextEnergy(at(mid), u, dt) > 0 ? lo : hi) = mid;
       }
       out = at(hi);
-      ++stat_reserve_;
+    } else if (speed2 > settings_.min_speed * settings_.min_speed) {
+      // Not even W = 0 covers it: E_obs > 0 already, after a motion beyond the bound. Damp
+      // the debt away as the plain dead-beat damper would.
+      const double a = std::max(energy_ - settings_.energy_tolerance, 0.0) / (speed2 * dt);
+      out = Wrench{{-a * u[0], -a * u[1], -a * u[2]}, {-a * l2 * u[3], -a * l2 * u[4], -a * l2 * u[5]}};
     }
   }
   const Wrench change = out + (-1.0) * planned;
-  const double removed = -power(change, v);
-  double alpha = removed > 0 ? removed / speed2 : 0.0;
-  if (removed <= 0) ++stat_none_;
-  alpha_ = alpha;
-  if (!isFinite(change)) {
-    alpha_ = 0;
-    return Wrench{};
+  if (!isFinite(change)) return Wrench{};
+  const double removed = -power(change, u);  // W taken out of the plan
+  if (removed > 0) {
+    alpha_ = speed2 > 0 ? removed / speed2 : 0.0;
+    dissipated_ += removed * dt;
   }
-  dissipated_ += std::max(removed, 0.0) * dt;
   ++active_ticks_;
   return change;
 }
+
+namespace {
+
+double partNorm(const double* v) {
+  return std::sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
+}
+
+}  // namespace
 
 void PassivityController::observe(const double v[6], double dt, bool holding) {
   if (!holding) {
@@ -222,29 +220,30 @@ void PassivityController::observe(const double v[6], double dt, bool holding) {
     held_ = Wrench{};
     speed_bound_[0] = speed_bound_[1] = 0;
     change_bound_[0] = change_bound_[1] = 0;
-    have_v_ = false;
+    have_v_ = 0;
     return;
   }
   // The speed bounds: the peak speeds of the last speed_hold_time or so (an oscillation's
   // amplitude, also at its turning points, where the speed passes through zero).
   const double decay = dt > 0 ? std::exp(-dt / settings_.speed_hold_time) : 1.0;
-  const double lin = std::sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
-  const double ang = std::sqrt(v[3] * v[3] + v[4] * v[4] + v[5] * v[5]);
+  const double lin = partNorm(v), ang = partNorm(v + 3);
   if (std::isfinite(lin)) speed_bound_[0] = std::max(lin, decay * speed_bound_[0]);
   if (std::isfinite(ang)) speed_bound_[1] = std::max(ang, decay * speed_bound_[1]);
-  if (have_v_) {
-    const double dl = std::sqrt((v[0] - last_v_[0]) * (v[0] - last_v_[0]) +
-                                (v[1] - last_v_[1]) * (v[1] - last_v_[1]) +
-                                (v[2] - last_v_[2]) * (v[2] - last_v_[2]));
-    const double da = std::sqrt((v[3] - last_v_[3]) * (v[3] - last_v_[3]) +
-                                (v[4] - last_v_[4]) * (v[4] - last_v_[4]) +
-                                (v[5] - last_v_[5]) * (v[5] - last_v_[5]));
-    if (std::isfinite(dl)) change_bound_[0] = std::max(dl, decay * change_bound_[0]);
-    if (std::isfinite(da)) change_bound_[1] = std::max(da, decay * change_bound_[1]);
+  // The change bounds: the peak error of predicting this tick's twist from the last two,
+  // v(n) - (2 v(n-1) - v(n-2)), over the same time.
+  if (have_v_ >= 2) {
+    double error[6];
+    for (int k = 0; k < 6; ++k)
+      error[k] = v[k] - (2 * last_v_[k] - prev_v_[k]);
+    const double el = partNorm(error), ea = partNorm(error + 3);
+    if (std::isfinite(el)) change_bound_[0] = std::max(el, decay * change_bound_[0]);
+    if (std::isfinite(ea)) change_bound_[1] = std::max(ea, decay * change_bound_[1]);
   }
-  for (int k = 0; k < 6; ++k)
+  for (int k = 0; k < 6; ++k) {
+    prev_v_[k] = last_v_[k];
     last_v_[k] = std::isfinite(v[k]) ? v[k] : 0.0;
-  have_v_ = true;
+  }
+  have_v_ = std::min(have_v_ + 1, 2);
   const double delta = power(held_, v) * dt;
   if (std::isfinite(delta)) energy_ += delta;
   if (energy_ > max_energy_) max_energy_ = energy_;

@@ -113,7 +113,9 @@ ClosedTrace runClosedLoop(const ClosedLoop& c) {
   }
   if (const char* dump = std::getenv("TORSION_CLOSED_LOOP_DUMP")) {
     std::string error;
-    loop.writeLog(std::string(dump) + (c.passivity ? "_pc.csv" : "_free.csv"), &error);
+    loop.writeLog(std::string(dump) + "_" + std::to_string(static_cast<int>(1e3 * c.delay)) +
+                      (c.passivity ? (c.rate_limited ? "_rl.csv" : "_pc.csv") : "_free.csv"),
+                  &error);
   }
   ClosedTrace trace;
   const device::LoopLogRow* previous = nullptr;

@@ -109,7 +109,7 @@ TEST(Passivity, TheObserverBooksAPressedSpringAsStoredEnergyAndTheControllerStay
     x += v[0] * dt;
     pc.observe(v, dt, true);
     const Wrench w{{-k * x, 0, 0}, {}};
-    EXPECT_EQ(pc.damping(w, v, dt).force.x, 0);
+    EXPECT_EQ(pc.correction(w, v, dt).force.x, 0);
     pc.written(w);
     EXPECT_LE(pc.portEnergy(), 0);
   }
@@ -125,7 +125,7 @@ TEST(Passivity, TheControllerRemovesExactlyTheGeneratedEnergy) {
   const double v[6] = {0.1, 0, 0, 0, 0, 1.0};
   const Wrench push{{2, 0, 0}, {0, 0, 0.02}};
   pc.observe(v, 0.001, true);
-  const Wrench d = pc.damping(push, v, 0.001);
+  const Wrench d = pc.correction(push, v, 0.001);
   const double generated = (2 * 0.1 + 0.02 * 1.0) * 0.001;
   EXPECT_NEAR(pc.alpha(), generated / ((0.01 + 0.01 * 1.0) * 0.001), 1e-9);
   EXPECT_NEAR(d.torque.z / d.force.x, 0.01 * 1.0 / 0.1, 1e-12);  // alpha l^2 w / (alpha v)
@@ -144,7 +144,7 @@ TEST(Passivity, ABoundedControllerLeavesTheRestOfTheEnergyForTheNextTicks) {
   const double v[6] = {0.1, 0, 0, 0, 0, 0};
   const Wrench push{{2, 0, 0}, {}};  // generates 2e-4 J per tick at 0.1 m/s
   pc.observe(v, 0.001, true);
-  const Wrench d = pc.damping(push, v, 0.001);
+  const Wrench d = pc.correction(push, v, 0.001);
   EXPECT_EQ(pc.alpha(), 1);
   EXPECT_NEAR(d.force.x, -0.1, 1e-15);  // alpha v, not the 2 N it would take
   pc.written(push + d);

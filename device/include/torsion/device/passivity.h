@@ -13,7 +13,35 @@
 // -E_obs = K x^2 / 2 and returns it). E_obs > 0 is energy the coupling generated (delay, sample
 // and hold, a stale simulation wrench), the source of the growing buzz of an unstable coupling.
 //
-// Controller (impedance causality: the twist comes in, the wrench goes out). Two kinds.
+// Controller (impedance causality: the twist comes in, the wrench goes out). At tick n the
+// wrench W(n) is chosen, then held while the hand moves: its work W(n) . v(n+1) dt is booked at
+// the next tick and depends on a motion not yet known. No wrench but zero is passive against
+// every motion, so a strict controller must bound the coming motion. Three kinds.
+//
+// Dead-beat damper with a misprediction reserve (the default: misprediction_margin > 0). The
+// coming twist is predicted as u = 2 v(n) - v(n-1) (the last tick's change goes on), and the
+// error of that prediction bounded by b = the peak error it had over about the last
+// speed_hold_time (decaying), per part (b_f m/s, b_t rad/s). With m = misprediction_margin,
+//     G(W) = E_obs(n) - energy_tolerance + W . u dt + m dt (b_f |f| + b_t |tau|)     (J)
+// is E_obs after the tick at the worst twist within m b of u. G(W_plan) <= 0: W = W_plan, the
+// controller does nothing. Else W = the wrench nearest W_plan with G(W) <= 0 (metric
+// |df|^2 + |dtau|^2 / l^2; the set is convex and holds W = 0 while E_obs <= 0): each part of
+// the plan, with a damping of the predicted motion mu/2 (u_lin, l^2 u_ang) added, shrunk toward
+// zero by mu/2 times its share m b (the KKT point; mu by bisection). Then E_obs <= 0 after the
+// tick whenever the hand's twist stays within m b of the prediction, to rounding. A motion
+// beyond the bound leaves a debt (E_obs > 0), damped away at the next ticks. The correction
+// goes on after the safety filter's rate limit: the written wrench steps while it acts (the
+// step damps the predicted motion and shrinks the wrench toward zero; docs/haptics.md).
+//
+// Plain dead-beat damper (Hannaford & Ryu; misprediction_margin = 0). For W_plan and the last
+// twist v(n),
+//     E_pre = E_obs(n) - energy_tolerance + W_plan . v(n) dt;
+//     E_pre > 0 and |v|_w > min_speed:  alpha = E_pre / (|v|_w^2 dt),
+//                                        W = W_plan - alpha (v_lin, l^2 v_ang)
+// with |v|_w^2 = |v_lin|^2 + l^2 |v_ang|^2 and l = `length_scale` (the one damping coefficient
+// alpha, N s/m, acts on rotation as alpha l^2, N m s/rad): E_obs after the tick is exactly
+// energy_tolerance if the motion goes on as in the last tick, and exceeds it by the
+// misprediction W . (v(n+1) - v(n)) dt otherwise.
 //
 // Rate-limited energy reserve (`rate_limited: true`). The wrench written to the device
 // changes by at most the safety filter's rate limit per tick (r_f N/s, r_t N m/s), damping
@@ -39,16 +67,6 @@
 // the output small and then damps, at the rate limit, until it is repaid. A slow, quasi-static
 // motion into a spring keeps a reserve of the spring's stored energy and is left alone.
 //
-// Dead-beat damper (Hannaford & Ryu; the default, `rate_limited: false`). At tick n, for W_plan,
-//     E_pre = E_obs(n-1) - energy_tolerance + W_plan . v(n) dt;
-//     E_pre > 0 and |v|_w > min_speed:  alpha = E_pre / (|v|_w^2 dt),
-//                                        W = W_plan - alpha (v_lin, l^2 v_ang)
-// with |v|_w^2 = |v_lin|^2 + l^2 |v_ang|^2 and l = `length_scale` (the one damping coefficient
-// alpha, N s/m, acts on rotation as alpha l^2, N m s/rad). Then W . v dt = E_pre - alpha |v|_w^2
-// dt brings E_obs(n) to exactly energy_tolerance (0 by default) in one tick; the damping is
-// added after the rate limit, so the
-// written wrench may step (about 1 N m in a tick where the limit allows 0.03 N m).
-//
 // Either way the observer books the wrench actually written, so what saturation holds back is
 // caught at the next tick, and alpha() reports the damping as an equivalent coefficient: the
 // power taken out of W_plan over |v|_w^2 (N s/m).
@@ -68,8 +86,14 @@ struct PassivitySettings {
   /// The energy-reserve controller whose output respects the rate limit (above); false (the
   /// default): the dead-beat damper added after the rate limit (docs/haptics.md compares them).
   bool rate_limited = false;
-  /// s, rate-limited controller: how long the speed bound holds a peak speed (it decays as
-  /// exp(-t / speed_hold_time)); about an oscillation period of the hand on the device.
+  /// Dead-beat damper: m above, the factor on the bound of the twist's prediction error the
+  /// controller keeps a reserve for. 0: the plain dead-beat damper (no reserve, E_obs exceeds 0
+  /// by each tick's misprediction). 3 by default: E_obs <= 0 to rounding on every validation
+  /// run (docs/haptics.md, "Passivity"; 2 lets mispredictions of 0.2 mJ through).
+  double misprediction_margin = 3;
+  /// s: how long the speed bound (rate-limited controller) and the bound of the twist's
+  /// prediction error (dead-beat damper) hold a peak (they decay as exp(-t / speed_hold_time));
+  /// about an oscillation period of the hand on the device.
   double speed_hold_time = 0.1;
   /// Rate-limited controller: the speed bound's factor. The wrench being ramped down keeps
   /// accelerating the hand meanwhile, so the speed while braking exceeds the one measured.
@@ -81,14 +105,11 @@ struct PassivitySettings {
   /// tolerance lets a larger misprediction through on a delayed one (docs/haptics.md,
   /// "Passivity", measures both). 0: the strict controller.
   double energy_tolerance = 0;
-  double min_speed = 1e-6;  ///< m/s of |v|_w below which no damping is added (alpha -> inf)
-  /// Dead-beat damper: N s/m, largest alpha (rotation: alpha l^2); infinity: none. A bound
-  /// leaves some generated energy for the following ticks instead of a damping spike.
+  /// m/s of |v|_w below which the plain dead-beat damper adds no damping (alpha -> inf)
+  double min_speed = 1e-6;
+  /// Plain dead-beat damper: N s/m, largest alpha (rotation: alpha l^2); infinity: none. A
+  /// bound leaves some generated energy for the following ticks instead of a damping spike.
   double max_alpha = std::numeric_limits<double>::infinity();
-  /// Dead-beat damper: the reserve it keeps against the next tick's misprediction of the hand's
-  /// motion, as a factor on the largest change of the hand's velocity in one tick over about the
-  /// last speed_hold_time. 0: the plain dead-beat damper (E_obs exceeds 0 by a misprediction).
-  double misprediction_margin = 2;
 
   /// Empty when valid, else the message naming the field.
   std::string validate() const;
@@ -98,17 +119,18 @@ class PassivityController {
  public:
   explicit PassivityController(const PassivitySettings& settings = {}) : settings_(settings) {}
 
-  /// Dead-beat damper: the damping wrench to add to `planned` (the wrench about to be written)
-  /// for twist `v` (linear m/s, angular rad/s) over `dt`; zero when the controller is off or
-  /// not needed.
-  Wrench damping(const Wrench& planned, const double v[6], double dt);
+  /// Dead-beat damper: the change to add to `planned` (the wrench about to be written) after
+  /// the twist `v` (linear m/s, angular rad/s) of the tick of `dt` just observed: a damping of
+  /// the predicted motion and, with the reserve, a shrink toward zero; zero when the
+  /// controller is off or not needed.
+  Wrench correction(const Wrench& planned, const double v[6], double dt);
   /// Rate-limited energy reserve: the wrench to write this tick. `previous`: the wrench written
   /// at the last tick; `planned`: the rate-limited step from it toward the rendering (within
   /// `force_step` N and `torque_step` N m of `previous`); the result is too, and within
   /// `limits`. `planned` itself when the controller is off or not needed.
   Wrench limit(const Wrench& previous, const Wrench& planned, const double v[6], double dt,
                double force_step, double torque_step, const DeviceLimits& limits);
-  /// The loop's choice: limit() when settings().rate_limited, else planned + damping(),
+  /// The loop's choice: limit() when settings().rate_limited, else planned + correction(),
   /// saturated.
   Wrench control(const Wrench& previous, const Wrench& planned, const double v[6], double dt,
                  double force_step, double torque_step, const DeviceLimits& limits);
@@ -123,25 +145,24 @@ class PassivityController {
   double maxPortEnergy() const { return max_energy_; }  ///< J, largest E_obs seen
   double alpha() const { return alpha_; }               ///< N s/m, this tick's damping (equivalent)
   double dissipated() const { return dissipated_; }     ///< J, power taken out of W_plan, summed
-  std::uint64_t activeTicks() const { return active_ticks_; }  ///< ticks with alpha > 0
+  std::uint64_t activeTicks() const { return active_ticks_; }  ///< ticks it changed the wrench
   const PassivitySettings& settings() const { return settings_; }
-  std::uint64_t stat_reserve_ = 0, stat_plain_ = 0, stat_none_ = 0;  // DEBUG
-  ~PassivityController();  // DEBUG
 
  private:
   /// J: E_obs plus the work of `w` over the coming tick plus what ramping it to zero at the
   /// rates (N/s, N m/s) could give out at the speed bounds; > 0: not covered by the reserve.
   double reserveNeed(const Wrench& w, const double v[6], double dt, double force_rate,
                      double torque_rate) const;
-  /// J: E_obs after the coming tick with `w` held, at the worst velocity within the change
-  /// bounds (times misprediction_margin) of `v`.
+  /// J: G(w) above, E_obs after the coming tick with `w` held at the worst twist within
+  /// misprediction_margin times the change bounds of the predicted twist `v`.
   double worstNextEnergy(const Wrench& w, const double v[6], double dt) const;
 
   PassivitySettings settings_;
   double speed_bound_[2] = {0, 0};  // m/s, rad/s: peak speeds, decaying
-  double change_bound_[2] = {0, 0};  // m/s, rad/s: peak velocity changes in one tick, decaying
-  double last_v_[6] = {};
-  bool have_v_ = false;
+  double change_bound_[2] = {0, 0};  // m/s, rad/s: peak prediction errors of the twist, decaying
+  double last_v_[6] = {};            // v(n), then v(n-1): the twists the prediction starts from
+  double prev_v_[6] = {};
+  int have_v_ = 0;  // how many of them are known (0-2)
   Wrench held_;
   double energy_ = 0;
   double max_energy_ = 0;
