@@ -8,6 +8,12 @@
 
 namespace torsion::device {
 
+namespace {
+
+constexpr double kNegligibleEnergy = 1e-12;  // J
+
+}  // namespace
+
 std::string PassivitySettings::validate() const {
   if (!(length_scale > 0 && std::isfinite(length_scale)))
     return "passivity.length_scale must be positive (m)";
@@ -151,7 +157,10 @@ Wrench PassivityController::correction(const Wrench& planned, const double v[6],
   const double speed2 =
       u[0] * u[0] + u[1] * u[1] + u[2] * u[2] + l2 * (u[3] * u[3] + u[4] * u[4] + u[5] * u[5]);
   const double worst = worstNextEnergy(planned, u, dt);
-  if (!(worst > 0)) return Wrench{};
+  // A worst case below a picojoule is rounding (the first ticks of a grab, when the hand's
+  // motion is not yet known and the wrench is still fading in): left alone, so that a passive
+  // rendering never wakes the controller. E_obs may then end a tick that far above 0.
+  if (!(worst > (m > 0 ? kNegligibleEnergy : 0.0))) return Wrench{};
   Wrench out;
   if (m == 0) {
     // The plain dead-beat damper.
@@ -173,22 +182,36 @@ Wrench PassivityController::correction(const Wrench& planned, const double v[6],
       const double keep = 1 - cut / n;
       return Vec3{keep * y.x, keep * y.y, keep * y.z};
     };
-    auto at = [&](double mu) {
-      return Wrench{part(planned.force, u, 1.0, change_bound_[0], mu),
-                    part(planned.torque, u + 3, l2, change_bound_[1], mu)};
+    // Only the parts whose own worst-case work is positive are changed (a part that cannot
+    // give energy is left as planned): damping the other part's predicted motion would pay for
+    // this one's risk with a kick that the prediction does not cover.
+    auto partWorst = [&](const Vec3& w, const double* v_part, double bound) {
+      return (w.x * v_part[0] + w.y * v_part[1] + w.z * v_part[2]) * dt +
+             m * dt * bound * norm3(w);
     };
-    double hi = speed2 > 0 ? 2 * worst / (speed2 * dt) : 1.0;
-    int doublings = 0;
-    for (; doublings < 400 && worstNextEnergy(at(hi), u, dt) > 0; ++doublings)
-      hi *= 2;
-    if (doublings < 400) {
+    const bool risky[2] = {partWorst(planned.force, u, change_bound_[0]) > 0,
+                           partWorst(planned.torque, u + 3, change_bound_[1]) > 0};
+    auto project = [&](bool force, bool torque, Wrench* result) {
+      auto at = [&](double mu) {
+        return Wrench{force ? part(planned.force, u, 1.0, change_bound_[0], mu) : planned.force,
+                      torque ? part(planned.torque, u + 3, l2, change_bound_[1], mu)
+                             : planned.torque};
+      };
+      double hi = speed2 > 0 ? 2 * worst / (speed2 * dt) : 1.0;
+      int doublings = 0;
+      for (; doublings < 400 && worstNextEnergy(at(hi), u, dt) > 0; ++doublings)
+        hi *= 2;
+      if (doublings == 400) return false;
       double lo = 0;
       for (int k = 0; k < 64; ++k) {
         const double mid = 0.5 * (lo + hi);
         (worstNextEnergy(at(mid), u, dt) > 0 ? lo : hi) = mid;
       }
-      out = at(hi);
-    } else if (speed2 > settings_.min_speed * settings_.min_speed) {
+      *result = at(hi);
+      return true;
+    };
+    if (!((risky[0] || risky[1]) && project(risky[0], risky[1], &out)) &&
+        !project(true, true, &out) && speed2 > settings_.min_speed * settings_.min_speed) {
       // Not even W = 0 covers it: E_obs > 0 already, after a motion beyond the bound. Damp
       // the debt away as the plain dead-beat damper would.
       const double a = std::max(energy_ - settings_.energy_tolerance, 0.0) / (speed2 * dt);
