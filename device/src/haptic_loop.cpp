@@ -110,15 +110,18 @@ void HapticLoop::tick(double now, double deadline) {
   Wrench desired;
   if (published && simulated_.grabbed) {
     desired = renderLocalModel(simulated_, sample.pose, twist, settings_.damper, &limits_);
-    if (blend_.enabled()) {
+    if (blend_.enabled() && predicts(simulated_)) {
       // A new step of the same grab comes in through the blend (step_blend.h); a new grab
-      // starts from the model.
+      // starts from the model. Only with K_h: it carries the spring about the current pose at
+      // once, and the blend takes what it did not predict.
       Wrench jump;
       if (fresh && previous_step.step > 0 && previous_step.grabbed)
         jump = desired + (-1.0) * renderLocalModel(previous_step, sample.pose, twist,
                                                    settings_.damper, &limits_);
       blend_.update(jump, dt);
       desired = desired + blend_.offset();
+    } else {
+      blend_.reset();
     }
   } else {
     blend_.reset();

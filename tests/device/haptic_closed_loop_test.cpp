@@ -31,7 +31,7 @@ struct ClosedLoop {
   double wrist_damping = 0.1;
   double tilt_damping = -1;  // N m s/rad about x and y (the grip); negative: wrist_damping
   double duration = 2;
-  double step_blend_hz = 0;  // HapticLoopSettings::step_blend_hz
+  double step_blend_hz = device::HapticLoopSettings{}.step_blend_hz;
   Rendering rendering = Rendering::kInternalForce;
 };
 
@@ -207,6 +207,7 @@ TEST(HapticClosedLoop,
 TEST(HapticClosedLoop, WithAFirmGripOnTheTiltASlowTwistFeelsTheBodysStaticStiffness) {
   ClosedLoop c;
   c.delay = 0;
+  c.step_blend_hz = 0;  // the reference: the rendering as simulated
   c.local_stiffness = true;
   c.passivity = false;
   c.twist_time = 1.5;
@@ -241,8 +242,10 @@ TEST(HapticClosedLoop, WithAFirmGripOnTheTiltASlowTwistFeelsTheBodysStaticStiffn
   // With a 10 uJ tolerance it leaves the loop alone: the same torque and felt stiffness within
   // 2 %, and the port within the tolerance.
   c.passivity = true;
+  c.step_blend_hz = ClosedLoop{}.step_blend_hz;  // the default configuration
   const ClosedTrace strict = runClosedLoop(c);
   c.energy_tolerance = 1e-5;
+  c.step_blend_hz = 0;
   const ClosedTrace tolerant = runClosedLoop(c);
   const double reference = firm.mean(firm.torque, 2, 3);
   std::printf(
@@ -276,6 +279,7 @@ TEST(HapticClosedLoop, ADelayedSlowTwistStaysPassiveAndFeelsTheUndelayedTorqueUn
   c.wrist_damping = 1.0;
   c.tilt_damping = 10;
   c.duration = 3;
+  c.step_blend_hz = 0;  // the reference: the rendering as simulated
   const ClosedTrace reference = runClosedLoop(c);
   const double torque = reference.mean(reference.torque, 2, 3);
   const double angle = reference.mean(reference.angle, 2, 3);
@@ -288,7 +292,7 @@ TEST(HapticClosedLoop, ADelayedSlowTwistStaysPassiveAndFeelsTheUndelayedTorqueUn
     c.step_blend_hz = 0;
     c.passivity = true;
     const ClosedTrace unblended = runClosedLoop(c);
-    c.step_blend_hz = 8;
+    c.step_blend_hz = ClosedLoop{}.step_blend_hz;  // the default, 8 Hz
     c.passivity = false;
     const ClosedTrace free = runClosedLoop(c);
     c.passivity = true;

@@ -33,7 +33,8 @@ TEST(DeviceParser, ReadsAScriptedDeviceWithEverySetting) {
       "limits": {"max_force": 12, "max_torque": 1.5}, "rate_hz": 500, "step_blend_hz": 5,
       "damper": {"linear": 2, "angular": 0.1},
       "passivity": {"enabled": true, "length_scale": 0.05, "rate_limited": true,
-                    "speed_hold_time": 0.2, "speed_margin": 3, "energy_tolerance": 1e-5},
+                    "speed_hold_time": 0.2, "speed_margin": 3, "energy_tolerance": 1e-5,
+                    "misprediction_margin": 0},
       "safety": {"max_force_rate": 100, "max_torque_rate": 10, "stale_after": 0.05, "fade_time": 0.3}})"));
   ASSERT_TRUE(r.ok()) << r.error().message;
   const HandSpec& h = r.value().hands.at(0);
@@ -58,6 +59,7 @@ TEST(DeviceParser, ReadsAScriptedDeviceWithEverySetting) {
   EXPECT_EQ(d.loop.passivity.speed_hold_time, 0.2);
   EXPECT_EQ(d.loop.passivity.speed_margin, 3);
   EXPECT_EQ(d.loop.passivity.energy_tolerance, 1e-5);
+  EXPECT_EQ(d.loop.passivity.misprediction_margin, 0);
   EXPECT_EQ(d.loop.safety.fade_time, 0.3);
   EXPECT_EQ(h.initial.origin.z(), 9.9);  // the device's anchor
 }

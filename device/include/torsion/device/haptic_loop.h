@@ -6,8 +6,8 @@
 //      enabled; button 2 pressed -> a release request and force disabled;
 //   3. hand the simulation a HandCommand (lock-free, commands());
 //   4. take the newest SimulationWrench (lock-free, wrenches()) and render the local model
-//      W_sim + K_h dpose - B twist (local_wrench_model.h), a new step's change blended in when
-//      step_blend_hz is set (step_blend.h);
+//      W_sim + K_h dpose - B twist (local_wrench_model.h), a new step's change blended in while
+//      the step carries K_h (step_blend.h, step_blend_hz);
 //   5. pass the wrench through the SafetyFilter, let the passivity controller (passivity.h) take
 //      back the generated energy (the dead-beat damper on top of the filter's output, or the
 //      rate-limited controller within the filter's rate limit, the filter then following what
@@ -39,9 +39,10 @@ struct HapticLoopSettings {
   PassivitySettings passivity;  ///< time-domain passivity observer and controller (on)
   double twist_cutoff_hz = 50;  ///< low-pass of the velocity the damper sees
   /// Hz: each new simulation step's change of the local model is blended in through a
-  /// first-order low-pass of this cutoff instead of stepping (step_blend.h); 0: off (the
-  /// default). For a stiff body under delay with the rate-limited controller, docs/haptics.md.
-  double step_blend_hz = 0;
+  /// first-order low-pass of this cutoff instead of stepping (step_blend.h), while the step
+  /// carries a local stiffness K_h (without one the whole rendering would be low-passed); 0:
+  /// off. 8 by default: a stiff body under delay is felt as without delay (docs/haptics.md).
+  double step_blend_hz = 8;
   std::size_t log_capacity = 0;  ///< rows kept in memory (one per tick); 0: no log
   /// SCHED_FIFO priority (1-99) the loop's thread asks for; it keeps the default policy,
   /// silently, when that is not permitted (LoopStats::realtime says which). 0: do not ask.
