@@ -103,8 +103,7 @@ void readLoop(const JsonObject& d, DeviceSpec& spec) {
     p.speed_hold_time = positive(o, "speed_hold_time", p.speed_hold_time, " s");
     p.speed_margin = positive(o, "speed_margin", p.speed_margin, "");
     p.energy_tolerance = nonNegative(o, "energy_tolerance", p.energy_tolerance, " J");
-    p.misprediction_margin =
-        nonNegative(o, "misprediction_margin", p.misprediction_margin, "");
+    p.misprediction_margin = nonNegative(o, "misprediction_margin", p.misprediction_margin, "");
     o.finish();
   }
   if (d.has("safety")) {

@@ -186,16 +186,15 @@ Wrench PassivityController::correction(const Wrench& planned, const double v[6],
     // give energy is left as planned): damping the other part's predicted motion would pay for
     // this one's risk with a kick that the prediction does not cover.
     auto partWorst = [&](const Vec3& w, const double* v_part, double bound) {
-      return (w.x * v_part[0] + w.y * v_part[1] + w.z * v_part[2]) * dt +
-             m * dt * bound * norm3(w);
+      return (w.x * v_part[0] + w.y * v_part[1] + w.z * v_part[2]) * dt + m * dt * bound * norm3(w);
     };
     const bool risky[2] = {partWorst(planned.force, u, change_bound_[0]) > 0,
                            partWorst(planned.torque, u + 3, change_bound_[1]) > 0};
     auto project = [&](bool force, bool torque, Wrench* result) {
       auto at = [&](double mu) {
-        return Wrench{force ? part(planned.force, u, 1.0, change_bound_[0], mu) : planned.force,
-                      torque ? part(planned.torque, u + 3, l2, change_bound_[1], mu)
-                             : planned.torque};
+        return Wrench{
+            force ? part(planned.force, u, 1.0, change_bound_[0], mu) : planned.force,
+            torque ? part(planned.torque, u + 3, l2, change_bound_[1], mu) : planned.torque};
       };
       double hi = speed2 > 0 ? 2 * worst / (speed2 * dt) : 1.0;
       int doublings = 0;
@@ -215,7 +214,8 @@ Wrench PassivityController::correction(const Wrench& planned, const double v[6],
       // Not even W = 0 covers it: E_obs > 0 already, after a motion beyond the bound. Damp
       // the debt away as the plain dead-beat damper would.
       const double a = std::max(energy_ - settings_.energy_tolerance, 0.0) / (speed2 * dt);
-      out = Wrench{{-a * u[0], -a * u[1], -a * u[2]}, {-a * l2 * u[3], -a * l2 * u[4], -a * l2 * u[5]}};
+      out = Wrench{{-a * u[0], -a * u[1], -a * u[2]},
+                   {-a * l2 * u[3], -a * l2 * u[4], -a * l2 * u[5]}};
     }
   }
   const Wrench change = out + (-1.0) * planned;

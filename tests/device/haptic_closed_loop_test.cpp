@@ -22,8 +22,9 @@ namespace {
 struct ClosedLoop {
   double delay = 0.02;  // s from a step's end to its wrench reaching the loop
   bool passivity = true;
-  bool rate_limited = false;     // passivity.rate_limited
-  double margin = device::PassivitySettings{}.misprediction_margin;  // 0: plain dead-beat
+  bool rate_limited = false;  // passivity.rate_limited
+  // passivity.misprediction_margin; 0: the plain dead-beat damper
+  double margin = device::PassivitySettings{}.misprediction_margin;
   double energy_tolerance = 0;   // J, passivity.energy_tolerance
   bool local_stiffness = false;  // publish K_h
   double twist = 0.05;           // rad the operator means to turn
@@ -117,7 +118,9 @@ ClosedTrace runClosedLoop(const ClosedLoop& c) {
     std::string error;
     loop.writeLog(std::string(dump) + "_" + std::to_string(static_cast<int>(1e3 * c.delay)) +
                       "ms_blend" + std::to_string(static_cast<int>(c.step_blend_hz)) +
-                      (c.passivity ? (c.rate_limited ? "_rl.csv" : c.margin > 0 ? "_pc.csv" : "_plain.csv")
+                      (c.passivity ? (c.rate_limited ? "_rl.csv"
+                                      : c.margin > 0 ? "_pc.csv"
+                                                     : "_plain.csv")
                                    : "_free.csv"),
                   &error);
   }
@@ -376,8 +379,9 @@ TEST(HapticClosedLoop, AFastTurnStaysPassiveAndTheHandSinksInLessThanWithinTheRa
         "rad with %.4f N m against %.4f simulated (step %.3g N m, max E_obs %.3g J)\n",
         1e3 * delay, hold(reserve), reserve.mean(reserve.torque, 1.5, 2), reserve.max_torque_step,
         reserve.max_energy, hold(stiff), stiff.max_torque_step, stiff.max_energy, hold(plain),
-        plain.max_torque_step, plain.max_energy, hold(limited), limited.mean(limited.torque, 1.5, 2),
-        limited.mean(limited.simulated, 1.5, 2), limited.max_torque_step, limited.max_energy);
+        plain.max_torque_step, plain.max_energy, hold(limited),
+        limited.mean(limited.torque, 1.5, 2), limited.mean(limited.simulated, 1.5, 2),
+        limited.max_torque_step, limited.max_energy);
     EXPECT_LE(reserve.max_energy, 1e-9);
     EXPECT_LE(stiff.max_energy, 1e-9);
     EXPECT_GT(reserve.max_torque_step, 10 * rate_step);

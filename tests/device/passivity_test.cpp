@@ -27,8 +27,9 @@ struct Scenario {
   double delay = 0.02;          // s from the simulation's step to its wrench reaching the loop
   bool give_stiffness = false;  // publish K_h (the local model then bridges the delay)
   bool passivity = true;
-  bool rate_limited = false;    // the energy-reserve controller instead of the dead-beat damper
-  double margin = PassivitySettings{}.misprediction_margin;  // 0: the plain dead-beat damper
+  bool rate_limited = false;  // the energy-reserve controller instead of the dead-beat damper
+  // passivity.misprediction_margin; 0: the plain dead-beat damper
+  double margin = PassivitySettings{}.misprediction_margin;
   double twist = 0.2;           // rad the operator means to turn
   double twist_time = 0.2;      // s the turn takes
   double wrist_damping = 0.1;   // N m s/rad, the operator's grip
@@ -167,7 +168,7 @@ TEST(Passivity, TheReserveKeepsThePortPassiveForEveryTwistWithinItsBound) {
   PassivityController pc;             // the default: the reserve
   const double m = pc.settings().misprediction_margin;
   ASSERT_GT(m, 0);
-  pc.written({{}, {0, 0, -0.1}});  // a spring pressed in: credit
+  pc.written({{}, {0, 0, -0.1}});         // a spring pressed in: credit
   for (double w : {1.0, 1.0, 1.0 + b}) {  // the third twist misses the prediction 1 by b
     const double v[6] = {0, 0, 0, 0, 0, w};
     pc.observe(v, dt, true);

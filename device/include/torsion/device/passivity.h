@@ -158,7 +158,7 @@ class PassivityController {
   double worstNextEnergy(const Wrench& w, const double v[6], double dt) const;
 
   PassivitySettings settings_;
-  double speed_bound_[2] = {0, 0};  // m/s, rad/s: peak speeds, decaying
+  double speed_bound_[2] = {0, 0};   // m/s, rad/s: peak speeds, decaying
   double change_bound_[2] = {0, 0};  // m/s, rad/s: peak prediction errors of the twist, decaying
   double last_v_[6] = {};            // v(n), then v(n-1): the twists the prediction starts from
   double prev_v_[6] = {};
