@@ -369,13 +369,12 @@ TEST(HapticClosedLoop, AFastTurnStaysPassiveAndTheHandSinksInLessThanWithinTheRa
     const ClosedTrace plain = runClosedLoop(c);
     c.margin = ClosedLoop{}.margin;
     c.rate_limited = true;
-    c.step_blend_hz = 8;
     const ClosedTrace limited = runClosedLoop(c);
     auto hold = [](const ClosedTrace& t) { return t.mean(t.angle, 1.5, 2); };
     std::printf(
         "fast turn, delay %.0f ms: default holds %.4f rad with %.4f N m (largest step %.3g N m, "
         "max E_obs %.3g J), with K_h %.4f rad (step %.3g N m, max E_obs %.3g J); plain "
-        "dead-beat %.4f rad (step %.3g N m, max E_obs %.3g J); rate-limited with the blend %.4f "
+        "dead-beat %.4f rad (step %.3g N m, max E_obs %.3g J); rate-limited %.4f "
         "rad with %.4f N m against %.4f simulated (step %.3g N m, max E_obs %.3g J)\n",
         1e3 * delay, hold(reserve), reserve.mean(reserve.torque, 1.5, 2), reserve.max_torque_step,
         reserve.max_energy, hold(stiff), stiff.max_torque_step, stiff.max_energy, hold(plain),
