@@ -83,7 +83,7 @@ struct LoopStats {
   std::atomic<std::uint64_t> nonfinite{0};    ///< rendered wrenches with NaN/inf (zeroed)
   std::atomic<std::uint64_t> saturated{0};    ///< ticks whose wrench exceeded a device limit
   std::atomic<bool> realtime{false};          ///< the thread runs under SCHED_FIFO
-  std::atomic<std::uint64_t> pc_active{0};    ///< ticks the passivity controller damped
+  std::atomic<std::uint64_t> pc_active{0};    ///< ticks the passivity controller acted
   std::atomic<double> pc_dissipated{0};       ///< J the passivity controller took out
   std::atomic<double> max_port_energy{0};     ///< J, largest E_obs (> 0: energy was generated)
 };
