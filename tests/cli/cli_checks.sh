@@ -640,7 +640,7 @@ PY
     grep -q '"isolated": false' inproc/summary.json || fail "inproc/summary.json: not in process"
     run "$torsion" run typo.json --haptics lockstep --out typo --steps 10 --threads 1
     expect_rc nonzero
-    expect_out "^error: typo.json: .*isolated.*"
+    expect_out "^error: typo.json: hands\[0\]\.device\.isolated: expected true or false"
     ;;
 
   run_press)
