@@ -102,10 +102,11 @@ Result<std::unique_ptr<device::HapticDevice>> openDevice(const DeviceSpec& spec,
       if (spec.isolated) {
         settings.host_program = deviceHostProgram();
         if (settings.host_program.empty()) {
-          return Error{settings.library +
-                       ": the device host torsion_device_host, which runs an isolated plug-in, "
-                       "is not installed beside this torsion (<libdir>/torsion); run the plug-in "
-                       "in process instead (\"isolated\": false, or --device HAND=plugin-inproc:...)"};
+          return Error{
+              settings.library +
+              ": the device host torsion_device_host, which runs an isolated plug-in, "
+              "is not installed beside this torsion (<libdir>/torsion); run the plug-in "
+              "in process instead (\"isolated\": false, or --device HAND=plugin-inproc:...)"};
         }
       }
       if (lockstep) settings.read_deadline = 0.1;

@@ -3,12 +3,12 @@
 // (docs/haptics.md, "Device plug-ins"). Started by PluginDevice (isolated), never by hand: it
 // serves the shared-memory slot it inherits as fd 3 (plugin_host_protocol.h) until Torsion asks
 // it to close or Torsion ends.
-#include <signal.h>
 #include <sys/mman.h>
 #include <sys/prctl.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <csignal>
 #include <cstdio>
 #include <cstdlib>
 #include <string>

@@ -56,9 +56,13 @@ Loaded<std::unique_ptr<PluginDevice>> PluginDevice::open(const PluginDeviceSetti
 
 PluginDevice::~PluginDevice() = default;  // the transport closes the plug-in
 
-std::string PluginDevice::hostExit() const { return transport_->exitReason(); }
+std::string PluginDevice::hostExit() const {
+  return transport_->exitReason();
+}
 
-int PluginDevice::hostProcessId() const { return transport_->processId(); }
+int PluginDevice::hostProcessId() const {
+  return transport_->processId();
+}
 
 DeviceSample PluginDevice::read(double time) {
   torsion_device_state state{};

@@ -3,7 +3,6 @@
 // that crashes ends only the host: the loop sees its reads stop, this side reaps the host, names
 // the signal, and the device is dead from then on.
 #include <fcntl.h>
-#include <signal.h>
 #include <spawn.h>
 #include <sys/mman.h>
 #include <sys/wait.h>
@@ -12,6 +11,7 @@
 #include <algorithm>
 #include <cerrno>
 #include <chrono>
+#include <csignal>
 #include <cstring>
 #include <iostream>
 #include <mutex>
@@ -38,8 +38,8 @@ using host::futexWake;
 constexpr double kWaitSlice = 0.005;
 
 Clock::time_point after(double seconds) {
-  return Clock::now() + std::chrono::duration_cast<Clock::duration>(
-                            std::chrono::duration<double>(seconds));
+  return Clock::now() +
+         std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(seconds));
 }
 
 double secondsUntil(Clock::time_point until) {
@@ -107,8 +107,7 @@ class HostTransport final : public PluginTransport {
       channel_.time = time;
       send();
     }  // else the host is still inside an earlier call: let it finish, but do not use it
-    const bool answered =
-        waitForResponse(after(deadline));
+    const bool answered = waitForResponse(after(deadline));
     if (reaped_) return Answer::kGone;
     if (!answered || !asked) return Answer::kLate;
     state = channel_.state;
@@ -218,8 +217,8 @@ class HostTransport final : public PluginTransport {
   double wrench_[6] = {};
   bool has_wrench_ = false;
   bool reaped_ = false;
-  bool running_ = false;  // opened and not yet closing: an exit now is a failure, and warned of
-  std::string ended_how_;          // how the host ended, once reaped
+  bool running_ = false;   // opened and not yet closing: an exit now is a failure, and warned of
+  std::string ended_how_;  // how the host ended, once reaped
   mutable std::mutex exit_mutex_;  // exit_reason_ is read by stats() callers on any thread
   std::string exit_reason_;        // set when the host ended while running
 };
@@ -245,8 +244,7 @@ Loaded<std::unique_ptr<PluginTransport>> startHostTransport(const PluginDeviceSe
   }
   if (ftruncate(mapping->fd, sizeof(Channel)) != 0)
     return fail("cannot size the device host's shared memory");
-  void* memory =
-      mmap(nullptr, sizeof(Channel), PROT_READ | PROT_WRITE, MAP_SHARED, mapping->fd, 0);
+  void* memory = mmap(nullptr, sizeof(Channel), PROT_READ | PROT_WRITE, MAP_SHARED, mapping->fd, 0);
   if (memory == MAP_FAILED) return fail("cannot map the device host's shared memory");
   mapping->channel = new (memory) Channel();
   mapping->channel->request.store(1, std::memory_order_relaxed);  // the open (protocol header)
@@ -268,11 +266,13 @@ Loaded<std::unique_ptr<PluginTransport>> startHostTransport(const PluginDeviceSe
   std::vector<std::string> args = {settings.host_program, settings.library, settings.config,
                                    parent};
   std::vector<char*> argv;
-  for (std::string& a : args) argv.push_back(a.data());
+  argv.reserve(args.size() + 1);
+  for (std::string& a : args)
+    argv.push_back(a.data());
   argv.push_back(nullptr);
   pid_t pid = 0;
-  const int spawned = posix_spawn(&pid, settings.host_program.c_str(), &actions, &attributes,
-                                  argv.data(), environ);
+  const int spawned =
+      posix_spawn(&pid, settings.host_program.c_str(), &actions, &attributes, argv.data(), environ);
   posix_spawn_file_actions_destroy(&actions);
   posix_spawnattr_destroy(&attributes);
   if (spawned != 0) {

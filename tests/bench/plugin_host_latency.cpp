@@ -43,7 +43,9 @@ void measure(bool isolated, int reads) {
     device.write(torsion::device::Wrench{});
   }
   std::sort(us.begin(), us.end());
-  auto at = [&](double q) { return us[static_cast<std::size_t>(q * static_cast<double>(us.size() - 1))]; };
+  auto at = [&](double q) {
+    return us[static_cast<std::size_t>(q * static_cast<double>(us.size() - 1))];
+  };
   std::printf("%-10s reads %d  p50 %.1f us  p99 %.1f us  max %.1f us  late %llu\n",
               isolated ? "isolated" : "in-process", reads, at(0.5), at(0.99), us.back(),
               static_cast<unsigned long long>(device.stats().late.load()));

@@ -1,7 +1,6 @@
 #include "torsion/device/plugin_device.h"
 
 #include <gtest/gtest.h>
-
 #include <sys/wait.h>
 
 #include <cerrno>
@@ -78,7 +77,8 @@ std::unique_ptr<PluginDevice> openOrFail(const PluginDeviceSettings& settings) {
   return opened ? std::move(*opened.value) : nullptr;
 }
 
-TEST_P(PluginDeviceAnywhere, TheSimulatedDeviceTwistsAgainstASpringAndSettlesWhereTheWristBalancesIt) {
+TEST_P(PluginDeviceAnywhere,
+       TheSimulatedDeviceTwistsAgainstASpringAndSettlesWhereTheWristBalancesIt) {
   PluginDeviceSettings settings = settingsFor(TORSION_SIMULATED_DEVICE_PLUGIN);
   // The operator turns the wrist 0.5 rad about z in 0.5 s and holds; the device's motors push
   // back with the spring's torque. Deadline generous: this checks the physics, not the clock.
@@ -144,8 +144,8 @@ TEST_P(PluginDeviceAnywhere, AMissingLibraryAnAlienLibraryAndABadConfigAreClearE
 
 // Runs a faulty plug-in under a constant 5 N push until `until` s; the fault starts at 0.3 s.
 struct FaultRun {
-  double before = 0;    // N written just before the fault
-  double at_end = -1;   // N written at `until`
+  double before = 0;      // N written just before the fault
+  double at_end = -1;     // N written at `until`
   double zero_from = -1;  // s, loop time from which the output stayed exactly zero
   bool always_finite = true;
   bool alive_at_end = true;

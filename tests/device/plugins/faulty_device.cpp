@@ -7,8 +7,8 @@
 // Built a second time with FAULTY_ABI_VERSION=99 to claim an ABI this Torsion does not speak.
 
 #include <chrono>
-#include <csignal>
 #include <cmath>
+#include <csignal>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>

@@ -21,7 +21,8 @@
 //     for a built-in device that stopped answering. Each kind of fault is counted (stats()).
 //   - at destruction: the last (zero) wrench, then close(). A plug-in that does not return within
 //     `close_timeout` is, isolated, killed with its host; in process, its thread is detached and
-//     the library stays loaded (unloading code that may still run would crash), and the run goes on.
+//     the library stays loaded (unloading code that may still run would crash), and the run goes
+//     on.
 //
 // Threads: read(), write() from the haptic loop's thread only (as every HapticDevice); stats(),
 // hostExit() from any thread. The plug-in itself is only ever called from one thread (the worker

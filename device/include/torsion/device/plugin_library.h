@@ -18,10 +18,10 @@
 namespace torsion::device {
 
 struct PluginLibrary {
-  void* library = nullptr;                  ///< dlopen handle
-  const torsion_device_v1* table = nullptr; ///< the plug-in's function table
-  void* handle = nullptr;                   ///< what the plug-in's open() returned
-  torsion_device_info info{};               ///< checked, name NUL-terminated
+  void* library = nullptr;                   ///< dlopen handle
+  const torsion_device_v1* table = nullptr;  ///< the plug-in's function table
+  void* handle = nullptr;                    ///< what the plug-in's open() returned
+  torsion_device_info info{};                ///< checked, name NUL-terminated
 };
 
 /// dlopen + ABI checks + open(config) + info(), as above.
