@@ -42,6 +42,17 @@ std::string pluginPath(const std::string& named) {
   return fs::is_regular_file(installed, ec) ? installed.lexically_normal().string() : named;
 }
 
+// The device host that runs an isolated plug-in, installed (and built) in <libdir>/torsion, found
+// from the data directory like the plug-ins; empty when it is not there.
+std::string deviceHostProgram() {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  const std::optional<std::string> data = dataDirectory();
+  if (!data) return {};
+  const fs::path host = fs::path(*data) / TORSION_DEVICE_HOST_FROM_DATA;
+  return fs::is_regular_file(host, ec) ? host.lexically_normal().string() : std::string();
+}
+
 }  // namespace
 
 Result<std::unique_ptr<device::HapticDevice>> openDevice(const DeviceSpec& spec, bool lockstep) {
@@ -87,6 +98,17 @@ Result<std::unique_ptr<device::HapticDevice>> openDevice(const DeviceSpec& spec,
       settings.config = spec.config;
       settings.max_force = spec.max_force;
       settings.max_torque = spec.max_torque;
+      settings.isolated = spec.isolated;
+      if (spec.isolated) {
+        settings.host_program = deviceHostProgram();
+        if (settings.host_program.empty()) {
+          return Error{
+              settings.library +
+              ": the device host torsion_device_host, which runs an isolated plug-in, "
+              "is not installed beside this torsion (<libdir>/torsion); run the plug-in "
+              "in process instead (\"isolated\": false, or --device HAND=plugin-inproc:...)"};
+        }
+      }
       if (lockstep) settings.read_deadline = 0.1;
       auto opened = device::PluginDevice::open(settings);
       if (!opened) return Error{opened.error};

@@ -183,6 +183,7 @@ DeviceSpec readDevice(const JsonObject& hand, const std::string& base_directory)
     spec.kind = DeviceSpec::Kind::kPlugin;
     spec.file = resolve(d.string("library"), base_directory);
     spec.config = d.string("config", "");
+    spec.isolated = d.boolean("isolated", spec.isolated);
   } else {
     d.fail("type", "'" + type + "' is not one of: scripted, replay, network, spacemouse, plugin");
   }
@@ -264,16 +265,18 @@ Status applyDeviceOverride(SceneSpec& scene, const std::string& text) {
   } else if (type == "spacemouse") {
     if (!arg.empty()) return Error{flag + ": spacemouse takes no argument"};
     spec.kind = DeviceSpec::Kind::kSpaceMouse;
-  } else if (type == "plugin") {
+  } else if (type == "plugin" || type == "plugin-inproc") {
+    // plugin: in the device host process; plugin-inproc: in this process (its crash ends the run)
     const size_t config = arg.find(':');
     spec.kind = DeviceSpec::Kind::kPlugin;
+    spec.isolated = type == "plugin";
     spec.file = arg.substr(0, config);
     spec.config = config == std::string::npos ? "" : arg.substr(config + 1);
     if (spec.file.empty())
-      return Error{flag + ": plugin needs a shared library: plugin:LIBRARY[:CONFIG]"};
+      return Error{flag + ": " + type + " needs a shared library: " + type + ":LIBRARY[:CONFIG]"};
   } else {
     return Error{flag + ": unknown device type '" + type +
-                 "' (known: scripted, replay, network, spacemouse, plugin)"};
+                 "' (known: scripted, replay, network, spacemouse, plugin, plugin-inproc)"};
   }
   if (!hand->keyframes.empty()) {  // the scripted motion gives way; its start is the anchor
     hand->initial = hand->keyframes.front().second;

@@ -16,7 +16,10 @@ struct DeviceSpec {
   enum class Kind { kScripted, kReplay, kNetwork, kSpaceMouse, kPlugin } kind = Kind::kScripted;
   std::string file;    ///< scripted: trajectory JSON; replay: loop log CSV; plugin: shared library
   std::string config;  ///< plugin: the text handed to the plug-in's open()
-  double speed = 1;    ///< scripted, replay: playback speed (2: twice as fast)
+  /// plugin: run it in its own process (torsion_device_host), so that its crash ends only that
+  /// process; false: in Torsion's process (a little faster; its crash ends the run)
+  bool isolated = true;
+  double speed = 1;                ///< scripted, replay: playback speed (2: twice as fast)
   std::string host = "127.0.0.1";  ///< network: IPv4 address the poses arrive on
   int port = 5750;                 ///< network: UDP port
   double timeout = 0.05;           ///< network: s without a pose before the device is dead

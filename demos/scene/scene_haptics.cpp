@@ -201,7 +201,9 @@ nlohmann::json SceneHaptics::statistics(const Channel& c) const {
     j["plugin"] = {{"rate_hz", plugin->rateHz()},   {"reads", p.reads.load()},
                    {"late", p.late.load()},         {"failed", p.failed.load()},
                    {"rejected", p.rejected.load()}, {"held", p.held.load()},
-                   {"dead", p.dead.load()}};
+                   {"dead", p.dead.load()},         {"isolated", plugin->isolated()}};
+    // Only when the host ended during the run: how ("killed by signal 11 (SIGSEGV)").
+    if (std::string ended = plugin->hostExit(); !ended.empty()) j["plugin"]["host_exit"] = ended;
   }
   return j;
 }

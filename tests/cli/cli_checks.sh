@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # The torsion tool as a user runs it: one check per call, named by its first argument.
-#   cli_checks.sh CASE TORSION ASSETS_DIR [HAPTIC_PEER] [DEVICE_PLUGIN]
+#   cli_checks.sh CASE TORSION ASSETS_DIR [HAPTIC_PEER] [DEVICE_PLUGIN] [FAULTY_PLUGIN]
 # Exit 0: pass; 77: skipped (e.g. no tetgen on PATH; CTest SKIP_RETURN_CODE); anything else: fail.
 # Each case works in a fresh temporary directory, removed afterwards. TORSION_BULLET_PRECISION
 # (double or float, set by CTest) names the Bullet the tool was built on.
@@ -11,6 +11,7 @@ torsion=$2
 assets=$3
 peer=${4:-}
 plugin=${5:-}
+faulty_plugin=${6:-}
 scenes=$(cd "$(dirname "$0")/../../demos/scenes" && pwd)
 
 work_name=torsion-cli-test
@@ -597,6 +598,49 @@ EOF
     run "$torsion" run twist.json --device "hand=plugin:$assets/cylinder_2430.node" --out bad --steps 5
     expect_rc nonzero
     expect_out "^error: twist.json: hands\[0\] 'hand': device: .*cylinder_2430.node: cannot load the device plug-in: "
+    ;;
+
+  run_haptic_plugin_crash)
+    # A plug-in that segfaults 50 ms into the run, isolated in its device host (the default): the
+    # run goes on to its end, the host's death is reported once and in the summary, the device is
+    # dead from then on and its output zero once held (5 ms) and faded (0.2 s); no host is left.
+    [[ -f $faulty_plugin ]] || fail "no faulty device plug-in given"
+    sed "s|../../assets/meshes|$assets|" "$scenes/twist_cylinder_2430.json" > twist.json
+    run "$torsion" run twist.json --device "hand=plugin:$faulty_plugin:fault=segv,after=0.05" \
+      --haptics lockstep --out crash --steps 40 --threads 1
+    expect_rc 0
+    expect_out "^done: 40 steps"
+    [[ $(grep -c "warning: the device host of .*libtorsion_faulty_device.so killed by signal 11 (SIGSEGV); the device is dead" <<< "$out") -eq 1 ]] ||
+      fail "the host's death was not reported exactly once"
+    grep -q '"host_exit": "killed by signal 11 (SIGSEGV)"' crash/summary.json ||
+      fail "crash/summary.json: no host_exit"
+    grep -q '"isolated": true' crash/summary.json || fail "crash/summary.json: not isolated"
+    grep -q '"dead": [1-9]' crash/summary.json || fail "crash/summary.json: the device never died"
+    awk -F, 'NR == 1 { for (i = 1; i <= NF; i++) c[$i] = i; next }
+      $c["time"] > 0.05 + 0.005 + 0.2 + 0.002 {
+        n++; if ($c["alive"] != 0) bad++
+        for (k = 0; k < 6; k++) if ($(c["fx"] + k) != 0) bad++ }
+      END { exit !(n >= 100 && bad == 0) }' crash/haptic_hand.csv ||
+      fail "crash/haptic_hand.csv: the device is not dead with a zero output after the fade"
+    pgrep -f "torsion_device_host .*libtorsion_faulty_device.so fault=segv,after=0.05" &&
+      fail "a device host outlived torsion"
+    # The same plug-in in process ("isolated": false): the scene key, and what a typo in it says.
+    /usr/bin/python3 - "$faulty_plugin" <<'PY'
+import json, sys
+scene = json.load(open("twist.json"))
+hand = scene["hands"][0]
+del hand["motion"]
+hand["device"] = {"type": "plugin", "library": sys.argv[1], "isolated": False}
+json.dump(scene, open("inproc.json", "w"))
+hand["device"]["isolated"] = "yes"
+json.dump(scene, open("typo.json", "w"))
+PY
+    run "$torsion" run inproc.json --haptics lockstep --out inproc --steps 10 --threads 1
+    expect_rc 0
+    grep -q '"isolated": false' inproc/summary.json || fail "inproc/summary.json: not in process"
+    run "$torsion" run typo.json --haptics lockstep --out typo --steps 10 --threads 1
+    expect_rc nonzero
+    expect_out "^error: typo.json: hands\[0\]\.device\.isolated: expected true or false"
     ;;
 
   run_press)

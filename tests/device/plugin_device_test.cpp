@@ -1,9 +1,12 @@
 #include "torsion/device/plugin_device.h"
 
 #include <gtest/gtest.h>
+#include <sys/wait.h>
 
+#include <cerrno>
 #include <chrono>
 #include <cmath>
+#include <csignal>
 
 #include "stand_in_simulation.h"
 #include "torsion/device/haptic_loop.h"
@@ -11,7 +14,8 @@
 
 // Device plug-ins loaded through the C ABI: the example simulated device in closed loop on a
 // fake 1 kHz clock, and plug-ins that misbehave (NaN, non-unit quaternion, failing or blocking
-// reads, a wrong ABI version). Paths come from CMake (TORSION_*_PLUGIN).
+// reads, a wrong ABI version), each both isolated in the device host and in process; plug-ins
+// that crash, isolated only. Paths come from CMake (TORSION_*_PLUGIN, TORSION_DEVICE_HOST).
 namespace torsion::device {
 namespace {
 
@@ -43,15 +47,39 @@ struct ConstantPush {
   }
 };
 
+// Where the plug-in runs: the parameter of the tests that hold either way.
+class PluginDeviceAnywhere : public ::testing::TestWithParam<bool> {
+ protected:
+  PluginDeviceSettings settingsFor(const char* library) const {
+    PluginDeviceSettings settings;
+    settings.library = library;
+    settings.isolated = GetParam();
+    settings.host_program = TORSION_DEVICE_HOST;
+    return settings;
+  }
+};
+
+INSTANTIATE_TEST_SUITE_P(Both, PluginDeviceAnywhere, ::testing::Bool(),
+                         [](const ::testing::TestParamInfo<bool>& where) {
+                           return where.param ? "Isolated" : "InProcess";
+                         });
+
+PluginDeviceSettings isolatedSettings(const char* library) {
+  PluginDeviceSettings settings;
+  settings.library = library;
+  settings.host_program = TORSION_DEVICE_HOST;
+  return settings;
+}
+
 std::unique_ptr<PluginDevice> openOrFail(const PluginDeviceSettings& settings) {
   auto opened = PluginDevice::open(settings);
   EXPECT_TRUE(opened) << opened.error;
   return opened ? std::move(*opened.value) : nullptr;
 }
 
-TEST(PluginDevice, TheSimulatedDeviceTwistsAgainstASpringAndSettlesWhereTheWristBalancesIt) {
-  PluginDeviceSettings settings;
-  settings.library = TORSION_SIMULATED_DEVICE_PLUGIN;
+TEST_P(PluginDeviceAnywhere,
+       TheSimulatedDeviceTwistsAgainstASpringAndSettlesWhereTheWristBalancesIt) {
+  PluginDeviceSettings settings = settingsFor(TORSION_SIMULATED_DEVICE_PLUGIN);
   // The operator turns the wrist 0.5 rad about z in 0.5 s and holds; the device's motors push
   // back with the spring's torque. Deadline generous: this checks the physics, not the clock.
   settings.config =
@@ -86,18 +114,16 @@ TEST(PluginDevice, TheSimulatedDeviceTwistsAgainstASpringAndSettlesWhereTheWrist
   EXPECT_EQ(loop.stats().pc_active, 0u);
 }
 
-TEST(PluginDevice, AWrongAbiVersionIsRefusedWithBothVersionsNamed) {
-  PluginDeviceSettings settings;
-  settings.library = TORSION_WRONG_ABI_PLUGIN;
+TEST_P(PluginDeviceAnywhere, AWrongAbiVersionIsRefusedWithBothVersionsNamed) {
+  PluginDeviceSettings settings = settingsFor(TORSION_WRONG_ABI_PLUGIN);
   auto opened = PluginDevice::open(settings);
   ASSERT_FALSE(opened);
   EXPECT_NE(opened.error.find("ABI version 99"), std::string::npos) << opened.error;
   EXPECT_NE(opened.error.find("speaks version 1"), std::string::npos) << opened.error;
 }
 
-TEST(PluginDevice, AMissingLibraryAnAlienLibraryAndABadConfigAreClearErrors) {
-  PluginDeviceSettings settings;
-  settings.library = "/nonexistent/libnodevice.so";
+TEST_P(PluginDeviceAnywhere, AMissingLibraryAnAlienLibraryAndABadConfigAreClearErrors) {
+  PluginDeviceSettings settings = settingsFor("/nonexistent/libnodevice.so");
   auto missing = PluginDevice::open(settings);
   ASSERT_FALSE(missing);
   EXPECT_NE(missing.error.find("cannot load"), std::string::npos) << missing.error;
@@ -113,12 +139,14 @@ TEST(PluginDevice, AMissingLibraryAnAlienLibraryAndABadConfigAreClearErrors) {
   auto bad = PluginDevice::open(settings);
   ASSERT_FALSE(bad);
   EXPECT_NE(bad.error.find("device_mass: 'heavy' is not a number"), std::string::npos) << bad.error;
+  EXPECT_EQ(bad.error.rfind(settings.library + ": ", 0), 0u) << bad.error;
 }
 
 // Runs a faulty plug-in under a constant 5 N push until `until` s; the fault starts at 0.3 s.
 struct FaultRun {
-  double before = 0;   // N written just before the fault
-  double at_end = -1;  // N written at `until`
+  double before = 0;      // N written just before the fault
+  double at_end = -1;     // N written at `until`
+  double zero_from = -1;  // s, loop time from which the output stayed exactly zero
   bool always_finite = true;
   bool alive_at_end = true;
 };
@@ -133,6 +161,10 @@ FaultRun runFaulty(PluginDevice& device, double until) {
     const Wrench& w = loop.lastOutput();
     run.always_finite = run.always_finite && isFinite(w);
     if (k == 299) run.before = norm(w.force);
+    if (norm(w.force) != 0)
+      run.zero_from = -1;
+    else if (run.zero_from < 0)
+      run.zero_from = k * kDt;
   }
   HandCommand c;
   loop.commands().read(c);
@@ -141,11 +173,10 @@ FaultRun runFaulty(PluginDevice& device, double until) {
   return run;
 }
 
-TEST(PluginDevice, NanNonUnitQuaternionAndFailedReadsFadeTheForceAndAreCounted) {
+TEST_P(PluginDeviceAnywhere, NanNonUnitQuaternionAndFailedReadsFadeTheForceAndAreCounted) {
   for (const char* fault : {"nan", "quat", "fail"}) {
     SCOPED_TRACE(fault);
-    PluginDeviceSettings settings;
-    settings.library = TORSION_FAULTY_PLUGIN;
+    PluginDeviceSettings settings = settingsFor(TORSION_FAULTY_PLUGIN);
     settings.config = std::string("fault=") + fault + ",after=0.3";
     settings.read_deadline = 0.5;
     std::unique_ptr<PluginDevice> device = openOrFail(settings);
@@ -163,9 +194,8 @@ TEST(PluginDevice, NanNonUnitQuaternionAndFailedReadsFadeTheForceAndAreCounted) 
   }
 }
 
-TEST(PluginDevice, APluginThatBlocksMissesItsDeadlinesTheLoopGoesOnAndTheForceFades) {
-  PluginDeviceSettings settings;
-  settings.library = TORSION_FAULTY_PLUGIN;
+TEST_P(PluginDeviceAnywhere, APluginThatBlocksMissesItsDeadlinesTheLoopGoesOnAndTheForceFades) {
+  PluginDeviceSettings settings = settingsFor(TORSION_FAULTY_PLUGIN);
   settings.config = "fault=block,after=0.3,block_ms=30";
   settings.read_deadline = 0.002;
   std::unique_ptr<PluginDevice> device = openOrFail(settings);
@@ -192,6 +222,75 @@ TEST(PluginDevice, APluginThatBlocksMissesItsDeadlinesTheLoopGoesOnAndTheForceFa
   EXPECT_LT(after_fault, 1.5);
   EXPECT_GT(device->stats().late, 150u);
   EXPECT_EQ(norm(loop.lastOutput().force), 0);
+}
+
+// A plug-in that crashes, isolated: the fault starts at 0.3 s; the last good reading (0.299 s) is
+// held 5 ms, then the device is dead and the safety filter fades 5 N to zero in its fade_time
+// (0.2 s). The host's death is reported with its signal and the host is reaped.
+void expectCrashSurvived(const std::string& config, const std::string& signal_text) {
+  PluginDeviceSettings settings = isolatedSettings(TORSION_FAULTY_PLUGIN);
+  settings.config = config;
+  settings.read_deadline = 0.5;  // fake clock: this checks the rules, not the machine's speed
+  std::unique_ptr<PluginDevice> device = openOrFail(settings);
+  ASSERT_TRUE(device);
+  const int pid = device->hostProcessId();
+  ASSERT_GT(pid, 0);
+  const double hold = settings.hold_time, fade = HapticLoopSettings{}.safety.fade_time;
+  const FaultRun run = runFaulty(*device, 0.3 + hold + fade + 0.05);
+  EXPECT_NEAR(run.before, 5, 1e-9);
+  EXPECT_TRUE(run.always_finite);
+  EXPECT_FALSE(run.alive_at_end);
+  EXPECT_EQ(run.at_end, 0);
+  // Held, then faded (not cut), and exactly zero within fade_time after the hold, to a tick.
+  EXPECT_GT(run.zero_from, 0.3 + hold);
+  EXPECT_LE(run.zero_from, 0.3 + hold + fade + 2 * kDt);
+  EXPECT_NEAR(static_cast<double>(device->stats().held.load()), 5, 1);
+  EXPECT_NE(device->hostExit().find(signal_text), std::string::npos) << device->hostExit();
+  // Reaped as soon as its death was seen: no zombie left, neither now nor after close.
+  int status = 0;
+  EXPECT_EQ(waitpid(pid, &status, WNOHANG), -1);
+  EXPECT_EQ(errno, ECHILD);
+  device.reset();
+  EXPECT_EQ(waitpid(pid, &status, WNOHANG), -1);
+}
+
+TEST(PluginDeviceHost, APluginThatSegfaultsEndsOnlyItsHostTheForceFadesAndTheSignalIsReported) {
+  expectCrashSurvived("fault=segv,after=0.3", "killed by signal 11 (SIGSEGV)");
+}
+
+TEST(PluginDeviceHost, APluginThatAbortsAfterNReadsEndsOnlyItsHostAndTheSignalIsReported) {
+  // Reads at 0, 1, ..., 299 ms answer; the 301st (0.3 s) aborts.
+  expectCrashSurvived("fault=abort,reads=301", "killed by signal 6 (SIGABRT)");
+}
+
+TEST(PluginDeviceHost, AHealthyHostIsClosedAndReapedWithTheDeviceAndReportsNoExit) {
+  PluginDeviceSettings settings = isolatedSettings(TORSION_FAULTY_PLUGIN);
+  settings.read_deadline = 0.5;
+  std::unique_ptr<PluginDevice> device = openOrFail(settings);
+  ASSERT_TRUE(device);
+  const int pid = device->hostProcessId();
+  EXPECT_NE(pid, getpid());
+  const FaultRun run = runFaulty(*device, 0.05);
+  EXPECT_TRUE(run.alive_at_end);
+  EXPECT_EQ(device->hostExit(), "");
+  device.reset();
+  int status = 0;
+  EXPECT_EQ(waitpid(pid, &status, WNOHANG), -1);  // reaped: not our child any more
+  EXPECT_EQ(errno, ECHILD);
+}
+
+TEST(PluginDeviceHost, AMissingHostProgramIsAClearError) {
+  PluginDeviceSettings settings = isolatedSettings(TORSION_FAULTY_PLUGIN);
+  settings.host_program = "/nonexistent/torsion_device_host";
+  auto opened = PluginDevice::open(settings);
+  ASSERT_FALSE(opened);
+  EXPECT_NE(opened.error.find("cannot start the device host '/nonexistent/torsion_device_host'"),
+            std::string::npos)
+      << opened.error;
+  settings.host_program.clear();
+  auto unset = PluginDevice::open(settings);
+  ASSERT_FALSE(unset);
+  EXPECT_NE(unset.error.find("host_program"), std::string::npos) << unset.error;
 }
 
 }  // namespace

@@ -79,6 +79,21 @@ TEST(DeviceParser, ReadsNetworkReplayAndSpaceMouse) {
   EXPECT_EQ(mouse.value().hands[0].device->spacemouse.dead_zone, 20);
 }
 
+TEST(DeviceParser, APluginRunsIsolatedUnlessTheSceneSaysOtherwise) {
+  Result<SceneSpec> isolated = parse(sceneWith(R"({"type": "plugin", "library": "/a/libd.so"})"));
+  ASSERT_TRUE(isolated.ok()) << isolated.error().message;
+  EXPECT_TRUE(isolated.value().hands[0].device->isolated);
+  Result<SceneSpec> inproc =
+      parse(sceneWith(R"({"type": "plugin", "library": "/a/libd.so", "isolated": false})"));
+  ASSERT_TRUE(inproc.ok()) << inproc.error().message;
+  EXPECT_FALSE(inproc.value().hands[0].device->isolated);
+  EXPECT_TRUE(
+      failsWith(parse(sceneWith(R"({"type": "plugin", "library": "/a/libd.so", "isolated": 1})")),
+                {"s.json: hands[0].device.isolated: expected true or false"}));
+  EXPECT_TRUE(failsWith(parse(sceneWith(R"({"type": "replay", "log": "a", "isolated": true})")),
+                        {"hands[0].device.isolated: unknown key"}));  // plug-ins only
+}
+
 TEST(DeviceParser, BadInputNamesTheKey) {
   EXPECT_TRUE(failsWith(parse(sceneWith(R"({"type": "joystick"})")),
                         {"s.json: hands[0].device.type: 'joystick' is not one of"}));
@@ -154,6 +169,13 @@ TEST(DeviceOverride, TurnsAScriptedHandIntoADeviceHand) {
   EXPECT_EQ(s.hands[0].device->config, "port=/dev/ttyUSB0,gain=2:x");
   ASSERT_TRUE(applyDeviceOverride(s, "hand=plugin:libdev.so").ok());
   EXPECT_EQ(s.hands[0].device->config, "");
+  EXPECT_TRUE(s.hands[0].device->isolated);
+  // plugin-inproc: the same, in Torsion's process.
+  ASSERT_TRUE(applyDeviceOverride(s, "hand=plugin-inproc:/opt/libdev.so:gain=2").ok());
+  EXPECT_EQ(s.hands[0].device->kind, DeviceSpec::Kind::kPlugin);
+  EXPECT_EQ(s.hands[0].device->file, "/opt/libdev.so");
+  EXPECT_EQ(s.hands[0].device->config, "gain=2");
+  EXPECT_FALSE(s.hands[0].device->isolated);
 }
 
 TEST(DeviceOverride, KeepsTheScenesMappingAndNamesFaults) {
@@ -173,6 +195,8 @@ TEST(DeviceOverride, KeepsTheScenesMappingAndNamesFaults) {
   EXPECT_TRUE(failsWith(applyDeviceOverride(s, "hand=scripted"), {"scripted needs a file"}));
   EXPECT_TRUE(failsWith(applyDeviceOverride(s, "hand=glove"), {"unknown device type 'glove'"}));
   EXPECT_TRUE(failsWith(applyDeviceOverride(s, "hand=plugin"), {"plugin needs a shared library"}));
+  EXPECT_TRUE(failsWith(applyDeviceOverride(s, "hand=plugin-inproc"),
+                        {"plugin-inproc needs a shared library: plugin-inproc:LIBRARY[:CONFIG]"}));
   EXPECT_TRUE(failsWith(parseHapticsMode("fast"), {"--haptics 'fast'", "lockstep or threaded"}));
   EXPECT_TRUE(parseHapticsMode("threaded").ok());
 }

@@ -2,11 +2,13 @@
 // origin with button 1 pressed from the start and, from time `after` (s) on, does one of:
 //   fault=nan    returns a NaN position        fault=quat  returns a quaternion of norm 2
 //   fault=block  sleeps `block_ms` in read()   fault=fail  returns -1 from read()
-//   fault=none   (default) behaves
+//   fault=segv   dies of SIGSEGV in read()     fault=none  (default) behaves
+//   fault=abort  calls abort() in its `reads`-th read() (counted from 1), whatever the time
 // Built a second time with FAULTY_ABI_VERSION=99 to claim an ABI this Torsion does not speak.
 
 #include <chrono>
 #include <cmath>
+#include <csignal>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
@@ -25,6 +27,8 @@ struct Faulty {
   std::string fault = "none";
   double after = 0;
   double block_ms = 50;
+  long abort_at = 0;
+  long reads = 0;
   long writes = 0;
 };
 
@@ -45,6 +49,8 @@ void* openDevice(const char* config, char* error, size_t error_size) {
       d->after = std::atof(value.c_str());
     else if (key == "block_ms")
       d->block_ms = std::atof(value.c_str());
+    else if (key == "reads")
+      d->abort_at = std::atol(value.c_str());
     else {
       std::snprintf(error, error_size, "faulty device: unknown key '%s'", key.c_str());
       delete d;
@@ -64,7 +70,8 @@ int info(void*, torsion_device_info* out) {
 }
 
 int read(void* handle, double time, torsion_device_state* out) {
-  const Faulty& d = *static_cast<Faulty*>(handle);
+  Faulty& d = *static_cast<Faulty*>(handle);
+  if (d.fault == "abort" && ++d.reads >= d.abort_at) std::abort();
   std::memset(out, 0, sizeof *out);
   out->orientation[0] = 1;
   out->buttons = 1;
@@ -73,6 +80,7 @@ int read(void* handle, double time, torsion_device_state* out) {
   if (d.fault == "nan") out->position[0] = std::nan("");
   if (d.fault == "quat") out->orientation[0] = 2;
   if (d.fault == "fail") return -1;
+  if (d.fault == "segv") std::raise(SIGSEGV);  // as a stray pointer would, but on cue
   if (d.fault == "block")
     std::this_thread::sleep_for(std::chrono::duration<double, std::milli>(d.block_ms));
   return 0;

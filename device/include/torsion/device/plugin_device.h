@@ -2,24 +2,32 @@
 // A haptic device in a shared library, loaded at run time through the C ABI of plugin_abi.h
 // (`--device HAND=plugin:/path/libdev.so[:CONFIG]`, docs/haptics.md).
 //
-// The loader trusts nothing the library returns:
-//   - open: the entry symbol must exist and its table must carry TORSION_DEVICE_ABI_VERSION,
-//     every function pointer must be set, info() must give finite non-negative limits and a
-//     positive rate; otherwise open() fails with a message naming the library and the fault;
-//   - every tick: the plug-in is called on a worker thread of its own, and read() waits for it
-//     only until `read_deadline` (an answer that comes later, to an earlier tick, is not used); a
-//     reading that is late, failed (non-zero return), non-finite or has a non-unit quaternion is
-//     not used: the device keeps its last good reading for at most `hold_time` (a late tick on a
-//     busy machine does not fade the force), then reports itself dead, so the haptic loop's safety
-//     filter fades the output to zero exactly as for a built-in device that stopped answering. Each
-//     kind of fault is counted (stats()).
-//   - a plug-in that never returns is abandoned at destruction after `close_timeout`: its
-//     thread is detached and the library stays loaded (unloading code that may still run would
-//     crash), and the run goes on.
+// Where the plug-in runs:
+//   - isolated (the default): in a process of its own, torsion_device_host (`host_program`),
+//     reached through shared memory. A plug-in that crashes (segfault, abort) ends only that
+//     process: the device reaps it, reports how it ended (hostExit(), printed once as a warning)
+//     and is dead from then on, so the loop fades the output to zero and the run goes on;
+//   - in process (`isolated = false`): on a worker thread of Torsion's process, a little faster;
+//     a crash in the plug-in ends Torsion.
 //
-// Threads: read(), write() from the haptic loop's thread only (as every HapticDevice); stats()
-// from any thread. The plug-in itself is only ever called from the worker thread, one call at a
-// time.
+// The loader trusts nothing the library returns, wherever it runs:
+//   - open: the checks of plugin_library.h (entry symbol, ABI version, function table, open(),
+//     info()); otherwise open() fails with a message naming the library and the fault;
+//   - every tick: read() waits for the plug-in only until `read_deadline` (an answer that comes
+//     later, to an earlier tick, is not used); a reading that is late, failed (non-zero return),
+//     non-finite or has a non-unit quaternion is not used: the device keeps its last good reading
+//     for at most `hold_time` (a late tick on a busy machine does not fade the force), then
+//     reports itself dead, so the haptic loop's safety filter fades the output to zero exactly as
+//     for a built-in device that stopped answering. Each kind of fault is counted (stats()).
+//   - at destruction: the last (zero) wrench, then close(). A plug-in that does not return within
+//     `close_timeout` is, isolated, killed with its host; in process, its thread is detached and
+//     the library stays loaded (unloading code that may still run would crash), and the run goes
+//     on.
+//
+// Threads: read(), write() from the haptic loop's thread only (as every HapticDevice); stats(),
+// hostExit() from any thread. The plug-in itself is only ever called from one thread (the worker
+// or the host's), one call at a time. open() from a thread that outlives the device: the host is
+// killed when the thread that started it ends (PR_SET_PDEATHSIG).
 
 #include <atomic>
 #include <cstdint>
@@ -32,12 +40,20 @@
 
 namespace torsion::device {
 
+class PluginTransport;  // where the plug-in's calls run (plugin_transport.h, private)
+
 struct PluginDeviceSettings {
   std::string library;            ///< path of the shared library (dlopen)
   std::string config;             ///< text handed to the plug-in's open(), maybe empty
   double read_deadline = 0.0005;  ///< s the loop waits for one read() of the plug-in
   double hold_time = 0.005;       ///< s a good reading may stand in for late or bad ones
   double close_timeout = 1.0;     ///< s to wait for the plug-in's last calls at destruction
+  /// Run the plug-in in its own process (torsion_device_host) rather than in Torsion's.
+  bool isolated = true;
+  /// isolated: path of the torsion_device_host program (built and installed in
+  /// <libdir>/torsion, beside the plug-ins' directory).
+  std::string host_program;
+  double start_timeout = 10.0;  ///< isolated: s for the host to start and open the plug-in
   /// N and N m: the output stays within these even when the device could do more (a scene may
   /// ask for less than the hardware's limits; never for more).
   double max_force = std::numeric_limits<double>::infinity();
@@ -59,8 +75,8 @@ struct PluginStats {
 
 class PluginDevice : public HapticDevice {
  public:
-  /// Loads the library, checks its ABI version and table, opens the device and reads its
-  /// info. Errors: "<library>: <what is wrong>".
+  /// Loads the library (in the host when isolated), checks its ABI version and table, opens the
+  /// device and reads its info. Errors: "<library>: <what is wrong>".
   static Loaded<std::unique_ptr<PluginDevice>> open(const PluginDeviceSettings& settings);
   ~PluginDevice() override;
   PluginDevice(const PluginDevice&) = delete;
@@ -74,8 +90,12 @@ class PluginDevice : public HapticDevice {
   /// The rate the device's own servo loop expects (info().rate_hz).
   double rateHz() const { return rate_hz_; }
   const PluginStats& stats() const { return *stats_; }
-
-  struct Shared;  // state shared with the worker thread (plugin_device.cpp)
+  bool isolated() const { return settings_.isolated; }
+  /// Empty while the host runs (or in process); once the host has ended during the run, how:
+  /// "killed by signal 11 (SIGSEGV)", "exited with code 3".
+  std::string hostExit() const;
+  /// The host process's id (0 in process); it is reaped by the time the device is destroyed.
+  int hostProcessId() const;
 
  private:
   PluginDevice() = default;
@@ -84,11 +104,10 @@ class PluginDevice : public HapticDevice {
   std::string name_;
   DeviceLimits limits_;
   double rate_hz_ = 0;
-  std::shared_ptr<Shared> shared_;
   std::shared_ptr<PluginStats> stats_;
+  std::unique_ptr<PluginTransport> transport_;
   DeviceSample last_good_;
   bool have_good_ = false;
-  std::uint64_t request_ = 0;
 };
 
 }  // namespace torsion::device
