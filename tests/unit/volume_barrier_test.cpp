@@ -268,6 +268,64 @@ TEST(VolumeBarrier, TheStepperAddsItsForcesAndStiffness) {
   EXPECT_LT((Ky_with - Ky_without - expected).norm(), 1e-9 * expected.norm());
 }
 
+TEST(VolumeBarrier, Tet10BodiesApplyItToTheirEightSubTets) {
+  // One quadratic element with a mid-edge node pushed through the corner tet's opposite face:
+  // some of its 8 linear sub-tets (FemModel::mesh()) fall below the threshold, and the stepper's
+  // forces and K gain exactly the barrier's terms of those sub-tets.
+  auto mesh = std::make_shared<TetMesh>(std::vector<Eigen::Vector3d>(kRest.begin(), kRest.end()),
+                                        std::vector<Tet>{{0, 1, 2, 3}});
+  Material without;
+  without.barrier_threshold = 0;
+  auto with_model = FemModel::create(mesh, Material{}, ElementKind::kTet10).value();
+  auto without_model = FemModel::create(mesh, without, ElementKind::kTet10).value();
+  Parallel parallel(1);
+  ImplicitStepper with_stepper(with_model, SolverSettings{}, parallel);
+  ImplicitStepper without_stepper(without_model, SolverSettings{}, parallel);
+  FemState state = FemState::atRest(*with_model);
+  const int n = with_model->nodeCount();
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<double> noise(-0.02, 0.02);
+  for (int i = 0; i < 3 * n; ++i)
+    state.positions[i] += noise(rng);
+  const int mid_edge = with_model->elementNodes()[9];  // a mid-edge node (local 9)
+  state.positions.segment<3>(3 * mid_edge) += Eigen::Vector3d(0.25, -0.2, 0.3);
+  FemState other = state;
+  with_stepper.computeElasticForces(state);
+  without_stepper.computeElasticForces(other);
+  const VolumeBarrier barrier = defaultBarrier();
+  Eigen::VectorXd expected_forces = Eigen::VectorXd::Zero(3 * n);
+  Eigen::MatrixXd K = Eigen::MatrixXd::Zero(3 * n, 3 * n);
+  int below = 0;
+  for (size_t t = 0; t < with_model->mesh().tets().size(); ++t) {
+    const Tet& tet = with_model->mesh().tets()[t];
+    const TetRestData& rest = with_model->tetRestData()[t];
+    Nodes x;
+    for (size_t a = 0; a < 4; ++a)
+      x[a] = state.positions.segment<3>(3 * tet[a]);
+    const Eigen::Matrix3d F = deformationGradient(x, rest.rest_shape_inverse);
+    if (barrier.active(F.determinant())) ++below;
+    const Nodes f = volumeBarrierForces(F, rest, barrier);
+    const TetStiffness k = volumeBarrierStiffness(F, rest, barrier);
+    for (size_t a = 0; a < 4; ++a) {
+      expected_forces.segment<3>(3 * tet[a]) += f[a];
+      for (size_t b = 0; b < 4; ++b)
+        K.block<3, 3>(3 * tet[a], 3 * tet[b]) +=
+            k.block<3, 3>(3 * static_cast<int>(a), 3 * static_cast<int>(b));
+    }
+  }
+  ASSERT_GT(below, 0);
+  ASSERT_LT(below, 8);
+  const Eigen::VectorXd added = with_stepper.elasticForces() - without_stepper.elasticForces();
+  EXPECT_LT((added - expected_forces).norm(), 1e-9 * expected_forces.norm());
+  Eigen::VectorXd y(3 * n), Ky_with, Ky_without;
+  for (int i = 0; i < y.size(); ++i)
+    y[i] = noise(rng);
+  with_stepper.system().multiplyStiffness(y, Ky_with);
+  without_stepper.system().multiplyStiffness(y, Ky_without);
+  const Eigen::VectorXd expected = K * y;
+  EXPECT_LT((Ky_with - Ky_without - expected).norm(), 1e-9 * expected.norm());
+}
+
 // Minimum volume ratio of a tet whose apex is thrown at `speed` toward its base.
 double smallestVolumeRatio(const Material& material, double speed) {
   auto mesh = std::make_shared<TetMesh>(std::vector<Eigen::Vector3d>(kRest.begin(), kRest.end()),
