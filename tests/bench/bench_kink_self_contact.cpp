@@ -125,8 +125,7 @@ int main(int argc, char** argv) {
     for (AnomalyKind kind : monitor.observe(k, observation))
       std::printf("step %d: %s starts\n", k, toString(kind));
     peak_torque = std::max(
-        peak_torque,
-        std::abs(body->groupWrench(hand, Eigen::Vector3d(0, 0, length)).torque.z()));
+        peak_torque, std::abs(body->groupWrench(hand, Eigen::Vector3d(0, 0, length)).torque.z()));
     const SelfContactSolver* contact = body->selfContact();
     if (contact != nullptr && !contact->stats().converged) ++unconverged;
     int crossings = -1;
@@ -228,7 +227,7 @@ int main(int argc, char** argv) {
       kinds_total.within_tolerance, kinds_total.deepest, deep_crossing_steps, peak_inverted,
       inverted_steps, peak_barrier, peak_torque);
   for (const Anomaly& a : monitor.anomalies())
-    std::printf("anomaly %s: steps %d-%d, peak %g\n", toString(a.kind), a.first_step,
-                a.last_step, a.peak);
+    std::printf("anomaly %s: steps %d-%d, peak %g\n", toString(a.kind), a.first_step, a.last_step,
+                a.peak);
   return 0;
 }

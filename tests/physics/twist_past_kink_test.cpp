@@ -116,8 +116,7 @@ TwistRun twist(const TwistOptions& options) {
     run.peak_kinetic = std::max(run.peak_kinetic, r.kinetic_energy);
     run.peak_speed = std::max(run.peak_speed, r.max_speed);
     run.end_elastic = r.elastic_energy;
-    run.end_torque =
-        std::abs(body->groupWrench(hand, Eigen::Vector3d(0, 0, kLength)).torque.z());
+    run.end_torque = std::abs(body->groupWrench(hand, Eigen::Vector3d(0, 0, kLength)).torque.z());
     run.peak_torque = std::max(run.peak_torque, run.end_torque);
     if (options.check_from < 0 || k < options.check_from) continue;
     ++run.checked_steps;
@@ -126,11 +125,11 @@ TwistRun twist(const TwistOptions& options) {
     if (pairs.empty()) continue;
     ++run.crossing_steps;
     const SelfContactSolver* contact = body->selfContact();
-    const CrossingKinds kinds = classifyCrossings(
-        pairs, mesh.surfaceTriangles(), body->state().positions,
-        contact != nullptr ? contact->contacts() : std::vector<SurfaceContact>{},
-        contact != nullptr ? contact->settings().max_depth : 0.25,
-        contact != nullptr ? contact->gapTolerance() : 0.0);
+    const CrossingKinds kinds =
+        classifyCrossings(pairs, mesh.surfaceTriangles(), body->state().positions,
+                          contact != nullptr ? contact->contacts() : std::vector<SurfaceContact>{},
+                          contact != nullptr ? contact->settings().max_depth : 0.25,
+                          contact != nullptr ? contact->gapTolerance() : 0.0);
     if (kinds.within_tolerance < static_cast<int>(pairs.size())) ++run.deep_steps;
     run.deepest = std::max(run.deepest, kinds.deepest);
   }
