@@ -140,10 +140,19 @@ double ImplicitStepper::addVolumeBarrier(const FemState& state) {
       x[a] = state.positions.segment<3>(3 * tets[t][a]);
     return deformationGradient(x, rest[t].rest_shape_inverse);
   };
+  // J = det(Ds) / det(Dm) = det(Ds) / (6 V): a triple product per tet, no F (this pass runs over
+  // every tet every step; F is formed below only for the few tets under the threshold).
   volume_ratio_.resize(tets.size());
+  const double* x = state.positions.data();
   parallel_.forRange(static_cast<int>(tets.size()), kTetGrain, [&](int begin, int end) {
-    for (size_t t = static_cast<size_t>(begin); t < static_cast<size_t>(end); ++t)
-      volume_ratio_[t] = gradientOf(t).determinant();
+    for (size_t t = static_cast<size_t>(begin); t < static_cast<size_t>(end); ++t) {
+      const Tet& tet = tets[t];
+      const Eigen::Map<const Eigen::Vector3d> x0(x + 3 * tet[0]);
+      const Eigen::Vector3d e1 = Eigen::Map<const Eigen::Vector3d>(x + 3 * tet[1]) - x0;
+      const Eigen::Vector3d e2 = Eigen::Map<const Eigen::Vector3d>(x + 3 * tet[2]) - x0;
+      const Eigen::Vector3d e3 = Eigen::Map<const Eigen::Vector3d>(x + 3 * tet[3]) - x0;
+      volume_ratio_[t] = e1.dot(e2.cross(e3)) / (6.0 * rest[t].volume);
+    }
   });
   // Few tets are ever below the threshold (none at ordinary strains: then nothing below changes
   // a bit of the forces or of K), so the rest runs serially, in tet order.
