@@ -58,6 +58,8 @@ Material readMaterial(const JsonObject& m) {
   material.density = m.number("density");
   material.mass_damping = m.number("mass_damping", material.mass_damping);
   material.stiffness_damping = m.number("stiffness_damping", material.stiffness_damping);
+  material.barrier_threshold = m.number("barrier_threshold", material.barrier_threshold);
+  material.barrier_stiffness = m.number("barrier_stiffness", material.barrier_stiffness);
   const std::string volumetric =
       m.string("volumetric_strain", toString(material.volumetric_strain));
   if (auto kind = parseVolumetricStrain(volumetric)) {

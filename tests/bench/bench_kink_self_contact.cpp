@@ -9,8 +9,11 @@
 //
 //   bench_kink_self_contact [--friction MU] [--dt S] [--rate RAD_PER_S] [--hold STEPS]
 //                           [--check-from STEP] [--print STEPS] [--detail STEP]
-//                           [--no-self-contact]
+//                           [--no-self-contact] [--barrier-threshold J0] [--barrier-stiffness K]
+//                           [--angle TURN_IN_PI]
 // --detail prints that step's crossing pairs and the contacts on them, as for the first one.
+// --barrier-threshold / --barrier-stiffness set the material's volume barrier
+// (fem/volume_barrier.h; threshold 0 turns it off, as the code was before it existed).
 #include <Eigen/Geometry>
 #include <chrono>
 #include <cmath>
@@ -30,9 +33,10 @@
 using namespace torsion;
 
 int main(int argc, char** argv) {
-  double friction = 0.3, dt = 0.01, rate = 0.5;
+  double friction = 0.3, dt = 0.01, rate = 0.5, max_angle = 4 * M_PI;
   int hold = 300, check_from = 0, print_every = 100, detail_step = -1;
   bool self_contact = true;
+  Material material;
   for (int i = 1; i < argc; ++i) {
     const std::string arg = argv[i];
     auto value = [&]() { return i + 1 < argc ? std::atof(argv[++i]) : 0.0; };
@@ -52,6 +56,12 @@ int main(int argc, char** argv) {
       detail_step = static_cast<int>(value());
     else if (arg == "--no-self-contact")
       self_contact = false;
+    else if (arg == "--angle")
+      max_angle = value() * M_PI;
+    else if (arg == "--barrier-threshold")
+      material.barrier_threshold = value();
+    else if (arg == "--barrier-stiffness")
+      material.barrier_stiffness = value();
     else {
       std::fprintf(stderr, "unknown argument '%s'\n", arg.c_str());
       return 2;
@@ -67,13 +77,13 @@ int main(int argc, char** argv) {
   settings.gravity.setZero();
   settings.solver.time_step = dt;
   FemWorld world(settings);
-  FemBody* body = world.addBody("bar", mesh, Material{}).value();
+  FemBody* body = world.addBody("bar", mesh, material).value();
   if (self_contact) {
     SelfContactSettings contact;
     contact.friction = friction;
     if (!body->enableSelfContact(contact).ok()) return 1;
   }
-  const double length = 10, max_angle = 4 * M_PI;
+  const double length = 10;
   std::vector<int> base, top;
   for (int n = 0; n < mesh.nodeCount(); ++n) {
     const double z = mesh.restPositions()[static_cast<size_t>(n)].z();
@@ -99,6 +109,8 @@ int main(int argc, char** argv) {
   CrossingKinds kinds_total;
   int deep_crossing_steps = 0;  // steps with a pair deeper than the gap tolerance
   double peak_elastic = 0;
+  int peak_inverted = 0, peak_barrier = 0, inverted_steps = 0;
+  double peak_torque = 0;
   for (int k = 1; k <= steps; ++k) {
     if (!world.step().ok) {
       std::printf("step %d failed: %s\n", k, body->lastReport().message.c_str());
@@ -106,9 +118,14 @@ int main(int argc, char** argv) {
     }
     const StepReport& r = body->lastReport();
     peak_elastic = std::max(peak_elastic, r.elastic_energy);
-    for (AnomalyKind kind :
-         monitor.observe(k, observeStep(body->model(), body->state().positions, r)))
+    const StepObservation observation = observeStep(body->model(), body->state().positions, r);
+    peak_inverted = std::max(peak_inverted, observation.inverted_elements);
+    peak_barrier = std::max(peak_barrier, r.barrier_tets);
+    if (observation.inverted_elements > 0) ++inverted_steps;
+    for (AnomalyKind kind : monitor.observe(k, observation))
       std::printf("step %d: %s starts\n", k, toString(kind));
+    peak_torque = std::max(
+        peak_torque, std::abs(body->groupWrench(hand, Eigen::Vector3d(0, 0, length)).torque.z()));
     const SelfContactSolver* contact = body->selfContact();
     if (contact != nullptr && !contact->stats().converged) ++unconverged;
     int crossings = -1;
@@ -185,10 +202,12 @@ int main(int argc, char** argv) {
       const Wrench w = body->groupWrench(hand, Eigen::Vector3d(0, 0, length));
       std::printf(
           "step %d: twist %.3f pi, hand torque %.5g N m, elastic %.5g J, kinetic %.4g J, "
-          "active contacts %d, contact iterations %d, crossing pairs %d\n",
+          "active contacts %d, contact iterations %d, crossing pairs %d, inverted tets %d, "
+          "tets in the barrier %d\n",
           k, std::min(rate * k * dt, max_angle) / M_PI, std::abs(w.torque.z()), r.elastic_energy,
           r.kinetic_energy, contact ? contact->stats().active : 0,
-          contact ? contact->stats().iterations : 0, crossings);
+          contact ? contact->stats().iterations : 0, crossings, observation.inverted_elements,
+          r.barrier_tets);
     }
   }
   const Wrench w = body->groupWrench(hand, Eigen::Vector3d(0, 0, length));
@@ -197,12 +216,18 @@ int main(int argc, char** argv) {
       "of %d checked (first %d), unconverged contact solves %d, %.1f s\n"
       "crossing pairs summed over those steps: %d node in face (%d deep), %d edge-edge; %d with "
       "a candidate (%d edge-edge); %d within the gap tolerance, deepest %.3g m; steps with a "
-      "pair deeper than the tolerance %d\n",
+      "pair deeper than the tolerance %d\n"
+      "inverted tets: at most %d, in %d steps; tets in the barrier: at most %d; peak hand torque "
+      "%.5g N m\n",
       std::abs(w.torque.z()), body->lastReport().elastic_energy, peak_elastic, crossing_steps,
       checked, first_crossing, unconverged,
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(),
       kinds_total.node_in_face, kinds_total.node_in_face_deep, kinds_total.edge_edge,
       kinds_total.with_candidate, kinds_total.edge_edge_with_candidate,
-      kinds_total.within_tolerance, kinds_total.deepest, deep_crossing_steps);
+      kinds_total.within_tolerance, kinds_total.deepest, deep_crossing_steps, peak_inverted,
+      inverted_steps, peak_barrier, peak_torque);
+  for (const Anomaly& a : monitor.anomalies())
+    std::printf("anomaly %s: steps %d-%d, peak %g\n", toString(a.kind), a.first_step, a.last_step,
+                a.peak);
   return 0;
 }

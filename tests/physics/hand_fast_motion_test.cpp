@@ -133,7 +133,9 @@ TEST(HandFastMotion, UnlimitedFastTurnOverDeformsAndTheSpeedLimitPreventsIt) {
   const TurnHistory fine = fastTurn(0.0, kDt / 10, 10 * kTurnSteps, 20);
   std::printf("[figures] unlimited at dt = 1 ms: worst strain %.3f, worst inverted %d\n",
               fine.worst_strain, fine.worst_inverted);
-  EXPECT_GT(fine.worst_inverted, 5);
+  // The volume barrier (fem/volume_barrier.h) keeps most of the 1 ms run's tets from inverting
+  // (4 invert, 27 without it), not its strain.
+  EXPECT_GT(fine.worst_inverted, 0);
   EXPECT_GT(fine.worst_strain, 1.5);
 
   // After: never a tet inverted, the worst strain within twice the limit's nominal drag strain

@@ -367,7 +367,11 @@ Result<FemBodyCheckpoint> readBody(Reader& r, FemWorld& world, FemBody& body,
   const size_t nodes = r.u32(), elements = r.u32();
   const auto kind = r.enumeration(ElementKind::kTet10);
   const auto hash = r.raw<std::uint64_t>();
-  const Material material = readMaterial(r);
+  Material material = readMaterial(r);
+  // The format does not store the volume barrier's constants (live edits do not change them):
+  // they stay the body's own.
+  material.barrier_threshold = model.material().barrier_threshold;
+  material.barrier_stiffness = model.material().barrier_stiffness;
   if (!r.ok()) return Error{"the checkpoint is truncated or corrupted"};
   if (nodes != static_cast<size_t>(model.nodeCount()) ||
       elements != static_cast<size_t>(model.elementCount()) || kind != model.elementKind() ||

@@ -31,6 +31,10 @@ Status Material::validate() const {
     return bad("mass_damping", mass_damping, "must be >= 0 1/s");
   if (!(std::isfinite(stiffness_damping) && stiffness_damping >= 0))
     return bad("stiffness_damping", stiffness_damping, "must be >= 0 s");
+  if (!(std::isfinite(barrier_threshold) && barrier_threshold >= 0 && barrier_threshold < 1))
+    return bad("barrier_threshold", barrier_threshold, "must be in [0, 1)");
+  if (!(std::isfinite(barrier_stiffness) && barrier_stiffness >= 0))
+    return bad("barrier_stiffness", barrier_stiffness, "must be >= 0");
   return Ok{};
 }
 

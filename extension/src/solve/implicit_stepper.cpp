@@ -9,6 +9,7 @@
 #include "torsion/fem/nodal_pressure.h"
 #include "torsion/fem/polar_rotation.h"
 #include "torsion/fem/quadratic_element.h"
+#include "torsion/fem/volume_barrier.h"
 #include "torsion/solve/cholmod_solver.h"
 
 namespace torsion {
@@ -121,9 +122,61 @@ double ImplicitStepper::computeElasticForces(FemState& state) {
     });
   }
   system_.gather(element_forces_, 1.0, elastic_forces_);
-  double energy = nodal_energy;
+  double energy = nodal_energy + addVolumeBarrier(state);
   for (double e : element_energy_)
     energy += e;
+  return energy;
+}
+
+double ImplicitStepper::addVolumeBarrier(const FemState& state) {
+  barrier_tets_ = 0;
+  const VolumeBarrier barrier = volumeBarrierOf(model_->material());
+  if (!(barrier.threshold > 0 && barrier.pressure > 0)) return 0.0;
+  const std::vector<Tet>& tets = model_->mesh().tets();
+  const std::vector<TetRestData>& rest = model_->tetRestData();
+  auto gradientOf = [&](size_t t) {
+    std::array<Eigen::Vector3d, 4> x;
+    for (size_t a = 0; a < 4; ++a)
+      x[a] = state.positions.segment<3>(3 * tets[t][a]);
+    return deformationGradient(x, rest[t].rest_shape_inverse);
+  };
+  // J = det(Ds) / det(Dm) = det(Ds) / (6 V): a triple product per tet, no F (this pass runs over
+  // every tet every step; F is formed below only for the few tets under the threshold).
+  volume_ratio_.resize(tets.size());
+  const double* x = state.positions.data();
+  parallel_.forRange(static_cast<int>(tets.size()), kTetGrain, [&](int begin, int end) {
+    for (size_t t = static_cast<size_t>(begin); t < static_cast<size_t>(end); ++t) {
+      const Tet& tet = tets[t];
+      const Eigen::Map<const Eigen::Vector3d> x0(x + 3 * tet[0]);
+      const Eigen::Vector3d e1 = Eigen::Map<const Eigen::Vector3d>(x + 3 * tet[1]) - x0;
+      const Eigen::Vector3d e2 = Eigen::Map<const Eigen::Vector3d>(x + 3 * tet[2]) - x0;
+      const Eigen::Vector3d e3 = Eigen::Map<const Eigen::Vector3d>(x + 3 * tet[3]) - x0;
+      volume_ratio_[t] = e1.dot(e2.cross(e3)) / (6.0 * rest[t].volume);
+    }
+  });
+  // Few tets are ever below the threshold (none at ordinary strains: then nothing below changes
+  // a bit of the forces or of K), so the rest runs serially, in tet order.
+  double energy = 0;
+  std::vector<SystemOperator::SlotBlock> additions;
+  for (size_t t = 0; t < tets.size(); ++t) {
+    if (!barrier.active(volume_ratio_[t])) continue;
+    ++barrier_tets_;
+    const Eigen::Matrix3d F = gradientOf(t);
+    const std::array<Eigen::Vector3d, 4> forces = volumeBarrierForces(F, rest[t], barrier);
+    for (size_t a = 0; a < 4; ++a)
+      elastic_forces_.segment<3>(3 * tets[t][a]) += forces[a];
+    energy += volumeBarrierEnergy(F, rest[t], barrier);
+    const TetStiffness K = volumeBarrierStiffness(F, rest[t], barrier);
+    for (int a = 0; a < 4; ++a) {
+      for (int b = 0; b < 4; ++b) {
+        const int row = tets[t][static_cast<size_t>(a)];
+        const int column = tets[t][static_cast<size_t>(b)];
+        if (row > column) continue;  // stored as (column, row), the transposed block of (b, a)
+        additions.push_back({system_.blockSlot(row, column), K.block<3, 3>(3 * a, 3 * b)});
+      }
+    }
+  }
+  system_.setStiffnessAdditions(std::move(additions));
   return energy;
 }
 
@@ -148,6 +201,7 @@ StepReport ImplicitStepper::step(FemState& state, const NodeConstraints& constra
   internal_forces_valid_ = false;
   last_dt_ = dt;
   report.elastic_energy = computeElasticForces(state);
+  report.barrier_tets = barrier_tets_;
   if (!buildRightHandSide(state, external_forces, dt, report)) return report;
   report.solve = solveVelocities(state, constraints, dt);
   integratePositions(state, dt);

@@ -228,7 +228,22 @@ void SystemOperator::assemble() const {
       kernels_->tet4_rows(in, begin, end);
     }
   });
+  for (const SlotBlock& addition : stiffness_additions_)
+    block_values_[static_cast<size_t>(addition.slot)] += addition.block;
   assembled_ = true;
+}
+
+void SystemOperator::setStiffnessAdditions(std::vector<SlotBlock> additions) {
+  if (additions.empty() && stiffness_additions_.empty()) return;  // K as it was
+  stiffness_additions_ = std::move(additions);
+  assembled_ = false;
+}
+
+int SystemOperator::blockSlot(int row, int column) const {
+  const auto begin = block_columns_.begin() + row_offsets_[static_cast<size_t>(row)];
+  const auto end = block_columns_.begin() + row_offsets_[static_cast<size_t>(row) + 1];
+  const auto at = std::lower_bound(begin, end, column);
+  return at != end && *at == column ? static_cast<int>(at - block_columns_.begin()) : -1;
 }
 
 void SystemOperator::rotateGradients(int element) {

@@ -33,6 +33,12 @@ struct Material {
   /// Per element (default) or averaged over nodes: set kNodalAverage for tet4 bodies with nu
   /// above about 0.4 (docs/validation.md, "Nearly incompressible tet4").
   VolumetricStrain volumetric_strain = VolumetricStrain::kPerElement;
+  /// Volume barrier against inverted tets (fem/volume_barrier.h): an energy that is exactly zero
+  /// while every tet keeps more than barrier_threshold of its rest volume (J = det F), so it
+  /// changes nothing at ordinary strains. J0 in [0, 1); 0 turns it off.
+  double barrier_threshold = 0.3;
+  /// The barrier's pressure at J = 0 in units of the bulk modulus (k = barrier_stiffness kappa).
+  double barrier_stiffness = 30.0;
 
   /// Lame's first parameter lambda = E nu / ((1 + nu)(1 - 2 nu)), Pa.
   double lambda() const {

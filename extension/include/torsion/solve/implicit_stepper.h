@@ -5,7 +5,8 @@
 //   1-2. computeElasticForces  per element, in one pass: F = Ds Bm (tet4) or the element's mean F
 //                              (tet10), its rotation R (warm-started polar decomposition), and the
 //                              elastic forces f(x) = -Re Ke (Re^T x - X); gathered per node;
-//                              elastic energy
+//                              elastic energy; the volume barrier of the tets near inversion
+//                              (fem/volume_barrier.h) adds its forces, energy and stiffness
 //   3. buildRightHandSide      b = M v + dt (f(x) + f_ext); a non-finite b ends the step before
 //                              the state is touched
 //   4. solveVelocities         (M (1 + dt alpha) + (dt^2 + dt beta) K) v' = b, warm-started,
@@ -54,7 +55,9 @@ inline bool isFatal(StepHealth h) {
 
 struct StepReport {
   LinearSolveReport solve;
-  double elastic_energy = 0;  ///< J, at the start of the step
+  double elastic_energy = 0;  ///< J, at the start of the step (the volume barrier's included)
+  /// Tets below the volume barrier's threshold at the start of the step (fem/volume_barrier.h).
+  int barrier_tets = 0;
   double kinetic_energy = 0;  ///< J, at the end of the step
   double max_speed = 0;       ///< m/s, at the end of the step
   StepHealth health = StepHealth::kOk;
@@ -126,6 +129,9 @@ class ImplicitStepper {
  private:
   // Stage 2's pressure pass for nodal pressure (adds to element_forces_); the volumetric energy.
   double addNodalPressureForces();
+  // Stage 2's volume barrier (fem/volume_barrier.h): adds its forces to elastic_forces_ and its
+  // stiffness to K for the tets of mesh() below the threshold; returns its energy, J.
+  double addVolumeBarrier(const FemState& state);
   // Stage 3: rhs_. False (and report's health and message set) when b is not finite.
   bool buildRightHandSide(const FemState& state, const Eigen::VectorXd& external_forces, double dt,
                           StepReport& report);
@@ -154,6 +160,9 @@ class ImplicitStepper {
   std::vector<double> tet_strain_, node_strain_;
   // Per tet: 1 where the batched force pass saw det F <= 0 and the SVD path redid it.
   std::vector<unsigned char> needs_svd_;
+  // Per tet of mesh(): J = det F this step (volume barrier); how many are below its threshold.
+  std::vector<double> volume_ratio_;
+  int barrier_tets_ = 0;
   bool internal_forces_valid_ = false;
   double last_dt_;  // s, dt of the last step (the internal forces' linearisation uses it)
 };

@@ -70,6 +70,18 @@ class SystemOperator {
   }
   /// rotated_gradients[4 e + a] = rotations()[e] g_a for one element e.
   void rotateGradients(int element);
+  /// A 3x3 block added to K's stored block at `slot` (blockSlot()).
+  struct SlotBlock {
+    int slot = -1;
+    Eigen::Matrix3d block = Eigen::Matrix3d::Zero();
+  };
+  /// Blocks added to K after each assembly until replaced (the volume barrier's stiffness of the
+  /// tets below its threshold, fem/volume_barrier.h): they enter every product, the diagonal
+  /// blocks and stiffnessBlocks(). Added in the given order, so K stays deterministic.
+  void setStiffnessAdditions(std::vector<SlotBlock> additions);
+  /// The slot of the stored block K(row, column), row <= column, or -1 when the pattern has none
+  /// (the two nodes share no element).
+  int blockSlot(int row, int column) const;
   /// The system coefficients: A = mass_coefficient M + stiffness_coefficient K.
   void setCoefficients(double mass_coefficient, double stiffness_coefficient);
 
@@ -160,6 +172,7 @@ class SystemOperator {
   const Parallel& parallel_;
   std::vector<Eigen::Matrix3d> rotations_;
   const AddedOperatorTerm* added_term_ = nullptr;
+  std::vector<SlotBlock> stiffness_additions_;
   double mass_coefficient_ = 1;
   double stiffness_coefficient_ = 0;
 
