@@ -7,11 +7,14 @@
 //
 //   bench_self_contact SCENE [--steps N] [--threads T] [--check-every K]
 //                            [--save-at K FILE] [--resume FILE] [--self-contact off]
+//                            [--search-skin S]
 //
 // --save-at writes a checkpoint (checkpoint_io.h) after step K; --resume starts from one, so that
 // the contact phase (the plectoneme's last ~350 steps) can be profiled alone. `--self-contact off`
 // runs the same scene with the body's self-contact turned off (the cost of having it on).
-// search_ms_per_step is the wall time of self-contact's tree searches (SelfContactStats).
+// search_ms_per_step is the wall time of self-contact's tree searches (SelfContactStats),
+// search_builds how many of them walked the tree (the others reused the pairs kept across
+// steps); `--search-skin S` sets SelfContactSettings::search_skin (0: a fresh search every step).
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
@@ -35,18 +38,20 @@ int main(int argc, char** argv) {
   if (argc < 2) {
     std::fprintf(stderr,
                  "usage: %s SCENE [--steps N] [--threads T] [--check-every K] [--save-at K FILE] "
-                 "[--resume FILE] [--self-contact off]\n",
+                 "[--resume FILE] [--self-contact off] [--search-skin S]\n",
                  argv[0]);
     return 1;
   }
   int steps = -1, threads = -1, check_every = 50, save_at = -1;
   std::string save_file, resume_file;
   bool self_contact = true;
+  double search_skin = -1;  // -1: the scene's (or the checkpoint's)
   for (int a = 2; a + 1 < argc; a += 2) {
     if (!std::strcmp(argv[a], "--steps")) steps = std::atoi(argv[a + 1]);
     if (!std::strcmp(argv[a], "--threads")) threads = std::atoi(argv[a + 1]);
     if (!std::strcmp(argv[a], "--check-every")) check_every = std::atoi(argv[a + 1]);
     if (!std::strcmp(argv[a], "--resume")) resume_file = argv[a + 1];
+    if (!std::strcmp(argv[a], "--search-skin")) search_skin = std::atof(argv[a + 1]);
     if (!std::strcmp(argv[a], "--self-contact"))
       self_contact = std::strcmp(argv[a + 1], "off") != 0;
     if (!std::strcmp(argv[a], "--save-at") && a + 2 < argc) {
@@ -95,8 +100,15 @@ int main(int argc, char** argv) {
   }
   // After a checkpoint's restore, which brings self-contact back as it was saved.
   if (!self_contact) body->disableSelfContact();
+  if (search_skin >= 0 && body->selfContact() != nullptr) {
+    // Through a checkpoint: the solver comes back as it was (warm starts), with the new skin.
+    FemBodyCheckpoint c = body->checkpoint();
+    c.self_contact_settings.search_skin = search_skin;
+    body->restore(c);
+  }
   const std::vector<Triangle>& surface = body->model().mesh().surfaceTriangles();
-  int unconverged = 0, at_cap = 0, max_active = 0, searches = 0, crossing_checks = 0,
+  int unconverged = 0, at_cap = 0, max_active = 0, searches = 0, search_builds = 0,
+      crossing_checks = 0,
       crossing_first = -1, exact_crossing_checks = 0;
   CrossingKinds kinds;  // the exact checker's pairs at the checks, summed (crossing_kinds.h)
   long updates = 0;
@@ -127,6 +139,7 @@ int main(int argc, char** argv) {
       max_active = std::max(max_active, s.active);
       worst_end = std::max(worst_end, s.max_end_penetration);
       searches += s.searches;
+      search_builds += s.search_builds;
       searching += s.search_seconds;
     }
     if (check_every > 0 && k % check_every == 0) {
@@ -159,7 +172,8 @@ int main(int argc, char** argv) {
       "\"uzawa_updates\": %ld, "
       "\"unconverged\": %d, \"unconverged_at_max_iterations\": %d, \"max_active\": %d, "
       "\"worst_end_penetration_m\": %.3g, "
-      "\"gap_tolerance_m\": %.3g, \"searches\": %d, \"crossing_checks\": %d, "
+      "\"gap_tolerance_m\": %.3g, \"searches\": %d, \"search_builds\": %d, "
+      "\"crossing_checks\": %d, "
       "\"first_crossing_step\": %d, \"exact_crossing_checks\": %d, "
       "\"crossing_pairs_node_in_face\": %d, \"crossing_pairs_node_in_face_deep\": %d, "
       "\"crossing_pairs_edge_edge\": %d, \"crossing_pairs_with_candidate\": %d, "
@@ -167,7 +181,7 @@ int main(int argc, char** argv) {
       "\"crossing_pairs_within_gap_tolerance\": %d, \"deepest_crossing_m\": %.3g}\n",
       scene.spec.name.c_str(), steps, threads, steps / stepping, cpu / steps,
       1e3 * searching / steps, self_contact ? "true" : "false", updates, unconverged, at_cap,
-      max_active, worst_end, gap_tolerance, searches, crossing_checks, crossing_first,
+      max_active, worst_end, gap_tolerance, searches, search_builds, crossing_checks, crossing_first,
       exact_crossing_checks, kinds.node_in_face, kinds.node_in_face_deep, kinds.edge_edge,
       kinds.with_candidate, kinds.edge_edge_with_candidate, kinds.within_tolerance, kinds.deepest);
   return 0;

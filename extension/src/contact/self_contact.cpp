@@ -36,6 +36,8 @@ Status SelfContactSettings::validate() const {
   if (!(std::isfinite(rough_tolerance_factor) && rough_tolerance_factor >= 1))
     return Error{"self_contact: rough_tolerance_factor = " + formatNumber(rough_tolerance_factor) +
                  ": must be >= 1"};
+  if (!(std::isfinite(search_skin) && search_skin >= 0))
+    return Error{"self_contact: search_skin = " + formatNumber(search_skin) + ": must be >= 0"};
   if (max_iterations < 1)
     return Error{"self_contact: max_iterations = " + std::to_string(max_iterations) +
                  ": must be >= 1"};
@@ -56,8 +58,8 @@ SelfContactSolver::SelfContactSolver(std::shared_ptr<const FemModel> model,
       settings_(settings),
       own_parallel_(parallel != nullptr ? nullptr : std::make_unique<Parallel>(1)),
       parallel_(parallel != nullptr ? parallel : own_parallel_.get()),
-      tree_(model_->mesh().surfaceTriangles()),
-      surface_edges_(model_->mesh().surfaceTriangles()) {
+      surface_edges_(model_->mesh().surfaceTriangles()),
+      pairs_(model_->mesh().surfaceTriangles(), surface_edges_, model_->mesh().surfaceNodes()) {
   // Converged once the solved motion is within the gap tolerance of a physical one (every
   // impulse in Coulomb's cone), not once every state has stopped changing: in the plectoneme's
   // coils a few contacts switching stick and slide, or a sliding friction impulse still moving
@@ -100,7 +102,9 @@ bool SelfContactSolver::detect(const FemState& state, const NodeConstraints& con
 int SelfContactSolver::addCandidates(const Eigen::VectorXd& x, const Eigen::VectorXd& end) {
   ++stats_.searches;
   const auto started = std::chrono::steady_clock::now();
-  tree_.refit(x, end, settings_.margin * mean_edge_);
+  if (pairs_.prepare(x, end, settings_.margin * mean_edge_, settings_.search_skin * mean_edge_,
+                     *parallel_))
+    ++stats_.search_builds;
   const size_t before = set_.contacts().size();
   // Nodes against triangles: every triangle found is kept. A node passing over an edge or a
   // corner gets a contact with each triangle there (redundant constraints share the impulse; one
@@ -119,7 +123,7 @@ int SelfContactSolver::addCandidates(const Eigen::VectorXd& x, const Eigen::Vect
       for (size_t k = static_cast<size_t>(block) * kSearchBlock; k < end_node; ++k) {
         const int p = nodes[k];
         const Eigen::Vector3d xp = x.segment<3>(3 * p), ep = end.segment<3>(3 * p);
-        tree_.query(xp.cwiseMin(ep), xp.cwiseMax(ep), found);
+        pairs_.nodeTriangles(static_cast<int>(k), xp.cwiseMin(ep), xp.cwiseMax(ep), found);
         for (int t : found)
           if (std::optional<SurfaceContact> c = nodeCandidate(p, t, x, end)) finds.push_back(*c);
       }
@@ -147,7 +151,7 @@ int SelfContactSolver::addCandidates(const Eigen::VectorXd& x, const Eigen::Vect
     edge_hi_[i] = p0.cwiseMax(q0).cwiseMax(p1).cwiseMax(q1);
   }
   parallel_->forRange(edge_blocks, 1, [&](int first, int last) {
-    std::vector<int> scratch;
+    std::array<std::vector<int>, 2> scratch;
     for (int block = first; block < last; ++block) {
       std::vector<SurfaceContact>& finds = block_finds_[static_cast<size_t>(block)];
       finds.clear();
@@ -175,7 +179,7 @@ int SelfContactSolver::addCandidates(const Eigen::VectorXd& x, const Eigen::Vect
 std::optional<SurfaceContact> SelfContactSolver::nodeCandidate(int p, int t,
                                                                const Eigen::VectorXd& x,
                                                                const Eigen::VectorXd& end) const {
-  const Triangle& tri = tree_.triangles()[static_cast<size_t>(t)];
+  const Triangle& tri = pairs_.triangles()[static_cast<size_t>(t)];
   if (tri[0] == p || tri[1] == p || tri[2] == p) return std::nullopt;  // the node's own one-ring
   for (int k : node_contacts_[static_cast<size_t>(p)])                 // a pair this step has
     if (set_.contacts()[static_cast<size_t>(k)].triangle == t) return std::nullopt;
@@ -198,7 +202,7 @@ std::optional<SurfaceContact> SelfContactSolver::nodeCandidate(int p, int t,
 }
 
 void SelfContactSolver::edgeCandidates(int i, const Eigen::VectorXd& x, const Eigen::VectorXd& end,
-                                       std::vector<int>& scratch,
+                                       std::array<std::vector<int>, 2>& scratch,
                                        std::vector<SurfaceContact>& out) const {
   const double margin = settings_.margin * mean_edge_;
   const std::vector<std::array<int, 2>>& edges = surface_edges_.edges;
@@ -208,23 +212,18 @@ void SelfContactSolver::edgeCandidates(int i, const Eigen::VectorXd& x, const Ei
   };
   const std::array<std::array<Eigen::Vector3d, 2>, 2> edge_e = {
       {{at(x, e[0]), at(x, e[1])}, {at(end, e[0]), at(end, e[1])}}};
-  std::vector<int>& triangles = scratch;
-  tree_.query(edge_lo_[static_cast<size_t>(i)], edge_hi_[static_cast<size_t>(i)], triangles);
-  // The later edges of the triangles found, each once, ascending.
-  std::vector<int> later;
-  later.reserve(3 * triangles.size());
-  for (int t : triangles)
-    for (int j : surface_edges_.triangle_edges[static_cast<size_t>(t)])
-      if (j > i) later.push_back(j);
-  std::sort(later.begin(), later.end());
-  later.erase(std::unique(later.begin(), later.end()), later.end());
+  // The later edges of the triangles whose boxes the edge's meets, each once, ascending (and
+  // possibly some the box test below drops: surface_pair_cache.h).
+  const std::vector<int>& later =
+      pairs_.laterEdges(i, edge_lo_[static_cast<size_t>(i)], edge_hi_[static_cast<size_t>(i)],
+                        scratch[0], scratch[1]);
   // Asked only for pairs that pass the cheap tests (made once per edge, for the current pair).
   SurfaceContact contact;
   contact.edge = i;
   const std::function<const Eigen::Vector3d*()> held = [&] { return set_.warmStartOf(contact); };
   const std::function<Eigen::Vector3d()> outward = [&]() -> Eigen::Vector3d {
-    return surface_edges_.outwardNormal(contact.triangle, tree_.triangles(), x) -
-           surface_edges_.outwardNormal(i, tree_.triangles(), x);
+    return surface_edges_.outwardNormal(contact.triangle, pairs_.triangles(), x) -
+           surface_edges_.outwardNormal(i, pairs_.triangles(), x);
   };
   for (int j : later) {
     const std::array<int, 2>& f = edges[static_cast<size_t>(j)];

@@ -36,9 +36,8 @@ SurfaceTree::~SurfaceTree() {
   tree_.clear();
 }
 
-void SurfaceTree::refit(const Eigen::VectorXd& start, const Eigen::VectorXd& end, double pad) {
-  const bool first = leaves_.empty();
-  if (first) leaves_.resize(triangles_.size());
+void SurfaceTree::setBoxes(const Eigen::VectorXd& start, const Eigen::VectorXd& end, double pad) {
+  boxes_.resize(triangles_.size());
   for (size_t t = 0; t < triangles_.size(); ++t) {
     Eigen::Vector3d lo = start.segment<3>(3 * triangles_[t][0]);
     Eigen::Vector3d hi = lo;
@@ -48,8 +47,16 @@ void SurfaceTree::refit(const Eigen::VectorXd& start, const Eigen::VectorXd& end
         hi = hi.cwiseMax(x->segment<3>(3 * corner));
       }
     }
-    btDbvtVolume volume =
-        boxOf(lo - Eigen::Vector3d::Constant(pad), hi + Eigen::Vector3d::Constant(pad));
+    boxes_[t] = boxOf(lo - Eigen::Vector3d::Constant(pad), hi + Eigen::Vector3d::Constant(pad));
+  }
+}
+
+void SurfaceTree::refit(const Eigen::VectorXd& start, const Eigen::VectorXd& end, double pad) {
+  setBoxes(start, end, pad);
+  const bool first = leaves_.empty();
+  if (first) leaves_.resize(triangles_.size());
+  for (size_t t = 0; t < triangles_.size(); ++t) {
+    btDbvtVolume volume = boxes_[t];
     if (first) {
       leaves_[t] = tree_.insert(volume, nullptr);
       leaves_[t]->dataAsInt = static_cast<int>(t);
@@ -57,6 +64,10 @@ void SurfaceTree::refit(const Eigen::VectorXd& start, const Eigen::VectorXd& end
       tree_.update(leaves_[t], volume);
     }
   }
+}
+
+btDbvtVolume SurfaceTree::queryBox(const Eigen::Vector3d& lo, const Eigen::Vector3d& hi) {
+  return boxOf(lo, hi);
 }
 
 void SurfaceTree::query(const Eigen::Vector3d& lo, const Eigen::Vector3d& hi,

@@ -32,7 +32,7 @@
 
 #include "torsion/contact/surface_candidates.h"
 #include "torsion/contact/surface_contact_set.h"
-#include "torsion/contact/surface_tree.h"
+#include "torsion/contact/surface_pair_cache.h"
 #include "torsion/fem/fem_model.h"
 #include "torsion/result.h"
 #include "torsion/solve/fem_state.h"
@@ -68,6 +68,11 @@ struct SelfContactSettings {
   /// on an accurate solve, judged as before). 1: every solve accurate. On the plectoneme's
   /// contact phase 100 took 31 % less CPU than 1, and 30 only 13 % less (docs/performance.md).
   double rough_tolerance_factor = 100;
+  /// The candidate search keeps its pairs across steps while every surface node stays within
+  /// this fraction of the mean surface edge of where it was when they were found
+  /// (surface_pair_cache.h): the same candidates as a fresh search, most steps without a tree
+  /// walk. 0: a fresh search every step.
+  double search_skin = 0.25;
 
   Status validate() const;
 };
@@ -78,6 +83,7 @@ struct SelfContactStats {
   int sticking = 0;    ///< of which sticking
   int iterations = 0;  ///< Uzawa updates (CG solves) this step
   int searches = 0;    ///< tree searches this step: 1, plus the re-searches along the solved motion
+  int search_builds = 0;  ///< of which walked the tree (the others reused the kept pairs)
   double search_seconds = 0;  ///< s, wall time of those searches (refit, queries, candidates)
   bool converged = true;
   double normal_impulse = 0;       ///< N s, sum over active contacts
@@ -136,7 +142,8 @@ class SelfContactSolver {
   // Edge-against-edge pairs (i, j > i) along the same motion: crossing edges that no node meets
   // (reads only; appended to out in ascending j).
   void edgeCandidates(int i, const Eigen::VectorXd& x, const Eigen::VectorXd& end,
-                      std::vector<int>& scratch, std::vector<SurfaceContact>& out) const;
+                      std::array<std::vector<int>, 2>& scratch,
+                      std::vector<SurfaceContact>& out) const;
   // Margin, depth and crease rule of the shared candidate tests (surface_candidates.h).
   CandidateRules rules() const;
 
@@ -146,11 +153,12 @@ class SelfContactSolver {
   double gap_tolerance_ = 0;
   std::unique_ptr<Parallel> own_parallel_;  // serial, when no Parallel was given
   const Parallel* parallel_ = nullptr;
-  SurfaceTree tree_;
   std::vector<std::vector<int>> node_triangles_;    // surface triangles of each node
   std::vector<std::vector<int>> node_contacts_;     // this step's contacts of each node
   std::vector<int> touched_nodes_;                  // nodes with an entry in node_contacts_
   SurfaceEdges surface_edges_;                      // surface edges and each triangle's three
+  // The broad phase: the surface tree, and the pairs it found, kept across steps.
+  SurfacePairCache pairs_;
   std::vector<Eigen::Vector3d> edge_lo_, edge_hi_;  // each edge's box over the searched motion
   std::vector<std::vector<SurfaceContact>> block_finds_;  // per block of nodes (edges), in order
   std::set<std::uint64_t> edge_pairs_;                    // this step's edge pairs (i << 32 | j)
