@@ -344,6 +344,7 @@ BodySpec readBody(const JsonObject& b, const SceneSpec& scene, const std::string
     SelfContactSettings self;
     self.friction = c.number("friction", self.friction);
     self.gap_tolerance = c.number("gap_tolerance", self.gap_tolerance);
+    self.thickness_factor = c.number("thickness_factor", self.thickness_factor);
     c.finish();
     if (Status valid = self.validate(); !valid) b.fail("self_contact", valid.error().message);
     body.self_contact = self;

@@ -33,7 +33,8 @@ struct BodySpec {
   Eigen::Vector3d linear_velocity = Eigen::Vector3d::Zero();
   Eigen::Vector3d angular_velocity = Eigen::Vector3d::Zero();
   ElementKind element = ElementKind::kTet4;  ///< "element": "tet4" | "tet10"
-  /// "self_contact": {"friction", "gap_tolerance"}: on when present (docs/contact.md).
+  /// "self_contact": {"friction", "gap_tolerance", "thickness_factor"}: on when present
+  /// (docs/contact.md).
   std::optional<SelfContactSettings> self_contact;
 };
 

@@ -7,11 +7,13 @@
 //
 //   bench_self_contact SCENE [--steps N] [--threads T] [--check-every K]
 //                            [--save-at K FILE] [--resume FILE] [--self-contact off]
-//                            [--search-skin S]
+//                            [--search-skin S] [--thickness FACTOR] [--per-step 1]
 //
 // --save-at writes a checkpoint (checkpoint_io.h) after step K; --resume starts from one, so that
 // the contact phase (the plectoneme's last ~350 steps) can be profiled alone. `--self-contact off`
-// runs the same scene with the body's self-contact turned off (the cost of having it on).
+// runs the same scene with the body's self-contact turned off (the cost of having it on);
+// `--thickness` with its thickness_factor (docs/contact.md, "Contact thickness"; 0: none);
+// `--per-step 1` prints each step's contact figures and each check's crossings on stderr.
 // search_ms_per_step is the wall time of self-contact's tree searches (SelfContactStats),
 // search_builds how many of them walked the tree (the others reused the pairs kept across
 // steps); `--search-skin S` sets SelfContactSettings::search_skin (0: a fresh search every step).
@@ -38,7 +40,8 @@ int main(int argc, char** argv) {
   if (argc < 2) {
     std::fprintf(stderr,
                  "usage: %s SCENE [--steps N] [--threads T] [--check-every K] [--save-at K FILE] "
-                 "[--resume FILE] [--self-contact off] [--search-skin S]\n",
+                 "[--resume FILE] [--self-contact off] [--search-skin S] [--thickness F] "
+                 "[--per-step 1]\n",
                  argv[0]);
     return 1;
   }
@@ -46,12 +49,16 @@ int main(int argc, char** argv) {
   std::string save_file, resume_file;
   bool self_contact = true;
   double search_skin = -1;  // -1: the scene's (or the checkpoint's)
+  double thickness = -1;  // --thickness: self-contact's thickness_factor (-1: the scene's)
+  bool per_step = false;  // --per-step 1: each step's contact figures on stderr
   for (int a = 2; a + 1 < argc; a += 2) {
     if (!std::strcmp(argv[a], "--steps")) steps = std::atoi(argv[a + 1]);
     if (!std::strcmp(argv[a], "--threads")) threads = std::atoi(argv[a + 1]);
     if (!std::strcmp(argv[a], "--check-every")) check_every = std::atoi(argv[a + 1]);
     if (!std::strcmp(argv[a], "--resume")) resume_file = argv[a + 1];
     if (!std::strcmp(argv[a], "--search-skin")) search_skin = std::atof(argv[a + 1]);
+    if (!std::strcmp(argv[a], "--thickness")) thickness = std::atof(argv[a + 1]);
+    if (!std::strcmp(argv[a], "--per-step")) per_step = std::atoi(argv[a + 1]) != 0;
     if (!std::strcmp(argv[a], "--self-contact"))
       self_contact = std::strcmp(argv[a + 1], "off") != 0;
     if (!std::strcmp(argv[a], "--save-at") && a + 2 < argc) {
@@ -100,6 +107,16 @@ int main(int argc, char** argv) {
   }
   // After a checkpoint's restore, which brings self-contact back as it was saved.
   if (!self_contact) body->disableSelfContact();
+  if (self_contact && thickness >= 0) {
+    // Turned on again with the other thickness (warm starts are lost: resume where none is
+    // active, or from the start).
+    SelfContactSettings settings = body->selfContact()->settings();
+    settings.thickness_factor = thickness;
+    if (Status on = body->enableSelfContact(settings); !on) {
+      std::fprintf(stderr, "%s\n", on.error().message.c_str());
+      return 1;
+    }
+  }
   if (search_skin >= 0 && body->selfContact() != nullptr) {
     // Through a checkpoint: the solver comes back as it was (warm starts), with the new skin.
     FemBodyCheckpoint c = body->checkpoint();
@@ -107,6 +124,13 @@ int main(int argc, char** argv) {
     body->restore(c);
   }
   const std::vector<Triangle>& surface = body->model().mesh().surfaceTriangles();
+  double mean_edge = 0;  // m, of the rest surface (for --per-step's local folds)
+  for (const Triangle& t : surface)
+    for (size_t a = 0; a < 3; ++a)
+      mean_edge += (body->model().mesh().restPositions()[static_cast<size_t>(t[a])] -
+                    body->model().mesh().restPositions()[static_cast<size_t>(t[(a + 1) % 3])])
+                       .norm();
+  mean_edge /= 3.0 * static_cast<double>(std::max<size_t>(surface.size(), 1));
   int unconverged = 0, at_cap = 0, max_active = 0, searches = 0, search_builds = 0,
       crossing_checks = 0,
       crossing_first = -1, exact_crossing_checks = 0;
@@ -141,6 +165,12 @@ int main(int argc, char** argv) {
       searches += s.searches;
       search_builds += s.search_builds;
       searching += s.search_seconds;
+      if (per_step)
+        std::fprintf(stderr,
+                     "step %d: candidates %d, active %d, updates %d, searches %d, %s, end "
+                     "penetration %.3g m\n",
+                     k, s.candidates, s.active, s.iterations, s.searches,
+                     s.converged ? "converged" : "UNCONVERGED", s.max_end_penetration);
     }
     if (check_every > 0 && k % check_every == 0) {
       const std::vector<Triangle>& triangles = surface;
@@ -162,6 +192,26 @@ int main(int argc, char** argv) {
         kinds.edge_edge_with_candidate += found.edge_edge_with_candidate;
         kinds.within_tolerance += found.within_tolerance;
         kinds.deepest = std::max(kinds.deepest, found.deepest);
+        if (per_step) {
+          // Local folds (the two triangles' rest centroids within two mean edges: a kink's
+          // inverted tets) apart from contact between distant parts of the surface.
+          const std::vector<Eigen::Vector3d>& rest = body->model().mesh().restPositions();
+          auto centroid = [&](int t) {
+            Eigen::Vector3d c = Eigen::Vector3d::Zero();
+            for (int n : triangles[static_cast<size_t>(t)])
+              c += rest[static_cast<size_t>(n)];
+            return Eigen::Vector3d(c / 3);
+          };
+          int local = 0;
+          for (const TrianglePair& pr : pairs)
+            if ((centroid(pr.first) - centroid(pr.second)).norm() < 2 * mean_edge) ++local;
+          std::fprintf(stderr,
+                       "step %d: %zu crossing pairs (%d local: rest centroids within two mean "
+                       "edges), %d edge-edge, %d node in face beyond max_depth, %d with a "
+                       "candidate, %d within the tolerance, deepest %.3g m\n",
+                       k, pairs.size(), local, found.edge_edge, found.node_in_face_deep,
+                       found.with_candidate, found.within_tolerance, found.deepest);
+        }
       }
     }
   }

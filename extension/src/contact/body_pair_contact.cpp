@@ -63,6 +63,9 @@ Status BodyContactSettings::validate() const {
   if (!(std::isfinite(gap_tolerance) && gap_tolerance >= 0))
     return Error{"fem_contact: gap_tolerance = " + formatNumber(gap_tolerance) +
                  ": must be >= 0 m (0: from the meshes)"};
+  if (!(std::isfinite(thickness_factor) && thickness_factor >= 0))
+    return Error{"fem_contact: thickness_factor = " + formatNumber(thickness_factor) +
+                 ": must be >= 0 (times gap_tolerance)"};
   if (!(std::isfinite(margin) && margin >= 0 && margin <= 1))
     return Error{"fem_contact: margin = " + formatNumber(margin) + ": must be in [0, 1]"};
   if (!(std::isfinite(max_depth) && max_depth > 0 && max_depth <= 0.5))
@@ -204,6 +207,7 @@ void BodyPairContact::addCandidates(const FemModel& nodes_model, int node_offset
       c.triangle = pair_triangle;
       c.normal = hit->normal;
       c.gap = hit->gap;
+      c.target_gap = thickness();
       c.friction = settings_.friction;
       set_.add(c);
     }
@@ -276,6 +280,7 @@ void BodyPairContact::addEdgeCandidates(const Eigen::VectorXd& xa, const Eigen::
       c.beta = {1.0 - hit->u, hit->u, -(1.0 - hit->v), -hit->v};
       c.normal = hit->normal;
       c.gap = hit->gap;
+      c.target_gap = thickness();
       c.friction = settings_.friction;
       set_.add(c);
     }
@@ -298,7 +303,7 @@ int BodyPairContact::correctGaps(const Eigen::VectorXd& v, double dt, double tol
     if (!(n.norm() > 0)) continue;
     n.normalize();
     const double true_gap = n.dot(p - a);
-    if (true_gap >= -tolerance) continue;
+    if (true_gap >= c.target_gap - tolerance) continue;  // within the tolerance of its target
     const Eigen::Vector3d w = projectionWeights(p, a, b, t);
     if (!w.allFinite() || w.minCoeff() < -kInsideTolerance) continue;  // slid off: not this face
     Eigen::Vector3d u = Eigen::Vector3d::Zero();

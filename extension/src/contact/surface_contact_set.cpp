@@ -26,7 +26,7 @@ Eigen::Vector3d SurfaceContactSet::rightHandSideImpulse(const SurfaceContact& c,
   const Eigen::Vector3d lambda = c.state == SurfaceContact::State::kStick
                                      ? c.multiplier
                                      : Eigen::Vector3d(c.normal * c.normal.dot(c.multiplier));
-  return lambda - c.penalty * c.normal * (c.gap / dt);
+  return lambda - c.penalty * c.normal * ((c.gap - c.target_gap) / dt);
 }
 
 SurfaceContactSet::WarmStarts SurfaceContactSet::warmStarts() const {
@@ -145,7 +145,7 @@ bool SurfaceContactSet::update(const Eigen::VectorXd& v, double dt, double activ
     if (c.determined) continue;
     const Eigen::Vector3d u = relativeVelocity(c, v);
     const double un = c.normal.dot(u);
-    const double hn = un + c.gap / dt;
+    const double hn = un + (c.gap - c.target_gap) / dt;  // towards the target gap
     c.end_gap = dt * hn;
     if (c.state == State::kInactive) {
       // A released contact comes back only if it penetrates beyond the tolerance (anti-cycling).
@@ -242,7 +242,7 @@ double SurfaceContactSet::maxGapError() const {
 double SurfaceContactSet::maxEndPenetration() const {
   double deepest = 0;
   for (const SurfaceContact& c : contacts_)
-    if (!c.determined) deepest = std::max(deepest, -c.end_gap);
+    if (!c.determined) deepest = std::max(deepest, -(c.end_gap + c.target_gap));
   return deepest;
 }
 

@@ -31,6 +31,10 @@ struct BodyContactSettings {
   /// m: the end-of-step gap every contact is driven to within (no penetration beyond it).
   /// 0: 1e-3 times the smaller of the two bodies' mean surface edges (rest mesh).
   double gap_tolerance = 0;
+  /// The contact thickness in units of the gap tolerance: every contact aims its end gap at
+  /// thickness_factor x gap_tolerance instead of zero, so that bodies held apart by contact do
+  /// not touch (docs/contact.md, "Contact thickness"). 0: aim at zero gap, as before.
+  double thickness_factor = 2;
   /// Candidates: nodes within this fraction of the triangle body's mean surface edge of a
   /// triangle at the start of the step, besides those whose predicted path crosses it.
   double margin = 0.25;
@@ -43,10 +47,11 @@ struct BodyContactSettings {
   /// Uzawa updates per step (each one linear solve of every body of the island).
   int max_iterations = 60;
   /// Edge-against-edge candidates besides node-against-triangle ones: two edges crossing where
-  /// no node meets a face (an edge across an edge). Off by default while its effect on the
-  /// contact scenes (soft_grasp's hand torque, soft_stack, bullet_collide_soft) is not judged
-  /// (docs/contact.md, "Edge against edge between bodies").
-  bool edge_edge = false;
+  /// no node meets a face (an edge across an edge). On by default: with them the exact checker
+  /// finds fewer crossings in the contact scenes (soft_stack: 360 crossing triangle pairs over
+  /// 200 steps instead of 4266), and their own tests pass (docs/contact.md, "Edge against edge
+  /// between bodies").
+  bool edge_edge = true;
 
   Status validate() const;
 };
@@ -77,6 +82,8 @@ class BodyPairContact {
   int nodeCountA() const { return node_count_a_; }
   /// m, the gap tolerance in use (settings or its default from the two meshes).
   double gapTolerance() const { return gap_tolerance_; }
+  /// m, the separation every contact aims at (thickness_factor x the gap tolerance).
+  double thickness() const { return settings_.thickness_factor * gap_tolerance_; }
   const BodyContactSettings& settings() const { return settings_; }
   SurfaceContactSet& set() { return set_; }
   const SurfaceContactSet& set() const { return set_; }

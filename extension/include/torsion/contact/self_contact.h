@@ -49,6 +49,11 @@ struct SelfContactSettings {
   /// m: the end-of-step gap every contact is driven to within (no penetration beyond it).
   /// 0: 1e-3 times the mean surface edge of the rest mesh.
   double gap_tolerance = 0;
+  /// The contact thickness in units of the gap tolerance: every contact aims its end gap at
+  /// thickness_factor x gap_tolerance instead of zero, so that a converged contact (its end gap
+  /// within the tolerance of the target) leaves its surfaces apart, never touching
+  /// (docs/contact.md, "Contact thickness"). 0: aim at zero gap, as before.
+  double thickness_factor = 2;
   /// Candidates: nodes within this fraction of the mean surface edge of a triangle at the start
   /// of the step (resting contacts), besides those whose predicted path crosses it.
   double margin = 0.25;
@@ -103,6 +108,8 @@ class SelfContactSolver {
   const SelfContactSettings& settings() const { return settings_; }
   /// The gap tolerance in use (m): settings().gap_tolerance or its default from the mesh.
   double gapTolerance() const { return gap_tolerance_; }
+  /// m, the separation every contact aims at (thickness_factor x the gap tolerance).
+  double thickness() const { return settings_.thickness_factor * gap_tolerance_; }
 
   /// Before the solve: candidates from the state at the start of the step and its predicted
   /// motion. Returns whether there are any (then the solve hook and operator term are needed).
@@ -136,6 +143,12 @@ class SelfContactSolver {
   // have yet, then the edge pairs; returns how many. The tree queries run in fixed blocks of
   // nodes (edges) on the threads, and the blocks' finds are added in block order.
   int addCandidates(const Eigen::VectorXd& x, const Eigen::VectorXd& end);
+  // Moves the linearised gaps onto the true end-of-step geometry of the solved motion x + dt v:
+  // each contact whose true end gap (node against the end triangle's plane; edge against edge
+  // along the end edges' common normal, where their closest points lie inside both) is below
+  // its target by more than the tolerance, and below its linearised one, takes the difference
+  // into its gap (a secant step of the gap function). Returns how many moved.
+  int correctGaps(const Eigen::VectorXd& v);
   // The contact of node p with triangle t along the motion, if they are a candidate (reads only).
   std::optional<SurfaceContact> nodeCandidate(int p, int t, const Eigen::VectorXd& x,
                                               const Eigen::VectorXd& end) const;

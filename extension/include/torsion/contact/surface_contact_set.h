@@ -6,25 +6,26 @@
 // A contact c joins a surface node p and a surface triangle (a, b, c) it must not pass through.
 // With the triangle point's barycentric weights w, the relative velocity is
 //   u = v_p - (w_a v_a + w_b v_b + w_c v_c) = sum_k beta_k v_k,   beta = (1, -w_a, -w_b, -w_c),
-// and the linearised gap at the end of the step is gap + dt n.u >= 0 (n: the triangle's outward
-// normal at the step's start). The impulse lambda (N s) acts on p and -w_j lambda on the
-// triangle's corners, so the pair exchanges momentum exactly (sum beta_k = 0) and, the lever being
-// the same point, angular momentum up to the linearisation.
+// and the linearised gap at the end of the step is gap + dt n.u >= d (n: the triangle's outward
+// normal at the step's start; d the contact's target_gap, its thickness: the solve aims at a small
+// separation so that surfaces it holds never touch, docs/contact.md, "Contact thickness"). The
+// impulse lambda (N s) acts on p and -w_j lambda on the triangle's corners, so the pair exchanges
+// momentum exactly (sum beta_k = 0) and, the lever being the same point, angular momentum up to the
+// linearisation.
 //
 // Augmented Lagrangian (Alart & Curnier 1991; Uzawa's update) for the normal impulse, with
 // Coulomb's friction implicit in the tangential direction. Each linear solve takes the impulse as
-//   sticking: lambda = Lambda - rho h,                         h = u + n gap / dt,
+//   sticking: lambda = Lambda - rho h,                         h = u + n (gap - d) / dt,
 //   sliding:  lambda = n (n.Lambda - rho n.h) - k_t (I - n n^T) u,
 // which adds rho beta_k beta_l I (sticking) or beta_k beta_l (rho n n^T + k_t (I - n n^T))
-// (sliding) to the system (this class is the AddedOperatorTerm) and beta_k (Lambda - rho n gap /
-// dt) to its right-hand side (only Lambda's normal part when sliding). After each solve update()
-// projects on Coulomb's cone: lambda_n = max(0, n.Lambda - rho n.h); a sticking contact keeps
-// Lambda - rho h while its tangential part stays within mu lambda_n; a sliding one gets
-// k_t = mu lambda_n / |u_t| (at most rho: below the slip speed mu lambda_n / rho it sticks again),
-// so its friction impulse -k_t u_t is Coulomb's, opposes the slip of the same solve and can never
-// reverse it (a fixed point of lagged stiffnesses: Kacanov's iteration, not an explicit force).
-// rho is `penalty_factor` times the contact's effective mass from the system's 3x3 diagonal
-// blocks.
+// (sliding) to the system (this class is the AddedOperatorTerm) and beta_k (Lambda - rho n (gap -
+// d) / dt) to its right-hand side (only Lambda's normal part when sliding). After each solve
+// update() projects on Coulomb's cone: lambda_n = max(0, n.Lambda - rho n.h); a sticking contact
+// keeps Lambda - rho h while its tangential part stays within mu lambda_n; a sliding one gets k_t =
+// mu lambda_n / |u_t| (at most rho: below the slip speed mu lambda_n / rho it sticks again), so its
+// friction impulse -k_t u_t is Coulomb's, opposes the slip of the same solve and can never reverse
+// it (a fixed point of lagged stiffnesses: Kacanov's iteration, not an explicit force). rho is
+// `penalty_factor` times the contact's effective mass from the system's 3x3 diagonal blocks.
 
 #include <Eigen/Core>
 #include <array>
@@ -43,8 +44,12 @@ struct SurfaceContact {
   int edge = -1;           ///< edge-against-edge: the first edge's index (key); -1: node-triangle
   Eigen::Vector3d normal;  ///< unit, the triangle's outward normal at the step's start
   double gap = 0;          ///< m, signed distance of p along normal, start of the step
-  double friction = 0;     ///< Coulomb coefficient mu
-  double penalty = 0;      ///< rho, kg
+  /// m, the separation the solve drives the end gap to (the contact thickness, >= 0): the
+  /// constraint is gap + dt n.u >= target_gap. The impulses' weights are unchanged (sum beta_k =
+  /// 0), so momentum is exchanged exactly whatever it is.
+  double target_gap = 0;
+  double friction = 0;                                   ///< Coulomb coefficient mu
+  double penalty = 0;                                    ///< rho, kg
   Eigen::Vector3d multiplier = Eigen::Vector3d::Zero();  ///< Lambda, N s on p
   State state = State::kInactive;
   bool determined = false;  ///< all four nodes fully prescribed: sits the solves out
@@ -53,7 +58,9 @@ struct SurfaceContact {
   /// kg, sliding: k_t, the friction impulse being -k_t u_t (the tangential relative velocity);
   /// at most the penalty. Negative: the penalty (a warm-started contact's first solve).
   double tangential_stiffness = 0;
-  double end_gap = 0;  ///< m, the linearised end-of-step gap after the last solve
+  /// m, the linearised end-of-step gap after the last solve, less target_gap (< 0: inside the
+  /// contact's thickness).
+  double end_gap = 0;
 };
 
 class SurfaceContactSet final : public AddedOperatorTerm {
@@ -84,7 +91,8 @@ class SurfaceContactSet final : public AddedOperatorTerm {
   /// (its impulse on the relative velocity u is -block u beyond the right-hand side's).
   static Eigen::Matrix3d operatorBlock(const SurfaceContact& c);
   /// N s: what the contact puts on the right-hand side (times beta_k on its nodes): Lambda
-  /// (sliding: its normal part; the friction is in the operator) less rho n gap / dt.
+  /// (sliding: its normal part; the friction is in the operator) less rho n (gap - target_gap) /
+  /// dt.
   static Eigen::Vector3d rightHandSideImpulse(const SurfaceContact& c, double dt);
   /// Marks contacts whose nodes the solve cannot move (is_fixed(node) for all four).
   template <typename IsFixed>
@@ -95,13 +103,14 @@ class SurfaceContactSet final : public AddedOperatorTerm {
         c.determined = c.determined && is_fixed(node);
     }
   }
-  /// b += sum over active contacts of beta_k (Lambda - rho n gap / dt).
+  /// b += sum over active contacts of beta_k (Lambda - rho n (gap - target_gap) / dt).
   void addRightHandSide(double dt, Eigen::VectorXd& b) const;
   /// Uzawa's projection after a solve with velocities v (3n). Activates contacts whose end gap is
-  /// below -activation_tolerance. Returns whether the set has converged: no contact changed
-  /// state, every end gap within gap_tolerance (no penetration beyond it, no active contact
-  /// pushing across a gap beyond it), no sticking contact slipping more than gap_tolerance and
-  /// every sliding contact's friction impulse within 2 % of mu lambda_n of the last solve's.
+  /// below target_gap - activation_tolerance. Gaps below are judged against target_gap. Returns
+  /// whether the set has converged: no contact changed state, every end gap within gap_tolerance
+  /// (no penetration beyond it, no active contact pushing across a gap beyond it), no sticking
+  /// contact slipping more than gap_tolerance and every sliding contact's friction impulse within 2
+  /// % of mu lambda_n of the last solve's.
   bool update(const Eigen::VectorXd& v, double dt, double activation_tolerance,
               double gap_tolerance);
   /// Whether update() judges convergence by what the last solve's motion is off by, rather than
@@ -114,10 +123,11 @@ class SurfaceContactSet final : public AddedOperatorTerm {
   /// does a sliding impulse still moving by more than 2 % of mu lambda_n with no effect on the
   /// motion. Off by default (the changes of state count).
   void setConvergedWithinTolerance(bool on) { within_tolerance_ = on; }
-  /// m, the deepest linearised end-of-step penetration of any candidate (>= 0).
+  /// m, the deepest linearised end-of-step penetration of any candidate (>= 0): below zero gap,
+  /// not below its target_gap.
   double maxEndPenetration() const;
-  /// m, the largest gap error after the last update: penetration of any candidate, or an active
-  /// contact's end gap away from zero.
+  /// m, the largest gap error after the last update: any candidate's end gap below its target,
+  /// or an active contact's end gap away from its target.
   double maxGapError() const;
 
   // AddedOperatorTerm: beta_k beta_l (rho I or rho n n^T + k_t (I - n n^T)) of the active contacts.
