@@ -477,6 +477,9 @@ Result<FemBodyCheckpoint> readBody(Reader& r, FemWorld& world, FemBody& body,
 
   c.self_contact = r.u8() != 0;
   SelfContactSettings& s = c.self_contact_settings;
+  // What the format does not store (thickness_factor, rough_tolerance_factor, search_skin: they
+  // do not change between saving and restoring a run) stays the body's own.
+  s = now.self_contact_settings;
   s.friction = r.f64();
   s.gap_tolerance = r.f64();
   s.margin = r.f64();
