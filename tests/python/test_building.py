@@ -111,6 +111,13 @@ def test_material_and_frame_reject_bad_values():
         torsion.Material(nu=0.5)
     with pytest.raises(ValueError, match="volumetric_strain"):
         torsion.Material(volumetric_strain="x")
+    with pytest.raises(ValueError, match="barrier_threshold"):
+        torsion.Material(barrier_threshold=1.0)
+    with pytest.raises(ValueError, match="barrier_stiffness"):
+        torsion.Material(barrier_stiffness=-1.0)
+    plain = torsion.Material(barrier_threshold=0.0)  # the volume barrier turned off
+    assert plain.barrier_threshold == 0.0
+    assert torsion.Material().barrier_threshold == pytest.approx(0.3)
     with pytest.raises(ValueError, match="rotation"):
         torsion.Frame.from_matrix(np.diag([2.0, 1, 1, 1]))
     with pytest.raises(ValueError, match="linear_solver"):

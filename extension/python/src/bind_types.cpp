@@ -88,7 +88,8 @@ void bindTypes(py::module_& m) {
 
   py::class_<Material>(m, "Material", "Linear elastic material, SI units.")
       .def(py::init([](double E, double nu, double rho, double mass_damping,
-                       double stiffness_damping, const std::string& volumetric_strain) {
+                       double stiffness_damping, const std::string& volumetric_strain,
+                       double barrier_threshold, double barrier_stiffness) {
              Material mat;
              mat.youngs_modulus = E;
              mat.poisson_ratio = nu;
@@ -101,6 +102,8 @@ void bindTypes(py::module_& m) {
                                      "': expected 'element' or 'nodal_average'");
              }
              mat.volumetric_strain = *kind;
+             mat.barrier_threshold = barrier_threshold;
+             mat.barrier_stiffness = barrier_stiffness;
              if (Status valid = mat.validate(); !valid)
                throw py::value_error(valid.error().message);
              return mat;
@@ -108,8 +111,12 @@ void bindTypes(py::module_& m) {
            py::arg("E") = 1e5, py::arg("nu") = 0.3, py::arg("rho") = 1000.0,
            py::arg("mass_damping") = 0.0, py::arg("stiffness_damping") = 0.01,
            py::arg("volumetric_strain") = "element",
+           py::arg("barrier_threshold") = Material{}.barrier_threshold,
+           py::arg("barrier_stiffness") = Material{}.barrier_stiffness,
            "E: Young's modulus, Pa; nu: Poisson's ratio in [0, 0.5); rho: density, kg/m^3; "
-           "mass_damping: 1/s; stiffness_damping: s.")
+           "mass_damping: 1/s; stiffness_damping: s; barrier_threshold: the volume ratio J below "
+           "which the volume barrier against inverted tets acts, in [0, 1), 0 turns it off; "
+           "barrier_stiffness: its pressure at J = 0 in bulk moduli.")
       .def_readonly("E", &Material::youngs_modulus, "Young's modulus, Pa")
       .def_readonly("nu", &Material::poisson_ratio, "Poisson's ratio")
       .def_readonly("rho", &Material::density, "density, kg/m^3")
@@ -117,6 +124,10 @@ void bindTypes(py::module_& m) {
       .def_readonly("stiffness_damping", &Material::stiffness_damping, "s")
       .def_property_readonly("volumetric_strain",
                              [](const Material& mat) { return toString(mat.volumetric_strain); })
+      .def_readonly("barrier_threshold", &Material::barrier_threshold,
+                    "volume ratio J below which the volume barrier acts (0: off)")
+      .def_readonly("barrier_stiffness", &Material::barrier_stiffness,
+                    "the barrier's pressure at J = 0, in bulk moduli")
       .def_property_readonly("shear_modulus", &Material::mu, "G, Pa")
       .def("__repr__", [](const Material& mat) {
         return "Material(E=" + std::to_string(mat.youngs_modulus) +

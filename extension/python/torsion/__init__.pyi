@@ -46,16 +46,21 @@ class Frame:
 
 class Material:
     """Linear elastic material: E (Pa), nu, rho (kg/m^3), mass_damping (1/s),
-    stiffness_damping (s), volumetric_strain "element" | "nodal_average"."""
+    stiffness_damping (s), volumetric_strain "element" | "nodal_average", and the volume
+    barrier against inverted tets: barrier_threshold (J below which it acts, 0: off),
+    barrier_stiffness (its pressure at J = 0, in bulk moduli)."""
     def __init__(self, E: float = 1e5, nu: float = 0.3, rho: float = 1000.0,
                  mass_damping: float = 0.0, stiffness_damping: float = 0.01,
-                 volumetric_strain: str = "element") -> None: ...
+                 volumetric_strain: str = "element", barrier_threshold: float = 0.3,
+                 barrier_stiffness: float = 30.0) -> None: ...
     E: float
     nu: float
     rho: float
     mass_damping: float
     stiffness_damping: float
     volumetric_strain: str
+    barrier_threshold: float
+    barrier_stiffness: float
     shear_modulus: float  # Pa
 
 class State:
