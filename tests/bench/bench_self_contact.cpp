@@ -49,8 +49,8 @@ int main(int argc, char** argv) {
   std::string save_file, resume_file;
   bool self_contact = true;
   double search_skin = -1;  // -1: the scene's (or the checkpoint's)
-  double thickness = -1;  // --thickness: self-contact's thickness_factor (-1: the scene's)
-  bool per_step = false;  // --per-step 1: each step's contact figures on stderr
+  double thickness = -1;    // --thickness: self-contact's thickness_factor (-1: the scene's)
+  bool per_step = false;    // --per-step 1: each step's contact figures on stderr
   for (int a = 2; a + 1 < argc; a += 2) {
     if (!std::strcmp(argv[a], "--steps")) steps = std::atoi(argv[a + 1]);
     if (!std::strcmp(argv[a], "--threads")) threads = std::atoi(argv[a + 1]);
@@ -132,8 +132,7 @@ int main(int argc, char** argv) {
                        .norm();
   mean_edge /= 3.0 * static_cast<double>(std::max<size_t>(surface.size(), 1));
   int unconverged = 0, at_cap = 0, max_active = 0, searches = 0, search_builds = 0,
-      crossing_checks = 0,
-      crossing_first = -1, exact_crossing_checks = 0;
+      crossing_checks = 0, crossing_first = -1, exact_crossing_checks = 0;
   CrossingKinds kinds;  // the exact checker's pairs at the checks, summed (crossing_kinds.h)
   long updates = 0;
   double worst_end = 0, stepping = 0, searching = 0;
@@ -231,8 +230,9 @@ int main(int argc, char** argv) {
       "\"crossing_pairs_within_gap_tolerance\": %d, \"deepest_crossing_m\": %.3g}\n",
       scene.spec.name.c_str(), steps, threads, steps / stepping, cpu / steps,
       1e3 * searching / steps, self_contact ? "true" : "false", updates, unconverged, at_cap,
-      max_active, worst_end, gap_tolerance, searches, search_builds, crossing_checks, crossing_first,
-      exact_crossing_checks, kinds.node_in_face, kinds.node_in_face_deep, kinds.edge_edge,
-      kinds.with_candidate, kinds.edge_edge_with_candidate, kinds.within_tolerance, kinds.deepest);
+      max_active, worst_end, gap_tolerance, searches, search_builds, crossing_checks,
+      crossing_first, exact_crossing_checks, kinds.node_in_face, kinds.node_in_face_deep,
+      kinds.edge_edge, kinds.with_candidate, kinds.edge_edge_with_candidate, kinds.within_tolerance,
+      kinds.deepest);
   return 0;
 }

@@ -129,6 +129,25 @@ void expectCoulomb(const Slope& s, double tolerance, const char* label) {
 
 // Without friction the box feels only the normal force: before the fix the nodes just ahead of
 // its leading edge took its front face for a wall, and it moved 21 cm of 1.68 m, in jerks.
+// The box's distance in 1 s one degree below and one degree above the friction angle
+// atan(mu), and Coulomb's distance above it: the stick/slip threshold's two sides.
+struct Threshold {
+  double friction_angle;  ///< deg
+  double below;           ///< m moved, 1 deg below
+  double above;           ///< m moved, 1 deg above
+  double coulomb;         ///< m, Coulomb's distance 1 deg above
+};
+Threshold oneDegreeEitherSide(Slope s) {
+  Threshold t;
+  t.friction_angle = std::atan(s.mu) * 180 / M_PI;
+  s.degrees = t.friction_angle - 1;
+  t.below = slideDistance(s, 1.0);
+  s.degrees = t.friction_angle + 1;
+  t.above = slideDistance(s, 1.0);
+  t.coulomb = coulombDistance(s, 1.0);
+  return t;
+}
+
 TEST(Sliding, FrictionlessBoxSlidesAsOnAPlaneOverSoftAndStiffSlabs) {
   for (double E : {1e5, 1e8}) {
     Slope s;
@@ -183,17 +202,12 @@ TEST(Sliding, StiffSlabHoldsTheBoxBelowTheFrictionAngleAndLetsItSlideAbove) {
   Slope s;
   s.youngs_modulus = 1e8;
   s.settle = false;
-  const double friction_angle = std::atan(s.mu) * 180 / M_PI;
-  s.degrees = friction_angle - 1;
-  const double below = slideDistance(s, 1.0);
-  s.degrees = friction_angle + 1;
-  const double above = slideDistance(s, 1.0);
-  const double coulomb = coulombDistance(s, 1.0);
-  std::cout << "[figures] sliding threshold (stiff slab, mu 0.3): " << friction_angle - 1
-            << " deg moved " << below << " m; " << friction_angle + 1 << " deg moved " << above
-            << " m (Coulomb " << coulomb << " m)\n";
-  EXPECT_LT(std::abs(below), 2e-3);
-  EXPECT_NEAR(above, coulomb, 0.15 * coulomb);
+  const Threshold t = oneDegreeEitherSide(s);
+  std::cout << "[figures] sliding threshold (stiff slab, mu 0.3): " << t.friction_angle - 1
+            << " deg moved " << t.below << " m; " << t.friction_angle + 1 << " deg moved "
+            << t.above << " m (Coulomb " << t.coulomb << " m)\n";
+  EXPECT_LT(std::abs(t.below), 2e-3);
+  EXPECT_NEAR(t.above, t.coulomb, 0.15 * t.coulomb);
 }
 
 // The stick/slip threshold tan(a) = mu (16.7 deg for mu = 0.3) on soft and stiff, tet4 and tet10
@@ -222,19 +236,14 @@ TEST(Sliding, BoxHoldsOneDegreeBelowTheFrictionAngleAndSlidesOneDegreeAboveOnEve
     s.youngs_modulus = c.youngs_modulus;
     s.cells_along = c.cells;
     s.element = c.element;
-    const double friction_angle = std::atan(s.mu) * 180 / M_PI;
-    s.degrees = friction_angle - 1;
-    const double below = slideDistance(s, 1.0);
-    s.degrees = friction_angle + 1;
-    const double above = slideDistance(s, 1.0);
-    const double coulomb = coulombDistance(s, 1.0);
+    const Threshold t = oneDegreeEitherSide(s);
     const char* element = c.element == ElementKind::kTet10 ? "tet10" : "tet4";
     std::cout << "[figures] sliding threshold (settled, mu 0.3), E " << c.youngs_modulus << ", "
-              << element << ": " << friction_angle - 1 << " deg moved " << below << " m; "
-              << friction_angle + 1 << " deg moved " << above << " m (Coulomb " << coulomb << " m, "
-              << 100 * (above / coulomb - 1) << " %)\n";
-    EXPECT_LT(std::abs(below), c.held_bound) << c.youngs_modulus << " Pa, " << element;
-    EXPECT_NEAR(above, coulomb, c.above_tolerance * coulomb)
+              << element << ": " << t.friction_angle - 1 << " deg moved " << t.below << " m; "
+              << t.friction_angle + 1 << " deg moved " << t.above << " m (Coulomb " << t.coulomb
+              << " m, " << 100 * (t.above / t.coulomb - 1) << " %)\n";
+    EXPECT_LT(std::abs(t.below), c.held_bound) << c.youngs_modulus << " Pa, " << element;
+    EXPECT_NEAR(t.above, t.coulomb, c.above_tolerance * t.coulomb)
         << c.youngs_modulus << " Pa, " << element;
   }
 }

@@ -46,11 +46,11 @@ TEST(Plectoneme, TheRodCoilsOntoItselfWithoutAnySurfaceTrianglesCrossingAtAnySte
       if (first_crossing < 0) first_crossing = k;
     }
   }
-  std::printf("plectoneme: %d steps, self-contact active in %d (at most %d contacts), %d "
-              "unconverged, deepest end gap %.3g m (tolerance %.3g), %d steps with crossing "
-              "triangles\n",
-              steps, contact_steps, max_active, unconverged, deepest_end, gap_tolerance,
-              crossing_steps);
+  std::printf(
+      "plectoneme: %d steps, self-contact active in %d (at most %d contacts), %d "
+      "unconverged, deepest end gap %.3g m (tolerance %.3g), %d steps with crossing "
+      "triangles\n",
+      steps, contact_steps, max_active, unconverged, deepest_end, gap_tolerance, crossing_steps);
   // The coil presses on itself: the test is about held contact, not a rod that never touches.
   EXPECT_GE(contact_steps, 100);
   EXPECT_GE(max_active, 10);

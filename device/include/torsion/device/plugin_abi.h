@@ -15,9 +15,9 @@
  * the haptic loop's), read() and write() about once per loop tick, and close() once at the end.
  * A plug-in need not be thread-safe: no two calls overlap. By default that thread is in a process
  * of its own, torsion_device_host, so a plug-in that crashes ends only that process (the device
- * is then dead and its force fades); the plug-in sees no difference. read() should return within a small
- * part of the loop's period (1 ms at 1 kHz): the loader waits for it only until a deadline, and
- * a device that misses it counts as not answering that tick (its force fades to zero, as for a
+ * is then dead and its force fades); the plug-in sees no difference. read() should return within a
+ * small part of the loop's period (1 ms at 1 kHz): the loader waits for it only until a deadline,
+ * and a device that misses it counts as not answering that tick (its force fades to zero, as for a
  * built-in device that died). Every returned value is checked: a non-finite number, a quaternion
  * whose norm is not 1 within 1e-3, or a non-zero return code makes that tick's reading invalid.
  *

@@ -88,7 +88,7 @@ struct SelfContactStats {
   int sticking = 0;    ///< of which sticking
   int iterations = 0;  ///< Uzawa updates (CG solves) this step
   int searches = 0;    ///< tree searches this step: 1, plus the re-searches along the solved motion
-  int search_builds = 0;  ///< of which walked the tree (the others reused the kept pairs)
+  int search_builds = 0;      ///< of which walked the tree (the others reused the kept pairs)
   double search_seconds = 0;  ///< s, wall time of those searches (refit, queries, candidates)
   bool converged = true;
   double normal_impulse = 0;       ///< N s, sum over active contacts
@@ -166,10 +166,10 @@ class SelfContactSolver {
   double gap_tolerance_ = 0;
   std::unique_ptr<Parallel> own_parallel_;  // serial, when no Parallel was given
   const Parallel* parallel_ = nullptr;
-  std::vector<std::vector<int>> node_triangles_;    // surface triangles of each node
-  std::vector<std::vector<int>> node_contacts_;     // this step's contacts of each node
-  std::vector<int> touched_nodes_;                  // nodes with an entry in node_contacts_
-  SurfaceEdges surface_edges_;                      // surface edges and each triangle's three
+  std::vector<std::vector<int>> node_triangles_;  // surface triangles of each node
+  std::vector<std::vector<int>> node_contacts_;   // this step's contacts of each node
+  std::vector<int> touched_nodes_;                // nodes with an entry in node_contacts_
+  SurfaceEdges surface_edges_;                    // surface edges and each triangle's three
   // The broad phase: the surface tree, and the pairs it found, kept across steps.
   SurfacePairCache pairs_;
   std::vector<Eigen::Vector3d> edge_lo_, edge_hi_;  // each edge's box over the searched motion
