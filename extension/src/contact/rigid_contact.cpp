@@ -87,6 +87,14 @@ LinearSolveReport RigidContactSolver::solve(const SystemOperator& op,
                                             const SolverSettings& settings, Eigen::VectorXd& v) {
   base_ = &constraints;
   numberRigidUnknowns();
+  if (solvesInContactSpace(op)) {
+    const LinearSolveReport r = solveInContactSpace(op, constraints, b, v);
+    if (r.breakdown) return r;
+    collectImpulses();
+    solveHeld(v, dt_);
+    measureEndGaps(v);
+    return r;
+  }
   warmStart(v);
   setFacePenalties(op);
   LinearSolveReport total;

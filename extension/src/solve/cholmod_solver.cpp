@@ -81,6 +81,10 @@ void SparseCholesky::solve(const Eigen::VectorXd& b, Eigen::VectorXd& x) const {
   x = impl_->factor.solve(b);
 }
 
+void SparseCholesky::solve(const Eigen::MatrixXd& B, Eigen::MatrixXd& X) const {
+  X = impl_->factor.solve(B);
+}
+
 long SparseCholesky::factorEntries() const {
   if (!valid_) return 0;
 #if TORSION_WITH_CHOLMOD

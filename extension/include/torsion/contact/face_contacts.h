@@ -87,6 +87,9 @@ class FaceContactSet {
               const btTransform& transform, const Eigen::Vector3d& lo, const Eigen::Vector3d& hi,
               double reach, double dt, int partner, const RigidPartner& p, double friction);
   const std::vector<FaceContact>& contacts() const { return contacts_; }
+  /// The contacts, for a solve that sets their states and impulses itself (the contact-space
+  /// solve, rigid_contact_coulomb.cpp).
+  std::vector<FaceContact>& mutableContacts() { return contacts_; }
   /// Back to contacts as contacts() gave them (checkpoints read back from bytes): the next
   /// beginStep() takes over their states and multipliers.
   void restoreContacts(std::vector<FaceContact> contacts) {

@@ -42,11 +42,13 @@
 #include <memory>
 #include <vector>
 
+#include "torsion/contact/coulomb_problem.h"
 #include "torsion/contact/face_contacts.h"
 #include "torsion/contact/multibody_partner.h"
 #include "torsion/contact/node_anchors.h"
 #include "torsion/contact/rigid_partner.h"
 #include "torsion/fem/fem_model.h"
+#include "torsion/solve/cholmod_solver.h"
 #include "torsion/solve/fem_state.h"
 #include "torsion/solve/node_constraints.h"
 #include "torsion/solve/projected_cg.h"
@@ -71,6 +73,18 @@ struct ContactSettings {
   /// m: face contacts iterate until every active one's end-of-step gap is within this (the
   /// stated penetration tolerance of a rigid feature between nodes).
   double face_gap_tolerance = 1e-5;
+  /// How stick, slide and separation are decided (docs/contact.md). kContactSpace factorises the
+  /// step's matrix, condenses it onto the contacts and solves Coulomb's law there for all of them
+  /// at once (coulomb_problem.h): the states are consistent with the impulses by construction.
+  /// kActiveSet switches states between CG solves by rules (the method of earlier versions); a
+  /// body in FEM-FEM contact (whose pair penalties the factor does not hold) always uses it.
+  enum class FrictionSolve { kContactSpace, kActiveSet };
+  FrictionSolve friction_solve = FrictionSolve::kContactSpace;
+  /// m/s: the contact-space solve stops when every contact satisfies Coulomb's law to this.
+  double coulomb_tolerance = 1e-7;
+  /// Projected Gauss-Seidel sweeps at most per step (a step that needs more is reported as not
+  /// converged).
+  int coulomb_max_sweeps = 3000;
 };
 
 /// One node in contact with one rigid object during a step.
@@ -121,6 +135,8 @@ struct ContactStepStats {
                                    ///< step's start
                                    ///< (measured: the result of the previous step)
   double max_end_penetration = 0;  ///< m, deepest linearised end-of-step gap after the solve
+  int coulomb_sweeps = 0;          ///< contact-space solve: Gauss-Seidel sweeps this step
+  double coulomb_residual = 0;     ///< m/s, its largest violation of Coulomb's law at the end
 };
 
 /// What a RigidContactSolver's next step takes over from its last (its warm starts), with the
@@ -262,6 +278,36 @@ class RigidContactSolver {
                          Eigen::VectorXd& node_out, Eigen::VectorXd& rigid_out) const;
   void precondition(const Eigen::VectorXd& r, Eigen::VectorXd& z) const;
 
+  // The solve in contact space (rigid_contact_coulomb.cpp).
+  /// One contact of the contact-space problem: a node (weights (1, 0, 0)) or a face point.
+  struct CoulombRow {
+    int node_contact = -1;  ///< index into contacts_, or -1
+    int face_contact = -1;  ///< index into faces_.contacts(), or -1
+    std::array<int, 3> nodes{-1, -1, -1};
+    Eigen::Vector3d weights = Eigen::Vector3d::Zero();
+    int partner = -1;
+    Eigen::Vector3d normal = Eigen::Vector3d::UnitZ();
+    Eigen::Vector3d lever = Eigen::Vector3d::Zero();
+    double gap = 0;
+    double friction = 0;
+    bool bilateral = false;
+  };
+  /// A node contact's impulse at the end of the last step: the next step's warm start.
+  struct CarriedImpulse {
+    int node = -1;
+    const btCollisionObject* object = nullptr;
+    Eigen::Vector3d impulse = Eigen::Vector3d::Zero();
+  };
+  bool solvesInContactSpace(const SystemOperator& op) const;
+  LinearSolveReport solveInContactSpace(const SystemOperator& op,
+                                        const NodeConstraints& constraints,
+                                        const Eigen::VectorXd& b, Eigen::VectorXd& v);
+  void gatherCoulombRows();
+  void warmStartCoulomb();
+  /// Each contact's state and impulse from the solved impulses (and product_ for
+  /// collectImpulses()).
+  void recordCoulombStates();
+
   // The active set (rigid_contact_active_set.cpp).
   /// `p`: the node constraints' impulses (Coulomb's bounds: each scaled by its partner's
   /// friction_share).
@@ -300,6 +346,22 @@ class RigidContactSolver {
   Eigen::VectorXd b_friction_;  // b plus the sliding node contacts' friction impulses
   Eigen::VectorXd rigid_rhs_;   // the rigid unknowns' part of the right-hand side
   PcgScratch cg_;
+
+  // Contact-space workspace. A copy of the solver (a checkpoint) starts with a fresh one.
+  struct FactorWorkspace {
+    std::unique_ptr<CholmodSolver> assembler = std::make_unique<CholmodSolver>();
+    std::unique_ptr<SparseCholesky> factor = std::make_unique<SparseCholesky>();
+    FactorWorkspace() = default;
+    FactorWorkspace(const FactorWorkspace& /*other*/) : FactorWorkspace() {}
+    FactorWorkspace& operator=(const FactorWorkspace& /*other*/) { return *this; }
+    ~FactorWorkspace() = default;
+  };
+  FactorWorkspace factorisation_;
+  std::vector<CoulombRow> rows_;
+  Eigen::MatrixXd responses_;  // 3n x 3m: node velocities per unit contact impulse
+  CoulombProblem coulomb_;
+  Eigen::VectorXd impulses_, contact_velocity_;
+  std::vector<CarriedImpulse> previous_impulses_;
 };
 
 }  // namespace torsion

@@ -35,6 +35,8 @@ class SparseCholesky {
   bool valid() const { return valid_; }
   /// x = A^-1 b with the last successful factor.
   void solve(const Eigen::VectorXd& b, Eigen::VectorXd& x) const;
+  /// X = A^-1 B, column by column of the dense B, in one pass of the factor.
+  void solve(const Eigen::MatrixXd& B, Eigen::MatrixXd& X) const;
   /// Entries of the factor L (supernodal storage counts its padding), for cost reports.
   long factorEntries() const;
 
