@@ -8,8 +8,6 @@
 #include <Eigen/Dense>
 #include <algorithm>
 #include <cmath>
-#include <cstdio>
-#include <cstdlib>
 #include <limits>
 
 #include "torsion/contact/rigid_contact.h"
@@ -31,8 +29,12 @@ Eigen::Matrix<double, 3, 6> pointJacobian(const Eigen::Vector3d& r) {
 bool RigidContactSolver::solvesInContactSpace(const SystemOperator& op) const {
   // The factor holds M and K (and the volume barrier's blocks), not an added operator term: a body
   // in FEM-FEM contact (its pair penalties) keeps the active set.
+  // Multibody links keep it too: an anchored light multibody pendulum blew up within 20 steps in
+  // contact space (not yet understood; docs/contact.md).
+  const bool touches_link = std::any_of(partners_.begin(), partners_.end(),
+                                        [](const RigidPartner& k) { return k.link != nullptr; });
   return settings_.friction_solve == ContactSettings::FrictionSolve::kContactSpace &&
-         op.addedTerm() == nullptr;
+         op.addedTerm() == nullptr && !touches_link;
 }
 
 void RigidContactSolver::gatherCoulombRows() {
@@ -167,21 +169,11 @@ LinearSolveReport RigidContactSolver::solveInContactSpace(const SystemOperator& 
   warmStartCoulomb();
   CoulombSettings cs;
   cs.tolerance = settings_.coulomb_tolerance;
+  cs.acceptable = settings_.coulomb_acceptable;
   cs.max_sweeps = settings_.coulomb_max_sweeps;
   const CoulombReport solved = solveCoulomb(problem, cs, impulses_, contact_velocity_);
   stats_.coulomb_sweeps = solved.sweeps;
   stats_.coulomb_residual = solved.residual;
-  if (std::getenv("TORSION_COULOMB_DEBUG") != nullptr) {
-    int stick = 0, slide = 0, active = 0;
-    for (int i = 0; i < m; ++i) {
-      const Eigen::Vector3d r = impulses_.segment<3>(3 * i);
-      const double rn = rows_[static_cast<size_t>(i)].normal.dot(r);
-      if (rn <= 0) continue;
-      ++active;
-      if ((r - rows_[static_cast<size_t>(i)].normal * rn).norm() >= rows_[static_cast<size_t>(i)].friction * rn * (1 - 1e-9)) ++slide; else ++stick;
-    }
-    std::fprintf(stderr, "coulomb m %d active %d stick %d slide %d sweeps %d residual %.3g conv %d\n", m, active, stick, slide, solved.sweeps, solved.residual, solved.converged ? 1 : 0);
-  }
 
   // Velocities from the impulses.
   v = v_free + responses_ * impulses_;
@@ -205,7 +197,20 @@ LinearSolveReport RigidContactSolver::solveInContactSpace(const SystemOperator& 
     }
   }
   constraints.filter(r_);
-  report.relative_residual = reference > 0 ? r_.norm() / reference : 0.0;
+  // Relative to the larger of the free right-hand side and the contact impulses (a body at rest
+  // held by its contacts has a right-hand side of rounding size).
+  scratch_.setZero(3 * n);
+  for (int i = 0; i < m; ++i) {
+    const CoulombRow& row = rows_[static_cast<size_t>(i)];
+    for (size_t a = 0; a < 3; ++a) {
+      if (row.nodes[a] >= 0)
+        scratch_.segment<3>(3 * row.nodes[a]) +=
+            row.weights[static_cast<Eigen::Index>(a)] * impulses_.segment<3>(3 * i);
+    }
+  }
+  constraints.filter(scratch_);
+  const double scale = std::max(reference, scratch_.norm());
+  report.relative_residual = scale > 0 ? r_.norm() / scale : 0.0;
   report.iterations = solved.sweeps;
   if (!std::isfinite(report.relative_residual) || !v.allFinite()) {
     report.breakdown = true;
@@ -251,8 +256,8 @@ void RigidContactSolver::recordCoulombStates() {
     const double rn = row.normal.dot(r);
     const Eigen::Vector3d rt = r - row.normal * rn;
     const bool active = row.bilateral || rn > 0;
-    const bool sliding = active && !row.bilateral && rt.norm() >= row.friction * rn * (1 - 1e-9) &&
-                         rt.norm() > 0;
+    const bool sliding =
+        active && !row.bilateral && rt.norm() >= row.friction * rn * (1 - 1e-9) && rt.norm() > 0;
     if (row.face_contact >= 0) {
       FaceContact& f = faces[static_cast<size_t>(row.face_contact)];
       f.determined = false;

@@ -73,17 +73,21 @@ struct ContactSettings {
   /// m: face contacts iterate until every active one's end-of-step gap is within this (the
   /// stated penetration tolerance of a rigid feature between nodes).
   double face_gap_tolerance = 1e-5;
-  /// How stick, slide and separation are decided (docs/contact.md). kContactSpace factorises the
-  /// step's matrix, condenses it onto the contacts and solves Coulomb's law there for all of them
-  /// at once (coulomb_problem.h): the states are consistent with the impulses by construction.
-  /// kActiveSet switches states between CG solves by rules (the method of earlier versions); a
-  /// body in FEM-FEM contact (whose pair penalties the factor does not hold) always uses it.
-  enum class FrictionSolve { kContactSpace, kActiveSet };
-  FrictionSolve friction_solve = FrictionSolve::kContactSpace;
-  /// m/s: the contact-space solve stops when every contact satisfies Coulomb's law to this.
+  /// How stick, slide and separation are decided (docs/contact.md, "Coulomb's law solved in
+  /// contact space"). kActiveSet (the default) switches states between CG solves by rules.
+  /// kContactSpace (experimental) factorises the step's matrix, condenses it onto the contacts and
+  /// solves Coulomb's law there for all of them at once (coulomb_problem.h): the states are
+  /// consistent with the impulses by construction; it holds a box at the stick/slip threshold on
+  /// soft slabs where the active set lets it creep, but converges slowly on stiff ones. A body in
+  /// FEM-FEM contact (whose pair penalties the factor does not hold) always uses the active set.
+  enum class FrictionSolve { kActiveSet, kContactSpace };
+  FrictionSolve friction_solve = FrictionSolve::kActiveSet;
+  /// m/s: the contact-space solve iterates until every contact satisfies Coulomb's law to this;
+  /// a step that ends its sweeps within coulomb_acceptable counts as converged.
   double coulomb_tolerance = 1e-7;
-  /// Projected Gauss-Seidel sweeps at most per step (a step that needs more is reported as not
-  /// converged).
+  double coulomb_acceptable = 1e-6;
+  /// Projected Gauss-Seidel sweeps at most per step; a step that needs more is reported as not
+  /// converged (ContactStepStats::active_set_converged).
   int coulomb_max_sweeps = 3000;
 };
 
