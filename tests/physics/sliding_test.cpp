@@ -200,6 +200,37 @@ TEST(Sliding, BoxWithFrictionSlidesAsCoulombSaysOnAStiffSlab) {
 
 // The stick/slip threshold tan(a) = mu (16.7 deg for mu = 0.3), on a stiff slab: 1 deg below the
 // box stays (creep within 2 mm in 1 s), 1 deg above it slides as Coulomb says (8.9 cm in 1 s).
+// One slab of the threshold tests, its bounds, and the friction solve it runs with.
+struct ThresholdCase {
+  double youngs_modulus;
+  int cells;
+  ElementKind element;
+  double held_bound;       ///< m in 1 s, 1 deg below
+  double above_tolerance;  ///< of Coulomb's distance, 1 deg above
+};
+
+// The box settled, then pulled 1 deg below and 1 deg above the friction angle on each slab.
+void expectThresholds(const std::vector<ThresholdCase>& cases,
+                      ContactSettings::FrictionSolve friction_solve, const char* label) {
+  for (const ThresholdCase& c : cases) {
+    Slope s;
+    s.youngs_modulus = c.youngs_modulus;
+    s.cells_along = c.cells;
+    s.element = c.element;
+    s.friction_solve = friction_solve;
+    const Threshold t = oneDegreeEitherSide(s);
+    const char* element = c.element == ElementKind::kTet10 ? "tet10" : "tet4";
+    std::cout << "[figures] sliding threshold" << label << " (settled, mu 0.3), E "
+              << c.youngs_modulus << ", " << element << ": " << t.friction_angle - 1
+              << " deg moved " << t.below << " m; " << t.friction_angle + 1 << " deg moved "
+              << t.above << " m (Coulomb " << t.coulomb << " m, " << 100 * (t.above / t.coulomb - 1)
+              << " %)\n";
+    EXPECT_LT(std::abs(t.below), c.held_bound) << c.youngs_modulus << " Pa, " << element;
+    EXPECT_NEAR(t.above, t.coulomb, c.above_tolerance * t.coulomb)
+        << c.youngs_modulus << " Pa, " << element;
+  }
+}
+
 // The box is dropped onto the slope (settled first: the next test).
 TEST(Sliding, StiffSlabHoldsTheBoxBelowTheFrictionAngleAndLetsItSlideAbove) {
   Slope s;
@@ -223,32 +254,11 @@ TEST(Sliding, StiffSlabHoldsTheBoxBelowTheFrictionAngleAndLetsItSlideAbove) {
 // resistance gained (docs/contact.md, "The friction's direction inside the solve"): before it the
 // box crept 3.1 cm below and went 25 % too far above.
 TEST(Sliding, BoxHoldsOneDegreeBelowTheFrictionAngleAndSlidesOneDegreeAboveOnEverySlab) {
-  struct Case {
-    double youngs_modulus;
-    int cells;
-    ElementKind element;
-    double held_bound;       ///< m in 1 s, 1 deg below
-    double above_tolerance;  ///< of Coulomb's distance, 1 deg above
-  };
-  const Case cases[] = {{1e5, 20, ElementKind::kTet4, 5e-3, 0.12},
-                        {1e8, 20, ElementKind::kTet4, 1e-4, 0.05},
-                        {1e5, 10, ElementKind::kTet10, 5e-3, 0.12},
-                        {1e8, 10, ElementKind::kTet10, 1e-4, 0.05}};
-  for (const Case& c : cases) {
-    Slope s;
-    s.youngs_modulus = c.youngs_modulus;
-    s.cells_along = c.cells;
-    s.element = c.element;
-    const Threshold t = oneDegreeEitherSide(s);
-    const char* element = c.element == ElementKind::kTet10 ? "tet10" : "tet4";
-    std::cout << "[figures] sliding threshold (settled, mu 0.3), E " << c.youngs_modulus << ", "
-              << element << ": " << t.friction_angle - 1 << " deg moved " << t.below << " m; "
-              << t.friction_angle + 1 << " deg moved " << t.above << " m (Coulomb " << t.coulomb
-              << " m, " << 100 * (t.above / t.coulomb - 1) << " %)\n";
-    EXPECT_LT(std::abs(t.below), c.held_bound) << c.youngs_modulus << " Pa, " << element;
-    EXPECT_NEAR(t.above, t.coulomb, c.above_tolerance * t.coulomb)
-        << c.youngs_modulus << " Pa, " << element;
-  }
+  expectThresholds({{1e5, 20, ElementKind::kTet4, 5e-3, 0.12},
+                    {1e8, 20, ElementKind::kTet4, 1e-4, 0.05},
+                    {1e5, 10, ElementKind::kTet10, 5e-3, 0.12},
+                    {1e8, 10, ElementKind::kTet10, 1e-4, 0.05}},
+                   ContactSettings::FrictionSolve::kActiveSet, "");
 }
 
 // The same threshold with Coulomb's law solved in contact space (ContactSettings::kContactSpace,
@@ -261,34 +271,11 @@ TEST(Sliding, BoxHoldsOneDegreeBelowTheFrictionAngleAndSlidesOneDegreeAboveOnEve
 // nodes move under the edges) and a few stick. Bounds: 2 mm below, 6 % above on the soft slabs;
 // the stiff slabs as in the test above.
 TEST(Sliding, CoulombSolvedInContactSpaceHoldsTheBoxBelowTheFrictionAngleOnEverySlab) {
-  struct Case {
-    double youngs_modulus;
-    int cells;
-    ElementKind element;
-    double held_bound;       ///< m in 1 s, 1 deg below
-    double above_tolerance;  ///< of Coulomb's distance, 1 deg above
-  };
-  const Case cases[] = {{1e5, 20, ElementKind::kTet4, 2e-3, 0.06},
-                        {1e8, 20, ElementKind::kTet4, 1e-4, 0.05},
-                        {1e5, 10, ElementKind::kTet10, 2e-3, 0.06},
-                        {1e8, 10, ElementKind::kTet10, 1e-4, 0.05}};
-  for (const Case& c : cases) {
-    Slope s;
-    s.youngs_modulus = c.youngs_modulus;
-    s.cells_along = c.cells;
-    s.element = c.element;
-    s.friction_solve = ContactSettings::FrictionSolve::kContactSpace;
-    const Threshold t = oneDegreeEitherSide(s);
-    const char* element = c.element == ElementKind::kTet10 ? "tet10" : "tet4";
-    std::cout << "[figures] sliding threshold, contact space (settled, mu 0.3), E "
-              << c.youngs_modulus << ", " << element << ": " << t.friction_angle - 1
-              << " deg moved " << t.below << " m; " << t.friction_angle + 1 << " deg moved "
-              << t.above << " m (Coulomb " << t.coulomb << " m, " << 100 * (t.above / t.coulomb - 1)
-              << " %)\n";
-    EXPECT_LT(std::abs(t.below), c.held_bound) << c.youngs_modulus << " Pa, " << element;
-    EXPECT_NEAR(t.above, t.coulomb, c.above_tolerance * t.coulomb)
-        << c.youngs_modulus << " Pa, " << element;
-  }
+  expectThresholds({{1e5, 20, ElementKind::kTet4, 2e-3, 0.06},
+                    {1e8, 20, ElementKind::kTet4, 1e-4, 0.05},
+                    {1e5, 10, ElementKind::kTet10, 2e-3, 0.06},
+                    {1e8, 10, ElementKind::kTet10, 1e-4, 0.05}},
+                   ContactSettings::FrictionSolve::kContactSpace, ", contact space");
 }
 
 // Coulomb's distance whatever the slab: soft (E = 1e5 Pa) and stiff (1e8), node rows 0.2 m (the

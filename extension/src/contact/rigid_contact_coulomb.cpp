@@ -24,6 +24,16 @@ Eigen::Matrix<double, 3, 6> pointJacobian(const Eigen::Vector3d& r) {
   return J;
 }
 
+// Applies the node constraints' filter S to every column of `columns` (3n rows), in place.
+void filterColumns(const NodeConstraints& constraints, Eigen::MatrixXd& columns) {
+  Eigen::VectorXd column;
+  for (Eigen::Index c = 0; c < columns.cols(); ++c) {
+    column = columns.col(c);
+    constraints.filter(column);
+    columns.col(c) = column;
+  }
+}
+
 }  // namespace
 
 bool RigidContactSolver::solvesInContactSpace(const SystemOperator& op) const {
@@ -106,26 +116,20 @@ LinearSolveReport RigidContactSolver::solveInContactSpace(const SystemOperator& 
   // Contact space: each row's impulse r_i (on the soft side) moves the nodes by C_i r_i.
   gatherCoulombRows();
   const int m = static_cast<int>(rows_.size());
-  Eigen::MatrixXd unit_impulses = Eigen::MatrixXd::Zero(3 * n, 3 * m);
+  // G^T, filtered (column j: the node forces of a unit impulse along row j's axis), kept as a
+  // member so that a step does not allocate it anew.
+  unit_impulses_.setZero(3 * n, 3 * m);
   for (int i = 0; i < m; ++i) {
     const CoulombRow& row = rows_[static_cast<size_t>(i)];
     for (size_t a = 0; a < 3; ++a) {
       if (row.nodes[a] < 0 || row.weights[static_cast<Eigen::Index>(a)] == 0) continue;
-      unit_impulses.block<3, 3>(3 * row.nodes[a], 3 * i) +=
+      unit_impulses_.block<3, 3>(3 * row.nodes[a], 3 * i) +=
           row.weights[static_cast<Eigen::Index>(a)] * Eigen::Matrix3d::Identity();
     }
   }
-  for (int col = 0; col < 3 * m; ++col) {
-    Eigen::VectorXd column = unit_impulses.col(col);
-    constraints.filter(column);
-    unit_impulses.col(col) = column;
-  }
-  factorisation_.factor->solve(unit_impulses, responses_);
-  for (int col = 0; col < 3 * m; ++col) {
-    Eigen::VectorXd column = responses_.col(col);
-    constraints.filter(column);
-    responses_.col(col) = column;
-  }
+  filterColumns(constraints, unit_impulses_);
+  factorisation_.factor->solve(unit_impulses_, responses_);
+  filterColumns(constraints, responses_);
 
   CoulombProblem& problem = coulomb_;
   problem.delassus.setZero(3 * m, 3 * m);
@@ -185,30 +189,14 @@ LinearSolveReport RigidContactSolver::solveInContactSpace(const SystemOperator& 
   }
   recordCoulombStates();
 
-  // The honest residual of the result: A v - b - (contact impulses), filtered.
+  // The honest residual of the result: S (A v - b - G^T r), relative to the larger of the free
+  // right-hand side and the contact impulses (a body at rest held by its contacts has a
+  // right-hand side of rounding size).
   op.multiply(v, product_);
   r_ = product_ - b;
-  for (int i = 0; i < m; ++i) {
-    const CoulombRow& row = rows_[static_cast<size_t>(i)];
-    for (size_t a = 0; a < 3; ++a) {
-      if (row.nodes[a] < 0) continue;
-      r_.segment<3>(3 * row.nodes[a]) -=
-          row.weights[static_cast<Eigen::Index>(a)] * impulses_.segment<3>(3 * i);
-    }
-  }
   constraints.filter(r_);
-  // Relative to the larger of the free right-hand side and the contact impulses (a body at rest
-  // held by its contacts has a right-hand side of rounding size).
-  scratch_.setZero(3 * n);
-  for (int i = 0; i < m; ++i) {
-    const CoulombRow& row = rows_[static_cast<size_t>(i)];
-    for (size_t a = 0; a < 3; ++a) {
-      if (row.nodes[a] >= 0)
-        scratch_.segment<3>(3 * row.nodes[a]) +=
-            row.weights[static_cast<Eigen::Index>(a)] * impulses_.segment<3>(3 * i);
-    }
-  }
-  constraints.filter(scratch_);
+  scratch_.noalias() = unit_impulses_ * impulses_;
+  r_ -= scratch_;
   const double scale = std::max(reference, scratch_.norm());
   report.relative_residual = scale > 0 ? r_.norm() / scale : 0.0;
   report.iterations = solved.sweeps;
@@ -235,9 +223,9 @@ void RigidContactSolver::warmStartCoulomb() {
     }
     const NodeContact& c = contacts_[static_cast<size_t>(row.node_contact)];
     const btCollisionObject* object = partners_[static_cast<size_t>(c.partner)].object;
-    for (const CarriedImpulse& carried : previous_impulses_) {
-      if (carried.node == c.node && carried.object == object) {
-        impulses_.segment<3>(3 * i) = carried.impulse;
+    for (size_t k = 0; k < previous_active_.size(); ++k) {
+      if (previous_active_[k].first == c.node && previous_active_[k].second == object) {
+        impulses_.segment<3>(3 * i) = previous_impulse_[k];
         break;
       }
     }

@@ -170,14 +170,13 @@ void RigidContactSolver::rememberActiveContacts() {
   // Last step's active contacts start this step active (warm active set).
   previous_active_.clear();
   previous_state_.clear();
-  previous_impulses_.clear();
+  previous_impulse_.clear();
   std::vector<char> slid(partners_.size(), 0), stuck(partners_.size(), 0);
   for (const NodeContact& c : contacts_) {
     if (c.state != NodeContact::State::kInactive && !c.held) {
       previous_active_.emplace_back(c.node, partners_[static_cast<size_t>(c.partner)].object);
       previous_state_.push_back(c.state);
-      previous_impulses_.push_back({c.node, partners_[static_cast<size_t>(c.partner)].object,
-                                    c.impulse});
+      previous_impulse_.push_back(c.impulse);
       (c.state == NodeContact::State::kSlide ? slid : stuck)[static_cast<size_t>(c.partner)] = 1;
     }
   }

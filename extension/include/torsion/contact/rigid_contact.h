@@ -296,12 +296,7 @@ class RigidContactSolver {
     double friction = 0;
     bool bilateral = false;
   };
-  /// A node contact's impulse at the end of the last step: the next step's warm start.
-  struct CarriedImpulse {
-    int node = -1;
-    const btCollisionObject* object = nullptr;
-    Eigen::Vector3d impulse = Eigen::Vector3d::Zero();
-  };
+
   bool solvesInContactSpace(const SystemOperator& op) const;
   LinearSolveReport solveInContactSpace(const SystemOperator& op,
                                         const NodeConstraints& constraints,
@@ -335,6 +330,7 @@ class RigidContactSolver {
   std::vector<int> node_contact_;  // per node: index into contacts_ (free nodes only) or -1
   std::vector<std::pair<int, const btCollisionObject*>> previous_active_;  // (node, object)
   std::vector<NodeContact::State> previous_state_;
+  std::vector<Eigen::Vector3d> previous_impulse_;  // N s, the contact-space warm start
   std::vector<std::pair<NodeContact::State, Eigen::Vector3d>> solved_states_;
   std::vector<FaceContact::State> solved_face_states_;
   std::vector<const btCollisionObject*> previous_sliding_;  // bodies sliding at the last step's end
@@ -362,10 +358,10 @@ class RigidContactSolver {
   };
   FactorWorkspace factorisation_;
   std::vector<CoulombRow> rows_;
-  Eigen::MatrixXd responses_;  // 3n x 3m: node velocities per unit contact impulse
+  Eigen::MatrixXd unit_impulses_;  // 3n x 3m: S G^T, node forces per unit contact impulse
+  Eigen::MatrixXd responses_;      // 3n x 3m: node velocities per unit contact impulse
   CoulombProblem coulomb_;
   Eigen::VectorXd impulses_, contact_velocity_;
-  std::vector<CarriedImpulse> previous_impulses_;
 };
 
 }  // namespace torsion
