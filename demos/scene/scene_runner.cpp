@@ -78,6 +78,7 @@ struct ContactTotals {
   void add(const FemWorld& world) {
     int active = 0;
     bool converged = true;
+    bool fell_back = false;
     for (const auto& body : world.bodies()) {
       if (const SelfContactSolver* self = body->selfContact()) {
         const SelfContactStats& s = self->stats();
@@ -93,6 +94,11 @@ struct ContactTotals {
       max_penetration = std::max(max_penetration, s.max_penetration);
       active_set_iterations_max = std::max(active_set_iterations_max, s.active_set_iterations);
       converged = converged && s.active_set_converged;
+      if (body->contacts().settings().friction_solve ==
+          ContactSettings::FrictionSolve::kContactSpace) {
+        has_contact_space = true;
+        fell_back = fell_back || s.coulomb_fell_back;
+      }
     }
     if (const FemContactIslands* islands = world.femSolver().femContact()) {
       const FemContactStats& s = islands->stats();
@@ -110,7 +116,12 @@ struct ContactTotals {
     active_sum += active;
     active_max = std::max(active_max, active);
     if (!converged) ++unconverged_steps;
+    if (fell_back) ++fallback_steps;
   }
+  // Bodies with "friction_solve": "contact_space": steps whose Coulomb problem did not converge
+  // and were solved by the active set instead.
+  bool has_contact_space = false;
+  int fallback_steps = 0;
   // Self-contact (bodies with "self_contact"): summed over bodies, steps counted per body.
   bool has_self_contact = false;
   int self_active_max = 0;
@@ -132,6 +143,7 @@ struct ContactTotals {
                         {"max_penetration_m", max_penetration},
                         {"active_set_iterations_max", active_set_iterations_max},
                         {"active_set_unconverged_steps", unconverged_steps}};
+    if (has_contact_space) j["contact_space_fallback_steps"] = fallback_steps;
     if (has_self_contact) {
       j["self_contact"] = {{"active_max", self_active_max},
                            {"iterations_max", self_iterations_max},

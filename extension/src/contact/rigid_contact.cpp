@@ -87,13 +87,22 @@ LinearSolveReport RigidContactSolver::solve(const SystemOperator& op,
                                             const SolverSettings& settings, Eigen::VectorXd& v) {
   base_ = &constraints;
   numberRigidUnknowns();
+  stats_.coulomb_fell_back = false;
   if (solvesInContactSpace(op)) {
+    // A step whose Coulomb problem does not converge falls back to the active set: stopped early,
+    // the sweeps leave near-stick contacts stuck (measured: a box on a stiff tet10 slab 1 deg
+    // above the friction angle slid 5 % short), where the active set's states hold within 3 %.
+    fallback_velocity_ = v;
     const LinearSolveReport r = solveInContactSpace(op, constraints, b, v);
     if (r.breakdown) return r;
-    collectImpulses();
-    solveHeld(v, dt_);
-    measureEndGaps(v);
-    return r;
+    if (!stats_.coulomb_fell_back) {
+      collectImpulses();
+      solveHeld(v, dt_);
+      measureEndGaps(v);
+      return r;
+    }
+    v = fallback_velocity_;
+    numberRigidUnknowns();
   }
   warmStart(v);
   setFacePenalties(op);

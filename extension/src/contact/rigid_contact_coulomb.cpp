@@ -24,16 +24,6 @@ Eigen::Matrix<double, 3, 6> pointJacobian(const Eigen::Vector3d& r) {
   return J;
 }
 
-// Applies the node constraints' filter S to every column of `columns` (3n rows), in place.
-void filterColumns(const NodeConstraints& constraints, Eigen::MatrixXd& columns) {
-  Eigen::VectorXd column;
-  for (Eigen::Index c = 0; c < columns.cols(); ++c) {
-    column = columns.col(c);
-    constraints.filter(column);
-    columns.col(c) = column;
-  }
-}
-
 }  // namespace
 
 bool RigidContactSolver::solvesInContactSpace(const SystemOperator& op) const {
@@ -104,88 +94,57 @@ LinearSolveReport RigidContactSolver::solveInContactSpace(const SystemOperator& 
     return report;
   }
   const Eigen::SparseMatrix<double>& A = factorisation_.assembler->assemble(op, constraints);
-  if (!factorisation_.factor->factorize(A)) {
+  if (!factoriseContactSystem(A)) {
     report.breakdown = true;
     report.breakdown_reason = "the Cholesky factorisation failed (matrix not positive definite)";
     return report;
   }
-  factorisation_.factor->solve(r_, scratch_);
+  scratch_ = factorisation_.factor->solve(r_);
   constraints.filter(scratch_);
-  Eigen::VectorXd v_free = v_c_ + scratch_;
+  v_free_ = v_c_ + scratch_;
 
-  // Contact space: each row's impulse r_i (on the soft side) moves the nodes by C_i r_i.
+  // Every contact found is a row; the problem holds those that can push this step: closing
+  // under the free motion, pushing last step, or bilateral. A row left out keeps a zero impulse,
+  // which is Coulomb's law for it as long as its gap stays open at the end of the step; the rows
+  // that the solved motion closes join and the problem is solved again. (A ball falling onto
+  // the ground has all its surface nodes as rows, and a few of them touch.)
   gatherCoulombRows();
-  const int m = static_cast<int>(rows_.size());
-  // G^T, filtered (column j: the node forces of a unit impulse along row j's axis), kept as a
-  // member so that a step does not allocate it anew.
-  unit_impulses_.setZero(3 * n, 3 * m);
-  for (int i = 0; i < m; ++i) {
-    const CoulombRow& row = rows_[static_cast<size_t>(i)];
-    for (size_t a = 0; a < 3; ++a) {
-      if (row.nodes[a] < 0 || row.weights[static_cast<Eigen::Index>(a)] == 0) continue;
-      unit_impulses_.block<3, 3>(3 * row.nodes[a], 3 * i) +=
-          row.weights[static_cast<Eigen::Index>(a)] * Eigen::Matrix3d::Identity();
-    }
-  }
-  filterColumns(constraints, unit_impulses_);
-  factorisation_.factor->solve(unit_impulses_, responses_);
-  filterColumns(constraints, responses_);
-
-  CoulombProblem& problem = coulomb_;
-  problem.delassus.setZero(3 * m, 3 * m);
-  problem.free_velocity.setZero(3 * m);
-  problem.normal.resize(static_cast<size_t>(m));
-  problem.friction.resize(static_cast<size_t>(m));
-  problem.bilateral.assign(static_cast<size_t>(m), 0);
-  std::vector<Eigen::Matrix<double, 3, 6>> jacobians(static_cast<size_t>(m));
-  for (int i = 0; i < m; ++i) {
-    const CoulombRow& row = rows_[static_cast<size_t>(i)];
-    const RigidPartner& k = partners_[static_cast<size_t>(row.partner)];
-    Eigen::Vector3d soft = Eigen::Vector3d::Zero();
-    for (size_t a = 0; a < 3; ++a) {
-      if (row.nodes[a] < 0) continue;
-      const double w = row.weights[static_cast<Eigen::Index>(a)];
-      soft += w * v_free.segment<3>(3 * row.nodes[a]);
-      problem.delassus.middleRows<3>(3 * i) += w * responses_.middleRows<3>(3 * row.nodes[a]);
-    }
-    problem.free_velocity.segment<3>(3 * i) =
-        soft - pointVelocity(k.entry_velocity, row.lever) + row.normal * (row.gap / dt);
-    problem.normal[static_cast<size_t>(i)] = row.normal;
-    problem.friction[static_cast<size_t>(i)] = row.friction;
-    problem.bilateral[static_cast<size_t>(i)] = row.bilateral ? 1 : 0;
-    jacobians[static_cast<size_t>(i)] = pointJacobian(row.lever);
-  }
-  // A dynamic partner moves under every impulse on it: W_ij += J_i M^-1 J_j^T.
-  for (int i = 0; i < m; ++i) {
-    const RigidPartner& ki = partners_[static_cast<size_t>(rows_[static_cast<size_t>(i)].partner)];
-    if (!ki.dynamic) continue;
-    for (int j = 0; j < m; ++j) {
-      if (rows_[static_cast<size_t>(j)].partner != rows_[static_cast<size_t>(i)].partner) continue;
-      const Eigen::Matrix<double, 3, 6>& Jj = jacobians[static_cast<size_t>(j)];
-      Eigen::Matrix<double, 6, 3> response;
-      for (int a = 0; a < 3; ++a)
-        response.col(a) = partnerResponse(ki, Jj.row(a).transpose());
-      problem.delassus.block<3, 3>(3 * i, 3 * j) += jacobians[static_cast<size_t>(i)] * response;
-    }
-  }
-
-  // Warm start: last step's impulses of the contacts found again.
   warmStartCoulomb();
-  CoulombSettings cs;
-  cs.tolerance = settings_.coulomb_tolerance;
-  cs.acceptable = settings_.coulomb_acceptable;
-  cs.max_sweeps = settings_.coulomb_max_sweeps;
-  const CoulombReport solved = solveCoulomb(problem, cs, impulses_, contact_velocity_);
+  const int all = static_cast<int>(rows_.size());
+  selected_.clear();
+  for (int i = 0; i < all; ++i) {
+    const CoulombRow& row = rows_[static_cast<size_t>(i)];
+    const bool pushed = impulses_.segment<3>(3 * i).squaredNorm() > 0;
+    if (row.bilateral || pushed ||
+        normalVelocity(row, v_free_, partners_[static_cast<size_t>(row.partner)].entry_velocity) *
+                dt <
+            settings_.activation_tolerance)
+      selected_.push_back(i);
+  }
+  const Eigen::VectorXd warm = impulses_;
+  CoulombReport solved;
+  for (int round = 0;; ++round) {
+    solved = solveSelectedRows(constraints, warm, v);
+    // Rows left out that the solved motion drives into the surface join the problem.
+    std::vector<int> joining;
+    std::vector<char> in(static_cast<size_t>(all), 0);
+    for (int i : selected_)
+      in[static_cast<size_t>(i)] = 1;
+    for (int i = 0; i < all; ++i) {
+      if (in[static_cast<size_t>(i)]) continue;
+      const CoulombRow& row = rows_[static_cast<size_t>(i)];
+      const RigidPartner& k = partners_[static_cast<size_t>(row.partner)];
+      if (normalVelocity(row, v, k.velocity) < -settings_.coulomb_tolerance) joining.push_back(i);
+    }
+    if (joining.empty() || round == kMaxRowRounds) break;
+    selected_.insert(selected_.end(), joining.begin(), joining.end());
+    std::sort(selected_.begin(), selected_.end());
+  }
   stats_.coulomb_sweeps = solved.sweeps;
   stats_.coulomb_residual = solved.residual;
-
-  // Velocities from the impulses.
-  v = v_free + responses_ * impulses_;
-  for (int i = 0; i < m; ++i) {
-    const CoulombRow& row = rows_[static_cast<size_t>(i)];
-    RigidPartner& k = partners_[static_cast<size_t>(row.partner)];
-    if (!k.dynamic) continue;
-    k.velocity -= partnerResponse(k, pointWrench(impulses_.segment<3>(3 * i), row.lever));
+  if (!solved.converged && settings_.coulomb_fallback) {
+    stats_.coulomb_fell_back = true;  // solve() takes the active set; contacts_ are untouched
+    return report;
   }
   recordCoulombStates();
 
@@ -193,11 +152,9 @@ LinearSolveReport RigidContactSolver::solveInContactSpace(const SystemOperator& 
   // right-hand side and the contact impulses (a body at rest held by its contacts has a
   // right-hand side of rounding size).
   op.multiply(v, product_);
-  r_ = product_ - b;
+  r_ = product_ - b - contact_forces_;
   constraints.filter(r_);
-  scratch_.noalias() = unit_impulses_ * impulses_;
-  r_ -= scratch_;
-  const double scale = std::max(reference, scratch_.norm());
+  const double scale = std::max(reference, contact_forces_.norm());
   report.relative_residual = scale > 0 ? r_.norm() / scale : 0.0;
   report.iterations = solved.sweeps;
   if (!std::isfinite(report.relative_residual) || !v.allFinite()) {
@@ -209,6 +166,139 @@ LinearSolveReport RigidContactSolver::solveInContactSpace(const SystemOperator& 
   ++stats_.active_set_iterations;
   stats_.active_set_converged = solved.converged;
   return report;
+}
+
+double RigidContactSolver::normalVelocity(const CoulombRow& row, const Eigen::VectorXd& v,
+                                          const Eigen::Matrix<double, 6, 1>& rigid) const {
+  // The row's end gap rate n.(v_soft - v_rigid) + gap / dt: negative when the step ends inside.
+  Eigen::Vector3d soft = Eigen::Vector3d::Zero();
+  for (size_t a = 0; a < 3; ++a) {
+    if (row.nodes[a] < 0) continue;
+    soft += row.weights[static_cast<Eigen::Index>(a)] * v.segment<3>(3 * row.nodes[a]);
+  }
+  return row.normal.dot(soft - pointVelocity(rigid, row.lever)) + row.gap / dt_;
+}
+
+CoulombReport RigidContactSolver::solveSelectedRows(const NodeConstraints& constraints,
+                                                    const Eigen::VectorXd& warm,
+                                                    Eigen::VectorXd& v) {
+  const double dt = dt_;
+  const int m = static_cast<int>(selected_.size());
+  for (RigidPartner& k : partners_)
+    k.velocity = k.entry_velocity;
+  buildUnitImpulses(constraints);
+  // W_soft = (S G^T)^T A^-1 (S G^T) = B^T B with B = L^-1 P S G^T (P A P^T = L L^T): one sparse
+  // forward substitution per column, each reaching only the factor's columns below the row's
+  // nodes, instead of two solves of the whole system per column.
+  condensed_ = factorisation_.factor->permutationP() * unit_impulses_;
+  factorisation_.factor->matrixL().solveInPlace(condensed_);
+
+  CoulombProblem& problem = coulomb_;
+  dense_condensed_ = condensed_;
+  problem.delassus.resize(3 * m, 3 * m);
+  problem.delassus.triangularView<Eigen::Lower>() = dense_condensed_.transpose() * dense_condensed_;
+  problem.delassus.triangularView<Eigen::StrictlyUpper>() =
+      problem.delassus.transpose().triangularView<Eigen::StrictlyUpper>();
+  problem.free_velocity.setZero(3 * m);
+  problem.normal.resize(static_cast<size_t>(m));
+  problem.friction.resize(static_cast<size_t>(m));
+  problem.bilateral.assign(static_cast<size_t>(m), 0);
+  Eigen::VectorXd start(3 * m);
+  std::vector<Eigen::Matrix<double, 3, 6>> jacobians(static_cast<size_t>(m));
+  for (int s = 0; s < m; ++s) {
+    const int i = selected_[static_cast<size_t>(s)];
+    const CoulombRow& row = rows_[static_cast<size_t>(i)];
+    const RigidPartner& k = partners_[static_cast<size_t>(row.partner)];
+    Eigen::Vector3d soft = Eigen::Vector3d::Zero();
+    for (size_t a = 0; a < 3; ++a) {
+      if (row.nodes[a] < 0) continue;
+      soft += row.weights[static_cast<Eigen::Index>(a)] * v_free_.segment<3>(3 * row.nodes[a]);
+    }
+    problem.free_velocity.segment<3>(3 * s) =
+        soft - pointVelocity(k.entry_velocity, row.lever) + row.normal * (row.gap / dt);
+    problem.normal[static_cast<size_t>(s)] = row.normal;
+    problem.friction[static_cast<size_t>(s)] = row.friction;
+    problem.bilateral[static_cast<size_t>(s)] = row.bilateral ? 1 : 0;
+    jacobians[static_cast<size_t>(s)] = pointJacobian(row.lever);
+    start.segment<3>(3 * s) = warm.segment<3>(3 * i);
+  }
+  // A dynamic partner moves under every impulse on it: W_ij += J_i M^-1 J_j^T.
+  for (int s = 0; s < m; ++s) {
+    const int partner = rows_[static_cast<size_t>(selected_[static_cast<size_t>(s)])].partner;
+    const RigidPartner& k = partners_[static_cast<size_t>(partner)];
+    if (!k.dynamic) continue;
+    for (int t = 0; t < m; ++t) {
+      if (rows_[static_cast<size_t>(selected_[static_cast<size_t>(t)])].partner != partner)
+        continue;
+      const Eigen::Matrix<double, 3, 6>& Jt = jacobians[static_cast<size_t>(t)];
+      Eigen::Matrix<double, 6, 3> response;
+      for (int a = 0; a < 3; ++a)
+        response.col(a) = partnerResponse(k, Jt.row(a).transpose());
+      problem.delassus.block<3, 3>(3 * s, 3 * t) += jacobians[static_cast<size_t>(s)] * response;
+    }
+  }
+
+  CoulombSettings cs;
+  cs.tolerance = settings_.coulomb_tolerance;
+  cs.acceptable = settings_.coulomb_acceptable;
+  cs.max_sweeps = settings_.coulomb_max_sweeps;
+  const CoulombReport solved = solveCoulomb(problem, cs, start, contact_velocity_);
+  // Every row's impulse (zero for those left out), and the velocities they give: one more solve,
+  // with the contacts' node forces S G^T r.
+  impulses_.setZero(3 * static_cast<Eigen::Index>(rows_.size()));
+  for (int s = 0; s < m; ++s)
+    impulses_.segment<3>(3 * selected_[static_cast<size_t>(s)]) = start.segment<3>(3 * s);
+  contact_forces_ = unit_impulses_ * start;
+  scratch_ = factorisation_.factor->solve(contact_forces_);
+  constraints.filter(scratch_);
+  v = v_free_ + scratch_;
+  for (int s = 0; s < m; ++s) {
+    const CoulombRow& row = rows_[static_cast<size_t>(selected_[static_cast<size_t>(s)])];
+    RigidPartner& k = partners_[static_cast<size_t>(row.partner)];
+    if (!k.dynamic) continue;
+    k.velocity -= partnerResponse(k, pointWrench(start.segment<3>(3 * s), row.lever));
+  }
+  return solved;
+}
+
+bool RigidContactSolver::factoriseContactSystem(const Eigen::SparseMatrix<double>& lower) {
+  if (!Eigen::Map<const Eigen::VectorXd>(lower.valuePtr(), lower.nonZeros()).allFinite())
+    return false;
+  FactorWorkspace& f = factorisation_;
+  if (f.rows != lower.rows() || f.entries != lower.nonZeros()) {
+    f.factor->analyzePattern(lower);
+    f.rows = lower.rows();
+    f.entries = lower.nonZeros();
+  }
+  f.factor->factorize(lower);
+  return f.factor->info() == Eigen::Success;
+}
+
+void RigidContactSolver::buildUnitImpulses(const NodeConstraints& constraints) {
+  // Column 3s + a: the node forces S G_i^T e_a of a unit impulse along axis a of the s-th
+  // selected row i (the
+  // weights of a face point spread it over the triangle's nodes; S leaves the free components).
+  const int n = model_->nodeCount();
+  std::vector<Eigen::Triplet<double>> entries;
+  entries.reserve(27 * selected_.size());
+  for (size_t i = 0; i < selected_.size(); ++i) {
+    const CoulombRow& row = rows_[static_cast<size_t>(selected_[i])];
+    for (size_t a = 0; a < 3; ++a) {
+      const int node = row.nodes[a];
+      const double w = row.weights[static_cast<Eigen::Index>(a)];
+      if (node < 0 || w == 0) continue;
+      for (int axis = 0; axis < 3; ++axis) {
+        const Eigen::Vector3d column =
+            constraints.filterNode(node, w * Eigen::Vector3d::Unit(axis));
+        for (int d = 0; d < 3; ++d) {
+          if (column[d] != 0)
+            entries.emplace_back(3 * node + d, 3 * static_cast<int>(i) + axis, column[d]);
+        }
+      }
+    }
+  }
+  unit_impulses_.resize(3 * n, 3 * static_cast<Eigen::Index>(selected_.size()));
+  unit_impulses_.setFromTriplets(entries.begin(), entries.end());
 }
 
 void RigidContactSolver::warmStartCoulomb() {

@@ -39,6 +39,8 @@
 #include <BulletSoftBody/btSoftBody.h>
 
 #include <Eigen/Core>
+#include <Eigen/SparseCholesky>
+#include <Eigen/SparseCore>
 #include <memory>
 #include <vector>
 
@@ -89,6 +91,9 @@ struct ContactSettings {
   /// Projected Gauss-Seidel sweeps at most per step; a step that needs more is reported as not
   /// converged (ContactStepStats::active_set_converged).
   int coulomb_max_sweeps = 3000;
+  /// A step whose contact-space solve does not converge is solved again by the active set
+  /// (ContactStepStats::coulomb_fell_back); off, the unconverged impulses are kept.
+  bool coulomb_fallback = true;
 };
 
 /// One node in contact with one rigid object during a step.
@@ -141,6 +146,7 @@ struct ContactStepStats {
   double max_end_penetration = 0;  ///< m, deepest linearised end-of-step gap after the solve
   int coulomb_sweeps = 0;          ///< contact-space solve: Gauss-Seidel sweeps this step
   double coulomb_residual = 0;     ///< m/s, its largest violation of Coulomb's law at the end
+  bool coulomb_fell_back = false;  ///< the contact-space solve did not converge: active set used
 };
 
 /// What a RigidContactSolver's next step takes over from its last (its warm starts), with the
@@ -302,6 +308,17 @@ class RigidContactSolver {
                                         const NodeConstraints& constraints,
                                         const Eigen::VectorXd& b, Eigen::VectorXd& v);
   void gatherCoulombRows();
+  /// Factorises the step's constrained matrix (lower triangle); false if not SPD or not finite.
+  bool factoriseContactSystem(const Eigen::SparseMatrix<double>& lower);
+  /// unit_impulses_ = S G^T for the selected rows.
+  void buildUnitImpulses(const NodeConstraints& constraints);
+  /// Solves Coulomb's problem on the selected rows from `warm` (every row's impulse): impulses_
+  /// (every row's, zero for the others), contact_forces_, the velocities `v` and the partners'.
+  CoulombReport solveSelectedRows(const NodeConstraints& constraints, const Eigen::VectorXd& warm,
+                                  Eigen::VectorXd& v);
+  /// The row's end gap rate with node velocities `v` and its partner's velocity `rigid`.
+  double normalVelocity(const CoulombRow& row, const Eigen::VectorXd& v,
+                        const Eigen::Matrix<double, 6, 1>& rigid) const;
   void warmStartCoulomb();
   /// Each contact's state and impulse from the solved impulses (and product_ for
   /// collectImpulses()).
@@ -348,9 +365,14 @@ class RigidContactSolver {
   PcgScratch cg_;
 
   // Contact-space workspace. A copy of the solver (a checkpoint) starts with a fresh one.
+  // The factor is simplicial (no BLAS, no supernodes): the condensation needs its L itself, and
+  // the bodies in contact are small enough that supernodes do not pay (measured: CHOLMOD's
+  // supernodal factor and dense solves took 77 % of a contact-space step on the 441-node slab).
+  using Factor = Eigen::SimplicialLLT<Eigen::SparseMatrix<double>, Eigen::Lower>;
   struct FactorWorkspace {
     std::unique_ptr<CholmodSolver> assembler = std::make_unique<CholmodSolver>();
-    std::unique_ptr<SparseCholesky> factor = std::make_unique<SparseCholesky>();
+    std::unique_ptr<Factor> factor = std::make_unique<Factor>();
+    Eigen::Index rows = -1, entries = -1;  // the pattern the factor analysed
     FactorWorkspace() = default;
     FactorWorkspace(const FactorWorkspace& /*other*/) : FactorWorkspace() {}
     FactorWorkspace& operator=(const FactorWorkspace& /*other*/) { return *this; }
@@ -358,10 +380,16 @@ class RigidContactSolver {
   };
   FactorWorkspace factorisation_;
   std::vector<CoulombRow> rows_;
-  Eigen::MatrixXd unit_impulses_;  // 3n x 3m: S G^T, node forces per unit contact impulse
-  Eigen::MatrixXd responses_;      // 3n x 3m: node velocities per unit contact impulse
+  std::vector<int> selected_;  // the rows in this solve's problem (indices into rows_)
+  static constexpr int kMaxRowRounds = 8;
+  Eigen::SparseMatrix<double> unit_impulses_;  // 3n x 3m: S G^T, node forces per unit impulse
+  Eigen::SparseMatrix<double> condensed_;      // 3n x 3m: L^-1 P S G^T (W_soft = its Gram matrix)
   CoulombProblem coulomb_;
   Eigen::VectorXd impulses_, contact_velocity_;
+  Eigen::VectorXd contact_forces_;     // 3n: S G^T r, the solved impulses' node forces
+  Eigen::VectorXd v_free_;             // 3n: the step's velocities without contact
+  Eigen::VectorXd fallback_velocity_;  // 3n: the solve's given velocities, kept for a fallback
+  Eigen::MatrixXd dense_condensed_;
 };
 
 }  // namespace torsion
