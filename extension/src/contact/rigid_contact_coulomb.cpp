@@ -151,8 +151,10 @@ LinearSolveReport RigidContactSolver::solveInContactSpace(const SystemOperator& 
   // The honest residual of the result: S (A v - b - G^T r), relative to the larger of the free
   // right-hand side and the contact impulses (a body at rest held by its contacts has a
   // right-hand side of rounding size).
-  op.multiply(v, product_);
-  r_ = product_ - b - contact_forces_;
+  // (scratch_, not product_: product_ holds the node impulses collectImpulses() reads, and with
+  // them what a supported partner receives.)
+  op.multiply(v, scratch_);
+  r_ = scratch_ - b - contact_forces_;
   constraints.filter(r_);
   const double scale = std::max(reference, contact_forces_.norm());
   report.relative_residual = scale > 0 ? r_.norm() / scale : 0.0;
