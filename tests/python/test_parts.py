@@ -81,3 +81,45 @@ def test_a_capsule_set_moving_coasts_at_its_velocity_without_gravity():
 def test_a_frame_prints_its_origin_and_rotation():
     text = repr(torsion.Frame(position=(1, 2, 3)))
     assert "1.0" in text and "quaternion=(0.0" in text
+
+
+def box_on_a_tilted_slab(degrees, friction_solve):
+    """A 1 kg box on a soft slab (1 x 1 x 0.2 m, base held) under gravity tilted by `degrees`
+    about y; mu = 0.5 (the body's 1.0 times the box's 0.5). Returns the box's x after 0.5 s."""
+    a = np.radians(degrees)
+    world = torsion.World(gravity=(9.81 * np.sin(a), 0, -9.81 * np.cos(a)), dt=0.01,
+                          tolerance=1e-6, max_iterations=1000, threads=1)
+    nodes, tets = cube_mesh(4)
+    nodes = nodes * [1.0, 1.0, 0.2]
+    slab = world.add_body("slab", nodes=nodes, tets=tets,
+                          material=torsion.Material(E=1e6, nu=0.3, rho=200, stiffness_damping=0.01))
+    slab.friction_solve = friction_solve
+    assert slab.friction_solve == friction_solve
+    world.add_node_set("base", slab, plane=((0, 0, 0), (0, 0, 1)))
+    box = world.add_rigid_body("box", "box", half_extents=(0.15, 0.15, 0.05), mass=1.0,
+                               frame=torsion.Frame(position=(0.35, 0.5, 0.2 + 0.05 + 1e-4)),
+                               friction=0.5)
+    x0 = box.position[0]
+    world.step(50)
+    return box.position[0] - x0
+
+
+@pytest.mark.parametrize("friction_solve", ["active_set", "contact_space"])
+def test_a_box_on_a_soft_slab_holds_below_the_friction_angle_and_slides_as_coulomb_above(
+        friction_solve):
+    # atan(0.5) = 26.6 deg. 20 deg below: held (the landing's slip and the slab's shear only).
+    assert abs(box_on_a_tilted_slab(20, friction_solve)) < 2e-3
+    # 35 deg: Coulomb's 0.5 g (sin a - mu cos a) t^2 = 0.201 m in 0.5 s; dropped 0.1 mm onto the
+    # slope, the box first falls freely along it for 5 ms (+4 %), hence 10 %.
+    a = np.radians(35)
+    coulomb = 0.5 * 9.81 * (np.sin(a) - 0.5 * np.cos(a)) * 0.5 ** 2
+    assert box_on_a_tilted_slab(35, friction_solve) == pytest.approx(coulomb, rel=0.1)
+
+
+def test_friction_solve_names_what_it_accepts():
+    world = torsion.World()
+    nodes, tets = cube_mesh(1)
+    body = world.add_body("cube", nodes=nodes, tets=tets)
+    assert body.friction_solve == "active_set"
+    with pytest.raises(ValueError, match="active_set.*contact_space.*exact"):
+        body.friction_solve = "exact"

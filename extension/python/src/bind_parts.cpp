@@ -173,6 +173,30 @@ void bindParts(py::module_& m) {
             return vectorArray(out.data(), static_cast<py::ssize_t>(out.size()));
           },
           "Per tet, dimensionless: equivalent strain sqrt(2/3 dev(eps):dev(eps)).")
+      .def_property(
+          "friction_solve",
+          [](const B& b) {
+            return b.body->contacts().settings().friction_solve ==
+                           ContactSettings::FrictionSolve::kContactSpace
+                       ? "contact_space"
+                       : "active_set";
+          },
+          [](const B& b, const std::string& how) {
+            ContactSettings::FrictionSolve solve;
+            if (how == "active_set") {
+              solve = ContactSettings::FrictionSolve::kActiveSet;
+            } else if (how == "contact_space") {
+              solve = ContactSettings::FrictionSolve::kContactSpace;
+            } else {
+              throw py::value_error("friction_solve: expected \"active_set\" or \"contact_space\", "
+                                    "got \"" + how + "\"");
+            }
+            WorldGuard guard(*b.world, WorldGuard::kWrite);
+            b.body->contacts().settings().friction_solve = solve;
+          },
+          "How the body's contacts with rigid bodies decide stick, slide and separation: "
+          "\"active_set\" (default) or \"contact_space\" (Coulomb's law solved for all contacts "
+          "at once; a step that does not converge falls back to the active set).")
       .def_property_readonly(
           "kinetic_energy", [](const B& b) { return b.body->lastReport().kinetic_energy; },
           "J, at the end of the last step")

@@ -80,7 +80,8 @@ struct ContactSettings {
   /// kContactSpace (experimental) factorises the step's matrix, condenses it onto the contacts and
   /// solves Coulomb's law there for all of them at once (coulomb_problem.h): the states are
   /// consistent with the impulses by construction; it holds a box at the stick/slip threshold on
-  /// soft slabs where the active set lets it creep, but converges slowly on stiff ones. A body in
+  /// soft slabs where the active set lets it creep, but converges slowly on stiff ones (a step
+  /// that does not converge falls back to the active set: coulomb_fallback). A body in
   /// FEM-FEM contact (whose pair penalties the factor does not hold) always uses the active set.
   enum class FrictionSolve { kActiveSet, kContactSpace };
   FrictionSolve friction_solve = FrictionSolve::kActiveSet;
@@ -390,6 +391,7 @@ class RigidContactSolver {
   Eigen::VectorXd v_free_;             // 3n: the step's velocities without contact
   Eigen::VectorXd fallback_velocity_;  // 3n: the solve's given velocities, kept for a fallback
   Eigen::MatrixXd dense_condensed_;
+  Eigen::VectorXd cold_start_, cold_velocity_;  // the retry from zero impulses
 };
 
 }  // namespace torsion
