@@ -264,16 +264,16 @@ TEST(Sliding, BoxHoldsOneDegreeBelowTheFrictionAngleAndSlidesOneDegreeAboveOnEve
 // The same threshold with Coulomb's law solved in contact space (ContactSettings::kContactSpace,
 // docs/contact.md, "Coulomb's law solved in contact space"): every contact's stick, slide or
 // separation consistent with the step's impulses, instead of states switched between CG solves; a
-// step whose Coulomb problem does not converge is solved by the active set instead. 1 deg above
-// the friction angle every slab slides within 5 % of Coulomb's distance (measured +3.2 %, +1.2 %,
-// -2.8 %, +1.8 %; the active set: +8.9 %, +2.0 %, +9.6 %, +3.1 %). 1 deg below, the soft slabs move
-// 1.5 mm (tet4) and 2.0 mm (tet10) in 1 s, against 3.0 and 3.3 mm with the active set: the elastic
-// shear under the pull is 0.23 mm, the rest a creep while most contacts under the box's edges
-// slide and from the steps that fell back. The stiff slabs move 0.3 um.
+// step whose Coulomb problem does not converge is retried from zero impulses, then solved by the
+// active set. 1 deg above the friction angle every slab slides within 5 % of Coulomb's distance
+// (measured +3.7 %, +1.2 %, +3.5 %, +0.2 %; the active set: +8.9 %, +2.0 %, +9.6 %, +3.1 %). 1 deg
+// below, the soft slabs move 0.45 mm (tet4) and 1.2 mm (tet10) in 1 s, against 3.0 and 3.3 mm with
+// the active set: the elastic shear under the pull is 0.23 mm, the rest a creep while most
+// contacts under the box's edges slide. The stiff slabs move 1.1 and 0.4 um.
 TEST(Sliding, CoulombSolvedInContactSpaceHoldsTheBoxBelowTheFrictionAngleOnEverySlab) {
-  expectThresholds({{1e5, 20, ElementKind::kTet4, 2.5e-3, 0.05},
+  expectThresholds({{1e5, 20, ElementKind::kTet4, 2e-3, 0.05},
                     {1e8, 20, ElementKind::kTet4, 1e-5, 0.05},
-                    {1e5, 10, ElementKind::kTet10, 2.5e-3, 0.05},
+                    {1e5, 10, ElementKind::kTet10, 2e-3, 0.05},
                     {1e8, 10, ElementKind::kTet10, 1e-5, 0.05}},
                    ContactSettings::FrictionSolve::kContactSpace, ", contact space");
 }

@@ -188,8 +188,10 @@ void bindParts(py::module_& m) {
             } else if (how == "contact_space") {
               solve = ContactSettings::FrictionSolve::kContactSpace;
             } else {
-              throw py::value_error("friction_solve: expected \"active_set\" or \"contact_space\", "
-                                    "got \"" + how + "\"");
+              throw py::value_error(
+                  "friction_solve: expected \"active_set\" or \"contact_space\", "
+                  "got \"" +
+                  how + "\"");
             }
             WorldGuard guard(*b.world, WorldGuard::kWrite);
             b.body->contacts().settings().friction_solve = solve;

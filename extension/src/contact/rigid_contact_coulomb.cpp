@@ -29,12 +29,8 @@ Eigen::Matrix<double, 3, 6> pointJacobian(const Eigen::Vector3d& r) {
 bool RigidContactSolver::solvesInContactSpace(const SystemOperator& op) const {
   // The factor holds M and K (and the volume barrier's blocks), not an added operator term: a body
   // in FEM-FEM contact (its pair penalties) keeps the active set.
-  // Multibody links keep it too: an anchored light multibody pendulum blew up within 20 steps in
-  // contact space (not yet understood; docs/contact.md).
-  const bool touches_link = std::any_of(partners_.begin(), partners_.end(),
-                                        [](const RigidPartner& k) { return k.link != nullptr; });
   return settings_.friction_solve == ContactSettings::FrictionSolve::kContactSpace &&
-         op.addedTerm() == nullptr && !touches_link;
+         op.addedTerm() == nullptr;
 }
 
 void RigidContactSolver::gatherCoulombRows() {
