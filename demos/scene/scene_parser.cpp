@@ -349,11 +349,10 @@ BodySpec readBody(const JsonObject& b, const SceneSpec& scene, const std::string
     if (Status valid = self.validate(); !valid) b.fail("self_contact", valid.error().message);
     body.self_contact = self;
   }
-  const std::string friction_solve = b.string("friction_solve", "active_set");
-  if (friction_solve == "active_set") {
-    body.friction_solve = ContactSettings::FrictionSolve::kActiveSet;
-  } else if (friction_solve == "contact_space") {
-    body.friction_solve = ContactSettings::FrictionSolve::kContactSpace;
+  const std::string friction_solve =
+      b.string("friction_solve", frictionSolveName(body.friction_solve));
+  if (const auto solve = frictionSolveFromName(friction_solve)) {
+    body.friction_solve = *solve;
   } else {
     b.fail("friction_solve",
            "'" + friction_solve + "' is not a friction solve (active_set or contact_space)");

@@ -176,25 +176,16 @@ void bindParts(py::module_& m) {
       .def_property(
           "friction_solve",
           [](const B& b) {
-            return b.body->contacts().settings().friction_solve ==
-                           ContactSettings::FrictionSolve::kContactSpace
-                       ? "contact_space"
-                       : "active_set";
+            return frictionSolveName(b.body->contacts().settings().friction_solve);
           },
           [](const B& b, const std::string& how) {
-            ContactSettings::FrictionSolve solve;
-            if (how == "active_set") {
-              solve = ContactSettings::FrictionSolve::kActiveSet;
-            } else if (how == "contact_space") {
-              solve = ContactSettings::FrictionSolve::kContactSpace;
-            } else {
+            const auto solve = frictionSolveFromName(how);
+            if (!solve)
               throw py::value_error(
-                  "friction_solve: expected \"active_set\" or \"contact_space\", "
-                  "got \"" +
-                  how + "\"");
-            }
+                  "friction_solve: expected \"active_set\" or \"contact_space\", got \"" + how +
+                  "\"");
             WorldGuard guard(*b.world, WorldGuard::kWrite);
-            b.body->contacts().settings().friction_solve = solve;
+            b.body->contacts().settings().friction_solve = *solve;
           },
           "How the body's contacts with rigid bodies decide stick, slide and separation: "
           "\"active_set\" (default) or \"contact_space\" (Coulomb's law solved for all contacts "

@@ -15,6 +15,18 @@
 
 namespace torsion {
 
+const char* frictionSolveName(ContactSettings::FrictionSolve solve) {
+  return solve == ContactSettings::FrictionSolve::kContactSpace ? "contact_space" : "active_set";
+}
+
+std::optional<ContactSettings::FrictionSolve> frictionSolveFromName(const std::string& name) {
+  for (ContactSettings::FrictionSolve solve : {ContactSettings::FrictionSolve::kActiveSet,
+                                               ContactSettings::FrictionSolve::kContactSpace}) {
+    if (name == frictionSolveName(solve)) return solve;
+  }
+  return std::nullopt;
+}
+
 namespace {
 
 // m/s: a body whose contacts all slid in the last step is sliding over the surface if it slips

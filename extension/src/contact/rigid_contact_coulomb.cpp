@@ -123,11 +123,8 @@ LinearSolveReport RigidContactSolver::solveInContactSpace(const SystemOperator& 
     solved = solveSelectedRows(constraints, warm, v);
     // Rows left out that the solved motion drives into the surface join the problem.
     std::vector<int> joining;
-    std::vector<char> in(static_cast<size_t>(all), 0);
-    for (int i : selected_)
-      in[static_cast<size_t>(i)] = 1;
     for (int i = 0; i < all; ++i) {
-      if (in[static_cast<size_t>(i)]) continue;
+      if (std::binary_search(selected_.begin(), selected_.end(), i)) continue;  // sorted
       const CoulombRow& row = rows_[static_cast<size_t>(i)];
       const RigidPartner& k = partners_[static_cast<size_t>(row.partner)];
       if (normalVelocity(row, v, k.velocity) < -settings_.coulomb_tolerance) joining.push_back(i);
@@ -286,9 +283,9 @@ bool RigidContactSolver::factoriseContactSystem(const Eigen::SparseMatrix<double
 }
 
 void RigidContactSolver::buildUnitImpulses(const NodeConstraints& constraints) {
-  // Column 3s + a: the node forces S G_i^T e_a of a unit impulse along axis a of the s-th
-  // selected row i (the
-  // weights of a face point spread it over the triangle's nodes; S leaves the free components).
+  // Column 3s + a: the node forces S G_i^T e_a of a unit impulse along axis a of the s-th selected
+  // row i (the weights of a face point spread it over the triangle's nodes; S leaves the free
+  // components).
   const int n = model_->nodeCount();
   std::vector<Eigen::Triplet<double>> entries;
   entries.reserve(27 * selected_.size());

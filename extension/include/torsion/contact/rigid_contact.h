@@ -42,6 +42,8 @@
 #include <Eigen/SparseCholesky>
 #include <Eigen/SparseCore>
 #include <memory>
+#include <optional>
+#include <string>
 #include <vector>
 
 #include "torsion/contact/coulomb_problem.h"
@@ -96,6 +98,12 @@ struct ContactSettings {
   /// (ContactStepStats::coulomb_fell_back); off, the unconverged impulses are kept.
   bool coulomb_fallback = true;
 };
+
+/// The names scene files and Python use for ContactSettings::FrictionSolve: "active_set",
+/// "contact_space".
+const char* frictionSolveName(ContactSettings::FrictionSolve solve);
+/// The solve `name` names, or nullopt.
+std::optional<ContactSettings::FrictionSolve> frictionSolveFromName(const std::string& name);
 
 /// One node in contact with one rigid object during a step.
 struct NodeContact {
