@@ -20,7 +20,9 @@ namespace {
 // hand after the world was built and turned about z.
 class BlockRig {
  public:
-  BlockRig() : world_(test::checkpointWorldSettings()) {
+  explicit BlockRig(
+      ContactSettings::FrictionSolve friction_solve = ContactSettings{}.friction_solve)
+      : world_(test::checkpointWorldSettings()) {
     Material material;
     material.youngs_modulus = 2e4;
     body_ =
@@ -28,6 +30,7 @@ class BlockRig {
             .addBody("block", makeBoxTetMesh({-0.2, -0.2, 0.02}, {0.2, 0.2, 0.42}, 2, 2, 2).value(),
                      material)
             .value();
+    body_->contacts().settings().friction_solve = friction_solve;
     btTransform slab;
     slab.setIdentity();
     slab.setOrigin(btVector3(0, 0, btScalar(-0.5)));
@@ -68,8 +71,11 @@ std::uint64_t fnv1a(const std::string& bytes, size_t from) {
 
 constexpr size_t kHeader = 28;  // magic, version, length, hash
 
-TEST(CheckpointIo, BytesReadIntoANewWorldContinueBitForBitWithContactsAndAGrab) {
-  BlockRig rig;
+// Saved after 40 steps, the world goes on 20; a world built the same way and read from the bytes
+// must take the same 20 steps to the bit (the contacts' warm starts included: states for the
+// active set, impulses for the contact-space solve).
+void expectBytesContinueBitForBit(ContactSettings::FrictionSolve friction_solve) {
+  BlockRig rig(friction_solve);
   for (int k = 0; k < 40; ++k)
     rig.step();
   ASSERT_FALSE(rig.body_->contacts().contacts().empty()) << "the block must rest on the slab";
@@ -78,7 +84,7 @@ TEST(CheckpointIo, BytesReadIntoANewWorldContinueBitForBitWithContactsAndAGrab) 
   for (int k = 0; k < 20; ++k)
     rig.step();
 
-  BlockRig fresh;  // built the same way, never stepped, nothing grabbed
+  BlockRig fresh(friction_solve);  // built the same way, never stepped, nothing grabbed
   ASSERT_TRUE(fresh.load(bytes).ok());
   EXPECT_TRUE(fresh.hand_->grabbed());
   for (int k = 0; k < 20; ++k)
@@ -88,6 +94,14 @@ TEST(CheckpointIo, BytesReadIntoANewWorldContinueBitForBitWithContactsAndAGrab) 
             0.0);
   EXPECT_EQ(fresh.hand_->wrench().torque, rig.hand_->wrench().torque);
   EXPECT_GT(rig.hand_->wrench().torque.norm(), 1e-4) << "the block must be twisted";
+}
+
+TEST(CheckpointIo, BytesReadIntoANewWorldContinueBitForBitWithContactsAndAGrab) {
+  expectBytesContinueBitForBit(ContactSettings::FrictionSolve::kActiveSet);
+}
+
+TEST(CheckpointIo, BytesCarryTheContactSpaceSolvesImpulsesAndContinueBitForBit) {
+  expectBytesContinueBitForBit(ContactSettings::FrictionSolve::kContactSpace);
 }
 
 TEST(CheckpointIo, TruncatedForeignOrAlteredBytesAreRefusedWithTheirReason) {

@@ -10,7 +10,8 @@ CarriedContacts RigidContactSolver::carriedContacts() const {
   CarriedContacts carried;
   for (const NodeContact& c : contacts_) {
     if (c.state == NodeContact::State::kInactive || c.held) continue;
-    carried.nodes.push_back({c.node, partners_[static_cast<size_t>(c.partner)].object, c.state});
+    carried.nodes.push_back(
+        {c.node, partners_[static_cast<size_t>(c.partner)].object, c.state, c.impulse});
   }
   for (const FaceContact& c : faces_.contacts()) {
     if (c.state == FaceContact::State::kInactive) continue;
@@ -41,6 +42,7 @@ void RigidContactSolver::restoreCarriedContacts(const CarriedContacts& carried) 
     c.node = n.node;
     c.partner = partner(n.object);
     c.state = n.state;
+    c.impulse = n.impulse;
     contacts_.push_back(c);
   }
   std::vector<FaceContact> faces;

@@ -7,6 +7,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <limits>
 
 namespace torsion {
 
@@ -264,8 +265,16 @@ CoulombReport solveCoulomb(const CoulombProblem& problem, const CoulombSettings&
   // A few sweeps find the states; Newton then converges fast whatever W's conditioning (a box
   // on a stiff slab: W is the box's rank-6 response plus a small compliance); sweeps take over
   // where a Newton step fails to make progress.
+  // The best iterate is kept: the sweeps' residual is not monotone, and an unconverged solve
+  // should end on its best answer, not its last.
   int newton_steps = 0;
+  double best = std::numeric_limits<double>::infinity();
+  Eigen::VectorXd best_r = r;
   while (report.sweeps < settings.max_sweeps && !converged()) {
+    if (report.residual < best) {
+      best = report.residual;
+      best_r = r;
+    }
     const bool try_newton = m <= settings.newton_max_contacts &&
                             report.sweeps >= settings.sweeps_before_newton &&
                             newton_steps < settings.max_newton_steps;
@@ -276,6 +285,10 @@ CoulombReport solveCoulomb(const CoulombProblem& problem, const CoulombSettings&
     }
     sweep(ws, r, velocity);
     ++report.sweeps;
+  }
+  if (report.residual > best) {
+    report.residual = best;
+    r = best_r;
   }
   report.converged = report.residual <= std::max(settings.tolerance, settings.acceptable);
   // The velocities of the final impulses, free of the sweeps' accumulated rounding.

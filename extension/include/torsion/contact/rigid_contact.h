@@ -167,6 +167,8 @@ struct CarriedContacts {
     int node = -1;
     const btCollisionObject* object = nullptr;
     NodeContact::State state = NodeContact::State::kSlide;
+    /// N s: the contact-space solve's warm start (the active set starts from the states alone).
+    Eigen::Vector3d impulse = Eigen::Vector3d::Zero();
   };
   struct Face {
     std::array<int, 3> key{};
@@ -391,6 +393,7 @@ class RigidContactSolver {
   std::vector<CoulombRow> rows_;
   std::vector<int> selected_;  // the rows in this solve's problem (indices into rows_)
   static constexpr int kMaxRowRounds = 8;
+  static constexpr double kFaceOnNode = 0.9;   // gatherCoulombRows()
   Eigen::SparseMatrix<double> unit_impulses_;  // 3n x 3m: S G^T, node forces per unit impulse
   Eigen::SparseMatrix<double> condensed_;      // 3n x 3m: L^-1 P S G^T (W_soft = its Gram matrix)
   CoulombProblem coulomb_;
