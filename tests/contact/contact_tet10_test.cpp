@@ -207,5 +207,26 @@ TEST(ContactTet10, BoxRestsOnSlabWithConvergedSag) {
   EXPECT_NEAR(run.sag, reference, 0.1 * reference);
 }
 
+// The same box landing on the same slab with Coulomb's law solved in contact space: every step's
+// problem converges (none falls back to the active set) and the box rests above the slab. The
+// box's edges put face points on slab nodes that are rows themselves (weights 0.986); kept as
+// rows, those near-copies made W nearly singular and every step after the landing stalled at
+// 1e-5 m/s (docs/contact.md, "Coulomb's law solved in contact space", step 2).
+TEST(ContactTet10, ABoxLandingOnASlabInContactSpaceConvergesEveryStep) {
+  PunchProblem p;
+  p.punch_half_width = 0.27;
+  p.load = 20 * kGravity;
+  p.material = softMaterial(2e4, 100);
+  const RestingBoxRun run =
+      runRestingBox(p, 8, 2, ElementKind::kTet10, 0.5, p.punch_half_width - 0.001,
+                    ContactSettings::FrictionSolve::kContactSpace);
+  std::cout << "[figures] box landing on tet10 slab, contact space: " << run.fell_back_steps
+            << " of 50 steps fell back, worst penetration " << run.worst_penetration
+            << " m, off centre " << run.off_centre << " m\n";
+  EXPECT_EQ(run.fell_back_steps, 0);
+  EXPECT_LT(run.worst_penetration, 1e-4);
+  EXPECT_LT(run.off_centre, 1e-3);
+}
+
 }  // namespace
 }  // namespace torsion::test

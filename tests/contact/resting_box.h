@@ -28,14 +28,16 @@ struct RestingBoxRun {
   int slab_nodes = 0;
   int most_active_set_iterations = 0;  ///< per step, over the run
   int unconverged_steps = 0;           ///< active set not settled within its cap
-  long cg_iterations = 0;              ///< over the run
+  int fell_back_steps = 0;  ///< contact-space solve unconverged, the active set's result taken
+  long cg_iterations = 0;   ///< over the run
 };
 
 /// `p` gives the slab, the box's footprint (half-width c) and weight; the box is 0.1 m high and
 /// starts 2 cm above the slab. The slab's node rows are at +-`row` (punchSlabMesh). Steps of
 /// 0.01 s for `seconds`.
-inline RestingBoxRun runRestingBox(const PunchProblem& p, int cells_across, int cells_thick,
-                                   ElementKind element, double seconds, double row) {
+inline RestingBoxRun runRestingBox(
+    const PunchProblem& p, int cells_across, int cells_thick, ElementKind element, double seconds,
+    double row, ContactSettings::FrictionSolve friction_solve = ContactSettings{}.friction_solve) {
   const double box_half_height = 0.05, box_mass = p.load / p.gravity;
   FemWorld world(contactSettings(0.01));
   Result<FemBody*> added = world.addBody("slab", punchSlabMesh(p, cells_across, cells_thick, row),
@@ -45,6 +47,7 @@ inline RestingBoxRun runRestingBox(const PunchProblem& p, int cells_across, int 
     return {};
   }
   FemBody* slab = added.value();
+  slab->contacts().settings().friction_solve = friction_solve;
   std::vector<int> base;
   for (int i = 0; i < slab->model().nodeCount(); ++i) {
     if (slab->state().position(i).z() < 1e-9) base.push_back(i);
@@ -68,6 +71,7 @@ inline RestingBoxRun runRestingBox(const PunchProblem& p, int cells_across, int 
     run.most_active_set_iterations =
         std::max(run.most_active_set_iterations, stats.active_set_iterations);
     if (!stats.active_set_converged) ++run.unconverged_steps;
+    if (stats.coulomb_fell_back) ++run.fell_back_steps;
     run.cg_iterations += slab->lastReport().solve.iterations;
     // Measured on the geometry after each step, every node (tet10: mid-edge nodes too).
     for (int i = 0; i < slab->model().nodeCount(); ++i) {
