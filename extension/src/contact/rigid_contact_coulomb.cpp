@@ -206,9 +206,12 @@ CoulombReport RigidContactSolver::solveSelectedRows(const NodeConstraints& const
   CoulombProblem& problem = coulomb_;
   dense_condensed_ = condensed_;
   problem.delassus.resize(3 * m, 3 * m);
-  problem.delassus.triangularView<Eigen::Lower>() = dense_condensed_.transpose() * dense_condensed_;
-  problem.delassus.triangularView<Eigen::StrictlyUpper>() =
-      problem.delassus.transpose().triangularView<Eigen::StrictlyUpper>();
+  if (m > 0) {  // (Eigen's triangular product reads a null pointer for an empty matrix)
+    problem.delassus.triangularView<Eigen::Lower>() =
+        dense_condensed_.transpose() * dense_condensed_;
+    problem.delassus.triangularView<Eigen::StrictlyUpper>() =
+        problem.delassus.transpose().triangularView<Eigen::StrictlyUpper>();
+  }
   problem.free_velocity.setZero(3 * m);
   problem.normal.resize(static_cast<size_t>(m));
   problem.friction.resize(static_cast<size_t>(m));
