@@ -54,8 +54,10 @@ void RigidContactSolver::gatherCoulombRows() {
   // kFaceOnNode) while that node is a row against the same partner adds a second, slightly
   // tilted copy of the node's constraint: the pair makes W nearly singular and the solve stalls
   // (measured: a box resting on a tet10 slab, 52 such face points at the box's edges, residual
-  // stuck near 1e-5 m/s). The node's row holds that point.
-  std::vector<int> node_row(static_cast<size_t>(model_->nodeCount()), -1);
+  // stuck near 1e-5 m/s). The node's row holds that point. (A node touching two partners keeps
+  // its last row here: a face point on it may then stay a row, which is only the former cost.)
+  std::vector<int>& node_row = node_row_;
+  node_row.assign(static_cast<size_t>(model_->nodeCount()), -1);
   for (size_t i = 0; i < rows_.size(); ++i)
     node_row[static_cast<size_t>(rows_[i].nodes[0])] = static_cast<int>(i);
   const std::vector<FaceContact>& faces = faces_.contacts();

@@ -392,6 +392,7 @@ class RigidContactSolver {
   FactorWorkspace factorisation_;
   std::vector<CoulombRow> rows_;
   std::vector<int> selected_;  // the rows in this solve's problem (indices into rows_)
+  std::vector<int> node_row_;  // gatherCoulombRows(): each node's row, or -1 (kept capacity)
   static constexpr int kMaxRowRounds = 8;
   static constexpr double kFaceOnNode = 0.9;   // gatherCoulombRows()
   Eigen::SparseMatrix<double> unit_impulses_;  // 3n x 3m: S G^T, node forces per unit impulse
