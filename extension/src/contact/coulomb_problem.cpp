@@ -53,10 +53,10 @@ namespace {
 struct Workspace {
   const CoulombProblem& problem;
   const Eigen::MatrixXd& W;
-  // W plus a small compliance on its diagonal (1e-6 of its largest entry), for the Newton steps'
-  // Jacobian only (F itself is always W's): W is only semi-definite where contacts constrain the
-  // same motion (a face point and the nodes of its triangle), and a box on a stiff slab makes it
-  // nearly so; the exact Jacobian's steps then run along that null space (impulses moved between
+  // W plus a small compliance on its diagonal (CoulombSettings::newton_regularization of its
+  // largest entry, 1e-6 by default), for the Newton steps' Jacobian only (F itself is always
+  // W's): W is only semi-definite where contacts constrain the same motion (a face point and the
+  // nodes of its triangle), and a box on a stiff slab makes it nearly so; the exact Jacobian's steps then run along that null space (impulses moved between
   // redundant contacts, 10 to 100 times the impulses themselves) and the line search stalls.
   // Measured on a box landing on a stiff slab (21 contacts): 1e-10 took 41 steps, 1e-6 24,
   // 1e-4 did not converge in 50.
@@ -71,10 +71,10 @@ struct Workspace {
   }
 };
 
-Workspace prepare(const CoulombProblem& problem) {
+Workspace prepare(const CoulombProblem& problem, const CoulombSettings& settings) {
   Workspace ws{problem, problem.delassus, {}, problem.size(), {}, {}, {}, {}};
   ws.W_newton = ws.W;
-  ws.W_newton.diagonal().array() += 1e-6 * ws.W.diagonal().maxCoeff();
+  ws.W_newton.diagonal().array() += settings.newton_regularization * ws.W.diagonal().maxCoeff();
   const size_t m = static_cast<size_t>(ws.m);
   ws.normal_step.assign(m, 0.0);
   ws.tangent_step.assign(m, 0.0);
@@ -257,7 +257,7 @@ CoulombReport solveCoulomb(const CoulombProblem& problem, const CoulombSettings&
     report.converged = true;
     return report;
   }
-  const Workspace ws = prepare(problem);
+  const Workspace ws = prepare(problem, settings);
   auto converged = [&]() {
     report.residual = worstResidual(ws, r, velocity);
     return report.residual <= settings.tolerance;

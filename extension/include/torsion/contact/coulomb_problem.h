@@ -51,6 +51,10 @@ struct CoulombSettings {
   int sweeps_before_newton = 5;
   int max_newton_steps = 50;
   int newton_max_contacts = 60;
+  /// The Newton steps' Jacobian uses W plus this times W's largest diagonal entry: W is only
+  /// semi-definite where contacts constrain the same motion (coulomb_problem.cpp). 0 for a
+  /// problem whose W is definite (the FEM-rigid solve adds a contact compliance itself).
+  double newton_regularization = 1e-6;
   /// m/s: at max_sweeps, a result whose residual is below this still counts as converged (0: only
   /// the tolerance counts). The FEM-rigid contact solve accepts 1e-6 m/s: the slips of a body
   /// resting on a stiff slab are resolved to 1e-7 m/s only in thousands of sweeps.
