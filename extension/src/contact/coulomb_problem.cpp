@@ -56,10 +56,10 @@ struct Workspace {
   // W plus a small compliance on its diagonal (CoulombSettings::newton_regularization of its
   // largest entry, 1e-6 by default), for the Newton steps' Jacobian only (F itself is always
   // W's): W is only semi-definite where contacts constrain the same motion (a face point and the
-  // nodes of its triangle), and a box on a stiff slab makes it nearly so; the exact Jacobian's steps then run along that null space (impulses moved between
-  // redundant contacts, 10 to 100 times the impulses themselves) and the line search stalls.
-  // Measured on a box landing on a stiff slab (21 contacts): 1e-10 took 41 steps, 1e-6 24,
-  // 1e-4 did not converge in 50.
+  // nodes of its triangle), and a box on a stiff slab makes it nearly so; the exact Jacobian's
+  // steps then run along that null space (impulses moved between redundant contacts, 10 to 100
+  // times the impulses themselves) and the line search stalls. Measured on a box landing on a stiff
+  // slab (21 contacts): 1e-10 took 41 steps, 1e-6 24, 1e-4 did not converge in 50.
   Eigen::MatrixXd W_newton;
   int m;
   std::vector<double> normal_step, tangent_step;
