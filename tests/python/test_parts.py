@@ -120,6 +120,6 @@ def test_friction_solve_names_what_it_accepts():
     world = torsion.World()
     nodes, tets = cube_mesh(1)
     body = world.add_body("cube", nodes=nodes, tets=tets)
-    assert body.friction_solve == "contact_space"
+    assert body.friction_solve == "active_set"
     with pytest.raises(ValueError, match="active_set.*contact_space.*exact"):
         body.friction_solve = "exact"

@@ -1,4 +1,4 @@
-// The body key "friction_solve" (contact_space | active_set, default contact_space): how the body's
+// The body key "friction_solve" (active_set | contact_space, default active_set): how the body's
 // contacts with rigid bodies decide stick and slide (docs/contact.md, "Coulomb's law solved in
 // contact space"). Parsed, rejected with the key named, and carried onto the built body.
 #include <gtest/gtest.h>
@@ -16,14 +16,14 @@ std::string sceneWith(const std::string& entry) {
          R"( "material": {"youngs_modulus": 5e4, "poisson_ratio": 0.3, "density": 300}}]})";
 }
 
-TEST(SceneFrictionSolveKey, DefaultsToContactSpaceAndReadsTheActiveSet) {
+TEST(SceneFrictionSolveKey, DefaultsToTheActiveSetAndReadsContactSpace) {
   Result<SceneSpec> plain = parseScene(sceneWith(""), "s.json", "/base");
   ASSERT_TRUE(plain.ok()) << plain.error().message;
-  EXPECT_EQ(plain.value().bodies[0].friction_solve, ContactSettings::FrictionSolve::kContactSpace);
-  Result<SceneSpec> rules =
-      parseScene(sceneWith(R"( "friction_solve": "active_set",)"), "s.json", "/base");
-  ASSERT_TRUE(rules.ok()) << rules.error().message;
-  EXPECT_EQ(rules.value().bodies[0].friction_solve, ContactSettings::FrictionSolve::kActiveSet);
+  EXPECT_EQ(plain.value().bodies[0].friction_solve, ContactSettings::FrictionSolve::kActiveSet);
+  Result<SceneSpec> space =
+      parseScene(sceneWith(R"( "friction_solve": "contact_space",)"), "s.json", "/base");
+  ASSERT_TRUE(space.ok()) << space.error().message;
+  EXPECT_EQ(space.value().bodies[0].friction_solve, ContactSettings::FrictionSolve::kContactSpace);
 }
 
 TEST(SceneFrictionSolveKey, AnUnknownSolveOrWrongTypeNamesTheKey) {
@@ -37,9 +37,9 @@ TEST(SceneFrictionSolveKey, AnUnknownSolveOrWrongTypeNamesTheKey) {
 
 TEST(SceneFrictionSolveKey, TheBuiltBodyUsesTheSolveTheSceneNames) {
   for (const auto& [entry, expected] :
-       {std::pair{std::string(), ContactSettings::FrictionSolve::kContactSpace},
-        std::pair{std::string(R"( "friction_solve": "active_set",)"),
-                  ContactSettings::FrictionSolve::kActiveSet}}) {
+       {std::pair{std::string(), ContactSettings::FrictionSolve::kActiveSet},
+        std::pair{std::string(R"( "friction_solve": "contact_space",)"),
+                  ContactSettings::FrictionSolve::kContactSpace}}) {
     Result<SceneSpec> spec = parseScene(sceneWith(entry), "s.json", "/base");
     ASSERT_TRUE(spec.ok()) << spec.error().message;
     Result<std::unique_ptr<BuiltScene>> built = buildScene(spec.value());

@@ -188,9 +188,8 @@ void bindParts(py::module_& m) {
             b.body->contacts().settings().friction_solve = *solve;
           },
           "How the body's contacts with rigid bodies decide stick, slide and separation: "
-          "\"contact_space\" (default: Coulomb's law solved for all contacts at once; a step "
-          "that does not converge falls back to the active set) or \"active_set\" (states "
-          "switched between linear solves by rules).")
+          "\"active_set\" (default) or \"contact_space\" (Coulomb's law solved for all contacts "
+          "at once; a step that does not converge falls back to the active set).")
       .def_property_readonly(
           "kinetic_energy", [](const B& b) { return b.body->lastReport().kinetic_energy; },
           "J, at the end of the last step")

@@ -78,16 +78,15 @@ struct ContactSettings {
   /// stated penetration tolerance of a rigid feature between nodes).
   double face_gap_tolerance = 1e-5;
   /// How stick, slide and separation are decided (docs/contact.md, "Coulomb's law solved in
-  /// contact space"). kContactSpace (the default) factorises the step's matrix, condenses it onto
-  /// the contacts and solves Coulomb's law there for all of them at once (coulomb_problem.h): the
-  /// states are consistent with the impulses by construction, and a box holds at the stick/slip
-  /// threshold and slides as Coulomb says on soft and stiff, coarse and fine slabs (a step that
-  /// does not converge falls back to the active set: coulomb_fallback). kActiveSet switches states
-  /// between CG solves by rules (on soft slabs a box 1 deg below the friction angle creeps 3 mm in
-  /// 1 s). A body in FEM-FEM contact (whose pair penalties the factor does not hold) always uses
-  /// the active set.
+  /// contact space"). kActiveSet (the default) switches states between CG solves by rules.
+  /// kContactSpace (experimental) factorises the step's matrix, condenses it onto the contacts and
+  /// solves Coulomb's law there for all of them at once (coulomb_problem.h): the states are
+  /// consistent with the impulses by construction; it holds a box at the stick/slip threshold on
+  /// soft slabs where the active set lets it creep (a step that does not converge falls back to
+  /// the active set: coulomb_fallback). A body in FEM-FEM contact (whose pair penalties the factor
+  /// does not hold) always uses the active set.
   enum class FrictionSolve { kActiveSet, kContactSpace };
-  FrictionSolve friction_solve = FrictionSolve::kContactSpace;
+  FrictionSolve friction_solve = FrictionSolve::kActiveSet;
   /// m/s: the contact-space solve iterates until every contact satisfies Coulomb's law to this;
   /// a step that ends its sweeps within coulomb_acceptable counts as converged.
   double coulomb_tolerance = 1e-7;
