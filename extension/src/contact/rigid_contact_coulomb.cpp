@@ -258,8 +258,8 @@ CoulombReport RigidContactSolver::solveSelectedRows(const NodeConstraints& const
   // contacts constrain the same motion (a rigid box on a stiff slab: its rank-6 response plus a
   // compliance 10^-10 of it, so the split of its load between the contacts is barely determined),
   // and the sweeps and Newton steps crawled there (a box sliding at up to 1.8 m/s over a coarse
-  // stiff slab: a third of its steps ended at 1e-6 to 1e-5 m/s after 3000 sweeps). With it W is definite, the Newton steps use it exactly,
-  // and those steps converge in a few.
+  // stiff slab: a third of its steps ended at 1e-6 to 1e-5 m/s after 3000 sweeps). With it W is
+  // definite, the Newton steps use it exactly, and those steps converge in a few.
   if (m > 0 && settings_.coulomb_compliance > 0)
     problem.delassus.diagonal().array() +=
         settings_.coulomb_compliance * problem.delassus.diagonal().maxCoeff();
