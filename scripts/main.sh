@@ -7,7 +7,8 @@ cd "$(dirname "$0")/.."
 jobs=$(nproc 2>/dev/null || echo 2)
 
 bash scripts/setup.sh
-cmake -S . -B build -G Ninja -DCMAKE_BUILD_TYPE=Release
+# Unity batches (TORSION_UNITY_BUILD) halve a clean build's minutes on 2 cores.
+cmake -S . -B build -G Ninja -DCMAKE_BUILD_TYPE=Release -DTORSION_UNITY_BUILD=ON
 cmake --build build -j"$jobs" --target torsion
 
 scene=demos/scenes/twist_cylinder_2430.json

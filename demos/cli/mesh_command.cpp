@@ -4,6 +4,7 @@
 #include <iostream>
 #include <memory>
 
+#include "cli_messages.h"
 #include "mesh_generate_command.h"
 #include "structured_mesh_command.h"
 #include "torsion/mesh/mesh_io.h"
@@ -25,11 +26,6 @@ struct ConvertOptions {
   bool refuse_inverted = false;
   bool reorder = false;  // renumber the nodes in reverse Cuthill-McKee order
 };
-
-void printWarnings(const LoadedMesh& loaded) {
-  for (const std::string& w : loaded.warnings)
-    std::cerr << "warning: " << w << "\n";
-}
 
 int runInfo(const InfoOptions& options) {
   Result<LoadedMesh> loaded = readMesh(options.file, {options.refuse_inverted});

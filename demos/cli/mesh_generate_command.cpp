@@ -6,6 +6,7 @@
 #include <memory>
 #include <string>
 
+#include "cli_messages.h"
 #include "cylinder_mesher.h"
 #include "gmsh_runner.h"
 #include "surface_mesh.h"
@@ -51,16 +52,6 @@ struct TetrahedralizeOptions {
   bool keep_surface = false;
   bool verbose = false;
 };
-
-int fail(const std::string& message) {
-  std::cerr << "error: " << message << "\n";
-  return 1;
-}
-
-void printWarnings(const LoadedMesh& loaded) {
-  for (const std::string& w : loaded.warnings)
-    std::cerr << "warning: " << w << "\n";
-}
 
 std::string number(double x) {
   char buffer[64];

@@ -5,6 +5,7 @@
 #include <iostream>
 #include <memory>
 
+#include "cli_messages.h"
 #include "device_options.h"
 #include "frame_recorder.h"
 #include "progress_bar.h"
@@ -177,11 +178,6 @@ Ran runWithProgress(const RunArguments& args, scene::BuiltScene& s, render::Fram
   }
   if (normal) bar.finish();
   return ran;
-}
-
-int fail(const std::string& message) {
-  std::cerr << "error: " << message << "\n";
-  return 1;
 }
 
 // Exit codes: 0 done and stable, 1 bad input or output error, 3 the simulation went unstable,

@@ -6,6 +6,7 @@
 #include <string>
 #include <vector>
 
+#include "cli_messages.h"
 #include "torsion/mesh/ball_mesh.h"
 #include "torsion/mesh/box_mesh.h"
 #include "torsion/mesh/mesh_io.h"
@@ -26,11 +27,6 @@ struct BallOptions {
   std::vector<double> center{0, 0, 0};
   std::string output;
 };
-
-int fail(const std::string& message) {
-  std::cerr << "error: " << message << "\n";
-  return 1;
-}
 
 int write(const std::string& command, const Result<TetMesh>& mesh, const std::string& output,
           const std::string& what) {

@@ -27,16 +27,18 @@ bool prefersWallClockTime(DeviceSpec::Kind kind) {
   return livesInWallClockTime(kind) || kind == DeviceSpec::Kind::kPlugin;
 }
 
-double percentile(std::vector<double> values, double p) {
+// The value at rank round(p (n - 1)) of the sorted values (no interpolation: a reported p99 is a
+// latency that occurred).
+double nearestRankPercentile(std::vector<double> values, double p) {
   if (values.empty()) return 0;
   std::sort(values.begin(), values.end());
   return values[static_cast<size_t>(std::lround(p * static_cast<double>(values.size() - 1)))];
 }
 
 nlohmann::json spread(const std::vector<double>& values) {
-  return {{"p50", percentile(values, 0.5)},
-          {"p99", percentile(values, 0.99)},
-          {"max", percentile(values, 1.0)}};
+  return {{"p50", nearestRankPercentile(values, 0.5)},
+          {"p99", nearestRankPercentile(values, 0.99)},
+          {"max", nearestRankPercentile(values, 1.0)}};
 }
 
 std::string fileSafe(const std::string& name) {

@@ -38,16 +38,12 @@ double power(const Wrench& w, const double v[6]) {
 
 namespace {
 
-double norm3(const Vec3& v) {
-  return std::sqrt(v.x * v.x + v.y * v.y + v.z * v.z);
-}
-
 Vec3 lerp(const Vec3& a, const Vec3& b, double u) {
   return {a.x + u * (b.x - a.x), a.y + u * (b.y - a.y), a.z + u * (b.z - a.z)};
 }
 
 Vec3 clampNorm(const Vec3& v, double limit) {
-  const double n = norm3(v);
+  const double n = norm(v);
   if (!(n > limit)) return v;
   const double s = limit / n;
   return {s * v.x, s * v.y, s * v.z};
@@ -74,7 +70,7 @@ Vec3 brakePart(const Vec3& from, const Vec3& v, double dt, double speed, double 
     const double s = dt * rate / speed;
     return approach(from, {-s * v.x, -s * v.y, -s * v.z}, step);
   }
-  const double n = norm3(v);
+  const double n = norm(v);
   if (!(n > 0)) return from;
   return {from.x - step * v.x / n, from.y - step * v.y / n, from.z - step * v.z / n};
 }
@@ -141,7 +137,7 @@ Wrench PassivityController::control(const Wrench& previous, const Wrench& planne
 double PassivityController::worstNextEnergy(const Wrench& w, const double v[6], double dt) const {
   return energy_ - settings_.energy_tolerance + power(w, v) * dt +
          settings_.misprediction_margin * dt *
-             (change_bound_[0] * norm3(w.force) + change_bound_[1] * norm3(w.torque));
+             (change_bound_[0] * norm(w.force) + change_bound_[1] * norm(w.torque));
 }
 
 Wrench PassivityController::correction(const Wrench& planned, const double v[6], double dt) {
@@ -177,7 +173,7 @@ Wrench PassivityController::correction(const Wrench& planned, const double v[6],
     auto part = [&](const Vec3& p, const double* w, double scale, double bound, double mu) {
       const double d = 0.5 * mu * scale;
       const Vec3 y{p.x - d * w[0], p.y - d * w[1], p.z - d * w[2]};
-      const double n = norm3(y), cut = d * m * bound;
+      const double n = norm(y), cut = d * m * bound;
       if (!(n > cut)) return Vec3{};
       const double keep = 1 - cut / n;
       return Vec3{keep * y.x, keep * y.y, keep * y.z};
@@ -186,7 +182,7 @@ Wrench PassivityController::correction(const Wrench& planned, const double v[6],
     // give energy is left as planned): damping the other part's predicted motion would pay for
     // this one's risk with a kick that the prediction does not cover.
     auto partWorst = [&](const Vec3& w, const double* v_part, double bound) {
-      return (w.x * v_part[0] + w.y * v_part[1] + w.z * v_part[2]) * dt + m * dt * bound * norm3(w);
+      return (w.x * v_part[0] + w.y * v_part[1] + w.z * v_part[2]) * dt + m * dt * bound * norm(w);
     };
     const bool risky[2] = {partWorst(planned.force, u, change_bound_[0]) > 0,
                            partWorst(planned.torque, u + 3, change_bound_[1]) > 0};

@@ -10,10 +10,6 @@ namespace torsion {
 
 namespace {
 
-// A projection within this of a triangle's edge (barycentric units) still counts as inside: a
-// node passing exactly over an edge is caught by both triangles (as for self-contact).
-constexpr double kInsideTolerance = 0.05;
-
 // A node pairs with a triangle only where its body's surface faces the triangle: its normal
 // (n_p, the mean of its surface triangles' normals) against the triangle's, n_p . n below
 // -kFacing. A node whose surface runs along the face cannot be pushed out through it: on a soft
@@ -197,7 +193,7 @@ void BodyPairContact::addCandidates(const FemModel& nodes_model, int node_offset
       // triangle only later on the path takes the crossing's weights, clamped.
       const Eigen::Vector3d w_start =
           hit->when > 0 ? projectionWeights(xp, t0[0], t0[1], t0[2]) : w;
-      const Eigen::Vector3d wc = w_start.allFinite() && w_start.minCoeff() >= -kInsideTolerance
+      const Eigen::Vector3d wc = w_start.allFinite() && w_start.minCoeff() >= -kFaceInsideTolerance
                                      ? w_start
                                      : Eigen::Vector3d(w.cwiseMax(0.0) / w.cwiseMax(0.0).sum());
       SurfaceContact c;
@@ -305,7 +301,8 @@ int BodyPairContact::correctGaps(const Eigen::VectorXd& v, double dt, double tol
     const double true_gap = n.dot(p - a);
     if (true_gap >= c.target_gap - tolerance) continue;  // within the tolerance of its target
     const Eigen::Vector3d w = projectionWeights(p, a, b, t);
-    if (!w.allFinite() || w.minCoeff() < -kInsideTolerance) continue;  // slid off: not this face
+    if (!w.allFinite() || w.minCoeff() < -kFaceInsideTolerance)
+      continue;  // slid off: not this face
     Eigen::Vector3d u = Eigen::Vector3d::Zero();
     for (size_t k = 0; k < 4; ++k)
       u += c.beta[k] * v.segment<3>(3 * c.nodes[k]);

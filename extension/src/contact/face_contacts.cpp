@@ -26,13 +26,6 @@ constexpr double kCarriedPastSpeed = 0.01;
 // m: round-off between the nearest pair's and a supporting plane's predicted end gaps.
 constexpr double kPlaneChoiceMargin = 1e-9;
 
-Eigen::Matrix<double, 3, 6> pointJacobian(const Eigen::Vector3d& r) {
-  Eigen::Matrix<double, 3, 6> J;
-  J << Eigen::Matrix3d::Identity(),
-      (Eigen::Matrix3d() << 0, r.z(), -r.y(), -r.z(), 0, r.x(), r.y(), -r.x(), 0).finished();
-  return J;  // J V = v + omega x r = v - [r]x omega
-}
-
 // Whether the contact takes part in this solve.
 bool participates(const FaceContact& c) {
   return c.state != FaceContact::State::kInactive && !c.determined;

@@ -21,7 +21,7 @@ constexpr double kGaussSeidelPenaltyScale = 0.01;
 // detection's normal as its slope: on the soft cubes thrown at each other at 15 m/s
 // (bullet_collide_soft) the deepest node ends 1.1 mm inside the other cube instead of 9.6 mm
 // (docs/contact.md, "Fast impacts").
-constexpr int kMaxGapCorrections = 4;
+constexpr int kMaxPairGapCorrections = 4;
 
 bool participates(const SurfaceContact& c) {
   return !c.determined && c.state != SurfaceContact::State::kInactive;
@@ -396,7 +396,7 @@ IslandContactStats IslandContactSolve::solve(std::vector<Body>& bodies,
     double gap_error = 0;
     for (const Pair* pair : live)
       gap_error = std::max(gap_error, pair->contact->set().maxGapError());
-    if ((settled || gap_error <= min_tolerance) && corrections < kMaxGapCorrections) {
+    if ((settled || gap_error <= min_tolerance) && corrections < kMaxPairGapCorrections) {
       int shifted = 0;
       for (const Pair* pair : live) {
         pairVelocities(bodies, *pair, pair_v_);

@@ -14,18 +14,6 @@
 
 namespace torsion {
 
-namespace {
-
-// The 3x6 map from a partner's (v, omega) to the velocity of its point at lever r.
-Eigen::Matrix<double, 3, 6> pointJacobian(const Eigen::Vector3d& r) {
-  Eigen::Matrix<double, 3, 6> J;
-  J << Eigen::Matrix3d::Identity(),
-      (Eigen::Matrix3d() << 0, r.z(), -r.y(), -r.z(), 0, r.x(), r.y(), -r.x(), 0).finished();
-  return J;
-}
-
-}  // namespace
-
 bool RigidContactSolver::solvesInContactSpace(const SystemOperator& op) const {
   // The factor holds M and K (and the volume barrier's blocks), not an added operator term: a body
   // in FEM-FEM contact (its pair penalties) keeps the active set.

@@ -18,9 +18,7 @@ constexpr int kMaxRedetections = 3;
 // max_iterations if need be (at most kMaxRedetections times this per step).
 constexpr int kRoundsAfterRedetection = 5;
 // Passes of correctGaps per step (each reopens the loop on the shifted gaps).
-constexpr int kMaxGapCorrections = 3;
-// A projection within this of a triangle's edge (barycentric units) is still on the triangle.
-constexpr double kInsideSlack = 0.05;
+constexpr int kMaxSelfGapCorrections = 3;
 // Surface nodes (edges) per block of the parallel search: blocks are fixed, whatever the thread
 // count, and their finds are added in block order.
 constexpr int kSearchBlock = 64;
@@ -280,7 +278,7 @@ int SelfContactSolver::correctGaps(const Eigen::VectorXd& v) {
       if (!(n.norm() > 0)) continue;
       n.normalize();
       const Eigen::Vector3d w = projectionWeights(p, q, r, t);
-      if (!w.allFinite() || w.minCoeff() < -kInsideSlack) continue;  // slid off this face
+      if (!w.allFinite() || w.minCoeff() < -kFaceInsideTolerance) continue;  // slid off this face
       true_gap = n.dot(p - q);
     } else {
       double u = 0, s = 0, distance = 0;
@@ -436,7 +434,7 @@ LinearSolveReport SelfContactSolver::solve(const SystemOperator& op,
     // Greenhill rod's closed loop edge pairs crossed by up to 0.5 mm with their contacts in
     // place, at a thickness of 12 um): shifted gaps reopen the loop (docs/contact.md, "Contact
     // thickness").
-    if ((settled || error <= gap_tolerance_) && corrections < kMaxGapCorrections &&
+    if ((settled || error <= gap_tolerance_) && corrections < kMaxSelfGapCorrections &&
         correctGaps(v) > 0) {
       ++corrections;
       set_.update(v, dt_, activation, gap_tolerance_);  // activates the shifted ones

@@ -7,10 +7,6 @@ namespace torsion {
 
 namespace {
 
-// A projection within this of a triangle's edge (in barycentric units) still counts as inside:
-// a node passing exactly over an edge is caught by both triangles (one is kept).
-constexpr double kInsideTolerance = 0.05;
-
 // When on the path a gap of g0 at the start and g1 at the end reaches the margin: now, at the
 // crossing, at the end; none if apart all along.
 std::optional<double> meetingTime(double g0, double g1, double margin) {
@@ -107,7 +103,7 @@ std::optional<NodeTriangleHit> nodeTriangleCandidate(
   const double when = *s;
   const Eigen::Vector3d w = projectionWeights(xp + when * (ep - xp), a0 + when * (a1 - a0),
                                               b0 + when * (b1 - b0), c0 + when * (c1 - c0));
-  if (!w.allFinite() || w.minCoeff() < -kInsideTolerance) return std::nullopt;
+  if (!w.allFinite() || w.minCoeff() < -kFaceInsideTolerance) return std::nullopt;
   NodeTriangleHit hit;
   hit.normal = n0;
   hit.gap = g0;

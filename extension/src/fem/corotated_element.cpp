@@ -1,5 +1,7 @@
 #include "torsion/fem/corotated_element.h"
 
+#include "linear_stress.h"
+
 namespace torsion {
 
 namespace {
@@ -9,10 +11,6 @@ namespace {
 std::array<Eigen::Vector3d, 4> nodeForces(const Eigen::Matrix3d& P, const TetRestData& rest) {
   const Eigen::Matrix3d H = -rest.volume * P * rest.rest_shape_inverse.transpose();
   return {-(H.col(0) + H.col(1) + H.col(2)), H.col(0), H.col(1), H.col(2)};
-}
-
-Eigen::Matrix3d linearStress(const Eigen::Matrix3d& strain, double mu, double lambda) {
-  return 2 * mu * strain + lambda * strain.trace() * Eigen::Matrix3d::Identity();
 }
 
 }  // namespace
@@ -37,7 +35,7 @@ CorotatedResponse corotatedResponse(const Eigen::Matrix3d& F, const Eigen::Matri
   const Eigen::Matrix3d strain = 0.5 * (RtF + RtF.transpose()) - Eigen::Matrix3d::Identity();
   const double trace = strain.trace();
   CorotatedResponse response;
-  response.forces = nodeForces(R * linearStress(strain, mu, lambda), rest);
+  response.forces = nodeForces(R * detail::linearStress(strain, mu, lambda), rest);
   response.energy = rest.volume * (mu * strain.squaredNorm() + 0.5 * lambda * trace * trace);
   return response;
 }
@@ -49,7 +47,7 @@ std::array<Eigen::Vector3d, 4> corotatedForceDifferential(const std::array<Eigen
   const Eigen::Matrix3d dF = deformationGradient(dx, rest.rest_shape_inverse);
   const Eigen::Matrix3d RtdF = R.transpose() * dF;
   const Eigen::Matrix3d dstrain = 0.5 * (RtdF + RtdF.transpose());
-  return nodeForces(R * linearStress(dstrain, mu, lambda), rest);
+  return nodeForces(R * detail::linearStress(dstrain, mu, lambda), rest);
 }
 
 double corotatedEnergy(const Eigen::Matrix3d& F, const Eigen::Matrix3d& R, const TetRestData& rest,

@@ -4,6 +4,7 @@
 #include <Eigen/Eigenvalues>
 #include <Eigen/Geometry>
 
+#include "linear_stress.h"
 #include "torsion/mesh/quadratic_tet_mesh.h"
 
 namespace torsion {
@@ -12,10 +13,6 @@ namespace {
 
 constexpr double kA = 0.5854101966249685;  // (5 + 3 sqrt 5) / 20
 constexpr double kB = 0.1381966011250105;  // (5 - sqrt 5) / 20
-
-Eigen::Matrix3d linearStress(const Eigen::Matrix3d& strain, double mu, double lambda) {
-  return 2 * mu * strain + lambda * strain.trace() * Eigen::Matrix3d::Identity();
-}
 
 // The axial vector of skew(A): skew(A) y = axial x y.
 Eigen::Vector3d axialOfSkew(const Eigen::Matrix3d& A) {
@@ -104,7 +101,7 @@ QuadraticResponse quadraticResponse(const Tet10Vectors& x, const Eigen::Matrix3d
     const Eigen::Matrix3d RtF = R.transpose() * gradientOf(x, rest.gradients[q]);
     const Eigen::Matrix3d strain = 0.5 * (RtF + RtF.transpose()) - Eigen::Matrix3d::Identity();
     const double trace = strain.trace();
-    const Eigen::Matrix3d stress = linearStress(strain, mu, lambda);
+    const Eigen::Matrix3d stress = detail::linearStress(strain, mu, lambda);
     const Eigen::Matrix3d P = weight * (R * stress);
     for (size_t a = 0; a < 10; ++a)
       response.forces[a].noalias() -= P * rest.gradients[q][a];
@@ -139,7 +136,7 @@ Tet10Vectors quadraticForceDifferential(const Tet10Vectors& dx, const Eigen::Mat
   for (size_t q = 0; q < kTet10QuadraturePoints; ++q) {
     const Eigen::Matrix3d RtdF = R.transpose() * gradientOf(dx, rest.gradients[q]);
     const Eigen::Matrix3d dP =
-        weight * (R * linearStress(0.5 * (RtdF + RtdF.transpose()), mu, lambda));
+        weight * (R * detail::linearStress(0.5 * (RtdF + RtdF.transpose()), mu, lambda));
     for (size_t a = 0; a < 10; ++a)
       df[a].noalias() -= dP * rest.gradients[q][a];
   }

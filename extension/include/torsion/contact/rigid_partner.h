@@ -71,6 +71,15 @@ inline Eigen::Vector3d pointVelocity(const Vector6d& V, const Eigen::Vector3d& r
   return V.head<3>() + V.tail<3>().cross(r);
 }
 
+/// J, the 3x6 map from a partner's (v, omega) to the velocity of its point at lever r:
+/// J V = v + omega x r = v - [r]x omega.
+inline Eigen::Matrix<double, 3, 6> pointJacobian(const Eigen::Vector3d& r) {
+  Eigen::Matrix<double, 3, 6> J;
+  J << Eigen::Matrix3d::Identity(),
+      (Eigen::Matrix3d() << 0, r.z(), -r.y(), -r.z(), 0, r.x(), r.y(), -r.x(), 0).finished();
+  return J;
+}
+
 /// J^T y = (y, r x y): the wrench about the centre of mass of a point impulse y at lever r.
 inline Vector6d pointWrench(const Eigen::Vector3d& y, const Eigen::Vector3d& r) {
   Vector6d w;

@@ -20,6 +20,11 @@
 
 namespace torsion {
 
+/// A node's projection within this of a triangle's edge (barycentric units) still counts as on
+/// the triangle: a node passing exactly over an edge is caught by both triangles (one is kept).
+/// Shared by node-face candidates, FEM-FEM pairs and self-contact.
+inline constexpr double kFaceInsideTolerance = 0.05;
+
 /// Surface edges of a triangle list, each once, and the edges of every triangle.
 struct SurfaceEdges {
   std::vector<std::array<int, 2>> edges;         ///< corners ascending, sorted
