@@ -48,11 +48,8 @@ ctest --test-dir build -j"$jobs" --output-on-failure --timeout 900
 # The pytest suite is one CTest test (python.pytest); its own count of tests:
 grep -hEo "^[0-9]+ passed.* in [0-9.]+s" build/Testing/Temporary/LastTest.log | tail -1 |
   sed 's/^/== pytest (label python): /' || true
-stage "clang-tidy (.clang-tidy) over extension/ and device/, one source at a time"
-# clang-tidy needs each source's own compile command, which a unity build does not list: a tree
-# configured without it (not built; no header is generated) gives them.
-cmake -S . -B build-tidy -G Ninja -DCMAKE_BUILD_TYPE=Release -DTORSION_WARNINGS_AS_ERRORS=ON >/dev/null
-bash scripts/clang_tidy.sh build-tidy
+stage "clang-tidy (.clang-tidy) over extension/ and device/, from build/compile_commands.json"
+bash scripts/clang_tidy.sh build
 
 stage "ThreadSanitizer build (build-tsan/, clang): the haptic loop's thread, its buffers, the runtime"
 cmake -S . -B build-tsan -G Ninja "${sanitizer_flags[@]}" "${fast_only[@]}" -DTORSION_TSAN=ON \

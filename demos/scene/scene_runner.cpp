@@ -79,6 +79,7 @@ struct ContactTotals {
     int active = 0;
     bool converged = true;
     bool fell_back = false;
+    bool in_contact_space = false;
     for (const auto& body : world.bodies()) {
       if (const SelfContactSolver* self = body->selfContact()) {
         const SelfContactStats& s = self->stats();
@@ -94,9 +95,10 @@ struct ContactTotals {
       max_penetration = std::max(max_penetration, s.max_penetration);
       active_set_iterations_max = std::max(active_set_iterations_max, s.active_set_iterations);
       converged = converged && s.active_set_converged;
-      if (body->contacts().settings().friction_solve ==
-          ContactSettings::FrictionSolve::kContactSpace) {
+      if (body->contacts().settings().friction_solve !=
+          ContactSettings::FrictionSolve::kActiveSet) {
         has_contact_space = true;
+        in_contact_space = in_contact_space || s.in_contact_space;
         fell_back = fell_back || s.coulomb_fell_back;
       }
     }
@@ -117,10 +119,13 @@ struct ContactTotals {
     active_max = std::max(active_max, active);
     if (!converged) ++unconverged_steps;
     if (fell_back) ++fallback_steps;
+    if (in_contact_space) ++contact_space_steps;
   }
-  // Bodies with "friction_solve": "contact_space": steps whose Coulomb problem did not converge
-  // and were solved by the active set instead.
+  // Bodies whose "friction_solve" may take contact space ("auto", "contact_space"): steps that
+  // took it, and steps whose Coulomb problem did not converge and were solved by the active set
+  // instead.
   bool has_contact_space = false;
+  int contact_space_steps = 0;
   int fallback_steps = 0;
   // Self-contact (bodies with "self_contact"): summed over bodies, steps counted per body.
   bool has_self_contact = false;
@@ -143,7 +148,10 @@ struct ContactTotals {
                         {"max_penetration_m", max_penetration},
                         {"active_set_iterations_max", active_set_iterations_max},
                         {"active_set_unconverged_steps", unconverged_steps}};
-    if (has_contact_space) j["contact_space_fallback_steps"] = fallback_steps;
+    if (has_contact_space) {
+      j["contact_space_steps"] = contact_space_steps;
+      j["contact_space_fallback_steps"] = fallback_steps;
+    }
     if (has_self_contact) {
       j["self_contact"] = {{"active_max", self_active_max},
                            {"iterations_max", self_iterations_max},

@@ -37,10 +37,9 @@ struct BodySpec {
   /// "self_contact": {"friction", "gap_tolerance", "thickness_factor"}: on when present
   /// (docs/contact.md).
   std::optional<SelfContactSettings> self_contact;
-  /// "friction_solve": "active_set" (default) | "contact_space" (experimental): how the body's
-  /// contacts with rigid bodies decide stick and slide (ContactSettings::friction_solve,
-  /// docs/contact.md).
-  ContactSettings::FrictionSolve friction_solve = ContactSettings::FrictionSolve::kActiveSet;
+  /// "friction_solve": "auto" (default) | "contact_space" | "active_set": how the body's contacts
+  /// with rigid bodies decide stick and slide (ContactSettings::friction_solve, docs/contact.md).
+  ContactSettings::FrictionSolve friction_solve = ContactSettings{}.friction_solve;
 };
 
 /// Which nodes of a body a set takes (rest positions, after the body's pose).

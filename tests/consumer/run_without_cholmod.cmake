@@ -13,9 +13,10 @@ function(run)
   set(last_output "${out}" PARENT_SCOPE)
 endfunction()
 
-# The library tree is kept between runs (only its changed files rebuild).
+# The library tree is kept between runs (only its changed batches rebuild); unity batches
+# (TORSION_UNITY_BUILD) halve this second build of the library in a clean test run.
 run(${CMAKE_COMMAND} -S "${SOURCE_DIR}" -B "${WORK_DIR}/torsion" -G "${GENERATOR}"
-    -DCMAKE_BUILD_TYPE=Release -DTORSION_CHOLMOD=OFF -DTORSION_BUILD_DEMOS=OFF
+    -DCMAKE_BUILD_TYPE=Release -DTORSION_CHOLMOD=OFF -DTORSION_BUILD_DEMOS=OFF -DTORSION_UNITY_BUILD=ON
     -DTORSION_BUILD_TESTS=OFF -DTORSION_BUILD_BENCHMARKS=OFF
     "-DTORSION_BULLET_PRECISION=${PRECISION}" "-DCMAKE_CXX_COMPILER_LAUNCHER=${LAUNCHER}")
 run(${CMAKE_COMMAND} --build "${WORK_DIR}/torsion")

@@ -4,7 +4,9 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <vector>
 #include <iostream>
 
 #include "contact_fixtures.h"
@@ -83,6 +85,37 @@ TEST(ContactPhysics, BoxRestsOnSlabWithStaticSag) {
   // face contacts sit out: docs/contact.md, "Sliding over nodes").
   EXPECT_LT(run.largest_gap_under_box, 0.1 * run.sag);
   EXPECT_GT(run.contacts, 0);
+}
+
+// The default friction solve ("auto") takes contact space only in the steps where a dynamic rigid
+// body touches the FEM body: a soft block resting on static ground uses the active set (no
+// factorisation per step for a body on the floor), and a box dropped onto it switches the block to
+// contact space from its landing on, while it rests there.
+TEST(ContactPhysics, AutoFrictionSolveTakesContactSpaceOnlyWhileADynamicBodyTouches) {
+  FemWorld world(contactSettings(0.01));
+  addGround(world, 0.5);
+  FemBody* block =
+      addBox(world, "block", {-0.3, -0.3, 0.0}, {0.3, 0.3, 0.2}, 3, 3, 1, softMaterial(5e4, 200));
+  ASSERT_NE(block, nullptr);
+  ASSERT_EQ(block->contacts().settings().friction_solve, ContactSettings::FrictionSolve::kAuto);
+  // The box's underside starts 0.2 m above the block: it lands after about 0.2 s.
+  btRigidBody* box = world.addRigidBody(std::make_unique<btBoxShape>(btVector3(0.1, 0.1, 0.1)), 2,
+                                        at({0.0, 0.0, 0.5}));
+  box->setFriction(0.5);
+  std::vector<bool> in_contact_space;
+  for (int k = 0; k < 60; ++k) {
+    const WorldStepReport report = world.step();
+    ASSERT_TRUE(report.ok) << report.message;
+    in_contact_space.push_back(block->contacts().stats().in_contact_space);
+  }
+  const auto first = std::find(in_contact_space.begin(), in_contact_space.end(), true);
+  const long landing = first - in_contact_space.begin();
+  std::cout << "[figures] auto friction solve: contact space from step " << landing << " of 60\n";
+  EXPECT_GE(landing, 15);  // on the ground alone, the active set
+  EXPECT_LE(landing, 25);  // the box lands at about 0.2 s
+  EXPECT_TRUE(std::all_of(first, in_contact_space.end(), [](bool b) { return b; }));
+  EXPECT_FALSE(block->contacts().stats().coulomb_fell_back);
+  EXPECT_GT(toDouble(box->getWorldTransform().getOrigin().z()), 0.2 + 0.1 - 0.01);  // on top
 }
 
 // A deformable block slides on frictionless ground into a free rigid box: the horizontal momentum

@@ -245,51 +245,36 @@ TEST(Sliding, StiffSlabHoldsTheBoxBelowTheFrictionAngleAndLetsItSlideAbove) {
 }
 
 // The stick/slip threshold tan(a) = mu (16.7 deg for mu = 0.3) on soft and stiff, tet4 and tet10
-// slabs, the box settled first and then pulled along the slope. 1 deg below it the box should
-// stay: the slab's elastic shear under the pull (88 Pa over the box's 0.06 m2 in a 0.1 m layer)
-// moves it 0.23 mm on the soft slab (shear modulus 3.8e4 Pa) and 0.23 um on the stiff one. 1 deg
-// above it slides as Coulomb says (8.9 cm in 1 s). The stiff slabs hold within 0.1 mm and slide
-// within 5 %. The soft slabs still creep 3 mm in 1 s (13 times the elastic shear) and slide 9 to
-// 10 % too far (docs/validation.md, open); their bounds (5 mm, 12 %) hold what the friction's slip
-// resistance gained (docs/contact.md, "The friction's direction inside the solve"): before it the
-// box crept 3.1 cm below and went 25 % too far above.
+// slabs, the box settled first and then pulled along the slope, with the default friction solve
+// ("auto": Coulomb's law solved in contact space while the dynamic box touches the slab,
+// docs/contact.md). 1 deg below it the box should stay:
+// the slab's elastic shear under the pull (88 Pa over the box's 0.06 m2 in a 0.1 m layer) moves it
+// 0.23 mm on the soft slab (shear modulus 3.8e4 Pa) and 0.23 um on the stiff one. 1 deg above it
+// slides as Coulomb says (8.9 cm in 1 s), a distance that magnifies a friction error by
+// mu cos a / (sin a - mu cos a) = 15.7. Measured: below 0.26 mm, 1.6 um, 2.0 mm, 3.1 um; above
+// +3.5 %, +1.0 %, +3.2 %, -1.0 % (soft tet4, stiff tet4, soft tet10, stiff tet10). The soft tet10
+// slab's 2 mm is a creep while most contacts under the box's edges slide (docs/contact.md); it is
+// bounded at 2.5 mm, under 3 % of the 1 deg-above slide's distance; the stiff slabs at 10 um.
 TEST(Sliding, BoxHoldsOneDegreeBelowTheFrictionAngleAndSlidesOneDegreeAboveOnEverySlab) {
+  expectThresholds({{1e5, 20, ElementKind::kTet4, 1e-3, 0.05},
+                    {1e8, 20, ElementKind::kTet4, 1e-5, 0.05},
+                    {1e5, 10, ElementKind::kTet10, 2.5e-3, 0.05},
+                    {1e8, 10, ElementKind::kTet10, 1e-5, 0.05}},
+                   ContactSettings{}.friction_solve, "");
+}
+
+// The same threshold with the active set (ContactSettings::kActiveSet, the default before "auto",
+// kept as an option): states switched between CG solves by rules. Every anti-cycling budget lets some
+// step end outside Coulomb's law, and on the soft slabs that shows: the box creeps 3.0 mm (tet4)
+// and 3.3 mm (tet10) in 1 s below the threshold and slides 8.9 % and 9.6 % too far above it
+// (stiff slabs: 2 and 6 um, +2.0 % and +3.1 %). These bounds hold what the active set reaches,
+// not the physical bound (docs/contact.md, "Open: the soft slabs at the threshold").
+TEST(Sliding, TheActiveSetOptionHoldsTheStiffThresholdAndNearlyTheSoftOne) {
   expectThresholds({{1e5, 20, ElementKind::kTet4, 5e-3, 0.12},
                     {1e8, 20, ElementKind::kTet4, 1e-4, 0.05},
                     {1e5, 10, ElementKind::kTet10, 5e-3, 0.12},
                     {1e8, 10, ElementKind::kTet10, 1e-4, 0.05}},
-                   ContactSettings::FrictionSolve::kActiveSet, "");
-}
-
-// The same threshold with Coulomb's law solved in contact space (ContactSettings::kContactSpace,
-// docs/contact.md, "Coulomb's law solved in contact space"): every contact's stick, slide or
-// separation consistent with the step's impulses, instead of states switched between CG solves; a
-// step whose Coulomb problem does not converge is retried from zero impulses, then solved by the
-// active set. 1 deg above the friction angle every slab slides within 5 % of Coulomb's distance
-// (measured +3.7 %, +1.1 %, +1.6 %, -4.2 %; the active set: +8.9 %, +2.0 %, +9.6 %, +3.1 %). 1 deg
-// below, the soft slabs move 0.59 mm (tet4) and 1.8 mm (tet10) in 1 s, against 3.0 and 3.3 mm with
-// the active set: the elastic shear under the pull is 0.23 mm, the rest a creep while most
-// contacts under the box's edges slide. The stiff slabs move 2.1 and 0.4 um.
-TEST(Sliding, CoulombSolvedInContactSpaceHoldsTheBoxBelowTheFrictionAngleOnEverySlab) {
-  expectThresholds({{1e5, 20, ElementKind::kTet4, 2e-3, 0.05},
-                    {1e8, 20, ElementKind::kTet4, 1e-5, 0.05},
-                    {1e5, 10, ElementKind::kTet10, 2e-3, 0.05},
-                    {1e8, 10, ElementKind::kTet10, 1e-5, 0.05}},
-                   ContactSettings::FrictionSolve::kContactSpace, ", contact space");
-}
-
-// Contact space over the coarse stiff slab (node rows 0.2 m apart, the box's length), where the box
-// reaches 1.8 m/s: without the contact compliance (ContactSettings::coulomb_compliance) a third of
-// its steps stopped unconverged at 1e-6 to 1e-5 m/s, one fell back to the active set and took
-// 0.58 m/s off the box, and it ended 28 % short of Coulomb's distance. Measured now: +1.0 %.
-TEST(Sliding, CoulombSolvedInContactSpaceSlidesAsCoulombSaysOverACoarseStiffSlab) {
-  Slope s;
-  s.degrees = 25;
-  s.mu = 0.2;
-  s.youngs_modulus = 1e8;
-  s.cells_along = 10;
-  s.friction_solve = ContactSettings::FrictionSolve::kContactSpace;
-  expectCoulomb(s, 0.05, "contact_space_coarse_stiff");
+                   ContactSettings::FrictionSolve::kActiveSet, ", active set");
 }
 
 // Coulomb's distance whatever the slab: soft (E = 1e5 Pa) and stiff (1e8), node rows 0.2 m (the
@@ -298,7 +283,10 @@ TEST(Sliding, CoulombSolvedInContactSpaceSlidesAsCoulombSaysOverACoarseStiffSlab
 // (docs/contact.md, "Sliding over nodes") the soft slab gave -64 % at 20 deg with mu = 0.3; before
 // the friction's slip resistance node rows as long as the box gave +6.4 % (soft) and +5.0 %
 // (stiff) at 20 deg with mu = 0.3, and the box on the stiff coarse tet10 slab at 25 deg with
-// mu = 0.2 stopped dead at a node row at 2 m/s (-15 %).
+// mu = 0.2 stopped dead at a node row at 2 m/s (-15 %). With the default contact-space solve before
+// its contact compliance (ContactSettings::coulomb_compliance) the coarse stiff slab at 25 deg with
+// mu = 0.2 gave -28 %: a third of the steps stopped unconverged at 1e-6 to 1e-5 m/s, and one that
+// fell back to the active set took 0.58 m/s off the box.
 TEST(Sliding, BoxWithFrictionSlidesAsCoulombSaysOverSoftStiffCoarseFineTet4AndTet10Slabs) {
   struct Case {
     double degrees, mu, youngs_modulus;

@@ -104,7 +104,7 @@ def box_on_a_tilted_slab(degrees, friction_solve):
     return box.position[0] - x0
 
 
-@pytest.mark.parametrize("friction_solve", ["active_set", "contact_space"])
+@pytest.mark.parametrize("friction_solve", ["auto", "active_set", "contact_space"])
 def test_a_box_on_a_soft_slab_holds_below_the_friction_angle_and_slides_as_coulomb_above(
         friction_solve):
     # atan(0.5) = 26.6 deg. 20 deg below: held (the landing's slip and the slab's shear only).
@@ -120,6 +120,9 @@ def test_friction_solve_names_what_it_accepts():
     world = torsion.World()
     nodes, tets = cube_mesh(1)
     body = world.add_body("cube", nodes=nodes, tets=tets)
-    assert body.friction_solve == "active_set"
-    with pytest.raises(ValueError, match="active_set.*contact_space.*exact"):
+    assert body.friction_solve == "auto"
+    for name in ("active_set", "contact_space", "auto"):
+        body.friction_solve = name
+        assert body.friction_solve == name
+    with pytest.raises(ValueError, match="auto.*active_set.*contact_space.*exact"):
         body.friction_solve = "exact"

@@ -182,14 +182,17 @@ void bindParts(py::module_& m) {
             const auto solve = frictionSolveFromName(how);
             if (!solve)
               throw py::value_error(
-                  "friction_solve: expected \"active_set\" or \"contact_space\", got \"" + how +
-                  "\"");
+                  "friction_solve: expected \"auto\", \"active_set\" or \"contact_space\", got "
+                  "\"" +
+                  how + "\"");
             WorldGuard guard(*b.world, WorldGuard::kWrite);
             b.body->contacts().settings().friction_solve = *solve;
           },
           "How the body's contacts with rigid bodies decide stick, slide and separation: "
-          "\"active_set\" (default) or \"contact_space\" (Coulomb's law solved for all contacts "
-          "at once; a step that does not converge falls back to the active set).")
+          "\"auto\" (default: contact space in the steps where a dynamic rigid body touches the "
+          "body, the active set otherwise), \"contact_space\" (Coulomb's law solved for all "
+          "contacts at once; a step that does not converge falls back to the active set) or "
+          "\"active_set\" (states switched between linear solves by rules).")
       .def_property_readonly(
           "kinetic_energy", [](const B& b) { return b.body->lastReport().kinetic_energy; },
           "J, at the end of the last step")

@@ -17,7 +17,8 @@ static_assert(__BYTE_ORDER__ == __ORDER_LITTLE_ENDIAN__, "checkpoint bytes are l
 constexpr char kMagic[8] = {'T', 'R', 'S', 'N', 'C', 'K', 'P', 'T'};
 // 2: the pair multipliers of contact between FEM bodies.
 // 3: the node contacts' impulses (the contact-space friction solve's warm start).
-constexpr std::uint32_t kVersion = 3;
+// 4: the node contacts' normals (the plane a contact keeps while its node stays over it).
+constexpr std::uint32_t kVersion = 4;
 constexpr size_t kHeaderSize = sizeof(kMagic) + 4 + 8 + 8;
 
 std::uint64_t fnv1a(std::string_view bytes) {
@@ -330,6 +331,7 @@ void writeBody(Writer& w, FemWorld& world, const FemBody& body, const FemBodyChe
     w.i32(collisionObjectIndex(world, n.object));
     w.u8(static_cast<int>(n.state));
     w.vec3(n.impulse);
+    w.vec3(n.normal);
   }
   w.u32(carried.faces.size());
   for (const CarriedContacts::Face& f : carried.faces) {
@@ -456,12 +458,13 @@ Result<FemBodyCheckpoint> readBody(Reader& r, FemWorld& world, FemBody& body,
     return objects[index];
   };
   CarriedContacts carried;
-  carried.nodes.resize(r.count(33));
+  carried.nodes.resize(r.count(57));
   for (CarriedContacts::Node& n : carried.nodes) {
     n.node = r.i32();
     n.object = objectAt(r.i32());
     n.state = r.enumeration(NodeContact::State::kStick);
     n.impulse = r.vec3();
+    n.normal = r.vec3();
     if (n.node < 0 || n.node >= model.nodeCount()) r.fail();
   }
   carried.faces.resize(r.count(45));

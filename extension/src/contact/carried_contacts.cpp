@@ -11,7 +11,7 @@ CarriedContacts RigidContactSolver::carriedContacts() const {
   for (const NodeContact& c : contacts_) {
     if (c.state == NodeContact::State::kInactive || c.held) continue;
     carried.nodes.push_back(
-        {c.node, partners_[static_cast<size_t>(c.partner)].object, c.state, c.impulse});
+        {c.node, partners_[static_cast<size_t>(c.partner)].object, c.state, c.impulse, c.normal});
   }
   for (const FaceContact& c : faces_.contacts()) {
     if (c.state == FaceContact::State::kInactive) continue;
@@ -37,7 +37,7 @@ void RigidContactSolver::restoreCarriedContacts(const CarriedContacts& carried) 
   std::fill(node_contact_.begin(), node_contact_.end(), -1);
   for (const CarriedContacts::Node& n : carried.nodes) {
     NodeContact c;
-    c.normal.setZero();
+    c.normal = n.normal;
     c.lever.setZero();
     c.node = n.node;
     c.partner = partner(n.object);

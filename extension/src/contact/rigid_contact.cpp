@@ -16,12 +16,21 @@
 namespace torsion {
 
 const char* frictionSolveName(ContactSettings::FrictionSolve solve) {
-  return solve == ContactSettings::FrictionSolve::kContactSpace ? "contact_space" : "active_set";
+  switch (solve) {
+    case ContactSettings::FrictionSolve::kActiveSet:
+      return "active_set";
+    case ContactSettings::FrictionSolve::kContactSpace:
+      return "contact_space";
+    case ContactSettings::FrictionSolve::kAuto:
+      break;
+  }
+  return "auto";
 }
 
 std::optional<ContactSettings::FrictionSolve> frictionSolveFromName(const std::string& name) {
-  for (ContactSettings::FrictionSolve solve : {ContactSettings::FrictionSolve::kActiveSet,
-                                               ContactSettings::FrictionSolve::kContactSpace}) {
+  for (ContactSettings::FrictionSolve solve :
+       {ContactSettings::FrictionSolve::kAuto, ContactSettings::FrictionSolve::kActiveSet,
+        ContactSettings::FrictionSolve::kContactSpace}) {
     if (name == frictionSolveName(solve)) return solve;
   }
   return std::nullopt;
@@ -100,7 +109,8 @@ LinearSolveReport RigidContactSolver::solve(const SystemOperator& op,
   base_ = &constraints;
   numberRigidUnknowns();
   stats_.coulomb_fell_back = false;
-  if (solvesInContactSpace(op)) {
+  stats_.in_contact_space = solvesInContactSpace(op);
+  if (stats_.in_contact_space) {
     // A step whose Coulomb problem does not converge falls back to the active set: stopped early,
     // the sweeps leave near-stick contacts stuck (measured: a box on a stiff tet10 slab 1 deg
     // above the friction angle slid 5 % short), where the active set's states hold within 3 %.

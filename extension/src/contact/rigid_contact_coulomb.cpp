@@ -17,8 +17,22 @@ namespace torsion {
 bool RigidContactSolver::solvesInContactSpace(const SystemOperator& op) const {
   // The factor holds M and K (and the volume barrier's blocks), not an added operator term: a body
   // in FEM-FEM contact (its pair penalties) keeps the active set.
-  return settings_.friction_solve == ContactSettings::FrictionSolve::kContactSpace &&
-         op.addedTerm() == nullptr;
+  if (op.addedTerm() != nullptr) return false;
+  switch (settings_.friction_solve) {
+    case ContactSettings::FrictionSolve::kActiveSet:
+      return false;
+    case ContactSettings::FrictionSolve::kContactSpace:
+      return true;
+    case ContactSettings::FrictionSolve::kAuto:
+      break;
+  }
+  // A dynamic partner's contacts share its six velocities: what one contact's stick or slide
+  // does moves all the others, which the active set's rules decide one contact at a time and
+  // contact space decides together. Nodes on static or kinematic geometry (partners_ holds this
+  // step's touched partners only) each meet a prescribed motion, where the rules are right and
+  // no factorisation is paid for.
+  return std::any_of(partners_.begin(), partners_.end(),
+                     [](const RigidPartner& k) { return k.dynamic; });
 }
 
 void RigidContactSolver::gatherCoulombRows() {

@@ -78,15 +78,20 @@ struct ContactSettings {
   /// stated penetration tolerance of a rigid feature between nodes).
   double face_gap_tolerance = 1e-5;
   /// How stick, slide and separation are decided (docs/contact.md, "Coulomb's law solved in
-  /// contact space"). kActiveSet (the default) switches states between CG solves by rules.
-  /// kContactSpace (experimental) factorises the step's matrix, condenses it onto the contacts and
-  /// solves Coulomb's law there for all of them at once (coulomb_problem.h): the states are
-  /// consistent with the impulses by construction; it holds a box at the stick/slip threshold on
-  /// soft slabs where the active set lets it creep (a step that does not converge falls back to
-  /// the active set: coulomb_fallback). A body in FEM-FEM contact (whose pair penalties the factor
-  /// does not hold) always uses the active set.
-  enum class FrictionSolve { kActiveSet, kContactSpace };
-  FrictionSolve friction_solve = FrictionSolve::kActiveSet;
+  /// contact space"). kContactSpace factorises the step's matrix, condenses it onto the contacts
+  /// and solves Coulomb's law there for all of them at once (coulomb_problem.h): the states are
+  /// consistent with the impulses by construction, and a rigid box holds at the stick/slip
+  /// threshold and slides as Coulomb says over soft and stiff, coarse and fine slabs (a step that
+  /// does not converge falls back to the active set: coulomb_fallback). kActiveSet switches states
+  /// between CG solves by rules: right for nodes on static or kinematic geometry, each contact
+  /// on its own, but a dynamic rigid body's contacts share its motion and there the rules let a
+  /// box creep 3 mm in 1 s 1 deg below the friction angle of a soft slab. kAuto (the default)
+  /// takes contact space in the steps where a dynamic rigid body touches the FEM body and the
+  /// active set otherwise, so a large body on the ground does not pay for a factorisation each
+  /// step. A body in FEM-FEM contact (whose pair penalties the factor does not hold) always uses
+  /// the active set.
+  enum class FrictionSolve { kActiveSet, kContactSpace, kAuto };
+  FrictionSolve friction_solve = FrictionSolve::kAuto;
   /// m/s: the contact-space solve iterates until every contact satisfies Coulomb's law to this;
   /// a step that ends its sweeps within coulomb_acceptable counts as converged.
   double coulomb_tolerance = 1e-7;
@@ -106,8 +111,8 @@ struct ContactSettings {
   bool coulomb_fallback = true;
 };
 
-/// The names scene files and Python use for ContactSettings::FrictionSolve: "active_set",
-/// "contact_space".
+/// The names scene files and Python use for ContactSettings::FrictionSolve: "auto",
+/// "active_set", "contact_space".
 const char* frictionSolveName(ContactSettings::FrictionSolve solve);
 /// The solve `name` names, or nullopt.
 std::optional<ContactSettings::FrictionSolve> frictionSolveFromName(const std::string& name);
@@ -163,6 +168,7 @@ struct ContactStepStats {
   int coulomb_sweeps = 0;          ///< contact-space solve: Gauss-Seidel sweeps this step
   double coulomb_residual = 0;     ///< m/s, its largest violation of Coulomb's law at the end
   bool coulomb_fell_back = false;  ///< the contact-space solve did not converge: active set used
+  bool in_contact_space = false;   ///< the step took the contact-space solve (fallback or not)
 };
 
 /// What a RigidContactSolver's next step takes over from its last (its warm starts), with the
@@ -176,6 +182,9 @@ struct CarriedContacts {
     NodeContact::State state = NodeContact::State::kSlide;
     /// N s: the contact-space solve's warm start (the active set starts from the states alone).
     Eigen::Vector3d impulse = Eigen::Vector3d::Zero();
+    /// The plane the contact was linearised on (its outward normal): detect() keeps it while the
+    /// node stays over that face of the object.
+    Eigen::Vector3d normal = Eigen::Vector3d::Zero();
   };
   struct Face {
     std::array<int, 3> key{};
@@ -269,6 +278,9 @@ class RigidContactSolver {
   void chooseSupportPlane(const btCollisionShape& shape, const btTransform& transform,
                           const Eigen::Vector3d& x, const Eigen::Vector3d& node_velocity,
                           const Eigen::Vector3d& into_surface, double dt, NodeContact& c) const;
+  void keepPreviousPlane(const btCollisionShape& shape, const btTransform& transform,
+                         const Eigen::Vector3d& x, const Eigen::Vector3d& into_surface,
+                         const btCollisionObject& object, NodeContact& c) const;
   btTransform startPoseOf(const btCollisionObject& object) const;
   void recordAnchorStartPoses();  // node_anchors.cpp
 
@@ -366,6 +378,8 @@ class RigidContactSolver {
   std::vector<std::pair<int, const btCollisionObject*>> previous_active_;  // (node, object)
   std::vector<NodeContact::State> previous_state_;
   std::vector<Eigen::Vector3d> previous_impulse_;  // N s, the contact-space warm start
+  std::vector<Eigen::Vector3d> previous_normal_;   // the plane it was linearised on
+  std::vector<int> previous_of_node_;              // per node: its index in previous_active_, or -1
   std::vector<std::pair<NodeContact::State, Eigen::Vector3d>> solved_states_;
   std::vector<FaceContact::State> solved_face_states_;
   std::vector<const btCollisionObject*> previous_sliding_;  // bodies sliding at the last step's end
