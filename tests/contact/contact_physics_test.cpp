@@ -6,8 +6,8 @@
 
 #include <algorithm>
 #include <cmath>
-#include <vector>
 #include <iostream>
+#include <vector>
 
 #include "contact_fixtures.h"
 #include "resting_box.h"

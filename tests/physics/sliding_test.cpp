@@ -264,9 +264,9 @@ TEST(Sliding, BoxHoldsOneDegreeBelowTheFrictionAngleAndSlidesOneDegreeAboveOnEve
 }
 
 // The same threshold with the active set (ContactSettings::kActiveSet, the default before "auto",
-// kept as an option): states switched between CG solves by rules. Every anti-cycling budget lets some
-// step end outside Coulomb's law, and on the soft slabs that shows: the box creeps 3.0 mm (tet4)
-// and 3.3 mm (tet10) in 1 s below the threshold and slides 8.9 % and 9.6 % too far above it
+// kept as an option): states switched between CG solves by rules. Every anti-cycling budget lets
+// some step end outside Coulomb's law, and on the soft slabs that shows: the box creeps 3.0 mm
+// (tet4) and 3.3 mm (tet10) in 1 s below the threshold and slides 8.9 % and 9.6 % too far above it
 // (stiff slabs: 2 and 6 um, +2.0 % and +3.1 %). These bounds hold what the active set reaches,
 // not the physical bound (docs/contact.md, "Open: the soft slabs at the threshold").
 TEST(Sliding, TheActiveSetOptionHoldsTheStiffThresholdAndNearlyTheSoftOne) {
