@@ -354,12 +354,9 @@ void RigidContactSolver::warmStartCoulomb() {
     }
     const NodeContact& c = contacts_[static_cast<size_t>(row.node_contact)];
     const btCollisionObject* object = partners_[static_cast<size_t>(c.partner)].object;
-    for (size_t k = 0; k < previous_active_.size(); ++k) {
-      if (previous_active_[k].first == c.node && previous_active_[k].second == object) {
-        impulses_.segment<3>(3 * i) = previous_impulse_[k];
-        break;
-      }
-    }
+    const int k = previous_of_node_[static_cast<size_t>(c.node)];
+    if (k >= 0 && previous_active_[static_cast<size_t>(k)].second == object)
+      impulses_.segment<3>(3 * i) = previous_impulse_[static_cast<size_t>(k)];
   }
 }
 

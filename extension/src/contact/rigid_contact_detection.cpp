@@ -349,12 +349,11 @@ void RigidContactSolver::dropUntouchedPartners() {
 void RigidContactSolver::warmStartActiveSet() {
   for (NodeContact& c : contacts_) {
     if (c.held || c.anchored) continue;
-    for (size_t k = 0; k < previous_active_.size(); ++k) {
-      if (previous_active_[k].first == c.node &&
-          previous_active_[k].second == partners_[static_cast<size_t>(c.partner)].object) {
-        c.state = c.friction > 0 ? previous_state_[k] : NodeContact::State::kSlide;
-      }
-    }
+    const int k = previous_of_node_[static_cast<size_t>(c.node)];
+    if (k >= 0 && previous_active_[static_cast<size_t>(k)].second ==
+                      partners_[static_cast<size_t>(c.partner)].object)
+      c.state =
+          c.friction > 0 ? previous_state_[static_cast<size_t>(k)] : NodeContact::State::kSlide;
   }
   for (RigidPartner& k : partners_)
     k.sliding = std::find(previous_sliding_.begin(), previous_sliding_.end(), k.object) !=
