@@ -201,21 +201,17 @@ CoulombReport RigidContactSolver::solveSelectedRows(const NodeConstraints& const
   for (RigidPartner& k : partners_)
     k.velocity = k.entry_velocity;
   buildUnitImpulses(constraints);
-  // W_soft = (S G^T)^T A^-1 (S G^T) = B^T B with B = L^-1 P S G^T (P A P^T = L L^T): one sparse
-  // forward substitution per column, each reaching only the factor's columns below the row's
-  // nodes, instead of two solves of the whole system per column.
-  condensed_ = factorisation_.factor->permutationP() * unit_impulses_;
-  factorisation_.factor->matrixL().solveInPlace(condensed_);
-
+  // W_soft = (S G^T)^T A^-1 (S G^T) = B^T B with B = L^-1 P S G^T (P A P^T = L L^T): sparse
+  // forward substitutions, each reaching only the factor's rows above the row's nodes in the
+  // elimination tree, instead of two solves of the whole system per column
+  // (delassus_condensation.h).
   CoulombProblem& problem = coulomb_;
-  dense_condensed_ = condensed_;
-  problem.delassus.resize(3 * m, 3 * m);
-  if (m > 0) {  // (Eigen's triangular product reads a null pointer for an empty matrix)
-    problem.delassus.triangularView<Eigen::Lower>() =
-        dense_condensed_.transpose() * dense_condensed_;
+  condensation_.lowerGram(factorisation_.factor->matrixL().nestedExpression(),
+                          factorisation_.factor->permutationP().indices(), unit_impulses_,
+                          problem.delassus);
+  if (m > 0)
     problem.delassus.triangularView<Eigen::StrictlyUpper>() =
         problem.delassus.transpose().triangularView<Eigen::StrictlyUpper>();
-  }
   problem.free_velocity.setZero(3 * m);
   problem.normal.resize(static_cast<size_t>(m));
   problem.friction.resize(static_cast<size_t>(m));

@@ -47,6 +47,7 @@
 #include <vector>
 
 #include "torsion/contact/coulomb_problem.h"
+#include "torsion/contact/delassus_condensation.h"
 #include "torsion/contact/face_contacts.h"
 #include "torsion/contact/multibody_partner.h"
 #include "torsion/contact/node_anchors.h"
@@ -417,13 +418,12 @@ class RigidContactSolver {
   static constexpr int kMaxRowRounds = 8;
   static constexpr double kFaceOnNode = 0.9;   // gatherCoulombRows()
   Eigen::SparseMatrix<double> unit_impulses_;  // 3n x 3m: S G^T, node forces per unit impulse
-  Eigen::SparseMatrix<double> condensed_;      // 3n x 3m: L^-1 P S G^T (W_soft = its Gram matrix)
+  DelassusCondensation condensation_;          // W_soft = (L^-1 P S G^T)^T (L^-1 P S G^T)
   CoulombProblem coulomb_;
   Eigen::VectorXd impulses_, contact_velocity_;
   Eigen::VectorXd contact_forces_;     // 3n: S G^T r, the solved impulses' node forces
   Eigen::VectorXd v_free_;             // 3n: the step's velocities without contact
   Eigen::VectorXd fallback_velocity_;  // 3n: the solve's given velocities, kept for a fallback
-  Eigen::MatrixXd dense_condensed_;
   Eigen::VectorXd cold_start_, cold_velocity_;  // the retry from zero impulses
 };
 
