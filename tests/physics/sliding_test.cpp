@@ -322,7 +322,7 @@ TEST(Sliding, BoxWithFrictionSlidesAsCoulombSaysOverSoftStiffCoarseFineTet4AndTe
 // Rubber-like slabs, the materials people twist: nu = 0.49 and 0.499 on tet4 with the nodal
 // average of the volumetric strain (per element, tet4 locks: the slab would be far stiffer than
 // the material says, docs/validation.md), and nu = 0.49 on tet10 per element. The slab's contact
-// solve factorises its matrix with the large volumetric stiffness lambda (24.5 to 250 times mu)
+// solve factorises its matrix with the large volumetric stiffness lambda (49 to 499 times mu)
 // and condenses it onto the contacts: the box must still feel only the normal force and Coulomb's
 // friction.
 TEST(Sliding, BoxWithFrictionSlidesAsCoulombSaysOverNearlyIncompressibleSlabs) {
