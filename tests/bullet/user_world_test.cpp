@@ -8,6 +8,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <limits>
 
 #include "torsion/bt_conversions.h"
 #include "torsion/mesh/ball_mesh.h"
@@ -372,7 +373,8 @@ TEST(UserWorld, PerNodeExternalForcesActEveryStepUntilChanged) {
   }
   EXPECT_NEAR(momentum / mass, 1.0, 1e-4);  // once only would give 0.01
   EXPECT_FALSE(ball->setNodeForce(ball->model().nodeCount(), a).ok());
-  EXPECT_FALSE(ball->setNodeForce(0, Eigen::Vector3d(NAN, 0, 0)).ok());
+  EXPECT_FALSE(
+      ball->setNodeForce(0, Eigen::Vector3d(std::numeric_limits<double>::quiet_NaN(), 0, 0)).ok());
   EXPECT_FALSE(ball->setExternalForces(Eigen::VectorXd::Zero(5)).ok());
 }
 

@@ -265,14 +265,14 @@ bool mutateNode(Json& root, std::mt19937& random, std::vector<std::string>& raw,
 
 extern "C" size_t LLVMFuzzerCustomMutator(uint8_t* data, size_t size, size_t max_size,
                                           unsigned int seed) {
-  std::mt19937 random(seed);
-  if (random() % 2 == 0) return LLVMFuzzerMutate(data, size, max_size);
+  std::mt19937 rng(seed);
+  if (rng() % 2 == 0) return LLVMFuzzerMutate(data, size, max_size);
   Json root = Json::parse(data, data + size, nullptr, false);
   if (root.is_discarded()) return LLVMFuzzerMutate(data, size, max_size);
   std::vector<std::string> raw;
-  const int edits = 1 + static_cast<int>(random() % 3);
+  const int edits = 1 + static_cast<int>(rng() % 3);
   for (int k = 0; k < edits; ++k) {
-    if (!mutateNode(root, random, raw, max_size)) return LLVMFuzzerMutate(data, size, max_size);
+    if (!mutateNode(root, rng, raw, max_size)) return LLVMFuzzerMutate(data, size, max_size);
   }
   std::string text = root.dump(1);
   for (size_t k = 0; k < raw.size(); ++k) {
