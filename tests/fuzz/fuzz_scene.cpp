@@ -264,8 +264,8 @@ bool mutateNode(Json& root, std::mt19937& random, std::vector<std::string>& raw,
 }  // namespace
 
 extern "C" size_t LLVMFuzzerCustomMutator(uint8_t* data, size_t size, size_t max_size,
-                                          unsigned int seed) {
-  std::mt19937 rng(seed);
+                                          unsigned int mutation_seed) {
+  std::mt19937 rng(mutation_seed);
   if (rng() % 2 == 0) return LLVMFuzzerMutate(data, size, max_size);
   Json root = Json::parse(data, data + size, nullptr, false);
   if (root.is_discarded()) return LLVMFuzzerMutate(data, size, max_size);
