@@ -62,7 +62,8 @@ void DelassusCondensation::lowerGram(const Eigen::SparseMatrix<double>& lower,
 
   // W_soft's lower triangle in order_'s order: per panel T^T T, added where its groups are.
   const Eigen::Index padded = static_cast<Eigen::Index>(kGroupColumns) * groups;
-  ordered_.setZero(padded, padded);
+  ordered_.assign(static_cast<size_t>(padded * padded), 0.0);
+  Eigen::Map<Eigen::MatrixXd> ordered(ordered_.data(), padded, padded);
   for (Eigen::Index b = 0; b < panel_count; ++b) {
     const Panel& p = panels_[static_cast<size_t>(b)];
     const int k = static_cast<int>(p.groups.size());
@@ -70,21 +71,23 @@ void DelassusCondensation::lowerGram(const Eigen::SparseMatrix<double>& lower,
     const Eigen::Index rows = std::min<Eigen::Index>(kPanelRows, size - b * kPanelRows);
     const Eigen::Map<const Eigen::MatrixXd> panel(p.values.data(), rows, kGroupColumns * k);
     if (k == groups) {  // every group reaches it (near the tree's root): in place
-      ordered_.selfadjointView<Eigen::Lower>().rankUpdate(panel.transpose());
+      ordered.selfadjointView<Eigen::Lower>().rankUpdate(panel.transpose());
       continue;
     }
-    gram_.setZero(kGroupColumns * k, kGroupColumns * k);
-    gram_.selfadjointView<Eigen::Lower>().rankUpdate(panel.transpose());
+    const Eigen::Index columns = static_cast<Eigen::Index>(kGroupColumns) * k;
+    gram_.assign(static_cast<size_t>(columns * columns), 0.0);
+    Eigen::Map<Eigen::MatrixXd> gram(gram_.data(), columns, columns);
+    gram.selfadjointView<Eigen::Lower>().rankUpdate(panel.transpose());
     for (int j = 0; j < k; ++j) {
       const Eigen::Index oj = kGroupColumns * p.groups[static_cast<size_t>(j)];
       for (int i = j; i < k; ++i) {  // groups increasing: i >= j lands in the lower triangle
         const Eigen::Index oi = kGroupColumns * p.groups[static_cast<size_t>(i)];
-        ordered_.block<kGroupColumns, kGroupColumns>(oi, oj) +=
-            gram_.block<kGroupColumns, kGroupColumns>(kGroupColumns * i, kGroupColumns * j);
+        ordered.block<kGroupColumns, kGroupColumns>(oi, oj) +=
+            gram.block<kGroupColumns, kGroupColumns>(kGroupColumns * i, kGroupColumns * j);
       }
     }
   }
-  // (A diagonal block above adds gram_'s zero strict upper part: ordered_'s stays 0.)
+  // (A diagonal block above adds gram's zero strict upper part: ordered's stays 0.)
 
   // Back to the contact rows' own order, 3x3 blocks, lower triangle only.
   delassus.setZero(3 * contact_rows, 3 * contact_rows);
@@ -92,7 +95,7 @@ void DelassusCondensation::lowerGram(const Eigen::SparseMatrix<double>& lower,
     const Eigen::Index sq = 3 * order_[static_cast<size_t>(q)];
     for (int p = q; p < contact_rows; ++p) {
       const Eigen::Index sp = 3 * order_[static_cast<size_t>(p)];
-      const auto block = ordered_.block<3, 3>(3 * p, 3 * q);  // (p, q) in the lower triangle
+      const auto block = ordered.block<3, 3>(3 * p, 3 * q);  // (p, q) in the lower triangle
       if (p == q) {
         delassus.block<3, 3>(sp, sq).triangularView<Eigen::Lower>() = block;
       } else if (sp > sq) {
