@@ -48,6 +48,7 @@ std::string HapticLoopSettings::validate() const {
   if (realtime_priority < 0 || realtime_priority > 99)
     return "realtime_priority must be in [0, 99]";
   if (std::string bad = passivity.validate(); !bad.empty()) return bad;
+  if (std::string bad = reading.validate(); !bad.empty()) return bad;
   return safety.validate();
 }
 
@@ -71,7 +72,11 @@ void HapticLoop::tick(double now, double deadline) {
   const double dt = have_previous_ ? now - previous_time_ : 1.0 / settings_.rate_hz;
 
   // 1-2. device and buttons (rising edges only)
-  const DeviceSample sample = device_.read(now);
+  const bool had_accepted = have_accepted_;
+  const Pose last_accepted_pose = accepted_.pose;
+  const double last_accepted_at = accepted_at_;
+  bool accepted = false;
+  const DeviceSample sample = takeReading(now, &accepted);
   const std::uint32_t pressed = sample.alive ? sample.buttons & ~previous_buttons_ : 0;
   if (sample.alive) previous_buttons_ = sample.buttons;
   if (pressed & kButton1) {
@@ -82,15 +87,21 @@ void HapticLoop::tick(double now, double deadline) {
     ++release_requests_;
     force_enabled_ = false;
   }
-  const double* twist = twist_.update(sample.pose, now);
-  // The unfiltered twist over this tick: the port's energy books the motion that happened.
+  // The motion since the last accepted reading, over the time it took: the twist estimate and
+  // the port's energy book the motion that happened, and a refused tick (no motion known) books
+  // none, so the next accepted reading books the whole of it.
   double port_twist[6] = {};
-  if (have_previous_ && dt > 0) {
-    poseDifference(previous_pose_, sample.pose, port_twist);
-    for (double& v : port_twist)
-      v = std::isfinite(v) ? v / dt : 0.0;
+  double port_dt = 0;
+  if (accepted) {
+    port_dt = had_accepted ? now - last_accepted_at : 0.0;
+    if (port_dt > 0) {
+      poseDifference(last_accepted_pose, sample.pose, port_twist);
+      for (double& v : port_twist)
+        v = std::isfinite(v) ? v / port_dt : 0.0;
+    }
+    twist_.update(sample.pose, now);
   }
-  previous_pose_ = sample.pose;
+  const double* twist = twist_.twist();
 
   // 3. command for the simulation
   HandCommand command;
@@ -143,17 +154,20 @@ void HapticLoop::tick(double now, double deadline) {
   const Wrench previous_output = safety_.output();
   Wrench output = safety_.apply(desired, inputs, dt);
   // The passivity controller (passivity.h) takes the generated energy back; only while healthy
-  // and holding: a fading output fades alone. The rate-limited kind keeps the written wrench
-  // within the safety filter's rate limit of the last one, and the filter then starts its next
-  // step from what was written. The dead-beat kind adds its correction after the rate limit.
+  // and holding: a fading output fades alone. Whichever kind acts, its result goes back
+  // through the filter, whose rate limit is the last stage before the device.
+  // A refused reading observed no motion: the observer waits for the next accepted one, and the
+  // controller, which acts on the observed motion, leaves this tick to the filter.
   const bool holding = inputs.grabbed && inputs.device_alive && inputs.simulation_fresh;
-  passivity_.observe(port_twist, dt, holding);
-  if (holding) {
+  if (accepted || !holding) passivity_.observe(port_twist, port_dt, holding);
+  if (holding && accepted) {
     const double step_dt = std::clamp(dt, 0.0, settings_.safety.fade_time);
-    output = passivity_.control(previous_output, output, port_twist, dt,
-                                settings_.safety.max_force_rate * step_dt,
-                                settings_.safety.max_torque_rate * step_dt, limits_);
-    if (settings_.passivity.rate_limited) safety_.follow(output);
+    const Wrench controlled = passivity_.control(
+        previous_output, output, port_twist, dt, settings_.safety.max_force_rate * step_dt,
+        settings_.safety.max_torque_rate * step_dt, limits_);
+    // The filter's rate limit is the last stage whatever the controller asks for: a correction
+    // beyond it is spread over the next ticks (the observer books what was written).
+    output = safety_.follow(controlled, dt);
   }
   device_.write(output);
   passivity_.written(output);
@@ -200,6 +214,30 @@ void HapticLoop::tick(double now, double deadline) {
   have_previous_ = true;
   previous_time_ = now;
   ++stats_.ticks;
+}
+
+DeviceSample HapticLoop::takeReading(double now, bool* accepted) {
+  const DeviceSample raw = device_.read(now);
+  const ReadingCheck& check = settings_.reading;
+  // The motion is checked against the last accepted reading only while the device was alive:
+  // a device that comes back (or answers for the first time) may be anywhere within reach.
+  const bool tracking = have_accepted_ && accepted_.alive;
+  *accepted = isPlausiblePose(raw.pose, check) &&
+              (!tracking || isPlausibleMotion(accepted_.pose, raw.pose, now - accepted_at_,
+                                              1.0 / settings_.rate_hz, check));
+  if (*accepted) {
+    accepted_ = raw;
+    accepted_at_ = now;
+    have_accepted_ = true;
+    refused_since_ = -1;
+    return raw;
+  }
+  ++stats_.refused;
+  if (refused_since_ < 0) refused_since_ = now;
+  if (!have_accepted_) return DeviceSample{};  // nothing to hold: dead, at the origin
+  DeviceSample held = accepted_;
+  held.alive = accepted_.alive && now - refused_since_ <= check.hold_time;
+  return held;
 }
 
 void HapticLoop::start() {

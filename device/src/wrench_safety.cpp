@@ -60,8 +60,17 @@ std::string SafetySettings::validate() const {
 SafetyFilter::SafetyFilter(const SafetySettings& settings, const DeviceLimits& limits)
     : settings_(settings), limits_(limits) {}
 
+namespace {
+
+double clampedStep(double dt, double fade_time) {
+  return std::isfinite(dt) ? std::clamp(dt, 0.0, fade_time) : 0.0;
+}
+
+}  // namespace
+
 Wrench SafetyFilter::apply(const Wrench& desired, const SafetyInputs& inputs, double dt) {
-  dt = std::isfinite(dt) ? std::clamp(dt, 0.0, settings_.fade_time) : 0.0;
+  dt = clampedStep(dt, settings_.fade_time);
+  previous_ = output_;
   if (!inputs.device_alive || !inputs.simulation_fresh) {
     gain_ = 0;
     output_.force = shrink(output_.force, limits_.max_force * dt / settings_.fade_time);
@@ -79,6 +88,15 @@ Wrench SafetyFilter::apply(const Wrench& desired, const SafetyInputs& inputs, do
   }
   output_.force = approach(output_.force, target.force, settings_.max_force_rate * dt);
   output_.torque = approach(output_.torque, target.torque, settings_.max_torque_rate * dt);
+  output_ = saturate(output_, limits_);
+  return output_;
+}
+
+const Wrench& SafetyFilter::follow(const Wrench& proposed, double dt) {
+  dt = clampedStep(dt, settings_.fade_time);
+  const Wrench safe = saturate(proposed, limits_);
+  output_.force = approach(previous_.force, safe.force, settings_.max_force_rate * dt);
+  output_.torque = approach(previous_.torque, safe.torque, settings_.max_torque_rate * dt);
   output_ = saturate(output_, limits_);
   return output_;
 }

@@ -22,7 +22,7 @@ namespace {
 struct ClosedLoop {
   double delay = 0.02;  // s from a step's end to its wrench reaching the loop
   bool passivity = true;
-  bool rate_limited = false;  // passivity.rate_limited
+  bool rate_limited = device::PassivitySettings{}.rate_limited;  // passivity.rate_limited
   // passivity.misprediction_margin; 0: the plain dead-beat damper
   double margin = device::PassivitySettings{}.misprediction_margin;
   double energy_tolerance = 0;   // J, passivity.energy_tolerance
@@ -160,13 +160,14 @@ TEST(HapticClosedLoop, DelayedStiffCylinderGeneratesEnergyUncontrolledAndIsDampe
         controlled.max_energy, controlled.swing(0.5, 1.0), controlled.swing(1.5, 2.0),
         controlled.dissipated, static_cast<unsigned long long>(controlled.active));
     // Uncontrolled the coupling generates joules (the twisted cylinder holds 0.2 mJ at the
-    // device at rest); controlled the port stays passive to rounding (1e-9 J, 5e-6 of what the
-    // body holds; measured 7e-37 J), and the swing dies down, to under a tenth of the
-    // uncontrolled one.
+    // device at rest); under the default (rate-limited) controller the port stays passive within
+    // 1 % of what the body holds (measured 4.7e-8 J, in the grab's first ticks), and the swing
+    // dies down, to about a milliradian, under half the uncontrolled one.
     EXPECT_GT(free.max_energy, 1.0);
-    EXPECT_LE(controlled.max_energy, 1e-9);
+    EXPECT_LE(controlled.max_energy, 2e-6);
     EXPECT_LT(controlled.swing(1.5, 2.0), controlled.swing(0.5, 1.0));
-    EXPECT_LT(controlled.swing(1.5, 2.0), 0.1 * free.swing(1.5, 2.0));
+    EXPECT_LT(controlled.swing(1.5, 2.0), 0.002);
+    EXPECT_LT(controlled.swing(1.5, 2.0), 0.5 * free.swing(1.5, 2.0));
     EXPECT_GT(controlled.active, 0u);
   }
 }
@@ -193,7 +194,7 @@ TEST(HapticClosedLoop,
         controlled.max_energy, controlled.swing(1.5, 2.0),
         static_cast<unsigned long long>(controlled.active));
     EXPECT_GT(free.max_energy, 1.0);
-    EXPECT_LE(controlled.max_energy, 1e-9);
+    EXPECT_LE(controlled.max_energy, 2e-6);  // 1 % of the 0.2 mJ the body holds (as above)
     EXPECT_LT(controlled.swing(1.5, 2.0), 0.01);
     EXPECT_LT(controlled.swing(1.5, 2.0), 0.25 * free.swing(1.5, 2.0));
   }
@@ -240,8 +241,8 @@ TEST(HapticClosedLoop, WithAFirmGripOnTheTiltASlowTwistFeelsTheBodysStaticStiffn
   EXPECT_LT(-felt(loose), 0.7 * -felt(firm));
 
   // The controller against this reference. Strict (the default), it acts on the sampled
-  // rendering's microjoules and keeps the port passive to rounding, at a torque within 2 % of
-  // the reference (measured 0.7 % less, at 1.25 times the angle: the hand sinks in a little).
+  // rendering's microjoules and keeps the port passive within 1 % of the 0.14 mJ the body holds
+  // at the device, at a torque within 2 % of the reference.
   // With a 10 uJ tolerance it leaves the loop alone: the same torque and felt stiffness within
   // 2 %, and the port within the tolerance.
   c.passivity = true;
@@ -258,7 +259,7 @@ TEST(HapticClosedLoop, WithAFirmGripOnTheTiltASlowTwistFeelsTheBodysStaticStiffn
       static_cast<unsigned long long>(strict.active), tolerant.mean(tolerant.torque, 2, 3),
       tolerant.mean(tolerant.angle, 2, 3), tolerant.max_energy,
       static_cast<unsigned long long>(tolerant.active));
-  EXPECT_LE(strict.max_energy, 1e-9);
+  EXPECT_LE(strict.max_energy, 1.4e-6);
   EXPECT_NEAR(strict.mean(strict.torque, 2, 3), reference, 0.02 * std::abs(reference));
   EXPECT_NEAR(tolerant.mean(tolerant.torque, 2, 3), reference, 0.02 * std::abs(reference));
   EXPECT_NEAR(felt(tolerant), felt(firm), 0.02 * std::abs(felt(firm)));
@@ -266,13 +267,12 @@ TEST(HapticClosedLoop, WithAFirmGripOnTheTiltASlowTwistFeelsTheBodysStaticStiffn
 }
 
 // The delayed stiff cylinder in the slow twist (as above, firm grip), with the step blend
-// (step_blend.h, 8 Hz) under the default controller and under the rate-limited one. Without a
-// controller the delayed loop gains energy in the twist and keeps oscillating; with either the
-// port stays passive to rounding, the motion settles, and the hold's torque is the one felt
-// without delay and without any controller: the reference, since that loop is passive on its
-// own (the test above) and a delay does not change the static equilibrium of a passive body and
-// the operator's wrist. Without the blend the default controller holds 1.3-2.0 % less torque
-// (the hand sinks in by a third more angle), printed here.
+// (step_blend.h, 8 Hz) under the default controller (rate-limited). Without a controller the
+// delayed loop gains energy in the twist and keeps oscillating; with it the port stays passive,
+// the motion settles, the torque never steps beyond the rate limit, and the hold's torque is the
+// one felt without delay and without any controller: the reference, since that loop is passive
+// on its own (the test above) and a delay does not change the static equilibrium of a passive
+// body and the operator's wrist. Without the blend the hold is softer (printed here).
 TEST(HapticClosedLoop, ADelayedSlowTwistStaysPassiveAndFeelsTheUndelayedTorqueUnderTheController) {
   ClosedLoop c;
   c.delay = 0;
@@ -300,24 +300,17 @@ TEST(HapticClosedLoop, ADelayedSlowTwistStaysPassiveAndFeelsTheUndelayedTorqueUn
     const ClosedTrace free = runClosedLoop(c);
     c.passivity = true;
     const ClosedTrace controlled = runClosedLoop(c);
-    c.rate_limited = true;
-    const ClosedTrace limited = runClosedLoop(c);
-    c.rate_limited = false;
     std::printf(
         "slow twist, delay %.0f ms (blend 8 Hz; reference %.4f N m at %.5f rad): uncontrolled "
         "E_obs %.3g J at 1 s, %.3g J at 3 s, off the undelayed twist by %.3g rad in 0.1-0.3 s, "
         "%.3g in 2.5-3 s; default: max E_obs %.3g J, largest step %.3g N m, swing %.3g -> %.3g "
-        "rad, torque %.4f N m (%+.2f %%) at %.5f rad, %llu active ticks; rate-limited: max E_obs "
-        "%.3g J, largest step %.3g N m, swing %.3g rad, torque %.4f N m (%+.2f %%) at %.5f rad; "
-        "default unblended: max E_obs %.3g J, swing %.3g rad, torque %.4f N m (%+.2f %%) at "
-        "%.5f rad\n",
+        "rad, torque %.4f N m (%+.2f %%) at %.5f rad, %llu active ticks; default unblended: max "
+        "E_obs %.3g J, swing %.3g rad, torque %.4f N m (%+.2f %%) at %.5f rad\n",
         1e3 * delay, torque, angle, free.energyAt(1), free.energyAt(3),
         free.deviation(reference, 0.1, 0.3), free.deviation(reference, 2.5, 3),
         controlled.max_energy, controlled.max_torque_step, controlled.swing(1, 1.5),
         controlled.swing(2.5, 3), controlled.mean(controlled.torque, 2, 3), off(controlled),
         controlled.mean(controlled.angle, 2, 3), static_cast<unsigned long long>(controlled.active),
-        limited.max_energy, limited.max_torque_step, limited.swing(2.5, 3),
-        limited.mean(limited.torque, 2, 3), off(limited), limited.mean(limited.angle, 2, 3),
         unblended.max_energy, unblended.swing(2.5, 3), unblended.mean(unblended.torque, 2, 3),
         off(unblended), unblended.mean(unblended.angle, 2, 3));
     // Uncontrolled: the port gains energy, far beyond the 0.14 mJ the twisted body holds at the
@@ -326,24 +319,19 @@ TEST(HapticClosedLoop, ADelayedSlowTwistStaysPassiveAndFeelsTheUndelayedTorqueUn
     EXPECT_GT(free.energyAt(1), 0.01);
     EXPECT_GT(free.energyAt(3), free.energyAt(1));
     EXPECT_GT(free.deviation(reference, 2.5, 3), 2 * free.deviation(reference, 0.1, 0.3));
-    // Controlled, either way: E_obs <= 0 to rounding (1e-9 J, 1e-5 of what the body holds), the
-    // motion settled to under a milliradian and a tenth of the uncontrolled swing, and the
-    // torque of the hold within 2 % of the reference.
-    for (const ClosedTrace* t : {&controlled, &limited}) {
-      EXPECT_LE(t->max_energy, t == &limited ? 1.4e-6 : 1e-9);
-      EXPECT_LT(t->swing(2.5, 3), 1e-3);
-      EXPECT_LT(t->swing(2.5, 3), 0.1 * free.swing(2.5, 3));
-      EXPECT_NEAR(t->mean(t->torque, 2, 3), torque, 0.02 * std::abs(torque));
+    // Controlled: E_obs within 1 % of what the body holds, the motion settled to under a
+    // milliradian and a tenth of the uncontrolled swing, no step beyond the rate limit, and the
+    // torque of the hold within 2 % of the reference. The torque of the hold is mostly the
+    // operator's wrist (3 N m/rad against the body's 74), so the angle says more of the
+    // stiffness felt: within a fifth of the undelayed angle.
+    for (const ClosedTrace* t : {&controlled, &unblended}) {
+      EXPECT_LE(t->max_energy, 1.4e-6);
+      EXPECT_LE(t->max_torque_step, rate_step * (1 + 1e-9));
     }
-    // The rate-limited controller never steps beyond the rate limit.
-    EXPECT_LE(limited.max_torque_step, rate_step * (1 + 1e-9));
-    // The torque of the hold is mostly the operator's wrist (3 N m/rad against the body's 74), so
-    // the angle says more of the stiffness felt: the rate-limited hand holds within a fifth of
-    // the undelayed angle, the default's within a third (measured 24 % less at 50 ms: the body
-    // feels stiffer, never softer).
-    EXPECT_NEAR(limited.mean(limited.angle, 2, 3), angle, 0.2 * angle);
-    EXPECT_NEAR(controlled.mean(controlled.angle, 2, 3), angle, 0.3 * angle);
-    EXPECT_LE(unblended.max_energy, 1e-9);
+    EXPECT_LT(controlled.swing(2.5, 3), 1e-3);
+    EXPECT_LT(controlled.swing(2.5, 3), 0.1 * free.swing(2.5, 3));
+    EXPECT_NEAR(controlled.mean(controlled.torque, 2, 3), torque, 0.02 * std::abs(torque));
+    EXPECT_NEAR(controlled.mean(controlled.angle, 2, 3), angle, 0.2 * angle);
   }
 }
 
@@ -351,46 +339,39 @@ TEST(HapticClosedLoop, ADelayedSlowTwistStaysPassiveAndFeelsTheUndelayedTorqueUn
 // at 1 rad/s; the step's own stiffness is 20 times that) where the rate limit allows 30. Within
 // the rate limit the torque cannot keep up while the hand presses in, the port stores less than
 // the body holds, and a strictly passive port may not give the difference back: the hand sinks
-// in. The default controller steps beyond the rate limit (damping the predicted motion and
-// shrinking the wrench) and keeps the port passive to rounding with the hand 3-7 times less
-// deep; the plain dead-beat damper keeps it out further still, but only by letting each tick's
-// misprediction through (E_obs up to 0.2 mJ). Without K_h, and with it for the default.
-TEST(HapticClosedLoop, AFastTurnStaysPassiveAndTheHandSinksInLessThanWithinTheRateLimit) {
+// in (a passive rendering that never steps beyond the rate limit r cannot feel stiffer than
+// r / v at speed v). Both controllers stay within the rate limit; the default, rate-limited one
+// plans for it and stays passive, with and without K_h; the dead-beat damper, its correction
+// spread by the rate limit, lets energy through.
+TEST(HapticClosedLoop, AFastTurnStaysPassiveWithinTheRateLimit) {
   const double rate_step = 30 * 1e-3;
   for (double delay : {0.005, 0.02, 0.05}) {
     SCOPED_TRACE(delay);
     ClosedLoop c;
     c.delay = delay;
-    const ClosedTrace reserve = runClosedLoop(c);
+    const ClosedTrace limited = runClosedLoop(c);
     c.local_stiffness = true;
     const ClosedTrace stiff = runClosedLoop(c);
     c.local_stiffness = false;
-    c.margin = 0;
-    const ClosedTrace plain = runClosedLoop(c);
-    c.margin = ClosedLoop{}.margin;
-    c.rate_limited = true;
-    const ClosedTrace limited = runClosedLoop(c);
+    c.rate_limited = false;
+    const ClosedTrace dead_beat = runClosedLoop(c);
     auto hold = [](const ClosedTrace& t) { return t.mean(t.angle, 1.5, 2); };
     std::printf(
-        "fast turn, delay %.0f ms: default holds %.4f rad with %.4f N m (largest step %.3g N m, "
-        "max E_obs %.3g J), with K_h %.4f rad (step %.3g N m, max E_obs %.3g J); plain "
-        "dead-beat %.4f rad (step %.3g N m, max E_obs %.3g J); rate-limited %.4f "
-        "rad with %.4f N m against %.4f simulated (step %.3g N m, max E_obs %.3g J)\n",
-        1e3 * delay, hold(reserve), reserve.mean(reserve.torque, 1.5, 2), reserve.max_torque_step,
-        reserve.max_energy, hold(stiff), stiff.max_torque_step, stiff.max_energy, hold(plain),
-        plain.max_torque_step, plain.max_energy, hold(limited),
-        limited.mean(limited.torque, 1.5, 2), limited.mean(limited.simulated, 1.5, 2),
-        limited.max_torque_step, limited.max_energy);
-    EXPECT_LE(reserve.max_energy, 1e-9);
-    EXPECT_LE(stiff.max_energy, 1e-9);
-    EXPECT_GT(reserve.max_torque_step, 10 * rate_step);
-    EXPECT_LT(hold(reserve), 0.015);
-    EXPECT_LT(hold(stiff), 0.012);
-    EXPECT_GT(plain.max_energy, 1e-6);
-    EXPECT_LT(hold(plain), 0.005);
-    EXPECT_LE(limited.max_torque_step, rate_step * (1 + 1e-9));
-    EXPECT_LE(limited.max_energy, 1.4e-6);
-    EXPECT_GT(hold(limited), 2.5 * hold(reserve));
+        "fast turn, delay %.0f ms: default (rate-limited) holds %.4f rad with %.4f N m against "
+        "%.4f simulated (largest step %.3g N m, max E_obs %.3g J), with K_h %.4f rad (step %.3g "
+        "N m, max E_obs %.3g J); dead-beat %.4f rad (step %.3g N m, max E_obs %.3g J)\n",
+        1e3 * delay, hold(limited), limited.mean(limited.torque, 1.5, 2),
+        limited.mean(limited.simulated, 1.5, 2), limited.max_torque_step, limited.max_energy,
+        hold(stiff), stiff.max_torque_step, stiff.max_energy, hold(dead_beat),
+        dead_beat.max_torque_step, dead_beat.max_energy);
+    for (const ClosedTrace* t : {&limited, &stiff, &dead_beat})
+      EXPECT_LE(t->max_torque_step, rate_step * (1 + 1e-9));
+    // Passive within 1 % of the 0.2 mJ the body holds at the device.
+    EXPECT_LE(limited.max_energy, 2e-6);
+    EXPECT_LE(stiff.max_energy, 2e-6);
+    // The hand is held short of the 0.05 rad it meant to turn, the torque against it.
+    EXPECT_LT(hold(limited), 0.05);
+    EXPECT_LT(limited.mean(limited.torque, 1.5, 2), 0);
   }
 }
 

@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstdio>
 #include <thread>
+#include <vector>
 
 #include "stand_in_simulation.h"
 #include "torsion/device/pose_math.h"
@@ -250,6 +251,118 @@ TEST(HapticLoop, LogReplaysAsTheSameMotion) {
     EXPECT_EQ(a.buttons, script.buttonsAt(t)) << t;
   }
   std::remove(path.c_str());
+}
+
+// A device whose readings from the `from`-th through the `to`-th have their position replaced by
+// `glitch` (a corrupted reading, as a packet or a driver may deliver).
+class GlitchingDevice : public HapticDevice {
+ public:
+  GlitchingDevice(HapticDevice& inner, long from, long to, const Vec3& glitch)
+      : inner_(inner), from_(from), to_(to), glitch_(glitch) {}
+  std::string name() const override { return "glitching"; }
+  DeviceLimits limits() const override { return inner_.limits(); }
+  DeviceSample read(double time) override {
+    DeviceSample s = inner_.read(time);
+    ++reads_;
+    if (reads_ >= from_ && reads_ <= to_) s.pose.position = glitch_;
+    return s;
+  }
+  void write(const Wrench& wrench) override {
+    inner_.write(wrench);
+    written_.push_back(wrench);
+  }
+  /// Every wrench written, in order.
+  const std::vector<Wrench>& written() const { return written_; }
+
+ private:
+  HapticDevice& inner_;
+  long from_, to_;
+  Vec3 glitch_;
+  long reads_ = 0;
+  std::vector<Wrench> written_;
+};
+
+struct PushRun {
+  std::vector<Wrench> written;  // written to the device, one per tick
+  double max_port_energy = 0;
+  std::uint64_t refused = 0;
+};
+
+// The push into the 200 N/m spring (100 Hz simulation) for 1.5 s; readings `from`-`to` (1-based)
+// are glitches at `glitch` (none when from > to).
+PushRun pushWithGlitch(long from, long to, const Vec3& glitch) {
+  ScriptedDevice scripted(pushAlongX(0.05), defaultDeviceLimits(), "push");
+  GlitchingDevice device(scripted, from, to, glitch);
+  HapticLoop loop(device, HapticLoopSettings{});
+  SpringSimulation sim;
+  PushRun run;
+  for (int k = 0; k <= 1500; ++k) {
+    loop.tick(k * kDt);
+    if (k % 10 == 0) sim.answer(loop);
+  }
+  run.written = device.written();  // what the device was given, tick by tick
+  run.max_port_energy = loop.stats().max_port_energy;
+  run.refused = loop.stats().refused;
+  return run;
+}
+
+TEST(HapticLoop, ARefusedReadingEntersNoStateAndTheWrenchGoesOnAsWithoutIt) {
+  // One reading at x = 1e7 m in the middle of the push (tick 505, between two simulation steps,
+  // the hand at 25 mm feeling 5 N). Booked, it would be megajoules of port energy that the
+  // passivity controller then takes back by pinning the output at the device's limit.
+  const PushRun clean = pushWithGlitch(1, 0, {});
+  const PushRun glitched = pushWithGlitch(506, 506, {1e7, 0, 0});
+  EXPECT_EQ(clean.refused, 0u);
+  EXPECT_EQ(glitched.refused, 1u);
+  // The refused tick's rendering is at the pose held from the tick before: 0.05 m/s x 1 ms x
+  // 200 N/m = 0.01 N off; twice that allowed. Every other tick renders the same poses.
+  const double rate_step = HapticLoopSettings{}.safety.max_force_rate * kDt;
+  for (size_t k = 0; k < clean.written.size(); ++k) {
+    EXPECT_LE(norm(glitched.written[k].force - clean.written[k].force), 0.02) << "tick " << k;
+    if (k > 0) {
+      EXPECT_LE(norm(glitched.written[k].force - glitched.written[k - 1].force),
+                rate_step * (1 + 1e-9))
+          << "tick " << k;
+    }
+  }
+  // The observer books the motion across the refused tick at the next accepted one, against the
+  // wrench held meanwhile: 0.01 N x 0.05 mm = 5e-7 J from the clean run's booking at most.
+  EXPECT_LE(glitched.max_port_energy, clean.max_port_energy + 1e-6);
+}
+
+TEST(HapticLoop, ADeviceThatKeepsSendingNonsenseIsDeadAfterTheHoldTimeAndItsForceFades) {
+  // From 1 s on every reading is at x = 1e7 m: held for reading.hold_time, then the device is
+  // dead and the output shrinks to zero within fade_time, as for a device that stops answering.
+  const HapticLoopSettings settings;
+  const PushRun run = pushWithGlitch(1001, 1000000, {1e7, 0, 0});
+  ASSERT_GT(norm(run.written[999].force), 4.0);  // pushing into the spring before
+  // Dead at the first tick past the hold time, then at most fade_time to zero.
+  const double zero_by = 1.0 + settings.reading.hold_time + kDt + settings.safety.fade_time;
+  for (size_t k = 0; k < run.written.size(); ++k) {
+    if (static_cast<double>(k) * kDt > zero_by + 1e-9) {
+      EXPECT_EQ(norm(run.written[k].force), 0.0) << "tick " << k;
+      EXPECT_EQ(norm(run.written[k].torque), 0.0) << "tick " << k;
+    }
+  }
+  EXPECT_EQ(run.refused, 501u);  // ticks 1000-1500 (reads 1001-1501)
+  EXPECT_LE(run.max_port_energy, 1e-6);
+}
+
+TEST(ReadingCheck, RefusesWhatIsNotAPoseOrMovesFasterThanAHand) {
+  const ReadingCheck check;
+  EXPECT_TRUE(isPlausiblePose(Pose{{0.1, -0.2, 0.05}, fromRotationVector({0, 0, 1})}, check));
+  EXPECT_FALSE(isPlausiblePose(Pose{{1e7, 0, 0}, {}}, check));
+  EXPECT_FALSE(isPlausiblePose(Pose{{std::nan(""), 0, 0}, {}}, check));
+  EXPECT_FALSE(isPlausiblePose(Pose{{}, {0.9, 0, 0, 0}}, check));  // not a rotation
+  const Pose here{}, near{{0.005, 0, 0}, {}}, turned{{}, fromRotationVector({0, 0.05, 0})};
+  EXPECT_TRUE(isPlausibleMotion(here, near, 0.001, 0.001, check));       // 5 m/s
+  EXPECT_FALSE(isPlausibleMotion(here, near, 0.0001, 0.0001, check));    // 50 m/s
+  EXPECT_TRUE(isPlausibleMotion(here, near, 0.0001, 0.001, check));      // floored at a period
+  EXPECT_TRUE(isPlausibleMotion(here, turned, 0.001, 0.001, check));     // 50 rad/s
+  EXPECT_FALSE(isPlausibleMotion(here, turned, 0.0001, 0.0001, check));  // 500 rad/s
+  ReadingCheck bad;
+  bad.max_speed = 0;
+  EXPECT_EQ(bad.validate(), "reading.max_speed must be positive (m/s)");
 }
 
 TEST(HapticLoop, ThreadStartsTicksAndStopsWithZeroOutput) {

@@ -27,7 +27,7 @@ struct Scenario {
   double delay = 0.02;          // s from the simulation's step to its wrench reaching the loop
   bool give_stiffness = false;  // publish K_h (the local model then bridges the delay)
   bool passivity = true;
-  bool rate_limited = false;  // the energy-reserve controller instead of the dead-beat damper
+  bool rate_limited = PassivitySettings{}.rate_limited;  // false: the dead-beat damper
   // passivity.misprediction_margin; 0: the plain dead-beat damper
   double margin = PassivitySettings{}.misprediction_margin;
   double twist = 0.2;           // rad the operator means to turn
@@ -220,7 +220,8 @@ TEST(Passivity, DelayedStiffObjectGeneratesEnergyUncontrolledAndSettlesUnderTheC
     sc.passivity = false;
     const Trace free = run(sc);
     sc.passivity = true;
-    const Trace controlled = run(sc);
+    const Trace controlled = run(sc);  // the default: the rate-limited controller
+    sc.rate_limited = false;
     sc.margin = 0;
     const Trace plain = run(sc);
     const double early_free = free.swing(0.5, 1.0), late_free = free.swing(2.5, 3.0);
@@ -239,16 +240,17 @@ TEST(Passivity, DelayedStiffObjectGeneratesEnergyUncontrolledAndSettlesUnderTheC
     EXPECT_GT(free.max_energy, 1.0);
     EXPECT_GT(late_free, 0.5);
     // Controlled, the port stays passive to rounding (1e-9 J, 1.5e-7 of what the object holds;
-    // measured 0), and the swing dies down to a fraction of a degree: a residual chatter (the
-    // controller cuts the wrench when the credit runs out) well under 1 % of the uncontrolled
-    // swing.
+    // measured 0), and the swing dies down to a fraction of a degree, well under 1 % of the
+    // uncontrolled swing.
     EXPECT_LE(controlled.max_energy, 1e-9);
     EXPECT_LT(late_controlled, 0.01);
     EXPECT_LT(late_controlled, 0.01 * late_free);
     EXPECT_GT(controlled.active, 0u);
-    // Without the reserve the dead-beat damper lets each tick's misprediction through.
-    EXPECT_GT(plain.max_energy, 1e-6);
-    EXPECT_LE(plain.max_energy, 0.05 * 6.8e-3);
+    // The plain dead-beat damper needs about 1 N m in one tick; held to the rate limit, its
+    // correction comes too late and the port gains several times what the object holds
+    // (measured 33-45 mJ): why the default is the rate-limited controller.
+    EXPECT_LE(plain.max_torque_step, 30 * kDt * (1 + 1e-9));
+    EXPECT_GT(plain.max_energy, 6.8e-3);
   }
 }
 
@@ -293,9 +295,11 @@ TEST(Passivity, TheRateLimitedControllerBrakesWithinTheRateLimit) {
   EXPECT_EQ(pc.activeTicks(), 1u);
 }
 
-// The same delayed stiff object under the rate-limited energy-reserve controller: the written
-// torque never changes by more than the rate limit (30 N m/s: 0.03 N m per tick) and the port
-// never gains energy; the default dead-beat damper keeps it passive by stepping far beyond it.
+// The same delayed stiff object under the rate-limited energy-reserve controller (the default):
+// the written torque never changes by more than the rate limit (30 N m/s: 0.03 N m per tick) and
+// the port never gains energy. The dead-beat damper's correction, which would step the torque by
+// up to 1 N m in a tick, is held to the same rate limit: the safety filter is the last stage
+// before the device, whatever a controller asks for.
 TEST(Passivity, TheRateLimitedControllerKeepsThePortPassiveWithoutSteppingTheWrench) {
   const double rate_step = 30 * kDt;
   for (double delay : {0.005, 0.02, 0.05}) {
@@ -305,6 +309,7 @@ TEST(Passivity, TheRateLimitedControllerKeepsThePortPassiveWithoutSteppingTheWre
     sc.passivity = false;
     const Trace free = run(sc);
     sc.passivity = true;
+    sc.rate_limited = false;
     const Trace dead_beat = run(sc);
     sc.rate_limited = true;
     const Trace reserve = run(sc);
@@ -315,7 +320,7 @@ TEST(Passivity, TheRateLimitedControllerKeepsThePortPassiveWithoutSteppingTheWre
         1e3 * delay, dead_beat.max_energy, dead_beat.max_torque_step, dead_beat.swing(2.5, 3.0),
         reserve.max_energy, reserve.max_torque_step, reserve.swing(2.5, 3.0), reserve.dissipated,
         static_cast<unsigned long long>(reserve.active));
-    EXPECT_GT(dead_beat.max_torque_step, 5 * rate_step);
+    EXPECT_LE(dead_beat.max_torque_step, rate_step * (1 + 1e-9));
     EXPECT_LE(reserve.max_torque_step, rate_step * (1 + 1e-9));
     // Passive: the reserve covers every tick (measured: E_obs never above 0); 1 % of the 6.8 mJ
     // the object holds at rest allowed for rounding and the motor's lag.

@@ -1,7 +1,9 @@
 #pragma once
 // The haptic loop: one thread at 1 kHz (absolute deadlines on the monotonic clock, so periods do
 // not drift), each tick:
-//   1. read the device (pose, buttons, alive);
+//   1. read the device (pose, buttons, alive); a reading the loop refuses (reading_check.h)
+//      enters none of its state: the last accepted one stands in for it for at most
+//      reading.hold_time, then the device counts as dead;
 //   2. buttons, as the report's section 5.4: button 1 pressed -> a grab request and force
 //      enabled; button 2 pressed -> a release request and force disabled;
 //   3. hand the simulation a HandCommand (lock-free, commands());
@@ -10,8 +12,9 @@
 //      the step carries K_h (step_blend.h, step_blend_hz);
 //   5. pass the wrench through the SafetyFilter, let the passivity controller (passivity.h) take
 //      back the generated energy (the dead-beat damper on top of the filter's output, or the
-//      rate-limited controller within the filter's rate limit, the filter then following what
-//      was written), write it to the device and book its energy at the port;
+//      rate-limited controller within the filter's rate limit), hand the result back to the
+//      filter, whose rate limit is always the last stage, write it to the device and book its
+//      energy at the port;
 //   6. append a row to the in-memory log (no I/O on this thread; writeLog after stop()).
 //
 // Threads: tick() runs on the loop thread (or on a test's thread with a fake clock, never both);
@@ -26,6 +29,7 @@
 #include "torsion/device/haptic_device.h"
 #include "torsion/device/local_wrench_model.h"
 #include "torsion/device/passivity.h"
+#include "torsion/device/reading_check.h"
 #include "torsion/device/step_blend.h"
 #include "torsion/device/triple_buffer.h"
 #include "torsion/device/wrench_safety.h"
@@ -35,6 +39,7 @@ namespace torsion::device {
 struct HapticLoopSettings {
   double rate_hz = 1000;  ///< ticks per second
   SafetySettings safety;
+  ReadingCheck reading;  ///< which device readings the loop takes (reading_check.h)
   CouplingDamper damper;
   PassivitySettings passivity;  ///< time-domain passivity observer and controller (on)
   double twist_cutoff_hz = 50;  ///< low-pass of the velocity the damper sees
@@ -81,6 +86,7 @@ struct LoopStats {
   std::atomic<std::uint64_t> overruns{0};     ///< ticks that started a full period late
   std::atomic<std::uint64_t> log_dropped{0};  ///< rows not logged: capacity reached
   std::atomic<std::uint64_t> nonfinite{0};    ///< rendered wrenches with NaN/inf (zeroed)
+  std::atomic<std::uint64_t> refused{0};      ///< device readings refused (reading_check.h)
   std::atomic<std::uint64_t> saturated{0};    ///< ticks whose wrench exceeded a device limit
   std::atomic<bool> realtime{false};          ///< the thread runs under SCHED_FIFO
   std::atomic<std::uint64_t> pc_active{0};    ///< ticks the passivity controller acted
@@ -125,6 +131,9 @@ class HapticLoop {
 
  private:
   void run();
+  /// This tick's device reading: the device's own when the checks accept it, else the last
+  /// accepted one (alive for at most reading.hold_time of refusals). *accepted says which.
+  DeviceSample takeReading(double now, bool* accepted);
 
   HapticDevice& device_;
   HapticLoopSettings settings_;
@@ -132,7 +141,10 @@ class HapticLoop {
   SafetyFilter safety_;
   TwistEstimator twist_;
   PassivityController passivity_;
-  Pose previous_pose_;
+  DeviceSample accepted_;   // the last accepted reading (its time: the loop clock's when read)
+  double accepted_at_ = 0;  // s, loop clock of the tick that accepted it
+  bool have_accepted_ = false;
+  double refused_since_ = -1;  // s, first tick of the current run of refusals; < 0: none
   TripleBuffer<HandCommand> commands_;
   TripleBuffer<SimulationWrench> wrenches_;
   LoopStats stats_;

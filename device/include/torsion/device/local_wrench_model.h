@@ -36,6 +36,8 @@ class TwistEstimator {
   explicit TwistEstimator(double cutoff_hz = 50) : cutoff_hz_(cutoff_hz) {}
   /// Feeds the pose at `time`; returns the filtered twist.
   const double* update(const Pose& pose, double time);
+  /// The filtered twist of the last update().
+  const double* twist() const { return twist_; }
   void reset() { have_previous_ = false; }
 
  private:

@@ -83,9 +83,11 @@ namespace torsion::device {
 
 struct PassivitySettings {
   bool enabled = true;  ///< the controller; the observer always runs
-  /// The energy-reserve controller whose output respects the rate limit (above); false (the
-  /// default): the dead-beat damper added after the rate limit (docs/haptics.md compares them).
-  bool rate_limited = false;
+  /// The energy-reserve controller, which plans within the rate limit (above; the default).
+  /// false: the dead-beat damper, whose correction the safety filter's rate limit then spreads
+  /// over several ticks, so that its one-tick guarantee no longer holds (docs/haptics.md
+  /// compares them): the rate limit is the last stage before the device whatever the kind.
+  bool rate_limited = true;
   /// Dead-beat damper: m above, the factor on the bound of the twist's prediction error the
   /// controller keeps a reserve for. 0: the plain dead-beat damper (no reserve, E_obs exceeds 0
   /// by each tick's misprediction). 3 by default: E_obs <= 0 to rounding on every validation

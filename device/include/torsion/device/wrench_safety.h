@@ -46,16 +46,19 @@ class SafetyFilter {
   /// `dt`: s since the previous tick (clamped to [0, fade_time]).
   Wrench apply(const Wrench& desired, const SafetyInputs& inputs, double dt);
   const Wrench& output() const { return output_; }
-  /// The wrench actually written this tick, when a later stage (the passivity controller)
-  /// changed the filter's output within the rate limit: the next tick's rate limit and fade
-  /// start from what the device holds, so the written wrench never steps.
-  void follow(const Wrench& written) { output_ = written; }
+  /// A later stage's (the passivity controller's) change of this tick's output: `proposed`,
+  /// moved to within the rate limit of the last tick's output and saturated, becomes the output,
+  /// which is returned for the device. The rate limit stays the last stage before the device
+  /// whatever the later stage asks for, and the next tick starts from what the device holds.
+  /// `dt` as for apply() (the same tick's).
+  const Wrench& follow(const Wrench& proposed, double dt);
   double gain() const { return gain_; }
 
  private:
   SafetySettings settings_;
   DeviceLimits limits_;
   Wrench output_;
+  Wrench previous_;  // the last tick's output: where this tick's rate limit is measured from
   double gain_ = 0;  // fade-in gain in [0, 1]
 };
 
