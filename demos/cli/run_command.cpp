@@ -41,19 +41,22 @@ extern "C" void requestStop(int signal) {
   g_stop_signal = signal;
 }
 
-// SIGINT and SIGTERM stop the run at the end of the current step (scene_runner.h) while this
-// object lives; the previous handlers come back afterwards. A signal the process was started
-// ignoring (a background job of a non-interactive shell ignores SIGINT, nohup SIGHUP) stays
-// ignored, as is the convention.
+// SIGINT, SIGTERM and SIGHUP (the terminal or ssh session closed) stop the run at the end of the
+// current step (scene_runner.h) while this object lives: a device hand's force then fades and
+// the device gets a zero wrench, and the directory is left consistent. The previous handlers
+// come back afterwards. A signal the process was started ignoring (a background job of a
+// non-interactive shell ignores SIGINT, nohup SIGHUP) stays ignored, as is the convention.
 class StopOnSignals {
  public:
   StopOnSignals() {
     catchUnlessIgnored(SIGINT, previous_int_);
     catchUnlessIgnored(SIGTERM, previous_term_);
+    catchUnlessIgnored(SIGHUP, previous_hup_);
   }
   ~StopOnSignals() {
     sigaction(SIGINT, &previous_int_, nullptr);
     sigaction(SIGTERM, &previous_term_, nullptr);
+    sigaction(SIGHUP, &previous_hup_, nullptr);
   }
   StopOnSignals(const StopOnSignals&) = delete;
   StopOnSignals& operator=(const StopOnSignals&) = delete;
@@ -70,7 +73,19 @@ class StopOnSignals {
 
   struct sigaction previous_int_ {};
   struct sigaction previous_term_ {};
+  struct sigaction previous_hup_ {};
 };
+
+const char* stopSignalName(int signal) {
+  switch (signal) {
+    case SIGINT:
+      return "SIGINT";
+    case SIGHUP:
+      return "SIGHUP";
+    default:
+      return "SIGTERM";
+  }
+}
 
 // The scene file, with --device / --haptics applied, built into a live world.
 Result<std::unique_ptr<scene::BuiltScene>> loadAndBuild(const RunArguments& args) {
@@ -149,7 +164,7 @@ struct Ran {
 };
 
 // The headless run with a progress bar, a picture every --render-every steps, and SIGINT /
-// SIGTERM stopping it at the end of a step.
+// SIGTERM / SIGHUP stopping it at the end of a step.
 Ran runWithProgress(const RunArguments& args, scene::BuiltScene& s, render::FrameRecorder* recorder,
                     VtkSeries* series) {
   Ran ran;
@@ -181,8 +196,8 @@ Ran runWithProgress(const RunArguments& args, scene::BuiltScene& s, render::Fram
 }
 
 // Exit codes: 0 done and stable, 1 bad input or output error, 3 the simulation went unstable,
-// 4 stopped at an anomaly (--stop-on-anomaly), 128 + signal when SIGINT (130) or SIGTERM (143)
-// stopped the run.
+// 4 stopped at an anomaly (--stop-on-anomaly), 128 + signal when SIGHUP (129), SIGINT (130) or
+// SIGTERM (143) stopped the run.
 int reportOutcome(const RunArguments& args, const scene::BuiltScene& s, const Ran& ran,
                   render::FrameRecorder* recorder, const VtkSeries* series) {
   const bool normal = verbosity() != Verbosity::kQuiet;
@@ -202,8 +217,8 @@ int reportOutcome(const RunArguments& args, const scene::BuiltScene& s, const Ra
   }
   const scene::RunOutcome& outcome = ran.outcome.value();
   if (const int signal = outcome.stopped_by; signal != 0) {
-    std::cerr << "stopped by " << (signal == SIGINT ? "SIGINT" : "SIGTERM") << " after "
-              << outcome.steps_done << " steps; results so far in " << args.out
+    std::cerr << "stopped by " << stopSignalName(signal) << " after " << outcome.steps_done
+              << " steps; results so far in " << args.out
               << "/ (summary.json says \"completed\": false)\n";
     return 128 + signal;
   }

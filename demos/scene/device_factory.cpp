@@ -109,7 +109,12 @@ Result<std::unique_ptr<device::HapticDevice>> openDevice(const DeviceSpec& spec,
               "in process instead (\"isolated\": false, or --device HAND=plugin-inproc:...)"};
         }
       }
-      if (lockstep) settings.read_deadline = 0.1;
+      if (lockstep) {
+        settings.read_deadline = 0.1;
+        // The simulated clock pauses the loop for as long as a step takes: no wall-clock
+        // watchdog (the host still fades when Torsion ends).
+        settings.watchdog_timeout = 0;
+      }
       auto opened = device::PluginDevice::open(settings);
       if (!opened) return Error{opened.error};
       return std::unique_ptr<device::HapticDevice>(std::move(*opened.value));

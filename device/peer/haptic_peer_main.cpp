@@ -6,7 +6,8 @@
 //                       [--rate 1000] [--log received.csv] [--key-file FILE]
 //
 // With --key-file (or TORSION_HAPTIC_KEY_FILE / TORSION_HAPTIC_KEY in the environment) it signs
-// its packets with the shared key (packet_key.h); the key itself is never an argument.
+// its packets with the shared key (packet_key.h); the key itself is never an argument. What it
+// renders fades to zero when the simulation's wrenches stop arriving (wrench_watchdog.h).
 #include <signal.h>  // NOLINT(modernize-deprecated-headers): POSIX sigaction
 #include <time.h>    // NOLINT(modernize-deprecated-headers): POSIX clock_gettime and friends
 
@@ -60,7 +61,9 @@ int runPeer(int argc, char** argv) {
   app.add_option("--rate", rate, "Poses sent per second (Hz)")
       ->check(CLI::Range(1e-3, 1e6))
       ->capture_default_str();
-  app.add_option("--log", log_path, "Write the received wrenches to this CSV file");
+  app.add_option("--log", log_path,
+                 "Write the wrench rendered each tick to this CSV file (the one received; faded "
+                 "to zero when wrenches stop arriving)");
   app.add_option("--key-file", key_path,
                  "Shared key file: sign packets (docs/haptics.md, \"Authentication\"); also "
                  "TORSION_HAPTIC_KEY_FILE or TORSION_HAPTIC_KEY in the environment");
@@ -136,7 +139,7 @@ int runPeer(int argc, char** argv) {
     if (t > duration) break;
     p.tick(t);
     if (log.is_open()) {
-      const Wrench& w = p.newestWrench();
+      const Wrench& w = p.renderedWrench();  // what the device renders (watchdog: fades)
       log << t << ',' << w.force.x << ',' << w.force.y << ',' << w.force.z << ',' << w.torque.x
           << ',' << w.torque.y << ',' << w.torque.z << ',' << p.newestEcho() << '\n';
     }

@@ -7,22 +7,34 @@ namespace torsion::device {
 
 Loaded<std::unique_ptr<NetworkPeer>> NetworkPeer::open(const UdpEndpoint& simulation,
                                                        Trajectory trajectory,
-                                                       std::optional<PacketKey> key) {
+                                                       std::optional<PacketKey> key,
+                                                       const DeviceLimits& limits,
+                                                       const WatchdogSettings& watchdog) {
   using Out = Loaded<std::unique_ptr<NetworkPeer>>;
   auto socket = UdpSocket::open(UdpEndpoint{simulation.address, 0});
   if (!socket) return Out::fail("network peer: " + socket.error);
-  return Out{std::unique_ptr<NetworkPeer>(
-                 new NetworkPeer(*socket.value, simulation, std::move(trajectory), std::move(key))),
-             {}};
+  return Out{
+      std::unique_ptr<NetworkPeer>(new NetworkPeer(*socket.value, simulation, std::move(trajectory),
+                                                   std::move(key), limits, watchdog)),
+      {}};
 }
 
 NetworkPeer::NetworkPeer(std::shared_ptr<UdpSocket> socket, UdpEndpoint simulation,
-                         Trajectory trajectory, std::optional<PacketKey> key)
+                         Trajectory trajectory, std::optional<PacketKey> key,
+                         const DeviceLimits& limits, const WatchdogSettings& watchdog)
     : socket_(std::move(socket)),
       simulation_(simulation),
       trajectory_(std::move(trajectory)),
       key_(std::move(key)),
-      session_(key_ ? randomSessionId() : 0) {}
+      session_(key_ ? randomSessionId() : 0),
+      watchdog_(watchdog, limits) {}
+
+DeviceLimits NetworkPeer::peerLimits() {
+  DeviceLimits l;
+  l.max_force = 30;
+  l.max_torque = 3;
+  return l;
+}
 
 std::uint32_t NetworkPeer::nextSequence() {
   if (key() && sequence_ == UINT32_MAX) {
@@ -35,7 +47,8 @@ std::uint32_t NetworkPeer::nextSequence() {
 
 void NetworkPeer::tick(double time) {
   sendPose(nextSequence(), trajectory_.poseAt(time), trajectory_.buttonsAt(time), true);
-  drain();
+  drain(time);
+  rendered_ = watchdog_.render(time);
 }
 
 void NetworkPeer::sayGoodbye(double time) {
@@ -73,7 +86,7 @@ void NetworkPeer::sendRaw(const void* bytes, std::size_t size) {
   }
 }
 
-void NetworkPeer::drain() {
+void NetworkPeer::drain(double time) {
   unsigned char buffer[kMaxPacketSize + 1];
   UdpEndpoint from;
   long size;
@@ -88,7 +101,10 @@ void NetworkPeer::drain() {
       ++stats_.replayed;  // signed, but for another session of this key
       continue;
     }
-    if (filter_.inOrder(packet, stats_)) newest_ = packet;
+    if (filter_.inOrder(packet, stats_)) {
+      newest_ = packet;
+      watchdog_.receive(packet.wrench, time);
+    }
   }
 }
 

@@ -17,6 +17,10 @@ std::string PluginDeviceSettings::validate() const {
   if (isolated && host_program.empty())
     return "host_program: an isolated plug-in needs the path of torsion_device_host";
   if (isolated && !(start_timeout > 0)) return "start_timeout must be positive (s)";
+  if (!(watchdog_timeout >= 0 && watchdog_timeout <= 10))
+    return "watchdog_timeout must be in [0, 10] s";
+  if (!(watchdog_fade_time > 0 && watchdog_fade_time <= 10))
+    return "watchdog_fade_time must be in (0, 10] s";
   return {};
 }
 

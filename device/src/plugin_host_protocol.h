@@ -46,6 +46,9 @@ struct Channel {
   torsion_device_state state{};
   torsion_device_info info{};
   char error[1024] = {};  ///< NUL-terminated: why the library could not be opened
+  // Set by Torsion before the host starts (PluginDeviceSettings).
+  double watchdog_timeout = 0.1;    ///< s without a wrench before the host fades; 0: never
+  double watchdog_fade_time = 0.2;  ///< s from the limit to zero
 };
 
 static_assert(std::atomic<std::uint32_t>::is_always_lock_free);

@@ -247,6 +247,8 @@ Loaded<std::unique_ptr<PluginTransport>> startHostTransport(const PluginDeviceSe
   void* memory = mmap(nullptr, sizeof(Channel), PROT_READ | PROT_WRITE, MAP_SHARED, mapping->fd, 0);
   if (memory == MAP_FAILED) return fail("cannot map the device host's shared memory");
   mapping->channel = new (memory) Channel();
+  mapping->channel->watchdog_timeout = settings.watchdog_timeout;
+  mapping->channel->watchdog_fade_time = settings.watchdog_fade_time;
   mapping->channel->request.store(1, std::memory_order_relaxed);  // the open (protocol header)
 
   // posix_spawn, not fork: Torsion has threads. The host gets the page as fd 3, default signal

@@ -203,6 +203,10 @@ case "$case_name" in
   sigterm_stops_at_a_step)
     stop_with TERM 143
     ;;
+  sighup_stops_at_a_step)
+    # The terminal or ssh session that started the run closed: stopped as by SIGTERM.
+    stop_with HUP 129
+    ;;
   sigkill_leaves_whole_rows)
     # After SIGKILL nothing is finished, but what is on disk parses and says so.
     twist_scene > twist.json
@@ -338,6 +342,45 @@ case "$case_name" in
     expect_out "^warning: hand 'hand': the network device listens on 0.0.0.0, outside loopback"
     ;;
 
+  sigkill_fades_the_network_peer)
+    # torsion killed while a peer is holding the hand: nothing more is sent, and the peer's
+    # watchdog fades the wrench it renders to zero (0.1 s without a wrench, then at most 0.2 s),
+    # down through values in between, never holding the last one.
+    [[ -x $peer ]] || fail "no torsion_haptic_peer given"
+    twist_scene > twist.json
+    cat > hold.json <<'JSON'
+{"segments": [{"duration": 0.6, "angular_velocity": [0, 0, 0.5]}, {"duration": 60}],
+ "buttons": [{"time": 0, "held": [1]}]}
+JSON
+    port=$((20000 + RANDOM % 20000))
+    start_run out twist.json --device "hand=network:$port" --steps 100000 --threads 1
+    for _ in $(seq 100); do
+      grep -q "device network" run.log && break
+      sleep 0.1
+    done
+    "$peer" --trajectory hold.json --port "$port" --log peer.csv >peer.log 2>&1 &
+    peer_pid=$!
+    for _ in $(seq 300); do
+      head -n -1 peer.csv 2>/dev/null |
+        awk -F, 'NR > 1 && NF == 8 && ($7 > 0.1 || $7 < -0.1) { found = 1 } END { exit !found }' &&
+        break
+      sleep 0.1
+    done
+    kill -KILL "$sim"
+    wait "$sim"
+    rc=$?
+    sleep 0.6  # the peer goes on ticking: past the timeout and the fade
+    kill -TERM "$peer_pid" 2>/dev/null
+    wait "$peer_pid"
+    cat peer.log
+    expect_rc 137
+    tail -1 peer.csv | awk -F, '{ for (i = 2; i <= 7; i++) if ($i != 0) exit 1 }' ||
+      fail "the peer still renders a wrench: $(tail -1 peer.csv)"
+    # The torque about z after the last row of the held torque: falls through values in between.
+    awk -F, 'NR > 1 { t = $7 < 0 ? -$7 : $7; if (t > 0.1) { held = t; n = 0 } else if (held > 0 && t > 0) n++ }
+      END { exit !(held > 0 && n > 0) }' peer.csv ||
+      fail "the peer's torque did not fade (a cut or a hold)"
+    ;;
   sigint_zeroes_the_network_device)
     # Ctrl-C while a peer is holding the hand: the run stops marked, and the last wrench the peer
     # receives is zero (the loop's stop and the device's close each send one).

@@ -7,6 +7,11 @@
 #include <chrono>
 #include <cmath>
 #include <csignal>
+#include <cstdio>
+#include <fstream>
+#include <string>
+#include <thread>
+#include <vector>
 
 #include "stand_in_simulation.h"
 #include "torsion/device/haptic_loop.h"
@@ -277,6 +282,52 @@ TEST(PluginDeviceHost, AHealthyHostIsClosedAndReapedWithTheDeviceAndReportsNoExi
   int status = 0;
   EXPECT_EQ(waitpid(pid, &status, WNOHANG), -1);  // reaped: not our child any more
   EXPECT_EQ(errno, ECHILD);
+}
+
+// The force norms (N) of the wrenches a plug-in given log=PATH was written, in order.
+std::vector<double> loggedForces(const std::string& path) {
+  std::vector<double> forces;
+  std::ifstream in(path);
+  double w[6];
+  while (in >> w[0] >> w[1] >> w[2] >> w[3] >> w[4] >> w[5])
+    forces.push_back(std::sqrt(w[0] * w[0] + w[1] * w[1] + w[2] * w[2]));
+  return forces;
+}
+
+// Torsion stopped (SIGSTOP), hung, or gone without a word (SIGKILL): its wrenches stop coming,
+// and the host fades the one the plug-in renders to zero by itself, as the haptic loop fades on
+// a stall (wrench_watchdog.h), instead of leaving the device pushing. The faulty plug-in logs
+// every wrench it is given.
+TEST(PluginDeviceHost, WhenTorsionStopsSendingTheHostFadesTheWrenchToZeroByItself) {
+  const std::string log = ::testing::TempDir() + "host_watchdog_writes.txt";
+  std::remove(log.c_str());
+  PluginDeviceSettings settings = isolatedSettings(TORSION_FAULTY_PLUGIN);
+  settings.config = "log=" + log;
+  settings.read_deadline = 0.5;  // a loaded machine must not make these reads late
+  std::unique_ptr<PluginDevice> device = openOrFail(settings);
+  ASSERT_TRUE(device);
+  const Wrench held{{10, 0, 0}, {0, 0, 1}};  // within the plug-in's 20 N, 2 N m
+  for (int k = 0; k < 20; ++k) {             // each read carries the wrench written before it
+    device->write(held);
+    device->read(k * kDt);
+  }
+  // Nothing more comes: wait well past the timeout (0.1 s) and the fade (0.2 s from the limit).
+  std::this_thread::sleep_for(std::chrono::milliseconds(600));
+  const std::vector<double> forces = loggedForces(log);
+  ASSERT_GE(forces.size(), 20u);
+  EXPECT_EQ(forces.back(), 0.0);
+  // A fade, not a cut: down from 10 N through values in between, never rising.
+  size_t last_held = 0;
+  for (size_t k = 0; k < forces.size(); ++k)
+    if (forces[k] == 10) last_held = k;
+  size_t between = 0;
+  for (size_t k = last_held + 1; k < forces.size(); ++k) {
+    EXPECT_LE(forces[k], forces[k - 1]) << k;
+    if (forces[k] > 0 && forces[k] < 10) ++between;
+  }
+  EXPECT_GT(between, 0u);
+  device.reset();
+  std::remove(log.c_str());
 }
 
 TEST(PluginDeviceHost, AMissingHostProgramIsAClearError) {

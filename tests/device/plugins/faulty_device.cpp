@@ -4,6 +4,7 @@
 //   fault=block  sleeps `block_ms` in read()   fault=fail  returns -1 from read()
 //   fault=segv   dies of SIGSEGV in read()     fault=none  (default) behaves
 //   fault=abort  calls abort() in its `reads`-th read() (counted from 1), whatever the time
+// With log=PATH every wrench written is appended to PATH, one "fx fy fz tx ty tz" line each.
 // Built a second time with FAULTY_ABI_VERSION=99 to claim an ABI this Torsion does not speak.
 
 #include <chrono>
@@ -30,6 +31,7 @@ struct Faulty {
   long abort_at = 0;
   long reads = 0;
   long writes = 0;
+  std::FILE* log = nullptr;
 };
 
 void* openDevice(const char* config, char* error, size_t error_size) {
@@ -51,6 +53,8 @@ void* openDevice(const char* config, char* error, size_t error_size) {
       d->block_ms = std::atof(value.c_str());
     else if (key == "reads")
       d->abort_at = std::atol(value.c_str());
+    else if (key == "log")
+      d->log = std::fopen(value.c_str(), "a");
     else {
       std::snprintf(error, error_size, "faulty device: unknown key '%s'", key.c_str());
       delete d;
@@ -86,13 +90,21 @@ int read(void* handle, double time, torsion_device_state* out) {
   return 0;
 }
 
-int write(void* handle, const double*) {
-  ++static_cast<Faulty*>(handle)->writes;
+int write(void* handle, const double* wrench) {
+  Faulty& d = *static_cast<Faulty*>(handle);
+  ++d.writes;
+  if (d.log) {
+    std::fprintf(d.log, "%.17g %.17g %.17g %.17g %.17g %.17g\n", wrench[0], wrench[1], wrench[2],
+                 wrench[3], wrench[4], wrench[5]);
+    std::fflush(d.log);
+  }
   return 0;
 }
 
 void closeDevice(void* handle) {
-  delete static_cast<Faulty*>(handle);
+  Faulty* d = static_cast<Faulty*>(handle);
+  if (d->log) std::fclose(d->log);
+  delete d;
 }
 
 const torsion_device_v1 kTable = {FAULTY_ABI_VERSION, 0, openDevice, info, read, write,

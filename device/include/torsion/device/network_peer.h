@@ -3,7 +3,9 @@
 // scripted trajectory in place of the arm. Each tick it sends one pose packet to the simulation
 // and takes every wrench packet that arrived (newest wins). Used by the torsion_haptic_peer
 // program and by the loopback tests. With a key it signs its poses (packet_key.h) under a fresh
-// random session id and takes only signed wrenches of that session.
+// random session id and takes only signed wrenches of that session. What it renders goes through
+// a WrenchWatchdog (wrench_watchdog.h): when wrenches stop arriving (the simulation was killed,
+// stopped or hung) the rendered wrench fades to zero, as the haptic loop's output on a stall.
 
 #include <cstdint>
 #include <memory>
@@ -12,18 +14,25 @@
 #include "torsion/device/packet_stats.h"
 #include "torsion/device/trajectory.h"
 #include "torsion/device/udp_socket.h"
+#include "torsion/device/wrench_watchdog.h"
 
 namespace torsion::device {
 
 class NetworkPeer {
  public:
   /// Binds an ephemeral loopback port and sends to `simulation`; signs with `key` when given.
+  /// `limits`: the device behind the peer's (what it renders is saturated to them, and the
+  /// watchdog's fade runs at limit / fade_time).
   static Loaded<std::unique_ptr<NetworkPeer>> open(const UdpEndpoint& simulation,
                                                    Trajectory trajectory,
-                                                   std::optional<PacketKey> key = {});
+                                                   std::optional<PacketKey> key = {},
+                                                   const DeviceLimits& limits = peerLimits(),
+                                                   const WatchdogSettings& watchdog = {});
+  /// The desktop arm's 30 N, 3 N m (scripted_device.h's defaultDeviceLimits()).
+  static DeviceLimits peerLimits();
 
   /// Sends the trajectory's pose and buttons at `time` (s since the peer started), flagged
-  /// alive; then drains incoming wrenches.
+  /// alive; then drains incoming wrenches and updates the rendered wrench.
   void tick(double time);
   /// Sends raw bytes to the simulation (tests use it to inject bad packets).
   void sendRaw(const void* bytes, std::size_t size);
@@ -33,7 +42,11 @@ class NetworkPeer {
   void sendPose(std::uint32_t sequence, const Pose& pose, std::uint32_t buttons, bool alive,
                 bool goodbye = false);
 
+  /// The newest wrench received, as it came.
   const Wrench& newestWrench() const { return newest_.wrench; }
+  /// What the device behind the peer renders after the last tick(): the newest wrench while
+  /// wrenches keep arriving, fading to zero when they stop.
+  const Wrench& renderedWrench() const { return rendered_; }
   std::uint32_t newestEcho() const { return newest_.echo_sequence; }
   const PacketStats& stats() const { return stats_; }
   UdpEndpoint local() const { return socket_->local(); }
@@ -42,10 +55,12 @@ class NetworkPeer {
 
  private:
   NetworkPeer(std::shared_ptr<UdpSocket> socket, UdpEndpoint simulation, Trajectory trajectory,
-              std::optional<PacketKey> key);
+              std::optional<PacketKey> key, const DeviceLimits& limits,
+              const WatchdogSettings& watchdog);
   const PacketKey* key() const { return key_ ? &*key_ : nullptr; }
   std::uint32_t nextSequence();
-  void drain();
+  /// Takes every wrench that arrived; `time`: when, for the watchdog.
+  void drain(double time);
 
   std::shared_ptr<UdpSocket> socket_;
   UdpEndpoint simulation_;
@@ -55,6 +70,8 @@ class NetworkPeer {
   PacketFilter filter_{PacketKind::kWrench, key()};
   PacketStats stats_;
   Packet newest_;
+  WrenchWatchdog watchdog_;
+  Wrench rendered_;
   std::uint32_t sequence_ = 0;
 };
 

@@ -54,6 +54,12 @@ struct PluginDeviceSettings {
   /// <libdir>/torsion, beside the plug-ins' directory).
   std::string host_program;
   double start_timeout = 10.0;  ///< isolated: s for the host to start and open the plug-in
+  /// isolated: s without a wrench from Torsion after which the host fades the wrench it writes
+  /// to the plug-in to zero by itself (wrench_watchdog.h): Torsion stopped or hung. 0: only when
+  /// Torsion ends (lockstep runs serve the device on the simulated clock, with pauses as long
+  /// as a step). The host fades on Torsion's end in any case.
+  double watchdog_timeout = 0.1;
+  double watchdog_fade_time = 0.2;  ///< isolated: s the host's fade takes from the limit to zero
   /// N and N m: the output stays within these even when the device could do more (a scene may
   /// ask for less than the hardware's limits; never for more).
   double max_force = std::numeric_limits<double>::infinity();
