@@ -1,12 +1,59 @@
 #include "torsion/device/plugin_device.h"
 
 #include <algorithm>
+#include <chrono>
+#include <condition_variable>
 #include <filesystem>
+#include <memory>
+#include <mutex>
+#include <sstream>
+#include <thread>
 
 #include "plugin_transport.h"
 #include "torsion/device/scripted_device.h"
 
 namespace torsion::device {
+
+namespace {
+
+// openPluginLibrary on a thread of its own, waited for at most `timeout` s: a plug-in whose
+// open() never returns (hardware that does not answer, an SDK waiting on a licence server) must
+// not hang Torsion. An abandoned opening keeps its own state; should open() return after all,
+// the thread closes the device and unloads the library (no call into it runs then).
+Loaded<PluginLibrary> openPluginLibraryWithin(const std::string& path, const std::string& config,
+                                              double timeout) {
+  struct Opening {
+    std::mutex mutex;
+    std::condition_variable done_cv;
+    bool done = false;
+    bool abandoned = false;
+    Loaded<PluginLibrary> result;
+  };
+  auto opening = std::make_shared<Opening>();
+  std::thread([opening, path, config] {
+    Loaded<PluginLibrary> result = openPluginLibrary(path, config);
+    std::lock_guard<std::mutex> lock(opening->mutex);
+    if (opening->abandoned) {
+      if (result) closePluginLibrary(*result.value);
+      return;
+    }
+    opening->result = std::move(result);
+    opening->done = true;
+    opening->done_cv.notify_all();
+  }).detach();
+  std::unique_lock<std::mutex> lock(opening->mutex);
+  if (!opening->done_cv.wait_for(lock, std::chrono::duration<double>(timeout),
+                                 [&] { return opening->done; })) {
+    opening->abandoned = true;
+    std::ostringstream message;
+    message << path << ": the plug-in's open() did not return within " << timeout
+            << " s (start_timeout); it is abandoned";
+    return Loaded<PluginLibrary>::fail(message.str());
+  }
+  return std::move(opening->result);
+}
+
+}  // namespace
 
 std::string PluginDeviceSettings::validate() const {
   if (library.empty()) return "library: the path of the plug-in's shared library is empty";
@@ -16,7 +63,8 @@ std::string PluginDeviceSettings::validate() const {
   if (!(max_force >= 0) || !(max_torque >= 0)) return "max_force and max_torque must be >= 0";
   if (isolated && host_program.empty())
     return "host_program: an isolated plug-in needs the path of torsion_device_host";
-  if (isolated && !(start_timeout > 0)) return "start_timeout must be positive (s)";
+  if (!(start_timeout > 0)) return "start_timeout must be positive (s)";
+  if (!(hung_timeout > 0)) return "hung_timeout must be positive (s)";
   if (!(watchdog_timeout >= 0 && watchdog_timeout <= 10))
     return "watchdog_timeout must be in [0, 10] s";
   if (!(watchdog_fade_time > 0 && watchdog_fade_time <= 10))
@@ -42,7 +90,7 @@ Loaded<std::unique_ptr<PluginDevice>> PluginDevice::open(const PluginDeviceSetti
     if (std::string fault = checkPluginInfo(info); !fault.empty())
       return Result::fail(path + ": " + fault);
   } else {
-    auto opened = openPluginLibrary(path, settings.config);
+    auto opened = openPluginLibraryWithin(path, settings.config, settings.start_timeout);
     if (!opened) return Result::fail(opened.error);
     in_process = *opened.value;
     info = in_process.info;

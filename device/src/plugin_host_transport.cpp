@@ -76,6 +76,7 @@ class HostTransport final : public PluginTransport {
         pid_(pid),
         library_(settings.library),
         close_timeout_(settings.close_timeout),
+        hung_timeout_(settings.hung_timeout),
         stats_(std::move(stats)) {}
 
   ~HostTransport() override {
@@ -106,6 +107,12 @@ class HostTransport final : public PluginTransport {
       channel_.op = host::Op::kRead;
       channel_.time = time;
       send();
+      asked_at_ = Clock::now();
+      hung_warned_ = false;
+    } else if (isHung()) {
+      // Still inside the plug-in since long before this tick: waiting for it again would cost
+      // every tick its whole deadline (0.1 s in lockstep: a run 100 times slower).
+      return reapIfEnded() ? Answer::kGone : Answer::kLate;
     }  // else the host is still inside an earlier call: let it finish, but do not use it
     const bool answered = waitForResponse(after(deadline));
     if (reaped_) return Answer::kGone;
@@ -157,6 +164,19 @@ class HostTransport final : public PluginTransport {
       if (left <= 0 || reapIfEnded()) return false;
       futexWait(channel_.response, seen, std::min(left, kWaitSlice));
     }
+  }
+
+  // True once the outstanding call has been inside the plug-in for hung_timeout; warns once.
+  bool isHung() {
+    const double inside = std::chrono::duration<double>(Clock::now() - asked_at_).count();
+    if (inside <= hung_timeout_) return false;
+    if (!hung_warned_) {
+      std::cerr << "torsion: warning: the plug-in " << library_
+                << " has not returned from read() for " << hung_timeout_
+                << " s; the device is dead until it does and its force fades to zero\n";
+      hung_warned_ = true;
+    }
+    return true;
   }
 
   // Reaps the host if it has ended (no zombie), records why, warns once. True when it has.
@@ -211,6 +231,9 @@ class HostTransport final : public PluginTransport {
   pid_t pid_;
   std::string library_;
   double close_timeout_;
+  double hung_timeout_;
+  Clock::time_point asked_at_ = Clock::now();
+  bool hung_warned_ = false;
   std::shared_ptr<PluginStats> stats_;
   std::uint32_t request_ = 0;
   std::uint32_t wrench_request_ = 0;  // the request that carried a wrench, until answered

@@ -229,6 +229,47 @@ TEST_P(PluginDeviceAnywhere, APluginThatBlocksMissesItsDeadlinesTheLoopGoesOnAnd
   EXPECT_EQ(norm(loop.lastOutput().force), 0);
 }
 
+// A read() that never returns, with the lockstep deadline (0.1 s): each tick waiting for it
+// would make the run 100 times slower than the simulation. Once it has been inside the plug-in
+// for hung_timeout the device stops waiting for it and is dead.
+TEST_P(PluginDeviceAnywhere, AHungReadCostsTheLoopItsDeadlineOnlyUntilTheHungTimeout) {
+  PluginDeviceSettings settings = settingsFor(TORSION_FAULTY_PLUGIN);
+  settings.config = "fault=block,after=0.05,block_ms=5000";
+  settings.read_deadline = 0.1;
+  settings.hung_timeout = 0.3;
+  std::unique_ptr<PluginDevice> device = openOrFail(settings);
+  ASSERT_TRUE(device);
+  for (int k = 0; k < 50; ++k)
+    device->read(k * kDt);
+  const auto start = std::chrono::steady_clock::now();
+  DeviceSample last;
+  for (int k = 50; k < 150; ++k)
+    last = device->read(k * kDt);
+  const double took =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  // Waiting 0.1 s per tick until the read has been hung for 0.3 s, then not at all: about 0.4 s
+  // (2 s allowed for a busy machine) where 100 full deadlines would take 10 s.
+  EXPECT_LT(took, 2.0);
+  EXPECT_FALSE(last.alive);
+  EXPECT_GE(device->stats().late.load(), 100u);
+}
+
+// An open() that never returns fails after start_timeout, naming the plug-in, instead of hanging
+// Torsion before its first step.
+TEST_P(PluginDeviceAnywhere, AnOpenThatNeverReturnsFailsAfterTheStartTimeout) {
+  PluginDeviceSettings settings = settingsFor(TORSION_FAULTY_PLUGIN);
+  settings.config = "open_block_ms=5000";
+  settings.start_timeout = 0.3;
+  const auto start = std::chrono::steady_clock::now();
+  auto opened = PluginDevice::open(settings);
+  const double took =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  ASSERT_FALSE(opened);
+  EXPECT_EQ(opened.error.rfind(std::string(TORSION_FAULTY_PLUGIN) + ": ", 0), 0u) << opened.error;
+  EXPECT_NE(opened.error.find("within 0.3"), std::string::npos) << opened.error;
+  EXPECT_LT(took, 0.3 + 2.0);  // the timeout, and what a busy machine adds (a killed host: 1 s)
+}
+
 // A plug-in that crashes, isolated: the fault starts at 0.3 s; the last good reading (0.299 s) is
 // held 5 ms, then the device is dead and the safety filter fades 5 N to zero in its fade_time
 // (0.2 s). The host's death is reported with its signal and the host is reaped.

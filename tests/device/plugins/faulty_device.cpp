@@ -4,7 +4,8 @@
 //   fault=block  sleeps `block_ms` in read()   fault=fail  returns -1 from read()
 //   fault=segv   dies of SIGSEGV in read()     fault=none  (default) behaves
 //   fault=abort  calls abort() in its `reads`-th read() (counted from 1), whatever the time
-// With log=PATH every wrench written is appended to PATH, one "fx fy fz tx ty tz" line each.
+// With log=PATH every wrench written is appended to PATH, one "fx fy fz tx ty tz" line each;
+// with open_block_ms=N its open() sleeps N ms first (a device that does not answer).
 // Built a second time with FAULTY_ABI_VERSION=99 to claim an ABI this Torsion does not speak.
 
 #include <chrono>
@@ -55,6 +56,9 @@ void* openDevice(const char* config, char* error, size_t error_size) {
       d->abort_at = std::atol(value.c_str());
     else if (key == "log")
       d->log = std::fopen(value.c_str(), "a");
+    else if (key == "open_block_ms")
+      std::this_thread::sleep_for(
+          std::chrono::duration<double, std::milli>(std::atof(value.c_str())));
     else {
       std::snprintf(error, error_size, "faulty device: unknown key '%s'", key.c_str());
       delete d;

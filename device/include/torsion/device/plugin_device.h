@@ -19,6 +19,11 @@
 //     for at most `hold_time` (a late tick on a busy machine does not fade the force), then
 //     reports itself dead, so the haptic loop's safety filter fades the output to zero exactly as
 //     for a built-in device that stopped answering. Each kind of fault is counted (stats()).
+//   - a read() still inside the plug-in after `hung_timeout` is hung: later ticks do not wait for
+//     it (the device is dead until it returns), and a warning names the plug-in once;
+//   - open() that does not return within `start_timeout` (in process: on a thread of its own;
+//     isolated: in the host) fails, naming the plug-in; the thread is abandoned (or the host
+//     killed);
 //   - at destruction: the last (zero) wrench, then close(). A plug-in that does not return within
 //     `close_timeout` is, isolated, killed with its host; in process, its thread is detached and
 //     the library stays loaded (unloading code that may still run would crash), and the run goes
@@ -53,7 +58,13 @@ struct PluginDeviceSettings {
   /// isolated: path of the torsion_device_host program (built and installed in
   /// <libdir>/torsion, beside the plug-ins' directory).
   std::string host_program;
-  double start_timeout = 10.0;  ///< isolated: s for the host to start and open the plug-in
+  /// s for the plug-in's open() to return (isolated: for the host to start and open it); a
+  /// plug-in that takes longer is abandoned and open() fails, naming it.
+  double start_timeout = 10.0;
+  /// s a read() may stay inside the plug-in before it counts as hung: later ticks then stop
+  /// waiting for it (each would otherwise wait its whole read_deadline, 0.1 s in lockstep), a
+  /// warning names it once, and the device is dead until the plug-in answers again.
+  double hung_timeout = 1.0;
   /// isolated: s without a wrench from Torsion after which the host fades the wrench it writes
   /// to the plug-in to zero by itself (wrench_watchdog.h): Torsion stopped or hung. 0: only when
   /// Torsion ends (lockstep runs serve the device on the simulated clock, with pauses as long
