@@ -171,6 +171,7 @@ nlohmann::json SceneHaptics::statistics(const Channel& c) const {
       {"saturated_ticks", st.saturated.load()},
       {"overruns", st.overruns.load()},
       {"nonfinite", st.nonfinite.load()},
+      {"readings_refused", st.refused.load()},
       {"log_dropped", st.log_dropped.load()},
       {"poses_rejected", c.coupling->rejectedPoses()},
       {"simulation_priority",
