@@ -30,6 +30,32 @@ TEST(SafetyFilter, FollowsADesiredWrenchWithinLimitsAfterFadingIn) {
   EXPECT_NEAR(f.output().torque.y, 0.5, 1e-12);
 }
 
+TEST(SafetyFilter, ALaterStagesChangeIsHeldToTheRateLimitOfWhatTheDeviceHolds) {
+  // A passivity controller proposes a wrench far from the filter's output; follow() keeps the
+  // rate limit the last stage: from the last tick's output by at most 0.3 N and 0.03 N m, and
+  // the next tick starts from what was written.
+  const SafetySettings s;
+  SafetyFilter f(s, defaultDeviceLimits());
+  settle(f, {{5, 0, 0}, {0, 0, 1}});
+  const Wrench held = f.output();
+  f.apply({{5, 0, 0}, {0, 0, 1}}, healthy(), kDt);
+  const Wrench written = f.follow({{-30, 0, 0}, {0, 0, -3}}, kDt);
+  EXPECT_NEAR(norm(written.force - held.force), s.max_force_rate * kDt, 1e-12);
+  EXPECT_NEAR(norm(written.torque - held.torque), s.max_torque_rate * kDt, 1e-12);
+  EXPECT_NEAR(written.force.x, 5 - s.max_force_rate * kDt, 1e-12);  // toward the proposal
+  EXPECT_EQ(f.output().force.x, written.force.x);
+  // Next tick: within the rate limit of what was written the proposal is taken as it is.
+  f.apply({{5, 0, 0}, {0, 0, 1}}, healthy(), kDt);
+  const Wrench small = f.follow({{written.force.x + 0.1, 0, 0}, written.torque}, kDt);
+  EXPECT_NEAR(small.force.x, written.force.x + 0.1, 1e-12);
+  // And a non-finite proposal is a zero target, approached at the rate limit.
+  f.apply({{5, 0, 0}, {0, 0, 1}}, healthy(), kDt);
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  const Wrench zeroed = f.follow({{nan, 0, 0}, small.torque}, kDt);
+  EXPECT_TRUE(isFinite(zeroed));
+  EXPECT_NEAR(zeroed.force.x, small.force.x - s.max_force_rate * kDt, 1e-12);
+}
+
 TEST(SafetyFilter, NeverJumps) {
   const SafetySettings s;
   SafetyFilter f(s, defaultDeviceLimits());
