@@ -233,10 +233,17 @@ double partNorm(const double* v) {
 
 }  // namespace
 
+void PassivityController::written(const Wrench& wrench) {
+  held_ = wrench;
+  held_sum_ = held_sum_ + wrench;
+  ++held_count_;
+}
+
 void PassivityController::observe(const double v[6], double dt, bool holding) {
   if (!holding) {
     energy_ = 0;
-    held_ = Wrench{};
+    held_ = held_sum_ = Wrench{};
+    held_count_ = 0;
     speed_bound_[0] = speed_bound_[1] = 0;
     change_bound_[0] = change_bound_[1] = 0;
     have_v_ = 0;
@@ -263,7 +270,13 @@ void PassivityController::observe(const double v[6], double dt, bool holding) {
     last_v_[k] = std::isfinite(v[k]) ? v[k] : 0.0;
   }
   have_v_ = std::min(have_v_ + 1, 2);
-  const double delta = power(held_, v) * dt;
+  // The mean of the wrenches held over the motion (one wrench on every tick but after refused
+  // readings), each for an equal share of it; the last one when none was written since.
+  const Wrench held =
+      held_count_ > 0 ? (1.0 / static_cast<double>(held_count_)) * held_sum_ : held_;
+  held_sum_ = Wrench{};
+  held_count_ = 0;
+  const double delta = power(held, v) * dt;
   if (std::isfinite(delta)) energy_ += delta;
   if (energy_ > max_energy_) max_energy_ = energy_;
 }

@@ -120,6 +120,22 @@ TEST(Passivity, TheObserverBooksAPressedSpringAsStoredEnergyAndTheControllerStay
   EXPECT_EQ(pc.activeTicks(), 0u);
 }
 
+TEST(Passivity, AMotionAcrossUnobservedTicksIsBookedAgainstEveryWrenchHeldMeanwhile) {
+  // Two wrenches written (2 N, then 4 N along x) with no observation between (the loop refused
+  // the reading in between): the 2 ms of motion at 1 m/s are shared evenly, 3 N x 2 mm =
+  // 6 mJ, not all booked against the last one (8 mJ). Then, no new write: the device still holds
+  // 4 N, booked over the next 1 mm (4 mJ).
+  PassivityController pc;
+  const double still[6] = {}, moving[6] = {1, 0, 0, 0, 0, 0};
+  pc.observe(still, 0.001, true);
+  pc.written({{2, 0, 0}, {}});
+  pc.written({{4, 0, 0}, {}});
+  pc.observe(moving, 0.002, true);
+  EXPECT_NEAR(pc.portEnergy(), 3 * 1 * 0.002, 1e-15);
+  pc.observe(moving, 0.001, true);
+  EXPECT_NEAR(pc.portEnergy(), 3 * 1 * 0.002 + 4 * 1 * 0.001, 1e-15);
+}
+
 TEST(Passivity, ThePlainDeadBeatDamperRemovesExactlyTheGeneratedEnergy) {
   PassivitySettings settings;
   settings.misprediction_margin = 0;

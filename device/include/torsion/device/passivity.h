@@ -140,8 +140,10 @@ class PassivityController {
   /// the motion `v` dt that just happened. `holding`: a patch is grabbed with force on (else the
   /// port energy restarts at 0 and the held wrench is forgotten).
   void observe(const double v[6], double dt, bool holding);
-  /// The wrench actually written this tick; observe() books it at the next tick.
-  void written(const Wrench& wrench) { held_ = wrench; }
+  /// The wrench actually written this tick; observe() books it at the next tick. When ticks
+  /// pass without an observation (device readings the loop refused), the motion observed next
+  /// is shared evenly among the wrenches written meanwhile: each was held for its share of it.
+  void written(const Wrench& wrench);
 
   double portEnergy() const { return energy_; }         ///< J, E_obs (<= 0 when passive)
   double maxPortEnergy() const { return max_energy_; }  ///< J, largest E_obs seen
@@ -164,8 +166,10 @@ class PassivityController {
   double change_bound_[2] = {0, 0};  // m/s, rad/s: peak prediction errors of the twist, decaying
   double last_v_[6] = {};            // v(n), then v(n-1): the twists the prediction starts from
   double prev_v_[6] = {};
-  int have_v_ = 0;  // how many of them are known (0-2)
-  Wrench held_;
+  int have_v_ = 0;      // how many of them are known (0-2)
+  Wrench held_;         // the last wrench written: the device holds it until the next
+  Wrench held_sum_;     // the wrenches written since the last observe(), summed
+  int held_count_ = 0;  // how many
   double energy_ = 0;
   double max_energy_ = 0;
   double alpha_ = 0;
