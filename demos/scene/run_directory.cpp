@@ -51,9 +51,16 @@ Result<RunDirectory> RunDirectory::prepare(const std::string& directory,
   first_summary["outputs"] = outputs;
   if (Status written = dir.writeSummary(first_summary); !written) return written.error();
 
+  // Only regular files are removed: a FIFO, a device or a link at one of this run's names is an
+  // error (nothing would be written over it), at an earlier run's name it is left alone.
+  const std::set<std::string> ours(outputs.begin(), outputs.end());
   for (const std::string& name : stale) {
     if (!plainFileName(name)) continue;
     const std::string path = dir.path(name);
+    if (std::string refused = device::refuseUnlessRegularOrAbsent(path); !refused.empty()) {
+      if (ours.count(name) != 0) return Error{refused};
+      continue;
+    }
     if (::unlink(path.c_str()) != 0 && errno != ENOENT)
       return Error{path + ": cannot remove the earlier run's file: " + std::strerror(errno)};
   }

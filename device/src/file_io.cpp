@@ -25,6 +25,7 @@ std::string fileKind(mode_t mode) {
   if (S_ISCHR(mode)) return "a character device";
   if (S_ISBLK(mode)) return "a block device";
   if (S_ISSOCK(mode)) return "a socket";
+  if (S_ISLNK(mode)) return "a symbolic link";
   return "not a file";
 }
 
@@ -51,6 +52,7 @@ std::string temporaryBeside(const std::string& path) {
 // Writes `text` to a new temporary beside `path` and flushes it to disk; the temporary's name on
 // success, an error naming `path` otherwise (and no temporary left).
 std::string writeTemporary(const std::string& path, std::string_view text, std::string& temp) {
+  if (std::string refused = refuseUnlessRegularOrAbsent(path); !refused.empty()) return refused;
   temp = temporaryBeside(path);
   const int fd = ::open(temp.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
   if (fd < 0) return path + ": cannot write: " + reason(errno);
@@ -69,6 +71,17 @@ std::string writeTemporary(const std::string& path, std::string_view text, std::
 }
 
 }  // namespace
+
+// A rename replaces whatever holds the name: a device node, a FIFO or a symbolic link would
+// become a regular file (as root, "/dev/full" would stop being the device). So every write checks
+// here, the atomic ones before their temporary is written and again just before the rename.
+// lstat: a symbolic link is refused itself, not judged by what it points to.
+std::string refuseUnlessRegularOrAbsent(const std::string& path) {
+  struct stat st {};
+  if (::lstat(path.c_str(), &st) != 0) return {};  // nothing there (or unreachable: open says)
+  if (S_ISREG(st.st_mode)) return {};
+  return path + ": cannot write: is " + fileKind(st.st_mode) + ", not a regular file";
+}
 
 std::size_t maxInputFileBytes() {
   return g_max_input_bytes.load();
@@ -120,6 +133,10 @@ std::string readRegularFile(const std::string& path, std::string& text) {
 std::string writeFileAtomically(const std::string& path, std::string_view text) {
   std::string temp;
   if (std::string error = writeTemporary(path, text, temp); !error.empty()) return error;
+  if (std::string refused = refuseUnlessRegularOrAbsent(path); !refused.empty()) {
+    ::unlink(temp.c_str());
+    return refused;
+  }
   if (::rename(temp.c_str(), path.c_str()) != 0) {
     const int error = errno;
     ::unlink(temp.c_str());
@@ -149,9 +166,8 @@ std::string writeFilesTogether(const std::vector<std::pair<std::string, std::str
   for (; replaced < files.size(); ++replaced) {
     const std::string& path = files[replaced].first;
     const std::string backup = path + ".old-" + std::to_string(::getpid());
-    struct stat st {};
-    if (::lstat(path.c_str(), &st) == 0 && S_ISDIR(st.st_mode)) {
-      failure = path + ": cannot write: " + reason(EISDIR);  // link() would say EPERM
+    if (std::string refused = refuseUnlessRegularOrAbsent(path); !refused.empty()) {
+      failure = refused;
       break;
     }
     if (::link(path.c_str(), backup.c_str()) == 0) {
@@ -217,7 +233,10 @@ RowFile::~RowFile() {
 std::string RowFile::open(const std::string& path) {
   if (fd_ >= 0) ::close(fd_);
   path_ = path;
-  fd_ = ::open(path.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_APPEND | O_CLOEXEC, 0644);
+  if (std::string refused = refuseUnlessRegularOrAbsent(path); !refused.empty()) return refused;
+  // O_NOFOLLOW: a symbolic link put there after the check is not followed either.
+  fd_ =
+      ::open(path.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_APPEND | O_CLOEXEC | O_NOFOLLOW, 0644);
   if (fd_ < 0) return path + ": cannot write: " + reason(errno);
   return {};
 }

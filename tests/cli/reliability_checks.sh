@@ -144,7 +144,7 @@ case "$case_name" in
     mkdir -p out/summary.json/inside
     run "$torsion" run drop.json --out out --steps 3
     expect_rc 1
-    expect_out "^error: out/summary.json: cannot write: Is a directory$"
+    expect_out "^error: out/summary.json: cannot write: is a directory, not a regular file$"
     no_temporaries out
     ;;
   full_disk_csv)
@@ -178,7 +178,7 @@ case "$case_name" in
     mkdir out.ele
     run "$torsion" mesh convert box.vtk out.node
     expect_rc 1
-    expect_out "^error: out.ele: cannot write: Is a directory$"
+    expect_out "^error: out.ele: cannot write: is a directory, not a regular file$"
     [[ $(cat out.node) == old ]] || fail "out.node was replaced without its .ele"
     no_temporaries .
     ;;
@@ -482,6 +482,54 @@ PY
     expect_rc 1
     expect_out "^error: --key: a key on the command line is visible to every local user"
     [[ ! -e bad ]] || fail "nothing may be written when the key cannot be read"
+    ;;
+  outputs_replace_only_regular_files)
+    # A file written whole is renamed over its name, which would make a FIFO, a device or a
+    # symbolic link a regular file: those are refused, named with their kind, and left as they are.
+    drop_scene > drop.json
+    mkdir fifo link series
+    mkfifo fifo/summary.json
+    run "$torsion" run drop.json --out fifo --steps 3
+    expect_rc 1
+    expect_out "^error: fifo/summary.json: cannot write: is a FIFO, not a regular file$"
+    [[ -p fifo/summary.json ]] || fail "the FIFO was replaced"
+    no_temporaries fifo
+    printf 'kept\n' > target.json
+    ln -s ../target.json link/summary.json
+    run "$torsion" run drop.json --out link --steps 3
+    expect_rc 1
+    expect_out "^error: link/summary.json: cannot write: is a symbolic link, not a regular file$"
+    [[ -L link/summary.json && $(cat target.json) == kept ]] || fail "the link or its target changed"
+    no_temporaries link
+    # At a name the run writes, a FIFO or a link is not removed to make room: the same error.
+    mkdir csv
+    mkfifo csv/wrench.csv
+    run "$torsion" run drop.json --out csv --steps 3
+    expect_rc 1
+    expect_out "^error: csv/wrench.csv: cannot write: is a FIFO, not a regular file$"
+    [[ -p csv/wrench.csv ]] || fail "the FIFO at wrench.csv was replaced"
+    rm csv/wrench.csv
+    ln -s ../target.json csv/ball.vtk
+    run "$torsion" run drop.json --out csv --steps 3
+    expect_rc 1
+    expect_out "^error: csv/ball.vtk: cannot write: is a symbolic link, not a regular file$"
+    [[ -L csv/ball.vtk && $(cat target.json) == kept ]] || fail "the link at ball.vtk changed"
+    # A FIFO among the series' files (only regular .vtu files are cleared when a series starts).
+    mkdir series/series
+    mkfifo series/series/ball_000000.vtu
+    run "$torsion" run drop.json --out series --steps 3 --vtk-every 1
+    expect_rc 1
+    expect_out "^error: --vtk-every: series/series/ball_000000.vtu: cannot write: is a FIFO, not a regular file$"
+    [[ -p series/series/ball_000000.vtu ]] || fail "the series FIFO was replaced"
+    # torsion mesh writes its output the same way.
+    "$torsion" mesh box --min 0 0 0 --max 1 1 1 --cells 1 1 1 -o box.vtk >/dev/null ||
+      fail "mesh box failed"
+    ln -s target.json linked.vtk
+    run "$torsion" mesh convert box.vtk linked.vtk
+    expect_rc 1
+    expect_out "^error: linked.vtk: cannot write: is a symbolic link, not a regular file$"
+    [[ -L linked.vtk && $(cat target.json) == kept ]] || fail "mesh convert replaced the link"
+    no_temporaries .
     ;;
   *)
     fail "unknown case '$case_name'"

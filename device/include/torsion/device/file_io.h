@@ -4,8 +4,10 @@
 //
 // Writing: a whole file goes to a temporary beside it ("<name>.tmp-<pid>"), is flushed to disk,
 // then renamed over the name, so a reader sees the old file or the new one, never a torn one; on
-// any failure the temporary is removed and the old file is left as it was. A file that grows row
-// by row (RowFile) is written in whole rows, one write() each, so a killed process leaves only
+// any failure the temporary is removed and the old file is left as it was. Only a regular file (or
+// nothing) is replaced: a rename would turn a device node, a FIFO, a socket or a symbolic link into
+// a regular file, so those (and directories) are refused with their kind named. A file that grows
+// row by row (RowFile) is written in whole rows, one write() each, so a killed process leaves only
 // whole rows behind.
 //
 // Reading: only regular files are read (a FIFO would block forever, /dev/zero never ends), and
@@ -33,12 +35,19 @@ void setMaxInputFileBytes(std::size_t bytes);
 /// size cap of 1073741824 bytes (raise it with --max-input-mb)", "<path>: read failed: <reason>".
 std::string readRegularFile(const std::string& path, std::string& text);
 
-/// Replaces `path` by `text` (temporary, fsync, rename). Errors: "<path>: cannot write: <reason>".
+/// Empty when `path` holds a regular file or nothing, the only things a write may replace;
+/// otherwise "<path>: cannot write: is a FIFO, not a regular file" (or a character device, a block
+/// device, a socket, a directory, a symbolic link). Every writer here checks with it.
+std::string refuseUnlessRegularOrAbsent(const std::string& path);
+
+/// Replaces `path` by `text` (temporary, fsync, rename). Errors: "<path>: cannot write: <reason>",
+/// "<path>: cannot write: is a FIFO, not a regular file" (a device, socket, directory or symbolic
+/// link likewise: nothing is written and what is there stays).
 std::string writeFileAtomically(const std::string& path, std::string_view text);
 
 /// Replaces several files together or none of them (e.g. a TetGen .node/.ele pair): all are
 /// written to temporaries first, then renamed; a failed rename puts back the files already
-/// replaced.
+/// replaced. Each name must hold a regular file or nothing, as for writeFileAtomically.
 std::string writeFilesTogether(const std::vector<std::pair<std::string, std::string>>& files);
 
 /// A file written row by row under its final name: each row goes out whole in one write() (no
@@ -52,7 +61,8 @@ class RowFile {
   RowFile& operator=(RowFile&& other) noexcept;
   ~RowFile();  ///< closes without reporting; call close() to learn of a failure
 
-  /// Creates (truncates) the file. Error: "<path>: cannot write: <reason>".
+  /// Creates (truncates) the file; only a regular file or nothing may be at `path`
+  /// (refuseUnlessRegularOrAbsent). Error: "<path>: cannot write: <reason>".
   std::string open(const std::string& path);
   bool isOpen() const { return fd_ >= 0; }
   const std::string& path() const { return path_; }
