@@ -159,12 +159,11 @@ Result<std::unique_ptr<VtkSeries>> startSeries(const RunArguments& args, scene::
 
 struct Ran {
   Result<scene::RunOutcome> outcome = Error{};
-  std::string render_error;  ///< the first picture that could not be drawn ("" when none)
-  std::string series_error;  ///< the first series step that could not be written
 };
 
 // The headless run with a progress bar, a picture every --render-every steps, and SIGINT /
-// SIGTERM / SIGHUP stopping it at the end of a step.
+// SIGTERM / SIGHUP stopping it at the end of a step. A picture or series step that cannot be
+// written stops the run as an output error (summary.json says so).
 Ran runWithProgress(const RunArguments& args, scene::BuiltScene& s, render::FrameRecorder* recorder,
                     VtkSeries* series) {
   Ran ran;
@@ -175,16 +174,19 @@ Ran runWithProgress(const RunArguments& args, scene::BuiltScene& s, render::Fram
   options.steps = args.steps;
   options.stop_on_anomaly = args.stop_on_anomaly;
   if (series) options.extra_outputs.push_back("series.pvd");
+  options.write_step_outputs = [&](int done, int total, double rate) -> Status {
+    if (recorder) {
+      Status drawn = done == total ? recorder->capture(s, rate) : recorder->onStep(s, rate);
+      if (!drawn) return Error{"--render: " + drawn.error().message};
+    }
+    if (series) {
+      Status written = series->onStep(s, done, total);
+      if (!written) return Error{"--vtk-every: " + written.error().message};
+    }
+    return Ok{};
+  };
   options.progress = [&](int done, int total, double rate) {
     if (normal) bar.update(done, total, rate);
-    if (recorder && ran.render_error.empty()) {
-      Status drawn = done == total ? recorder->capture(s, rate) : recorder->onStep(s, rate);
-      if (!drawn) ran.render_error = drawn.error().message;
-    }
-    if (series && ran.series_error.empty()) {
-      Status written = series->onStep(s, done, total);
-      if (!written) ran.series_error = written.error().message;
-    }
   };
   options.stop_requested = [] { return static_cast<int>(g_stop_signal); };
   {
@@ -202,8 +204,6 @@ int reportOutcome(const RunArguments& args, const scene::BuiltScene& s, const Ra
                   render::FrameRecorder* recorder, const VtkSeries* series) {
   const bool normal = verbosity() != Verbosity::kQuiet;
   if (!ran.outcome) return fail(ran.outcome.error().message);
-  if (!ran.series_error.empty()) return fail("--vtk-every: " + ran.series_error);
-  if (!ran.render_error.empty()) return fail("--render: " + ran.render_error);
   if (s.haptics) {
     for (const std::string& w : s.haptics->warnings())
       std::cerr << "warning: haptics: " << w << "\n";

@@ -237,6 +237,7 @@ class Run {
     outcome_.steps_done = k + 1;
     if (Status recorded = recordStep(report); !recorded) return recorded.error();
     if (stopsAtAnomaly(report.step)) return false;
+    if (Status written = writeStepOutputs(k + 1); !written) return written.error();
     reportProgress(k + 1);
     return !stopWasRequested();
   }
@@ -274,11 +275,19 @@ class Run {
     return true;
   }
 
-  void reportProgress(int done) const {
-    if (!options_.progress) return;
+  double stepsPerSecond(int done) const {
     const double elapsed =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - run_start_).count();
-    options_.progress(done, steps_, elapsed > 0 ? done / elapsed : 0.0);
+    return elapsed > 0 ? done / elapsed : 0.0;
+  }
+
+  Status writeStepOutputs(int done) const {
+    if (!options_.write_step_outputs) return Ok{};
+    return options_.write_step_outputs(done, steps_, stepsPerSecond(done));
+  }
+
+  void reportProgress(int done) const {
+    if (options_.progress) options_.progress(done, steps_, stepsPerSecond(done));
   }
 
   bool stopWasRequested() {

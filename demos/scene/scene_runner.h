@@ -25,6 +25,11 @@ struct RunOptions {
   int steps = -1;  ///< < 0: the scene's own
   /// Called after every step with (step, total, steps per second so far).
   std::function<void(int, int, double)> progress;
+  /// Called after every step, before `progress`, with the same values: writes the caller's own
+  /// outputs of the step (a ParaView series, pictures). An error is an output that could not be
+  /// written: the run stops there, summary.json says "completed": false with the error, and
+  /// runScene returns it.
+  std::function<Status(int, int, double)> write_step_outputs;
   /// Stop after the step in which the first anomaly (scene_anomalies.h) starts.
   bool stop_on_anomaly = false;
   /// Polled after every step: a signal number (SIGINT, SIGTERM) stops the run there, with every

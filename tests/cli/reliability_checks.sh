@@ -531,6 +531,20 @@ PY
     [[ -L linked.vtk && $(cat target.json) == kept ]] || fail "mesh convert replaced the link"
     no_temporaries .
     ;;
+  step_output_error_is_no_completed_run)
+    # A series step that cannot be written stops the run as an output error: exit 1, and the
+    # summary says the run did not complete, with the error.
+    drop_scene > drop.json
+    with_full_disk _000002.vtu 0 "$torsion" run drop.json --out out --steps 5 --vtk-every 1
+    expect_rc 1
+    expect_out "^error: --vtk-every: out/series/ball_000002.vtu: cannot write: No space left on device$"
+    [[ $(json_field out/summary.json completed) == False ]] || fail "summary says completed"
+    json_field out/summary.json error | grep -q "out/series/ball_000002.vtu: cannot write" ||
+      fail "summary.json lacks the error"
+    [[ $(json_field out/summary.json steps) -eq 2 ]] || fail "the run did not stop at step 2"
+    csv_rows_whole out/wrench.csv
+    no_temporaries out
+    ;;
   *)
     fail "unknown case '$case_name'"
     ;;
