@@ -9,6 +9,7 @@
 #include <sstream>
 
 #include "torsion/device/file_io.h"
+#include "torsion/device/json_check.h"
 #include "torsion/mesh/vtk_format.h"
 
 namespace torsion::cli {
@@ -42,6 +43,13 @@ Result<nlohmann::json> readSummary(const fs::path& directory) {
   const fs::path path = directory / "summary.json";
   if (std::string error = device::readRegularFile(path.string(), text); !error.empty())
     return Error{error};
+  // The strict pass bounds the nesting before anything walks the document (flatten recurses).
+  if (const auto fault = device::findJsonTextFault(text)) {
+    const std::string where =
+        fault->line > 0 ? ":" + std::to_string(fault->line) + ":" + std::to_string(fault->column)
+                        : std::string();
+    return Error{path.string() + where + ": invalid JSON: " + fault->what};
+  }
   nlohmann::json summary = nlohmann::json::parse(text, nullptr, /*allow_exceptions=*/false);
   if (summary.is_discarded() || !summary.is_object())
     return Error{path.string() + ": not a JSON object"};
@@ -137,6 +145,13 @@ Result<Csv> readCsv(const fs::path& path) {
   std::string text;
   if (std::string error = device::readRegularFile(path.string(), text); !error.empty())
     return Error{error};
+  // The runner writes every row whole with its line end: a last line without one was torn (the
+  // writer was killed, or the file was cut), and is refused rather than read as a short row.
+  if (!text.empty() && text.back() != '\n') {
+    const auto last_line = 1 + std::count(text.begin(), text.end(), '\n');
+    return Error{path.string() + ":" + std::to_string(last_line) +
+                 ": the last row ends without its newline: a torn row"};
+  }
   std::stringstream lines(text);
   Csv csv;
   std::string line;

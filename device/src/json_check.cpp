@@ -26,6 +26,30 @@ void locate(std::string_view text, size_t offset, JsonTextFault& fault) {
   fault.column = static_cast<int>(offset - line_start + 1);
 }
 
+// The offset of the bracket that opens nesting level `level` (1 = the outermost), skipping
+// strings; the text is well-formed up to there (the parser got that far).
+size_t openingOfLevel(std::string_view text, size_t level) {
+  size_t depth = 0;
+  bool in_string = false;
+  for (size_t i = 0; i < text.size(); ++i) {
+    const char c = text[i];
+    if (in_string) {
+      if (c == '\\') {
+        ++i;
+      } else if (c == '"') {
+        in_string = false;
+      }
+    } else if (c == '"') {
+      in_string = true;
+    } else if (c == '[' || c == '{') {
+      if (++depth == level) return i;
+    } else if (c == ']' || c == '}') {
+      --depth;
+    }
+  }
+  return text.size();
+}
+
 // A SAX consumer that builds nothing: it keeps, per open object, the keys seen so far and the
 // path to it, and stops at the first fault.
 class StrictChecker {
@@ -42,10 +66,7 @@ class StrictChecker {
   bool string(json::string_t&) { return value(); }
   bool binary(json::binary_t&) { return value(); }
 
-  bool start_object(std::size_t) {
-    open(true);
-    return true;
-  }
+  bool start_object(std::size_t) { return open(true); }
   bool key(json::string_t& k) {
     Level& level = levels_.back();
     if (!level.keys.insert(k).second) {
@@ -62,10 +83,7 @@ class StrictChecker {
     close();
     return true;
   }
-  bool start_array(std::size_t) {
-    open(false);
-    return true;
-  }
+  bool start_array(std::size_t) { return open(false); }
   bool end_array() {
     close();
     return true;
@@ -107,9 +125,17 @@ class StrictChecker {
     if (!levels_.empty() && !levels_.back().is_object) ++levels_.back().index;
     return true;
   }
-  void open(bool is_object) {
+  // False (the parse stops) when the new level is one too deep.
+  bool open(bool is_object) {
+    if (levels_.size() >= static_cast<size_t>(kMaxJsonDepth)) {
+      fault_ = JsonTextFault{};
+      locate(text_, openingOfLevel(text_, levels_.size() + 1), *fault_);
+      fault_->what = "nested deeper than " + std::to_string(kMaxJsonDepth) + " levels";
+      return false;
+    }
     levels_.emplace_back();
     levels_.back().is_object = is_object;
+    return true;
   }
   void close() {
     levels_.pop_back();

@@ -127,6 +127,30 @@ PY
     expect_out "^error: no_such_dir/summary.json: cannot open"
     ;;
 
+  check_refuses_deep_json_and_torn_rows)
+    # A summary.json nested 200000 levels deep is refused before anything walks it (the walk
+    # recurses), at the bracket that opens level 65; a CSV whose last row lost its newline (a
+    # torn write) or some of its fields is refused with the file and the line.
+    twist a
+    cp -r a b
+    /usr/bin/python3 -c 'print("{\"a\": " + "[" * 200000 + "]" * 200000 + "}")' > b/summary.json
+    run "$torsion" check b a
+    expect_rc 1
+    expect_out "^error: b/summary.json:1:70: invalid JSON: nested deeper than 64 levels$"
+    cp a/summary.json b/
+    head -c -1 a/wrench.csv > b/wrench.csv
+    run "$torsion" check b a
+    expect_rc 1
+    expect_out "^error: b/wrench.csv:21: the last row ends without its newline: a torn row$"
+    sed '$ s/,[^,]*$//' a/wrench.csv > b/wrench.csv
+    run "$torsion" check b a
+    expect_rc 1
+    expect_out "^error: b/wrench.csv:21: 13 values, the header has 14$"
+    cp a/wrench.csv b/
+    run "$torsion" check b a
+    expect_rc 0
+    ;;
+
   *)
     fail "unknown case $case_name"
     ;;

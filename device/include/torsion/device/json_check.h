@@ -21,8 +21,14 @@ struct JsonTextFault {
   std::string what;
 };
 
-/// Nothing when the text is one well-formed JSON value with no duplicate key in any object and no
-/// number outside a double's range; otherwise the first fault.
+/// The deepest nesting of arrays and objects a JSON text may have. Code that walks a document
+/// recurses once per level (and so does nlohmann's copy, comparison and dump): a bound keeps a
+/// hostile or broken file from overflowing the stack. Project files nest a few levels.
+inline constexpr int kMaxJsonDepth = 64;
+
+/// Nothing when the text is one well-formed JSON value with no duplicate key in any object, no
+/// number outside a double's range and no nesting deeper than kMaxJsonDepth; otherwise the first
+/// fault ("nested deeper than 64 levels", at the bracket that opens level 65).
 std::optional<JsonTextFault> findJsonTextFault(std::string_view text);
 
 /// The text made safe for a one-line message: printable ASCII kept, other bytes as \xHH,
