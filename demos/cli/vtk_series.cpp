@@ -153,6 +153,10 @@ Result<std::unique_ptr<VtkSeries>> VtkSeries::start(const std::string& out_dir, 
     if (entry.path().extension() == ".vtu" && entry.is_regular_file(ec))
       fs::remove(entry.path(), ec);
   }
+  // And what a killed run's atomic writes left: "<body>_<step>.vtu.tmp-<pid>".
+  const std::string left = device::removeStaleTemporaries(
+      dir.string(), [](const std::string& name) { return fs::path(name).extension() == ".vtu"; });
+  if (!left.empty()) return Error{left};
   std::unique_ptr<VtkSeries> series(new VtkSeries(out_dir, every));
   if (Status written = series->write(scene, 0); !written) return written.error();
   return series;

@@ -10,9 +10,9 @@
 //                            set and hand on the body ("wrench_<name>", N and N m)
 //   rigid_<name>_<step>.vtu  rigid body: its surface (rigid_surface.h) in its pose; field data
 //                            TimeValue, step, position (m) and orientation [qx qy qz qw]
-// Steps 0, N, 2N, ... and the last step are written. series/ is emptied of .vtu files when a
-// series starts; series.pvd is rewritten (whole) after each written step, so a stopped run leaves
-// a series ParaView opens.
+// Steps 0, N, 2N, ... and the last step are written. series/ is emptied of .vtu files (and of
+// the temporaries a killed run left of them) when a series starts; series.pvd is rewritten (whole)
+// after each written step, so a stopped run leaves a series ParaView opens.
 
 #include <memory>
 #include <string>

@@ -64,6 +64,12 @@ Result<RunDirectory> RunDirectory::prepare(const std::string& directory,
     if (::unlink(path.c_str()) != 0 && errno != ENOENT)
       return Error{path + ": cannot remove the earlier run's file: " + std::strerror(errno)};
   }
+  // A killed run leaves the temporaries of its atomic writes ("<name>.tmp-<pid>"): those of
+  // these names, summary.json's included, whose process is gone.
+  stale.insert(kSummary);
+  const std::string left = device::removeStaleTemporaries(
+      directory, [&stale](const std::string& name) { return stale.count(name) != 0; });
+  if (!left.empty()) return Error{left};
   return dir;
 }
 

@@ -3,7 +3,7 @@
 // (docs/outputs.md):
 //   1. summary.json is replaced first, saying "completed": false and listing the run's outputs;
 //   2. the files of the earlier run (the "outputs" of its summary.json) and this run's own names
-//      are removed;
+//      are removed, and so are the temporaries a killed run left of those names;
 //   3. the CSVs grow row by row under their own names (whole rows only);
 //   4. at the end the meshes and haptic logs are written whole, and summary.json is replaced by
 //      the final one.

@@ -1,11 +1,13 @@
 #include "torsion/device/file_io.h"
 
+#include <dirent.h>
 #include <fcntl.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
 #include <atomic>
 #include <cerrno>
+#include <csignal>
 #include <cstdio>
 #include <cstring>
 
@@ -209,6 +211,36 @@ std::string writeFilesTogether(const std::vector<std::pair<std::string, std::str
   }
   for (std::size_t k = replaced; k < temps.size(); ++k)
     ::unlink(temps[k].c_str());
+  return failure;
+}
+
+std::string removeStaleTemporaries(const std::string& directory,
+                                   const std::function<bool(const std::string&)>& ours) {
+  DIR* dir = ::opendir(directory.c_str());
+  if (dir == nullptr) return errno == ENOENT ? std::string() : directory + ": " + reason(errno);
+  std::string failure;
+  while (const dirent* entry = ::readdir(dir)) {
+    const std::string name = entry->d_name;
+    // "<name>.tmp-<pid>" (temporaryBeside) or "<name>.old-<pid>" (writeFilesTogether's backup).
+    const size_t dash = name.rfind('-');
+    if (dash == std::string::npos || dash < 4 || dash + 1 == name.size() || dash + 10 < name.size())
+      continue;
+    const std::string tag = name.substr(dash - 4, 5);
+    if (tag != ".tmp-" && tag != ".old-") continue;
+    const std::string digits = name.substr(dash + 1);
+    if (digits.find_first_not_of("0123456789") != std::string::npos) continue;
+    if (!ours(name.substr(0, dash - 4))) continue;
+    const long pid = std::stol(digits);
+    // Alive (or not ours to signal: EPERM) means it may still be writing: keep it.
+    if (pid == ::getpid() || pid <= 0 || ::kill(static_cast<pid_t>(pid), 0) == 0 || errno != ESRCH)
+      continue;
+    const std::string path = directory + "/" + name;
+    struct stat st {};
+    if (::lstat(path.c_str(), &st) != 0 || !S_ISREG(st.st_mode)) continue;
+    if (::unlink(path.c_str()) != 0 && errno != ENOENT && failure.empty())
+      failure = path + ": cannot remove a stale temporary: " + reason(errno);
+  }
+  ::closedir(dir);
   return failure;
 }
 

@@ -545,6 +545,26 @@ PY
     csv_rows_whole out/wrench.csv
     no_temporaries out
     ;;
+  stale_temporaries_removed)
+    # A killed run leaves the temporaries of its atomic writes; the next run into the directory
+    # removes those of its own file names whose process is gone, and nothing else.
+    drop_scene > drop.json
+    mkdir -p out/series
+    dead=99999999  # above any pid_max: no such process
+    for f in summary.json ball.vtk series.pvd; do
+      echo torn > "out/$f.tmp-$dead"
+    done
+    echo torn > "out/ball.vtk.old-$dead"
+    echo torn > "out/series/ball_000010.vtu.tmp-$dead"
+    echo mine > "out/notes.txt.tmp-$dead"      # not a name of the run
+    echo mine > "out/ball.vtk.tmp-$$"          # its process (this shell) still runs
+    echo mine > "out/ball.vtk.tmp-backup"      # not a process id
+    run "$torsion" run drop.json --out out --steps 3 --vtk-every 1
+    expect_rc 0
+    left=$(cd out && find . -name '*.tmp-*' -o -name '*.old-*' | LC_ALL=C sort | tr '\n' ' ')
+    [[ $left == "./ball.vtk.tmp-$$ ./ball.vtk.tmp-backup ./notes.txt.tmp-$dead " ]] ||
+      fail "left behind: $left"
+    ;;
   *)
     fail "unknown case '$case_name'"
     ;;

@@ -16,6 +16,7 @@
 // Every error is a message naming the file and the system's reason (strerror); empty is success.
 
 #include <cstddef>
+#include <functional>
 #include <string>
 #include <string_view>
 #include <utility>
@@ -49,6 +50,14 @@ std::string writeFileAtomically(const std::string& path, std::string_view text);
 /// written to temporaries first, then renamed; a failed rename puts back the files already
 /// replaced. Each name must hold a regular file or nothing, as for writeFileAtomically.
 std::string writeFilesTogether(const std::vector<std::pair<std::string, std::string>>& files);
+
+/// Removes from `directory` the temporaries that atomic writes left when their process was killed
+/// (SIGKILL, a power cut): entries "<name>.tmp-<pid>" and "<name>.old-<pid>" whose process no
+/// longer runs, for the names `ours` accepts. Nothing else is touched: not another program's
+/// files, not a temporary of a process still running. An error names the entry that could not be
+/// removed.
+std::string removeStaleTemporaries(const std::string& directory,
+                                   const std::function<bool(const std::string&)>& ours);
 
 /// A file written row by row under its final name: each row goes out whole in one write() (no
 /// user-space buffer), so after a crash or SIGKILL the file holds whole rows only.
