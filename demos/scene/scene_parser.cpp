@@ -396,8 +396,19 @@ HandSpec readSceneHand(const JsonObject& h, const SceneSpec& scene,
 
 // Rigid bodies, the ground, a .bullet file and the camera.
 void readSurroundings(const JsonObject& root, const std::string& base_directory, SceneSpec& scene) {
-  for (const JsonObject& r : root.objects("rigid_bodies"))
+  for (const JsonObject& r : root.objects("rigid_bodies")) {
     scene.rigid_bodies.push_back(readRigidBody(r, scene.rigid_bodies));
+    // The series names a rigid body's files "rigid_<name>_<step>.vtu", a FEM body's
+    // "<name>_<step>.vtu" (docs/outputs.md): FEM body "rigid_X" and rigid body "X" would share
+    // them.
+    const std::string& name = scene.rigid_bodies.back().name;
+    for (const BodySpec& body : scene.bodies) {
+      if (body.name == "rigid_" + name)
+        r.fail("name", "rigid body '" + name + "' and FEM body '" + body.name +
+                           "' would write the same series files (series/rigid_" + name +
+                           "_<step>.vtu): rename one");
+    }
+  }
   if (root.has("ground")) scene.ground = readGround(root.object("ground"));
   if (root.has("bullet_file"))
     scene.bullet_file = resolved(root.string("bullet_file"), base_directory);

@@ -118,6 +118,24 @@ TEST(RigidScene, FaultsNameTheKey) {
                         {"ground.hieght", "unknown key"}));
 }
 
+// A series names a FEM body's files "<name>_<step>.vtu" and a rigid body's
+// "rigid_<name>_<step>.vtu": FEM body "rigid_crate" and rigid body "crate" would overwrite each
+// other's, so the scene is refused, naming both. Equal names, or "rigid_" on the rigid side, write
+// different files.
+TEST(RigidScene, FemAndRigidBodiesWithTheSameSeriesFilesAreRefused) {
+  const std::string crate = R"({"name": "crate", "shape": {"sphere": {"radius": 0.1}}})";
+  std::string text = scene(crate);
+  text.replace(text.find("\"block\""), 7, "\"rigid_crate\"");
+  EXPECT_TRUE(failsWith(parse(text), {"r.json: rigid_bodies[0].name", "rigid body 'crate'",
+                                      "FEM body 'rigid_crate'", "series/rigid_crate_<step>.vtu"}));
+  for (const char* name : {"block", "rigid_block"}) {
+    const std::string rigid =
+        R"({"name": ")" + std::string(name) + R"(", "shape": {"sphere": {"radius": 0.1}}})";
+    Result<SceneSpec> r = parse(scene(rigid));
+    EXPECT_TRUE(r.ok()) << name << ": " << r.error().message;
+  }
+}
+
 // A kinematic plate follows its script exactly (Bullet derives its velocity from the poses the
 // scripted motion state hands it), presses the block, and the run writes one rigid.csv row per
 // step and the contact figures.
