@@ -545,6 +545,22 @@ PY
     csv_rows_whole out/wrench.csv
     no_temporaries out
     ;;
+  render_error_is_no_completed_run)
+    # The same for a --render picture that cannot be written (a directory holds its name).
+    drop_scene > drop.json
+    "$torsion" run drop.json --out probe --steps 1 --render probe_pictures --render-size 64x48 \
+      >/dev/null 2>&1 || skip "no offscreen rendering (OSMesa) here"
+    mkdir -p pictures/frame_00002.png
+    run "$torsion" run drop.json --out out --steps 4 --render pictures --render-every 1 \
+      --render-size 64x48
+    expect_rc 1
+    expect_out "^error: --render: pictures/frame_00002.png: cannot open for writing$"
+    [[ $(json_field out/summary.json completed) == False ]] || fail "summary says completed"
+    json_field out/summary.json error | grep -q "pictures/frame_00002.png" ||
+      fail "summary.json lacks the error"
+    [[ $(json_field out/summary.json steps) -eq 2 ]] || fail "the run did not stop at step 2"
+    no_temporaries out
+    ;;
   stale_temporaries_removed)
     # A killed run leaves the temporaries of its atomic writes; the next run into the directory
     # removes those of its own file names whose process is gone, and nothing else.
