@@ -561,6 +561,24 @@ PY
     [[ $(json_field out/summary.json steps) -eq 2 ]] || fail "the run did not stop at step 2"
     no_temporaries out
     ;;
+  series_names_do_not_collide)
+    # A series names a FEM body's files "<name>_<step>.vtu" and a rigid body's
+    # "rigid_<name>_<step>.vtu": FEM body "rigid_X" beside rigid body "X" is refused before any
+    # step, for a rigid body of the scene and for one a .bullet file brings (named by the file).
+    drop_scene -e 's/"name": "ball"/"name": "rigid_floor"/; s/"body": "ball"/"body": "rigid_floor"/g' \
+      -e 's/"ground": {/"rigid_bodies": [{"name": "floor", "shape": {"sphere": {"radius": 0.1}}, "pose": {"position": [5, 5, 5]}, "mass": 0}], "ground": {/' > drop.json
+    grep -q '"floor"' drop.json || fail "the scene with a rigid body was not made"
+    run "$torsion" run drop.json --out out --steps 2
+    expect_rc 1
+    expect_out "^error: drop.json: rigid_bodies\[0\].name: rigid body 'floor' and FEM body 'rigid_floor' would write the same series files \(series/rigid_floor_<step>.vtu\): rename one$"
+    [[ ! -e out ]] || fail "nothing may be written for a bad scene"
+    sed -e "s|../../assets/meshes|$assets|; s|../../assets/bullet|$assets/../bullet|" \
+      -e 's/"slab"/"rigid_boxes_1"/g' "$scenes/bullet_boxes.json" > boxes.json
+    run "$torsion" run boxes.json --out out --steps 2
+    expect_rc 1
+    expect_out "^error: boxes.json: bullet_file: rigid body 'boxes_1' and FEM body 'rigid_boxes_1' would write the same series files"
+    [[ ! -e out ]] || fail "nothing may be written for a bad scene"
+    ;;
   stale_temporaries_removed)
     # A killed run leaves the temporaries of its atomic writes; the next run into the directory
     # removes those of its own file names whose process is gone, and nothing else.
