@@ -3,6 +3,7 @@
 import csv
 import json
 import os
+import stat
 import subprocess
 
 import numpy as np
@@ -135,6 +136,22 @@ def test_write_vtk_reads_back_as_the_positions_to_the_bit(tmp_path):
     world.step(10)
     world.write_vtk(str(tmp_path / "c.vtk"))
     assert np.array_equal(read_vtk_points(tmp_path / "c.vtk"), world.body("cylinder").positions)
+
+
+def test_write_vtk_replaces_only_a_regular_file(tmp_path):
+    # A FIFO or a symbolic link at the path (a device node likewise) is refused and left as it is.
+    world = torsion.World.from_scene("twist_cylinder_2430", threads=1)
+    fifo, link, target = tmp_path / "pipe.vtk", tmp_path / "link.vtk", tmp_path / "target.vtk"
+    os.mkfifo(fifo)
+    with pytest.raises(RuntimeError, match="pipe.vtk: cannot write: is a FIFO, not a regular file"):
+        world.write_vtk(str(fifo))
+    assert stat.S_ISFIFO(os.lstat(fifo).st_mode)
+    target.write_text("kept\n")
+    link.symlink_to(target)
+    with pytest.raises(RuntimeError, match="link.vtk: cannot write: is a symbolic link"):
+        world.write_vtk(str(link))
+    assert link.is_symlink() and target.read_text() == "kept\n"
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["link.vtk", "pipe.vtk", "target.vtk"]
 
 
 def test_render_gives_a_picture_with_the_body_in_it():
