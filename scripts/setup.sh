@@ -4,11 +4,15 @@
 # As root it runs apt-get itself. As another user it uses `sudo -n` when that works without a
 # password; otherwise it prints the exact apt-get command to run and exits with status 1, changing
 # nothing. Nothing is downloaded from anywhere but Debian's archive.
+#
+# apt-get's own output (thousands of lines on a fresh machine) goes to a log file,
+# build/setup.log (TORSION_SETUP_LOG overrides it); this prints one line per stage, and on a
+# failure the log's last lines, so every error stays visible.
 set -euo pipefail
 
 packages=(
-  # build
-  cmake ninja-build g++ pkg-config
+  # build; ccache: a tree built before on this machine recompiles only what changed
+  cmake ninja-build g++ pkg-config ccache
   # libraries
   libbullet-dev libbullet-extras-dev libeigen3-dev libsuitesparse-dev libccd-dev libtbb-dev
   libcli11-dev nlohmann-json3-dev libpng-dev
@@ -56,6 +60,21 @@ else
   exit 1
 fi
 export DEBIAN_FRONTEND=noninteractive
-"${as_root[@]}" apt-get update -qq
-"${as_root[@]}" apt-get install -y -qq --no-install-recommends "${missing[@]}"
+log=${TORSION_SETUP_LOG:-$(cd "$(dirname "$0")/.." && pwd)/build/setup.log}
+mkdir -p "$(dirname "$log")"
+: >"$log"
+# Runs one stage with its output in the log; on failure shows the log's end and stops.
+quietly() {
+  local what=$1
+  shift
+  echo "setup: $what (log: $log)"
+  if ! "$@" >>"$log" 2>&1; then
+    echo "setup: $what failed; the last lines of $log:" >&2
+    tail -n 40 "$log" >&2
+    exit 1
+  fi
+}
+quietly "updating the package lists" "${as_root[@]}" apt-get update -q
+quietly "installing ${#missing[@]} package(s)" \
+  "${as_root[@]}" apt-get install -y -q --no-install-recommends "${missing[@]}"
 echo "setup: done"

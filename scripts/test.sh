@@ -1,37 +1,31 @@
 #!/usr/bin/env bash
-# The whole test suite, from a fresh machine: set-up, Release build, every CTest test, clang-tidy
-# over the libraries, the fast tests again on float Bullet, then a clang build with ASan+UBSan
-# that runs the unit tests again and fuzzes each mesh reader for a bounded time. `.ci/run` calls
-# exactly this.
+# The whole test suite, from a fresh machine. `.ci/run` calls exactly this. Stages:
+#   1. set-up (scripts/setup.sh: the Debian packages, only those missing);
+#   2. Release build (build/, gcc, double Bullet, warnings as errors);
+#   3. the float-Bullet library without CHOLMOD (build-float/): the package tests install it
+#      beside build/'s (a consumer links each precision from one prefix) and alone (a consumer's
+#      direct solver works without CHOLMOD);
+#   4. every CTest test of build/;
+#   5. clang-tidy over extension/ and device/;
+#   6. ThreadSanitizer (build-tsan/): the haptic loop's thread, its buffers, the runtime;
+#   7. ASan + UBSan on float Bullet (build-asan/, clang): the fast tests and the fuzzers.
+# Every build compiles through ccache (scripts/ccache_env.sh): on a machine that built the same
+# tree before, the builds take seconds. Each stage's wall time and the cache's hits and misses
+# are printed at the end, whether the run passes or fails.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 jobs=$(nproc 2>/dev/null || echo 2)
+# shellcheck source=scripts/ccache_env.sh
+source scripts/ccache_env.sh
+# shellcheck source=scripts/stages.sh
+source scripts/stages.sh
+trap 'rc=$?; report_stages; ccache_report; exit $rc' EXIT
 
-# Each stage's wall time, printed at the end whether the run passes or fails, so a slow CI run
-# shows where its minutes went.
-stage_names=()
-stage_starts=()
-stage() {
-  echo "== $1"
-  stage_names+=("$1")
-  stage_starts+=("$SECONDS")
-}
-report_stages() {
-  local rc=$? i end
-  echo "== Stage times (wall, s)"
-  for i in "${!stage_names[@]}"; do
-    end=${stage_starts[$((i + 1))]:-$SECONDS}
-    printf '%6d  %s\n' $((end - stage_starts[i])) "${stage_names[$i]}"
-  done
-  printf '%6d  total\n' "$SECONDS"
-  return "$rc"
-}
-trap report_stages EXIT
-# Every build here starts clean, so the libraries, the tool and the Python module compile as
-# unity batches (TORSION_UNITY_BUILD: half the minutes on 2 cores).
-# The extra builds compile only what their fast labels run (no physics, regression or render
-# executables, no Python module, no benchmarks); the sanitizers keep line tables, not full debug
-# information, which is enough for their reports.
+# Every build here may start clean, so the libraries, the tool and the Python module compile as
+# unity batches (TORSION_UNITY_BUILD). The extra builds compile only what their stage runs: the
+# fast labels' executables (no physics, regression or render tests, no Python module, no
+# benchmarks). The sanitizers keep line tables, not full debug information, which is enough for
+# their reports.
 unity=(-DTORSION_UNITY_BUILD=ON)
 fast_only=("${unity[@]}" -DTORSION_BUILD_SLOW_TESTS=OFF -DTORSION_PYTHON=OFF -DTORSION_BUILD_BENCHMARKS=OFF)
 sanitizer_flags=(-DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_CXX_COMPILER=clang++
@@ -41,38 +35,47 @@ stage "Set-up (scripts/setup.sh)"
 bash scripts/setup.sh
 
 stage "Release build (build/)"
-cmake -S . -B build -G Ninja -DCMAKE_BUILD_TYPE=Release -DTORSION_WARNINGS_AS_ERRORS=ON "${unity[@]}"
-cmake --build build -j"$jobs"
-stage "Test suite"
-ctest --test-dir build -j"$jobs" --output-on-failure --timeout 900
+configure build -DCMAKE_BUILD_TYPE=Release -DTORSION_WARNINGS_AS_ERRORS=ON "${unity[@]}" \
+  -DTORSION_CONSUMER_ALSO_INSTALL="$PWD/build-float" -DTORSION_CONSUMER_WITHOUT_CHOLMOD="$PWD/build-float"
+build build
+
+# The libraries a consumer links, once more in the two settings a package may differ in: float
+# Bullet and no CHOLMOD (the GPL-free build). Float Bullet's behaviour (the tests) is checked in
+# the sanitizer build, stage 7.
+stage "Float-Bullet library without CHOLMOD (build-float/), for the package tests"
+configure build-float -DCMAKE_BUILD_TYPE=Release -DTORSION_WARNINGS_AS_ERRORS=ON "${unity[@]}" \
+  -DTORSION_BULLET_PRECISION=float -DTORSION_CHOLMOD=OFF -DTORSION_BUILD_TESTS=OFF \
+  -DTORSION_BUILD_DEMOS=OFF -DTORSION_BUILD_BENCHMARKS=OFF
+build build-float
+
+stage "Test suite (build/)"
+ctest --test-dir build -j"$jobs" --output-on-failure
 # The pytest suite is one CTest test (python.pytest); its own count of tests:
 grep -hEo "^[0-9]+ passed.* in [0-9.]+s" build/Testing/Temporary/LastTest.log | tail -1 |
   sed 's/^/== pytest (label python): /' || true
-stage "clang-tidy (.clang-tidy) over extension/ and device/, from build/compile_commands.json"
-bash scripts/clang_tidy.sh build
+
+stage "clang-tidy (.clang-tidy) over extension/ and device/"
+# From a configured, unbuilt tree without precompiled headers: clang-tidy cannot read gcc's.
+configure build-tidy -DCMAKE_BUILD_TYPE=Release "${fast_only[@]}" -DTORSION_PCH=OFF \
+  -DTORSION_BUILD_TESTS=OFF -DTORSION_BUILD_DEMOS=OFF
+bash scripts/clang_tidy.sh build-tidy
 
 stage "ThreadSanitizer build (build-tsan/, clang): the haptic loop's thread, its buffers, the runtime"
-cmake -S . -B build-tsan -G Ninja "${sanitizer_flags[@]}" "${fast_only[@]}" -DTORSION_TSAN=ON \
+configure build-tsan "${sanitizer_flags[@]}" "${fast_only[@]}" -DTORSION_TSAN=ON \
   -DTORSION_BUILD_DEMOS=OFF
-cmake --build build-tsan -j"$jobs" --target torsion_device_tests torsion_bullet_tests
+build build-tsan --target torsion_device_tests torsion_bullet_tests
 TSAN_OPTIONS="halt_on_error=1 second_deadlock_stack=1" \
-  ctest --test-dir build-tsan -j"$jobs" --output-on-failure --timeout 900 \
+  ctest --test-dir build-tsan -j"$jobs" --output-on-failure \
   -R "HapticLoop|TripleBuffer|NetworkDevice|PluginDevice|UserWorldHaptics"
 
-stage "Float-Bullet build (build-float/): Debian's default Bullet; fast tests and the package"
-# The same code on pkg-config `bullet` (btScalar = float), the Bullet most programs link. The
-# package test also installs build/ beside it and links each precision from the one prefix.
-cmake -S . -B build-float -G Ninja -DCMAKE_BUILD_TYPE=Release -DTORSION_WARNINGS_AS_ERRORS=ON \
-  -DTORSION_BULLET_PRECISION=float "${fast_only[@]}" \
-  -DTORSION_CONSUMER_ALSO_INSTALL="$PWD/build"
-cmake --build build-float -j"$jobs"
-# (The build without CHOLMOD is precision-independent and checked once, in the Release pass.)
-ctest --test-dir build-float -j"$jobs" --output-on-failure -L "unit|cli|package" --timeout 900 \
-  -E "package.builds_without_cholmod"
-
-stage "Sanitizer + fuzz build (build-asan/, clang, ASan+UBSan)"
-cmake -S . -B build-asan -G Ninja "${sanitizer_flags[@]}" "${fast_only[@]}" -DTORSION_SANITIZE=ON \
-  -DTORSION_FUZZ=ON
-cmake --build build-asan -j"$jobs"
+# One build for two things only it can catch: memory and undefined-behaviour errors (ASan, UBSan,
+# the fuzzers), and float Bullet (Debian's default btScalar, the one most programs link): the
+# unit and CLI tests run on float here, while the Release suite runs on double. (Warnings are not
+# errors here: clang's -Wdouble-promotion flags every btScalar widened to double, which is exact
+# and intended; float's narrowing is an error in the gcc float build, stage 3.)
+stage "Sanitizer + fuzz build on float Bullet (build-asan/, clang, ASan+UBSan)"
+configure build-asan "${sanitizer_flags[@]}" "${fast_only[@]}" -DTORSION_SANITIZE=ON \
+  -DTORSION_FUZZ=ON -DTORSION_BULLET_PRECISION=float
+build build-asan
 ASAN_OPTIONS=detect_leaks=1 UBSAN_OPTIONS=print_stacktrace=1 \
-  ctest --test-dir build-asan -j"$jobs" --output-on-failure -L "unit|cli|fuzz" --timeout 900
+  ctest --test-dir build-asan -j"$jobs" --output-on-failure -L "unit|cli|fuzz"

@@ -1,7 +1,8 @@
 # Installs the build tree into a scratch prefix, then configures, builds and runs an outside
 # project against it. Arguments: BUILD_DIR, SOURCE_DIR, WORK_DIR, GENERATOR, PRECISION (the
 # build's Bullet precision), and optionally ALSO_INSTALL: another Torsion build tree, of the other
-# precision, installed into the same prefix afterwards (both side by side).
+# precision, installed into the same prefix afterwards (both side by side); LAUNCHER (compiler
+# launcher, may be empty).
 file(REMOVE_RECURSE "${WORK_DIR}")
 file(MAKE_DIRECTORY "${WORK_DIR}")
 set(prefix "${WORK_DIR}/prefix")
@@ -23,7 +24,7 @@ endfunction()
 # must report PRECISION's btScalar.
 function(consume name precision)
   run(${CMAKE_COMMAND} -S "${SOURCE_DIR}" -B "${WORK_DIR}/${name}" -G "${GENERATOR}"
-      "-DCMAKE_PREFIX_PATH=${prefix}" -DCMAKE_BUILD_TYPE=Release ${ARGN})
+      "-DCMAKE_PREFIX_PATH=${prefix}" -DCMAKE_BUILD_TYPE=Release "-DCMAKE_CXX_COMPILER_LAUNCHER=${LAUNCHER}" ${ARGN})
   run(${CMAKE_COMMAND} --build "${WORK_DIR}/${name}")
   execute_process(COMMAND "${WORK_DIR}/${name}/consumer" RESULT_VARIABLE rc OUTPUT_VARIABLE out)
   if(precision STREQUAL "double")

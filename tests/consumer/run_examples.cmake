@@ -1,6 +1,7 @@
 # Builds examples/ against the installed package, as a user's project would, with the README's C++
 # snippet extracted from README.md, and runs every program. Arguments: BUILD_DIR, PROJECT_DIR,
-# WORK_DIR, GENERATOR, MESH (a mesh the README snippet reads from its working directory).
+# WORK_DIR, GENERATOR, MESH (a mesh the README snippet reads from its working directory),
+# LAUNCHER (compiler launcher, may be empty).
 file(REMOVE_RECURSE "${WORK_DIR}")
 file(MAKE_DIRECTORY "${WORK_DIR}/run")
 
@@ -27,7 +28,7 @@ file(WRITE "${WORK_DIR}/readme_snippet.cpp" "${snippet}")
 
 run(${CMAKE_COMMAND} --install "${BUILD_DIR}" --prefix "${WORK_DIR}/prefix")
 run(${CMAKE_COMMAND} -S "${PROJECT_DIR}/examples" -B "${WORK_DIR}/build" -G "${GENERATOR}"
-    "-DCMAKE_PREFIX_PATH=${WORK_DIR}/prefix" -DCMAKE_BUILD_TYPE=Release
+    "-DCMAKE_PREFIX_PATH=${WORK_DIR}/prefix" -DCMAKE_BUILD_TYPE=Release "-DCMAKE_CXX_COMPILER_LAUNCHER=${LAUNCHER}"
     "-DREADME_SNIPPET=${WORK_DIR}/readme_snippet.cpp" -DTORSION_EXAMPLES_STRICT=ON)
 run(${CMAKE_COMMAND} --build "${WORK_DIR}/build")
 

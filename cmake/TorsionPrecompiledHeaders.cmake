@@ -1,0 +1,79 @@
+# Precompiled headers: the third-party headers every source of a target parses (Eigen, Bullet,
+# GoogleTest, CLI11, nlohmann_json, pybind11) are parsed once per target instead of once per
+# source (or per unity batch). They are only third-party and standard headers, never our own, so
+# an edit to a Torsion header never rebuilds a precompiled header. TORSION_PCH=OFF turns them off
+# (e.g. to check that every source includes what it uses).
+option(TORSION_PCH "Precompile the heavy third-party headers of each target" ON)
+
+# Header sets, by what a target uses.
+set(TORSION_PCH_STD <algorithm> <array> <cmath> <functional> <map> <memory> <optional> <string>
+    <vector>)
+set(TORSION_PCH_SOLVER <Eigen/Core> <Eigen/Geometry> <Eigen/Sparse> <btBulletDynamicsCommon.h>)
+set(TORSION_PCH_GTEST <gtest/gtest.h>)
+set(TORSION_PCH_CLI <CLI/CLI.hpp>)
+set(TORSION_PCH_JSON <nlohmann/json.hpp>)
+
+# torsion_precompile_headers(TARGET SET...): SET names one of the sets above (STD, SOLVER, GTEST,
+# CLI, JSON) or is a header of its own (<pybind11/pybind11.h>).
+function(torsion_precompile_headers target)
+  if(NOT TORSION_PCH OR NOT TARGET ${target})
+    return()
+  endif()
+  set(headers)
+  foreach(item IN LISTS ARGN)
+    if(DEFINED TORSION_PCH_${item})
+      list(APPEND headers ${TORSION_PCH_${item}})
+    else()
+      list(APPEND headers ${item})
+    endif()
+  endforeach()
+  target_precompile_headers(${target} PRIVATE ${headers})
+endfunction()
+
+# A test executable: GoogleTest, plus the solver's headers when it links the library.
+function(torsion_precompile_test_headers target)
+  if(NOT TARGET ${target})
+    return()
+  endif()
+  get_target_property(libs ${target} LINK_LIBRARIES)
+  set(sets STD GTEST)
+  if(libs MATCHES "Torsion::extension|torsion_scene|torsion_render")
+    list(APPEND sets SOLVER)
+  endif()
+  torsion_precompile_headers(${target} ${sets})
+endfunction()
+
+# Every executable defined in DIR and its subdirectories: its precompiled headers, and
+# TORSION_TEST_OPTIMIZATION. The library under test keeps the build type's optimisation; test
+# code is thin glue around it, and at -O3 the Eigen expressions inlined into a test source cost
+# more to compile than the whole test costs to run.
+set(TORSION_TEST_OPTIMIZATION "-O1" CACHE STRING
+    "Optimisation flag for the test and benchmark-free test executables (empty: the build type's)")
+function(torsion_tune_test_targets dir)
+  get_property(targets DIRECTORY ${dir} PROPERTY BUILDSYSTEM_TARGETS)
+  foreach(target IN LISTS targets)
+    get_target_property(type ${target} TYPE)
+    if(NOT type STREQUAL "EXECUTABLE")
+      continue()
+    endif()
+    get_target_property(libs ${target} LINK_LIBRARIES)
+    set(sets STD)
+    if(libs MATCHES "GTest::")
+      list(APPEND sets GTEST)
+      if(TORSION_TEST_OPTIMIZATION)
+        target_compile_options(${target} PRIVATE ${TORSION_TEST_OPTIMIZATION})
+      endif()
+    endif()
+    if(libs MATCHES "Torsion::extension|torsion_scene|torsion_render")
+      list(APPEND sets SOLVER)
+    endif()
+    if(libs MATCHES "torsion_scene|torsion_render|nlohmann_json")
+      list(APPEND sets JSON)
+    endif()
+    torsion_precompile_headers(${target} ${sets})
+  endforeach()
+  get_property(subdirs DIRECTORY ${dir} PROPERTY SUBDIRECTORIES)
+  foreach(subdir IN LISTS subdirs)
+    torsion_tune_test_targets(${subdir})
+  endforeach()
+endfunction()

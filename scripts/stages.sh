@@ -1,0 +1,42 @@
+# Sourced by scripts/test.sh and scripts/main.sh: one line per stage, each stage's wall time at the
+# end, and quiet configure and build steps whose errors stay visible.
+
+stage_names=()
+stage_starts=()
+# stage NAME: a new stage starts now.
+stage() {
+  echo "== $1"
+  stage_names+=("$1")
+  stage_starts+=("$SECONDS")
+}
+# The table of stage times (wall, s); called from an EXIT trap, so a failed run shows it too.
+report_stages() {
+  local i end
+  echo "== Stage times (wall, s)"
+  for i in "${!stage_names[@]}"; do
+    end=${stage_starts[$((i + 1))]:-$SECONDS}
+    printf '%6d  %s\n' $((end - stage_starts[i])) "${stage_names[$i]}"
+  done
+  printf '%6d  total\n' "$SECONDS"
+}
+
+# configure DIR ARGS...: CMake's configure output goes to DIR/configure.log; on a failure its
+# last lines are shown.
+configure() {
+  local dir=$1
+  shift
+  mkdir -p "$dir"
+  if ! cmake -S . -B "$dir" -G Ninja "$@" >"$dir/configure.log" 2>&1; then
+    echo "configure of $dir failed; the last lines of $dir/configure.log:" >&2
+    tail -n 40 "$dir/configure.log" >&2
+    return 1
+  fi
+}
+
+# build DIR [ARGS...]: Ninja without its progress lines (--quiet): what is printed is a compiler's
+# warning or error, and ninja's summary of a failed edge.
+build() {
+  local dir=$1
+  shift
+  cmake --build "$dir" -j"${jobs:-2}" "$@" -- --quiet
+}
