@@ -112,11 +112,10 @@ std::string JsonObject::string(const std::string& key, const std::string& fallba
   return has(key) ? string(key) : fallback;
 }
 
-std::string JsonObject::name(const std::string& key) const {
-  const std::string value = string(key);
-  if (value.empty()) fail(key, "must not be empty");
-  if (value.size() > 64) fail(key, "must be at most 64 characters (it names files and columns)");
-  if (value == "." || value == "..") fail(key, "'" + value + "' cannot name a file");
+std::string nameFault(const std::string& value) {
+  if (value.empty()) return "must not be empty";
+  if (value.size() > 64) return "must be at most 64 characters (it names files and columns)";
+  if (value == "." || value == "..") return "'" + value + "' cannot name a file";
   for (const char c : value) {
     const auto byte = static_cast<unsigned char>(c);
     const bool allowed = std::isalnum(byte) || (c != '\0' && std::strchr(" -_.+()", c) != nullptr);
@@ -127,11 +126,17 @@ std::string JsonObject::name(const std::string& key) const {
       } else {
         std::snprintf(shown, sizeof shown, "\\x%02X", static_cast<unsigned>(byte));
       }
-      fail(key, std::string("character ") + shown +
-                    " not allowed: names become file names and CSV columns (use letters, digits "
-                    "and \" -_.+()\")");
+      return std::string("character ") + shown +
+             " not allowed: names become file names and CSV columns (use letters, digits "
+             "and \" -_.+()\")";
     }
   }
+  return "";
+}
+
+std::string JsonObject::name(const std::string& key) const {
+  const std::string value = string(key);
+  if (const std::string fault = nameFault(value); !fault.empty()) fail(key, fault);
   return value;
 }
 

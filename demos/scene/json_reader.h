@@ -30,6 +30,10 @@ struct JsonFault : std::runtime_error {
   SceneFault fault;
 };
 
+/// What is wrong with `value` as a name of a scene's part (JsonObject::name's rule), or "" when
+/// it is a valid name. Also applied to the names parts are given in code (the Python module).
+std::string nameFault(const std::string& value);
+
 class JsonObject {
  public:
   JsonObject(const nlohmann::json& json, std::string path, const std::string& file);

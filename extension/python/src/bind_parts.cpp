@@ -5,6 +5,7 @@
 #include "handles.h"
 #include "py_convert.h"
 #include "torsion/fem/corotated_element.h"
+#include "torsion/format_number.h"
 #include "torsion/haptics/patch_stiffness.h"
 
 namespace torsion::python {
@@ -297,6 +298,9 @@ void bindParts(py::module_& m) {
       .def(
           "stiffness",
           [](const H& h, double tolerance) {
+            if (!(tolerance > 0 && tolerance < 1))
+              throw py::value_error("stiffness: tolerance must be in (0, 1), got " +
+                                    formatNumber(tolerance));
             if (!h.hand->grabbed())
               throw py::value_error("hand '" + h.hand->name() + "': not grabbing");
             WorldGuard guard(*h.world, WorldGuard::kWrite);

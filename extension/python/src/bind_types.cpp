@@ -30,9 +30,10 @@ py::array_t<double> quaternionArray(const Eigen::Quaterniond& q) {
 }
 
 Eigen::Quaterniond toQuaternion(py::handle value) {
-  auto a = py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(value);
-  if (!a || a.size() != 4) throw py::value_error("quaternion: expected 4 numbers (x, y, z, w)");
+  auto a = toFloatArray(value, "quaternion");
+  if (a.size() != 4) throw py::value_error("quaternion: expected 4 numbers (x, y, z, w)");
   Eigen::Quaterniond q(a.data()[3], a.data()[0], a.data()[1], a.data()[2]);
+  if (!q.coeffs().allFinite()) throw py::value_error("quaternion: must be finite");
   if (!(q.norm() > 1e-12)) throw py::value_error("quaternion: zero length");
   return q.normalized();
 }
@@ -59,7 +60,9 @@ void bindTypes(py::module_& m) {
           [](py::object position, py::object axis, double angle) {
             Frame f;
             f.origin = toVector3(position, "position");
-            f.rotation = Eigen::AngleAxisd(angle, toVector3(axis, "axis").normalized());
+            const Eigen::Vector3d direction = toVector3(axis, "axis");
+            if (!(direction.norm() > 1e-12)) throw py::value_error("axis: must not be zero");
+            f.rotation = Eigen::AngleAxisd(finite(angle, "angle"), direction.normalized());
             return f;
           },
           py::arg("position"), py::arg("axis"), py::arg("angle"),

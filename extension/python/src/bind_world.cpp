@@ -2,6 +2,7 @@
 // pictures and VTK output.
 #include <pybind11/stl.h>
 
+#include <cmath>
 #include <filesystem>
 
 #include "camera.h"
@@ -10,6 +11,7 @@
 #include "offscreen.h"
 #include "py_convert.h"
 #include "scene_builder.h"
+#include "torsion/format_number.h"
 #include "torsion/mesh/mesh_io.h"
 #include "torsion/mesh/tet_mesh_builder.h"
 #include "torsion/mesh/vtk_format.h"
@@ -38,18 +40,22 @@ FemBody& findBody(PyWorld& world, py::handle body) {
 
 // A mesh from numpy nodes (n, 3) and tets (m, 4), validated like a mesh file.
 TetMesh meshFromArrays(py::handle nodes, py::handle tets) {
-  auto x = py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(nodes);
-  auto t = py::array_t<int, py::array::c_style | py::array::forcecast>::ensure(tets);
-  if (!x || x.ndim() != 2 || x.shape(1) != 3)
+  auto x = toFloatArray(nodes, "nodes");
+  const IndexArray t = toIndexArray(tets, "tets");
+  if (x.ndim() != 2 || x.shape(1) != 3)
     throw py::value_error("nodes: expected an array of shape (n, 3)");
-  if (!t || t.ndim() != 2 || t.shape(1) != 4)
+  if (t.shape.size() != 2 || t.shape[1] != 4)
     throw py::value_error("tets: expected an int array of shape (m, 4) (linear tets)");
   RawTetMesh raw;
   raw.element_file = "<tets array>";
-  for (py::ssize_t i = 0; i < x.shape(0); ++i)
-    raw.positions.emplace_back(x.at(i, 0), x.at(i, 1), x.at(i, 2));
-  for (py::ssize_t e = 0; e < t.shape(0); ++e) {
-    Tet tet{t.at(e, 0), t.at(e, 1), t.at(e, 2), t.at(e, 3)};
+  for (py::ssize_t i = 0; i < x.shape(0); ++i) {
+    const Eigen::Vector3d p(x.at(i, 0), x.at(i, 1), x.at(i, 2));
+    if (!p.allFinite()) throw py::value_error("nodes: row " + std::to_string(i) + " is not finite");
+    raw.positions.push_back(p);
+  }
+  for (py::ssize_t e = 0; e < t.shape[0]; ++e) {
+    const int* row = t.values.data() + 4 * e;
+    Tet tet{row[0], row[1], row[2], row[3]};
     for (int v : tet) {
       if (v < 0 || v >= static_cast<int>(raw.positions.size())) {
         raise(FailureKind::kMesh, "<tets array>: row " + std::to_string(e) + ": node " +
@@ -71,16 +77,22 @@ std::vector<int> selectedNodes(const TetMesh& mesh, py::object plane, py::object
   if (given != 1)
     throw py::value_error("add_node_set: give exactly one of plane, box, sphere or indices");
   if (!indices.is_none()) {
-    auto a = py::array_t<int, py::array::c_style | py::array::forcecast>::ensure(indices);
-    if (!a || a.ndim() != 1) throw py::value_error("indices: expected a 1-D int array");
-    return std::vector<int>(a.data(), a.data() + a.size());
+    IndexArray a = toIndexArray(indices, "indices");
+    if (a.shape.size() != 1) throw py::value_error("indices: expected a 1-D int array");
+    return std::move(a.values);
   }
   scene::NodeSelection selection;
   if (!plane.is_none()) {
     auto p = plane.cast<py::sequence>();
     selection.kind = scene::NodeSelection::Kind::kPlane;
     selection.point = toVector3(p[0], "plane point");
-    selection.normal = toVector3(p[1], "plane normal").normalized();
+    const Eigen::Vector3d normal = toVector3(p[1], "plane normal");
+    if (!(normal.norm() > 1e-12))
+      throw py::value_error("plane normal: must not be zero, got " +
+                            py::repr(p[1]).cast<std::string>());
+    selection.normal = normal.normalized();
+    if (!(tolerance >= 0 && std::isfinite(tolerance)))
+      throw py::value_error("tolerance: must be finite and >= 0 m, got " + formatNumber(tolerance));
     selection.tolerance = tolerance;
   } else if (!box.is_none()) {
     auto b = box.cast<py::sequence>();
@@ -92,6 +104,9 @@ std::vector<int> selectedNodes(const TetMesh& mesh, py::object plane, py::object
     selection.kind = scene::NodeSelection::Kind::kSphere;
     selection.point = toVector3(s[0], "sphere centre");
     selection.radius = s[1].cast<double>();
+    if (!(selection.radius > 0 && std::isfinite(selection.radius)))
+      throw py::value_error("sphere radius: must be finite and > 0 m, got " +
+                            formatNumber(selection.radius));
   }
   return scene::selectNodes(mesh, selection);
 }
@@ -325,7 +340,9 @@ void bindWorld(py::module_& m) {
             if (Status valid = settings.validate(); !valid)
               throw py::value_error(valid.error().message);
             WorldGuard guard(w, WorldGuard::kWrite);
-            return HandHandle{owner, &w, &w.addHand(findBody(w, body), name, settings)};
+            Result<Hand*> hand = w.addHand(findBody(w, body), name, settings);
+            if (!hand) throw py::value_error(hand.error().message);
+            return HandHandle{owner, &w, hand.value()};
           },
           py::arg("name"), py::arg("body"), py::arg("max_drag_strain") = 0.2,
           "A hand on `body`, not grabbing yet: call grab(frame), then move_to(frame) each step.")
@@ -346,15 +363,17 @@ void bindWorld(py::module_& m) {
             spec.friction = friction;
             spec.linear_velocity = toVector3(linear_velocity, "linear_velocity");
             WorldGuard guard(w, WorldGuard::kWrite);
-            btRigidBody* body = w.addRigidBody(spec, false);
-            return RigidHandle{owner, &w, name, body};
+            Result<btRigidBody*> body = w.addRigidBody(spec, false);
+            if (!body) throw py::value_error(body.error().message);
+            return RigidHandle{owner, &w, name, body.value()};
           },
           py::arg("name"), py::arg("shape") = "box", py::kw_only(),
           py::arg("half_extents") = py::make_tuple(0.5, 0.5, 0.5), py::arg("radius") = 0.5,
           py::arg("half_height") = 0.5, py::arg("mass") = 1.0, py::arg("frame") = py::none(),
           py::arg("friction") = 0.5, py::arg("linear_velocity") = py::make_tuple(0.0, 0.0, 0.0),
           "A Bullet rigid body: box (half_extents, m), sphere (radius) or capsule along z "
-          "(radius, half_height); mass in kg, 0 for static.")
+          "(radius, half_height), each length in (0, 1e6] m; mass in kg: 0 for static, else in "
+          "[1e-9, 1e12]. A unique name of letters, digits and \" -_.+()\".")
       .def(
           "add_ground",
           [](PyWorld& w, double height, double friction) {
@@ -366,10 +385,11 @@ void bindWorld(py::module_& m) {
             spec.mass = 0;
             spec.friction = friction;
             WorldGuard guard(w, WorldGuard::kWrite);
-            w.addRigidBody(spec, true);
+            if (Result<btRigidBody*> ground = w.addRigidBody(spec, true); !ground)
+              throw py::value_error(ground.error().message);
           },
           py::arg("height") = 0.0, py::arg("friction") = 0.5,
-          "A static ground plane z = height (m).")
+          "A static ground plane z = height (m, finite, within 1e6 of 0).")
       .def(
           "render",
           [](PyWorld& w, int width, int height, py::object camera, bool hud) {

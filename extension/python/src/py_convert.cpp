@@ -1,6 +1,10 @@
 #include "py_convert.h"
 
 #include <cmath>
+#include <cstdint>
+#include <limits>
+
+#include "torsion/format_number.h"
 
 namespace torsion::python {
 
@@ -26,28 +30,125 @@ py::array_t<double> wrenchArray(const Wrench& wrench) {
   return vectorArray(values, 6);
 }
 
-Eigen::Vector3d toVector3(py::handle value, const char* what) {
+namespace {
+
+// numpy's dtype kind of `value` as it would become an array: 'f', 'i', 'u', 'b', 'c', 'O', ...
+char dtypeKind(py::handle value, const char* what) {
+  py::array a;
+  try {
+    a = py::array::ensure(value);
+  } catch (const py::error_already_set&) {
+    a = py::array();
+  }
+  if (!a) throw py::type_error(std::string(what) + ": expected numbers");
+  return a.dtype().kind();
+}
+
+std::string shown(py::handle value) {
+  return py::repr(value).cast<std::string>();
+}
+
+}  // namespace
+
+py::array_t<double, py::array::c_style | py::array::forcecast> toFloatArray(py::handle value,
+                                                                            const char* what) {
+  const char kind = dtypeKind(value, what);
+  if (kind == 'c') {
+    throw py::type_error(std::string(what) + ": expected real numbers, got complex " +
+                         shown(value) + " (the imaginary part would be dropped)");
+  }
+  if (kind != 'f' && kind != 'i' && kind != 'u')
+    throw py::type_error(std::string(what) + ": expected numbers, got " + shown(value));
   auto a = py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(value);
-  if (!a || a.size() != 3) throw py::value_error(std::string(what) + ": expected 3 numbers");
-  return Eigen::Vector3d(a.data()[0], a.data()[1], a.data()[2]);
+  if (!a) throw py::type_error(std::string(what) + ": expected numbers, got " + shown(value));
+  return a;
+}
+
+IndexArray toIndexArray(py::handle value, const char* what) {
+  const char kind = dtypeKind(value, what);
+  if (kind != 'f' && kind != 'i' && kind != 'u') {
+    throw py::type_error(std::string(what) + ": expected integer indices, got " +
+                         (kind == 'b' ? std::string("booleans ") : std::string()) + shown(value));
+  }
+  // Each value is checked in its own type (int64, uint64 or double) before it is narrowed.
+  constexpr int64_t kLow = std::numeric_limits<int>::min();
+  constexpr int64_t kHigh = std::numeric_limits<int>::max();
+  IndexArray out;
+  auto fail = [&](py::ssize_t k, const std::string& number, const char* fault) {
+    throw py::value_error(std::string(what) + ": element " + std::to_string(k) + " (" + number +
+                          ") " + fault);
+  };
+  auto take = [&](auto a, auto check) {
+    out.shape.assign(a.shape(), a.shape() + a.ndim());
+    out.values.reserve(static_cast<size_t>(a.size()));
+    for (py::ssize_t k = 0; k < a.size(); ++k) {
+      check(k, a.data()[k]);
+      out.values.push_back(static_cast<int>(a.data()[k]));
+    }
+  };
+  if (kind == 'i') {
+    take(py::array_t<int64_t, py::array::c_style | py::array::forcecast>::ensure(value),
+         [&](py::ssize_t k, int64_t v) {
+           if (v < kLow || v > kHigh) fail(k, std::to_string(v), "is outside the int32 range");
+         });
+  } else if (kind == 'u') {
+    take(py::array_t<uint64_t, py::array::c_style | py::array::forcecast>::ensure(value),
+         [&](py::ssize_t k, uint64_t v) {
+           if (v > static_cast<uint64_t>(kHigh))
+             fail(k, std::to_string(v), "is outside the int32 range");
+         });
+  } else {
+    take(py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(value),
+         [&](py::ssize_t k, double v) {
+           if (!(std::isfinite(v) && v == std::floor(v)))
+             fail(k, formatNumber(v), "is not a whole number");
+           if (v < static_cast<double>(kLow) || v > static_cast<double>(kHigh))
+             fail(k, formatNumber(v), "is outside the int32 range");
+         });
+  }
+  return out;
+}
+
+double finite(double value, const char* what) {
+  if (!std::isfinite(value))
+    throw py::value_error(std::string(what) + ": must be finite, got " + formatNumber(value));
+  return value;
+}
+
+Eigen::Vector3d toVector3(py::handle value, const char* what) {
+  auto a = toFloatArray(value, what);
+  if (a.size() != 3)
+    throw py::value_error(std::string(what) + ": expected 3 numbers, got " + shown(value));
+  const Eigen::Vector3d v(a.data()[0], a.data()[1], a.data()[2]);
+  if (!v.allFinite())
+    throw py::value_error(std::string(what) + ": must be finite, got " + shown(value));
+  return v;
 }
 
 Eigen::VectorXd toNodeVectors(py::handle value, py::ssize_t expected, const char* what) {
-  auto a = py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(value);
-  if (!a || a.ndim() != 2 || a.shape(1) != 3 || (expected >= 0 && a.shape(0) != expected)) {
+  auto a = toFloatArray(value, what);
+  if (a.ndim() != 2 || a.shape(1) != 3 || (expected >= 0 && a.shape(0) != expected)) {
     throw py::value_error(std::string(what) + ": expected an array of shape (" +
                           (expected >= 0 ? std::to_string(expected) : std::string("n")) + ", 3)");
   }
-  return Eigen::Map<const Eigen::VectorXd>(a.data(), a.size());
+  Eigen::VectorXd v = Eigen::Map<const Eigen::VectorXd>(a.data(), a.size());
+  for (Eigen::Index k = 0; k < v.size(); ++k) {
+    if (!std::isfinite(v[k])) {
+      throw py::value_error(std::string(what) + ": row " + std::to_string(k / 3) +
+                            " is not finite (" + formatNumber(v[k]) + ")");
+    }
+  }
+  return v;
 }
 
 Frame toFrame(py::handle value, const char* what) {
   if (py::isinstance<Frame>(value)) return value.cast<Frame>();
-  auto a = py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(value);
-  if (!a || a.ndim() != 2 || a.shape(0) != 4 || a.shape(1) != 4) {
+  auto a = toFloatArray(value, what);
+  if (a.ndim() != 2 || a.shape(0) != 4 || a.shape(1) != 4) {
     throw py::value_error(std::string(what) + ": expected a torsion.Frame or a 4x4 matrix");
   }
   Eigen::Matrix4d m = Eigen::Map<const Eigen::Matrix<double, 4, 4, Eigen::RowMajor>>(a.data());
+  if (!m.allFinite()) throw py::value_error(std::string(what) + ": the 4x4 matrix is not finite");
   const Eigen::Matrix3d r = m.topLeftCorner<3, 3>();
   if (!((r.transpose() * r - Eigen::Matrix3d::Identity()).norm() < 1e-6) ||
       !(r.determinant() > 0)) {

@@ -6,6 +6,7 @@
 #include <pybind11/pybind11.h>
 
 #include <Eigen/Core>
+#include <cstdint>
 #include <string>
 #include <vector>
 
@@ -45,9 +46,27 @@ py::array_t<double> vectorArray(const double* data, py::ssize_t size);
 /// [fx, fy, fz, tx, ty, tz]: N and N m.
 py::array_t<double> wrenchArray(const Wrench& wrench);
 
-/// A 3-vector from any sequence of three numbers; ValueError naming `what` otherwise.
+/// `value` as a float64 array (numpy's own conversion), refusing what would lose information:
+/// TypeError naming `what` for complex values (numpy would drop the imaginary part) and for
+/// anything that is not numbers.
+py::array_t<double, py::array::c_style | py::array::forcecast> toFloatArray(py::handle value,
+                                                                            const char* what);
+/// `value` as int32 indices: integers, or floats with whole values, all within int32. Refuses
+/// (naming `what` and the value) what numpy's cast would wrap or truncate: TypeError for bool,
+/// complex or non-numeric arrays, ValueError for a fractional, non-finite or out-of-range value.
+/// The caller checks the returned shape.
+struct IndexArray {
+  std::vector<int> values;  ///< row-major
+  std::vector<py::ssize_t> shape;
+};
+IndexArray toIndexArray(py::handle value, const char* what);
+
+/// A finite float: ValueError naming `what` and the value otherwise.
+double finite(double value, const char* what);
+
+/// A 3-vector from any sequence of three finite numbers; ValueError naming `what` otherwise.
 Eigen::Vector3d toVector3(py::handle value, const char* what);
-/// An (n, 3) float array from `value`, with n rows checked when expected >= 0.
+/// An (n, 3) array of finite floats from `value`, with n rows checked when expected >= 0.
 Eigen::VectorXd toNodeVectors(py::handle value, py::ssize_t expected, const char* what);
 
 /// A torsion.Frame, or a 4x4 homogeneous matrix (rotation part orthonormal).

@@ -1,11 +1,93 @@
 #include "py_world.h"
 
+#include <cmath>
+
+#include "arithmetic_bounds.h"
+#include "json_reader.h"
 #include "scene_haptics.h"
 #include "scene_parser.h"
 #include "torsion/bullet/checkpoint_io.h"
 #include "torsion/bullet/rigid_health.h"
+#include "torsion/format_number.h"
 
 namespace torsion::python {
+
+namespace {
+
+// The scene file's rule for names, and no second part of the kind with the same name.
+Status checkName(const std::string& kind, const std::string& name, bool taken) {
+  std::string shown;
+  for (const char c : name) {
+    const auto byte = static_cast<unsigned char>(c);
+    if (byte >= 0x20 && byte < 0x7f) {
+      shown += c;
+    } else {
+      char escaped[8];
+      std::snprintf(escaped, sizeof escaped, "\\x%02X", static_cast<unsigned>(byte));
+      shown += escaped;
+    }
+  }
+  if (const std::string fault = scene::nameFault(name); !fault.empty())
+    return Error{kind + " name '" + shown + "': " + fault};
+  if (taken) return Error{kind + " name '" + shown + "': a " + kind + " of that name exists"};
+  return Ok{};
+}
+
+// A rigid length as the scene parser takes it: finite, > 0, at most kMaxRigidLength.
+Status checkLength(const std::string& body, const char* argument, double value) {
+  if (value > 0 && value <= scene::kMaxRigidLength) return Ok{};
+  return Error{"add_rigid_body '" + body + "': " + argument + " " + formatNumber(value) +
+               " m: must be > 0 and at most " + formatNumber(scene::kMaxRigidLength) + " m"};
+}
+
+// add_rigid_body's and add_ground's values, checked as readRigidBody / readGround check a scene's.
+Status checkRigidSpec(const scene::RigidBodySpec& spec, bool ground) {
+  using Shape = scene::RigidBodySpec::Shape;
+  const std::string who = ground ? std::string("add_ground") : "add_rigid_body '" + spec.name + "'";
+  if (!(spec.friction >= 0 && std::isfinite(spec.friction))) {
+    return Error{who + ": friction " + formatNumber(spec.friction) + ": must be finite and >= 0"};
+  }
+  if (ground) {
+    if (!(std::abs(spec.plane_offset) <= scene::kMaxPlacement)) {
+      return Error{who + ": height " + formatNumber(spec.plane_offset) +
+                   " m: must be finite and within " + formatNumber(scene::kMaxPlacement) +
+                   " m of the origin"};
+    }
+    return Ok{};
+  }
+  if (spec.shape == Shape::kBox) {
+    for (int i = 0; i < 3; ++i) {
+      if (Status s = checkLength(spec.name, "half_extents", spec.half_extents[i]); !s) {
+        return Error{who + ": half_extents (" + formatNumber(spec.half_extents.x()) + ", " +
+                     formatNumber(spec.half_extents.y()) + ", " +
+                     formatNumber(spec.half_extents.z()) + ") m: each must be > 0 and at most " +
+                     formatNumber(scene::kMaxRigidLength) + " m"};
+      }
+    }
+  }
+  if (spec.shape == Shape::kSphere || spec.shape == Shape::kCapsule) {
+    if (Status s = checkLength(spec.name, "radius", spec.radius); !s) return s;
+  }
+  if (spec.shape == Shape::kCapsule) {
+    if (Status s = checkLength(spec.name, "half_height", spec.half_height); !s) return s;
+  }
+  if (!(spec.mass == 0 ||
+        (spec.mass >= scene::kMinRigidMass && spec.mass <= scene::kMaxRigidMass))) {
+    return Error{who + ": mass " + formatNumber(spec.mass) + " kg: must be 0 (static) or within [" +
+                 formatNumber(scene::kMinRigidMass) + ", " + formatNumber(scene::kMaxRigidMass) +
+                 "] kg (Bullet divides by it; contact impulses would overflow)"};
+  }
+  if (!(spec.pose.origin.cwiseAbs().maxCoeff() <= scene::kMaxPlacement)) {
+    return Error{who + ": frame position: a coordinate is beyond " +
+                 formatNumber(scene::kMaxPlacement) + " m of the origin"};
+  }
+  if (spec.mass == 0 && spec.linear_velocity.norm() > 0) {
+    return Error{who + ": linear_velocity: only a dynamic body (mass > 0) starts with a velocity"};
+  }
+  return Ok{};
+}
+
+}  // namespace
 
 Result<std::unique_ptr<PyWorld>> PyWorld::fromScene(const std::string& name_or_path, int threads,
                                                     const scene::DeviceOverrides& devices,
@@ -92,11 +174,16 @@ Result<Ok> PyWorld::step(int n, FailureKind* kind) {
 Result<FemBody*> PyWorld::addBody(const std::string& name, const TetMesh& mesh,
                                   const Material& material, const Frame& pose,
                                   ElementKind element) {
+  if (Status s = checkName("body", name, false); !s) return s.error();
   return world().addBody(name, mesh, material, pose, element);
 }
 
 Result<int> PyWorld::addNodeSet(const std::string& name, FemBody& body, std::vector<int> nodes,
                                 const Eigen::Vector3d& wrench_about) {
+  bool taken = false;
+  for (const scene::NodeSetHandle& set : scene_->node_sets)
+    taken = taken || set.name == name;
+  if (Status s = checkName("node set", name, taken); !s) return s.error();
   if (nodes.empty()) return Error{"node set '" + name + "': it holds no node"};
   for (int node : nodes) {
     if (node < 0 || node >= body.model().nodeCount()) {
@@ -115,9 +202,14 @@ Result<int> PyWorld::addNodeSet(const std::string& name, FemBody& body, std::vec
   return static_cast<int>(scene_->node_sets.size()) - 1;
 }
 
-Hand& PyWorld::addHand(FemBody& body, const std::string& name, const HandSettings& settings) {
+Result<Hand*> PyWorld::addHand(FemBody& body, const std::string& name,
+                               const HandSettings& settings) {
+  bool taken = false;
+  for (Hand* hand : hands())
+    taken = taken || hand->name() == name;
+  if (Status s = checkName("hand", name, taken); !s) return s.error();
   own_hands_.push_back(std::make_unique<Hand>(body, name, settings));
-  return *own_hands_.back();
+  return own_hands_.back().get();
 }
 
 std::vector<Hand*> PyWorld::hands() {
@@ -136,7 +228,14 @@ const scene::HandSpec* PyWorld::handSpec(const Hand& hand) const {
   return nullptr;
 }
 
-btRigidBody* PyWorld::addRigidBody(const scene::RigidBodySpec& spec, bool ground) {
+Result<btRigidBody*> PyWorld::addRigidBody(const scene::RigidBodySpec& spec, bool ground) {
+  if (!ground) {
+    bool taken = false;
+    for (const scene::SceneRigidBody& r : scene_->rigid_bodies)
+      taken = taken || r.name == spec.name;
+    if (Status s = checkName("rigid body", spec.name, taken); !s) return s.error();
+  }
+  if (Status s = checkRigidSpec(spec, ground); !s) return s.error();
   scene::SceneRigidBody added = scene::addSceneRigidBody(world(), spec);
   btRigidBody* body = added.body;
   if (!ground) scene_->rigid_bodies.push_back(std::move(added));

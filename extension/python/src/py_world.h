@@ -60,18 +60,23 @@ class PyWorld {
   /// message until restoreState().
   Result<Ok> step(int n, FailureKind* kind);
 
-  /// Adds a body from a mesh file (MeshError on a bad file) or from a built mesh.
+  /// Adds a body from a mesh file (MeshError on a bad file) or from a built mesh. Names of
+  /// bodies, node sets, hands and rigid bodies follow the scene file's rule (scene::nameFault)
+  /// and are unique among their kind.
   Result<FemBody*> addBody(const std::string& name, const TetMesh& mesh, const Material& material,
                            const Frame& pose, ElementKind element);
   /// A node set (a fixed or carried group) over `nodes` of `body`; returns its index.
   Result<int> addNodeSet(const std::string& name, FemBody& body, std::vector<int> nodes,
                          const Eigen::Vector3d& wrench_about);
-  Hand& addHand(FemBody& body, const std::string& name, const HandSettings& settings);
+  Result<Hand*> addHand(FemBody& body, const std::string& name, const HandSettings& settings);
   /// All hands: the scene's (in file order), then those added in code.
   std::vector<Hand*> hands();
   /// The scene's spec of hand h, or null for a hand added in code.
   const scene::HandSpec* handSpec(const Hand& hand) const;
-  btRigidBody* addRigidBody(const scene::RigidBodySpec& spec, bool ground);
+  /// A rigid body (or, `ground`, the ground plane) after the scene parser's checks of its values:
+  /// lengths in (0, 1e6] m, mass 0 (static) or in [1e-9, 1e12] kg, all finite (errors name the
+  /// add_rigid_body / add_ground argument and its value).
+  Result<btRigidBody*> addRigidBody(const scene::RigidBodySpec& spec, bool ground);
 
   Result<PyWorldState> saveState();
   /// Back to `state`; a state of bytes alone is read for this world first (errors: corrupted
