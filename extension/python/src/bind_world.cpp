@@ -2,6 +2,7 @@
 // pictures and VTK output.
 #include <pybind11/stl.h>
 
+#include <chrono>
 #include <cmath>
 #include <filesystem>
 
@@ -181,16 +182,33 @@ void bindWorld(py::module_& m) {
             if (n < 0) throw py::value_error("step: n must be >= 0");
             FailureKind kind;
             Result<Ok> stepped = Ok{};
+            // Signals (Ctrl-C) are handled by Python with the GIL in the main thread: it is taken
+            // back between steps every kSignalCheck to ask, and a pending KeyboardInterrupt stops
+            // the run at that step boundary and is raised once the step returns.
+            constexpr auto kSignalCheck = std::chrono::milliseconds(20);
+            bool signalled = false;
+            auto last_check = std::chrono::steady_clock::now();
+            auto interrupted = [&] {
+              const auto now = std::chrono::steady_clock::now();
+              if (now - last_check < kSignalCheck) return false;
+              last_check = now;
+              py::gil_scoped_acquire acquire;
+              signalled = PyErr_CheckSignals() != 0;
+              return signalled;
+            };
             {
               WorldGuard guard(w);
               py::gil_scoped_release release;
-              stepped = w.step(n, &kind);
+              stepped = w.step(n, &kind, interrupted);
             }
+            if (signalled) throw py::error_already_set();
             if (!stepped) raise(kind, stepped.error().message);
           },
           py::arg("n") = 1,
           "n steps of dt, without the GIL. UnstableError (body and step in the message) when a "
-          "step fails: the bodies keep their last good state and the world goes no further.")
+          "step fails: the bodies keep their last good state and the world goes no further. "
+          "Ctrl-C (KeyboardInterrupt, or any exception a signal handler raises) stops it at a step "
+          "boundary: the world is as after the steps done.")
       .def_property_readonly(
           "time", [](PyWorld& w) { return w.world().time(); }, "s")
       .def_property_readonly("step_count", [](PyWorld& w) { return w.world().stepCount(); })

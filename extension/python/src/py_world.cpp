@@ -124,7 +124,7 @@ PyWorld::PyWorld(const WorldSettings& settings) : scene_(std::make_unique<scene:
   scene_->world = std::make_unique<FemWorld>(settings);
 }
 
-Result<Ok> PyWorld::step(int n, FailureKind* kind) {
+Result<Ok> PyWorld::step(int n, FailureKind* kind, const std::function<bool()>& interrupted) {
   *kind = FailureKind::kUnstable;
   if (!failure_.empty()) return Error{failure_};
   std::vector<NamedRigidBody> rigid;
@@ -167,6 +167,7 @@ Result<Ok> PyWorld::step(int n, FailureKind* kind) {
     // As the scene runner: Bullet lets a rigid body become NaN silently.
     if (auto fault = findUnhealthyRigidBody(rigid))
       return failWith("step " + std::to_string(report.step) + ": " + fault->message);
+    if (interrupted && interrupted()) break;
   }
   return Ok{};
 }

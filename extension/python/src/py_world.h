@@ -4,6 +4,7 @@
 // on purpose: the bindings (bind_*.cpp) translate its errors into exceptions and its storage into
 // numpy arrays.
 
+#include <functional>
 #include <memory>
 #include <mutex>
 #include <optional>
@@ -58,7 +59,9 @@ class PyWorld {
   /// Stops at the first failing step; the world is then back at the end of the last good step
   /// (bodies, hands, clock; not with device hands) and every later step fails with the same
   /// message until restoreState().
-  Result<Ok> step(int n, FailureKind* kind);
+  /// `interrupted`, when given, is asked after every step; true stops the run there, at a step
+  /// boundary (the world as after a shorter step(n)), and step returns Ok.
+  Result<Ok> step(int n, FailureKind* kind, const std::function<bool()>& interrupted = {});
 
   /// Adds a body from a mesh file (MeshError on a bad file) or from a built mesh. Names of
   /// bodies, node sets, hands and rigid bodies follow the scene file's rule (scene::nameFault)

@@ -132,7 +132,7 @@ class World:
     def from_scene(scene: str, threads: int = -1, *,
                    devices: Union[dict[str, str], Sequence[str], None] = None,
                    haptics: str = "", allow_remote_devices: bool = False) -> World: ...
-    def step(self, n: int = 1) -> None: ...  # releases the GIL
+    def step(self, n: int = 1) -> None: ...  # releases the GIL; Ctrl-C stops it between steps
     time: float  # s
     step_count: int
     dt: float  # s
