@@ -196,3 +196,18 @@ def test_stiffness_refuses_a_tolerance_outside_0_1(tolerance):
 def test_frames_and_vectors_refuse_non_finite_and_complex(make, error, match):
     with pytest.raises(error, match=match):
         make()
+
+
+@pytest.mark.parametrize("camera, match", [
+    ({"distance": NAN}, "camera distance: must be finite"),
+    ({"distance": -1.0}, "camera distance: must be > 0 m, got -1"),
+    ({"yaw": math.inf}, "camera yaw: must be finite"),
+    ({"pitch": NAN}, "camera pitch: must be finite"),
+    ({"fov_y": 0.0}, "camera fov_y: must be in \\(0, pi\\) rad"),
+    ({"up": (0, 0, 0)}, "camera up: must not be zero"),
+    ({"target": (NAN, 0, 0)}, "camera target: must be finite"),
+])
+def test_render_refuses_a_camera_it_cannot_look_through(camera, match):
+    world, _ = small_world()
+    with pytest.raises(ValueError, match=match):
+        world.render(16, 16, camera=camera)

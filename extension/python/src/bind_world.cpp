@@ -430,16 +430,23 @@ void bindWorld(py::module_& m) {
                 else if (key == "up")
                   cam.up = toVector3(item.second, "camera up").normalized();
                 else if (key == "distance")
-                  cam.distance = item.second.cast<double>();
+                  cam.distance = finite(item.second.cast<double>(), "camera distance");
                 else if (key == "yaw")
-                  cam.yaw = item.second.cast<double>();
+                  cam.yaw = finite(item.second.cast<double>(), "camera yaw");
                 else if (key == "pitch")
-                  cam.pitch = item.second.cast<double>();
+                  cam.pitch = finite(item.second.cast<double>(), "camera pitch");
                 else if (key == "fov_y")
-                  cam.fov_y = item.second.cast<double>();
+                  cam.fov_y = finite(item.second.cast<double>(), "camera fov_y");
                 else
                   throw py::value_error("camera: unknown key '" + key + "'");
               }
+              if (!(cam.distance > 0))
+                throw py::value_error("camera distance: must be > 0 m, got " +
+                                      formatNumber(cam.distance));
+              if (!(cam.fov_y > 0 && cam.fov_y < EIGEN_PI))
+                throw py::value_error("camera fov_y: must be in (0, pi) rad, got " +
+                                      formatNumber(cam.fov_y));
+              if (!(cam.up.norm() > 0)) throw py::value_error("camera up: must not be zero");
             }
             const render::Image image = renderer.value()->render(frame, cam, options);
             return copyArray(image.rgb.data(), image.height, image.width * 3)
