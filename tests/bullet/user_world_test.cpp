@@ -378,5 +378,61 @@ TEST(UserWorld, PerNodeExternalForcesActEveryStepUntilChanged) {
   EXPECT_FALSE(ball->setExternalForces(Eigen::VectorXd::Zero(5)).ok());
 }
 
+TEST(UserWorld, AnEmptyMeshIsRefusedNamingTheBody) {
+  UserWorld user;
+  Result<FemBody*> body = user.fem.addBody("empty", TetMesh{}, Material{});
+  ASSERT_FALSE(body.ok()) << "an empty mesh would step silently as a body of nothing";
+  EXPECT_NE(body.error().message.find("body 'empty'"), std::string::npos) << body.error().message;
+  EXPECT_NE(body.error().message.find("no tets"), std::string::npos) << body.error().message;
+  EXPECT_TRUE(user.fem.bodies().empty());
+}
+
+TEST(UserWorld, APoseWhoseQuaternionIsNotUnitIsRefusedNamingTheBody) {
+  UserWorld user;
+  const TetMesh mesh = makeBallTetMesh({0, 0, 0}, 0.5, 2).value();
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  for (const Eigen::Quaterniond& q :
+       {Eigen::Quaterniond(0, 0, 0, 0), Eigen::Quaterniond(2, 0, 0, 0),
+        Eigen::Quaterniond(0.9, 0, 0, 0), Eigen::Quaterniond(nan, 0, 0, 0)}) {
+    Result<FemBody*> body = user.fem.addBody("b", mesh, Material{}, Frame{{0, 0, 1}, q});
+    ASSERT_FALSE(body.ok()) << "quaternion (w, x, y, z) = (" << q.w() << ", " << q.x() << ", "
+                            << q.y() << ", " << q.z() << ") was taken";
+    EXPECT_NE(body.error().message.find("body 'b'"), std::string::npos) << body.error().message;
+    EXPECT_NE(body.error().message.find("unit quaternion"), std::string::npos)
+        << body.error().message;
+  }
+  Result<FemBody*> origin =
+      user.fem.addBody("o", mesh, Material{}, Frame{{nan, 0, 0}, Eigen::Quaterniond::Identity()});
+  ASSERT_FALSE(origin.ok());
+  EXPECT_NE(origin.error().message.find("body 'o'"), std::string::npos);
+  EXPECT_TRUE(user.fem.bodies().empty());
+
+  // Round-off off unit length (a quaternion composed from several) is normalised, not refused.
+  Result<FemBody*> body = user.fem.addBody("b", mesh, Material{},
+                                           Frame{{0, 0, 1}, Eigen::Quaterniond(1 + 1e-9, 0, 0, 0)});
+  ASSERT_TRUE(body.ok()) << body.error().message;
+  for (int i = 0; i < mesh.nodeCount(); ++i) {
+    const Eigen::Vector3d expected =
+        mesh.restPositions()[static_cast<size_t>(i)] + Eigen::Vector3d(0, 0, 1);
+    EXPECT_LT((body.value()->state().position(i) - expected).norm(), 1e-12);
+  }
+}
+
+TEST(UserWorld, ValueOfAFailedResultThrowsTheErrorsMessage) {
+  btSoftBodyRigidBodyCollisionConfiguration config;
+  btCollisionDispatcher dispatcher(&config);
+  btDbvtBroadphase broadphase;
+  btSequentialImpulseConstraintSolver solver;
+  btSoftRigidDynamicsWorld world(&dispatcher, &broadphase, &solver, &config);
+  std::string what;
+  try {
+    attach(world).value();
+  } catch (const std::exception& e) {
+    what = e.what();
+  }
+  EXPECT_NE(what.find("torsion::FemSoftBodySolver"), std::string::npos)
+      << "what(): '" << what << "'";
+}
+
 }  // namespace
 }  // namespace torsion

@@ -4,6 +4,7 @@
 #include <BulletSoftBody/btSoftRigidDynamicsWorld.h>
 
 #include <algorithm>
+#include <cmath>
 #include <sstream>
 
 #include "torsion/bt_conversions.h"
@@ -24,6 +25,26 @@ bool nodesTouch(btSoftBody& a, btSoftBody& b) {
   if (a.m_ndbvt.m_root == nullptr || b.m_ndbvt.m_root == nullptr) return false;
   a.m_ndbvt.collideTT(a.m_ndbvt.m_root, b.m_ndbvt.m_root, probe);
   return probe.hit;
+}
+
+// A body's pose: finite, and a unit quaternion up to round-off (1e-6 covers quaternions composed
+// in float or double). Beyond that the pose was never a rotation (the zero quaternion of
+// `Frame{origin, {}}`), and normalising it would place the body somewhere nobody meant.
+Result<Frame> checkedPose(const std::string& name, const Frame& pose) {
+  if (!pose.origin.allFinite())
+    return Error{"body '" + name + "': the pose's origin is not finite"};
+  const double norm = pose.rotation.norm();
+  if (!(std::abs(norm - 1) <= 1e-6)) {
+    std::ostringstream message;
+    message << "body '" << name
+            << "': the pose's rotation is not a unit quaternion (w, x, y, z) = ("
+            << pose.rotation.w() << ", " << pose.rotation.x() << ", " << pose.rotation.y() << ", "
+            << pose.rotation.z() << "), norm " << norm;
+    return Error{message.str()};
+  }
+  Frame unit = pose;
+  unit.rotation.normalize();
+  return unit;
 }
 
 const char* const kNotOurSolver =
@@ -102,9 +123,15 @@ Result<FemBody*> FemSoftBodySolver::addBody(const std::string& name, const TetMe
                  "': the solver is not attached to a world yet (torsion::attach(world) first)"};
   }
   if (body(name) != nullptr) return Error{"body '" + name + "' already exists"};
+  if (mesh.tetCount() == 0 || mesh.nodeCount() == 0) {
+    return Error{"body '" + name + "': the mesh has no tets (" + std::to_string(mesh.nodeCount()) +
+                 " nodes, " + std::to_string(mesh.tetCount()) + " tets)"};
+  }
+  Result<Frame> placement = checkedPose(name, pose);
+  if (!placement) return placement.error();
   std::vector<Eigen::Vector3d> placed = mesh.restPositions();
   for (Eigen::Vector3d& p : placed)
-    p = pose.toWorld(p);
+    p = placement.value().toWorld(p);
   auto placed_mesh = std::make_shared<const TetMesh>(std::move(placed), mesh.tets());
   Result<std::shared_ptr<const FemModel>> model = FemModel::create(placed_mesh, material, element);
   if (!model) return Error{"body '" + name + "': " + model.error().message};

@@ -111,7 +111,9 @@ class FemSoftBodySolver : public btSoftBodySolver {
 
   // ---- FEM bodies ----
   /// Adds an FEM body whose rest shape is `mesh` (linear tets) placed at `pose`, discretised with
-  /// `element`, to the bound world. Errors: not bound, bad material, a duplicate name.
+  /// `element`, to the bound world. Errors: not bound, an empty mesh (no tets), a pose not finite
+  /// or whose quaternion is off unit length by more than 1e-6 (closer, it is normalised), bad
+  /// material, a duplicate name.
   Result<FemBody*> addBody(const std::string& name, const TetMesh& mesh, const Material& material,
                            const Frame& pose = {}, ElementKind element = ElementKind::kTet4);
   /// Removes the body from the world and destroys it (pointers to it and its hands are stale).
