@@ -55,9 +55,10 @@ grep -hEo "^[0-9]+ passed.* in [0-9.]+s" build/Testing/Temporary/LastTest.log | 
   sed 's/^/== pytest (label python): /' || true
 
 stage "clang-tidy (.clang-tidy) over extension/ and device/"
-# From a configured, unbuilt tree without precompiled headers: clang-tidy cannot read gcc's.
-configure build-tidy -DCMAKE_BUILD_TYPE=Release "${fast_only[@]}" -DTORSION_PCH=OFF \
-  -DTORSION_BUILD_TESTS=OFF -DTORSION_BUILD_DEMOS=OFF
+# From a configured, unbuilt tree without precompiled headers (clang-tidy cannot read gcc's),
+# with the Python module, whose bindings live under extension/.
+configure build-tidy -DCMAKE_BUILD_TYPE=Release "${unity[@]}" -DTORSION_PCH=OFF \
+  -DTORSION_BUILD_TESTS=OFF -DTORSION_BUILD_BENCHMARKS=OFF
 bash scripts/clang_tidy.sh build-tidy
 
 stage "ThreadSanitizer build (build-tsan/, clang): the haptic loop's thread, its buffers, the runtime"

@@ -234,7 +234,9 @@ std::string removeStaleTemporaries(const std::string& directory,
     // Alive (or not ours to signal: EPERM) means it may still be writing: keep it.
     if (pid == ::getpid() || pid <= 0 || ::kill(static_cast<pid_t>(pid), 0) == 0 || errno != ESRCH)
       continue;
-    const std::string path = directory + "/" + name;
+    std::string path = directory;
+    path += '/';
+    path += name;
     struct stat st {};
     if (::lstat(path.c_str(), &st) != 0 || !S_ISREG(st.st_mode)) continue;
     if (::unlink(path.c_str()) != 0 && errno != ENOENT && failure.empty())

@@ -119,7 +119,7 @@ Eigen::Vector3d toVector3(py::handle value, const char* what) {
   auto a = toFloatArray(value, what);
   if (a.size() != 3)
     throw py::value_error(std::string(what) + ": expected 3 numbers, got " + shown(value));
-  const Eigen::Vector3d v(a.data()[0], a.data()[1], a.data()[2]);
+  Eigen::Vector3d v(a.data()[0], a.data()[1], a.data()[2]);
   if (!v.allFinite())
     throw py::value_error(std::string(what) + ": must be finite, got " + shown(value));
   return v;
