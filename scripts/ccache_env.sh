@@ -19,7 +19,8 @@ export CCACHE_STATSLOG="$ccache_statslog"
 ccache_report() {
   if command -v ccache >/dev/null 2>&1 && [ -s "$ccache_statslog" ]; then
     echo "== Compiler cache (ccache) for this run"
-    ccache --show-log-stats -v 2>/dev/null | grep -E "Hits|Misses|Uncacheable|Errors|Cacheable calls|Direct|Preprocessed" || true
+    # The first block: cacheable calls, hits (direct and preprocessed) and misses.
+    ccache --show-log-stats 2>/dev/null | awk 'NR > 1 && /^[^ ]/ {exit} {print}' || true
   fi
   rm -f "$ccache_statslog"
 }

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
+#include <limits>
 #include <map>
 #include <nlohmann/json.hpp>
 #include <set>
@@ -286,7 +287,7 @@ Status compareVtk(const std::string& name, const fs::path& run_dir, const fs::pa
     ++out.differences;
     return Ok{};
   }
-  Eigen::Vector3d lo = Eigen::Vector3d::Constant(INFINITY), hi = -lo;
+  Eigen::Vector3d lo = Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity()), hi = -lo;
   for (const Eigen::Vector3d& x : b) {
     lo = lo.cwiseMin(x);
     hi = hi.cwiseMax(x);
