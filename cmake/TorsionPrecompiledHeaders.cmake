@@ -28,6 +28,11 @@ function(torsion_precompile_headers target)
     endif()
   endforeach()
   target_precompile_headers(${target} PRIVATE ${headers})
+  # clang stamps a PCH with the time it was written, so ccache would see a new header in every
+  # build and miss every source that uses it.
+  if(CMAKE_CXX_COMPILER_ID MATCHES "Clang")
+    target_compile_options(${target} PRIVATE "SHELL:-Xclang -fno-pch-timestamp")
+  endif()
 endfunction()
 
 # A test executable: GoogleTest, plus the solver's headers when it links the library.
