@@ -49,6 +49,34 @@ start_run() {
   env --default-signal=INT "$torsion" run "$@" --out "$dir" >run.log 2>&1 &
   sim=$!
 }
+
+# A twist run whose hand the reference network peer holds (peer_pid), returning once the peer
+# renders a non-zero torque (up to 30 s: slow under sanitizers). Whole rows only: the peer's log
+# is being written, and its last line may be cut inside a number ("-1.2e-05" read as "-1.2"
+# looked like a held torque).
+peer_holds_the_hand() {
+  [[ -x $peer ]] || fail "no torsion_haptic_peer given"
+  twist_scene > twist.json
+  cat > hold.json <<'JSON'
+{"segments": [{"duration": 0.6, "angular_velocity": [0, 0, 0.5]}, {"duration": 60}],
+ "buttons": [{"time": 0, "held": [1]}]}
+JSON
+  port=$((20000 + RANDOM % 20000))
+  start_run out twist.json --device "hand=network:$port" --steps 100000 --threads 1
+  for _ in $(seq 100); do
+    grep -q "device network" run.log && break
+    sleep 0.1
+  done
+  "$peer" --trajectory hold.json --port "$port" --log peer.csv >peer.log 2>&1 &
+  peer_pid=$!
+  for _ in $(seq 300); do
+    head -n -1 peer.csv 2>/dev/null |
+      awk -F, 'NR > 1 && NF == 8 && ($7 > 0.1 || $7 < -0.1) { found = 1 } END { exit !found }' &&
+      break
+    sleep 0.1
+  done
+}
+
 # wait_rows FILE N: waits (up to 20 s) until FILE has at least N lines.
 wait_rows() {
   for _ in $(seq 200); do
@@ -346,26 +374,7 @@ case "$case_name" in
     # torsion killed while a peer is holding the hand: nothing more is sent, and the peer's
     # watchdog fades the wrench it renders to zero (0.1 s without a wrench, then at most 0.2 s),
     # down through values in between, never holding the last one.
-    [[ -x $peer ]] || fail "no torsion_haptic_peer given"
-    twist_scene > twist.json
-    cat > hold.json <<'JSON'
-{"segments": [{"duration": 0.6, "angular_velocity": [0, 0, 0.5]}, {"duration": 60}],
- "buttons": [{"time": 0, "held": [1]}]}
-JSON
-    port=$((20000 + RANDOM % 20000))
-    start_run out twist.json --device "hand=network:$port" --steps 100000 --threads 1
-    for _ in $(seq 100); do
-      grep -q "device network" run.log && break
-      sleep 0.1
-    done
-    "$peer" --trajectory hold.json --port "$port" --log peer.csv >peer.log 2>&1 &
-    peer_pid=$!
-    for _ in $(seq 300); do
-      head -n -1 peer.csv 2>/dev/null |
-        awk -F, 'NR > 1 && NF == 8 && ($7 > 0.1 || $7 < -0.1) { found = 1 } END { exit !found }' &&
-        break
-      sleep 0.1
-    done
+    peer_holds_the_hand
     kill -KILL "$sim"
     wait "$sim"
     rc=$?
@@ -384,29 +393,7 @@ JSON
   sigint_zeroes_the_network_device)
     # Ctrl-C while a peer is holding the hand: the run stops marked, and the last wrench the peer
     # receives is zero (the loop's stop and the device's close each send one).
-    [[ -x $peer ]] || fail "no torsion_haptic_peer given"
-    twist_scene > twist.json
-    cat > hold.json <<'JSON'
-{"segments": [{"duration": 0.6, "angular_velocity": [0, 0, 0.5]}, {"duration": 60}],
- "buttons": [{"time": 0, "held": [1]}]}
-JSON
-    port=$((20000 + RANDOM % 20000))
-    start_run out twist.json --device "hand=network:$port" --steps 100000 --threads 1
-    for _ in $(seq 100); do
-      grep -q "device network" run.log && break
-      sleep 0.1
-    done
-    "$peer" --trajectory hold.json --port "$port" --log peer.csv >peer.log 2>&1 &
-    peer_pid=$!
-    # Wait until the peer holds a non-zero torque (up to 30 s: slow under sanitizers), then
-    # interrupt the simulation. Whole rows only: the peer's log is being written, and its last
-    # line may be cut inside a number ("-1.2e-05" read as "-1.2" looked like a held torque).
-    for _ in $(seq 300); do
-      head -n -1 peer.csv 2>/dev/null |
-        awk -F, 'NR > 1 && NF == 8 && ($7 > 0.1 || $7 < -0.1) { found = 1 } END { exit !found }' &&
-        break
-      sleep 0.1
-    done
+    peer_holds_the_hand
     kill -INT "$sim"
     wait "$sim"
     rc=$?
