@@ -76,17 +76,6 @@ class StopOnSignals {
   struct sigaction previous_hup_ {};
 };
 
-const char* stopSignalName(int signal) {
-  switch (signal) {
-    case SIGINT:
-      return "SIGINT";
-    case SIGHUP:
-      return "SIGHUP";
-    default:
-      return "SIGTERM";
-  }
-}
-
 // The scene file, with --device / --haptics applied, built into a live world.
 Result<std::unique_ptr<scene::BuiltScene>> loadAndBuild(const RunArguments& args) {
   Result<scene::SceneSpec> spec = scene::loadScene(args.scene);
@@ -217,7 +206,7 @@ int reportOutcome(const RunArguments& args, const scene::BuiltScene& s, const Ra
   }
   const scene::RunOutcome& outcome = ran.outcome.value();
   if (const int signal = outcome.stopped_by; signal != 0) {
-    std::cerr << "stopped by " << stopSignalName(signal) << " after " << outcome.steps_done
+    std::cerr << "stopped by " << scene::signalName(signal) << " after " << outcome.steps_done
               << " steps; results so far in " << args.out
               << "/ (summary.json says \"completed\": false)\n";
     return 128 + signal;

@@ -172,19 +172,6 @@ struct ContactTotals {
   }
 };
 
-const char* signalName(int signal) {
-  switch (signal) {
-    case SIGINT:
-      return "SIGINT";
-    case SIGTERM:
-      return "SIGTERM";
-    case SIGHUP:
-      return "SIGHUP";
-    default:
-      return "signal";
-  }
-}
-
 // One run: its outputs, its statistics so far and the summary built from them.
 class Run {
  public:
@@ -490,6 +477,19 @@ class Run {
 };
 
 }  // namespace
+
+const char* signalName(int signal) {
+  switch (signal) {
+    case SIGINT:
+      return "SIGINT";
+    case SIGTERM:
+      return "SIGTERM";
+    case SIGHUP:
+      return "SIGHUP";
+    default:
+      return "signal";
+  }
+}
 
 Result<RunOutcome> runScene(BuiltScene& scene, const RunOptions& options) {
   return Run(scene, options).execute();

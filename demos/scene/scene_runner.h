@@ -40,6 +40,10 @@ struct RunOptions {
   std::vector<std::string> extra_outputs;
 };
 
+/// The name of a signal that stops a run ("SIGINT", "SIGTERM", "SIGHUP"), as summary.json's
+/// "stopped_by" says it.
+const char* signalName(int signal);
+
 struct RunOutcome {
   bool stable = true;
   std::string failure;  ///< the first fatal report, when not stable
