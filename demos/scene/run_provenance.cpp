@@ -6,24 +6,9 @@
 #include <cstdio>
 
 #include "build_info.h"
+#include "torsion/fnv1a.h"
 
 namespace torsion::scene {
-
-namespace {
-
-struct Fnv1a {
-  std::uint64_t h = 14695981039346656037ull;
-  void add(const void* data, size_t n) {
-    const auto* p = static_cast<const unsigned char*>(data);
-    for (size_t i = 0; i < n; ++i) {
-      h ^= p[i];
-      h *= 1099511628211ull;
-    }
-  }
-  void add(double v) { add(&v, sizeof v); }
-};
-
-}  // namespace
 
 void addProvenance(nlohmann::json& summary) {
   summary["schema_version"] = kSummarySchemaVersion;
@@ -46,7 +31,7 @@ std::string finalStateHash(const BuiltScene& scene,
       fnv.add(static_cast<double>(c));
   }
   char hex[17];
-  std::snprintf(hex, sizeof hex, "%016llx", static_cast<unsigned long long>(fnv.h));
+  std::snprintf(hex, sizeof hex, "%016llx", static_cast<unsigned long long>(fnv.value()));
   return hex;
 }
 

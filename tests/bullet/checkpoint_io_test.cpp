@@ -7,10 +7,13 @@
 
 #include <algorithm>
 #include <cstdint>
+#include <cstring>
 #include <random>
+#include <string_view>
 #include <vector>
 
 #include "checkpoint_rigs.h"
+#include "torsion/fnv1a.h"
 #include "torsion/mesh/box_mesh.h"
 
 namespace torsion {
@@ -60,16 +63,11 @@ class BlockRig {
   std::unique_ptr<Hand> hand_;
 };
 
-std::uint64_t fnv1a(const std::string& bytes, size_t from) {
-  std::uint64_t h = 1469598103934665603ull;
-  for (size_t k = from; k < bytes.size(); ++k) {
-    h ^= static_cast<unsigned char>(bytes[k]);
-    h *= 1099511628211ull;
-  }
-  return h;
-}
-
 constexpr size_t kHeader = 28;  // magic, version, length, hash
+
+std::uint64_t payloadHash(const std::string& bytes) {
+  return fnv1a(std::string_view(bytes).substr(kHeader));
+}
 
 // Saved after 40 steps, the world goes on 20; a world built the same way and read from the bytes
 // must take the same 20 steps to the bit (the contacts' warm starts included: states for the
@@ -121,6 +119,22 @@ TEST(CheckpointIo, TruncatedForeignOrAlteredBytesAreRefusedWithTheirReason) {
   EXPECT_TRUE(rig.load(bytes).ok());
 }
 
+// The published FNV-1a 64 test vectors (the IETF draft's), so that anyone can check a
+// checkpoint's hash with a standard implementation; the header carries exactly that hash of the
+// payload.
+TEST(CheckpointIo, TheHashIsTheStandardFnv1aOfThePayload) {
+  EXPECT_EQ(fnv1a(""), 0xcbf29ce484222325ull);
+  EXPECT_EQ(fnv1a("a"), 0xaf63dc4c8601ec8cull);
+  EXPECT_EQ(fnv1a("foobar"), 0x85944171f73967e8ull);
+  BlockRig rig;
+  rig.step();
+  const std::string bytes = rig.save();
+  ASSERT_GT(bytes.size(), kHeader);
+  std::uint64_t stored = 0;
+  std::memcpy(&stored, bytes.data() + 20, sizeof stored);
+  EXPECT_EQ(stored, payloadHash(bytes));
+}
+
 TEST(CheckpointIo, BytesAlteredBehindAValidHashAreRefusedOrReadNeverOutOfBounds) {
   BlockRig rig;
   for (int k = 0; k < 40; ++k)
@@ -134,7 +148,7 @@ TEST(CheckpointIo, BytesAlteredBehindAValidHashAreRefusedOrReadNeverOutOfBounds)
       const size_t at = kHeader + random() % (bytes.size() - kHeader);
       altered[at] = static_cast<char>(random() % 256);
     }
-    const std::uint64_t hash = fnv1a(altered, kHeader);
+    const std::uint64_t hash = payloadHash(altered);
     altered.replace(20, 8, reinterpret_cast<const char*>(&hash), 8);
     if (!rig.load(altered).ok()) {
       ++refused;

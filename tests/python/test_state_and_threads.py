@@ -113,7 +113,7 @@ def test_truncated_corrupted_or_foreign_bytes_raise_a_clear_error():
 
 
 def fnv1a(data):
-    h = 1469598103934665603
+    h = 14695981039346656037  # the standard FNV-1a 64 offset basis
     for byte in data:
         h = ((h ^ byte) * 1099511628211) & 0xFFFFFFFFFFFFFFFF
     return h

@@ -24,6 +24,7 @@
 #include "scene_haptics.h"
 #include "scene_parser.h"
 #include "torsion/bt_conversions.h"
+#include "torsion/fnv1a.h"
 #include "torsion/solve/system_operator.h"
 
 namespace torsion::scene {
@@ -95,20 +96,6 @@ struct Metrics {
   std::string hash;
 };
 
-// FNV-1a over the bytes of every body's positions and velocities and every rigid body's pose
-// and velocity.
-struct Fnv {
-  std::uint64_t h = 1469598103934665603ull;
-  void add(const void* data, size_t n) {
-    const auto* p = static_cast<const unsigned char*>(data);
-    for (size_t i = 0; i < n; ++i) {
-      h ^= p[i];
-      h *= 1099511628211ull;
-    }
-  }
-  void add(double v) { add(&v, sizeof v); }
-};
-
 Metrics runScenePath(const std::string& path, int steps, int threads, double stiffness_factor = 1) {
   Metrics m;
   Result<SceneSpec> spec = loadScene(path);
@@ -137,7 +124,9 @@ Metrics runScenePath(const std::string& path, int steps, int threads, double sti
     }
     m.steps = k + 1;
   }
-  Fnv fnv;
+  // FNV-1a over the bytes of every body's positions and velocities and every rigid body's pose
+  // and velocity.
+  Fnv1a fnv;
   for (const auto& body : s.world->bodies()) {
     m.kinetic += body->lastReport().kinetic_energy;
     m.elastic += body->lastReport().elastic_energy;
@@ -179,7 +168,7 @@ Metrics runScenePath(const std::string& path, int steps, int threads, double sti
     }
   }
   std::ostringstream hex;
-  hex << std::hex << fnv.h;
+  hex << std::hex << fnv.value();
   m.hash = hex.str();
   return m;
 }

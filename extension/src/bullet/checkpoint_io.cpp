@@ -7,6 +7,8 @@
 #include <mutex>
 #include <type_traits>
 
+#include "torsion/fnv1a.h"
+
 namespace torsion {
 namespace {
 
@@ -18,17 +20,10 @@ constexpr char kMagic[8] = {'T', 'R', 'S', 'N', 'C', 'K', 'P', 'T'};
 // 2: the pair multipliers of contact between FEM bodies.
 // 3: the node contacts' impulses (the contact-space friction solve's warm start).
 // 4: the node contacts' normals (the plane a contact keeps while its node stays over it).
-constexpr std::uint32_t kVersion = 4;
+// 5: the payload's hash is the standard FNV-1a (torsion/fnv1a.h); 4 used an offset basis one
+//    digit short of it.
+constexpr std::uint32_t kVersion = 5;
 constexpr size_t kHeaderSize = sizeof(kMagic) + 4 + 8 + 8;
-
-std::uint64_t fnv1a(std::string_view bytes) {
-  std::uint64_t h = 1469598103934665603ull;
-  for (const char c : bytes) {
-    h ^= static_cast<unsigned char>(c);
-    h *= 1099511628211ull;
-  }
-  return h;
-}
 
 class Writer {
  public:
