@@ -1,0 +1,59 @@
+#pragma once
+// The rows of an island's contact problem (docs/contact-solve.md): one row per contact point, a
+// 3-row Jacobian J_i that maps the island's velocities v to the relative contact velocity
+//
+//     v_c,i = J_i v = (v_t1, v_t2, v_n)   (m/s, in the contact frame: two tangents, normal last)
+//
+// of side B's point relative to side A's, so v_n > 0 separates. J_i is a sum of terms, each a
+// dense 3 x k block on k consecutive velocity dofs of one island body:
+//
+//   a node of a FEM body (k = 3): w R_c, w the node's barycentric weight on the contact point
+//     (negative on side A), R_c the frame (rows t1, t2, n);
+//   a point of a rigid body (k = 6, the twist [v; omega] about the centre of mass, world frame):
+//     +-R_c [I, -[r]x], r the point's offset from the centre of mass (v_point = v + omega x r).
+//
+// A node against a plane is one term, a node against a face of another FEM body 1 + 3, a point
+// between two rigid bodies 2, a node against a rigid body 2: one type for all. Besides J_i, a row
+// carries its physical data: the Coulomb coefficient mu, the contact stiffness k (N/m), the
+// dissipation time scale tau_d (s) and the signed gap phi0 (m) at the step's start, negative when
+// penetrating. sap_problem.h turns them into the regularisation of Castro et al. 2022.
+
+#include <Eigen/Core>
+#include <vector>
+
+namespace torsion::sap {
+
+/// A 3 x k block, k <= 6, stored inline.
+using TermBlock = Eigen::Matrix<double, 3, Eigen::Dynamic, Eigen::ColMajor, 3, 6>;
+
+struct ContactTerm {
+  int body = -1;      ///< the island body (index into the problem's bodies)
+  int first_dof = 0;  ///< the block's first column acts on this dof of the body
+  TermBlock block;    ///< contact-frame velocity per unit dof velocity
+};
+
+struct ContactRow {
+  std::vector<ContactTerm> terms;
+  /// Rows t1, t2, n (world): the frame the blocks are expressed in, for turning impulses back
+  /// into world vectors (impulse_world = frame^T gamma).
+  Eigen::Matrix3d frame = Eigen::Matrix3d::Identity();
+  double mu = 0;                ///< Coulomb coefficient, >= 0
+  double stiffness = 0;         ///< k, N/m, > 0
+  double dissipation_time = 0;  ///< tau_d, s, >= 0
+  double gap = 0;               ///< phi0, m, negative when penetrating
+};
+
+/// A right-handed frame with rows (t1, t2, n) for unit `normal`; t1 is the normal crossed with the
+/// world axis least aligned with it, so the frame is a deterministic function of the normal.
+Eigen::Matrix3d contactFrame(const Eigen::Vector3d& normal);
+
+/// Node `node` (dofs 3 node .. 3 node + 2) of `body` with weight `weight` (barycentric, signed:
+/// negative on side A).
+ContactTerm nodeTerm(int body, int node, double weight, const Eigen::Matrix3d& frame);
+
+/// The point at world offset `offset` from the centre of mass of rigid `body` (6 dofs: the twist
+/// [v; omega]); sign +1 on side B, -1 on side A.
+ContactTerm rigidPointTerm(int body, const Eigen::Vector3d& offset, double sign,
+                           const Eigen::Matrix3d& frame);
+
+}  // namespace torsion::sap

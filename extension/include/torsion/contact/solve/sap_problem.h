@@ -1,0 +1,167 @@
+#pragma once
+// One convex problem per contact island: SAP, the Semi-Analytic Primal formulation of
+// A. M. Castro, F. N. Permenter, X. Han, "An Unconstrained Convex Formulation of Compliant
+// Contact", IEEE Transactions on Robotics 39(2), 2023 (arXiv:2110.10107, 2022); Drake's SAP
+// solver. docs/contact-solve.md explains the model; this header gives the formulas.
+//
+// Unknowns: v, every velocity dof of the island's bodies (island_body.h), stacked body by body.
+// The velocities after the step minimise the strictly convex, C1 cost
+//
+//     ell(v) = 1/2 v^T A v - b^T v + sum_i ell_i(v_c,i),   v_c,i = J_i v   (contact_row.h)
+//
+// A = blockdiag(A_body) SPD, b the bodies' momenta with external impulses. Without contact the
+// minimiser is A v = b, the bodies' own implicit step.
+//
+// Contact i, regularised by its physical compliance (stiffness k, dissipation time scale tau_d,
+// gap phi0 at the step's start, step dt) and the Delassus estimate w_i (paper, sec. V and VII):
+//
+//     R_n = max(beta^2 / (4 pi^2) w_i, 1 / (dt (dt + tau_d) k))   (near-rigid cap: the contact's
+//           period is never shorter than beta dt, which the step can resolve)
+//     R_t = sigma w_i                    (regularised friction: a stuck contact slips at R_t
+//     |gamma_t|) v_hat = (0, 0, -phi0 / (dt + tau_d)) w_i = ||W_ii||_F / 3,  W_ii = sum over the
+//     row's terms B D^{-1} B^T, D the block of A the
+//           term acts on, inverted on its free dofs (exact for a rigid body; for a FEM node the
+//           block-Jacobi estimate of the node's compliance)
+//
+// with beta = 1 and sigma = 1e-3 (SapParameters). With R = diag(R_t, R_t, R_n) the impulse is
+//
+//     gamma_i = P(y_i),   y_i = -R^{-1} (v_c,i - v_hat)
+//
+// P the projection onto Coulomb's circular cone F = {|gamma_t| <= mu gamma_n} in the R-norm
+// |x|_R^2 = x^T R x. With y_r = |y_t|, mu_hat = mu R_t / R_n, mu_tilde^2 = mu^2 R_t / R_n:
+//
+//     stick      y_r <= mu y_n:           gamma = y
+//     separate   y_n <= -mu_hat y_r:      gamma = 0           (y in the polar cone)
+//     slide      otherwise:               gamma_n = (y_n + mu_hat y_r) / (1 + mu_tilde^2),
+//                                         gamma_t = mu gamma_n y_t / y_r
+//
+// ell_i = 1/2 gamma_i^T R gamma_i, whose gradient in v_c is -gamma_i. So
+//
+//     gradient  g = A v - b - J^T gamma
+//     Hessian   H = A + J^T G J,  G_i = -d gamma_i / d v_c,i = (d P / d y) R^{-1}, symmetric PSD:
+//               stick R^{-1}; separate 0; slide
+//               1/((1 + mu_tilde^2) R_n) u u^T + mu gamma_n / (y_r R_t) (I_t - t t^T),
+//               u = (mu t, 1), t = y_t / y_r, I_t the tangent-plane identity.
+//
+// At the minimiser (g = 0) u_i = v_c,i - v_hat + R gamma_i satisfies gamma in F, u in the dual
+// cone {mu |u_t| <= u_n}, gamma . u = 0: Coulomb's law with maximal dissipation, relaxed by R.
+//
+// Prescribed dofs (island_body.h) are held at their values: the unknowns are the free dofs, the
+// gradient and every Newton direction filtered by S.
+
+#include <Eigen/Core>
+#include <cstdint>
+#include <vector>
+
+#include "torsion/contact/solve/contact_row.h"
+#include "torsion/contact/solve/island_body.h"
+#include "torsion/result.h"
+
+namespace torsion::sap {
+
+/// The paper's regularisation constants (sec. V, VII).
+struct SapParameters {
+  /// R_t = sigma w: the stiction slip relative to the velocity a row's impulse gives (1e-3, the
+  /// paper's value: a thousandth of the slip-free response).
+  double sigma = 1e-3;
+  /// R_n >= beta^2 / (4 pi^2) w: a contact stiffer than that acts as one whose period is
+  /// beta dt (near-rigid; beta = 1, the paper's value).
+  double beta = 1.0;
+};
+
+enum class ContactState : std::uint8_t { kStick, kSlide, kSeparated };
+const char* toString(ContactState state);
+
+/// One row's regularised model, fixed for the solve.
+struct RowModel {
+  double mu = 0;
+  double rt = 0;     ///< R_t, m/(N s)
+  double rn = 0;     ///< R_n, m/(N s)
+  double v_hat = 0;  ///< v_hat_n, m/s
+  double w = 0;      ///< the Delassus estimate w_i, m/(N s)
+};
+
+/// The projection at one contact velocity.
+struct RowResponse {
+  Eigen::Vector3d gamma = Eigen::Vector3d::Zero();  ///< N s, contact frame (t1, t2, n)
+  Eigen::Matrix3d g = Eigen::Matrix3d::Zero();      ///< G = -d gamma / d v_c, N s^2/m
+  ContactState state = ContactState::kSeparated;
+  double cost = 0;  ///< ell_i = 1/2 gamma^T R gamma, J
+};
+
+/// gamma = P(y(v_c)) with its G and cost (the three regions above).
+RowResponse projectImpulse(const RowModel& model, const Eigen::Vector3d& contact_velocity);
+
+/// Everything the solver needs at one v.
+struct SapEvaluation {
+  Eigen::VectorXd v;
+  Eigen::VectorXd av;               ///< A v
+  Eigen::VectorXd contact_impulse;  ///< J^T gamma
+  Eigen::VectorXd gradient;         ///< S (A v - b - J^T gamma)
+  std::vector<Eigen::Vector3d> contact_velocity;
+  std::vector<RowResponse> rows;
+  double cost = 0;
+};
+
+class SapProblem {
+ public:
+  /// Fails on a malformed row (a term outside its body or not on one whole block, mu < 0, k <= 0,
+  /// tau_d < 0) or dt <= 0. The bodies are not owned and must outlive the problem.
+  static Result<SapProblem> create(std::vector<const IslandBody*> bodies,
+                                   std::vector<ContactRow> rows, double dt,
+                                   const SapParameters& parameters = {});
+
+  int dofs() const { return dofs_; }
+  int rowCount() const { return static_cast<int>(rows_.size()); }
+  const ContactRow& row(int i) const { return rows_[static_cast<size_t>(i)]; }
+  const RowModel& model(int i) const { return models_[static_cast<size_t>(i)]; }
+  /// The first island dof of body `body`.
+  int bodyOffset(int body) const { return body_offsets_[static_cast<size_t>(body)]; }
+  const Eigen::VectorXd& momentum() const { return momentum_; }
+  /// diag(A)^{-1/2}, the scaling of the optimality criterion (sap_solver.h).
+  const Eigen::VectorXd& inverseSqrtDiagonal() const { return inverse_sqrt_diagonal_; }
+
+  void multiplyA(const Eigen::VectorXd& x, Eigen::VectorXd& out) const;
+  Eigen::Vector3d rowVelocity(int i, const Eigen::VectorXd& v) const;
+  /// out += J_i^T f.
+  void addRowTranspose(int i, const Eigen::Vector3d& f, Eigen::VectorXd& out) const;
+  void filter(Eigen::VectorXd& x) const;
+  void impose(Eigen::VectorXd& v) const;
+
+  /// Fills `e` at v (v already holds the prescribed values).
+  void evaluate(const Eigen::VectorXd& v, SapEvaluation& e) const;
+  /// out = S H x at the evaluation's G blocks, x = S x.
+  void multiplyHessian(const SapEvaluation& e, const Eigen::VectorXd& x,
+                       Eigen::VectorXd& out) const;
+  /// Block-Jacobi preconditioner of S H S: per block k, S_k (S_k H_kk S_k + I - S_k)^{-1} S_k,
+  /// H_kk = A_kk + the G terms acting on block k.
+  void preconditionerBlocks(const SapEvaluation& e, std::vector<DiagonalBlock>& inverse) const;
+  /// out = the preconditioner applied to r.
+  void applyPreconditioner(const std::vector<DiagonalBlock>& inverse, const Eigen::VectorXd& r,
+                           Eigen::VectorXd& out) const;
+
+ private:
+  SapProblem() = default;
+  Status validate(const ContactRow& row) const;
+  void collectBlocks();
+  RowModel makeModel(const ContactRow& row, double dt, const SapParameters& parameters) const;
+  // The island dof of a term's first column.
+  int termOffset(const ContactTerm& term) const { return bodyOffset(term.body) + term.first_dof; }
+  int termBlock(const ContactTerm& term) const;
+
+  std::vector<const IslandBody*> bodies_;
+  std::vector<ContactRow> rows_;
+  std::vector<RowModel> models_;
+  std::vector<int> body_offsets_;          // dofs
+  std::vector<int> block_starts_;          // first global block of each body, then the block count
+  std::vector<int> block_offsets_;         // first island dof of each block
+  std::vector<DiagonalBlock> blocks_;      // A's diagonal blocks
+  std::vector<DiagonalBlock> projectors_;  // S per block
+  int dofs_ = 0;
+  Eigen::VectorXd momentum_;
+  Eigen::VectorXd inverse_sqrt_diagonal_;
+  // Per-body scratch of multiplyA (one solve thread per problem).
+  mutable std::vector<Eigen::VectorXd> body_in_, body_out_;
+};
+
+}  // namespace torsion::sap

@@ -1,0 +1,94 @@
+#pragma once
+// Newton's method on the SAP cost of an island (sap_problem.h; Castro, Permenter, Han 2022,
+// sec. VIII). Each iteration:
+//
+//   1. the gradient g = S (A v - b - J^T gamma) and the G blocks at v;
+//   2. the Newton direction from S H S dv = -g, H = A + J^T G J, by preconditioned CG, matrix-free
+//      (body products plus sum J_i^T G_i J_i), block-Jacobi preconditioned on H's diagonal blocks,
+//      started from dv = 0 and stopped at a relative residual eta_k = min(0.1, sqrt(r_k / r_0))
+//      (inexact Newton, tightening as it converges; never tighter than the tolerance needs).
+//      CG from zero on an SPD system returns a descent direction (g . dv < 0) after any number of
+//      iterations; should rounding break that, the preconditioned gradient step replaces it;
+//   3. an exact line search: alpha minimising the convex cost along dv, by safeguarded 1-D Newton
+//      on ell'(alpha) with bisection (the Hessian is only piecewise continuous). ell' is
+//      monotone, so the bracket always holds the minimiser, and the cost never increases.
+//
+// The cost is strictly convex and C1 with a piecewise-smooth gradient: Newton with exact line
+// search converges from any start. It stops on the paper's optimality criterion (sec. VIII-C),
+//
+//     |D g| <= eps_abs + eps_rel max(|D p|, |D j|),   D = diag(A)^{-1/2}, p = A v, j = J^T gamma
+//
+// (a momentum balance in units where every dof weighs alike). A solve that reaches its iteration
+// cap, or can no longer make progress, reports converged = false with the reason: it is never
+// silently accepted.
+//
+// Deterministic: rows, terms, bodies and blocks are visited in a fixed order and nothing is
+// threaded, so the same input gives bit-identical output.
+
+#include <Eigen/Core>
+#include <string>
+#include <vector>
+
+#include "torsion/contact/solve/sap_problem.h"
+
+namespace torsion::sap {
+
+struct SapSolverSettings {
+  double relative_tolerance = 1e-6;   ///< eps_rel (the paper's default)
+  double absolute_tolerance = 1e-14;  ///< eps_abs, sqrt(kg) m/s
+  int max_newton_iterations = 100;
+  int max_cg_iterations = 1000;  ///< per Newton direction
+  double max_forcing = 0.1;      ///< the CG's relative tolerance is at most this
+  int max_line_search_iterations = 100;
+};
+
+struct SapReport {
+  bool converged = false;
+  /// Why an unconverged solve stopped ("iteration cap", "no progress"); empty when converged.
+  std::string message;
+  int newton_iterations = 0;
+  int cg_iterations = 0;           ///< summed over the Newton iterations
+  int line_search_iterations = 0;  ///< summed
+  double residual = 0;             ///< |D g| at the returned velocities
+  double tolerance = 0;            ///< the criterion's right-hand side there
+  double cost = 0;                 ///< ell(v), J
+  /// Per row, at the returned velocities: gamma_i (N s, contact frame t1, t2, n), v_c,i (m/s)
+  /// and its region of the projection.
+  std::vector<Eigen::Vector3d> impulses;
+  std::vector<Eigen::Vector3d> contact_velocities;
+  std::vector<ContactState> states;
+};
+
+class SapSolver {
+ public:
+  explicit SapSolver(SapSolverSettings settings = {}) : settings_(settings) {}
+  const SapSolverSettings& settings() const { return settings_; }
+
+  /// Minimises the problem's cost. v: in, the warm start (the previous step's velocities), or
+  /// empty for zero; out, the velocities (prescribed dofs at their values).
+  SapReport solve(const SapProblem& problem, Eigen::VectorXd& v);
+
+ private:
+  // The CG solve of S H S dv = -g to relative tolerance eta; returns its iterations.
+  int newtonDirection(const SapProblem& problem, double eta, Eigen::VectorXd& dv);
+  // The step length minimising the cost along dv from evaluation_.v.
+  double lineSearch(const SapProblem& problem, const Eigen::VectorXd& dv, int& iterations);
+  // ell'(alpha) and ell''(alpha) along the line set up by lineSearch; noise: the size of the
+  // terms summed into ell', for the rounding floor.
+  void slopeAt(const SapProblem& problem, double alpha, double& slope, double& curvature,
+               double& noise) const;
+  void fillReport(const SapProblem& problem, SapReport& report) const;
+  double scaledNorm(const SapProblem& problem, const Eigen::VectorXd& x) const;
+
+  SapSolverSettings settings_;
+  // Workspace, kept between solves.
+  SapEvaluation evaluation_;
+  std::vector<DiagonalBlock> preconditioner_;
+  Eigen::VectorXd residual_, z_, p_, q_;
+  // The line: dv . (A v - b), dv . A dv, v_c and J dv per row.
+  double line_linear_ = 0, line_quadratic_ = 0;
+  Eigen::VectorXd a_dv_;
+  std::vector<Eigen::Vector3d> line_vc_, line_dvc_;
+};
+
+}  // namespace torsion::sap

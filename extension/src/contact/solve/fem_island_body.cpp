@@ -1,0 +1,33 @@
+#include "torsion/contact/solve/fem_island_body.h"
+
+#include <cassert>
+#include <utility>
+
+namespace torsion::sap {
+
+FemIslandBody::FemIslandBody(const SystemOperator& system, const NodeConstraints& constraints,
+                             Eigen::VectorXd momentum)
+    : system_(system), constraints_(constraints), momentum_(std::move(momentum)) {
+  assert(momentum_.size() == 3 * system_.model().nodeCount());
+  assert(constraints_.nodeCount() == system_.model().nodeCount());
+  system_.diagonalBlocks(blocks_);
+}
+
+void FemIslandBody::multiply(const Eigen::VectorXd& x, Eigen::VectorXd& out) const {
+  out.resize(x.size());
+  system_.multiply(x, out);
+}
+
+DiagonalBlock FemIslandBody::diagonalBlock(int node) const {
+  return blocks_[static_cast<size_t>(node)];
+}
+
+DiagonalBlock FemIslandBody::freeProjector(int node) const {
+  // S on one node: the filter applied to the unit vectors (identity, zero, or I - d d^T).
+  DiagonalBlock s(3, 3);
+  for (int k = 0; k < 3; ++k)
+    s.col(k) = constraints_.filterNode(node, Eigen::Vector3d::Unit(k));
+  return s;
+}
+
+}  // namespace torsion::sap

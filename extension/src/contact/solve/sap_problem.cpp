@@ -1,0 +1,254 @@
+// The SAP problem of an island (sap_problem.h; Castro, Permenter, Han 2022).
+#include "torsion/contact/solve/sap_problem.h"
+
+#include <Eigen/Cholesky>
+#include <algorithm>
+#include <cmath>
+#include <string>
+#include <utility>
+
+namespace torsion::sap {
+
+namespace {
+
+constexpr double kSapPi = 3.14159265358979323846;
+
+// S (S D S + I - S)^{-1} S: the inverse of D on the free dofs of its block, zero on the rest.
+// S D S + I - S is SPD for SPD D and a projector S, and equals D where every dof is free.
+DiagonalBlock inverseOnFreeDofs(const DiagonalBlock& d, const DiagonalBlock& s) {
+  const auto n = d.rows();
+  const DiagonalBlock identity = DiagonalBlock::Identity(n, n);
+  const DiagonalBlock compressed = s * d * s + (identity - s);
+  const DiagonalBlock inverse = compressed.llt().solve(identity);
+  return s * inverse * s;
+}
+
+}  // namespace
+
+const char* toString(ContactState state) {
+  switch (state) {
+    case ContactState::kStick:
+      return "stick";
+    case ContactState::kSlide:
+      return "slide";
+    case ContactState::kSeparated:
+      return "separated";
+  }
+  return "?";
+}
+
+RowResponse projectImpulse(const RowModel& m, const Eigen::Vector3d& vc) {
+  RowResponse out;
+  // y = -R^{-1} (v_c - v_hat); the three regions of the paper's analytic projection (sec. VII).
+  const Eigen::Vector2d yt = -vc.head<2>() / m.rt;
+  const double yn = (m.v_hat - vc(2)) / m.rn;
+  const double yr = yt.norm();
+  const double mu_hat = m.mu * m.rt / m.rn;
+  if (yr <= m.mu * yn) {
+    out.state = ContactState::kStick;
+    out.gamma << yt, yn;
+    out.g.diagonal() << 1 / m.rt, 1 / m.rt, 1 / m.rn;
+  } else if (yn <= -mu_hat * yr) {
+    out.state = ContactState::kSeparated;  // gamma and G stay zero
+    return out;
+  } else {
+    // Here y_r > 0: y_r = 0 would need 0 < y_n (not separated) and y_n < 0 (not stuck).
+    out.state = ContactState::kSlide;
+    const double factor = 1 / (1 + m.mu * mu_hat);  // 1 / (1 + mu_tilde^2)
+    const Eigen::Vector2d t = yt / yr;
+    const double gn = (yn + mu_hat * yr) * factor;
+    out.gamma << m.mu * gn * t, gn;
+    // G = factor / R_n u u^T + mu gamma_n / (y_r R_t) (I_t - t t^T), u = (mu t, 1).
+    const Eigen::Vector3d u(m.mu * t(0), m.mu * t(1), 1.0);
+    out.g = (factor / m.rn) * u * u.transpose();
+    out.g.topLeftCorner<2, 2>() +=
+        (m.mu * gn / (yr * m.rt)) * (Eigen::Matrix2d::Identity() - t * t.transpose());
+  }
+  out.cost = 0.5 * (m.rt * out.gamma.head<2>().squaredNorm() + m.rn * out.gamma(2) * out.gamma(2));
+  return out;
+}
+
+Result<SapProblem> SapProblem::create(std::vector<const IslandBody*> bodies,
+                                      std::vector<ContactRow> rows, double dt,
+                                      const SapParameters& parameters) {
+  if (!(dt > 0)) return Error{"SAP problem: time step " + std::to_string(dt) + " is not > 0"};
+  SapProblem p;
+  p.bodies_ = std::move(bodies);
+  for (const IslandBody* body : p.bodies_) {
+    if (body == nullptr) return Error{"SAP problem: a body is null"};
+    p.body_offsets_.push_back(p.dofs_);
+    p.dofs_ += body->dofs();
+  }
+  p.collectBlocks();
+  p.rows_ = std::move(rows);
+  for (size_t i = 0; i < p.rows_.size(); ++i) {
+    const Status status = p.validate(p.rows_[i]);
+    if (!status)
+      return Error{"SAP problem: row " + std::to_string(i) + ": " + status.error().message};
+  }
+  for (const ContactRow& row : p.rows_)
+    p.models_.push_back(p.makeModel(row, dt, parameters));
+  return Result<SapProblem>(std::move(p));
+}
+
+void SapProblem::collectBlocks() {
+  momentum_.resize(dofs_);
+  inverse_sqrt_diagonal_.resize(dofs_);
+  for (size_t b = 0; b < bodies_.size(); ++b) {
+    const IslandBody& body = *bodies_[b];
+    const int offset = body_offsets_[b];
+    momentum_.segment(offset, body.dofs()) = body.momentum();
+    block_starts_.push_back(static_cast<int>(blocks_.size()));
+    for (int k = 0; k < body.dofs() / body.blockSize(); ++k) {
+      blocks_.push_back(body.diagonalBlock(k));
+      projectors_.push_back(body.freeProjector(k));
+      block_offsets_.push_back(offset + k * body.blockSize());
+      const Eigen::VectorXd diagonal = blocks_.back().diagonal();
+      inverse_sqrt_diagonal_.segment(block_offsets_.back(), body.blockSize()) =
+          diagonal.cwiseSqrt().cwiseInverse();
+    }
+  }
+  block_starts_.push_back(static_cast<int>(blocks_.size()));
+  body_in_.resize(bodies_.size());
+  body_out_.resize(bodies_.size());
+}
+
+Status SapProblem::validate(const ContactRow& row) const {
+  if (row.terms.empty()) return Error{"no terms"};
+  if (!(row.mu >= 0)) return Error{"friction coefficient " + std::to_string(row.mu) + " < 0"};
+  if (!(row.stiffness > 0)) return Error{"stiffness " + std::to_string(row.stiffness) + " <= 0"};
+  if (!(row.dissipation_time >= 0))
+    return Error{"dissipation time " + std::to_string(row.dissipation_time) + " < 0"};
+  if (!std::isfinite(row.gap)) return Error{"gap is not finite"};
+  for (const ContactTerm& term : row.terms) {
+    if (term.body < 0 || term.body >= static_cast<int>(bodies_.size()))
+      return Error{"term on body " + std::to_string(term.body) + ", which is not in the island"};
+    const IslandBody& body = *bodies_[static_cast<size_t>(term.body)];
+    const int size = body.blockSize();
+    if (term.block.cols() != size || term.first_dof % size != 0 || term.first_dof < 0 ||
+        term.first_dof + size > body.dofs())
+      return Error{"term at dof " + std::to_string(term.first_dof) + " with " +
+                   std::to_string(term.block.cols()) + " columns is not one block of its body"};
+  }
+  return Ok{};
+}
+
+int SapProblem::termBlock(const ContactTerm& term) const {
+  const IslandBody& body = *bodies_[static_cast<size_t>(term.body)];
+  return block_starts_[static_cast<size_t>(term.body)] + term.first_dof / body.blockSize();
+}
+
+RowModel SapProblem::makeModel(const ContactRow& row, double dt,
+                               const SapParameters& parameters) const {
+  // W_ii estimated term by term from the blocks the row acts on (sap_problem.h).
+  Eigen::Matrix3d w_block = Eigen::Matrix3d::Zero();
+  for (const ContactTerm& term : row.terms) {
+    const auto k = static_cast<size_t>(termBlock(term));
+    w_block += term.block * inverseOnFreeDofs(blocks_[k], projectors_[k]) * term.block.transpose();
+  }
+  RowModel m;
+  m.mu = row.mu;
+  const double rn_physical = 1 / (dt * (dt + row.dissipation_time) * row.stiffness);
+  m.w = w_block.norm() / 3;
+  // A row on prescribed dofs alone moves nothing; any positive w keeps its model well defined.
+  if (!(m.w > 0)) m.w = rn_physical;
+  m.rn = std::max(parameters.beta * parameters.beta / (4 * kSapPi * kSapPi) * m.w, rn_physical);
+  m.rt = parameters.sigma * m.w;
+  m.v_hat = -row.gap / (dt + row.dissipation_time);
+  return m;
+}
+
+void SapProblem::multiplyA(const Eigen::VectorXd& x, Eigen::VectorXd& out) const {
+  out.resize(dofs_);
+  for (size_t b = 0; b < bodies_.size(); ++b) {
+    const int n = bodies_[b]->dofs();
+    body_in_[b] = x.segment(body_offsets_[b], n);
+    bodies_[b]->multiply(body_in_[b], body_out_[b]);
+    out.segment(body_offsets_[b], n) = body_out_[b];
+  }
+}
+
+Eigen::Vector3d SapProblem::rowVelocity(int i, const Eigen::VectorXd& v) const {
+  Eigen::Vector3d vc = Eigen::Vector3d::Zero();
+  for (const ContactTerm& term : row(i).terms)
+    vc += term.block * v.segment(termOffset(term), term.block.cols());
+  return vc;
+}
+
+void SapProblem::addRowTranspose(int i, const Eigen::Vector3d& f, Eigen::VectorXd& out) const {
+  for (const ContactTerm& term : row(i).terms)
+    out.segment(termOffset(term), term.block.cols()) += term.block.transpose() * f;
+}
+
+void SapProblem::filter(Eigen::VectorXd& x) const {
+  for (size_t b = 0; b < bodies_.size(); ++b) {
+    const int n = bodies_[b]->dofs();
+    body_in_[b] = x.segment(body_offsets_[b], n);
+    bodies_[b]->filter(body_in_[b]);
+    x.segment(body_offsets_[b], n) = body_in_[b];
+  }
+}
+
+void SapProblem::impose(Eigen::VectorXd& v) const {
+  for (size_t b = 0; b < bodies_.size(); ++b) {
+    const int n = bodies_[b]->dofs();
+    body_in_[b] = v.segment(body_offsets_[b], n);
+    bodies_[b]->impose(body_in_[b]);
+    v.segment(body_offsets_[b], n) = body_in_[b];
+  }
+}
+
+void SapProblem::evaluate(const Eigen::VectorXd& v, SapEvaluation& e) const {
+  e.v = v;
+  multiplyA(v, e.av);
+  e.contact_impulse.setZero(dofs_);
+  e.contact_velocity.resize(rows_.size());
+  e.rows.resize(rows_.size());
+  double contact_cost = 0;
+  // Rows in their order, terms in theirs: the sums are the same for the same input.
+  for (int i = 0; i < rowCount(); ++i) {
+    const auto k = static_cast<size_t>(i);
+    e.contact_velocity[k] = rowVelocity(i, v);
+    e.rows[k] = projectImpulse(models_[k], e.contact_velocity[k]);
+    addRowTranspose(i, e.rows[k].gamma, e.contact_impulse);
+    contact_cost += e.rows[k].cost;
+  }
+  e.gradient = e.av - momentum_ - e.contact_impulse;
+  filter(e.gradient);
+  e.cost = 0.5 * v.dot(e.av) - momentum_.dot(v) + contact_cost;
+}
+
+void SapProblem::multiplyHessian(const SapEvaluation& e, const Eigen::VectorXd& x,
+                                 Eigen::VectorXd& out) const {
+  multiplyA(x, out);
+  for (int i = 0; i < rowCount(); ++i) {
+    const RowResponse& r = e.rows[static_cast<size_t>(i)];
+    if (r.state == ContactState::kSeparated) continue;
+    addRowTranspose(i, r.g * rowVelocity(i, x), out);
+  }
+  filter(out);
+}
+
+void SapProblem::preconditionerBlocks(const SapEvaluation& e,
+                                      std::vector<DiagonalBlock>& inverse) const {
+  inverse = blocks_;
+  for (int i = 0; i < rowCount(); ++i) {
+    const RowResponse& r = e.rows[static_cast<size_t>(i)];
+    if (r.state == ContactState::kSeparated) continue;
+    for (const ContactTerm& term : row(i).terms)
+      inverse[static_cast<size_t>(termBlock(term))] += term.block.transpose() * r.g * term.block;
+  }
+  for (size_t k = 0; k < inverse.size(); ++k)
+    inverse[k] = inverseOnFreeDofs(inverse[k], projectors_[k]);
+}
+
+void SapProblem::applyPreconditioner(const std::vector<DiagonalBlock>& inverse,
+                                     const Eigen::VectorXd& r, Eigen::VectorXd& out) const {
+  out.resize(dofs_);
+  for (size_t k = 0; k < inverse.size(); ++k) {
+    const auto n = inverse[k].rows();
+    out.segment(block_offsets_[k], n) = inverse[k] * r.segment(block_offsets_[k], n);
+  }
+}
+
+}  // namespace torsion::sap

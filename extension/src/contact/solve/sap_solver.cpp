@@ -1,0 +1,163 @@
+// Newton's method with exact line search on the SAP cost (sap_solver.h).
+#include "torsion/contact/solve/sap_solver.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+namespace torsion::sap {
+
+namespace {
+
+// The line search stops when |ell'(alpha)| is this small relative to |ell'(0)|, or relative to
+// the size of the terms summed into it (below that, ell' is rounding).
+constexpr double kSlopeTolerance = 1e-10;
+constexpr double kSlopeRounding = 1e-13;
+
+}  // namespace
+
+double SapSolver::scaledNorm(const SapProblem& problem, const Eigen::VectorXd& x) const {
+  return x.cwiseProduct(problem.inverseSqrtDiagonal()).norm();
+}
+
+SapReport SapSolver::solve(const SapProblem& problem, Eigen::VectorXd& v) {
+  SapReport report;
+  if (v.size() != problem.dofs()) v.setZero(problem.dofs());
+  problem.impose(v);
+  Eigen::VectorXd dv;
+  double first_residual = 0;
+  for (;;) {
+    problem.evaluate(v, evaluation_);
+    // The scales p = A v and j = J^T gamma, on the free dofs (the unknowns) only.
+    z_ = evaluation_.av;
+    problem.filter(z_);
+    q_ = evaluation_.contact_impulse;
+    problem.filter(q_);
+    report.residual = scaledNorm(problem, evaluation_.gradient);
+    report.tolerance =
+        settings_.absolute_tolerance +
+        settings_.relative_tolerance * std::max(scaledNorm(problem, z_), scaledNorm(problem, q_));
+    if (report.residual <= report.tolerance) {
+      report.converged = true;
+      break;
+    }
+    if (report.newton_iterations >= settings_.max_newton_iterations) {
+      report.message = "iteration cap";
+      break;
+    }
+    if (report.newton_iterations == 0) first_residual = report.residual;
+    // Inexact Newton: loose while far, tighter as the residual falls, never tighter than what
+    // brings the residual to half the tolerance.
+    double eta = std::min(settings_.max_forcing, std::sqrt(report.residual / first_residual));
+    eta = std::max(eta, 0.5 * report.tolerance / report.residual);
+    report.cg_iterations += newtonDirection(problem, eta, dv);
+    const double alpha = lineSearch(problem, dv, report.line_search_iterations);
+    const double step = alpha * dv.lpNorm<Eigen::Infinity>();
+    if (!(step > std::numeric_limits<double>::epsilon() * v.lpNorm<Eigen::Infinity>())) {
+      report.message = "no progress";  // the step no longer changes v: rounding
+      break;
+    }
+    v += alpha * dv;
+    ++report.newton_iterations;
+  }
+  fillReport(problem, report);
+  return report;
+}
+
+int SapSolver::newtonDirection(const SapProblem& problem, double eta, Eigen::VectorXd& dv) {
+  const Eigen::VectorXd& g = evaluation_.gradient;
+  problem.preconditionerBlocks(evaluation_, preconditioner_);
+  dv.setZero(problem.dofs());
+  residual_ = -g;
+  problem.applyPreconditioner(preconditioner_, residual_, z_);
+  p_ = z_;
+  double rz = residual_.dot(z_);
+  const double target = eta * scaledNorm(problem, residual_);
+  int iterations = 0;
+  while (iterations < settings_.max_cg_iterations && scaledNorm(problem, residual_) > target) {
+    problem.multiplyHessian(evaluation_, p_, q_);
+    const double curvature = p_.dot(q_);
+    if (!(curvature > 0)) break;  // rounding: nothing left to gain along p
+    const double a = rz / curvature;
+    dv += a * p_;
+    residual_ -= a * q_;
+    problem.applyPreconditioner(preconditioner_, residual_, z_);
+    const double rz_next = residual_.dot(z_);
+    p_ = z_ + (rz_next / rz) * p_;
+    rz = rz_next;
+    ++iterations;
+  }
+  // CG from zero descends after any number of iterations; this guards against rounding only.
+  if (!(g.dot(dv) < 0)) {
+    problem.applyPreconditioner(preconditioner_, g, dv);
+    dv = -dv;
+  }
+  return iterations;
+}
+
+double SapSolver::lineSearch(const SapProblem& problem, const Eigen::VectorXd& dv,
+                             int& iterations) {
+  const SapEvaluation& e = evaluation_;
+  problem.multiplyA(dv, a_dv_);
+  line_linear_ = dv.dot(e.av) - dv.dot(problem.momentum());
+  line_quadratic_ = dv.dot(a_dv_);
+  line_vc_ = e.contact_velocity;
+  line_dvc_.resize(line_vc_.size());
+  for (int i = 0; i < problem.rowCount(); ++i)
+    line_dvc_[static_cast<size_t>(i)] = problem.rowVelocity(i, dv);
+  double slope0 = 0, curvature = 0, noise = 0;
+  slopeAt(problem, 0, slope0, curvature, noise);
+  if (!(slope0 < 0)) return 0;
+  // ell' is monotone (ell convex): [lo, hi] brackets its root, lo where ell' < 0.
+  double lo = 0, hi = std::numeric_limits<double>::infinity(), alpha = 1;
+  for (int k = 0; k < settings_.max_line_search_iterations; ++k) {
+    ++iterations;
+    double slope = 0;
+    slopeAt(problem, alpha, slope, curvature, noise);
+    if (std::abs(slope) <= std::max(-kSlopeTolerance * slope0, kSlopeRounding * noise))
+      return alpha;
+    if (slope < 0) {
+      lo = alpha;
+    } else {
+      hi = alpha;
+    }
+    if (hi - lo <= 4 * std::numeric_limits<double>::epsilon() * hi) break;
+    // Newton on ell'; bisection when it leaves the bracket (a kink of ell'' in between).
+    double next = alpha - slope / curvature;
+    if (!(next > lo && next < hi)) next = std::isfinite(hi) ? 0.5 * (lo + hi) : 2 * alpha;
+    alpha = next;
+  }
+  // Out of iterations or bracket: lo is on the descending side, so ell(lo) < ell(0).
+  return lo > 0 ? lo : alpha;
+}
+
+void SapSolver::slopeAt(const SapProblem& problem, double alpha, double& slope, double& curvature,
+                        double& noise) const {
+  // ell(v + alpha dv) = ell_A(alpha) + sum_i ell_i(v_c,i + alpha J_i dv), with
+  // ell_A' = dv.(A v - b) + alpha dv.A dv and ell_i' = -(J_i dv).gamma_i.
+  slope = line_linear_ + alpha * line_quadratic_;
+  curvature = line_quadratic_;
+  noise = std::abs(line_linear_) + alpha * std::abs(line_quadratic_);
+  for (int i = 0; i < problem.rowCount(); ++i) {
+    const auto k = static_cast<size_t>(i);
+    const RowResponse r = projectImpulse(problem.model(i), line_vc_[k] + alpha * line_dvc_[k]);
+    const double contact = line_dvc_[k].dot(r.gamma);
+    slope -= contact;
+    noise += std::abs(contact);
+    curvature += line_dvc_[k].dot(r.g * line_dvc_[k]);
+  }
+}
+
+void SapSolver::fillReport(const SapProblem& problem, SapReport& report) const {
+  const auto rows = static_cast<size_t>(problem.rowCount());
+  report.cost = evaluation_.cost;
+  report.impulses.resize(rows);
+  report.states.resize(rows);
+  report.contact_velocities = evaluation_.contact_velocity;
+  for (size_t i = 0; i < rows; ++i) {
+    report.impulses[i] = evaluation_.rows[i].gamma;
+    report.states[i] = evaluation_.rows[i].state;
+  }
+}
+
+}  // namespace torsion::sap

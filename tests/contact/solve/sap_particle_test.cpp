@@ -1,0 +1,116 @@
+// A particle resting on a plane under gravity (docs/contact-solve.md): it sticks below Coulomb's
+// threshold, slides with Coulomb's deceleration above it, keeps its speed without friction.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+
+#include "sap_test_support.h"
+
+namespace torsion::sap {
+namespace {
+
+constexpr double kMass = 1.0;
+constexpr double kDt = 1e-3;
+constexpr double kStiffness = 1e6;  // N/m: a static deflection of m g / k = 9.8 um
+constexpr double kTauD = 2e-3;      // s: about critical damping, 2 sqrt(m / k)
+
+struct ParticleRun {
+  double mean_friction_ratio = 0;  // sum |gamma_t| / sum gamma_n
+  double worst_ratio_error = 0;    // max over sliding steps of | |gamma_t| / (mu gamma_n) - 1 |
+  double max_stick_speed = 0;      // the largest |v_t| while stuck, after 0.1 s
+  double max_stick_slip = 0;       // its regularised value R_t |gamma_t| there
+  double velocity_x = 0;           // at the end
+  double position_z = 0;
+  int slide_steps = 0, stick_steps = 0;
+  int max_newton = 0;
+};
+
+// The particle starts at rest at its static deflection; a constant push f_x for `steps` steps.
+ParticleRun runParticle(double mu, double push, double v0_x, int steps) {
+  Eigen::Vector3d x(0, 0, -kMass * test::kGravity / kStiffness);
+  Eigen::Vector3d v(v0_x, 0, 0);
+  const Eigen::Vector3d force(push, 0, -kMass * test::kGravity);
+  ContactRow row;
+  row.frame = contactFrame(Eigen::Vector3d::UnitZ());
+  row.terms.push_back(nodeTerm(0, 0, 1.0, row.frame));
+  row.mu = mu;
+  row.stiffness = kStiffness;
+  row.dissipation_time = kTauD;
+  SapSolver solver;
+  ParticleRun run;
+  double sum_t = 0, sum_n = 0;
+  for (int step = 0; step < steps; ++step) {
+    MatrixBody particle(test::massMatrix({kMass}), kMass * v + kDt * force);
+    row.gap = x.z();
+    const SapProblem problem = SapProblem::create({&particle}, {row}, kDt).value();
+    Eigen::VectorXd next = v;  // warm start
+    const SapReport report = solver.solve(problem, next);
+    test::expectCoulombAndComplementarity(problem, report);
+    const Eigen::Vector3d& gamma = report.impulses[0];
+    run.max_newton = std::max(run.max_newton, report.newton_iterations);
+    sum_t += gamma.head<2>().norm();
+    sum_n += gamma(2);
+    if (report.states[0] == ContactState::kSlide) {
+      ++run.slide_steps;
+      run.worst_ratio_error =
+          std::max(run.worst_ratio_error, std::abs(gamma.head<2>().norm() / (mu * gamma(2)) - 1));
+    } else if (report.states[0] == ContactState::kStick) {
+      ++run.stick_steps;
+      if (step * kDt >= 0.1) {
+        run.max_stick_speed = std::max(run.max_stick_speed, next.head<2>().norm());
+        run.max_stick_slip =
+            std::max(run.max_stick_slip, problem.model(0).rt * gamma.head<2>().norm());
+      }
+    }
+    v = next;
+    x += kDt * v;
+  }
+  run.mean_friction_ratio = sum_t / sum_n;
+  run.velocity_x = v.x();
+  run.position_z = x.z();
+  return run;
+}
+
+// A push of 0.4 mu m g: static friction holds it. The only tangential motion left is the
+// regularised stiction slip v_t = -R_t gamma_t (R_t = 1e-3 w), whose steady value is
+// R_t f dt: about a micrometre per second.
+TEST(SapParticle, SticksBelowCoulombsThreshold) {
+  const double mu = 0.5, push = 0.4 * mu * kMass * test::kGravity;
+  const ParticleRun run = runParticle(mu, push, 0.0, 1000);
+  EXPECT_EQ(run.slide_steps, 0);
+  EXPECT_EQ(run.stick_steps, 1000);
+  const double rt = 1e-3 * std::sqrt(3.0) / 3 / kMass;
+  EXPECT_NEAR(run.max_stick_speed, rt * push * kDt, 1e-3 * rt * push * kDt);
+  EXPECT_LE(run.max_stick_speed, run.max_stick_slip * (1 + 1e-9));
+  EXPECT_LT(run.max_stick_speed, 2e-6);
+  // Resting at its static deflection.
+  EXPECT_NEAR(run.position_z, -kMass * test::kGravity / kStiffness, 1e-3 * 9.81e-6);
+  std::printf("particle stick: |v_t| = %.3e m/s, R_t f dt = %.3e m/s; Newton <= %d\n",
+              run.max_stick_speed, rt * push * kDt, run.max_newton);
+}
+
+// A push of 2 mu m g: it slides from the first step, friction exactly mu times the normal impulse
+// in every step, and after 1 s its speed is (f / m - mu g) t.
+TEST(SapParticle, SlidesWithCoulombsDecelerationAboveIt) {
+  const double mu = 0.5, push = 2 * mu * kMass * test::kGravity;
+  const ParticleRun run = runParticle(mu, push, 0.0, 1000);
+  EXPECT_EQ(run.slide_steps, 1000);
+  EXPECT_LT(run.worst_ratio_error, 1e-9);
+  EXPECT_NEAR(run.mean_friction_ratio, mu, 1e-9 * mu);
+  const double expected = (push / kMass - mu * test::kGravity) * 1.0;
+  EXPECT_NEAR(run.velocity_x, expected, 2e-3 * expected);
+  std::printf(
+      "particle slide: v(1 s) = %.6f m/s, Coulomb %.6f; worst |gamma_t|/(mu gamma_n)-1 = "
+      "%.2e; Newton <= %d\n",
+      run.velocity_x, expected, run.worst_ratio_error, run.max_newton);
+}
+
+TEST(SapParticle, FrictionlessKeepsItsTangentialSpeed) {
+  const ParticleRun run = runParticle(0.0, 0.0, 2.0, 1000);
+  EXPECT_NEAR(run.velocity_x, 2.0, 1e-12);
+  EXPECT_NEAR(run.position_z, -kMass * test::kGravity / kStiffness, 1e-3 * 9.81e-6);
+}
+
+}  // namespace
+}  // namespace torsion::sap

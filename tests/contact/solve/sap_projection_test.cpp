@@ -1,0 +1,113 @@
+// The SAP projection (sap_problem.h): its regions, its derivative G against finite differences,
+// the cost's gradient -gamma, and the regularisation's constants.
+#include <gtest/gtest.h>
+
+#include <Eigen/Eigenvalues>
+#include <cmath>
+#include <random>
+
+#include "sap_test_support.h"
+#include "torsion/contact/solve/sap_problem.h"
+
+namespace torsion::sap {
+namespace {
+
+RowModel someModel(double mu) {
+  RowModel m;
+  m.mu = mu;
+  m.rt = 2e-4;
+  m.rn = 3e-2;
+  m.v_hat = 0.01;
+  return m;
+}
+
+TEST(SapProjection, RegionsFollowTheCone) {
+  const RowModel m = someModel(0.5);
+  // At rest against the bias: y = (0, 0, v_hat / R_n) lies inside the cone.
+  RowResponse r = projectImpulse(m, Eigen::Vector3d::Zero());
+  EXPECT_EQ(r.state, ContactState::kStick);
+  EXPECT_DOUBLE_EQ(r.gamma(2), m.v_hat / m.rn);
+  // Separating fast: gamma = 0.
+  r = projectImpulse(m, Eigen::Vector3d(0.0, 0.0, 1.0));
+  EXPECT_EQ(r.state, ContactState::kSeparated);
+  EXPECT_EQ(r.gamma, Eigen::Vector3d::Zero());
+  // Sliding fast along t1: friction on the cone's surface, against the slip.
+  r = projectImpulse(m, Eigen::Vector3d(1.0, 0.0, 0.0));
+  EXPECT_EQ(r.state, ContactState::kSlide);
+  EXPECT_LT(r.gamma(0), 0);
+  EXPECT_NEAR(r.gamma.head<2>().norm(), m.mu * r.gamma(2), 1e-15 * r.gamma(2));
+}
+
+// G = -d gamma / d v_c, symmetric and positive semi-definite, and d ell_i / d v_c = -gamma, in
+// each region, by central differences.
+TEST(SapProjection, DerivativesMatchFiniteDifferences) {
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> uniform(-1.0, 1.0);
+  int seen[3] = {0, 0, 0};
+  for (int trial = 0; trial < 300; ++trial) {
+    const RowModel m = someModel(trial % 10 == 0 ? 0.0 : 0.8 * (uniform(rng) + 1));
+    // Slow slips (a third of the trials) land inside the cone, fast ones on it or past it.
+    const double slip = trial % 3 == 0 ? 1e-5 : 0.02;
+    const Eigen::Vector3d vc(slip * uniform(rng), slip * uniform(rng), 0.03 * uniform(rng));
+    const RowResponse r = projectImpulse(m, vc);
+    ++seen[static_cast<int>(r.state)];
+    const double h = 1e-9;
+    for (int j = 0; j < 3; ++j) {
+      const Eigen::Vector3d e = Eigen::Vector3d::Unit(j);
+      const RowResponse plus = projectImpulse(m, vc + h * e);
+      const RowResponse minus = projectImpulse(m, vc - h * e);
+      if (plus.state != r.state || minus.state != r.state) continue;  // on a region's boundary
+      const Eigen::Vector3d dgamma = (plus.gamma - minus.gamma) / (2 * h);
+      const double scale = r.g.norm() + 1 / m.rt;
+      EXPECT_LE((r.g.col(j) + dgamma).norm(), 1e-5 * scale) << "trial " << trial;
+      EXPECT_NEAR((plus.cost - minus.cost) / (2 * h), -r.gamma(j), 1e-5 * (r.gamma.norm() + 1e-9))
+          << "trial " << trial;
+    }
+    EXPECT_LE((r.g - r.g.transpose()).norm(), 1e-12 * r.g.norm());
+    EXPECT_GE(Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(r.g).eigenvalues().minCoeff(),
+              -1e-12 * r.g.norm());
+  }
+  EXPECT_GT(seen[0], 10);
+  EXPECT_GT(seen[1], 10);
+  EXPECT_GT(seen[2], 10);
+}
+
+// R_n from the stiffness until the near-rigid cap, R_t = sigma w, v_hat = -phi0 / (dt + tau_d).
+TEST(SapProjection, RegularisationFollowsTheCompliance) {
+  const double mass = 2.0, dt = 1e-3;
+  MatrixBody particle(test::massMatrix({mass}), Eigen::VectorXd::Zero(3));
+  ContactRow row;
+  row.frame = contactFrame(Eigen::Vector3d::UnitZ());
+  row.terms.push_back(nodeTerm(0, 0, 1.0, row.frame));
+  row.mu = 0.3;
+  row.dissipation_time = 4e-3;
+  row.gap = -1e-4;
+  const double w = std::sqrt(3.0) / mass / 3;  // |I / m|_F / 3
+  for (double k : {1e4, 1e9}) {
+    row.stiffness = k;
+    const SapProblem problem = SapProblem::create({&particle}, {row}, dt).value();
+    const RowModel& m = problem.model(0);
+    EXPECT_NEAR(m.w, w, 1e-15);
+    EXPECT_NEAR(m.rt, 1e-3 * w, 1e-18);
+    const double physical = 1 / (dt * (dt + 4e-3) * k);
+    const double pi = std::acos(-1.0);
+    const double cap = w / (4 * pi * pi);
+    EXPECT_DOUBLE_EQ(m.rn, std::max(physical, cap));
+    EXPECT_DOUBLE_EQ(m.v_hat, 1e-4 / (dt + 4e-3));
+  }
+}
+
+TEST(SapProjection, MalformedRowsAreRefused) {
+  MatrixBody particle(test::massMatrix({1.0}), Eigen::VectorXd::Zero(3));
+  ContactRow row;
+  row.terms.push_back(nodeTerm(0, 1, 1.0, row.frame));  // node 1 of a one-node body
+  row.stiffness = 1e5;
+  EXPECT_FALSE(SapProblem::create({&particle}, {row}, 1e-3).ok());
+  row.terms[0] = nodeTerm(0, 0, 1.0, row.frame);
+  EXPECT_TRUE(SapProblem::create({&particle}, {row}, 1e-3).ok());
+  row.mu = -0.1;
+  EXPECT_FALSE(SapProblem::create({&particle}, {row}, 1e-3).ok());
+}
+
+}  // namespace
+}  // namespace torsion::sap
