@@ -107,6 +107,50 @@ TEST(SapRigidBox, SlidesWithCoulombsAccelerationAboveTheFrictionAngle) {
   }
 }
 
+// A contact far stiffer than the step can resolve (k = 1e12 N/m): R_n is the near-rigid cap
+// beta^2 / (4 pi^2) w, and the box comes to rest on it without chatter: after 1 s nothing moves,
+// the impulses repeat step after step, and each corner rests where the capped compliance puts it,
+// phi = -(dt + tau_d) R_n gamma_n (v_n = 0 in gamma_n = (v_hat - v_n) / R_n); both to within ten
+// times the solve's relative tolerance (1e-6), which is what each step's solve is held to.
+TEST(SapRigidBox, NearRigidContactRestsWithoutChatter) {
+  const Eigen::Vector3d gravity(0, 0, -kGravity);
+  BoxState box;
+  box.position.z() = box.half.z() + 1e-3;  // dropped from 1 mm
+  SapSolver solver;
+  double max_speed = 0, max_impulse_change = 0, worst_rest_error = 0;
+  std::vector<double> last_normal(4, 0.0);
+  for (int step = 0; step < 1500; ++step) {
+    const RigidBody body(box.mass, box.inertia(), box.momentum(gravity, kDt));
+    std::vector<ContactRow> rows;
+    for (const Eigen::Vector3d& corner : box.bottomCorners()) {
+      rows.push_back(groundRow(0, box, corner, 0.5));
+      rows.back().stiffness = 1e12;
+      rows.back().dissipation_time = 0;
+    }
+    const SapProblem problem = SapProblem::create({&body}, rows, kDt).value();
+    Eigen::VectorXd v = box.twist;
+    const SapReport report = solver.solve(problem, v);
+    test::expectCoulombAndComplementarity(problem, report);
+    for (size_t i = 0; i < 4 && step >= 1000; ++i) {
+      const RowModel& m = problem.model(static_cast<int>(i));
+      EXPECT_GT(m.rn, 1.0 / (kDt * kDt * 1e12));  // the cap, not the stiffness, sets R_n
+      const double gn = report.impulses[i](2);
+      max_impulse_change = std::max(max_impulse_change, std::abs(gn - last_normal[i]) / gn);
+      const double rest = -kDt * m.rn * gn;
+      worst_rest_error = std::max(worst_rest_error, std::abs(rows[i].gap / rest - 1));
+    }
+    for (size_t i = 0; i < 4; ++i)
+      last_normal[i] = report.impulses[i](2);
+    if (step >= 1000) max_speed = std::max(max_speed, v.cwiseAbs().maxCoeff());
+    box.advance(v, kDt);
+  }
+  EXPECT_LT(max_speed, 1e-9);
+  EXPECT_LT(max_impulse_change, 1e-5);
+  EXPECT_LT(worst_rest_error, 1e-5);
+  std::printf("near-rigid box: |v| <= %.1e m/s, impulse change <= %.1e, rest depth error %.1e\n",
+              max_speed, max_impulse_change, worst_rest_error);
+}
+
 // A node (0.1 kg) between two thin rigid plates (1 kg each, pressed together by F = 10 N, no
 // gravity), pulled sideways by f. The plates' huge rotational inertia keeps them level (the rows
 // take their surfaces as fixed planes). Co-moving needs friction f M / (m + 2 M) at each face:
