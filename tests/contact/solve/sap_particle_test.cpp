@@ -106,6 +106,20 @@ TEST(SapParticle, SlidesWithCoulombsDecelerationAboveIt) {
       run.velocity_x, expected, run.worst_ratio_error, run.max_newton);
 }
 
+// The model's known limit (docs/contact-solve.md, "Limits"): SAP's convex relaxation of Coulomb's
+// law gives a sliding contact the normal velocity mu |v_t| over its compliant rest, so the sliding
+// particle rides (dt + tau_d) mu |v_t| above its static deflection (7.4 mm at 4.9 m/s here). Pinned
+// down so that a change of model shows.
+TEST(SapParticle, SlidingRidesAtTheConvexRelaxationsDilation) {
+  const double mu = 0.5, push = 2 * mu * kMass * test::kGravity;
+  const ParticleRun run = runParticle(mu, push, 0.0, 1000);
+  const double lift = run.position_z + kMass * test::kGravity / kStiffness;
+  const double dilation = (kDt + kTauD) * mu * run.velocity_x;
+  EXPECT_NEAR(lift, dilation, 0.01 * dilation);
+  std::printf("particle slide: rides %.3f mm above rest, (dt + tau_d) mu v_t = %.3f mm\n",
+              1e3 * lift, 1e3 * dilation);
+}
+
 TEST(SapParticle, FrictionlessKeepsItsTangentialSpeed) {
   const ParticleRun run = runParticle(0.0, 0.0, 2.0, 1000);
   EXPECT_NEAR(run.velocity_x, 2.0, 1e-12);
