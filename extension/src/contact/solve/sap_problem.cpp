@@ -39,7 +39,7 @@ const char* toString(ContactState state) {
 
 RowResponse projectImpulse(const RowModel& m, const Eigen::Vector3d& vc) {
   RowResponse out;
-  // y = -R^{-1} (v_c - v_hat); the three regions of the paper's analytic projection (sec. VII).
+  // y = -R^{-1} (v_c - v_hat); the three regions of the paper's analytic projection.
   const Eigen::Vector2d yt = -vc.head<2>() / m.rt;
   const double yn = (m.v_hat - vc(2)) / m.rn;
   const double yr = yt.norm();
@@ -58,9 +58,9 @@ RowResponse projectImpulse(const RowModel& m, const Eigen::Vector3d& vc) {
     const Eigen::Vector2d t = yt / yr;
     const double gn = (yn + mu_hat * yr) * factor;
     out.gamma << m.mu * gn * t, gn;
-    // G = factor / R_n u u^T + mu gamma_n / (y_r R_t) (I_t - t t^T), u = (mu t, 1).
-    const Eigen::Vector3d u(m.mu * t(0), m.mu * t(1), 1.0);
-    out.g = (factor / m.rn) * u * u.transpose();
+    // G = factor / R_n e e^T + mu gamma_n / (y_r R_t) (I_t - t t^T), e = (mu t, 1).
+    const Eigen::Vector3d e(m.mu * t(0), m.mu * t(1), 1.0);
+    out.g = (factor / m.rn) * e * e.transpose();
     out.g.topLeftCorner<2, 2>() +=
         (m.mu * gn / (yr * m.rt)) * (Eigen::Matrix2d::Identity() - t * t.transpose());
   }

@@ -1,7 +1,7 @@
 #pragma once
 // One convex problem per contact island: SAP, the Semi-Analytic Primal formulation of
 // A. M. Castro, F. N. Permenter, X. Han, "An Unconstrained Convex Formulation of Compliant
-// Contact", IEEE Transactions on Robotics 39(2), 2023 (arXiv:2110.10107, 2022); Drake's SAP
+// Contact", IEEE Transactions on Robotics, 2023 (arXiv:2110.10107, 2022); Drake's SAP
 // solver. docs/contact-solve.md explains the model; this header gives the formulas.
 //
 // Unknowns: v, every velocity dof of the island's bodies (island_body.h), stacked body by body.
@@ -13,17 +13,20 @@
 // minimiser is A v = b, the bodies' own implicit step.
 //
 // Contact i, regularised by its physical compliance (stiffness k, dissipation time scale tau_d,
-// gap phi0 at the step's start, step dt) and the Delassus estimate w_i (paper, sec. V and VII):
+// gap phi0 at the step's start, step dt) and the Delassus estimate w_i (the paper's
+// regularisation):
 //
-//     R_n = max(beta^2 / (4 pi^2) w_i, 1 / (dt (dt + tau_d) k))   (near-rigid cap: the contact's
-//           period is never shorter than beta dt, which the step can resolve)
-//     R_t = sigma w_i                    (regularised friction: a stuck contact slips at R_t
-//     |gamma_t|) v_hat = (0, 0, -phi0 / (dt + tau_d)) w_i = ||W_ii||_F / 3,  W_ii = sum over the
-//     row's terms B D^{-1} B^T, D the block of A the
-//           term acts on, inverted on its free dofs (exact for a rigid body; for a FEM node the
-//           block-Jacobi estimate of the node's compliance)
+//     R_n = max(beta^2 / (4 pi^2) w_i, 1 / (dt (dt + tau_d) k))
+//     R_t = sigma w_i
+//     v_hat = (0, 0, -phi0 / (dt + tau_d))
+//     w_i = ||W_ii||_F / 3,  W_ii = sum over the row's terms of B D^{-1} B^T
 //
-// with beta = 1 and sigma = 1e-3 (SapParameters). With R = diag(R_t, R_t, R_n) the impulse is
+// The cap on R_n (near-rigid regime): the contact's period is never shorter than beta dt, which
+// the step can resolve. R_t regularises friction: a stuck contact slips at R_t |gamma_t|. D is
+// the block of A a term acts on, inverted on its free dofs: exact for a rigid body, for a FEM node
+// the block-Jacobi estimate of its compliance. beta = 1 and sigma = 1e-3 (SapParameters).
+//
+// With R = diag(R_t, R_t, R_n) the impulse is
 //
 //     gamma_i = P(y_i),   y_i = -R^{-1} (v_c,i - v_hat)
 //
@@ -40,8 +43,8 @@
 //     gradient  g = A v - b - J^T gamma
 //     Hessian   H = A + J^T G J,  G_i = -d gamma_i / d v_c,i = (d P / d y) R^{-1}, symmetric PSD:
 //               stick R^{-1}; separate 0; slide
-//               1/((1 + mu_tilde^2) R_n) u u^T + mu gamma_n / (y_r R_t) (I_t - t t^T),
-//               u = (mu t, 1), t = y_t / y_r, I_t the tangent-plane identity.
+//               1/((1 + mu_tilde^2) R_n) e e^T + mu gamma_n / (y_r R_t) (I_t - t t^T),
+//               e = (mu t, 1), t = y_t / y_r, I_t the tangent-plane identity.
 //
 // At the minimiser (g = 0) u_i = v_c,i - v_hat + R gamma_i satisfies gamma in F, u in the dual
 // cone {mu |u_t| <= u_n}, gamma . u = 0: Coulomb's law with maximal dissipation, relaxed by R.
@@ -59,7 +62,7 @@
 
 namespace torsion::sap {
 
-/// The paper's regularisation constants (sec. V, VII).
+/// The paper's regularisation constants.
 struct SapParameters {
   /// R_t = sigma w: the stiction slip relative to the velocity a row's impulse gives (1e-3, the
   /// paper's value: a thousandth of the slip-free response).

@@ -1,6 +1,6 @@
 #pragma once
-// Newton's method on the SAP cost of an island (sap_problem.h; Castro, Permenter, Han 2022,
-// sec. VIII). Each iteration:
+// Newton's method on the SAP cost of an island (sap_problem.h; Castro, Permenter, Han 2022: the
+// paper's solver). Each iteration:
 //
 //   1. the gradient g = S (A v - b - J^T gamma) and the G blocks at v;
 //   2. the Newton direction from S H S dv = -g, H = A + J^T G J, by preconditioned CG, matrix-free
@@ -14,7 +14,7 @@
 //      monotone, so the bracket always holds the minimiser, and the cost never increases.
 //
 // The cost is strictly convex and C1 with a piecewise-smooth gradient: Newton with exact line
-// search converges from any start. It stops on the paper's optimality criterion (sec. VIII-C),
+// search converges from any start. It stops on the paper's optimality criterion,
 //
 //     |D g| <= eps_abs + eps_rel max(|D p|, |D j|),   D = diag(A)^{-1/2}, p = A v, j = J^T gamma
 //
