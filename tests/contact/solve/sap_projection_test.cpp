@@ -38,6 +38,18 @@ TEST(SapProjection, RegionsFollowTheCone) {
   EXPECT_NEAR(r.gamma.head<2>().norm(), m.mu * r.gamma(2), 1e-15 * r.gamma(2));
 }
 
+// Without friction a contact with no tangential velocity at all (a cold start at v = 0) still
+// separates when the normal velocity opens the gap: no negative normal impulse.
+TEST(SapProjection, FrictionlessContactWithoutSlipSeparates) {
+  const RowModel m = someModel(0.0);
+  RowResponse r = projectImpulse(m, Eigen::Vector3d(0.0, 0.0, 0.1));
+  EXPECT_EQ(r.state, ContactState::kSeparated);
+  EXPECT_EQ(r.gamma, Eigen::Vector3d::Zero());
+  r = projectImpulse(m, Eigen::Vector3d(0.0, 0.0, -0.1));
+  EXPECT_EQ(r.state, ContactState::kStick);
+  EXPECT_DOUBLE_EQ(r.gamma(2), (m.v_hat + 0.1) / m.rn);
+}
+
 // G = -d gamma / d v_c, symmetric and positive semi-definite, and d ell_i / d v_c = -gamma, in
 // each region, by central differences.
 TEST(SapProjection, DerivativesMatchFiniteDifferences) {

@@ -44,7 +44,8 @@ RowResponse projectImpulse(const RowModel& m, const Eigen::Vector3d& vc) {
   const double yn = (m.v_hat - vc(2)) / m.rn;
   const double yr = yt.norm();
   const double mu_hat = m.mu * m.rt / m.rn;
-  if (yr <= m.mu * yn) {
+  // Stick needs y_n >= 0 spelled out for mu = 0, where y_r = 0 <= 0 y_n holds for any y_n.
+  if (yr <= m.mu * yn && yn >= 0) {
     out.state = ContactState::kStick;
     out.gamma << yt, yn;
     out.g.diagonal() << 1 / m.rt, 1 / m.rt, 1 / m.rn;
