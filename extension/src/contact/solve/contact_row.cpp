@@ -1,5 +1,6 @@
 #include "torsion/contact/solve/contact_row.h"
 
+#include <Eigen/Geometry>
 #include <cmath>
 
 namespace torsion::sap {
