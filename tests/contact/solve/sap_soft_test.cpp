@@ -1,6 +1,7 @@
 // Deformable bodies in SAP islands (docs/contact-solve.md): a spring-network block (a sparse SPD
-// system over 8 nodes) slides down an incline as Coulomb says, with and without friction; a FEM
-// bar (SystemOperator + NodeConstraints through FemIslandBody) rests, holds and slides on a plane.
+// system over 8 nodes) slides down an incline as Coulomb says, with and without friction; a
+// particle on another body's face loads its nodes by their barycentric weights; a FEM bar
+// (SystemOperator + NodeConstraints through FemIslandBody) rests, holds and slides on a plane.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -114,6 +115,85 @@ TEST(SapSpringBlock, SlidesFreelyWithoutFriction) {
   EXPECT_NEAR(distance, free_slide, 0.03 * free_slide);
   std::printf("spring block, frictionless: %.5f m in 1 s, g sin a t^2 / 2 = %.5f (%+.3f %%)\n",
               distance, free_slide, 100 * (distance / free_slide - 1));
+}
+
+// ---- A node on another body's face (1 + 3 terms) ----
+// A 0.5 kg particle rests on a triangle of three 0.2 kg nodes of a second body (joined by springs
+// in the face's plane), which rest on the ground. The node-face row's Jacobian is v_particle -
+// sum_k w_k v_node_k with barycentric weights w = (0.2, 0.3, 0.5); at rest each face node carries
+// its own weight plus w_k of the particle's: ground impulse (M + w_k m) g dt.
+// Springs of 1e4 N/m along the edges of a right triangle in the plane z = 0 (legs 0.1 m): they
+// resist motion in the face's plane only.
+Eigen::SparseMatrix<double> triangleStiffness() {
+  const std::vector<Eigen::Vector3d> corners = {{0, 0, 0}, {0.1, 0, 0}, {0, 0.1, 0}};
+  Eigen::SparseMatrix<double> stiffness(9, 9);
+  std::vector<Eigen::Triplet<double>> entries;
+  for (int i = 0; i < 3; ++i) {
+    const int j = (i + 1) % 3;
+    const Eigen::Vector3d d =
+        (corners[static_cast<size_t>(j)] - corners[static_cast<size_t>(i)]).normalized();
+    const Eigen::Matrix3d block = 1e4 * d * d.transpose();
+    for (int a = 0; a < 3; ++a)
+      for (int b = 0; b < 3; ++b) {
+        entries.emplace_back(3 * i + a, 3 * i + b, block(a, b));
+        entries.emplace_back(3 * j + a, 3 * j + b, block(a, b));
+        entries.emplace_back(3 * i + a, 3 * j + b, -block(a, b));
+        entries.emplace_back(3 * j + a, 3 * i + b, -block(a, b));
+      }
+  }
+  stiffness.setFromTriplets(entries.begin(), entries.end());
+  return stiffness;
+}
+
+TEST(SapNodeOnFace, FaceNodesCarryTheParticleByItsBarycentricWeights) {
+  const double dt = 1e-3, m = 0.5, node_mass = 0.2;
+  const Eigen::Vector3d w(0.2, 0.3, 0.5);
+  const Eigen::SparseMatrix<double> face_a =
+      test::massMatrix({node_mass, node_mass, node_mass}) + dt * dt * triangleStiffness();
+  const Eigen::Matrix3d frame = contactFrame(Eigen::Vector3d::UnitZ());
+  Eigen::VectorXd face_z = Eigen::VectorXd::Zero(3), v = Eigen::VectorXd::Zero(12);
+  double particle_z = 0;
+  SapSolver solver;
+  SapReport report;
+  for (int step = 0; step < 1000; ++step) {
+    Eigen::VectorXd particle_b = m * v.head<3>(), face_b = node_mass * v.tail<9>();
+    particle_b(2) -= dt * m * kGravity;
+    for (int k = 0; k < 3; ++k)
+      face_b(3 * k + 2) -= dt * node_mass * kGravity;
+    MatrixBody particle(test::massMatrix({m}), particle_b);
+    MatrixBody face(face_a, face_b);
+    std::vector<ContactRow> rows(4);
+    for (ContactRow& row : rows) {
+      row.frame = frame;
+      row.mu = 0.5;
+      row.stiffness = 1e5;
+      row.dissipation_time = 2e-3;
+    }
+    rows[0].terms.push_back(nodeTerm(0, 0, 1.0, frame));
+    for (int k = 0; k < 3; ++k) {
+      rows[0].terms.push_back(nodeTerm(1, k, -w(k), frame));
+      rows[static_cast<size_t>(k + 1)].terms.push_back(nodeTerm(1, k, 1.0, frame));
+      rows[static_cast<size_t>(k + 1)].gap = face_z(k);
+    }
+    rows[0].gap = particle_z - w.dot(face_z);
+    const SapProblem problem = SapProblem::create({&particle, &face}, rows, dt).value();
+    report = solver.solve(problem, v);
+    test::expectCoulombAndComplementarity(problem, report);
+    particle_z += dt * v(2);
+    for (int k = 0; k < 3; ++k)
+      face_z(k) += dt * v(3 * k + 5);
+  }
+  EXPECT_NEAR(report.impulses[0](2), m * kGravity * dt, 1e-6 * m * kGravity * dt);
+  for (int k = 0; k < 3; ++k) {
+    const double expected = (node_mass + w(k) * m) * kGravity * dt;
+    EXPECT_NEAR(report.impulses[static_cast<size_t>(k + 1)](2), expected, 1e-6 * expected);
+  }
+  std::printf(
+      "node on a face: ground impulses / (g dt) = %.6f, %.6f, %.6f kg (M + w_k m = %.2f, "
+      "%.2f, %.2f)\n",
+      report.impulses[1](2) / (kGravity * dt), report.impulses[2](2) / (kGravity * dt),
+      report.impulses[3](2) / (kGravity * dt), node_mass + w(0) * m, node_mass + w(1) * m,
+      node_mass + w(2) * m);
 }
 
 // ---- FEM bar through FemIslandBody ----
