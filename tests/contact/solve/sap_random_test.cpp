@@ -123,7 +123,7 @@ bool bitIdentical(const Eigen::VectorXd& a, const Eigen::VectorXd& b) {
 
 // Solves islands first_seed .. first_seed + count - 1 and checks each (see the file's comment).
 void checkRandomIslands(const Spread& spread, unsigned first_seed, unsigned count, double dt) {
-  int worst_newton = 0, worst_cg = 0, total_newton = 0, worst_refine = 0;
+  int worst_newton = 0, worst_cg = 0, total_newton = 0, worst_refine = 0, total_search = 0;
   for (unsigned seed = first_seed; seed < first_seed + count; ++seed) {
     const RandomIsland island = randomIsland(seed, spread);
     std::vector<const IslandBody*> bodies;
@@ -139,6 +139,7 @@ void checkRandomIslands(const Spread& spread, unsigned first_seed, unsigned coun
     worst_newton = std::max(worst_newton, report.newton_iterations);
     worst_cg = std::max(worst_cg, report.cg_iterations);
     total_newton += report.newton_iterations;
+    total_search += report.line_search_iterations;
     // The same input again, on a fresh solver and on the used one: the same bits.
     for (int again = 0; again < 2; ++again) {
       SapSolver fresh;
@@ -167,10 +168,10 @@ void checkRandomIslands(const Spread& spread, unsigned first_seed, unsigned coun
     worst_refine = std::max(worst_refine, refined.newton_iterations);
   }
   std::printf(
-      "random islands: %d problems, Newton mean %.1f, max %d; CG per solve max %d; "
-      "1e-6 -> 1e-12 in <= %d\n",
+      "random islands: %d problems, Newton mean %.1f, max %d; CG per solve max %d; line "
+      "search %.1f evaluations per Newton step; 1e-6 -> 1e-12 in <= %d\n",
       static_cast<int>(count), static_cast<double>(total_newton) / count, worst_newton, worst_cg,
-      worst_refine);
+      static_cast<double>(total_search) / std::max(total_newton, 1), worst_refine);
 }
 
 TEST(SapRandom, RandomIslandsConvergeAndRepeatBitForBit) {
