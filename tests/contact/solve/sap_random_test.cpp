@@ -5,6 +5,7 @@
 
 #include <cstdio>
 #include <cstring>
+#include <limits>
 #include <memory>
 #include <random>
 
@@ -199,6 +200,22 @@ TEST(SapRandom, AnIterationCapIsReported) {
   EXPECT_FALSE(report.converged);
   EXPECT_EQ(report.message, "iteration cap");
   EXPECT_GT(report.residual, report.tolerance);
+}
+
+// A non-finite input (a NaN momentum from upstream) stops the solve at once, reported.
+TEST(SapRandom, ANonFiniteInputIsReported) {
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  MatrixBody particle(test::massMatrix({1.0}), Eigen::Vector3d(0.0, nan, 0.0));
+  ContactRow row;
+  row.terms.push_back(nodeTerm(0, 0, 1.0, row.frame));
+  row.stiffness = 1e5;
+  const SapProblem problem = SapProblem::create({&particle}, {row}, 1e-3).value();
+  SapSolver solver;
+  Eigen::VectorXd v;
+  const SapReport report = solver.solve(problem, v);
+  EXPECT_FALSE(report.converged);
+  EXPECT_EQ(report.message, "non-finite residual");
+  EXPECT_EQ(report.newton_iterations, 0);
 }
 
 }  // namespace

@@ -41,6 +41,10 @@ SapReport SapSolver::solve(const SapProblem& problem, Eigen::VectorXd& v) {
       report.converged = true;
       break;
     }
+    if (!std::isfinite(report.residual)) {
+      report.message = "non-finite residual";  // a non-finite b, A or warm start
+      break;
+    }
     if (report.newton_iterations >= settings_.max_newton_iterations) {
       report.message = "iteration cap";
       break;

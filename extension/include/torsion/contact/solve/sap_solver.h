@@ -44,7 +44,8 @@ struct SapSolverSettings {
 
 struct SapReport {
   bool converged = false;
-  /// Why an unconverged solve stopped ("iteration cap", "no progress"); empty when converged.
+  /// Why an unconverged solve stopped ("iteration cap", "no progress", "non-finite residual");
+  /// empty when converged.
   std::string message;
   int newton_iterations = 0;
   int cg_iterations = 0;           ///< summed over the Newton iterations
