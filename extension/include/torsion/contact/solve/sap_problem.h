@@ -109,7 +109,9 @@ struct SapEvaluation {
 class SapProblem {
  public:
   /// Fails on a malformed row (a term outside its body or not on one whole block, mu < 0, k <= 0,
-  /// tau_d < 0) or dt <= 0. The bodies are not owned and must outlive the problem.
+  /// tau_d < 0) or dt <= 0. The bodies are not owned and must outlive the problem; their b,
+  /// diagonal blocks and free-dof projectors are read here; their products, filters and prescribed
+  /// values at every solve.
   static Result<SapProblem> create(std::vector<const IslandBody*> bodies,
                                    std::vector<ContactRow> rows, double dt,
                                    const SapParameters& parameters = {});
