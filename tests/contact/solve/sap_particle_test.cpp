@@ -120,6 +120,52 @@ TEST(SapParticle, SlidingRidesAtTheConvexRelaxationsDilation) {
               1e3 * lift, 1e3 * dilation);
 }
 
+// A particle set at rest on a conveyor belt running at 1 m/s (a kinematic partner: the belt's
+// velocity enters the row as its velocity offset): friction accelerates it at mu g until it runs
+// with the belt, at t = v / (mu g) = 0.204 s, and from then on it sticks to the belt. The sudden
+// 1 m/s slip also shows the convex relaxation's dilation (docs/contact-solve.md, "Limits"): the
+// particle hops off the belt for a few tens of milliseconds at the start, and loses that much
+// friction: its speed at 0.1 s is held to 1 %, not to rounding.
+TEST(SapParticle, ConveyorBeltCarriesItAfterCoulombsRunUp) {
+  const double mu = 0.5, belt = 1.0;
+  Eigen::Vector3d x(0, 0, -kMass * test::kGravity / kStiffness), v = Eigen::Vector3d::Zero();
+  ContactRow row;
+  row.frame = contactFrame(Eigen::Vector3d::UnitZ());
+  row.terms.push_back(nodeTerm(0, 0, 1.0, row.frame));
+  row.mu = mu;
+  row.stiffness = kStiffness;
+  row.dissipation_time = kTauD;
+  row.velocity_offset = -row.frame * Eigen::Vector3d(belt, 0, 0);  // B the particle, A the belt
+  SapSolver solver;
+  double speed_at_100ms = 0, max_lift = 0;
+  int airborne = 0;
+  SapReport report;
+  for (int step = 0; step < 500; ++step) {
+    MatrixBody particle(test::massMatrix({kMass}),
+                        kMass * v + kDt * Eigen::Vector3d(0, 0, -kMass * test::kGravity));
+    row.gap = x.z();
+    const SapProblem problem = SapProblem::create({&particle}, {row}, kDt).value();
+    Eigen::VectorXd next = v;
+    report = solver.solve(problem, next);
+    test::expectCoulombAndComplementarity(problem, report);
+    if (step < 200) {  // still running up to the belt's speed: never stuck
+      EXPECT_NE(report.states[0], ContactState::kStick) << "step " << step;
+    }
+    airborne += report.states[0] == ContactState::kSeparated;
+    v = next;
+    x += kDt * v;
+    max_lift = std::max(max_lift, x.z() + kMass * test::kGravity / kStiffness);
+    if (step + 1 == 100) speed_at_100ms = v.x();
+  }
+  EXPECT_NEAR(speed_at_100ms, mu * test::kGravity * 0.1, 1e-2 * mu * test::kGravity * 0.1);
+  EXPECT_EQ(report.states[0], ContactState::kStick);
+  EXPECT_NEAR(v.x(), belt, 1e-6);
+  std::printf(
+      "conveyor: v(0.1 s) = %.5f m/s (mu g t = %.5f); v(0.5 s) = %.8f m/s, belt %.1f; "
+      "airborne %d steps, up to %.2f mm\n",
+      speed_at_100ms, mu * test::kGravity * 0.1, v.x(), belt, airborne, 1e3 * max_lift);
+}
+
 TEST(SapParticle, FrictionlessKeepsItsTangentialSpeed) {
   const ParticleRun run = runParticle(0.0, 0.0, 2.0, 1000);
   EXPECT_NEAR(run.velocity_x, 2.0, 1e-12);

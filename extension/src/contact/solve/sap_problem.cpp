@@ -121,6 +121,7 @@ Status SapProblem::validate(const ContactRow& row) const {
   if (!(row.dissipation_time >= 0))
     return Error{"dissipation time " + std::to_string(row.dissipation_time) + " < 0"};
   if (!std::isfinite(row.gap)) return Error{"gap is not finite"};
+  if (!row.velocity_offset.allFinite()) return Error{"velocity offset is not finite"};
   for (const ContactTerm& term : row.terms) {
     if (term.body < 0 || term.body >= static_cast<int>(bodies_.size()))
       return Error{"term on body " + std::to_string(term.body) + ", which is not in the island"};
@@ -170,10 +171,14 @@ void SapProblem::multiplyA(const Eigen::VectorXd& x, Eigen::VectorXd& out) const
 }
 
 Eigen::Vector3d SapProblem::rowVelocity(int i, const Eigen::VectorXd& v) const {
-  Eigen::Vector3d vc = Eigen::Vector3d::Zero();
+  return multiplyRow(i, v) + row(i).velocity_offset;
+}
+
+Eigen::Vector3d SapProblem::multiplyRow(int i, const Eigen::VectorXd& x) const {
+  Eigen::Vector3d product = Eigen::Vector3d::Zero();
   for (const ContactTerm& term : row(i).terms)
-    vc += term.block * v.segment(termOffset(term), term.block.cols());
-  return vc;
+    product += term.block * x.segment(termOffset(term), term.block.cols());
+  return product;
 }
 
 void SapProblem::addRowTranspose(int i, const Eigen::Vector3d& f, Eigen::VectorXd& out) const {
@@ -225,7 +230,7 @@ void SapProblem::multiplyHessian(const SapEvaluation& e, const Eigen::VectorXd& 
   for (int i = 0; i < rowCount(); ++i) {
     const RowResponse& r = e.rows[static_cast<size_t>(i)];
     if (r.state == ContactState::kSeparated) continue;
-    addRowTranspose(i, r.g * rowVelocity(i, x), out);
+    addRowTranspose(i, r.g * multiplyRow(i, x), out);
   }
   filter(out);
 }

@@ -108,7 +108,7 @@ double SapSolver::lineSearch(const SapProblem& problem, const Eigen::VectorXd& d
   line_vc_ = e.contact_velocity;
   line_dvc_.resize(line_vc_.size());
   for (int i = 0; i < problem.rowCount(); ++i)
-    line_dvc_[static_cast<size_t>(i)] = problem.rowVelocity(i, dv);
+    line_dvc_[static_cast<size_t>(i)] = problem.multiplyRow(i, dv);
   double slope0 = 0, curvature = 0, noise = 0;
   slopeAt(problem, 0, slope0, curvature, noise);
   if (!(slope0 < 0)) return 0;

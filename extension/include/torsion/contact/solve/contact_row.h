@@ -4,7 +4,8 @@
 //
 //     v_c,i = J_i v = (v_t1, v_t2, v_n)   (m/s, in the contact frame: two tangents, normal last)
 //
-// of side B's point relative to side A's, so v_n > 0 separates. J_i is a sum of terms, each a
+// of side B's point relative to side A's, so v_n > 0 separates (plus a known offset for a
+// kinematic partner, whose motion no island dof carries). J_i is a sum of terms, each a
 // dense 3 x k block on k consecutive velocity dofs of one island body:
 //
 //   a node of a FEM body (k = 3): w R_c, w the node's barycentric weight on the contact point
@@ -41,6 +42,9 @@ struct ContactRow {
   double stiffness = 0;         ///< k, N/m, > 0
   double dissipation_time = 0;  ///< tau_d, s, >= 0
   double gap = 0;               ///< phi0, m, negative when penetrating
+  /// The part of v_c that no island dof moves (m/s, contact frame): the motion of a kinematic
+  /// partner's point (a moving hand, a conveyor), entered as B's minus A's. v_c = J v + this.
+  Eigen::Vector3d velocity_offset = Eigen::Vector3d::Zero();
 };
 
 /// A right-handed frame with rows (t1, t2, n) for unit `normal`; t1 is the normal crossed with the

@@ -127,7 +127,10 @@ class SapProblem {
   const Eigen::VectorXd& inverseSqrtDiagonal() const { return inverse_sqrt_diagonal_; }
 
   void multiplyA(const Eigen::VectorXd& x, Eigen::VectorXd& out) const;
+  /// v_c,i = J_i v + the row's velocity offset.
   Eigen::Vector3d rowVelocity(int i, const Eigen::VectorXd& v) const;
+  /// J_i x (a direction: no offset).
+  Eigen::Vector3d multiplyRow(int i, const Eigen::VectorXd& x) const;
   /// out += J_i^T f.
   void addRowTranspose(int i, const Eigen::Vector3d& f, Eigen::VectorXd& out) const;
   void filter(Eigen::VectorXd& x) const;
