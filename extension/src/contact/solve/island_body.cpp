@@ -10,8 +10,8 @@ DiagonalBlock IslandBody::freeProjector(int /*block*/) const {
   return DiagonalBlock::Identity(blockSize(), blockSize());
 }
 
-MatrixBody::MatrixBody(Eigen::SparseMatrix<double> matrix, Eigen::VectorXd momentum)
-    : matrix_(std::move(matrix)), momentum_(std::move(momentum)) {
+MatrixBody::MatrixBody(const Eigen::SparseMatrix<double>& matrix, Eigen::VectorXd momentum)
+    : matrix_(matrix), momentum_(std::move(momentum)) {
   assert(matrix_.rows() == matrix_.cols() && matrix_.rows() == momentum_.size());
   assert(momentum_.size() % 3 == 0);
   matrix_.makeCompressed();

@@ -47,7 +47,7 @@ class IslandBody {
 /// optional prescribed dofs (each one a whole coordinate).
 class MatrixBody final : public IslandBody {
  public:
-  MatrixBody(Eigen::SparseMatrix<double> matrix, Eigen::VectorXd momentum);
+  MatrixBody(const Eigen::SparseMatrix<double>& matrix, Eigen::VectorXd momentum);
   /// Prescribes dof `dof` to `value` (m/s).
   void prescribe(int dof, double value);
 
