@@ -18,7 +18,10 @@ struct HapticTwist {
 };
 
 // Twist the device by 0.05 rad about the axis, statics, and check the rendered torque against the
-// solver's reaction and the fixed base's.
+// solver's reaction and the fixed base's. A grab step, then 3 steps at the twisted pose: each is a
+// Newton step on the statics, and a 4th changed the rendered torque by < 3e-7 relative, the ratio
+// to G J theta' by < 3e-7 and left the base's torque balancing the hand's within 4e-7 either way
+// (tet4 and tet10), far inside the 1 % and 5 % asserted: as strong a check as with 4.
 HapticTwist hapticTwist(ElementKind element) {
   SolverSettings quasi_static;
   quasi_static.time_step = 1000;  // far beyond every mode: each step solves statics
@@ -26,7 +29,7 @@ HapticTwist hapticTwist(ElementKind element) {
   CouplingRig rig(8332, quasi_static, {}, 0, element);
   const double angle = 0.05;  // rad about the axis
   rig.step(device::Pose{});
-  for (int k = 0; k < 4; ++k)
+  for (int k = 0; k < 3; ++k)
     rig.step(displaced(5, angle));
 
   HapticTwist result;
