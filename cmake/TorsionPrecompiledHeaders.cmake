@@ -54,6 +54,15 @@ endfunction()
 # more to compile than the whole test costs to run.
 set(TORSION_TEST_OPTIMIZATION "-O1" CACHE STRING
     "Optimisation flag for the test and benchmark-free test executables (empty: the build type's)")
+# With TORSION_UNITY_BUILD the GoogleTest executables compile in unity batches too, this many
+# sources a batch: small enough that the larger executables still give ninja several batches to
+# run side by side and that an edited test recompiles only its batch. A source whose helpers clash
+# with another's (the same name in an anonymous namespace, a macro) is left out of the batches
+# where its target is defined (SKIP_UNITY_BUILD_INCLUSION). tests/contact/ is left out whole
+# while the contact code is rewritten: its files change daily, and a clash seen only in the unity
+# build (CI's, not a developer's default build) would break CI for a new helper's name.
+set(TORSION_TEST_UNITY_BATCH_SIZE 4 CACHE STRING
+    "Sources per unity batch of a test executable (TORSION_UNITY_BUILD)")
 function(torsion_tune_test_targets dir)
   get_property(targets DIRECTORY ${dir} PROPERTY BUILDSYSTEM_TARGETS)
   foreach(target IN LISTS targets)
@@ -67,6 +76,11 @@ function(torsion_tune_test_targets dir)
       list(APPEND sets GTEST)
       if(TORSION_TEST_OPTIMIZATION)
         target_compile_options(${target} PRIVATE ${TORSION_TEST_OPTIMIZATION})
+      endif()
+      get_target_property(source_dir ${target} SOURCE_DIR)
+      if(TORSION_UNITY_BUILD AND NOT source_dir MATCHES "/tests/contact$")
+        set_target_properties(${target} PROPERTIES UNITY_BUILD ON
+                              UNITY_BUILD_BATCH_SIZE ${TORSION_TEST_UNITY_BATCH_SIZE})
       endif()
     endif()
     if(libs MATCHES "Torsion::extension|torsion_scene|torsion_render")
