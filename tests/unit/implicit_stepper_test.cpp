@@ -304,6 +304,55 @@ TEST(ImplicitStepper, NonFiniteInputIsReportedNotPropagatedSilently) {
   EXPECT_FALSE(r.message.empty());
 }
 
+TEST(ImplicitStepper, StagesDrivenByTheCallerAreTheStepBitForBit) {
+  // prepare, a solve of prepared() into a vector of the caller's, finish: what FemBody and the
+  // islands do. The same bits as step(), warm starts and internal forces included.
+  auto model = beamModel();
+  Parallel parallel(1);
+  SolverSettings settings;  // the default tolerance: CG stops early, so warm starts matter
+  ImplicitStepper whole(model, settings, parallel), staged(model, settings, parallel);
+  FemState a = FemState::atRest(*model), b = a;
+  NodeConstraints constraints(model->nodeCount());
+  for (int i = 0; i < model->nodeCount(); ++i) {
+    if (model->mesh().restPositions()[static_cast<size_t>(i)].x() < 1e-9)
+      constraints.prescribeVelocity(i, Eigen::Vector3d::Zero());
+  }
+  const Eigen::VectorXd f = gravityForces(*model, Eigen::Vector3d(0, 0, -9.81));
+  ProjectedCg cg;
+  for (int k = 0; k < 8; ++k) {
+    const StepReport r = whole.step(a, constraints, f);
+    StepReport s = staged.prepare(b, constraints, f, settings.time_step);
+    ASSERT_FALSE(isFatal(s.health));
+    const PreparedSystem system = staged.prepared();
+    Eigen::VectorXd v = *system.v;
+    s.solve = cg.solve(*system.op, *system.constraints, *system.b, *system.settings, v);
+    staged.finish(b, v, s);
+    ASSERT_EQ(r.health, s.health);
+    EXPECT_EQ(r.solve.iterations, s.solve.iterations);
+    EXPECT_EQ(r.kinetic_energy, s.kinetic_energy);
+    ASSERT_TRUE(a.positions == b.positions) << "step " << k;
+    ASSERT_TRUE(a.velocities == b.velocities) << "step " << k;
+    ASSERT_TRUE(whole.internalForces() == staged.internalForces()) << "step " << k;
+  }
+}
+
+TEST(ImplicitStepper, PrepareWithNonFiniteForcesEndsTheStepBeforeTheStateIsTouched) {
+  auto model = beamModel();
+  Parallel parallel(1);
+  ImplicitStepper stepper(model, tight(), parallel);
+  FemState state = FemState::atRest(*model);
+  state.velocities.setConstant(0.25);
+  const FemState start = state;
+  NodeConstraints constraints(model->nodeCount());
+  Eigen::VectorXd f = Eigen::VectorXd::Zero(3 * model->nodeCount());
+  f[4] = std::numeric_limits<double>::infinity();
+  const StepReport r = stepper.prepare(state, constraints, f, 0.01);
+  EXPECT_EQ(r.health, StepHealth::kNonFinite);
+  EXPECT_NE(r.message.find("external forces"), std::string::npos) << r.message;
+  EXPECT_TRUE(state.positions == start.positions);
+  EXPECT_TRUE(state.velocities == start.velocities);
+}
+
 TEST(ImplicitStepper, BlowUpIsDetected) {
   auto model = beamModel();
   Parallel parallel(1);

@@ -162,6 +162,15 @@ void FemBody::predict(double dt) {
 }
 
 const StepReport& FemBody::advance(const StepContext& ctx) {
+  if (!prepare(ctx)) return last_report_;
+  const PreparedSystem p = stepper_.prepared();
+  const LinearSolveReport solve =
+      hasContactSolve() ? solveContacts(*p.op, *p.constraints, *p.b, *p.settings, *p.v)
+                        : stepper_.solve();
+  return finish(*p.v, solve);
+}
+
+bool FemBody::prepare(const StepContext& ctx, const AddedOperatorTerm* island_term) {
   const double dt = ctx.dt;
   constraints_.reset(model_->nodeCount());
   for (const auto& group : groups_)
@@ -170,43 +179,41 @@ const StepReport& FemBody::advance(const StepContext& ctx) {
   for (int i = 0; i < model_->nodeCount(); ++i)
     step_forces_.segment<3>(3 * i) += model_->nodeMasses()[static_cast<size_t>(i)] * ctx.gravity;
   // Contacts with rigid bodies: unilateral constraints in the same projected solve.
-  const bool rigid = contacts_->detect(state_, constraints_, dt);
+  rigid_contact_ = contacts_->detect(state_, constraints_, dt);
   // Self-contact: an augmented Lagrangian added to the system, around the same solve.
   // Its solve runs whenever it is on, candidates or not: it looks again along the solved motion.
   const bool self = self_contact_ != nullptr;
   if (self) self_contact_->detect(state_, constraints_, dt);
-  ImplicitStepper::LinearSolveHook rigid_solve;
-  if (rigid) {
-    rigid_solve = [this](const SystemOperator& op, const NodeConstraints& c,
-                         const Eigen::VectorXd& b, const SolverSettings& s,
-                         Eigen::VectorXd& v) { return contacts_->solve(op, c, b, s, v); };
+  added_terms_.set(self ? &self_contact_->term() : nullptr, island_term);
+  if (self || island_term != nullptr) stepper_.setAddedOperatorTerm(&added_terms_);
+  last_report_ = stepper_.prepare(state_, constraints_, step_forces_, dt);
+  if (!isFatal(last_report_.health)) return true;
+  stepper_.setAddedOperatorTerm(nullptr);  // the terms are this step's only
+  return false;
+}
+
+LinearSolveReport FemBody::solveContacts(const SystemOperator& op,
+                                         const NodeConstraints& constraints,
+                                         const Eigen::VectorXd& b, const SolverSettings& settings,
+                                         Eigen::VectorXd& v) {
+  if (self_contact_ == nullptr) return contacts_->solve(op, constraints, b, settings, v);
+  // Self-contact's loop runs the rigid-contact solve once on its augmented system when there are
+  // rigid contacts, its own CG rounds otherwise.
+  SelfContactSolver::InnerSolve rigid_solve;
+  if (rigid_contact_) {
+    rigid_solve = [this](const SystemOperator& o, const NodeConstraints& c,
+                         const Eigen::VectorXd& rhs, const SolverSettings& s,
+                         Eigen::VectorXd& x) { return contacts_->solve(o, c, rhs, s, x); };
   }
-  ImplicitStepper::LinearSolveHook own_solve = rigid_solve;
-  if (self) {
-    own_solve = [this, rigid_solve](const SystemOperator& op, const NodeConstraints& c,
-                                    const Eigen::VectorXd& b, const SolverSettings& s,
-                                    Eigen::VectorXd& v) {
-      return self_contact_->solve(op, c, b, s, v, rigid_solve);
-    };
-  }
-  // In an island of touching FEM bodies the island's solve wraps the body's own.
-  const bool island = static_cast<bool>(island_solve_);
-  if (island) {
-    stepper_.setLinearSolveHook(
-        [this, own_solve](const SystemOperator& op, const NodeConstraints& c,
-                          const Eigen::VectorXd& b, const SolverSettings& s,
-                          Eigen::VectorXd& v) { return island_solve_(op, c, b, s, v, own_solve); });
-  } else {
-    stepper_.setLinearSolveHook(own_solve);
-  }
-  added_terms_.set(self ? &self_contact_->term() : nullptr, island ? island_term_ : nullptr);
-  if (self || island) stepper_.setAddedOperatorTerm(&added_terms_);
-  last_report_ = stepper_.step(state_, constraints_, step_forces_, dt);
+  return self_contact_->solve(op, constraints, b, settings, v, rigid_solve);
+}
+
+const StepReport& FemBody::finish(const Eigen::Ref<const Eigen::VectorXd>& velocities,
+                                  const LinearSolveReport& solve) {
+  last_report_.solve = solve;
+  stepper_.finish(state_, velocities, last_report_);
   stepper_.setAddedOperatorTerm(nullptr);
-  stepper_.setLinearSolveHook({});
-  island_solve_ = nullptr;
-  island_term_ = nullptr;
-  if (self && !self_contact_->stats().converged && !isFatal(last_report_.health)) {
+  if (self_contact_ && !self_contact_->stats().converged && !isFatal(last_report_.health)) {
     // Reported per step, never accepted silently (a warning: the step is usable).
     const SelfContactStats& s = self_contact_->stats();
     if (last_report_.health == StepHealth::kOk)

@@ -119,11 +119,28 @@ void FemContactIslands::advance(const std::vector<FemBody*>& group, const StepCo
     group.front()->advance(ctx);
     return;
   }
-  group_ = group;
+  setUpIsland(group);
+  // Every body up to its solve; one that stops there (non-finite forces) leaves the island, and
+  // its pairs sit the step out.
+  bool any = false;
+  for (size_t k = 0; k < group.size(); ++k) {
+    if (!group[k]->prepare(ctx, &terms_[k])) continue;
+    enter(k, group[k]);
+    any = true;
+  }
+  island_stats_ = any ? solver_.solve(slots_, island_pairs_, ctx.dt) : IslandContactStats{};
+  // Last body first: a dynamic rigid body touching several bodies of the island takes their
+  // corrections (RigidContactSolver::finish) in this fixed order, the first body's last.
+  for (size_t k = group.size(); k-- > 0;) {
+    if (slots_[k].present) group[k]->finish(*slots_[k].v, slots_[k].report);
+  }
+  addStats(group, any);
+}
+
+void FemContactIslands::setUpIsland(const std::vector<FemBody*>& group) {
   const size_t n = group.size();
   slots_.assign(n, IslandContactSolve::Body{});
   terms_.assign(n, PairContactTerm{});
-  advanced_.assign(n, 0);
   island_pairs_.clear();
   auto slot = [&](const FemBody* body) {
     return static_cast<int>(std::find(group.begin(), group.end(), body) - group.begin());
@@ -137,14 +154,36 @@ void FemContactIslands::advance(const std::vector<FemBody*>& group, const StepCo
     terms_[static_cast<size_t>(second)].addSide(
         {&contact->set(), na, key.second->model().nodeCount()});
   }
-  solved_ = false;
-  island_stats_ = IslandContactStats{};
-  advanceFrom(0, ctx);
-  // A body that stopped before its solve broke the chain: the rest step alone.
-  for (size_t k = 0; k < n; ++k) {
-    if (!advanced_[k]) group[k]->advance(ctx);
-  }
+}
 
+void FemContactIslands::enter(size_t k, FemBody* body) {
+  const PreparedSystem system = body->preparedSystem();
+  IslandContactSolve::Body& s = slots_[k];
+  s.op = system.op;
+  s.constraints = system.constraints;
+  s.b = system.b;
+  s.settings = system.settings;
+  s.v = system.v;
+  // Node contacts with prescribed rigid partners (the ground) join the island's joint solve; a
+  // body with self-contact or a dynamic rigid partner keeps its own solve.
+  s.rigid = nullptr;
+  s.solve = nullptr;
+  if (body->hasContactSolve()) {
+    if (body->selfContact() == nullptr && body->contacts().joinsIsland()) {
+      s.rigid = &body->contacts();
+    } else {
+      s.solve = [body](const SystemOperator& op, const NodeConstraints& constraints,
+                       const Eigen::VectorXd& b, const SolverSettings& settings,
+                       Eigen::VectorXd& v) {
+        return body->solveContacts(op, constraints, b, settings, v);
+      };
+    }
+  }
+  s.term = &terms_[k];
+  s.present = true;
+}
+
+void FemContactIslands::addStats(const std::vector<FemBody*>& group, bool solved) {
   ++stats_.islands;
   stats_.candidates += island_stats_.candidates;
   stats_.active += island_stats_.active;
@@ -153,53 +192,17 @@ void FemContactIslands::advance(const std::vector<FemBody*>& group, const StepCo
   stats_.normal_impulse += island_stats_.normal_impulse;
   stats_.max_end_penetration =
       std::max(stats_.max_end_penetration, island_stats_.max_end_penetration);
-  if (solved_ && !island_stats_.converged) {
-    // Reported per step, never accepted silently (a warning: the step is usable).
-    stats_.converged = false;
-    std::ostringstream s;
-    s << "contact between FEM bodies did not converge in " << island_stats_.iterations
-      << " updates (end penetration " << island_stats_.max_end_penetration << " m, tolerance "
-      << island_stats_.gap_tolerance << " m)";
-    for (size_t k = 0; k < n; ++k) {
-      if (slots_[k].present && !isFatal(group[k]->lastReport().health))
-        group[k]->noteContactNotConverged(s.str());
-    }
+  if (!solved || island_stats_.converged) return;
+  // Reported per step, never accepted silently (a warning: the step is usable).
+  stats_.converged = false;
+  std::ostringstream s;
+  s << "contact between FEM bodies did not converge in " << island_stats_.iterations
+    << " updates (end penetration " << island_stats_.max_end_penetration << " m, tolerance "
+    << island_stats_.gap_tolerance << " m)";
+  for (size_t k = 0; k < group.size(); ++k) {
+    if (slots_[k].present && !isFatal(group[k]->lastReport().health))
+      group[k]->noteContactNotConverged(s.str());
   }
-}
-
-void FemContactIslands::advanceFrom(size_t k, const StepContext& ctx) {
-  FemBody* body = group_[k];
-  body->setIslandSolve(
-      [this, k, &ctx](const SystemOperator& op, const NodeConstraints& constraints,
-                      const Eigen::VectorXd& b, const SolverSettings& settings, Eigen::VectorXd& v,
-                      const ImplicitStepper::LinearSolveHook& own) {
-        IslandContactSolve::Body& s = slots_[k];
-        s.op = &op;
-        s.constraints = &constraints;
-        s.b = &b;
-        s.settings = &settings;
-        s.v = &v;
-        // Node contacts with prescribed rigid partners (the ground) join the island's joint
-        // solve; a body with self-contact or a dynamic rigid partner keeps its own solve.
-        s.rigid = nullptr;
-        s.solve = own;
-        if (own && group_[k]->selfContact() == nullptr && group_[k]->contacts().joinsIsland()) {
-          s.rigid = &group_[k]->contacts();
-          s.solve = nullptr;
-        }
-        s.term = &terms_[k];
-        s.present = true;
-        // The next body steps up to its own solve (and so on); the last one solves the island.
-        if (k + 1 < group_.size()) advanceFrom(k + 1, ctx);
-        if (!solved_) {
-          solved_ = true;
-          island_stats_ = solver_.solve(slots_, island_pairs_, ctx.dt);
-        }
-        return slots_[k].report;
-      },
-      &terms_[k]);
-  body->advance(ctx);
-  advanced_[k] = 1;
 }
 
 }  // namespace torsion

@@ -312,7 +312,7 @@ IslandContactStats IslandContactSolve::solve(std::vector<Body>& bodies,
   IslandContactStats stats;
   cg_.resize(bodies.size());
   blocks_.resize(bodies.size());
-  std::vector<const Pair*> live;  // pairs whose two bodies both reached their solve
+  std::vector<const Pair*> live;  // pairs whose two bodies both prepared their step
   for (const Pair& pair : pairs) {
     if (bodies[static_cast<size_t>(pair.first)].present &&
         bodies[static_cast<size_t>(pair.second)].present)

@@ -197,16 +197,43 @@ double ImplicitStepper::addNodalPressureForces() {
 
 StepReport ImplicitStepper::step(FemState& state, const NodeConstraints& constraints,
                                  const Eigen::VectorXd& external_forces, double dt) {
+  StepReport report = prepare(state, constraints, external_forces, dt);
+  if (isFatal(report.health)) return report;
+  report.solve = solve();
+  finish(state, velocity_next_, report);
+  return report;
+}
+
+StepReport ImplicitStepper::prepare(FemState& state, const NodeConstraints& constraints,
+                                    const Eigen::VectorXd& external_forces, double dt) {
   StepReport report;
   internal_forces_valid_ = false;
   last_dt_ = dt;
+  constraints_ = &constraints;
   report.elastic_energy = computeElasticForces(state);
   report.barrier_tets = barrier_tets_;
+  // Non-finite b ends the step here: the system and the warm start's history stay the last step's.
   if (!buildRightHandSide(state, external_forces, dt, report)) return report;
-  report.solve = solveVelocities(state, constraints, dt);
-  integratePositions(state, dt);
-  checkHealth(state, report);
+  prepareSystem(state, dt);
   return report;
+}
+
+PreparedSystem ImplicitStepper::prepared() {
+  PreparedSystem p;
+  p.op = &system_;
+  p.constraints = constraints_;
+  p.b = &rhs_;
+  p.settings = &settings_;
+  p.v = &velocity_next_;
+  return p;
+}
+
+void ImplicitStepper::finish(FemState& state, const Eigen::Ref<const Eigen::VectorXd>& velocities,
+                             StepReport& report) {
+  // v' stays in velocity_next_: the internal forces and the next warm start read it.
+  if (velocities.data() != velocity_next_.data()) velocity_next_ = velocities;
+  integratePositions(state, last_dt_);
+  checkHealth(state, report);
 }
 
 bool ImplicitStepper::buildRightHandSide(const FemState& state,
@@ -231,8 +258,7 @@ bool ImplicitStepper::buildRightHandSide(const FemState& state,
   return false;
 }
 
-LinearSolveReport ImplicitStepper::solveVelocities(const FemState& state,
-                                                   const NodeConstraints& constraints, double dt) {
+void ImplicitStepper::prepareSystem(const FemState& state, double dt) {
   const Material& material = model_->material();
   system_.setCoefficients(1.0 + dt * material.mass_damping,
                           dt * dt + dt * material.stiffness_damping);
@@ -243,13 +269,14 @@ LinearSolveReport ImplicitStepper::solveVelocities(const FemState& state,
     velocity_next_ = state.velocities;
   }
   previous_velocities_ = state.velocities;
-  if (linear_solve_hook_)
-    return linear_solve_hook_(system_, constraints, rhs_, settings_, velocity_next_);
+}
+
+LinearSolveReport ImplicitStepper::solve() {
   if (settings_.linear_solver == LinearSolverKind::kCholmod) {
     if (!cholmod_) cholmod_ = std::make_unique<CholmodSolver>();
-    return cholmod_->solve(system_, constraints, rhs_, velocity_next_);
+    return cholmod_->solve(system_, *constraints_, rhs_, velocity_next_);
   }
-  return cg_.solve(system_, constraints, rhs_, settings_, velocity_next_);
+  return cg_.solve(system_, *constraints_, rhs_, settings_, velocity_next_);
 }
 
 void ImplicitStepper::integratePositions(FemState& state, double dt) const {

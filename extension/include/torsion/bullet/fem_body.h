@@ -6,7 +6,6 @@
 #include <BulletSoftBody/btSoftBody.h>
 #include <btBulletDynamicsCommon.h>
 
-#include <functional>
 #include <memory>
 #include <string>
 #include <vector>
@@ -100,8 +99,31 @@ class FemBody {
   /// Bullet's predictor: m_q = x_n, m_x = x_n + dt v_n, bounds and node tree refreshed, contacts
   /// cleared, so Bullet's collision detection runs on this step's motion.
   void predict(double dt);
-  /// The FEM step from ctx.time to ctx.endTime(); writes the result back into the btSoftBody.
+  /// The FEM step from ctx.time to ctx.endTime(): prepare(), the body's own solve (its contact
+  /// solve, or the stepper's CG / CHOLMOD without contacts), finish().
   const StepReport& advance(const StepContext& ctx);
+
+  // ---- the same step in stages (FemContactIslands solves several bodies' systems together) ----
+  /// Up to the linear solve: the node groups' prescriptions, this step's forces (external + m_i g),
+  /// contact detection (rigid, self), the stepper's prepare(). `island_term` (not owned; nullptr
+  /// outside an island) is added to the system, with self-contact's term, until finish(). False
+  /// when the step ended there (non-finite forces: lastReport() says why; the state untouched;
+  /// no finish()).
+  bool prepare(const StepContext& ctx, const AddedOperatorTerm* island_term = nullptr);
+  /// The prepared step's system: operator, constraints (the groups' and anchors'), b, warm start.
+  PreparedSystem preparedSystem() { return stepper_.prepared(); }
+  /// Whether this step has a contact solve of its own (rigid contacts found, or self-contact on).
+  bool hasContactSolve() const { return rigid_contact_ || self_contact_ != nullptr; }
+  /// This step's contact solve (hasContactSolve()) of A v = b: self-contact's loop around the
+  /// rigid-contact solve, or either alone. v: the warm start on entry, v' on return. Islands call
+  /// it with their own right-hand sides (contact/island_contact.h).
+  LinearSolveReport solveContacts(const SystemOperator& op, const NodeConstraints& constraints,
+                                  const Eigen::VectorXd& b, const SolverSettings& settings,
+                                  Eigen::VectorXd& v);
+  /// After the solve: the stepper's finish() with v' = `velocities` (3n) and `solve` (the solve's
+  /// report), the self-contact warning, impulses onto rigid bodies, the btSoftBody written back.
+  const StepReport& finish(const Eigen::Ref<const Eigen::VectorXd>& velocities,
+                           const LinearSolveReport& solve);
 
   const StepReport& lastReport() const { return last_report_; }
 
@@ -125,17 +147,6 @@ class FemBody {
   const SelfContactSolver* selfContact() const { return self_contact_.get(); }
 
   // ---- contact between FEM bodies (FemSoftBodySolver's islands, docs/contact.md) ----
-  /// The island's solve: gets this body's system and its own solve (rigid / self-contact; empty:
-  /// plain CG) and returns v' in v.
-  using IslandSolve = std::function<LinearSolveReport(
-      const SystemOperator&, const NodeConstraints&, const Eigen::VectorXd&, const SolverSettings&,
-      Eigen::VectorXd&, const ImplicitStepper::LinearSolveHook& own)>;
-  /// For the next advance() only: its linear solve goes through `solve`, and `term` (the pair
-  /// contacts' penalty on this body, not owned) is added to its system.
-  void setIslandSolve(IslandSolve solve, const AddedOperatorTerm* term) {
-    island_solve_ = std::move(solve);
-    island_term_ = term;
-  }
   /// Marks the last step's report as not converged in contact (a warning, unless the step was
   /// already worse) and appends `what` to its message.
   void noteContactNotConverged(const std::string& what);
@@ -155,8 +166,7 @@ class FemBody {
   std::unique_ptr<btSoftBody> soft_body_;
   std::unique_ptr<RigidContactSolver> contacts_;
   std::unique_ptr<SelfContactSolver> self_contact_;
-  IslandSolve island_solve_;  // the next advance()'s island solve, or empty
-  const AddedOperatorTerm* island_term_ = nullptr;
+  bool rigid_contact_ = false;      // this step found nodes near rigid bodies (prepare)
   SummedOperatorTerm added_terms_;  // self-contact and island terms together
   StepReport last_report_;
 };

@@ -8,11 +8,12 @@
 //              motion) overlap (FemSoftBodySolver::processCollision)
 //   plan       each such pair looks for contact candidates (BodyPairContact::detect); pairs with
 //              candidates join their bodies into islands (connected components), in body order
-//   advance    a lone body steps as always; an island's bodies step one inside the other: each
-//              body's stepper reaches its linear solve, hands its system over and steps the next
-//              body; the last one runs the island solve for all, then every stepper finishes its
-//              step with its own velocities (no change to ImplicitStepper). A body that stops
-//              before its solve (non-finite forces) leaves the island; its pairs sit the step out.
+//   advance    a lone body steps as always (FemBody::advance); an island's bodies step in stages:
+//              every body prepares its step (FemBody::prepare: forces, b, its system with the pair
+//              contacts' term added), the island solve runs once on all their systems, then
+//              every body finishes its step with the velocities the island solve left it
+//              (FemBody::finish: integration, health). A body whose prepare fails (non-finite
+//              forces) leaves the island; its pairs sit the step out.
 // Bodies apart cost nothing: no pair is noted, nothing is detected.
 
 #include <cstdint>
@@ -79,8 +80,12 @@ class FemContactIslands {
 
  private:
   using Key = std::pair<const FemBody*, const FemBody*>;
-  // Steps group body k, whose solve steps body k + 1 (and so on) before the island solve.
-  void advanceFrom(size_t k, const StepContext& ctx);
+  // The island's slots, its pairs (those of live_ inside the group) and each body's pair term.
+  void setUpIsland(const std::vector<FemBody*>& group);
+  // Body k's prepared system into its slot, with its own contact solve where it keeps one.
+  void enter(size_t k, FemBody* body);
+  // The island's statistics into stats_; a warning on its bodies when `solved` did not converge.
+  void addStats(const std::vector<FemBody*>& group, bool solved);
 
   BodyContactSettings settings_;
   std::vector<std::pair<FemBody*, FemBody*>> touching_;    // this substep's, as Bullet gave them
@@ -89,12 +94,9 @@ class FemContactIslands {
   FemContactStats stats_;
 
   // The island being stepped.
-  std::vector<FemBody*> group_;
   std::vector<IslandContactSolve::Body> slots_;
   std::vector<IslandContactSolve::Pair> island_pairs_;
   std::vector<PairContactTerm> terms_;
-  std::vector<char> advanced_;
-  bool solved_ = false;
   IslandContactStats island_stats_;
   IslandContactSolve solver_;
 };

@@ -78,7 +78,7 @@ class IslandContactSolve {
   using BodySolve = std::function<LinearSolveReport(const SystemOperator&, const NodeConstraints&,
                                                     const Eigen::VectorXd&, const SolverSettings&,
                                                     Eigen::VectorXd&)>;
-  /// What one body brings to the island solve: its system, taken inside its stepper's solve.
+  /// What one body brings to the island solve: its prepared system (ImplicitStepper::prepare).
   struct Body {
     const SystemOperator* op = nullptr;
     const NodeConstraints* constraints = nullptr;
@@ -91,7 +91,7 @@ class IslandContactSolve {
     RigidContactSolver* rigid = nullptr;
     PairContactTerm* term = nullptr;  ///< in op's added term (not owned)
     LinearSolveReport report;         ///< out: the body's solves, summed
-    bool present = false;             ///< reached its solve (else its pairs sit this step out)
+    bool present = false;             ///< prepared its step (else its pairs sit this step out)
   };
   struct Pair {
     BodyPairContact* contact = nullptr;

@@ -214,7 +214,8 @@ class RigidContactSolver {
   /// Stage 4, before the solve: narrow phase. `constraints` holds the node groups' prescriptions
   /// (held nodes). Returns whether any node is near a rigid object.
   bool detect(const FemState& state, const NodeConstraints& constraints, double dt);
-  /// The linear solve of the step with contacts (ImplicitStepper's hook).
+  /// The linear solve of the step with contacts, on the stepper's prepared system
+  /// (ImplicitStepper::prepared(); FemBody::solveContacts).
   LinearSolveReport solve(const SystemOperator& op, const NodeConstraints& constraints,
                           const Eigen::VectorXd& b, const SolverSettings& settings,
                           Eigen::VectorXd& v);

@@ -112,11 +112,12 @@ class SelfContactSolver {
   double thickness() const { return settings_.thickness_factor * gap_tolerance_; }
 
   /// Before the solve: candidates from the state at the start of the step and its predicted
-  /// motion. Returns whether there are any (then the solve hook and operator term are needed).
+  /// motion. Returns whether there are any.
   bool detect(const FemState& state, const NodeConstraints& constraints, double dt);
   /// The augmented Lagrangian term to add to the body's system operator for this step.
   const AddedOperatorTerm& term() const { return set_; }
-  /// The step's linear solve (ImplicitStepper's hook). `inner`, when given, is the solve that
+  /// The step's linear solve, on the stepper's prepared system with term() added
+  /// (ImplicitStepper::prepared(); FemBody::solveContacts). `inner`, when given, is the solve that
   /// would run without self-contact (the rigid contact solve): it runs once on the augmented
   /// system. Without it, CG solves alternate with Uzawa updates until converged.
   using InnerSolve = std::function<LinearSolveReport(const SystemOperator&, const NodeConstraints&,

@@ -1,17 +1,23 @@
 #pragma once
 // One linearised backward-Euler step of one FEM body (Baraff & Witkin 1998; the report's
-// integrator). step() is this list of stages, each a function of its own:
+// integrator), as stages the caller drives: prepare() (1-3, and the system of 4), a solve of
+// that system (the stepper's own solve(), or a contact solve run by the caller on
+// prepared()), finish() (5-6). step() is prepare, solve, finish for a body stepped alone. Each
+// stage is a function of its own:
 //
 //   1-2. computeElasticForces  per element, in one pass: F = Ds Bm (tet4) or the element's mean F
 //                              (tet10), its rotation R (warm-started polar decomposition), and the
 //                              elastic forces f(x) = -Re Ke (Re^T x - X); gathered per node;
 //                              elastic energy; the volume barrier of the tets near inversion
 //                              (fem/volume_barrier.h) adds its forces, energy and stiffness
-//   3. buildRightHandSide      b = M v + dt (f(x) + f_ext); a non-finite b ends the step before
-//                              the state is touched
-//   4. solveVelocities         (M (1 + dt alpha) + (dt^2 + dt beta) K) v' = b, warm-started,
+//   3. buildRightHandSide      b = M v + dt (f(x) + f_ext); a non-finite b ends the step in
+//                              prepare(), before the state is touched
+//      prepareSystem           the system's coefficients and the warm start of v'
+//   4. solve                   (M (1 + dt alpha) + (dt^2 + dt beta) K) v' = b, warm-started,
 //                              prescribed components of v' imposed (projection), free ones solved
-//                              by CG, CHOLMOD or the linear-solve hook (contacts)
+//                              by CG or CHOLMOD; with contacts the caller solves prepared()
+//                              instead (contact/rigid_contact.h, contact/self_contact.h,
+//                              contact/island_contact.h)
 //   5. integratePositions      x' = x + dt v'   (constrained nodes land exactly on their targets)
 //   6. checkHealth             non-finite values, speeds beyond SolverSettings::max_speed, a
 //                              linear solve that broke down or stopped above 10x its tolerance
@@ -21,7 +27,6 @@
 // available afterwards, linearised: f_int = f(x) - (dt + beta) K v'.
 
 #include <Eigen/Core>
-#include <functional>
 #include <memory>
 #include <string>
 #include <vector>
@@ -64,6 +69,18 @@ struct StepReport {
   std::string message;  ///< what went wrong, for the user
 };
 
+/// The linear system of a prepared step (ImplicitStepper::prepare), what any solve of it needs:
+/// A v' = b, the prescribed components of v' imposed. Valid until the stepper's next prepare().
+struct PreparedSystem {
+  /// A = M (1 + dt alpha) + (dt^2 + dt beta) K, plus the added term (setAddedOperatorTerm).
+  const SystemOperator* op = nullptr;
+  const NodeConstraints* constraints = nullptr;  ///< the ones given to prepare() (the caller's)
+  const Eigen::VectorXd* b = nullptr;            ///< M v + dt (f(x) + f_ext), 3n
+  const SolverSettings* settings = nullptr;      ///< the stepper's (tolerance, iterations)
+  /// The warm start 2 v_n - v_(n-1) (v_n on the first step), 3n: the solves write v' over it.
+  Eigen::VectorXd* v = nullptr;
+};
+
 class ImplicitStepper {
  public:
   ImplicitStepper(std::shared_ptr<const FemModel> model, const SolverSettings& settings,
@@ -72,10 +89,10 @@ class ImplicitStepper {
   ImplicitStepper(const ImplicitStepper&) = delete;
   ImplicitStepper& operator=(const ImplicitStepper&) = delete;
 
-  /// Advances `state` by one step of `dt` seconds. external_forces: 3n, N (e.g. m g per node).
-  /// Non-finite forces are caught before the state is touched; on any fatal report callers stop
-  /// and report instead of writing the state out. Inside a Bullet world dt is the world's substep
-  /// (StepContext::dt) and may change from one step to the next.
+  /// Advances `state` by one step of `dt` seconds: prepare(), solve(), finish(). external_forces:
+  /// 3n, N (e.g. m g per node). Non-finite forces are caught before the state is touched; on any
+  /// fatal report callers stop and report instead of writing the state out. Inside a Bullet world
+  /// dt is the world's substep (StepContext::dt) and may change from one step to the next.
   StepReport step(FemState& state, const NodeConstraints& constraints,
                   const Eigen::VectorXd& external_forces, double dt);
   /// A stepper used on its own (tests, benchmarks): one step of settings().time_step.
@@ -83,6 +100,24 @@ class ImplicitStepper {
                   const Eigen::VectorXd& external_forces) {
     return step(state, constraints, external_forces, settings_.time_step);
   }
+
+  // ---- a step in stages, driven by the caller (FemBody: contacts solve the prepared system) ----
+  /// Stages 1-3: forces at `state`, b, the system's coefficients and the warm start of v'
+  /// (prepared()). `constraints` must live until finish(). Returns the report so far: on a fatal
+  /// one (non-finite b) the step ends here, the state untouched, and finish() is not called.
+  StepReport prepare(FemState& state, const NodeConstraints& constraints,
+                     const Eigen::VectorXd& external_forces, double dt);
+  /// The prepared step's system and its warm start (valid until the next prepare()).
+  PreparedSystem prepared();
+  /// Stage 4 without contacts: CG or CHOLMOD (settings().linear_solver) on the prepared system,
+  /// v' over prepared().v.
+  LinearSolveReport solve();
+  /// Stages 5-6: v = v' (`velocities`, 3n, from any solve of the prepared system; may be
+  /// *prepared().v itself), x += dt v', and the health into `report`: prepare()'s, with
+  /// report.solve set to that solve's report (a broken-down or unconverged solve is judged here).
+  void finish(FemState& state, const Eigen::Ref<const Eigen::VectorXd>& velocities,
+              StepReport& report);
+
   /// s, the length of the last step taken (settings().time_step before the first).
   double lastTimeStep() const { return last_dt_; }
 
@@ -92,14 +127,6 @@ class ImplicitStepper {
   const Eigen::VectorXd& elasticForces() const { return elastic_forces_; }
 
   const SolverSettings& settings() const { return settings_; }
-  /// Replaces stage 4's linear solve (solveVelocities) when set: hook(system, constraints, b, v), v
-  /// holding the warm start on entry and v' on return. Contacts with rigid bodies use it
-  /// (contact/rigid_contact.h): they add unilateral constraints and rigid-body unknowns to the same
-  /// projected CG.
-  using LinearSolveHook = std::function<LinearSolveReport(
-      const SystemOperator&, const NodeConstraints&, const Eigen::VectorXd&, const SolverSettings&,
-      Eigen::VectorXd&)>;
-  void setLinearSolveHook(LinearSolveHook hook) { linear_solve_hook_ = std::move(hook); }
   /// Adds `term` (not owned; nullptr removes it) to the system of the following steps' solves
   /// (SystemOperator::setAddedTerm): self-contact's augmented Lagrangian.
   void setAddedOperatorTerm(const AddedOperatorTerm* term) { system_.setAddedTerm(term); }
@@ -135,9 +162,9 @@ class ImplicitStepper {
   // Stage 3: rhs_. False (and report's health and message set) when b is not finite.
   bool buildRightHandSide(const FemState& state, const Eigen::VectorXd& external_forces, double dt,
                           StepReport& report);
-  // Stage 4: velocity_next_ = v', warm-started from the last two steps' velocities.
-  LinearSolveReport solveVelocities(const FemState& state, const NodeConstraints& constraints,
-                                    double dt);
+  // Stage 4's system: A's coefficients for dt; velocity_next_ = the warm start, extrapolated from
+  // the last two steps' velocities.
+  void prepareSystem(const FemState& state, double dt);
   // Stage 5: v = v', x += dt v'.
   void integratePositions(FemState& state, double dt) const;
   // Stage 6: kinetic energy, top speed and the step's health, into report.
@@ -149,7 +176,7 @@ class ImplicitStepper {
   SystemOperator system_;
   ProjectedCg cg_;
   std::unique_ptr<CholmodSolver> cholmod_;
-  LinearSolveHook linear_solve_hook_;
+  const NodeConstraints* constraints_ = nullptr;  // the prepared step's (the caller's)
 
   Eigen::VectorXd elastic_forces_, rhs_, velocity_next_, internal_forces_, scratch_;
   Eigen::VectorXd previous_velocities_;          // v of the step before, for the CG warm start
