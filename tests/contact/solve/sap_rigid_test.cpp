@@ -49,6 +49,7 @@ InclineRun runIncline(double angle, double mu, double seconds) {
   SapSolver solver;
   InclineRun run;
   double x1 = 0, v1 = 0;
+  std::vector<double> lagged;  // each corner's normal impulse of the previous step
   const int steps = static_cast<int>(std::lround(seconds / kDt));
   const int window = static_cast<int>(std::lround(1.0 / kDt));
   for (int step = 0; step < steps; ++step) {
@@ -60,10 +61,12 @@ InclineRun runIncline(double angle, double mu, double seconds) {
     std::vector<ContactRow> rows;
     for (const Eigen::Vector3d& corner : box.bottomCorners())
       rows.push_back(groundRow(0, box, corner, mu));
+    test::carryLaggedImpulses(lagged, rows);
     const SapProblem problem = SapProblem::create({&body}, rows, kDt).value();
     Eigen::VectorXd v = box.twist;
     const SapReport report = solver.solve(problem, v);
     test::expectCoulombAndComplementarity(problem, report);
+    lagged = test::normalImpulses(report);
     run.max_newton = std::max(run.max_newton, report.newton_iterations);
     run.max_cg = std::max(run.max_cg, report.cg_iterations);
     for (int i = 0; i < problem.rowCount(); ++i)
@@ -127,6 +130,7 @@ TEST(SapRigidBox, NearRigidContactRestsWithoutChatter) {
       rows.back().stiffness = 1e12;
       rows.back().dissipation_time = 0;
     }
+    test::carryLaggedImpulses(last_normal, rows);
     const SapProblem problem = SapProblem::create({&body}, rows, kDt).value();
     Eigen::VectorXd v = box.twist;
     const SapReport report = solver.solve(problem, v);
@@ -192,6 +196,7 @@ SqueezeRun runSqueeze(double pull, double seconds) {
   Eigen::VectorXd v = Eigen::VectorXd::Zero(15), v_start;
   SapSolver solver;
   SqueezeRun run;
+  std::vector<double> lagged;  // each face's normal impulse of the previous step
   const int steps = static_cast<int>(std::lround(seconds / kDt));
   const int start = static_cast<int>(std::lround(0.05 / kDt));
   for (int step = 0; step < steps; ++step) {
@@ -203,11 +208,13 @@ SqueezeRun runSqueeze(double pull, double seconds) {
     MatrixBody particle(test::massMatrix({m}), m * v.head<3>() + kDt * Eigen::Vector3d(pull, 0, 0));
     const RigidBody lower_body(plate_mass, plate_inertia, lower_b);
     const RigidBody upper_body(plate_mass, plate_inertia, upper_b);
-    const SapProblem problem = SapProblem::create({&particle, &lower_body, &upper_body},
-                                                  squeezeRows(node, lower, upper), kDt)
-                                   .value();
+    std::vector<ContactRow> rows = squeezeRows(node, lower, upper);
+    test::carryLaggedImpulses(lagged, rows);
+    const SapProblem problem =
+        SapProblem::create({&particle, &lower_body, &upper_body}, rows, kDt).value();
     const SapReport report = solver.solve(problem, v);
     test::expectCoulombAndComplementarity(problem, report);
+    lagged = test::normalImpulses(report);
     node += kDt * v.head<3>();
     lower += kDt * v.segment<3>(3);
     upper += kDt * v.segment<3>(9);
@@ -289,6 +296,7 @@ TEST(SapStack, ThreeBoxesStandAtTheirStaticDeflection) {
     boxes[static_cast<size_t>(j)].position.z() = (2 * j + 1) * boxes[0].half.z();
   SapSolver solver;
   std::vector<double> depth_at_1s(3, 0.0), depth(3, 0.0), worst(3, 0.0);
+  std::vector<double> lagged;  // each row's normal impulse of the previous step
   int max_newton = 0;
   for (int step = 0; step < 3000; ++step) {
     std::vector<RigidBody> bodies;
@@ -301,10 +309,12 @@ TEST(SapStack, ThreeBoxesStandAtTheirStaticDeflection) {
     for (const RigidBody& body : bodies)
       island.push_back(&body);
     std::vector<int> level;
-    const std::vector<ContactRow> rows = stackRows(boxes, level);
+    std::vector<ContactRow> rows = stackRows(boxes, level);
+    test::carryLaggedImpulses(lagged, rows);
     const SapProblem problem = SapProblem::create(island, rows, kDt).value();
     const SapReport report = solver.solve(problem, v);
     test::expectCoulombAndComplementarity(problem, report);
+    lagged = test::normalImpulses(report);
     max_newton = std::max(max_newton, report.newton_iterations);
     std::fill(depth.begin(), depth.end(), 0.0);
     for (size_t i = 0; i < rows.size(); ++i) {

@@ -71,6 +71,7 @@ double slideSpringBlock(double angle, double mu, int& max_newton) {
   const Eigen::SparseMatrix<double> a = mass + (dt * dt + dt * beta) * block.stiffness;
   const Eigen::Matrix3d frame = contactFrame(Eigen::Vector3d::UnitZ());
   SapSolver solver;
+  std::vector<double> lagged;  // each bottom node's normal impulse of the previous step
   for (int step = 0; step < 1000; ++step) {
     Eigen::VectorXd b = mass * v + dt * (weight - block.stiffness * (x - rest));
     MatrixBody body(a, b);
@@ -85,9 +86,11 @@ double slideSpringBlock(double angle, double mu, int& max_newton) {
       row.gap = x(3 * i + 2);
       rows.push_back(row);
     }
+    test::carryLaggedImpulses(lagged, rows);
     const SapProblem problem = SapProblem::create({&body}, rows, dt).value();
     const SapReport report = solver.solve(problem, v);
     test::expectCoulombAndComplementarity(problem, report);
+    lagged = test::normalImpulses(report);
     max_newton = std::max(max_newton, report.newton_iterations);
     x += dt * v;
   }
@@ -176,6 +179,7 @@ TEST(SapNodeOnFace, FaceNodesCarryTheParticleByItsBarycentricWeights) {
       rows[static_cast<size_t>(k + 1)].gap = face_z(k);
     }
     rows[0].gap = particle_z - w.dot(face_z);
+    test::carryLaggedImpulses(test::normalImpulses(report), rows);
     const SapProblem problem = SapProblem::create({&particle, &face}, rows, dt).value();
     report = solver.solve(problem, v);
     test::expectCoulombAndComplementarity(problem, report);
@@ -261,15 +265,19 @@ BarRun runBar(double push_acceleration, double mu, int steps, Carry carry = Carr
   Eigen::VectorXd x = rest;
   SapSolver solver;
   BarRun run;
+  std::vector<double> lagged;  // each bottom node's normal impulse of the previous step
   for (int step = 0; step < steps; ++step) {
     system.multiplyStiffness(x - rest, ku);
     b = dt * (force - ku);
     for (int i = 0; i < n; ++i)
       b.segment<3>(3 * i) += mass[static_cast<size_t>(i)] * v.segment<3>(3 * i);
     const FemIslandBody body(system, constraints, b);
-    const SapProblem problem = SapProblem::create({&body}, barRows(rest, x, mu), dt).value();
+    std::vector<ContactRow> rows = barRows(rest, x, mu);
+    test::carryLaggedImpulses(lagged, rows);
+    const SapProblem problem = SapProblem::create({&body}, rows, dt).value();
     const SapReport report = solver.solve(problem, v);
     test::expectCoulombAndComplementarity(problem, report);
+    lagged = test::normalImpulses(report);
     run.max_newton = std::max(run.max_newton, report.newton_iterations);
     run.max_cg = std::max(run.max_cg, report.cg_iterations);
     double normal = 0;

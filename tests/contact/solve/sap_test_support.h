@@ -17,10 +17,12 @@ namespace torsion::sap::test {
 
 constexpr double kGravity = 9.81;
 
-/// Every row of a solve: the impulse lies in Coulomb's cone (exactly: |gamma_t| <= mu gamma_n to
-/// 1e-12 relative) and the regularised complementarity holds: with u = v_c - v_hat + R gamma,
-/// u lies in the dual cone (mu |u_t| <= u_n) and gamma . u = 0, to rounding of the velocities
-/// involved. Also: the solve converged, its residual within its tolerance.
+/// Every row of a solve obeys the lagged model (sap_problem.h): the normal impulse is the
+/// compliant law's, gamma_n >= 0 with u_n = v_n - v_hat + R_n gamma_n >= 0 and gamma_n u_n = 0;
+/// friction lies in the exact disk |gamma_t| <= r = mu gamma_n^lag (1e-12 relative) and opposes
+/// the regularised slip u_t = v_t + R_t gamma_t at maximal dissipation, r |u_t| + gamma_t . u_t = 0
+/// (u_t = 0 where stuck inside the disk), to rounding of the velocities involved. Also: the solve
+/// converged, its residual within its tolerance.
 inline void expectCoulombAndComplementarity(const SapProblem& problem, const SapReport& report) {
   EXPECT_TRUE(report.converged) << report.message;
   EXPECT_LE(report.residual, report.tolerance);
@@ -30,14 +32,34 @@ inline void expectCoulombAndComplementarity(const SapProblem& problem, const Sap
     const RowModel& m = problem.model(i);
     const Eigen::Vector3d& gamma = report.impulses[k];
     const Eigen::Vector3d& vc = report.contact_velocities[k];
+    EXPECT_NEAR(m.radius, m.mu * problem.row(i).lagged_normal_impulse, 1e-15 * m.radius);
     EXPECT_GE(gamma(2), 0.0) << "row " << i;
-    EXPECT_LE(gamma.head<2>().norm(), m.mu * gamma(2) * (1 + 1e-12)) << "row " << i;
+    EXPECT_LE(gamma.head<2>().norm(), m.radius * (1 + 1e-12)) << "row " << i;
     const Eigen::Vector3d r_gamma(m.rt * gamma(0), m.rt * gamma(1), m.rn * gamma(2));
     const Eigen::Vector3d u = vc - Eigen::Vector3d(0, 0, m.v_hat) + r_gamma;
     const double scale = vc.norm() + std::abs(m.v_hat) + r_gamma.norm();
-    EXPECT_LE(m.mu * u.head<2>().norm() - u(2), 1e-12 * scale) << "row " << i;
-    EXPECT_LE(std::abs(gamma.dot(u)), 1e-12 * scale * gamma.norm()) << "row " << i;
+    EXPECT_GE(u(2), -1e-12 * scale) << "row " << i;
+    EXPECT_LE(std::abs(gamma(2) * u(2)), 1e-12 * scale * gamma(2)) << "row " << i;
+    const Eigen::Vector2d ut = u.head<2>();
+    EXPECT_LE(std::abs(m.radius * ut.norm() + gamma.head<2>().dot(ut)), 1e-12 * scale * m.radius)
+        << "row " << i;
   }
+}
+
+/// The lagged model's loop (docs/contact-solve.md): each row's lagged normal impulse is the
+/// previous step's normal impulse of the same contact, rows[i] of this step being lagged[i]'s;
+/// lagged is empty or shorter at the first step (new contacts: 0).
+inline void carryLaggedImpulses(const std::vector<double>& lagged, std::vector<ContactRow>& rows) {
+  for (size_t i = 0; i < rows.size() && i < lagged.size(); ++i)
+    rows[i].lagged_normal_impulse = lagged[i];
+}
+
+/// The normal impulses of a solve, for the next step's rows.
+inline std::vector<double> normalImpulses(const SapReport& report) {
+  std::vector<double> normal;
+  for (const Eigen::Vector3d& gamma : report.impulses)
+    normal.push_back(gamma(2));
+  return normal;
 }
 
 /// A point mass m (3 dofs) with momentum b = m v0 + dt f.

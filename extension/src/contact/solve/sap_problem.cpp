@@ -39,33 +39,34 @@ const char* toString(ContactState state) {
 
 RowResponse projectImpulse(const RowModel& m, const Eigen::Vector3d& vc) {
   RowResponse out;
-  // y = -R^{-1} (v_c - v_hat); the three regions of the paper's analytic projection.
-  const Eigen::Vector2d yt = -vc.head<2>() / m.rt;
+  // The lagged model (sap_problem.h): the compliant normal law, friction on the disk of radius r.
   const double yn = (m.v_hat - vc(2)) / m.rn;
-  const double yr = yt.norm();
-  const double mu_hat = m.mu * m.rt / m.rn;
-  // Stick needs y_n >= 0 spelled out for mu = 0, where y_r = 0 <= 0 y_n holds for any y_n.
-  if (yr <= m.mu * yn && yn >= 0) {
-    out.state = ContactState::kStick;
-    out.gamma << yt, yn;
-    out.g.diagonal() << 1 / m.rt, 1 / m.rt, 1 / m.rn;
-  } else if (yn <= -mu_hat * yr) {
-    out.state = ContactState::kSeparated;  // gamma and G stay zero
-    return out;
-  } else {
-    // Here y_r > 0: y_r = 0 would need 0 < y_n (not separated) and y_n < 0 (not stuck).
-    out.state = ContactState::kSlide;
-    const double factor = 1 / (1 + m.mu * mu_hat);  // 1 / (1 + mu_tilde^2)
-    const Eigen::Vector2d t = yt / yr;
-    const double gn = (yn + mu_hat * yr) * factor;
-    out.gamma << m.mu * gn * t, gn;
-    // G = factor / R_n e e^T + mu gamma_n / (y_r R_t) (I_t - t t^T), e = (mu t, 1).
-    const Eigen::Vector3d e(m.mu * t(0), m.mu * t(1), 1.0);
-    out.g = (factor / m.rn) * e * e.transpose();
-    out.g.topLeftCorner<2, 2>() +=
-        (m.mu * gn / (yr * m.rt)) * (Eigen::Matrix2d::Identity() - t * t.transpose());
+  if (yn > 0) {
+    out.gamma(2) = yn;
+    out.g(2, 2) = 1 / m.rn;
+    out.cost = 0.5 * m.rn * yn * yn;
   }
-  out.cost = 0.5 * (m.rt * out.gamma.head<2>().squaredNorm() + m.rn * out.gamma(2) * out.gamma(2));
+  const Eigen::Vector2d yt = -vc.head<2>() / m.rt;
+  const double yr = yt.norm();
+  if (!(m.radius > 0)) {
+    // No friction (mu = 0 or no lagged impulse): ell_t = 0. The state says whether it slips.
+    const bool slips = yr > 0;
+    out.state = yn > 0 ? (slips ? ContactState::kSlide : ContactState::kStick)
+                       : ContactState::kSeparated;  // then gamma = 0 and G = 0
+  } else if (yr <= m.radius) {
+    out.state = ContactState::kStick;
+    out.gamma.head<2>() = yt;
+    out.g(0, 0) = out.g(1, 1) = 1 / m.rt;
+    out.cost += 0.5 * m.rt * yt.squaredNorm();
+  } else {
+    // Here y_r > r > 0. G_tt = r / (y_r R_t) (I - t t^T); ell_t = r |v_t| - R_t r^2 / 2.
+    out.state = ContactState::kSlide;
+    const Eigen::Vector2d t = yt / yr;
+    out.gamma.head<2>() = m.radius * t;
+    out.g.topLeftCorner<2, 2>() =
+        (m.radius / (yr * m.rt)) * (Eigen::Matrix2d::Identity() - t * t.transpose());
+    out.cost += m.rt * m.radius * (yr - 0.5 * m.radius);
+  }
   return out;
 }
 
@@ -122,6 +123,9 @@ Status SapProblem::validate(const ContactRow& row) const {
     return Error{"dissipation time " + std::to_string(row.dissipation_time) + " < 0"};
   if (!std::isfinite(row.gap)) return Error{"gap is not finite"};
   if (!row.velocity_offset.allFinite()) return Error{"velocity offset is not finite"};
+  if (!(row.lagged_normal_impulse >= 0) || !std::isfinite(row.lagged_normal_impulse))
+    return Error{"lagged normal impulse " + std::to_string(row.lagged_normal_impulse) +
+                 " is not finite and >= 0"};
   for (const ContactTerm& term : row.terms) {
     if (term.body < 0 || term.body >= static_cast<int>(bodies_.size()))
       return Error{"term on body " + std::to_string(term.body) + ", which is not in the island"};
@@ -150,6 +154,7 @@ RowModel SapProblem::makeModel(const ContactRow& row, double dt,
   }
   RowModel m;
   m.mu = row.mu;
+  m.radius = row.mu * row.lagged_normal_impulse;
   const double rn_physical = 1 / (dt * (dt + row.dissipation_time) * row.stiffness);
   m.w = w_block.norm() / 3;
   // A row on prescribed dofs alone moves nothing; any positive w keeps its model well defined.

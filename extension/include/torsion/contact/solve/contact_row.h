@@ -17,7 +17,9 @@
 // between two rigid bodies 2, a node against a rigid body 2: one type for all. Besides J_i, a row
 // carries its physical data: the Coulomb coefficient mu, the contact stiffness k (N/m), the
 // dissipation time scale tau_d (s) and the signed gap phi0 (m) at the step's start, negative when
-// penetrating. sap_problem.h turns them into the regularisation of Castro et al. 2022.
+// penetrating, and the lagged normal impulse: the contact's normal impulse of the previous step,
+// which bounds this step's friction (the lagged model of Castro, Han, Masterjohn 2023).
+// sap_problem.h turns them into the regularisation of Castro et al. 2022.
 
 #include <Eigen/Core>
 #include <vector>
@@ -42,6 +44,10 @@ struct ContactRow {
   double stiffness = 0;         ///< k, N/m, > 0
   double dissipation_time = 0;  ///< tau_d, s, >= 0
   double gap = 0;               ///< phi0, m, negative when penetrating
+  /// gamma_n of this contact in the previous step's solve (N s, >= 0; SapReport::impulses(2)):
+  /// friction is bounded by the disk |gamma_t| <= mu times it. 0 for a new contact, which then
+  /// has no friction in its first step (docs/contact-solve.md, "Limits").
+  double lagged_normal_impulse = 0;
   /// The part of v_c that no island dof moves (m/s, contact frame): the motion of a kinematic
   /// partner's point (a moving hand, a conveyor), entered as B's minus A's. v_c = J v + this.
   Eigen::Vector3d velocity_offset = Eigen::Vector3d::Zero();

@@ -26,28 +26,37 @@
 // the block of A a term acts on, inverted on its free dofs: exact for a rigid body, for a FEM node
 // the block-Jacobi estimate of its compliance. beta = 1 and sigma = 1e-3 (SapParameters).
 //
-// With R = diag(R_t, R_t, R_n) the impulse is
+// The impulse follows the lagged model (Castro, Han, Masterjohn, "A Theory of Irrotational
+// Contact Fields", 2023; Drake's kLagged): the normal impulse from the compliant normal law alone,
+// friction the regularised projection of the slip onto the disk of radius r = mu gamma_n^lag,
+// gamma_n^lag the contact's normal impulse of the previous step (ContactRow):
 //
-//     gamma_i = P(y_i),   y_i = -R^{-1} (v_c,i - v_hat)
+//     gamma_n = max(0, y_n),         y_n = (v_hat - v_n) / R_n
+//     gamma_t = P_r(y_t),            y_t = -v_t / R_t,  P_r the projection onto |x| <= r
 //
-// P the projection onto Coulomb's circular cone F = {|gamma_t| <= mu gamma_n} in the R-norm
-// |x|_R^2 = x^T R x. With y_r = |y_t|, mu_hat = mu R_t / R_n, mu_tilde^2 = mu^2 R_t / R_n:
+//     stick   |y_t| <= r:  gamma_t = y_t
+//     slide   otherwise:   gamma_t = r y_t / |y_t|   (|gamma_t| = r exactly, against the slip)
 //
-//     stick      y_r <= mu y_n:           gamma = y
-//     separate   y_n <= -mu_hat y_r:      gamma = 0           (y in the polar cone)
-//     slide      otherwise:               gamma_n = (y_n + mu_hat y_r) / (1 + mu_tilde^2),
-//                                         gamma_t = mu gamma_n y_t / y_r
+// The two parts are separable: ell_i = ell_n(v_n) + ell_t(v_t),
 //
-// ell_i = 1/2 gamma_i^T R gamma_i, whose gradient in v_c is -gamma_i. So
+//     ell_n = 1/2 R_n gamma_n^2
+//     ell_t = 1/2 R_t |gamma_t|^2          (stick)
+//           = r |v_t| - 1/2 R_t r^2        (slide: Huber's function of the slip)
+//
+// each convex and C1 with gradient -gamma in v_c, so
 //
 //     gradient  g = A v - b - J^T gamma
-//     Hessian   H = A + J^T G J,  G_i = -d gamma_i / d v_c,i = (d P / d y) R^{-1}, symmetric PSD:
-//               stick R^{-1}; separate 0; slide
-//               1/((1 + mu_tilde^2) R_n) e e^T + mu gamma_n / (y_r R_t) (I_t - t t^T),
-//               e = (mu t, 1), t = y_t / y_r, I_t the tangent-plane identity.
+//     Hessian   H = A + J^T G J,  G_i = -d gamma_i / d v_c,i, diagonal in (t, n), PSD:
+//               G_nn = 1 / R_n if y_n > 0, else 0;
+//               G_tt = I / R_t (stick), r / (|y_t| R_t) (I - t t^T) (slide), t = y_t / |y_t|.
 //
-// At the minimiser (g = 0) u_i = v_c,i - v_hat + R gamma_i satisfies gamma in F, u in the dual
-// cone {mu |u_t| <= u_n}, gamma . u = 0: Coulomb's law with maximal dissipation, relaxed by R.
+// At the minimiser the normal impulse is the compliant force of the contact's spring-damper
+// (within R_n), never dilated by the slip: a sliding contact rides at its rest height. Friction
+// is Coulomb's with the previous step's normal impulse: stuck inside the disk, sliding on its
+// circle against the slip (maximal dissipation), relaxed by R_t. The state reported is the
+// friction's, stick or slide; separated where the row exerts nothing and has no curvature
+// (gamma_n = 0 and r = 0: gamma = 0, G = 0). A row with r > 0 exerts its friction even in a step
+// where its normal impulse falls to zero (the lag: at most mu gamma_n^lag, for one step).
 //
 // Prescribed dofs (island_body.h) are held at their values: the unknowns are the free dofs, the
 // gradient and every Newton direction filtered by S.
@@ -78,10 +87,11 @@ const char* toString(ContactState state);
 /// One row's regularised model, fixed for the solve.
 struct RowModel {
   double mu = 0;
-  double rt = 0;     ///< R_t, m/(N s)
-  double rn = 0;     ///< R_n, m/(N s)
-  double v_hat = 0;  ///< v_hat_n, m/s
-  double w = 0;      ///< the Delassus estimate w_i, m/(N s)
+  double radius = 0;  ///< r = mu gamma_n^lag, N s: the friction disk's radius
+  double rt = 0;      ///< R_t, m/(N s)
+  double rn = 0;      ///< R_n, m/(N s)
+  double v_hat = 0;   ///< v_hat_n, m/s
+  double w = 0;       ///< the Delassus estimate w_i, m/(N s)
 };
 
 /// The projection at one contact velocity.
@@ -92,7 +102,7 @@ struct RowResponse {
   double cost = 0;  ///< ell_i = 1/2 gamma^T R gamma, J
 };
 
-/// gamma = P(y(v_c)) with its G and cost (the three regions above).
+/// gamma(v_c) with its G and cost (the lagged model above).
 RowResponse projectImpulse(const RowModel& model, const Eigen::Vector3d& contact_velocity);
 
 /// Everything the solver needs at one v.
@@ -109,9 +119,9 @@ struct SapEvaluation {
 class SapProblem {
  public:
   /// Fails on a malformed row (a term outside its body or not on one whole block, mu < 0, k <= 0,
-  /// tau_d < 0) or dt <= 0. The bodies are not owned and must outlive the problem; their b,
-  /// diagonal blocks and free-dof projectors are read here; their products, filters and prescribed
-  /// values at every solve.
+  /// tau_d < 0, a negative or non-finite lagged normal impulse) or dt <= 0. The bodies are not
+  /// owned and must outlive the problem; their b, diagonal blocks and free-dof projectors are read
+  /// here; their products, filters and prescribed values at every solve.
   static Result<SapProblem> create(std::vector<const IslandBody*> bodies,
                                    std::vector<ContactRow> rows, double dt,
                                    const SapParameters& parameters = {});
