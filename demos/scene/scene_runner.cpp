@@ -240,16 +240,17 @@ class Run {
   }
 
   // A step whose solve failed, or after which a rigid body is not finite, ends the run unstable.
+  // The solver's report covers both, but it knows a rigid body only by its index in the world:
+  // the scene's names are looked up first, so the message names the body as the scene does.
   bool stepWasGood(const WorldStepReport& report) {
-    if (!report.ok) {
-      outcome_.stable = false;
-      outcome_.failure = report.message;
-      return false;
-    }
-    // Bullet lets a rigid body become NaN silently; such a step is no good step.
     if (auto fault = findUnhealthyRigidBody(rigid_bodies_)) {
       outcome_.stable = false;
       outcome_.failure = "step " + std::to_string(report.step) + ": " + fault->message;
+      return false;
+    }
+    if (!report.ok) {
+      outcome_.stable = false;
+      outcome_.failure = report.message;
       return false;
     }
     return true;

@@ -434,5 +434,37 @@ TEST(UserWorld, ValueOfAFailedResultThrowsTheErrorsMessage) {
       << "what(): '" << what << "'";
 }
 
+// A rigid body that goes NaN (here set so; in practice an overflow Bullet integrates without
+// complaint) while it rests on an FEM slab fails the solver's status, naming the rigid body, so
+// a user who checks fem.status() after stepSimulation learns the world is no longer a number.
+TEST(UserWorld, ANonFiniteRigidBodyOnAnFemSlabFailsTheSolversStatus) {
+  UserWorld user;
+  Material material;
+  material.youngs_modulus = 1e6;
+  FemBody* slab =
+      user.fem.addBody("slab", makeBoxTetMesh({-1, -1, 0}, {1, 1, 0.2}, 6, 6, 2).value(), material)
+          .value();
+  slab->carryNodes(
+      "base", nodesWhere(*slab, [](const Eigen::Vector3d& p) { return p.z() < 1e-9; }),
+      [](double) { return Frame{}; }, user.fem.time());
+  btRigidBody* box = user.addRigid(
+      std::make_unique<btBoxShape>(btVector3(btScalar(0.1), btScalar(0.1), btScalar(0.1))), 1.0,
+      btVector3(0, 0, btScalar(0.3)));
+  for (int call = 0; call < 20; ++call)
+    user.world.stepSimulation(btScalar(0.01), 0);
+  ASSERT_TRUE(user.fem.status().ok) << user.fem.status().message;
+  ASSERT_FALSE(slab->contacts().contacts().empty()) << "the box must rest on the slab";
+
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  box->setLinearVelocity(btVector3(0, 0, btScalar(nan)));
+  user.world.stepSimulation(btScalar(0.01), 0);
+  ASSERT_FALSE(user.fem.status().ok);
+  EXPECT_EQ(user.fem.status().failed_step, 21);
+  EXPECT_NE(user.fem.status().message.find("step 21: rigid body '#"), std::string::npos)
+      << user.fem.status().message;
+  EXPECT_NE(user.fem.status().message.find("not finite"), std::string::npos)
+      << user.fem.status().message;
+}
+
 }  // namespace
 }  // namespace torsion

@@ -163,10 +163,11 @@ Result<Ok> PyWorld::step(int n, FailureKind* kind, const std::function<bool()>& 
       return Error{scene_->spec.file + ": " + stepped.error().message};
     }
     const WorldStepReport& report = stepped.value();
-    if (!report.ok) return failWith(report.message);
-    // As the scene runner: Bullet lets a rigid body become NaN silently.
+    // As the scene runner: a rigid body gone NaN fails the report too, but only the names here
+    // say which body it was.
     if (auto fault = findUnhealthyRigidBody(rigid))
       return failWith("step " + std::to_string(report.step) + ": " + fault->message);
+    if (!report.ok) return failWith(report.message);
     if (interrupted && interrupted()) break;
   }
   return Ok{};

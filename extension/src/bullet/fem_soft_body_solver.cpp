@@ -8,6 +8,7 @@
 #include <sstream>
 
 #include "torsion/bt_conversions.h"
+#include "torsion/bullet/rigid_health.h"
 
 namespace torsion {
 
@@ -296,6 +297,15 @@ void FemSoftBodySolver::solveConstraints(btScalar solver_dt) {
       fail(s.str());
       ok = false;
       break;
+    }
+  }
+  // Bullet integrates an overflowing rigid body into NaN without complaint, and the FEM contacts
+  // above may just have taken impulses from one: the substep is only good if every rigid body of
+  // the world is still a number (its final state: Bullet's integration and the FEM corrections).
+  if (ok) {
+    if (auto fault = findUnhealthyRigidBody(*world_)) {
+      fail("step " + std::to_string(ctx.index) + ": " + fault->message);
+      ok = false;
     }
   }
   time_ += ctx.dt;

@@ -7,8 +7,9 @@
 namespace torsion {
 
 Status SolverSettings::validate() const {
-  if (!(std::isfinite(time_step) && time_step > 0 && time_step <= 1))
-    return Error{"solver: time_step = " + formatNumber(time_step) + ": must be in (0, 1] s"};
+  if (!(std::isfinite(time_step) && time_step >= kMinTimeStep && time_step <= 1))
+    return Error{"solver: time_step = " + formatNumber(time_step) + ": must be in [" +
+                 formatNumber(kMinTimeStep) + ", 1] s"};
   if (!(std::isfinite(tolerance) && tolerance > 0 && tolerance < 1))
     return Error{"solver: tolerance = " + formatNumber(tolerance) + ": must be in (0, 1)"};
   if (max_iterations < 1)

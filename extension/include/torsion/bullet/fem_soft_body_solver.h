@@ -70,7 +70,9 @@ class StepListener {
 struct FemSolverStatus {
   bool ok = true;
   std::int64_t failed_step = 0;  ///< index of the failed step, 0 while ok
-  std::string message;           ///< "body 'cyl', step 123: blow-up: ..."
+  /// "body 'cyl', step 123: blow-up: ...", or a rigid body of the world that ended a substep
+  /// not finite: "step 12: rigid body '#3': ..." (rigid_health.h)
+  std::string message;
 };
 
 /// The solver's clock, health and every FEM body at a moment (FemSoftBodySolver::checkpoint).

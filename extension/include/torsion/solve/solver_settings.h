@@ -27,8 +27,14 @@ enum class PreconditionerKind {
   kTwoLevel,
 };
 
+/// s: the shortest step accepted. Bullet skips a step at or below its epsilon (1.2e-7 s with float
+/// Bullet, 2.2e-16 s with double) without stepping anything, so a FemWorld set to such a dt would
+/// report steps in which nothing moved; 1 us is also far below any step a twist, a contact or the
+/// 1 kHz haptic loop needs.
+inline constexpr double kMinTimeStep = 1e-6;
+
 struct SolverSettings {
-  double time_step = 0.01;  ///< dt, s
+  double time_step = 0.01;  ///< dt, s, in [kMinTimeStep, 1]
   LinearSolverKind linear_solver = LinearSolverKind::kConjugateGradient;
   PreconditionerKind preconditioner = PreconditionerKind::kBlockJacobi;
   /// CG stops when |S(b - A v)| <= tolerance |S(b - A v_prescribed)|, the residual of the
