@@ -6,8 +6,10 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
 #include <cstdint>
 #include <cstring>
+#include <limits>
 #include <random>
 #include <string_view>
 #include <vector>
@@ -133,6 +135,67 @@ TEST(CheckpointIo, TheHashIsTheStandardFnv1aOfThePayload) {
   std::uint64_t stored = 0;
   std::memcpy(&stored, bytes.data() + 20, sizeof stored);
   EXPECT_EQ(stored, payloadHash(bytes));
+}
+
+// Bytes crafted behind a valid hash (the hash only catches accidents) that carry values no save
+// writes are refused naming what is wrong, and the world is left as it was: a NaN or negative
+// clock, a step count of -1, a hand frame whose quaternion is not unit.
+std::string withValidHash(std::string bytes) {
+  const std::uint64_t hash = payloadHash(bytes);
+  bytes.replace(20, 8, reinterpret_cast<const char*>(&hash), 8);
+  return bytes;
+}
+
+template <typename T>
+std::string withValueAt(const std::string& bytes, size_t at, T value) {
+  std::string altered = bytes;
+  altered.replace(at, sizeof(T), reinterpret_cast<const char*>(&value), sizeof(T));
+  return withValidHash(altered);
+}
+
+TEST(CheckpointIo, CraftedValuesBehindAValidHashAreRefusedNamingTheValue) {
+  BlockRig rig;
+  for (int k = 0; k < 40; ++k)
+    rig.step();
+  ASSERT_TRUE(rig.hand_->grabbed());
+  const std::string bytes = rig.save();
+  const double time = rig.world_.time();
+  const auto expectRefused = [&](const std::string& altered, const std::string& what) {
+    const Status loaded = rig.load(altered);
+    ASSERT_FALSE(loaded.ok()) << what;
+    EXPECT_NE(loaded.error().message.find("holds an invalid value: " + what), std::string::npos)
+        << loaded.error().message;
+    EXPECT_EQ(rig.world_.time(), time) << "a refused checkpoint changes nothing";
+  };
+  // The payload starts with the clock: time (f64), steps (i64), last step (f64).
+  expectRefused(withValueAt(bytes, kHeader, std::nan("")), "the clock");
+  expectRefused(withValueAt(bytes, kHeader, -1.0), "the clock");
+  expectRefused(withValueAt(bytes, kHeader + 8, std::int64_t{-1}), "the clock");
+  expectRefused(withValueAt(bytes, kHeader + 16, std::numeric_limits<double>::infinity()),
+                "the clock");
+
+  // The hand's frames: the bytes of its patch frame's quaternion (x, y, z, w), wherever they are
+  // stored, scaled by 2.
+  const Eigen::Quaterniond q = rig.hand_->frame().rotation;
+  std::string pattern;
+  for (const double c : {q.x(), q.y(), q.z(), q.w()})
+    pattern.append(reinterpret_cast<const char*>(&c), sizeof c);
+  std::string scaled = bytes;
+  int found = 0;
+  for (size_t at = scaled.find(pattern, kHeader); at != std::string::npos;
+       at = scaled.find(pattern, at + pattern.size())) {
+    for (int k = 0; k < 4; ++k) {
+      double c = 0;
+      std::memcpy(&c, scaled.data() + at + 8 * k, sizeof c);
+      c *= 2;
+      std::memcpy(scaled.data() + at + 8 * k, &c, sizeof c);
+    }
+    ++found;
+  }
+  ASSERT_GT(found, 0) << "the hand's frame must be in the bytes";
+  expectRefused(withValidHash(scaled), "a frame");
+
+  ASSERT_TRUE(rig.load(bytes).ok()) << "the bytes as saved still load";
 }
 
 TEST(CheckpointIo, BytesAlteredBehindAValidHashAreRefusedOrReadNeverOutOfBounds) {

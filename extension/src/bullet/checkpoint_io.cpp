@@ -1,6 +1,7 @@
 #include "torsion/bullet/checkpoint_io.h"
 
 #include <algorithm>
+#include <cmath>
 #include <cstdint>
 #include <cstring>
 #include <deque>
@@ -8,6 +9,7 @@
 #include <type_traits>
 
 #include "torsion/fnv1a.h"
+#include "torsion/format_number.h"
 
 namespace torsion {
 namespace {
@@ -74,6 +76,13 @@ class Reader {
  public:
   explicit Reader(std::string_view bytes) : in_(bytes) {}
   bool ok() const { return ok_; }
+  /// Bytes that pass the hash can still carry values no save writes (crafted, or a writer's bug):
+  /// the first such value's description, empty while every value checked was valid.
+  const std::string& invalid() const { return invalid_; }
+  void refuse(const std::string& why) {
+    if (invalid_.empty()) invalid_ = why;
+    ok_ = false;
+  }
   template <typename T>
   T raw() {
     T value{};
@@ -115,11 +124,15 @@ class Reader {
       x = i32();
     return v;
   }
+  /// A frame as Frame holds one: a finite origin and a unit quaternion (saved from a unit one, so
+  /// its norm is 1 to rounding).
   Frame frame() {
     Frame f;
     f.origin = vec3();
     const double x = f64(), y = f64(), z = f64(), w = f64();
     f.rotation = Eigen::Quaterniond(w, x, y, z);
+    if (ok_ && !(f.origin.allFinite() && std::abs(f.rotation.norm() - 1) <= 1e-9))
+      refuse("a frame with a non-finite origin or a rotation that is not a unit quaternion");
     return f;
   }
   /// An enum stored as u8, at most `last`.
@@ -142,9 +155,16 @@ class Reader {
     return true;
   }
   std::string_view in_;
+  std::string invalid_;
   size_t at_ = 0;
   bool ok_ = true;
 };
+
+// Why a payload that passed its hash could not be read: cut short, or a value no save writes.
+Error unreadable(const Reader& r) {
+  if (!r.invalid().empty()) return Error{"the checkpoint holds an invalid value: " + r.invalid()};
+  return Error{"the checkpoint is truncated or corrupted"};
+}
 
 // The bytes of a mesh's rest positions and elements: a body restored onto another mesh would
 // index the wrong nodes.
@@ -371,7 +391,7 @@ Result<FemBodyCheckpoint> readBody(Reader& r, FemWorld& world, FemBody& body,
   // they stay the body's own.
   material.barrier_threshold = model.material().barrier_threshold;
   material.barrier_stiffness = model.material().barrier_stiffness;
-  if (!r.ok()) return Error{"the checkpoint is truncated or corrupted"};
+  if (!r.ok()) return unreadable(r);
   if (nodes != static_cast<size_t>(model.nodeCount()) ||
       elements != static_cast<size_t>(model.elementCount()) || kind != model.elementKind() ||
       hash != meshHash(model)) {
@@ -411,7 +431,7 @@ Result<FemBodyCheckpoint> readBody(Reader& r, FemWorld& world, FemBody& body,
       c.state.element_rotations.size() != now.state.element_rotations.size() ||
       !dofsOrEmpty(c.stepper.previous_velocities) || !dofsOrEmpty(c.stepper.velocity_next) ||
       !dofsOrEmpty(c.stepper.elastic_forces) || !dofsOrEmpty(c.stepper.internal_forces)) {
-    return Error{"the checkpoint is truncated or corrupted"};
+    return unreadable(r);
   }
 
   const size_t group_count = r.count(4);
@@ -493,7 +513,7 @@ Result<FemBodyCheckpoint> readBody(Reader& r, FemWorld& world, FemBody& body,
     lambda = r.vec3();
   }
   c.last_report = readReport(r);
-  if (!r.ok()) return Error{"the checkpoint is truncated or corrupted"};
+  if (!r.ok()) return unreadable(r);
   return c;
 }
 
@@ -585,12 +605,48 @@ Result<double> checkpointTime(std::string_view bytes) {
   return time;
 }
 
+// The clock as a run leaves it: a finite time and last step, counts that are not negative, and a
+// failure (if any) at most one step past the clock (a substep that failed in collision detection
+// is not counted).
+void checkClock(const FemCheckpoint& fem, Reader& r) {
+  if (!r.ok()) return;
+  if (!(std::isfinite(fem.time) && fem.time >= 0 && std::isfinite(fem.last_dt) &&
+        fem.last_dt >= 0 && fem.steps >= 0))
+    r.refuse("the clock (time " + formatNumber(fem.time) + " s, " + std::to_string(fem.steps) +
+             " steps, last step " + formatNumber(fem.last_dt) + " s)");
+  else if (fem.status.failed_step < 0 || fem.status.failed_step > fem.steps + 1 ||
+           fem.status.ok != (fem.status.failed_step == 0))
+    r.refuse("the health (failed step " + std::to_string(fem.status.failed_step) + " of " +
+             std::to_string(fem.steps) + ")");
+}
+
+// A rigid body's pose as Bullet keeps one: finite, its basis a rotation (to float Bullet's
+// rounding when saved from a float world).
+void checkRigidPose(const btMatrix3x3& basis, const btVector3 (&v)[3], Reader& r) {
+  if (!r.ok()) return;
+  bool finite = true;
+  for (int row = 0; row < 3; ++row) {
+    for (int k = 0; k < 3; ++k) {
+      finite = finite && std::isfinite(static_cast<double>(basis[row][k])) &&
+               std::isfinite(static_cast<double>(v[row][k]));
+    }
+  }
+  const btMatrix3x3 product = basis * basis.transpose();
+  double off_identity = 0;
+  for (int row = 0; row < 3; ++row) {
+    for (int col = 0; col < 3; ++col)
+      off_identity = std::max(off_identity, std::abs(static_cast<double>(product[row][col]) -
+                                                     (row == col ? 1.0 : 0.0)));
+  }
+  if (!finite || !(off_identity <= 1e-5) || !(basis.determinant() > 0))
+    r.refuse("a rigid body's pose or velocity (not finite, or a basis that is not a rotation)");
+}
+
 Result<StoredCheckpoint> readCheckpoint(std::string_view bytes, FemWorld& world,
                                         const std::vector<Hand*>& hands) {
   Result<std::string_view> payload = payloadOf(bytes);
   if (!payload) return payload.error();
   Reader r(payload.value());
-  const Error truncated{"the checkpoint is truncated or corrupted"};
   StoredCheckpoint stored;
   FemCheckpoint& fem = stored.world.fem;
   fem.time = r.f64();
@@ -599,16 +655,17 @@ Result<StoredCheckpoint> readCheckpoint(std::string_view bytes, FemWorld& world,
   fem.status.ok = r.u8() != 0;
   fem.status.failed_step = r.i64();
   fem.status.message = r.str();
+  checkClock(fem, r);
 
   const size_t hand_count = r.count(8);
-  if (!r.ok()) return truncated;
+  if (!r.ok()) return unreadable(r);
   if (hand_count != hands.size()) {
     return Error{anotherWorld("it has " + std::to_string(hand_count) + " hands, this world " +
                               std::to_string(hands.size()))};
   }
   for (size_t h = 0; h < hand_count; ++h) {
     const std::string name = r.str(), body = r.str();
-    if (!r.ok()) return truncated;
+    if (!r.ok()) return unreadable(r);
     if (name != hands[h]->name() || body != hands[h]->body().name()) {
       std::string difference = "its hand " + std::to_string(h) + " is '";
       difference += name;
@@ -630,18 +687,18 @@ Result<StoredCheckpoint> readCheckpoint(std::string_view bytes, FemWorld& world,
         std::all_of(s.triangles.begin(), s.triangles.end(), [&](int t) {
           return t >= 0 && static_cast<size_t>(t) < mesh.surfaceTriangles().size();
         });
-    if (!r.ok() || !in_range) return truncated;
+    if (!r.ok() || !in_range) return unreadable(r);
   }
 
   const size_t body_count = r.count(8);
-  if (!r.ok()) return truncated;
+  if (!r.ok()) return unreadable(r);
   if (body_count != world.bodies().size()) {
     return Error{anotherWorld("it has " + std::to_string(body_count) + " FEM bodies, this world " +
                               std::to_string(world.bodies().size()))};
   }
   for (size_t b = 0; b < body_count; ++b) {
     const std::string name = r.str();
-    if (!r.ok()) return truncated;
+    if (!r.ok()) return unreadable(r);
     FemBody* body = world.body(name);
     if (body == nullptr) return Error{anotherWorld("this world has no body '" + name + "'")};
     Result<FemBodyCheckpoint> saved = readBody(r, world, *body, hands, stored.hands);
@@ -650,11 +707,11 @@ Result<StoredCheckpoint> readCheckpoint(std::string_view bytes, FemWorld& world,
   }
 
   const size_t pair_count = r.count(16);
-  if (!r.ok()) return truncated;
+  if (!r.ok()) return unreadable(r);
   for (size_t p = 0; p < pair_count; ++p) {
     FemPairCheckpoint pair;
     const std::string a = r.str(), b = r.str();
-    if (!r.ok()) return truncated;
+    if (!r.ok()) return unreadable(r);
     pair.a = world.body(a);
     pair.b = world.body(b);
     if (pair.a == nullptr || pair.b == nullptr)
@@ -664,7 +721,7 @@ Result<StoredCheckpoint> readCheckpoint(std::string_view bytes, FemWorld& world,
       key = r.raw<std::uint64_t>();
       lambda = r.vec3();
     }
-    if (!r.ok()) return truncated;
+    if (!r.ok()) return unreadable(r);
     fem.fem_pairs.push_back(std::move(pair));
   }
 
@@ -674,12 +731,12 @@ Result<StoredCheckpoint> readCheckpoint(std::string_view bytes, FemWorld& world,
     for (const auto& [body, saved] : fem.bodies) {
       if (body == &hands[h]->body() &&
           (group < -1 || group >= static_cast<int>(saved.groups.size())))
-        return truncated;
+        return unreadable(r);
     }
   }
 
   const size_t rigid_count = r.count(18 * 8);
-  if (!r.ok()) return truncated;
+  if (!r.ok()) return unreadable(r);
   if (rigid_count != world.rigidBodies().size()) {
     return Error{anotherWorld("it has " + std::to_string(rigid_count) +
                               " rigid bodies, this world " +
@@ -697,12 +754,13 @@ Result<StoredCheckpoint> readCheckpoint(std::string_view bytes, FemWorld& world,
       for (int k = 0; k < 3; ++k)
         vector[k] = static_cast<btScalar>(r.f64());
     }
+    checkRigidPose(basis, v, r);
     rigid.pose = btTransform(basis, v[0]);
     rigid.linear_velocity = v[1];
     rigid.angular_velocity = v[2];
   }
   stored.extra = r.str();
-  if (!r.ok() || !r.atEnd()) return truncated;
+  if (!r.ok() || !r.atEnd()) return unreadable(r);
   return stored;
 }
 
