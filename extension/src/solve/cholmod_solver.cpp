@@ -31,6 +31,7 @@ struct CholmodSolver::Impl {
   std::vector<int> patch_nodes;
   std::vector<Eigen::Vector3d> patch_weights;
   bool analysed = false;
+  bool matrix_finite = false, factor_valid = false;  // of the last factorize()
 #if TORSION_WITH_CHOLMOD
   Eigen::CholmodDecomposition<Eigen::SparseMatrix<double>, Eigen::Lower> factor;
 #else
@@ -248,6 +249,33 @@ const Eigen::SparseMatrix<double>& CholmodSolver::assemble(const SystemOperator&
   return m.matrix;
 }
 
+bool CholmodSolver::factorize(const SystemOperator& op, const NodeConstraints& constraints) {
+  Impl& m = *impl_;
+  m.factor_valid = false;
+  const Eigen::SparseMatrix<double>& A = assemble(op, constraints);
+  m.matrix_finite = Eigen::Map<const Eigen::VectorXd>(A.valuePtr(), A.nonZeros()).allFinite();
+  if (!m.matrix_finite) return false;
+  if (!m.analysed) {
+    m.factor.analyzePattern(A);
+    m.analysed = true;
+  }
+  m.factor.factorize(A);
+  m.factor_valid = m.factor.info() == Eigen::Success;
+  return m.factor_valid;
+}
+
+bool CholmodSolver::factorized() const {
+  return impl_->factor_valid;
+}
+
+void CholmodSolver::applyInverse(const NodeConstraints& constraints, const Eigen::VectorXd& r,
+                                 Eigen::VectorXd& z) const {
+  Eigen::VectorXd filtered = r;
+  constraints.filter(filtered);
+  z = impl_->factor.solve(filtered);
+  constraints.filter(z);
+}
+
 LinearSolveReport CholmodSolver::solve(const SystemOperator& op, const NodeConstraints& constraints,
                                        const Eigen::VectorXd& b, Eigen::VectorXd& v) {
   Impl& m = *impl_;
@@ -263,16 +291,11 @@ LinearSolveReport CholmodSolver::solve(const SystemOperator& op, const NodeConst
   if (!std::isfinite(reference))  // an overflowed system must not pass as solved
     return brokenDown(report, "the right-hand side or the matrix is not finite (overflow)");
 
-  const Eigen::SparseMatrix<double>& A = assemble(op, constraints);
-  if (!Eigen::Map<const Eigen::VectorXd>(A.valuePtr(), A.nonZeros()).allFinite())
-    return brokenDown(report, "the matrix is not finite (overflow)");
-  if (!m.analysed) {
-    m.factor.analyzePattern(A);
-    m.analysed = true;
+  if (!factorize(op, constraints)) {
+    return brokenDown(report, m.matrix_finite ? "the Cholesky factorisation failed (matrix not "
+                                                "positive definite)"
+                                              : "the matrix is not finite (overflow)");
   }
-  m.factor.factorize(A);
-  if (m.factor.info() != Eigen::Success)
-    return brokenDown(report, "the Cholesky factorisation failed (matrix not positive definite)");
   m.solution = m.factor.solve(m.rhs);
   constraints.filter(m.solution);
   v = m.prescribed + m.solution;

@@ -57,6 +57,18 @@ class CholmodSolver {
   LinearSolveReport solve(const SystemOperator& op, const NodeConstraints& constraints,
                           const Eigen::VectorXd& b, Eigen::VectorXd& v);
 
+  /// Assembles and factorises A' = S A S + (I - S) for the operator's current state and the
+  /// constraints, without solving (solve() does this itself). False if A' is not finite or not
+  /// positive definite; the old factor is then gone.
+  bool factorize(const SystemOperator& op, const NodeConstraints& constraints);
+  /// Whether the last solve() or factorize() left a factor.
+  bool factorized() const;
+  /// z = S A'^-1 S r with that factor: the exact inverse of A on the free dofs, for a
+  /// preconditioner (a contact solve's, fem_island_body.h). Valid until the next solve() or
+  /// factorize(), and only for the operator state and constraints it was made from.
+  void applyInverse(const NodeConstraints& constraints, const Eigen::VectorXd& r,
+                    Eigen::VectorXd& z) const;
+
   /// The factorisation this build uses: "CHOLMOD" or "Eigen SimplicialLLT".
   static const char* backend();
 

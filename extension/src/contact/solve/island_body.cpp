@@ -10,6 +10,11 @@ DiagonalBlock IslandBody::freeProjector(int /*block*/) const {
   return DiagonalBlock::Identity(blockSize(), blockSize());
 }
 
+void IslandBody::applyPreconditioner(const Eigen::VectorXd& r, Eigen::VectorXd& z) const {
+  z = r;
+  filter(z);
+}
+
 MatrixBody::MatrixBody(const Eigen::SparseMatrix<double>& matrix, Eigen::VectorXd momentum)
     : matrix_(matrix), momentum_(std::move(momentum)) {
   assert(matrix_.rows() == matrix_.cols() && matrix_.rows() == momentum_.size());

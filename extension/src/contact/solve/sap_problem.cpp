@@ -240,25 +240,41 @@ void SapProblem::multiplyHessian(const SapEvaluation& e, const Eigen::VectorXd& 
   filter(out);
 }
 
-void SapProblem::preconditionerBlocks(const SapEvaluation& e,
+void SapProblem::preconditionerBlocks(const SapEvaluation* e,
                                       std::vector<DiagonalBlock>& inverse) const {
+  // Blocks of a body with its own preconditioner are not used (applyPreconditioner): left as A's.
   inverse = blocks_;
-  for (int i = 0; i < rowCount(); ++i) {
-    const RowResponse& r = e.rows[static_cast<size_t>(i)];
+  for (int i = 0; i < rowCount() && e != nullptr; ++i) {
+    const RowResponse& r = e->rows[static_cast<size_t>(i)];
     if (r.state == ContactState::kSeparated) continue;
     for (const ContactTerm& term : row(i).terms)
       inverse[static_cast<size_t>(termBlock(term))] += term.block.transpose() * r.g * term.block;
   }
-  for (size_t k = 0; k < inverse.size(); ++k)
-    inverse[k] = inverseOnFreeDofs(inverse[k], projectors_[k]);
+  for (size_t b = 0; b < bodies_.size(); ++b) {
+    if (bodies_[b]->hasPreconditioner()) continue;
+    for (int k = block_starts_[b]; k < block_starts_[b + 1]; ++k) {
+      const auto j = static_cast<size_t>(k);
+      inverse[j] = inverseOnFreeDofs(inverse[j], projectors_[j]);
+    }
+  }
 }
 
 void SapProblem::applyPreconditioner(const std::vector<DiagonalBlock>& inverse,
                                      const Eigen::VectorXd& r, Eigen::VectorXd& out) const {
   out.resize(dofs_);
-  for (size_t k = 0; k < inverse.size(); ++k) {
-    const auto n = inverse[k].rows();
-    out.segment(block_offsets_[k], n) = inverse[k] * r.segment(block_offsets_[k], n);
+  for (size_t b = 0; b < bodies_.size(); ++b) {
+    const IslandBody& body = *bodies_[b];
+    if (body.hasPreconditioner()) {
+      body_in_[b] = r.segment(body_offsets_[b], body.dofs());
+      body.applyPreconditioner(body_in_[b], body_out_[b]);
+      out.segment(body_offsets_[b], body.dofs()) = body_out_[b];
+      continue;
+    }
+    for (int k = block_starts_[b]; k < block_starts_[b + 1]; ++k) {
+      const auto j = static_cast<size_t>(k);
+      const auto n = inverse[j].rows();
+      out.segment(block_offsets_[j], n) = inverse[j] * r.segment(block_offsets_[j], n);
+    }
   }
 }
 

@@ -24,6 +24,7 @@ SapReport SapSolver::solve(const SapProblem& problem, Eigen::VectorXd& v) {
   SapReport report;
   if (v.size() != problem.dofs()) v.setZero(problem.dofs());
   problem.impose(v);
+  if (settings_.capacitance_correction) prepareCorrection(problem);
   Eigen::VectorXd dv;
   double first_residual = 0;
   for (;;) {
@@ -68,12 +69,58 @@ SapReport SapSolver::solve(const SapProblem& problem, Eigen::VectorXd& v) {
   return report;
 }
 
+void SapSolver::prepareCorrection(const SapProblem& problem) {
+  // P0: the bodies' own preconditioners and the inverse of A's blocks (no contact terms).
+  problem.preconditionerBlocks(nullptr, preconditioner_);
+  const int columns = 3 * problem.rowCount();
+  correction_y_.resize(problem.dofs(), columns);
+  for (int c = 0; c < columns; ++c) {
+    residual_.setZero(problem.dofs());
+    problem.addRowTranspose(c / 3, Eigen::Vector3d::Unit(c % 3), residual_);
+    problem.applyPreconditioner(preconditioner_, residual_, z_);
+    correction_y_.col(c) = z_;
+  }
+  correction_w_.resize(columns, columns);
+  for (int c = 0; c < columns; ++c) {
+    z_ = correction_y_.col(c);
+    for (int i = 0; i < problem.rowCount(); ++i)
+      correction_w_.block<3, 1>(3 * i, c) = problem.multiplyRow(i, z_);
+  }
+}
+
+void SapSolver::preparePreconditioner(const SapProblem& problem) {
+  if (!settings_.capacitance_correction) {
+    problem.preconditionerBlocks(&evaluation_, preconditioner_);
+    return;
+  }
+  // I + G W, G = blockdiag(G_i) (zero for a separated row).
+  capacitance_matrix_ = correction_w_;
+  for (int i = 0; i < problem.rowCount(); ++i) {
+    const Eigen::Matrix3d& g = evaluation_.rows[static_cast<size_t>(i)].g;
+    capacitance_matrix_.middleRows<3>(3 * i) = g * correction_w_.middleRows<3>(3 * i);
+  }
+  capacitance_matrix_ += Eigen::MatrixXd::Identity(correction_w_.rows(), correction_w_.cols());
+  capacitance_.compute(capacitance_matrix_);
+}
+
+void SapSolver::precondition(const SapProblem& problem, const Eigen::VectorXd& r,
+                             Eigen::VectorXd& z) {
+  problem.applyPreconditioner(preconditioner_, r, z);
+  if (!settings_.capacitance_correction || problem.rowCount() == 0) return;
+  // z = P0 r - Y (I + G W)^-1 G J P0 r.
+  row_values_.resize(3 * problem.rowCount());
+  for (int i = 0; i < problem.rowCount(); ++i)
+    row_values_.segment<3>(3 * i) =
+        evaluation_.rows[static_cast<size_t>(i)].g * problem.multiplyRow(i, z);
+  z.noalias() -= correction_y_ * capacitance_.solve(row_values_);
+}
+
 int SapSolver::newtonDirection(const SapProblem& problem, double eta, Eigen::VectorXd& dv) {
   const Eigen::VectorXd& g = evaluation_.gradient;
-  problem.preconditionerBlocks(evaluation_, preconditioner_);
+  preparePreconditioner(problem);
   dv.setZero(problem.dofs());
   residual_ = -g;
-  problem.applyPreconditioner(preconditioner_, residual_, z_);
+  precondition(problem, residual_, z_);
   p_ = z_;
   double rz = residual_.dot(z_);
   const double target = eta * scaledNorm(problem, residual_);
@@ -85,7 +132,7 @@ int SapSolver::newtonDirection(const SapProblem& problem, double eta, Eigen::Vec
     const double a = rz / curvature;
     dv += a * p_;
     residual_ -= a * q_;
-    problem.applyPreconditioner(preconditioner_, residual_, z_);
+    precondition(problem, residual_, z_);
     const double rz_next = residual_.dot(z_);
     p_ = z_ + (rz_next / rz) * p_;
     rz = rz_next;
@@ -93,7 +140,7 @@ int SapSolver::newtonDirection(const SapProblem& problem, double eta, Eigen::Vec
   }
   // CG from zero descends after any number of iterations; this guards against rounding only.
   if (!(g.dot(dv) < 0)) {
-    problem.applyPreconditioner(preconditioner_, g, dv);
+    precondition(problem, g, dv);
     dv = -dv;
   }
   return iterations;

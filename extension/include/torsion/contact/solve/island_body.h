@@ -41,6 +41,13 @@ class IslandBody {
   virtual void impose(Eigen::VectorXd& /*v*/) const {}
   /// S restricted to block `block` (blockSize() square). Default: the identity.
   virtual DiagonalBlock freeProjector(int block) const;
+  /// Whether the body brings its own approximate inverse of A (applyPreconditioner). Then the
+  /// island's CG preconditions this body's dofs with it alone; otherwise with block-Jacobi on
+  /// A's diagonal blocks plus the contact terms on them (sap_problem.h). Default: no.
+  virtual bool hasPreconditioner() const { return false; }
+  /// z = S P S r, P symmetric positive definite on the free dofs, approximating A^-1 there (the
+  /// step's Cholesky factor: exactly A^-1). Called only when hasPreconditioner(). Default: z = S r.
+  virtual void applyPreconditioner(const Eigen::VectorXd& r, Eigen::VectorXd& z) const;
 };
 
 /// A body given by an assembled sparse SPD matrix (tests; spring networks), 3x3 blocks, with

@@ -151,9 +151,12 @@ class SapProblem {
   /// out = S H x at the evaluation's G blocks, x = S x.
   void multiplyHessian(const SapEvaluation& e, const Eigen::VectorXd& x,
                        Eigen::VectorXd& out) const;
-  /// Block-Jacobi preconditioner of S H S: per block k, S_k (S_k H_kk S_k + I - S_k)^{-1} S_k,
-  /// H_kk = A_kk + the G terms acting on block k.
-  void preconditionerBlocks(const SapEvaluation& e, std::vector<DiagonalBlock>& inverse) const;
+  /// The preconditioner of S H S, body by body: a body with its own (IslandBody::
+  /// hasPreconditioner) applies it, P_b ~ A_b^-1 (the contact terms on it left to CG: with the
+  /// exact A_b^-1 they are a perturbation of rank at most 3 per row); every other body's block k
+  /// gets block-Jacobi, S_k (S_k H_kk S_k + I - S_k)^{-1} S_k, H_kk = A_kk + the G terms acting on
+  /// block k. `inverse`: those blocks. `e` null: A's blocks alone, without the contact terms.
+  void preconditionerBlocks(const SapEvaluation* e, std::vector<DiagonalBlock>& inverse) const;
   /// out = the preconditioner applied to r.
   void applyPreconditioner(const std::vector<DiagonalBlock>& inverse, const Eigen::VectorXd& r,
                            Eigen::VectorXd& out) const;

@@ -26,6 +26,7 @@
 // threaded, so the same input gives bit-identical output.
 
 #include <Eigen/Core>
+#include <Eigen/LU>
 #include <string>
 #include <vector>
 
@@ -40,6 +41,15 @@ struct SapSolverSettings {
   int max_cg_iterations = 1000;  ///< per Newton direction
   double max_forcing = 0.1;      ///< the CG's relative tolerance is at most this
   int max_line_search_iterations = 100;
+  /// The CG's preconditioner with the contacts folded in exactly (Woodbury): with P0 the
+  /// contact-free preconditioner (each body's own, IslandBody::applyPreconditioner, or the
+  /// block-Jacobi inverse of A's blocks), P = (P0^-1 + J^T G J)^-1
+  ///   = P0 - Y (I + G W)^-1 G Y^T,   Y = P0 J^T,  W = J P0 J^T,
+  /// Y and W made once per solve (3 applications of P0 per row), I + G W factorised per Newton
+  /// iteration (dense, 3 x rows square). With every P0 exact (a body's Cholesky factor, a rigid
+  /// body's mass) P = H^-1: one CG iteration per direction. Off: P0 with the contact terms added
+  /// to the block-Jacobi blocks of bodies without their own preconditioner (sap_problem.h).
+  bool capacitance_correction = false;
 };
 
 struct SapReport {
@@ -72,6 +82,12 @@ class SapSolver {
  private:
   // The CG solve of S H S dv = -g to relative tolerance eta; returns its iterations.
   int newtonDirection(const SapProblem& problem, double eta, Eigen::VectorXd& dv);
+  // The capacitance correction's Y and W (settings_.capacitance_correction), once per solve.
+  void prepareCorrection(const SapProblem& problem);
+  // The preconditioner at evaluation_ (its blocks, or I + G W factorised).
+  void preparePreconditioner(const SapProblem& problem);
+  // z = P r.
+  void precondition(const SapProblem& problem, const Eigen::VectorXd& r, Eigen::VectorXd& z);
   // The step length minimising the cost along dv from evaluation_.v.
   double lineSearch(const SapProblem& problem, const Eigen::VectorXd& dv, int& iterations);
   // ell'(alpha) and ell''(alpha) along the line set up by lineSearch; noise: the size of the
@@ -85,6 +101,10 @@ class SapSolver {
   // Workspace, kept between solves.
   SapEvaluation evaluation_;
   std::vector<DiagonalBlock> preconditioner_;
+  // The capacitance correction: P0 J^T, J P0 J^T, the LU of I + G W, scratch.
+  Eigen::MatrixXd correction_y_, correction_w_, capacitance_matrix_;
+  Eigen::PartialPivLU<Eigen::MatrixXd> capacitance_;
+  Eigen::VectorXd row_values_;
   Eigen::VectorXd residual_, z_, p_, q_;
   // The line: dv . (A v - b), dv . A dv, v_c and J dv per row.
   double line_linear_ = 0, line_quadratic_ = 0;
