@@ -2,7 +2,7 @@
 // A FEM slab in a SAP island for the preconditioner tests and bench_sap_precond: its bottom nodes
 // on the ground z = 0 (one row each) and, on its top, a rigid box resting on four top nodes (four
 // rows of two terms: the node, side A, and the box's corner, side B). One step from rest under
-// gravity, dt = 1 ms: b = M v0 + dt M g (no strain yet). gtest-free.
+// gravity (dt = 1 ms unless set): b = M v0 + dt M g (no strain yet). gtest-free.
 
 #include <Eigen/Core>
 #include <algorithm>
@@ -28,13 +28,12 @@ struct SlabSpec {
   bool box = true;                                        // rigid box on the top
   double box_mass = 2;                                    // kg
   double mu = 0.5;
+  double dt = 1e-3;               // s
   int max_ground_rows = 1 << 30;  // the first this many bottom nodes only
 };
 
 class SlabScene {
  public:
-  static constexpr double kDt = 1e-3;
-
   explicit SlabScene(const SlabSpec& spec) : spec_(spec), parallel_(1) {
     auto mesh = std::make_shared<const TetMesh>(
         makeBoxTetMesh(Eigen::Vector3d::Zero(), spec.size, spec.nx, spec.ny, spec.nz).value());
@@ -44,15 +43,17 @@ class SlabScene {
     material.stiffness_damping = 0.01;
     model_ = FemModel::create(mesh, material).value();
     system_ = std::make_unique<SystemOperator>(model_, parallel_);
-    system_->setCoefficients(1.0, kDt * kDt + kDt * material.stiffness_damping);
+    const double dt = spec.dt;
+    system_->setCoefficients(1.0, dt * dt + dt * material.stiffness_damping);
     constraints_ = std::make_unique<NodeConstraints>(model_->nodeCount());
     const int n = model_->nodeCount();
     b_.setZero(3 * n);
     for (int i = 0; i < n; ++i)
-      b_(3 * i + 2) = -kDt * 9.81 * model_->nodeMasses()[static_cast<size_t>(i)];
+      b_(3 * i + 2) = -dt * 9.81 * model_->nodeMasses()[static_cast<size_t>(i)];
     makeRows();
   }
 
+  double dt() const { return spec_.dt; }
   int nodeCount() const { return model_->nodeCount(); }
   int tetCount() const { return model_->mesh().tetCount(); }
   const SystemOperator& system() const { return *system_; }
@@ -64,7 +65,7 @@ class SlabScene {
   RigidBody boxBody() const {
     const double m = spec_.box_mass;
     Eigen::VectorXd b = Eigen::VectorXd::Zero(6);
-    b(2) = -kDt * 9.81 * m;
+    b(2) = -spec_.dt * 9.81 * m;
     return RigidBody(m, m / 6 * box_half_ * box_half_ * 4 * Eigen::Matrix3d::Identity(), b);
   }
 
@@ -72,7 +73,7 @@ class SlabScene {
   SapProblem problem(const FemIslandBody& slab, const RigidBody& box) const {
     std::vector<const IslandBody*> bodies{&slab};
     if (spec_.box) bodies.push_back(&box);
-    return SapProblem::create(bodies, rows_, kDt).value();
+    return SapProblem::create(bodies, rows_, spec_.dt).value();
   }
 
  private:

@@ -259,6 +259,11 @@ void SapProblem::preconditionerBlocks(const SapEvaluation* e,
   }
 }
 
+bool SapProblem::hasBodyPreconditioner() const {
+  return std::any_of(bodies_.begin(), bodies_.end(),
+                     [](const IslandBody* body) { return body->hasPreconditioner(); });
+}
+
 void SapProblem::applyPreconditioner(const std::vector<DiagonalBlock>& inverse,
                                      const Eigen::VectorXd& r, Eigen::VectorXd& out) const {
   out.resize(dofs_);

@@ -24,7 +24,8 @@ SapReport SapSolver::solve(const SapProblem& problem, Eigen::VectorXd& v) {
   SapReport report;
   if (v.size() != problem.dofs()) v.setZero(problem.dofs());
   problem.impose(v);
-  if (settings_.capacitance_correction) prepareCorrection(problem);
+  correction_ = problem.hasBodyPreconditioner();
+  if (correction_) prepareCorrection(problem);
   Eigen::VectorXd dv;
   double first_residual = 0;
   for (;;) {
@@ -89,7 +90,7 @@ void SapSolver::prepareCorrection(const SapProblem& problem) {
 }
 
 void SapSolver::preparePreconditioner(const SapProblem& problem) {
-  if (!settings_.capacitance_correction) {
+  if (!correction_) {
     problem.preconditionerBlocks(&evaluation_, preconditioner_);
     return;
   }
@@ -106,7 +107,7 @@ void SapSolver::preparePreconditioner(const SapProblem& problem) {
 void SapSolver::precondition(const SapProblem& problem, const Eigen::VectorXd& r,
                              Eigen::VectorXd& z) {
   problem.applyPreconditioner(preconditioner_, r, z);
-  if (!settings_.capacitance_correction || problem.rowCount() == 0) return;
+  if (!correction_ || problem.rowCount() == 0) return;
   // z = P0 r - Y (I + G W)^-1 G J P0 r.
   row_values_.resize(3 * problem.rowCount());
   for (int i = 0; i < problem.rowCount(); ++i)

@@ -157,6 +157,9 @@ class SapProblem {
   /// gets block-Jacobi, S_k (S_k H_kk S_k + I - S_k)^{-1} S_k, H_kk = A_kk + the G terms acting on
   /// block k. `inverse`: those blocks. `e` null: A's blocks alone, without the contact terms.
   void preconditionerBlocks(const SapEvaluation* e, std::vector<DiagonalBlock>& inverse) const;
+  /// Whether a body brings its own preconditioner (then sap_solver.h adds the contacts by the
+  /// capacitance correction).
+  bool hasBodyPreconditioner() const;
   /// out = the preconditioner applied to r.
   void applyPreconditioner(const std::vector<DiagonalBlock>& inverse, const Eigen::VectorXd& r,
                            Eigen::VectorXd& out) const;

@@ -4,7 +4,7 @@
 //
 //   1. the gradient g = S (A v - b - J^T gamma) and the G blocks at v;
 //   2. the Newton direction from S H S dv = -g, H = A + J^T G J, by preconditioned CG, matrix-free
-//      (body products plus sum J_i^T G_i J_i), block-Jacobi preconditioned on H's diagonal blocks,
+//      (body products plus sum J_i^T G_i J_i), preconditioned (below),
 //      started from dv = 0 and stopped at a relative residual eta_k = min(0.1, sqrt(r_k / r_0))
 //      (inexact Newton, tightening as it converges; never tighter than the tolerance needs).
 //      CG from zero on an SPD system returns a descent direction (g . dv < 0) after any number of
@@ -12,6 +12,20 @@
 //   3. an exact line search: alpha minimising the convex cost along dv, by safeguarded 1-D Newton
 //      on ell'(alpha) with bisection (the Hessian is only piecewise continuous). ell' is
 //      monotone, so the bracket always holds the minimiser, and the cost never increases.
+//
+// The preconditioner: block-Jacobi on H's diagonal blocks, unless a body brings its own
+// approximate inverse P_b of A_b (IslandBody::hasPreconditioner: a FEM body's step factor). Then,
+// with P0 = blockdiag(P_b, the inverse of A's blocks for the other bodies), the contacts are
+// folded in exactly by Woodbury's identity (the capacitance correction):
+//
+//     P = (P0^-1 + J^T G J)^-1 = P0 - Y (I + G W)^-1 G Y^T,   Y = P0 J^T,  W = J P0 J^T,
+//
+// Y and W made once per solve (3 applications of P0 per row: W is the Delassus operator when
+// P0 = A^-1), I + G W (dense, 3 rows square) factorised per Newton iteration. With every P0 exact
+// (a body's Cholesky factor, a rigid body's mass) P = H^-1: one CG iteration per direction. P0
+// alone, without the correction, leaves CG the rank-3-per-row perturbation A^-1 J^T G J, whose
+// stiff, spread eigenvalues (G ~ 1/R up to 1e3 times A's blocks) cost up to rank + 1 iterations
+// per direction and more with rounding: measured, it loses (docs/contact-solve.md, "Cost").
 //
 // The cost is strictly convex and C1 with a piecewise-smooth gradient: Newton with exact line
 // search converges from any start. It stops on the paper's optimality criterion,
@@ -41,15 +55,6 @@ struct SapSolverSettings {
   int max_cg_iterations = 1000;  ///< per Newton direction
   double max_forcing = 0.1;      ///< the CG's relative tolerance is at most this
   int max_line_search_iterations = 100;
-  /// The CG's preconditioner with the contacts folded in exactly (Woodbury): with P0 the
-  /// contact-free preconditioner (each body's own, IslandBody::applyPreconditioner, or the
-  /// block-Jacobi inverse of A's blocks), P = (P0^-1 + J^T G J)^-1
-  ///   = P0 - Y (I + G W)^-1 G Y^T,   Y = P0 J^T,  W = J P0 J^T,
-  /// Y and W made once per solve (3 applications of P0 per row), I + G W factorised per Newton
-  /// iteration (dense, 3 x rows square). With every P0 exact (a body's Cholesky factor, a rigid
-  /// body's mass) P = H^-1: one CG iteration per direction. Off: P0 with the contact terms added
-  /// to the block-Jacobi blocks of bodies without their own preconditioner (sap_problem.h).
-  bool capacitance_correction = false;
 };
 
 struct SapReport {
@@ -82,7 +87,7 @@ class SapSolver {
  private:
   // The CG solve of S H S dv = -g to relative tolerance eta; returns its iterations.
   int newtonDirection(const SapProblem& problem, double eta, Eigen::VectorXd& dv);
-  // The capacitance correction's Y and W (settings_.capacitance_correction), once per solve.
+  // The capacitance correction's Y and W, once per solve (a body brings its preconditioner).
   void prepareCorrection(const SapProblem& problem);
   // The preconditioner at evaluation_ (its blocks, or I + G W factorised).
   void preparePreconditioner(const SapProblem& problem);
@@ -105,6 +110,7 @@ class SapSolver {
   Eigen::MatrixXd correction_y_, correction_w_, capacitance_matrix_;
   Eigen::PartialPivLU<Eigen::MatrixXd> capacitance_;
   Eigen::VectorXd row_values_;
+  bool correction_ = false;  // this solve uses the capacitance correction
   Eigen::VectorXd residual_, z_, p_, q_;
   // The line: dv . (A v - b), dv . A dv, v_c and J dv per row.
   double line_linear_ = 0, line_quadratic_ = 0;
