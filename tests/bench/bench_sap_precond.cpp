@@ -7,9 +7,9 @@
 //   sap_*          the island's SAP solve (tolerance 1e-6) with the CG preconditioned by
 //     jacobi          block-Jacobi on H's diagonal blocks (the contact terms included)
 //     factor          the step's CHOLMOD factor for the slab (factorisation included) with the
-//                     capacitance correction (sap_solver.h)
-//     ic              the slab's incomplete Cholesky factor (LaggedFactorPreconditioner, factored
-//                     every solve) with the capacitance correction
+//                     capacitance correction (sap_solver.h), which above max_correction_rows = 32
+//                     rows falls back to block-Jacobi (the factorisation still paid)
+//     factor_all      the same with the correction at any number of rows
 // Counters: Newton and CG iterations per solve (plain: CG iterations), rows, nodes, tets.
 // Run: build/tests/bench/bench_sap_precond --benchmark_counters_tabular=true
 #include <benchmark/benchmark.h>
@@ -19,7 +19,6 @@
 #include "../contact/solve/sap_fem_scene.h"
 #include "torsion/contact/solve/sap_solver.h"
 #include "torsion/solve/cholmod_solver.h"
-#include "torsion/solve/lagged_factor_preconditioner.h"
 #include "torsion/solve/projected_cg.h"
 
 namespace {
@@ -27,7 +26,7 @@ namespace {
 using torsion::sap::test::SlabScene;
 using torsion::sap::test::SlabSpec;
 
-enum Method { kPlainCg, kPlainCholmod, kSapJacobi, kSapFactor, kSapIc };
+enum Method { kPlainCg, kPlainCholmod, kSapJacobi, kSapFactor, kSapFactorAll };
 
 SlabSpec slabSpec(int log10_e, bool ground, int dt_ms) {
   SlabSpec spec;
@@ -64,33 +63,24 @@ void plainStep(benchmark::State& state, SlabScene& scene, Method method) {
 void sapStep(benchmark::State& state, SlabScene& scene, Method method) {
   torsion::sap::SapSolverSettings settings;
   settings.max_cg_iterations = 100000;
+  if (method == kSapFactorAll) settings.max_correction_rows = 1 << 30;
   torsion::sap::SapSolver solver(settings);
   torsion::CholmodSolver factor;
-  torsion::LaggedFactorPreconditioner incomplete(torsion::PreconditionerKind::kIncompleteCholesky);
-  torsion::SolverSettings refactor_every_solve;
-  refactor_every_solve.refactor_interval = 1;
   const torsion::sap::RigidBody box = scene.boxBody();
   Eigen::VectorXd v;
   torsion::sap::SapReport report;
   for (auto _ : state) {
     torsion::sap::FemIslandBody slab(scene.system(), scene.constraints(), scene.momentum());
-    if (method == kSapFactor) {
+    if (method == kSapFactor || method == kSapFactorAll) {
       if (!factor.factorize(scene.system(), scene.constraints())) {
         state.SkipWithError("factorisation failed");
         return;
       }
       slab.usePreconditioner(factor);
-    } else if (method == kSapIc) {
-      if (!incomplete.prepare(scene.system(), scene.constraints(), refactor_every_solve)) {
-        state.SkipWithError("incomplete factorisation failed");
-        return;
-      }
-      slab.usePreconditioner(incomplete);
     }
     const torsion::sap::SapProblem problem = scene.problem(slab, box);
     v.resize(0);
     report = solver.solve(problem, v);
-    incomplete.solved(report.cg_iterations);  // with refactor_interval 1: refactor every solve
     benchmark::DoNotOptimize(v.data());
   }
   if (!report.converged) state.SkipWithError(("SAP: " + report.message).c_str());
@@ -112,8 +102,8 @@ void BM_SlabStep(benchmark::State& state) {
   state.counters["rows"] = static_cast<double>(scene.rows().size());
   state.counters["nodes"] = scene.nodeCount();
   state.counters["tets"] = scene.tetCount();
-  static const char* const kNames[] = {"plain_cg",   "plain_cholmod",  "sap_jacobi",
-                                       "sap_factor", "sap_factor_cap", "sap_jacobi_cap"};
+  static const char* const kNames[] = {"plain_cg", "plain_cholmod", "sap_jacobi", "sap_factor",
+                                       "sap_factor_all"};
   state.SetLabel(std::string(kNames[method]) + (ground ? " ground" : " box") + " E=1e" +
                  std::to_string(log10_e) + " dt=" + std::to_string(dt_ms) + "ms");
 }
@@ -122,7 +112,7 @@ void slabArguments(benchmark::internal::Benchmark* b) {
   for (int dt_ms : {1, 10})
     for (int log10_e : {5, 8})
       for (int ground : {0, 1})
-        for (int method = kPlainCg; method <= kSapIc; ++method)
+        for (int method = kPlainCg; method <= kSapFactorAll; ++method)
           b->Args({log10_e, ground, method, dt_ms});
 }
 

@@ -33,26 +33,14 @@ DiagonalBlock FemIslandBody::freeProjector(int node) const {
 void FemIslandBody::usePreconditioner(const CholmodSolver& factor) {
   assert(factor.factorized());
   factor_ = &factor;
-  lagged_ = nullptr;
-}
-
-void FemIslandBody::usePreconditioner(const LaggedFactorPreconditioner& preconditioner) {
-  lagged_ = &preconditioner;
-  factor_ = nullptr;
 }
 
 void FemIslandBody::applyPreconditioner(const Eigen::VectorXd& r, Eigen::VectorXd& z) const {
-  if (factor_ != nullptr) {
-    factor_->applyInverse(constraints_, r, z);  // S A'^-1 S r
+  if (factor_ == nullptr) {
+    IslandBody::applyPreconditioner(r, z);
     return;
   }
-  if (lagged_ != nullptr) {
-    filtered_ = r;  // the lagged factor expects a filtered residual
-    constraints_.filter(filtered_);
-    lagged_->apply(constraints_, filtered_, z);
-    return;
-  }
-  IslandBody::applyPreconditioner(r, z);
+  factor_->applyInverse(constraints_, r, z);  // S A'^-1 S r
 }
 
 }  // namespace torsion::sap

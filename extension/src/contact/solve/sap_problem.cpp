@@ -240,8 +240,8 @@ void SapProblem::multiplyHessian(const SapEvaluation& e, const Eigen::VectorXd& 
   filter(out);
 }
 
-void SapProblem::preconditionerBlocks(const SapEvaluation* e,
-                                      std::vector<DiagonalBlock>& inverse) const {
+void SapProblem::preconditionerBlocks(const SapEvaluation* e, std::vector<DiagonalBlock>& inverse,
+                                      bool use_bodies) const {
   // Blocks of a body with its own preconditioner are not used (applyPreconditioner): left as A's.
   inverse = blocks_;
   for (int i = 0; i < rowCount() && e != nullptr; ++i) {
@@ -251,7 +251,7 @@ void SapProblem::preconditionerBlocks(const SapEvaluation* e,
       inverse[static_cast<size_t>(termBlock(term))] += term.block.transpose() * r.g * term.block;
   }
   for (size_t b = 0; b < bodies_.size(); ++b) {
-    if (bodies_[b]->hasPreconditioner()) continue;
+    if (use_bodies && bodies_[b]->hasPreconditioner()) continue;
     for (int k = block_starts_[b]; k < block_starts_[b + 1]; ++k) {
       const auto j = static_cast<size_t>(k);
       inverse[j] = inverseOnFreeDofs(inverse[j], projectors_[j]);
@@ -265,11 +265,12 @@ bool SapProblem::hasBodyPreconditioner() const {
 }
 
 void SapProblem::applyPreconditioner(const std::vector<DiagonalBlock>& inverse,
-                                     const Eigen::VectorXd& r, Eigen::VectorXd& out) const {
+                                     const Eigen::VectorXd& r, Eigen::VectorXd& out,
+                                     bool use_bodies) const {
   out.resize(dofs_);
   for (size_t b = 0; b < bodies_.size(); ++b) {
     const IslandBody& body = *bodies_[b];
-    if (body.hasPreconditioner()) {
+    if (use_bodies && body.hasPreconditioner()) {
       body_in_[b] = r.segment(body_offsets_[b], body.dofs());
       body.applyPreconditioner(body_in_[b], body_out_[b]);
       out.segment(body_offsets_[b], body.dofs()) = body_out_[b];

@@ -24,7 +24,8 @@ SapReport SapSolver::solve(const SapProblem& problem, Eigen::VectorXd& v) {
   SapReport report;
   if (v.size() != problem.dofs()) v.setZero(problem.dofs());
   problem.impose(v);
-  correction_ = problem.hasBodyPreconditioner();
+  correction_ =
+      problem.hasBodyPreconditioner() && problem.rowCount() <= settings_.max_correction_rows;
   if (correction_) prepareCorrection(problem);
   Eigen::VectorXd dv;
   double first_residual = 0;
@@ -72,13 +73,13 @@ SapReport SapSolver::solve(const SapProblem& problem, Eigen::VectorXd& v) {
 
 void SapSolver::prepareCorrection(const SapProblem& problem) {
   // P0: the bodies' own preconditioners and the inverse of A's blocks (no contact terms).
-  problem.preconditionerBlocks(nullptr, preconditioner_);
+  problem.preconditionerBlocks(nullptr, preconditioner_, true);
   const int columns = 3 * problem.rowCount();
   correction_y_.resize(problem.dofs(), columns);
   for (int c = 0; c < columns; ++c) {
     residual_.setZero(problem.dofs());
     problem.addRowTranspose(c / 3, Eigen::Vector3d::Unit(c % 3), residual_);
-    problem.applyPreconditioner(preconditioner_, residual_, z_);
+    problem.applyPreconditioner(preconditioner_, residual_, z_, true);
     correction_y_.col(c) = z_;
   }
   correction_w_.resize(columns, columns);
@@ -91,7 +92,7 @@ void SapSolver::prepareCorrection(const SapProblem& problem) {
 
 void SapSolver::preparePreconditioner(const SapProblem& problem) {
   if (!correction_) {
-    problem.preconditionerBlocks(&evaluation_, preconditioner_);
+    problem.preconditionerBlocks(&evaluation_, preconditioner_, false);
     return;
   }
   // I + G W, G = blockdiag(G_i) (zero for a separated row).
@@ -106,7 +107,7 @@ void SapSolver::preparePreconditioner(const SapProblem& problem) {
 
 void SapSolver::precondition(const SapProblem& problem, const Eigen::VectorXd& r,
                              Eigen::VectorXd& z) {
-  problem.applyPreconditioner(preconditioner_, r, z);
+  problem.applyPreconditioner(preconditioner_, r, z, correction_);
   if (!correction_ || problem.rowCount() == 0) return;
   // z = P0 r - Y (I + G W)^-1 G J P0 r.
   row_values_.resize(3 * problem.rowCount());

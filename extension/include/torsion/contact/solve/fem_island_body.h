@@ -6,20 +6,18 @@
 // diagonal blocks are read once, at construction: the body is valid for one step.
 //
 // Its preconditioner in the island's CG (island_body.h), by default none (the island's
-// block-Jacobi with the contact blocks). usePreconditioner() hands it the step's own:
-//   - the step's CHOLMOD factor (CholmodSolver::factorize at this step's operator and
-//     constraints): P = A^-1 on the free dofs, exactly, so P H = I + A^-1 J^T G J and CG needs at
-//     most rank(J^T G J) + 1 iterations (docs/contact-solve.md, "Cost");
-//   - the body's CG preconditioner (LaggedFactorPreconditioner, prepared for this step: a lagged
-//     Cholesky or incomplete Cholesky factor).
-// Neither is owned: it must hold this step's factor for as long as the body is solved with.
+// block-Jacobi with the contact blocks). usePreconditioner() hands it the step's CHOLMOD factor
+// (CholmodSolver::factorize at this step's operator and constraints): P0 = A^-1 on the free dofs,
+// exactly, to which the solver adds the contacts by the capacitance correction (sap_solver.h).
+// Not owned: it must hold this step's factor for as long as the body is solved with. (The body's
+// incomplete Cholesky factor was measured in that place and lost to block-Jacobi everywhere:
+// docs/contact-solve.md, "Cost".)
 
 #include <Eigen/Core>
 #include <vector>
 
 #include "torsion/contact/solve/island_body.h"
 #include "torsion/solve/cholmod_solver.h"
-#include "torsion/solve/lagged_factor_preconditioner.h"
 #include "torsion/solve/node_constraints.h"
 #include "torsion/solve/system_operator.h"
 
@@ -42,9 +40,7 @@ class FemIslandBody final : public IslandBody {
 
   /// Preconditions with the step's factor (factor.factorized() must hold).
   void usePreconditioner(const CholmodSolver& factor);
-  /// Preconditions with the body's CG preconditioner, prepared for this step.
-  void usePreconditioner(const LaggedFactorPreconditioner& preconditioner);
-  bool hasPreconditioner() const override { return factor_ != nullptr || lagged_ != nullptr; }
+  bool hasPreconditioner() const override { return factor_ != nullptr; }
   void applyPreconditioner(const Eigen::VectorXd& r, Eigen::VectorXd& z) const override;
 
  private:
@@ -53,8 +49,6 @@ class FemIslandBody final : public IslandBody {
   Eigen::VectorXd momentum_;
   std::vector<Eigen::Matrix3d> blocks_;
   const CholmodSolver* factor_ = nullptr;
-  const LaggedFactorPreconditioner* lagged_ = nullptr;
-  mutable Eigen::VectorXd filtered_;  // scratch of applyPreconditioner
 };
 
 }  // namespace torsion::sap

@@ -156,13 +156,15 @@ class SapProblem {
   /// exact A_b^-1 they are a perturbation of rank at most 3 per row); every other body's block k
   /// gets block-Jacobi, S_k (S_k H_kk S_k + I - S_k)^{-1} S_k, H_kk = A_kk + the G terms acting on
   /// block k. `inverse`: those blocks. `e` null: A's blocks alone, without the contact terms.
-  void preconditionerBlocks(const SapEvaluation* e, std::vector<DiagonalBlock>& inverse) const;
+  /// `use_bodies` false: block-Jacobi for every body, its own preconditioner or not.
+  void preconditionerBlocks(const SapEvaluation* e, std::vector<DiagonalBlock>& inverse,
+                            bool use_bodies) const;
   /// Whether a body brings its own preconditioner (then sap_solver.h adds the contacts by the
   /// capacitance correction).
   bool hasBodyPreconditioner() const;
-  /// out = the preconditioner applied to r.
+  /// out = the preconditioner applied to r (`use_bodies` as preconditionerBlocks was given).
   void applyPreconditioner(const std::vector<DiagonalBlock>& inverse, const Eigen::VectorXd& r,
-                           Eigen::VectorXd& out) const;
+                           Eigen::VectorXd& out, bool use_bodies) const;
 
  private:
   SapProblem() = default;

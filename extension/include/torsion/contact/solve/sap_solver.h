@@ -14,7 +14,8 @@
 //      monotone, so the bracket always holds the minimiser, and the cost never increases.
 //
 // The preconditioner: block-Jacobi on H's diagonal blocks, unless a body brings its own
-// approximate inverse P_b of A_b (IslandBody::hasPreconditioner: a FEM body's step factor). Then,
+// approximate inverse P_b of A_b (IslandBody::hasPreconditioner: a FEM body's step factor) and the
+// island has at most max_correction_rows rows. Then,
 // with P0 = blockdiag(P_b, the inverse of A's blocks for the other bodies), the contacts are
 // folded in exactly by Woodbury's identity (the capacitance correction):
 //
@@ -55,6 +56,11 @@ struct SapSolverSettings {
   int max_cg_iterations = 1000;  ///< per Newton direction
   double max_forcing = 0.1;      ///< the CG's relative tolerance is at most this
   int max_line_search_iterations = 100;
+  /// The capacitance correction (below) costs 3 applications of the body preconditioners per
+  /// row; above this many rows the island falls back to block-Jacobi with the contact blocks for
+  /// every body. 32: on a 1445-node slab one CHOLMOD solve costs about 1/55 of its factorisation,
+  /// so 32 rows add at most about 1.7 factorisations (docs/contact-solve.md, "Cost").
+  int max_correction_rows = 32;
 };
 
 struct SapReport {
