@@ -23,7 +23,7 @@ struct Solved {
   SapReport report;
 };
 
-Solved solveScene(test::SlabScene& scene, Precond precond) {
+Solved solveScene(test::SlabScene& scene, Precond precond, const SapSolverSettings& settings = {}) {
   CholmodSolver factor;
   FemIslandBody slab(scene.system(), scene.constraints(), scene.momentum());
   if (precond != Precond::kBlockJacobi) {
@@ -32,7 +32,7 @@ Solved solveScene(test::SlabScene& scene, Precond precond) {
   }
   const RigidBody box = scene.boxBody();
   const SapProblem problem = scene.problem(slab, box);
-  SapSolver solver;
+  SapSolver solver(settings);
   Solved out;
   out.report = solver.solve(problem, out.v);
   test::expectCoulombAndComplementarity(problem, out.report);
@@ -98,6 +98,17 @@ TEST(SapPrecond, ExactBodyInverseNeedsAHandfulOfCgIterationsPerContact) {
   std::printf("one contact: CG %d in %d Newton (factor), %d in %d (block-Jacobi)\n",
               factor.report.cg_iterations, factor.report.newton_iterations,
               jacobi.report.cg_iterations, jacobi.report.newton_iterations);
+}
+
+// Above max_correction_rows the island ignores the factor: block-Jacobi's solve, bit for bit.
+TEST(SapPrecond, AboveTheRowCapFallsBackToBlockJacobi) {
+  test::SlabScene scene{test::SlabSpec{}};
+  SapSolverSettings settings;
+  settings.max_correction_rows = static_cast<int>(scene.rows().size()) - 1;
+  const Solved jacobi = solveScene(scene, Precond::kBlockJacobi, settings);
+  const Solved factor = solveScene(scene, Precond::kFactor, settings);
+  EXPECT_EQ(jacobi.v, factor.v);
+  EXPECT_EQ(jacobi.report.cg_iterations, factor.report.cg_iterations);
 }
 
 TEST(SapPrecond, FactorSolveIsDeterministic) {

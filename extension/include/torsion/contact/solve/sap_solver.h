@@ -58,8 +58,8 @@ struct SapSolverSettings {
   int max_line_search_iterations = 100;
   /// The capacitance correction (below) costs 3 applications of the body preconditioners per
   /// row; above this many rows the island falls back to block-Jacobi with the contact blocks for
-  /// every body. 32: on a 1445-node slab one CHOLMOD solve costs about 1/55 of its factorisation,
-  /// so 32 rows add at most about 1.7 factorisations (docs/contact-solve.md, "Cost").
+  /// every body. 32: on a 1445-node slab one CHOLMOD solve costs about 1/60 of its factorisation,
+  /// so 32 rows add at most about 1.6 factorisations (docs/contact-solve.md, "Cost").
   int max_correction_rows = 32;
 };
 
