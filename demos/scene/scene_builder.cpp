@@ -74,7 +74,12 @@ Status driveHands(BuiltScene& scene) {
                      "': grab at t = " + formatNumber(now) + " s: " + grabbed.error().message};
       }
     }
-    if (s.hand->grabbed()) s.hand->moveTo(s.spec.frameAt(now + dt));
+    if (s.hand->grabbed()) {
+      if (Status moved = s.hand->moveTo(s.spec.frameAt(now + dt)); !moved) {
+        return Error{"hands[" + std::to_string(h) + "] '" + s.spec.name +
+                     "': at t = " + formatNumber(now + dt) + " s: " + moved.error().message};
+      }
+    }
   }
   return Ok{};
 }
@@ -102,8 +107,11 @@ Result<std::unique_ptr<BuiltScene>> buildScene(SceneSpec spec, int threads_overr
         world.addBody(body.name, mesh.value().mesh, body.material, body.pose, body.element);
     if (!added) return Error{entry + ": " + added.error().message};
     if (body.linear_velocity != Eigen::Vector3d::Zero() ||
-        body.angular_velocity != Eigen::Vector3d::Zero())
-      added.value()->setRigidVelocity(body.linear_velocity, body.angular_velocity);
+        body.angular_velocity != Eigen::Vector3d::Zero()) {
+      if (Status set = added.value()->setRigidVelocity(body.linear_velocity, body.angular_velocity);
+          !set)
+        return Error{entry + ": " + set.error().message};
+    }
     if (body.self_contact) {
       if (Status on = added.value()->enableSelfContact(*body.self_contact); !on)
         return Error{entry + ": " + on.error().message};

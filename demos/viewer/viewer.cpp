@@ -260,7 +260,12 @@ class Viewer {
       unstable_ = driven.error().message;
       return;
     }
-    if (manual_ && hand() && hand()->hand->grabbed()) hand()->hand->moveTo(manual_frame_);
+    if (manual_ && hand() && hand()->hand->grabbed()) {
+      if (Status moved = hand()->hand->moveTo(manual_frame_); !moved) {
+        unstable_ = moved.error().message;
+        return;
+      }
+    }
     const auto t0 = std::chrono::steady_clock::now();
     // Device hands (if any) step through their haptic loops.
     const WorldStepReport r = scene_->haptics ? scene_->haptics->step() : scene_->world->step();

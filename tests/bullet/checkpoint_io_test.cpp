@@ -50,8 +50,8 @@ class BlockRig {
           hand_->grab(Frame{Eigen::Vector3d(0, 0, 0.3), Eigen::Quaterniond::Identity()}, t).ok());
     }
     if (hand_->grabbed()) {
-      hand_->moveTo(Frame{Eigen::Vector3d(0, 0, 0.3), Eigen::Quaterniond(Eigen::AngleAxisd(
-                                                          t - 0.25, Eigen::Vector3d::UnitZ()))});
+      const Eigen::Quaterniond turn(Eigen::AngleAxisd(t - 0.25, Eigen::Vector3d::UnitZ()));
+      ASSERT_TRUE(hand_->moveTo(Frame{Eigen::Vector3d(0, 0, 0.3), turn}).ok());
     }
     const WorldStepReport r = world_.step();
     ASSERT_TRUE(r.ok) << r.message;

@@ -38,7 +38,7 @@ class TwistRig {
       Frame start{Eigen::Vector3d(0.2, 0.2, 1.9), Eigen::Quaterniond::Identity()};
       ASSERT_TRUE(hand_->grab(start, t).ok());
     }
-    hand_->moveTo(goal);
+    EXPECT_TRUE(hand_->moveTo(goal).ok());
     const WorldStepReport r = world_.step();
     ASSERT_TRUE(r.ok) << r.message;
   }

@@ -133,7 +133,7 @@ struct ThrownBlocks {
                           makeBoxTetMesh({0.12, 0.03, 0.01}, {0.22, 0.13, 0.11}, 3, 3, 3).value(),
                           material)
                  .value();
-    thrown->setVelocity(Eigen::Vector3d(-speed, 0, 0));
+    EXPECT_TRUE(thrown->setVelocity(Eigen::Vector3d(-speed, 0, 0)).ok());
   }
   FemWorld world;
   FemBody* struck = nullptr;
@@ -307,7 +307,7 @@ CrossedBars dropRidgeOnRidge(bool edge_edge) {
   FemBody* above =
       world.addBody("above", ridgeBar(1, Eigen::Vector3d(0, 0, 2 * ridge + 0.005)), soft(1e6))
           .value();
-  above->setVelocity(Eigen::Vector3d(0, 0, -1));
+  EXPECT_TRUE(above->setVelocity(Eigen::Vector3d(0, 0, -1)).ok());
   CrossedBars result;
   for (int k = 0; k < 60; ++k) {
     const WorldStepReport r = world.step();

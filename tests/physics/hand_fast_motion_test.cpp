@@ -78,7 +78,7 @@ TurnHistory fastTurn(double max_drag_strain, double dt = kDt, int turn_steps = k
     Frame device = start;
     const double angle = M_PI / 2 * std::min(1.0, static_cast<double>(step) / turn_steps);
     device.rotation = Eigen::AngleAxisd(angle, Eigen::Vector3d::UnitZ());
-    hand.moveTo(device);
+    EXPECT_TRUE(hand.moveTo(device).ok());
     const WorldStepReport report = world.step();
     EXPECT_TRUE(report.ok) << report.message;
     if (!report.ok) break;

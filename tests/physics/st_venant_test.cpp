@@ -284,7 +284,7 @@ TEST_F(StVenant, SmallTwistThroughAHandMatchesTheEndRotation) {
   const double angle = 0.05;
   for (int k = 1; k <= 12; ++k) {
     frame.rotation = Eigen::AngleAxisd(angle * std::min(k / 3.0, 1.0), Eigen::Vector3d::UnitZ());
-    hand.moveTo(frame);
+    EXPECT_TRUE(hand.moveTo(frame).ok());
     const WorldStepReport r = world.step();
     ASSERT_TRUE(r.ok) << r.message;
   }
@@ -329,7 +329,7 @@ TEST(StVenantLargeTwist, TwoPiTwistThroughAHandStaysStableAndLinear) {
   const int steps = static_cast<int>(std::ceil(total / omega / dt)) + 200;
   for (int k = 1; k <= steps; ++k) {
     frame.rotation = Eigen::AngleAxisd(std::min(omega * k * dt, total), Eigen::Vector3d::UnitZ());
-    hand.moveTo(frame);
+    EXPECT_TRUE(hand.moveTo(frame).ok());
     const WorldStepReport r = world.step();
     ASSERT_TRUE(r.ok) << r.message;
   }

@@ -469,7 +469,7 @@ TEST(Hand, CarriesThePatchRigidlyFreesItAndTheBodyReturnsToRest) {
   const double total = 0.3;
   for (int s = 1; s <= steps; ++s) {
     const Frame target = makeFrame(O, about(Eigen::Vector3d::UnitZ(), total * s / steps));
-    hand.moveTo(target);
+    EXPECT_TRUE(hand.moveTo(target).ok());
     const WorldStepReport r = rig.world.step();
     ASSERT_TRUE(r.ok) << r.message;
     int carried = 0;
@@ -524,7 +524,7 @@ TEST(Hand, WrenchOpposesTheTwist) {
     ASSERT_TRUE(hand.grab(makeFrame(O), rig.world.time()).ok());
     EXPECT_EQ(hand.wrench().torque, Eigen::Vector3d::Zero());  // no step yet
     for (int s = 1; s <= 10; ++s) {
-      hand.moveTo(makeFrame(O, about(Eigen::Vector3d::UnitZ(), sign * 0.02 * s)));
+      EXPECT_TRUE(hand.moveTo(makeFrame(O, about(Eigen::Vector3d::UnitZ(), sign * 0.02 * s))).ok());
       ASSERT_TRUE(rig.world.step().ok);
     }
     const Wrench w = hand.wrench();
@@ -553,7 +553,7 @@ TEST(Hand, FailedGrabIsAnErrorAndTheHandGrabsAgainElsewhere) {
   const std::vector<int> first = hand.grabbedNodes();
   const int first_group = hand.group();
   for (int s = 1; s <= 5; ++s) {
-    hand.moveTo(makeFrame({0, 0, 9.99 + 0.002 * s}));
+    EXPECT_TRUE(hand.moveTo(makeFrame({0, 0, 9.99 + 0.002 * s})).ok());
     ASSERT_TRUE(rig.world.step().ok);
   }
   for (int node : first) {
@@ -575,7 +575,7 @@ TEST(Hand, FailedGrabIsAnErrorAndTheHandGrabsAgainElsewhere) {
   for (int node : hand.grabbedNodes())
     local.push_back(body.state().position(node) - mid.origin);
   for (int s = 1; s <= 5; ++s) {
-    hand.moveTo(makeFrame(mid.origin + Eigen::Vector3d(0.004 * s, 0, 0)));
+    EXPECT_TRUE(hand.moveTo(makeFrame(mid.origin + Eigen::Vector3d(0.004 * s, 0, 0))).ok());
     ASSERT_TRUE(rig.world.step().ok);
   }
   for (size_t k = 0; k < local.size(); ++k) {
@@ -616,8 +616,8 @@ TEST(Hand, TwoHandsAndFixedNodesOnOneBodyHoldTheirOwnPatchesInEquilibrium) {
   const Frame turned_b = makeFrame(b, about(Eigen::Vector3d::UnitZ(), -0.2));
   for (int s = 1; s <= 300; ++s) {
     const double f = std::min(1.0, s / 20.0);
-    middle.moveTo(makeFrame(a, about(Eigen::Vector3d::UnitZ(), 0.1 * f)));
-    end.moveTo(makeFrame(b, about(Eigen::Vector3d::UnitZ(), -0.2 * f)));
+    EXPECT_TRUE(middle.moveTo(makeFrame(a, about(Eigen::Vector3d::UnitZ(), 0.1 * f))).ok());
+    EXPECT_TRUE(end.moveTo(makeFrame(b, about(Eigen::Vector3d::UnitZ(), -0.2 * f))).ok());
     const WorldStepReport r = rig.world.step();
     ASSERT_TRUE(r.ok) << r.message;
   }
@@ -641,6 +641,46 @@ TEST(Hand, TwoHandsAndFixedNodesOnOneBodyHoldTheirOwnPatchesInEquilibrium) {
   // the rings' grabbed bands shorten the free lengths a little).
   EXPECT_GT(t_base, 0);  // the body drags the base along the middle's turn
   EXPECT_NEAR(t_end / t_base, (0.3 / 4.9) / (0.1 / 5), 0.1 * (0.3 / 4.9) / (0.1 / 5));
+}
+
+// A frame that is not a pose (the zero quaternion of Frame{origin, {}}, a scaled one, a NaN
+// origin) is refused by grab and moveTo with a message naming the hand, and changes nothing: the
+// goal stays where it was. A body's velocity that is not finite is refused likewise.
+TEST(Hand, FramesThatAreNotPosesAndNonFiniteVelocitiesAreRefused) {
+  TwistRig rig(Material{});
+  Hand hand(*rig.body, "left");
+  const Eigen::Vector3d O(0, 0, 9.99);
+  Frame zero{O, Eigen::Quaterniond(0, 0, 0, 0)};
+  Result<int> grabbed = hand.grab(zero, rig.world.time());
+  ASSERT_FALSE(grabbed.ok());
+  EXPECT_NE(grabbed.error().message.find("hand 'left' on body"), std::string::npos)
+      << grabbed.error().message;
+  EXPECT_NE(grabbed.error().message.find("not a unit quaternion"), std::string::npos)
+      << grabbed.error().message;
+  EXPECT_FALSE(hand.grabbed());
+
+  ASSERT_TRUE(hand.grab(makeFrame(O), rig.world.time()).ok());
+  const Frame goal = hand.goal();
+  const Frame scaled{O, Eigen::Quaterniond(2, 0, 0, 0)};
+  const Frame lost{Eigen::Vector3d(std::nan(""), 0, 0), Eigen::Quaterniond::Identity()};
+  for (const Frame& bad : {zero, scaled, lost}) {
+    const Status moved = hand.moveTo(bad);
+    ASSERT_FALSE(moved.ok());
+    EXPECT_NE(moved.error().message.find("hand 'left'"), std::string::npos)
+        << moved.error().message;
+    EXPECT_EQ(hand.goal().origin, goal.origin);
+    EXPECT_EQ(hand.goal().rotation.coeffs(), goal.rotation.coeffs());
+  }
+  const Eigen::VectorXd before = rig.body->state().velocities;
+  const Status set = rig.body->setVelocity(Eigen::Vector3d(0, std::nan(""), 0));
+  ASSERT_FALSE(set.ok());
+  EXPECT_NE(set.error().message.find("not finite"), std::string::npos) << set.error().message;
+  EXPECT_FALSE(
+      rig.body
+          ->setRigidVelocity(Eigen::Vector3d::Zero(),
+                             Eigen::Vector3d(std::numeric_limits<double>::infinity(), 0, 0))
+          .ok());
+  EXPECT_EQ((rig.body->state().velocities - before).cwiseAbs().maxCoeff(), 0.0);
 }
 
 }  // namespace

@@ -148,7 +148,8 @@ void bindParts(py::module_& m) {
           "set_velocity",
           [](const B& b, py::object velocity) {
             WorldGuard guard(*b.world, WorldGuard::kWrite);
-            b.body->setVelocity(toVector3(velocity, "velocity"));
+            if (Status s = b.body->setVelocity(toVector3(velocity, "velocity")); !s)
+              throw py::value_error(s.error().message);
           },
           py::arg("velocity"), "Every node's velocity, m/s.")
       .def(
@@ -265,7 +266,8 @@ void bindParts(py::module_& m) {
           [](const H& h, py::object frame) {
             const Frame f = toFrame(frame, "move_to");
             WorldGuard guard(*h.world, WorldGuard::kWrite);
-            h.hand->moveTo(f);
+            if (Status moved = h.hand->moveTo(f); !moved)
+              throw py::value_error(moved.error().message);
           },
           py::arg("frame"), "The goal frame the grabbed patch pursues from the next step on.")
       .def("release",

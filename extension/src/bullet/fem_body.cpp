@@ -84,13 +84,17 @@ Status FemBody::removeAnchor(int anchor) {
   return Ok{};
 }
 
-void FemBody::setVelocity(const Eigen::Vector3d& velocity) {
+Status FemBody::setVelocity(const Eigen::Vector3d& velocity) {
+  if (!velocity.allFinite()) return Error{"body '" + name_ + "': the velocity is not finite"};
   for (int i = 0; i < model_->nodeCount(); ++i)
     state_.velocities.segment<3>(3 * i) = velocity;
   writeBack();
+  return Ok{};
 }
 
-void FemBody::setRigidVelocity(const Eigen::Vector3d& linear, const Eigen::Vector3d& angular) {
+Status FemBody::setRigidVelocity(const Eigen::Vector3d& linear, const Eigen::Vector3d& angular) {
+  if (!(linear.allFinite() && angular.allFinite()))
+    return Error{"body '" + name_ + "': the rigid velocity is not finite"};
   const std::vector<double>& masses = model_->nodeMasses();
   Eigen::Vector3d centre = Eigen::Vector3d::Zero();
   for (int i = 0; i < model_->nodeCount(); ++i)
@@ -100,6 +104,7 @@ void FemBody::setRigidVelocity(const Eigen::Vector3d& linear, const Eigen::Vecto
     state_.velocities.segment<3>(3 * i) =
         linear + angular.cross(Eigen::Vector3d(state_.positions.segment<3>(3 * i)) - centre);
   writeBack();
+  return Ok{};
 }
 
 Status FemBody::setExternalForces(const Eigen::VectorXd& forces) {

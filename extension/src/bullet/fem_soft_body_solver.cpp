@@ -28,24 +28,9 @@ bool nodesTouch(btSoftBody& a, btSoftBody& b) {
   return probe.hit;
 }
 
-// A body's pose: finite, and a unit quaternion up to round-off (1e-6 covers quaternions composed
-// in float or double). Beyond that the pose was never a rotation (the zero quaternion of
-// `Frame{origin, {}}`), and normalising it would place the body somewhere nobody meant.
+// A body's pose (constraints/frame.h), its faults named with the body.
 Result<Frame> checkedPose(const std::string& name, const Frame& pose) {
-  if (!pose.origin.allFinite())
-    return Error{"body '" + name + "': the pose's origin is not finite"};
-  const double norm = pose.rotation.norm();
-  if (!(std::abs(norm - 1) <= 1e-6)) {
-    std::ostringstream message;
-    message << "body '" << name
-            << "': the pose's rotation is not a unit quaternion (w, x, y, z) = ("
-            << pose.rotation.w() << ", " << pose.rotation.x() << ", " << pose.rotation.y() << ", "
-            << pose.rotation.z() << "), norm " << norm;
-    return Error{message.str()};
-  }
-  Frame unit = pose;
-  unit.rotation.normalize();
-  return unit;
+  return checkedFrame(pose, "body '" + name + "': the pose");
 }
 
 const char* const kNotOurSolver =

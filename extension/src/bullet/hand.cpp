@@ -47,11 +47,14 @@ Hand::Hand(FemBody& body, std::string name, HandSettings settings)
   assert(settings.validate().ok());
 }
 
-Result<int> Hand::grab(const Frame& frame, double now) {
+Result<int> Hand::grab(const Frame& unchecked, double now) {
+  Result<Frame> checked = checkedFrame(unchecked, label() + ": the frame");
+  if (!checked) return checked.error();
+  const Frame& frame = checked.value();
   release();
   selection_ = selectGrabbedPatch(body_->model().mesh(), body_->state().positions, frame);
   if (selection_.status != HandSelectionStatus::kGrabbed) {
-    return Error{"hand '" + name_ + "' on body '" + body_->name() + "': " + selection_.message};
+    return Error{label() + ": " + selection_.message};
   }
   // A fresh pursuit per grab: a motion still held by an earlier group never sees this one.
   pursuit_ = std::make_shared<HandPursuit>();
@@ -73,8 +76,15 @@ FrameMotion followPursuit(std::shared_ptr<HandPursuit> pursuit) {
   };
 }
 
-void Hand::moveTo(const Frame& frame) {
-  pursuit_->goal = frame;
+Status Hand::moveTo(const Frame& frame) {
+  Result<Frame> checked = checkedFrame(frame, label() + ": the frame");
+  if (!checked) return checked.error();
+  pursuit_->goal = checked.value();
+  return Ok{};
+}
+
+std::string Hand::label() const {
+  return "hand '" + name_ + "' on body '" + body_->name() + "'";
 }
 
 void Hand::release() {

@@ -79,7 +79,7 @@ Status HandCoupling::apply(const device::HandCommand& command, double now) {
         goal_.rotation;  // HapticOrientation * Orientation^-1, Orientation = I
     return Ok{};
   }
-  if (hand_.grabbed()) hand_.moveTo(goal_);
+  if (hand_.grabbed()) return hand_.moveTo(goal_);
   return Ok{};
 }
 

@@ -70,13 +70,15 @@ class FemBody {
   /// Frees an anchor's nodes (its id stays reserved). Errors: an unknown or removed anchor.
   Status removeAnchor(int anchor);
 
-  /// Sets every node's velocity (m/s), e.g. an initial velocity before the first step.
-  void setVelocity(const Eigen::Vector3d& velocity);
+  /// Sets every node's velocity (m/s), e.g. an initial velocity before the first step. Errors
+  /// (nothing set): a velocity that is not finite.
+  Status setVelocity(const Eigen::Vector3d& velocity);
   /// Sets every node's velocity to a rigid motion: `linear` (m/s) for the centre of mass (lumped
   /// node masses, current positions) plus a spin `angular` (rad/s, axis times rate) about it,
   /// v_i = linear + angular x (x_i - c). The body's momentum is then M linear, its angular
   /// momentum about c is I_c angular (I_c: the lumped inertia of the current shape).
-  void setRigidVelocity(const Eigen::Vector3d& linear, const Eigen::Vector3d& angular);
+  /// Errors (nothing set): a velocity that is not finite.
+  Status setRigidVelocity(const Eigen::Vector3d& linear, const Eigen::Vector3d& angular);
 
   /// External forces on the nodes besides gravity (which the body takes from its world each
   /// step, m_i g), N, 3n: they stay applied every step until changed. Errors: wrong size,

@@ -93,13 +93,14 @@ class Hand {
   /// which becomes `frame`. Returns the number of grabbed nodes, or an Error with the selection's
   /// message (the plane misses the body, or the ray from O along i misses every cut triangle);
   /// then nothing is grabbed. A hand that already holds a patch releases it first. `now` is the
-  /// world's time (FemWorld::time()).
+  /// world's time (FemWorld::time()). A frame that is not a pose (checkedFrame) is an Error too.
   Result<int> grab(const Frame& frame, double now);
 
   /// Update(O, R): the device's frame, the goal the patch frame pursues from the next step on
   /// (reached at the end of that step unless the speed limit holds it back). Harmless when not
-  /// grabbing.
-  void moveTo(const Frame& frame);
+  /// grabbing. Errors (the goal kept): a frame whose origin is not finite or whose rotation is
+  /// not a unit quaternion (checkedFrame).
+  Status moveTo(const Frame& frame);
 
   /// Lets go: the grabbed nodes are free from the next step on (FemBody::releaseGroup). The hand
   /// may grab again, elsewhere. No-op when not grabbing.
@@ -135,6 +136,9 @@ class Hand {
   FemBody& body() const { return *body_; }
 
  private:
+  // "hand 'h' on body 'b'", for messages.
+  std::string label() const;
+
   FemBody* body_;
   std::string name_;
   HandSettings settings_;

@@ -5,6 +5,9 @@
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 #include <functional>
+#include <string>
+
+#include "torsion/result.h"
 
 namespace torsion {
 
@@ -18,6 +21,12 @@ struct Frame {
     return rotation.conjugate() * (world - origin);
   }
 };
+
+/// `frame` as a pose: a finite origin and a unit quaternion up to round-off (1e-6 covers
+/// quaternions composed in float or double), returned normalised. Beyond that the rotation was
+/// never one (the zero quaternion of `Frame{origin, {}}`), and normalising it would place things
+/// where nobody meant: an Error saying which, its message starting with `what` ("the pose").
+Result<Frame> checkedFrame(const Frame& frame, const std::string& what);
 
 /// A frame as a function of simulated time (s). Called once per step with that step's end time,
 /// in non-decreasing order; a motion may keep state between calls (the hand's pursuit does).
