@@ -1,0 +1,83 @@
+#pragma once
+// From detection to rows (docs/contact-solve.md, "From detection to rows"): one FEM body's node
+// contacts with rigid objects (RigidContactSolver::detect: NodeContact, RigidPartner) as a SAP
+// island, and the solve's impulses back to the partners and to the next step's lagged values.
+//
+// Side A is the rigid partner, side B the node: NodeContact::normal points out of the rigid body
+// towards the node, so v_n > 0 separates. Per node contact, one row:
+//
+//   node term    nodeTerm(fem_body, node, +1, R_c), R_c = contactFrame(normal)
+//   dynamic      + rigidPointTerm(partner's RigidBody, lever, -1, R_c): the partner's twist is
+//                  solved with the node's (its b = diag(m, I) times the velocity Bullet integrated
+//                  with: gravity and external forces of the step included)
+//   prescribed   (static, kinematic, supported by Bullet's ground, multibody link) velocity_offset
+//                  = -R_c (v + omega x lever): the partner point's known motion
+//
+// with mu the pair's coefficient, gap phi0 the contact's gap at the step's start, and k, tau_d
+// from RowDefaults. Face contacts and anchors are not mapped (they stay with RigidContactSolver).
+
+#include <Eigen/Core>
+#include <memory>
+#include <vector>
+
+#include "torsion/contact/rigid_contact.h"
+#include "torsion/contact/rigid_partner.h"
+#include "torsion/contact/solve/contact_row.h"
+#include "torsion/contact/solve/island_body.h"
+#include "torsion/contact/solve/sap_solver.h"
+
+namespace torsion::sap {
+
+/// The rows' contact parameters.
+struct RowDefaults {
+  /// k, N/m. Near-rigid by default: a node contact should add no compliance of its own to the FEM
+  /// body's (whose elasticity is the physics), so k is far above any node's stiffness and SAP's
+  /// cap R_n >= beta^2 / (4 pi^2) w decides: the contact's period is the step (beta = 1).
+  double stiffness = 1e15;
+  /// tau_d as a multiple of dt. 1/pi (Castro et al. 2022, near-rigid regime): the capped contact
+  /// oscillator of period beta dt is critically damped when tau_d = beta dt / pi.
+  double dissipation_steps = 1.0 / 3.141592653589793;
+};
+
+/// The node contacts' next-step memory: the normal impulse of each solved row, by node and
+/// rigid object (N s).
+struct LaggedImpulse {
+  int node = -1;
+  const btCollisionObject* object = nullptr;
+  double normal_impulse = 0;
+};
+
+/// One FEM body's island: bodies (0: the FEM body; 1.. the dynamic partners), rows, and the
+/// correspondence back to the contacts.
+struct NodeContactIsland {
+  std::vector<std::unique_ptr<RigidBody>> rigid_bodies;  ///< island bodies 1..
+  std::vector<int> partner_body;  ///< per partner: its island body, or -1 (prescribed)
+  std::vector<ContactRow> rows;
+  std::vector<int> row_contact;  ///< per row: its index in the NodeContact list
+};
+
+/// Builds the rows for `contacts` (active or not: every detected node contact, anchors and face
+/// contacts excepted) of FEM island body `fem_body` against `partners`, with lagged normal
+/// impulses from `lagged` (0 for a contact not in it) and parameters `defaults` at step dt.
+NodeContactIsland buildNodeContactIsland(const std::vector<NodeContact>& contacts,
+                                         const std::vector<RigidPartner>& partners, int fem_body,
+                                         const std::vector<LaggedImpulse>& lagged,
+                                         const RowDefaults& defaults, double dt);
+
+/// The island's bodies for SapProblem::create: `fem` first, then the rigid bodies.
+std::vector<const IslandBody*> islandBodies(const IslandBody& fem, const NodeContactIsland& island);
+
+/// Per partner, the impulse wrench the rows exert on it (N s; force, torque about its centre of
+/// mass): sum over its rows of J^T gamma on its side, -(R_c^T gamma) at the contact's lever.
+std::vector<Vector6d> partnerImpulses(const NodeContactIsland& island,
+                                      const std::vector<NodeContact>& contacts,
+                                      const std::vector<RigidPartner>& partners,
+                                      const SapReport& report);
+
+/// The next step's lagged normal impulses: per row with gamma_n > 0, its node and object.
+std::vector<LaggedImpulse> laggedImpulses(const NodeContactIsland& island,
+                                          const std::vector<NodeContact>& contacts,
+                                          const std::vector<RigidPartner>& partners,
+                                          const SapReport& report);
+
+}  // namespace torsion::sap

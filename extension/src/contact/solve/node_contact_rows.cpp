@@ -1,0 +1,96 @@
+#include "torsion/contact/solve/node_contact_rows.h"
+
+#include <cstddef>
+
+namespace torsion::sap {
+
+namespace {
+
+double laggedFor(const std::vector<LaggedImpulse>& lagged, int node,
+                 const btCollisionObject* object) {
+  for (const LaggedImpulse& l : lagged) {
+    if (l.node == node && l.object == object) return l.normal_impulse;
+  }
+  return 0;
+}
+
+ContactRow makeRow(const NodeContact& c, const RigidPartner& k, int fem_body, int rigid_body,
+                   const RowDefaults& defaults, double dt) {
+  ContactRow row;
+  row.frame = contactFrame(c.normal);
+  row.terms.push_back(nodeTerm(fem_body, c.node, 1.0, row.frame));
+  if (rigid_body >= 0) {
+    row.terms.push_back(rigidPointTerm(rigid_body, c.lever, -1.0, row.frame));
+  } else {
+    row.velocity_offset = -(row.frame * pointVelocity(k.velocity, c.lever));
+  }
+  row.mu = c.friction;
+  row.stiffness = defaults.stiffness;
+  row.dissipation_time = defaults.dissipation_steps * dt;
+  row.gap = c.gap;
+  return row;
+}
+
+}  // namespace
+
+NodeContactIsland buildNodeContactIsland(const std::vector<NodeContact>& contacts,
+                                         const std::vector<RigidPartner>& partners, int fem_body,
+                                         const std::vector<LaggedImpulse>& lagged,
+                                         const RowDefaults& defaults, double dt) {
+  NodeContactIsland island;
+  island.partner_body.assign(partners.size(), -1);
+  for (std::size_t p = 0; p < partners.size(); ++p) {
+    const RigidPartner& k = partners[p];
+    if (!k.dynamic || k.link != nullptr) continue;
+    island.partner_body[p] = static_cast<int>(island.rigid_bodies.size()) + 1;
+    island.rigid_bodies.push_back(std::make_unique<RigidBody>(
+        k.mass, k.inertia, Eigen::VectorXd(partnerMomentum(k, k.entry_velocity))));
+  }
+  for (std::size_t i = 0; i < contacts.size(); ++i) {
+    const NodeContact& c = contacts[i];
+    if (c.anchored) continue;
+    const auto p = static_cast<std::size_t>(c.partner);
+    ContactRow row = makeRow(c, partners[p], fem_body, island.partner_body[p], defaults, dt);
+    row.lagged_normal_impulse = laggedFor(lagged, c.node, partners[p].object);
+    island.rows.push_back(std::move(row));
+    island.row_contact.push_back(static_cast<int>(i));
+  }
+  return island;
+}
+
+std::vector<const IslandBody*> islandBodies(const IslandBody& fem,
+                                            const NodeContactIsland& island) {
+  std::vector<const IslandBody*> bodies{&fem};
+  for (const auto& r : island.rigid_bodies)
+    bodies.push_back(r.get());
+  return bodies;
+}
+
+std::vector<Vector6d> partnerImpulses(const NodeContactIsland& island,
+                                      const std::vector<NodeContact>& contacts,
+                                      const std::vector<RigidPartner>& partners,
+                                      const SapReport& report) {
+  std::vector<Vector6d> impulses(partners.size(), Vector6d::Zero());
+  for (std::size_t r = 0; r < island.rows.size(); ++r) {
+    const NodeContact& c = contacts[static_cast<std::size_t>(island.row_contact[r])];
+    const Eigen::Vector3d on_node = island.rows[r].frame.transpose() * report.impulses[r];
+    impulses[static_cast<std::size_t>(c.partner)] += pointWrench(-on_node, c.lever);
+  }
+  return impulses;
+}
+
+std::vector<LaggedImpulse> laggedImpulses(const NodeContactIsland& island,
+                                          const std::vector<NodeContact>& contacts,
+                                          const std::vector<RigidPartner>& partners,
+                                          const SapReport& report) {
+  std::vector<LaggedImpulse> lagged;
+  for (std::size_t r = 0; r < island.rows.size(); ++r) {
+    const double gamma_n = report.impulses[r].z();
+    if (!(gamma_n > 0)) continue;
+    const NodeContact& c = contacts[static_cast<std::size_t>(island.row_contact[r])];
+    lagged.push_back({c.node, partners[static_cast<std::size_t>(c.partner)].object, gamma_n});
+  }
+  return lagged;
+}
+
+}  // namespace torsion::sap

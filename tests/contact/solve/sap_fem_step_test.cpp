@@ -1,0 +1,341 @@
+// The SAP solve on the real pipeline (docs/contact-solve.md, "From detection to rows"): Bullet's
+// collision detection, FemBody::prepare (RigidContactSolver::detect), the node contacts as SAP
+// rows (node_contact_rows.h), the SAP solve in place of FemBody::solveContacts, FemBody::finish,
+// the dynamic partners' new twists written to Bullet. Each scene also runs with today's solver
+// (FemBody::advance) and the figures are printed side by side.
+
+#include <BulletSoftBody/btSoftBodyRigidBodyCollisionConfiguration.h>
+#include <BulletSoftBody/btSoftRigidDynamicsWorld.h>
+#include <btBulletDynamicsCommon.h>
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <cstdio>
+#include <memory>
+#include <vector>
+
+#include "torsion/bt_conversions.h"
+#include "torsion/bullet/fem_soft_body_solver.h"
+#include "torsion/contact/solve/fem_island_body.h"
+#include "torsion/contact/solve/node_contact_rows.h"
+#include "torsion/contact/solve/sap_problem.h"
+#include "torsion/contact/solve/sap_solver.h"
+#include "torsion/mesh/box_mesh.h"
+
+namespace torsion::sap {
+namespace {
+
+constexpr double kDt = 0.01;
+constexpr double kG = 9.81;
+
+/// The FEM step with the SAP contact solve (or today's, FemBody::advance), on every FEM body.
+class SapStepSolver final : public FemSoftBodySolver {
+ public:
+  explicit SapStepSolver(bool sap) : FemSoftBodySolver(settings()), sap_(sap) {}
+  void solveConstraints(btScalar solver_dt) override {
+    StepContext ctx;
+    ctx.dt = static_cast<double>(solver_dt);
+    ctx.time = time_;
+    ctx.index = ++steps_;
+    ctx.gravity = toEigen(world()->getGravity());
+    time_ += ctx.dt;
+    for (const auto& body : bodies()) {
+      if (!sap_) {
+        body->advance(ctx);
+      } else {
+        sapStep(*body, ctx);
+      }
+      EXPECT_FALSE(isFatal(body->lastReport().health)) << body->lastReport().message;
+    }
+  }
+
+  double normal_impulse = 0;  ///< N s, last step's sum of gamma_n
+  int max_newton = 0, max_cg = 0, unconverged = 0, solves = 0;
+  /// Over the run: |partnerImpulses - M (v' - v_entry)| of each dynamic partner / (m g dt).
+  double balance_error = 0;
+
+ private:
+  static SolverSettings settings() {
+    SolverSettings s;
+    s.threads = 1;
+    s.tolerance = 1e-6;
+    s.max_iterations = 1000;
+    return s;
+  }
+
+  void sapStep(FemBody& body, const StepContext& ctx) {
+    if (!body.prepare(ctx)) return;
+    const PreparedSystem p = body.preparedSystem();
+    normal_impulse = 0;
+    if (!body.hasContactSolve()) {
+      body.finish(*p.v, body.stepper().solve());
+      lagged_.clear();
+      return;
+    }
+    const RigidContactSolver& contacts = body.contacts();
+    const NodeContactIsland island = buildNodeContactIsland(
+        contacts.contacts(), contacts.partners(), 0, lagged_, RowDefaults{}, ctx.dt);
+    const FemIslandBody fem(*p.op, *p.constraints, *p.b);
+    SapProblem problem = SapProblem::create(islandBodies(fem, island), island.rows, ctx.dt).value();
+    Eigen::VectorXd v(problem.dofs());
+    v.head(p.v->size()) = *p.v;
+    for (std::size_t k = 0; k < contacts.partners().size(); ++k) {
+      const int b = island.partner_body[k];
+      if (b >= 0) v.segment<6>(problem.bodyOffset(b)) = contacts.partners()[k].entry_velocity;
+    }
+    SapSolver solver;
+    const SapReport report = solver.solve(problem, v);
+    record(report);
+    lagged_ = laggedImpulses(island, contacts.contacts(), contacts.partners(), report);
+    LinearSolveReport linear;
+    linear.converged = report.converged;
+    linear.iterations = report.cg_iterations;
+    body.finish(v.head(p.v->size()), linear);
+    checkBalance(island, contacts, report, problem, v);
+    writeRigid(island, contacts.partners(), problem, v, ctx.dt);
+  }
+
+  void record(const SapReport& report) {
+    ++solves;
+    if (!report.converged) ++unconverged;
+    max_newton = std::max(max_newton, report.newton_iterations);
+    max_cg = std::max(max_cg, report.cg_iterations);
+    for (const Eigen::Vector3d& g : report.impulses)
+      normal_impulse += g.z();
+  }
+
+  // The way back: the impulse the rows give a dynamic partner is its momentum change.
+  void checkBalance(const NodeContactIsland& island, const RigidContactSolver& contacts,
+                    const SapReport& report, const SapProblem& problem, const Eigen::VectorXd& v) {
+    const std::vector<Vector6d> impulses =
+        partnerImpulses(island, contacts.contacts(), contacts.partners(), report);
+    for (std::size_t k = 0; k < impulses.size(); ++k) {
+      const int b = island.partner_body[k];
+      if (b < 0) continue;
+      const RigidPartner& partner = contacts.partners()[k];
+      const Vector6d change =
+          partnerMomentum(partner, v.segment<6>(problem.bodyOffset(b)) - partner.entry_velocity);
+      balance_error =
+          std::max(balance_error, (impulses[k] - change).norm() / (partner.mass * kG * kDt));
+    }
+  }
+
+  // As RigidContactSolver::finish: the step's twist, and the pose Bullet integrated with the
+  // entry twist corrected by dt (v_new - v_entry).
+  static void writeRigid(const NodeContactIsland& island, const std::vector<RigidPartner>& partners,
+                         const SapProblem& problem, const Eigen::VectorXd& v, double dt) {
+    for (std::size_t k = 0; k < partners.size(); ++k) {
+      const int b = island.partner_body[k];
+      if (b < 0 || partners[k].body == nullptr) continue;
+      btRigidBody* body = partners[k].body;
+      const Vector6d twist = v.segment<6>(problem.bodyOffset(b));
+      const Vector6d dV = twist - partners[k].entry_velocity;
+      btTransform corrected;
+      btTransformUtil::integrateTransform(body->getCenterOfMassTransform(), toBt(dV.head<3>()),
+                                          toBt(dV.tail<3>()), toBtScalar(dt), corrected);
+      body->setLinearVelocity(toBt(twist.head<3>()));
+      body->setAngularVelocity(toBt(twist.tail<3>()));
+      body->setCenterOfMassTransform(corrected);
+      body->activate();
+    }
+  }
+
+  bool sap_;
+  double time_ = 0;
+  std::int64_t steps_ = 0;
+  std::vector<LaggedImpulse> lagged_;
+};
+
+/// A user world (tests/bullet/user_world.h) stepped by SapStepSolver.
+struct World {
+  explicit World(bool sap) : fem(sap) {
+    world.setGravity(btVector3(0, 0, btScalar(-kG)));
+    world.getWorldInfo().m_gravity = world.getGravity();
+    world.getWorldInfo().m_sparsesdf.Initialize();
+    EXPECT_TRUE(attach(world).ok());
+  }
+  ~World() {
+    for (auto& r : rigids)
+      world.removeRigidBody(r.get());
+  }
+  btRigidBody* addRigid(std::unique_ptr<btCollisionShape> shape, double mass, const btVector3& at,
+                        double friction) {
+    btVector3 inertia(0, 0, 0);
+    if (mass > 0) shape->calculateLocalInertia(btScalar(mass), inertia);
+    btRigidBody::btRigidBodyConstructionInfo info(btScalar(mass), nullptr, shape.get(), inertia);
+    info.m_startWorldTransform.setIdentity();
+    info.m_startWorldTransform.setOrigin(at);
+    rigids.push_back(std::make_unique<btRigidBody>(info));
+    rigids.back()->setActivationState(DISABLE_DEACTIVATION);
+    rigids.back()->setFriction(btScalar(friction));
+    world.addRigidBody(rigids.back().get());
+    shapes.push_back(std::move(shape));
+    return rigids.back().get();
+  }
+  FemBody* addSlab(const Eigen::Vector3d& lo, const Eigen::Vector3d& hi, int nx, int ny, int nz,
+                   double E, bool fix_base) {
+    Material m;
+    m.youngs_modulus = E;
+    m.poisson_ratio = 0.3;
+    m.density = 1000;
+    m.stiffness_damping = 0.01;
+    FemBody* body = fem.addBody("slab", makeBoxTetMesh(lo, hi, nx, ny, nz).value(), m).value();
+    body->contacts().settings().friction = 1.0;
+    if (!fix_base) return body;
+    std::vector<int> base;
+    for (int i = 0; i < body->model().nodeCount(); ++i)
+      if (body->state().position(i).z() < lo.z() + 1e-9) base.push_back(i);
+    body->carryNodes(
+        "base", base, [](double) { return Frame{}; }, 0.0);
+    return body;
+  }
+  void step() { world.stepSimulation(btScalar(kDt), 1, btScalar(kDt)); }
+
+  btSoftBodyRigidBodyCollisionConfiguration config;
+  btCollisionDispatcher dispatcher{&config};
+  btDbvtBroadphase broadphase;
+  btSequentialImpulseConstraintSolver solver;
+  SapStepSolver fem;
+  btSoftRigidDynamicsWorld world{&dispatcher, &broadphase, &solver, &config, &fem};
+  std::vector<std::unique_ptr<btCollisionShape>> shapes;
+  std::vector<std::unique_ptr<btRigidBody>> rigids;
+};
+
+double fastestNode(const FemBody& body) {
+  double v = 0;
+  for (int i = 0; i < body.model().nodeCount(); ++i)
+    v = std::max(v, body.state().velocity(i).norm());
+  return v;
+}
+
+double bodyMass(const FemBody& body) {
+  double m = 0;
+  for (double mi : body.model().nodeMasses())
+    m += mi;
+  return m;
+}
+
+struct BlockRun {
+  double impulse_error = 0;  ///< |sum gamma_n / (m g dt) - 1| at the end (SAP)
+  double settled_speed = 0;  ///< m/s, fastest node over the last 1 s
+};
+
+BlockRun runBlock(bool sap) {
+  World w(sap);
+  w.addRigid(std::make_unique<btStaticPlaneShape>(btVector3(0, 0, 1), 0), 0, btVector3(0, 0, 0),
+             0.5);
+  FemBody* block = w.addSlab({-0.1, -0.1, 0.001}, {0.1, 0.1, 0.201}, 4, 4, 4, 1e5, false);
+  BlockRun run;
+  for (int k = 0; k < 300; ++k) {
+    w.step();
+    if (k >= 200) run.settled_speed = std::max(run.settled_speed, fastestNode(*block));
+  }
+  const double weight = bodyMass(*block) * kG * kDt;
+  run.impulse_error = std::abs(
+      (sap ? w.fem.normal_impulse : block->contacts().stats().normal_impulse) / weight - 1);
+  std::printf("[block %s] normal impulse / (m g dt) - 1 = %.2e; fastest node, last 1 s: %.2e m/s",
+              sap ? "SAP  " : "today", run.impulse_error, run.settled_speed);
+  if (sap) std::printf("; max Newton %d, max CG %d", w.fem.max_newton, w.fem.max_cg);
+  std::printf("\n");
+  if (sap) {
+    EXPECT_EQ(w.fem.unconverged, 0);
+  }
+  return run;
+}
+
+TEST(SapFemStep, SoftBlockRestsOnGroundWithItsWeight) {
+  const BlockRun today = runBlock(false);
+  const BlockRun run = runBlock(true);
+  (void)today;
+  EXPECT_LT(run.impulse_error, 0.01);
+  EXPECT_LT(run.settled_speed, 1e-3);
+}
+
+struct BoxRun {
+  double fastest = 0;  ///< m/s, box speed over the last 2 s
+  double drift = 0;    ///< m/s, box displacement over the last 2 s / 2 s
+};
+
+/// A 1 kg box, 0.2 m, dropped from 1 cm onto a 0.6 x 0.6 x 0.1 m slab (E 50 kPa, base fixed) of
+/// `cells` x `cells` x 2 cells, then left for 4 s.
+BoxRun runRestingBox(bool sap, int cells) {
+  World w(sap);
+  w.addSlab({-0.3, -0.3, 0}, {0.3, 0.3, 0.1}, cells, cells, 2, 5e4, true);
+  btRigidBody* box =
+      w.addRigid(std::make_unique<btBoxShape>(btVector3(0.1, 0.1, 0.1)), 1.0, {0, 0, 0.2}, 1.0);
+  BoxRun run;
+  btVector3 start(0, 0, 0);
+  for (int k = 0; k < 400; ++k) {
+    w.step();
+    if (k == 199) start = box->getCenterOfMassPosition();
+    if (k >= 200) run.fastest = std::max(run.fastest, double(box->getLinearVelocity().length()));
+  }
+  run.drift = double((box->getCenterOfMassPosition() - start).length()) / 2.0;
+  std::printf(
+      "[box on slab, %d cells, %s] fastest after 2 s: %.2e m/s, drift over 2..4 s: %.2e m/s", cells,
+      sap ? "SAP  " : "today", run.fastest, run.drift);
+  if (sap)
+    std::printf(
+        "; max Newton %d, max CG %d, unconverged %d/%d; impulse - momentum change %.1e m g dt",
+        w.fem.max_newton, w.fem.max_cg, w.fem.unconverged, w.fem.solves, w.fem.balance_error);
+  std::printf("\n");
+  if (sap) {
+    EXPECT_EQ(w.fem.unconverged, 0);
+  }
+  return run;
+}
+
+// The box's edges between node rows (7 cells across: nodes at +-0.086 m and +-0.171 m): it rests
+// on the 3 x 3 nodes under its bottom face. Printed, not asserted: with its edges on node rows
+// (6 cells), the edge nodes are detected against the box's side faces and the box balances on the
+// middle node alone (docs/contact-solve.md, "From detection to rows").
+TEST(SapFemStep, RigidBoxRestsOnSoftSlab) {
+  runRestingBox(false, 6);
+  runRestingBox(true, 6);
+  runRestingBox(false, 7);
+  const BoxRun run = runRestingBox(true, 7);
+  EXPECT_LT(run.fastest, 1e-3);
+  EXPECT_LT(run.drift, 1e-4);
+}
+
+double runSlidingBox(bool sap, double mu) {
+  World w(sap);
+  w.addSlab({-1.0, -0.3, 0}, {1.0, 0.3, 0.1}, 20, 6, 2, 1e7, true);
+  btRigidBody* box =
+      w.addRigid(std::make_unique<btBoxShape>(btVector3(0.1, 0.1, 0.1)), 1.0, {-0.6, 0, 0.2}, mu);
+  for (int k = 0; k < 50; ++k)
+    w.step();
+  box->setLinearVelocity(btVector3(1.5, 0, 0));
+  for (int k = 0; k < 10; ++k)
+    w.step();
+  const double v0 = double(box->getLinearVelocity().x());
+  for (int k = 0; k < 30; ++k)
+    w.step();
+  const double decel = (v0 - double(box->getLinearVelocity().x())) / 0.3;
+  std::printf("[sliding box %s] deceleration %.4f m/s^2, mu g = %.4f: error %.2e",
+              sap ? "SAP  " : "today", decel, mu * kG, decel / (mu * kG) - 1);
+  if (sap)
+    std::printf(
+        "; sum gamma_n / (m g dt) %.4f; max Newton %d, max CG %d, unconverged %d/%d; "
+        "impulse - momentum change %.1e m g dt",
+        w.fem.normal_impulse / (kG * kDt), w.fem.max_newton, w.fem.max_cg, w.fem.unconverged,
+        w.fem.solves, w.fem.balance_error);
+  std::printf("\n");
+  if (sap) {
+    EXPECT_EQ(w.fem.unconverged, 0);
+    EXPECT_LT(w.fem.balance_error, 1e-5);
+  }
+  return decel / (mu * kG) - 1;
+}
+
+TEST(SapFemStep, SlidingBoxDeceleratesAsCoulombSays) {
+  const double today = runSlidingBox(false, 0.3);
+  const double error = runSlidingBox(true, 0.3);
+  (void)today;
+  EXPECT_LT(std::abs(error), 0.03);
+}
+
+}  // namespace
+}  // namespace torsion::sap
