@@ -197,6 +197,7 @@ nlohmann::json SceneHaptics::statistics(const Channel& c) const {
                     {"sent", p.sent.load()},
                     {"unauthenticated", p.unauthenticated.load()},
                     {"replayed", p.replayed.load()},
+                    {"old_version", p.old_version.load()},
                     {"authenticated", net->authenticated()}};
   }
   if (const auto* plugin = dynamic_cast<const device::PluginDevice*>(c.device.get())) {

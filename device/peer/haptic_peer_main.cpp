@@ -148,12 +148,13 @@ int runPeer(int argc, char** argv) {
   const PacketStats& s = p.stats();
   std::fprintf(stderr,
                "peer: sent %llu poses, accepted %llu wrenches, rejected %llu (unauthenticated "
-               "%llu, other session %llu)\n",
+               "%llu, other session %llu, older packet version %llu)\n",
                static_cast<unsigned long long>(s.sent.load()),
                static_cast<unsigned long long>(s.accepted.load()),
                static_cast<unsigned long long>(s.rejected()),
                static_cast<unsigned long long>(s.unauthenticated.load()),
-               static_cast<unsigned long long>(s.replayed.load()));
+               static_cast<unsigned long long>(s.replayed.load()),
+               static_cast<unsigned long long>(s.old_version.load()));
   return 0;
 }
 

@@ -1,5 +1,6 @@
 #include "torsion/device/network_device.h"
 
+#include <algorithm>
 #include <chrono>
 
 namespace torsion::device {
@@ -38,7 +39,11 @@ DeviceSample NetworkDevice::read(double time) {
   unsigned char buffer[kMaxPacketSize + 1];  // one spare byte: longer datagrams are seen as such
   UdpEndpoint from;
   long size;
-  while ((size = socket_->receive(buffer, sizeof buffer, from)) >= 0) {
+  // Bounded: a flood must not hold the tick; what is left waits in the socket for the next reads.
+  last_read_datagrams_ = 0;
+  while (last_read_datagrams_ < kMaxDatagramsPerRead &&
+         (size = socket_->receive(buffer, sizeof buffer, from)) >= 0) {
+    ++last_read_datagrams_;
     Packet packet;
     const std::size_t kept = std::min(static_cast<std::size_t>(size), sizeof buffer);
     if (static_cast<std::size_t>(size) != kept || kept > kMaxPacketSize) {
@@ -54,10 +59,9 @@ DeviceSample NetworkDevice::read(double time) {
       }
       endSession();  // the bound peer went silent: the session is over
     }
-    if (!freshSession(packet) || !filter_.inOrder(packet, stats_)) continue;
+    if ((key() && !inSession(packet, from)) || !filter_.inOrder(packet, stats_)) continue;
     newest_ = packet;
     peer_ = from;
-    session_ = packet.session;
     have_peer_ = true;
     last_accepted_time_ = time;
     if (packet.goodbye) {
@@ -73,25 +77,50 @@ DeviceSample NetworkDevice::read(double time) {
   return sample;
 }
 
-bool NetworkDevice::freshSession(const Packet& packet) {
-  if (!key()) return true;
-  for (const std::uint64_t ended : ended_sessions_) {
-    if (packet.session == ended) {
-      ++stats_.replayed;
-      return false;
-    }
+bool NetworkDevice::inSession(const Packet& packet, const UdpEndpoint& from) {
+  if (have_peer_ && packet.session == session_ && packet.device_nonce == nonce_) return true;
+  if (packet.device_nonce != 0 && challenged_ && from == challenge_to_ &&
+      packet.session == challenge_session_ && packet.device_nonce == challenge_nonce_) {
+    // The answer to the pending challenge: its session binds. A session still bound here is the
+    // same address's (another address's poses were refused as foreign above): its peer started
+    // a new session, and the old one ends.
+    if (have_peer_) endSession();
+    session_ = packet.session;
+    nonce_ = packet.device_nonce;
+    challenged_ = false;
+    return true;
   }
-  // The bound peer's address with a new session id: the peer restarted; its old session ends.
-  if (have_peer_ && packet.session != session_) endSession();
-  return true;
+  // A late hello of the bound session was answered already.
+  if (packet.device_nonce == 0 && have_peer_ && packet.session == session_) return false;
+  // A pose carrying a device nonce that is not the current one: recorded in an earlier session
+  // (a replay), or its peer lost the session (it timed out, or this device restarted). Refused
+  // either way; the challenge lets a live peer of the key open a new session.
+  if (packet.device_nonce != 0) ++stats_.replayed;
+  challenge(packet.session, from);
+  return false;
+}
+
+void NetworkDevice::challenge(std::uint64_t session, const UdpEndpoint& to) {
+  if (!(challenged_ && to == challenge_to_ && session == challenge_session_)) {
+    challenged_ = true;
+    challenge_to_ = to;
+    challenge_session_ = session;
+    challenge_nonce_ = randomNonce();
+  }
+  Packet packet;
+  packet.kind = PacketKind::kWrench;
+  packet.flag = false;  // force off: a challenge is not a wrench to render
+  packet.session = challenge_session_;
+  packet.device_nonce = challenge_nonce_;
+  send(packet, to);
 }
 
 void NetworkDevice::endSession() {
   write(Wrench{});  // the departing peer's device must not keep the last force
-  if (key()) ended_sessions_.push_back(session_);  // grows only with authenticated sessions
   have_peer_ = false;
   newest_ = Packet{};
   session_ = 0;
+  nonce_ = 0;  // retired: no packet of this session verifies as current again
   filter_ = PacketFilter(PacketKind::kPose, key());  // the next peer's sequence starts afresh
   last_accepted_time_ = -1e300;
 }
@@ -100,19 +129,24 @@ void NetworkDevice::write(const Wrench& wrench) {
   if (!have_peer_) return;
   Packet packet;
   packet.kind = PacketKind::kWrench;
-  packet.sequence = ++sent_sequence_;
-  packet.timestamp_ns = monotonicNanoseconds();
   packet.wrench = wrench;
   packet.flag = true;  // the loop only writes wrenches that passed its safety filter
   packet.echo_sequence = newest_.sequence;
   packet.session = session_;
+  packet.device_nonce = nonce_;
+  send(packet, peer_);
+}
+
+void NetworkDevice::send(Packet packet, const UdpEndpoint& to) {
+  packet.sequence = ++sent_sequence_;
+  packet.timestamp_ns = monotonicNanoseconds();
   bool sent;
   if (key()) {
     const SignedPacketBytes bytes = encodeSignedPacket(packet, *key());
-    sent = socket_->send(peer_, bytes.data(), bytes.size());
+    sent = socket_->send(to, bytes.data(), bytes.size());
   } else {
     const PacketBytes bytes = encodePacket(packet);
-    sent = socket_->send(peer_, bytes.data(), bytes.size());
+    sent = socket_->send(to, bytes.data(), bytes.size());
   }
   if (sent) {
     ++stats_.sent;

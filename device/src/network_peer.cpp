@@ -1,5 +1,6 @@
 #include "torsion/device/network_peer.h"
 
+#include <algorithm>
 #include <chrono>
 #include <cstdint>
 
@@ -26,7 +27,7 @@ NetworkPeer::NetworkPeer(std::shared_ptr<UdpSocket> socket, UdpEndpoint simulati
       simulation_(simulation),
       trajectory_(std::move(trajectory)),
       key_(std::move(key)),
-      session_(key_ ? randomSessionId() : 0),
+      session_(key_ ? randomNonce() : 0),
       watchdog_(watchdog, limits) {}
 
 DeviceLimits NetworkPeer::peerLimits() {
@@ -37,12 +38,18 @@ DeviceLimits NetworkPeer::peerLimits() {
 }
 
 std::uint32_t NetworkPeer::nextSequence() {
-  if (key() && sequence_ == UINT32_MAX) {
-    // Signed sequences never wrap (packet_stats.h): a new session starts instead.
-    session_ = randomSessionId();
-    sequence_ = 0;
-  }
+  // Signed sequences never wrap (packet_stats.h): a new session starts instead.
+  if (key() && sequence_ == UINT32_MAX) newSession();
   return ++sequence_;
+}
+
+void NetworkPeer::newSession() {
+  ended_session_ = session_;
+  session_ = randomNonce();
+  device_nonce_ = 0;
+  retired_.clear();
+  sequence_ = 0;
+  filter_ = PacketFilter(PacketKind::kWrench, key());
 }
 
 void NetworkPeer::tick(double time) {
@@ -53,6 +60,7 @@ void NetworkPeer::tick(double time) {
 
 void NetworkPeer::sayGoodbye(double time) {
   sendPose(nextSequence(), trajectory_.poseAt(time), trajectory_.buttonsAt(time), false, true);
+  if (key()) newSession();
 }
 
 void NetworkPeer::sendPose(std::uint32_t sequence, const Pose& pose, std::uint32_t buttons,
@@ -70,6 +78,7 @@ void NetworkPeer::sendPose(std::uint32_t sequence, const Pose& pose, std::uint32
   packet.buttons = buttons;
   if (key()) {
     packet.session = session_;
+    packet.device_nonce = device_nonce_;
     const SignedPacketBytes bytes = encodeSignedPacket(packet, *key());
     sendRaw(bytes.data(), bytes.size());
   } else {
@@ -86,6 +95,26 @@ void NetworkPeer::sendRaw(const void* bytes, std::size_t size) {
   }
 }
 
+bool NetworkPeer::inSession(const Packet& packet) {
+  if (packet.session == session_ && packet.device_nonce == device_nonce_) return true;
+  // The device's answer to the goodbye of the session just ended (its zero wrench): nothing to
+  // render, nothing wrong.
+  if (packet.session == ended_session_ && ended_session_ != 0) return false;
+  const bool retired =
+      std::find(retired_.begin(), retired_.end(), packet.device_nonce) != retired_.end();
+  if (packet.session != session_ || packet.device_nonce == 0 || retired) {
+    ++stats_.replayed;  // signed, but for another session of this key
+    return false;
+  }
+  // The device's challenge for this session (the first, or a newer one: the device lost the
+  // session, or restarted): its nonce replaces the earlier one for good, and the new device
+  // session numbers its wrenches afresh.
+  if (device_nonce_ != 0) retired_.push_back(device_nonce_);
+  device_nonce_ = packet.device_nonce;
+  filter_ = PacketFilter(PacketKind::kWrench, key());
+  return true;
+}
+
 void NetworkPeer::drain(double time) {
   unsigned char buffer[kMaxPacketSize + 1];
   UdpEndpoint from;
@@ -97,10 +126,7 @@ void NetworkPeer::drain(double time) {
     }
     Packet packet;
     if (!filter_.decode(buffer, static_cast<std::size_t>(size), packet, stats_)) continue;
-    if (key() && packet.session != session_) {
-      ++stats_.replayed;  // signed, but for another session of this key
-      continue;
-    }
+    if (key() && !inSession(packet)) continue;
     if (filter_.inOrder(packet, stats_)) {
       newest_ = packet;
       watchdog_.receive(packet.wrench, time);

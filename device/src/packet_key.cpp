@@ -92,11 +92,11 @@ bool PacketKey::verify(const unsigned char* mac_bytes, const unsigned char* byte
   return sodium_memcmp(expected.data(), mac_bytes, kMacBytes) == 0;
 }
 
-std::uint64_t randomSessionId() {
+std::uint64_t randomNonce() {
   sodiumReady();
   std::uint64_t id = 0;
   while (id == 0)
-    randombytes_buf(&id, sizeof id);  // 0 means "no session"
+    randombytes_buf(&id, sizeof id);  // 0 means "none yet"
   return id;
 }
 

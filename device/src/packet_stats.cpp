@@ -14,6 +14,10 @@ bool PacketFilter::decode(const unsigned char* bytes, std::size_t size, Packet& 
     ++stats.truncated;
     return false;
   }
+  if (error == PacketError::kOldVersion) {
+    ++stats.old_version;
+    return false;
+  }
   if (error == PacketError::kUnauthenticated) {
     ++stats.unauthenticated;
     return false;

@@ -105,13 +105,17 @@ SignedPacketBytes encodeSignedPacket(const Packet& packet, const PacketKey& key)
   SignedPacketBytes b{};
   encodeBody(packet, kSignedPacketVersion, b.data());
   put(&b[88], packet.session);
-  const Mac mac = key.mac(b.data(), 96);
-  std::memcpy(&b[96], mac.data(), mac.size());
+  put(&b[96], packet.device_nonce);
+  const Mac mac = key.mac(b.data(), 104);
+  std::memcpy(&b[104], mac.data(), mac.size());
   return b;
 }
 
 PacketError decodePacket(const unsigned char* bytes, std::size_t size, Packet& out,
                          const PacketKey* key) {
+  if (size == kOldSignedPacketSize && get<std::uint32_t>(bytes) == kPacketMagic &&
+      get<std::uint16_t>(bytes + 4) == kOldSignedPacketVersion)
+    return PacketError::kOldVersion;
   if (size != kPacketSize && size != kSignedPacketSize) return PacketError::kTruncated;
   if (get<std::uint32_t>(bytes) != kPacketMagic) return PacketError::kMalformed;
   const auto version = get<std::uint16_t>(bytes + 4);
@@ -122,9 +126,10 @@ PacketError decodePacket(const unsigned char* bytes, std::size_t size, Packet& o
   }
   if (version == kSignedPacketVersion && size == kSignedPacketSize) {
     // The MAC first: nothing of an unauthenticated packet is looked at further.
-    if (!key || !key->verify(bytes + 96, bytes, 96)) return PacketError::kUnauthenticated;
+    if (!key || !key->verify(bytes + 104, bytes, 104)) return PacketError::kUnauthenticated;
     const PacketError error = decodeBody(bytes, out);
     out.session = get<std::uint64_t>(bytes + 88);
+    out.device_nonce = get<std::uint64_t>(bytes + 96);
     return error;
   }
   return PacketError::kMalformed;

@@ -3,12 +3,18 @@
 // sendto returns, so nothing here waits; clocks are fake.
 #include <gtest/gtest.h>
 #include <sys/stat.h>
+#include <time.h>
 #include <unistd.h>
 
+#include <algorithm>
+#include <atomic>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <thread>
+#include <vector>
 
 #include "torsion/device/haptic_loop.h"
 #include "torsion/device/network_device.h"
@@ -35,16 +41,33 @@ struct Signed {
   std::unique_ptr<NetworkPeer> peer;
 };
 
-Signed openSigned() {
+std::unique_ptr<NetworkDevice> openSignedDevice(std::uint16_t port = 0) {
   NetworkDeviceSettings settings;
-  settings.local.port = 0;
+  settings.local.port = port;  // 0: any free port, tests may run in parallel
   settings.limits = defaultDeviceLimits();
   settings.key = keyOf(kSecret);
   auto device = NetworkDevice::open(settings);
   EXPECT_TRUE(device) << device.error;
-  auto peer = NetworkPeer::open((*device.value)->local(), kHere, keyOf(kSecret));
+  return device ? std::move(*device.value) : nullptr;
+}
+
+Signed openSigned() {
+  std::unique_ptr<NetworkDevice> device = openSignedDevice();
+  auto peer = NetworkPeer::open(device->local(), kHere, keyOf(kSecret));
   EXPECT_TRUE(peer) << peer.error;
-  return {std::move(*device.value), std::move(*peer.value)};
+  return {std::move(device), std::move(*peer.value)};
+}
+
+// The handshake, tick by tick: the peer's hello (sequence 1) draws the device's challenge; the
+// peer's next tick sends a second hello (2) and takes the challenge; its third sends the first
+// pose the device takes (3), which binds the session.
+void connect(NetworkPeer& peer, NetworkDevice& device, double time) {
+  for (int k = 0; k < 2; ++k) {
+    peer.tick(time);
+    EXPECT_FALSE(device.read(time).alive);  // a hello never drives the hand
+  }
+  peer.tick(time);
+  EXPECT_TRUE(device.read(time).alive);
 }
 
 std::unique_ptr<NetworkPeer> intruder(const NetworkDevice& device,
@@ -54,11 +77,12 @@ std::unique_ptr<NetworkPeer> intruder(const NetworkDevice& device,
   return std::move(*peer.value);
 }
 
-Packet pose(std::uint32_t sequence, std::uint64_t session, double x) {
+Packet pose(std::uint32_t sequence, std::uint64_t session, std::uint64_t device_nonce, double x) {
   Packet p;
   p.kind = PacketKind::kPose;
   p.sequence = sequence;
   p.session = session;
+  p.device_nonce = device_nonce;
   p.flag = true;
   p.pose = Pose{{x, 0, 0}, {}};
   return p;
@@ -66,30 +90,34 @@ Packet pose(std::uint32_t sequence, std::uint64_t session, double x) {
 
 TEST(PacketAuthentication, ASignedPacketDecodesOnlyUnderItsKey) {
   const PacketKey key = keyOf(kSecret);
-  const SignedPacketBytes bytes = encodeSignedPacket(pose(7, 42, 0.25), key);
+  const SignedPacketBytes bytes = encodeSignedPacket(pose(7, 42, 43, 0.25), key);
   Packet out;
   ASSERT_EQ(decodePacket(bytes.data(), bytes.size(), out, &key), PacketError::kNone);
   EXPECT_EQ(out.sequence, 7u);
   EXPECT_EQ(out.session, 42u);
+  EXPECT_EQ(out.device_nonce, 43u);
   EXPECT_DOUBLE_EQ(out.pose.position.x, 0.25);
 
   const PacketKey other = keyOf(kOtherSecret);
   EXPECT_EQ(decodePacket(bytes.data(), bytes.size(), out, &other), PacketError::kUnauthenticated);
   EXPECT_EQ(decodePacket(bytes.data(), bytes.size(), out), PacketError::kUnauthenticated);
-  for (std::size_t at : {4u, 8u, 30u, 88u, 100u, 127u}) {  // version, sequence, pose, session, MAC
+  // Version, sequence, pose, peer nonce, device nonce, MAC.
+  for (std::size_t at : {4u, 8u, 30u, 88u, 96u, 104u, 135u}) {
     SignedPacketBytes flipped = bytes;
     flipped[at] ^= 0x01;
     EXPECT_NE(decodePacket(flipped.data(), flipped.size(), out, &key), PacketError::kNone) << at;
   }
   // An unsigned packet, however well-formed, is refused once a key is configured.
-  const PacketBytes plain = encodePacket(pose(8, 0, 0.25));
+  const PacketBytes plain = encodePacket(pose(8, 0, 0, 0.25));
   EXPECT_EQ(decodePacket(plain.data(), plain.size(), out, &key), PacketError::kUnauthenticated);
   EXPECT_EQ(decodePacket(plain.data(), plain.size(), out), PacketError::kNone);
 }
 
 TEST(PacketAuthentication, SignedPeerAndDeviceExchangePosesAndWrenches) {
   Signed s = openSigned();
-  s.peer->tick(0.0);
+  connect(*s.peer, *s.device, 0.0);
+  EXPECT_NE(s.peer->deviceNonce(), 0u);  // the device's challenge came
+  s.peer->tick(0.001);
   const DeviceSample sample = s.device->read(0.001);
   EXPECT_TRUE(sample.alive);
   EXPECT_DOUBLE_EQ(sample.pose.position.z, 0.03);
@@ -103,8 +131,7 @@ TEST(PacketAuthentication, SignedPeerAndDeviceExchangePosesAndWrenches) {
 
 TEST(PacketAuthentication, HostilePeersAreRejectedAndCountedWhileTheLegitimatePeerKeepsControl) {
   Signed s = openSigned();
-  s.peer->tick(0.0);  // binds the session
-  ASSERT_TRUE(s.device->read(0.0).alive);
+  connect(*s.peer, *s.device, 0.0);  // binds the session with the pose of sequence 3
   const PacketKey key = keyOf(kSecret);
 
   auto wrong_key = intruder(*s.device, keyOf(kOtherSecret));
@@ -115,12 +142,14 @@ TEST(PacketAuthentication, HostilePeersAreRejectedAndCountedWhileTheLegitimatePe
   }
   // A packet of the legitimate session, recorded and replayed from the same address (a spoofed
   // source): its sequence is not new.
-  const SignedPacketBytes recorded = encodeSignedPacket(pose(1, s.peer->session(), 9), key);
+  const SignedPacketBytes recorded =
+      encodeSignedPacket(pose(3, s.peer->session(), s.peer->deviceNonce(), 9), key);
   s.peer->sendRaw(recorded.data(), recorded.size());
   // The same recording, and a validly signed pose with a much higher sequence, from another port.
   auto other_port = intruder(*s.device);
   other_port->sendRaw(recorded.data(), recorded.size());
-  const SignedPacketBytes ahead = encodeSignedPacket(pose(1000, s.peer->session(), 9), key);
+  const SignedPacketBytes ahead =
+      encodeSignedPacket(pose(1000, s.peer->session(), s.peer->deviceNonce(), 9), key);
   other_port->sendRaw(ahead.data(), ahead.size());
 
   DeviceSample sample = s.device->read(0.004);
@@ -148,9 +177,9 @@ TEST(PacketAuthentication, HostilePeersAreRejectedAndCountedWhileTheLegitimatePe
 TEST(PacketAuthentication, AnEndedSessionCannotBeReplayedToBindAgain) {
   Signed s = openSigned();
   const PacketKey key = keyOf(kSecret);
-  s.peer->tick(0.0);
-  ASSERT_TRUE(s.device->read(0.0).alive);
-  const SignedPacketBytes recorded = encodeSignedPacket(pose(2, s.peer->session(), 9), key);
+  connect(*s.peer, *s.device, 0.0);
+  const SignedPacketBytes recorded =
+      encodeSignedPacket(pose(4, s.peer->session(), s.peer->deviceNonce(), 9), key);
   s.peer->sayGoodbye(0.001);
   EXPECT_FALSE(s.device->read(0.001).alive);
   // The recorded pose of the ended session, sent later from another port: refused.
@@ -160,21 +189,19 @@ TEST(PacketAuthentication, AnEndedSessionCannotBeReplayedToBindAgain) {
   EXPECT_EQ(s.device->stats().replayed, 1u);
   // A new session of a key holder binds as usual.
   auto next = intruder(*s.device, keyOf(kSecret));
-  next->tick(0.003);
-  const DeviceSample sample = s.device->read(0.003);
-  EXPECT_TRUE(sample.alive);
-  EXPECT_DOUBLE_EQ(sample.pose.position.x, 5.0);
+  connect(*next, *s.device, 0.003);
+  EXPECT_DOUBLE_EQ(s.device->read(0.003).pose.position.x, 5.0);
 }
 
 TEST(PacketAuthentication, APeerRefusesWrenchesOfAnotherSession) {
   Signed s = openSigned();
-  s.peer->tick(0.0);
-  (void)s.device->read(0.0);
+  connect(*s.peer, *s.device, 0.0);
   const PacketKey key = keyOf(kSecret);
   Packet w;
   w.kind = PacketKind::kWrench;
   w.sequence = 99;
   w.session = s.peer->session() + 1;  // signed with the key, but for another session
+  w.device_nonce = s.peer->deviceNonce();
   w.wrench = {{7, 0, 0}, {0, 0, 0}};
   const SignedPacketBytes bytes = encodeSignedPacket(w, key);
   auto sender = UdpSocket::open(UdpEndpoint{0x7f000001, 0});
@@ -183,6 +210,232 @@ TEST(PacketAuthentication, APeerRefusesWrenchesOfAnotherSession) {
   s.peer->tick(0.001);
   EXPECT_EQ(s.peer->stats().replayed, 1u);
   EXPECT_DOUBLE_EQ(s.peer->newestWrench().force.x, 0.0);
+}
+
+// A man in the middle that records: the peer sends to it, it forwards to the device and the
+// device's answers back to the peer, keeping a copy of every datagram the peer sent.
+struct Recorder {
+  explicit Recorder(UdpEndpoint device_at) : device(device_at) {
+    auto opened = UdpSocket::open(UdpEndpoint{0x7f000001, 0});
+    EXPECT_TRUE(opened) << opened.error;
+    socket = *opened.value;
+  }
+  void pump() {
+    unsigned char bytes[512];
+    UdpEndpoint from;
+    long size;
+    while ((size = socket->receive(bytes, sizeof bytes, from)) >= 0) {
+      const auto n = static_cast<std::size_t>(size);
+      if (from == device) {
+        socket->send(peer, bytes, n);
+      } else {
+        peer = from;
+        recorded.emplace_back(bytes, bytes + n);
+        socket->send(device, bytes, n);
+      }
+    }
+  }
+  std::shared_ptr<UdpSocket> socket;
+  UdpEndpoint device;
+  UdpEndpoint peer;
+  std::vector<std::vector<unsigned char>> recorded;
+};
+
+// The reference peer drives `device` through `recorder` for `ticks` ticks from `time`.
+void drive(NetworkPeer& peer, Recorder& recorder, NetworkDevice& device, double time, int ticks) {
+  for (int k = 0; k < ticks; ++k) {
+    peer.tick(time + 0.001 * k);
+    recorder.pump();
+    (void)device.read(time + 0.001 * k);
+    recorder.pump();
+  }
+}
+
+// Recorded poses that carry a device nonce (the hellos before the challenge carry none).
+std::uint64_t posesWithADeviceNonce(const std::vector<std::vector<unsigned char>>& recorded) {
+  const PacketKey key = keyOf(kSecret);
+  std::uint64_t n = 0;
+  for (const auto& bytes : recorded) {
+    Packet p;
+    EXPECT_EQ(decodePacket(bytes.data(), bytes.size(), p, &key), PacketError::kNone);
+    n += p.device_nonce != 0 ? 1 : 0;
+  }
+  return n;
+}
+
+TEST(PacketAuthentication, RecordedSessionsNeverTakeTheHandAfterTheGoodbye) {
+  // An earlier run: an attacker on the path records a whole session of a real peer.
+  std::vector<std::vector<unsigned char>> earlier_run;
+  {
+    std::unique_ptr<NetworkDevice> earlier = openSignedDevice();
+    Recorder recorder(earlier->local());
+    auto peer = NetworkPeer::open(recorder.socket->local(), kThere, keyOf(kSecret));
+    ASSERT_TRUE(peer) << peer.error;
+    drive(**peer.value, recorder, *earlier, 0.0, 10);
+    const DeviceSample sample = earlier->read(0.01);
+    ASSERT_TRUE(sample.alive);
+    ASSERT_DOUBLE_EQ(sample.pose.position.x, 5.0);
+    earlier_run = recorder.recorded;  // that run is killed: no goodbye
+  }
+  // This run: the real peer's session, recorded too, ends with its goodbye.
+  std::unique_ptr<NetworkDevice> device = openSignedDevice();
+  Recorder recorder(device->local());
+  auto opened = NetworkPeer::open(recorder.socket->local(), kHere, keyOf(kSecret));
+  ASSERT_TRUE(opened) << opened.error;
+  NetworkPeer& peer = **opened.value;
+  drive(peer, recorder, *device, 0.0, 10);
+  ASSERT_TRUE(device->read(0.01).alive);
+  ASSERT_DOUBLE_EQ(device->read(0.01).pose.position.x, 0.01);
+  peer.sayGoodbye(0.011);
+  recorder.pump();
+  ASSERT_FALSE(device->read(0.011).alive);
+  const std::vector<std::vector<unsigned char>> this_run = recorder.recorded;
+  const std::uint64_t accepted = device->stats().accepted;
+  ASSERT_EQ(device->stats().replayed, 0u);
+
+  // Both recordings replayed, each from the address its session had and from another one.
+  auto attacker = UdpSocket::open(UdpEndpoint{0x7f000001, 0});
+  ASSERT_TRUE(attacker) << attacker.error;
+  const std::vector<const std::vector<std::vector<unsigned char>>*> recordings = {&earlier_run,
+                                                                                  &this_run};
+  for (const auto* recorded : recordings) {
+    for (const auto& bytes : *recorded) {
+      recorder.socket->send(device->local(), bytes.data(), bytes.size());
+      (*attacker.value)->send(device->local(), bytes.data(), bytes.size());
+    }
+    const DeviceSample sample = device->read(0.012);
+    EXPECT_FALSE(sample.alive);
+    EXPECT_NE(sample.pose.position.x, 5.0);
+    EXPECT_NE(sample.pose.position.x, 0.01);
+  }
+  const std::uint64_t replays =
+      2 * (posesWithADeviceNonce(earlier_run) + posesWithADeviceNonce(this_run));
+  EXPECT_GE(replays, 2u * (8 + 9));  // 10 ticks each, 2 of them hellos; this run's goodbye
+  EXPECT_EQ(device->stats().replayed, replays);
+  EXPECT_EQ(device->stats().accepted, accepted);  // not one replayed packet was taken
+  EXPECT_FALSE(device->read(0.013).alive);
+
+  // The real peer's new session binds as usual (its replayed hellos drew challenges it ignores).
+  recorder.pump();
+  drive(peer, recorder, *device, 0.02, 3);
+  const DeviceSample sample = device->read(0.022);
+  EXPECT_TRUE(sample.alive);
+  EXPECT_DOUBLE_EQ(sample.pose.position.x, 0.01);
+  device->write({{2, 0, 0}, {0, 0, 0}});
+  recorder.pump();
+  peer.tick(0.023);
+  EXPECT_DOUBLE_EQ(peer.newestWrench().force.x, 2.0);
+  EXPECT_EQ(device->stats().replayed, replays);
+}
+
+TEST(PacketAuthentication, APeerWhoseDeviceRestartedIsChallengedAndBindsAgain) {
+  Signed s = openSigned();
+  connect(*s.peer, *s.device, 0.0);
+  const std::uint64_t first = s.peer->deviceNonce();
+  const std::uint16_t port = s.device->local().port;
+  s.device.reset();  // the simulation restarts on the same port; the peer keeps going
+  s.device = openSignedDevice(port);
+  ASSERT_TRUE(s.device);
+  s.peer->tick(0.001);  // carries the old device nonce: refused, and answered with a challenge
+  EXPECT_FALSE(s.device->read(0.001).alive);
+  EXPECT_EQ(s.device->stats().replayed, 1u);
+  s.peer->tick(0.002);  // refused too; the peer takes the new challenge
+  EXPECT_FALSE(s.device->read(0.002).alive);
+  EXPECT_NE(s.peer->deviceNonce(), first);
+  s.peer->tick(0.003);
+  EXPECT_TRUE(s.device->read(0.003).alive);
+  s.device->write({{3, 0, 0}, {0, 0, 0}});
+  s.peer->tick(0.004);  // the new device's wrench sequence starts afresh: taken
+  EXPECT_DOUBLE_EQ(s.peer->newestWrench().force.x, 3.0);
+}
+
+TEST(PacketAuthentication, APeerOfTheEarlierSignedVersionIsRefusedAsSuch) {
+  std::unique_ptr<NetworkDevice> device = openSignedDevice();
+  // Version 2: 88 bytes of header and payload, a peer nonce, a MAC; no device nonce.
+  Packet p = pose(1, 42, 0, 0.25);
+  SignedPacketBytes v3 = encodeSignedPacket(p, keyOf(kSecret));
+  unsigned char v2[kOldSignedPacketSize] = {};
+  std::memcpy(v2, v3.data(), 96);
+  v2[4] = 2;
+  auto old_peer = UdpSocket::open(UdpEndpoint{0x7f000001, 0});
+  ASSERT_TRUE(old_peer) << old_peer.error;
+  (*old_peer.value)->send(device->local(), v2, sizeof v2);
+  EXPECT_FALSE(device->read(0.0).alive);
+  EXPECT_EQ(device->stats().old_version, 1u);
+  EXPECT_EQ(device->stats().rejected(), 1u);
+  Packet out;
+  EXPECT_EQ(decodePacket(v2, sizeof v2, out, nullptr), PacketError::kOldVersion);
+}
+
+long threadCpuNanoseconds() {
+  timespec t{};
+  ::clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
+  return static_cast<long>(t.tv_sec) * 1000000000L + t.tv_nsec;
+}
+
+long wallNanoseconds() {
+  timespec t{};
+  ::clock_gettime(CLOCK_MONOTONIC, &t);
+  return static_cast<long>(t.tv_sec) * 1000000000L + t.tv_nsec;
+}
+
+// A flood of valid signed poses of the bound session (a runaway driver, or a replayer that
+// holds the key): each read() takes at most kMaxDatagramsPerRead datagrams (deterministic), and
+// costs the loop's thread a bounded CPU time. The bound, 5 ms, is 5 ticks: 64 receives and HMACs
+// take about 0.25 ms; the rest is slack for a loaded 2-core machine. It is thread CPU time: the
+// two senders preempt the reader (wall-clock reads of 5-15 ms, with or without the cap), which
+// is scheduling, not the read's cost. Without the cap a read took all the socket held (its whole
+// buffer: 256 datagrams, about 1 ms, with the default 208 KiB) or, while the flood outpaced it,
+// more: however long the flood lasted.
+TEST(PacketAuthentication, AFloodOfValidPacketsCostsEachReadABoundedTime) {
+  Signed s = openSigned();
+  connect(*s.peer, *s.device, 0.0);
+  // Signed beforehand, so that the sender outpaces the receiver (which checks every MAC).
+  constexpr std::uint32_t kFlood = 100000;
+  const PacketKey key = keyOf(kSecret);
+  std::vector<SignedPacketBytes> flood(kFlood);
+  for (std::uint32_t k = 0; k < kFlood; ++k)
+    flood[k] =
+        encodeSignedPacket(pose(100 + k, s.peer->session(), s.peer->deviceNonce(), 0.02), key);
+  // Two senders from the bound peer's address: together they outpace the receiver.
+  std::atomic<int> flooding{2};
+  NetworkPeer& peer = *s.peer;
+  const auto send = [&peer, &flood, &flooding](std::size_t first) {
+    for (std::size_t k = first; k < flood.size(); k += 2)
+      peer.sendRaw(flood[k].data(), flood[k].size());
+    --flooding;
+  };
+  std::thread flooder(send, 0);
+  std::thread flooder2(send, 1);
+  int max_datagrams = 0;
+  long max_cpu = 0;
+  long max_wall = 0;
+  long reads = 0;
+  double time = 0.001;
+  while (true) {
+    const bool last = flooding.load() == 0;  // the flood is all queued: this read drains the rest
+    const long cpu0 = threadCpuNanoseconds();
+    const long wall0 = wallNanoseconds();
+    (void)s.device->read(time);
+    max_cpu = std::max(max_cpu, threadCpuNanoseconds() - cpu0);
+    max_wall = std::max(max_wall, wallNanoseconds() - wall0);
+    max_datagrams = std::max(max_datagrams, s.device->lastReadDatagrams());
+    ++reads;
+    time += 0.001;
+    if (last && s.device->lastReadDatagrams() < kMaxDatagramsPerRead) break;
+  }
+  flooder.join();
+  flooder2.join();
+  std::printf(
+      "flood of %u valid packets: %ld reads, %llu accepted; worst read %.3f ms CPU "
+      "(%.3f ms wall), at most %d datagrams\n",
+      kFlood, reads, static_cast<unsigned long long>(s.device->stats().accepted.load()),
+      1e-6 * static_cast<double>(max_cpu), 1e-6 * static_cast<double>(max_wall), max_datagrams);
+  EXPECT_LE(max_datagrams, kMaxDatagramsPerRead);
+  EXPECT_LT(max_cpu, 5000000L);
+  EXPECT_GT(s.device->stats().accepted, 1u);
+  EXPECT_EQ(s.device->stats().replayed, 0u);
+  EXPECT_DOUBLE_EQ(s.device->read(time).pose.position.x, 0.02);
 }
 
 TEST(PacketAuthentication, AnUnkeyedDeviceRefusesSignedPackets) {

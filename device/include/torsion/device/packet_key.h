@@ -13,6 +13,7 @@
 
 #include <array>
 #include <cstddef>
+#include <cstdint>
 #include <optional>
 #include <string>
 #include <vector>
@@ -52,7 +53,8 @@ class PacketKey {
   std::vector<unsigned char> secret_;
 };
 
-/// A random 64-bit number from the system's CSPRNG (libsodium): a peer's session id.
-std::uint64_t randomSessionId();
+/// A random, non-zero 64-bit number from the system's CSPRNG (libsodium's randombytes, which
+/// reads getrandom(2) on Linux): the nonces that bind a signed session (udp_packet.h).
+std::uint64_t randomNonce();
 
 }  // namespace torsion::device

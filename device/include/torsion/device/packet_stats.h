@@ -21,12 +21,14 @@ struct PacketStats {
   /// key: signed packets, which cannot be checked.
   std::atomic<std::uint64_t> unauthenticated{0};
   std::atomic<std::uint64_t> replayed{0};  ///< signed, but of a session that is not the current one
+  /// Signed in the earlier packet version 2 (a peer nonce only): the sender must be updated.
+  std::atomic<std::uint64_t> old_version{0};
   std::atomic<std::uint64_t> sent{0};
   std::atomic<std::uint64_t> send_failed{0};
 
   std::uint64_t rejected() const {
     return truncated.load() + malformed.load() + out_of_order.load() + duplicate.load() +
-           foreign.load() + unauthenticated.load() + replayed.load();
+           foreign.load() + unauthenticated.load() + replayed.load() + old_version.load();
   }
 };
 
