@@ -5,6 +5,10 @@
 #include <cstdio>
 #include <cstdlib>
 #include <memory>
+#include <string>
+#include <vector>
+
+#include "torsion/device/file_io.h"
 
 namespace torsion::render {
 
@@ -17,9 +21,19 @@ using File = std::unique_ptr<std::FILE, FileCloser>;
 
 }  // namespace
 
+namespace {
+
+// libpng's output into memory, so the file is written whole or not at all (device/file_io.h).
+void appendToString(png_structp png, png_bytep data, png_size_t length) {
+  static_cast<std::string*>(png_get_io_ptr(png))
+      ->append(reinterpret_cast<const char*>(data), length);
+}
+void flushNothing(png_structp /*png*/) {}
+
+}  // namespace
+
 Status writePng(const Image& image, const std::string& path) {
-  File file(std::fopen(path.c_str(), "wb"));
-  if (!file) return Error{path + ": cannot open for writing"};
+  std::string bytes;
   png_structp png = png_create_write_struct(PNG_LIBPNG_VER_STRING, nullptr, nullptr, nullptr);
   png_infop info = png ? png_create_info_struct(png) : nullptr;
   if (!png || !info) {
@@ -34,7 +48,7 @@ Status writePng(const Image& image, const std::string& path) {
     png_destroy_write_struct(&png, &info);
     return Error{path + ": libpng failed to write the picture"};
   }
-  png_init_io(png, file.get());
+  png_set_write_fn(png, &bytes, appendToString, flushNothing);
   png_set_IHDR(png, info, static_cast<png_uint_32>(image.width),
                static_cast<png_uint_32>(image.height), 8, PNG_COLOR_TYPE_RGB, PNG_INTERLACE_NONE,
                PNG_COMPRESSION_TYPE_DEFAULT, PNG_FILTER_TYPE_DEFAULT);
@@ -42,6 +56,10 @@ Status writePng(const Image& image, const std::string& path) {
   png_write_rows(png, const_cast<png_bytepp>(rows.data()), static_cast<png_uint_32>(image.height));
   png_write_end(png, nullptr);
   png_destroy_write_struct(&png, &info);
+  // A temporary beside it, then a rename: a picture is whole or absent, and only a regular file
+  // (or nothing) is replaced.
+  if (std::string failed = device::writeFileAtomically(path, bytes); !failed.empty())
+    return Error{failed};
   return Ok{};
 }
 

@@ -541,7 +541,7 @@ PY
     run "$torsion" run drop.json --out out --steps 4 --render pictures --render-every 1 \
       --render-size 64x48
     expect_rc 1
-    expect_out "^error: --render: pictures/frame_00002.png: cannot open for writing$"
+    expect_out "^error: --render: pictures/frame_00002.png: cannot write: is a directory, not a regular file$"
     [[ $(json_field out/summary.json completed) == False ]] || fail "summary says completed"
     json_field out/summary.json error | grep -q "pictures/frame_00002.png" ||
       fail "summary.json lacks the error"
