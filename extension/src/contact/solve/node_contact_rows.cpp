@@ -72,6 +72,7 @@ std::vector<Vector6d> partnerImpulses(const NodeContactIsland& island,
                                       const SapReport& report) {
   std::vector<Vector6d> impulses(partners.size(), Vector6d::Zero());
   for (std::size_t r = 0; r < island.rows.size(); ++r) {
+    if (island.row_contact[r] < 0) continue;
     const NodeContact& c = contacts[static_cast<std::size_t>(island.row_contact[r])];
     const Eigen::Vector3d on_node = island.rows[r].frame.transpose() * report.impulses[r];
     impulses[static_cast<std::size_t>(c.partner)] += pointWrench(-on_node, c.lever);
@@ -86,7 +87,7 @@ std::vector<LaggedImpulse> laggedImpulses(const NodeContactIsland& island,
   std::vector<LaggedImpulse> lagged;
   for (std::size_t r = 0; r < island.rows.size(); ++r) {
     const double gamma_n = report.impulses[r].z();
-    if (!(gamma_n > 0)) continue;
+    if (island.row_contact[r] < 0 || !(gamma_n > 0)) continue;
     const NodeContact& c = contacts[static_cast<std::size_t>(island.row_contact[r])];
     lagged.push_back({c.node, partners[static_cast<std::size_t>(c.partner)].object, gamma_n});
   }

@@ -14,7 +14,7 @@
 //                  = -R_c (v + omega x lever): the partner point's known motion
 //
 // with mu the pair's coefficient, gap phi0 the contact's gap at the step's start, and k, tau_d
-// from RowDefaults. Face contacts and anchors are not mapped (they stay with RigidContactSolver).
+// from RowDefaults. Face contacts: face_contact_rows.h. Anchors are not mapped.
 
 #include <Eigen/Core>
 #include <memory>
@@ -53,7 +53,10 @@ struct NodeContactIsland {
   std::vector<std::unique_ptr<RigidBody>> rigid_bodies;  ///< island bodies 1..
   std::vector<int> partner_body;  ///< per partner: its island body, or -1 (prescribed)
   std::vector<ContactRow> rows;
-  std::vector<int> row_contact;  ///< per row: its index in the NodeContact list
+  std::vector<int> row_contact;  ///< per row: its index in the NodeContact list, or -1
+  /// Per row: its index in the FaceContact list, or -1 (face_contact_rows.h; empty without face
+  /// rows).
+  std::vector<int> row_face;
 };
 
 /// Builds the rows for `contacts` (active or not: every detected node contact, anchors and face
@@ -68,13 +71,14 @@ NodeContactIsland buildNodeContactIsland(const std::vector<NodeContact>& contact
 std::vector<const IslandBody*> islandBodies(const IslandBody& fem, const NodeContactIsland& island);
 
 /// Per partner, the impulse wrench the rows exert on it (N s; force, torque about its centre of
-/// mass): sum over its rows of J^T gamma on its side, -(R_c^T gamma) at the contact's lever.
+/// mass): sum over its node rows of J^T gamma on its side, -(R_c^T gamma) at the contact's lever
+/// (face rows: addFacePartnerImpulses).
 std::vector<Vector6d> partnerImpulses(const NodeContactIsland& island,
                                       const std::vector<NodeContact>& contacts,
                                       const std::vector<RigidPartner>& partners,
                                       const SapReport& report);
 
-/// The next step's lagged normal impulses: per row with gamma_n > 0, its node and object.
+/// The next step's lagged normal impulses: per node row with gamma_n > 0, its node and object.
 std::vector<LaggedImpulse> laggedImpulses(const NodeContactIsland& island,
                                           const std::vector<NodeContact>& contacts,
                                           const std::vector<RigidPartner>& partners,

@@ -1,0 +1,117 @@
+#include "torsion/contact/solve/face_contact_rows.h"
+
+#include <cstddef>
+
+namespace torsion::sap {
+
+namespace {
+
+double laggedFor(const std::vector<LaggedFaceImpulse>& lagged, const btCollisionObject* object,
+                 const Eigen::Vector3d& lever, double match_radius) {
+  double nearest = match_radius;
+  double impulse = 0;
+  for (const LaggedFaceImpulse& l : lagged) {
+    if (l.object != object) continue;
+    const double d = (l.lever - lever).norm();
+    if (d <= nearest) {
+      nearest = d;
+      impulse = l.normal_impulse;
+    }
+  }
+  return impulse;
+}
+
+ContactRow makeFaceRow(const FaceContact& c, const RigidPartner& k, int fem_body, int rigid_body,
+                       const RowDefaults& defaults, double dt) {
+  ContactRow row;
+  row.frame = contactFrame(c.normal);
+  for (std::size_t j = 0; j < 3; ++j) {
+    const double w = c.weights[static_cast<Eigen::Index>(j)];
+    if (w > 0) row.terms.push_back(nodeTerm(fem_body, c.nodes[j], w, row.frame));
+  }
+  if (rigid_body >= 0) {
+    row.terms.push_back(rigidPointTerm(rigid_body, c.lever, -1.0, row.frame));
+  } else {
+    row.velocity_offset = -(row.frame * pointVelocity(k.velocity, c.lever));
+  }
+  row.mu = c.friction;
+  row.stiffness = defaults.stiffness;
+  row.dissipation_time = defaults.dissipation_steps * dt;
+  row.gap = c.gap;
+  return row;
+}
+
+bool insideDisk(const ContactRow& row, const Eigen::Vector3d& gamma) {
+  return gamma.head<2>().norm() < (1 - 1e-6) * row.mu * row.lagged_normal_impulse;
+}
+
+}  // namespace
+
+void addFaceContactRows(NodeContactIsland& island, const std::vector<FaceContact>& faces,
+                        const std::vector<RigidPartner>& partners, int fem_body,
+                        const std::vector<LaggedFaceImpulse>& lagged, double match_radius,
+                        const RowDefaults& defaults, double dt) {
+  island.row_face.resize(island.rows.size(), -1);
+  for (std::size_t i = 0; i < faces.size(); ++i) {
+    const FaceContact& c = faces[i];
+    const auto p = static_cast<std::size_t>(c.partner);
+    ContactRow row = makeFaceRow(c, partners[p], fem_body, island.partner_body[p], defaults, dt);
+    row.lagged_normal_impulse = laggedFor(lagged, partners[p].object, c.lever, match_radius);
+    island.rows.push_back(std::move(row));
+    island.row_contact.push_back(-1);
+    island.row_face.push_back(static_cast<int>(i));
+  }
+}
+
+void addFacePartnerImpulses(const NodeContactIsland& island, const std::vector<FaceContact>& faces,
+                            const SapReport& report, std::vector<Vector6d>& impulses) {
+  for (std::size_t r = 0; r < island.row_face.size(); ++r) {
+    if (island.row_face[r] < 0) continue;
+    const FaceContact& c = faces[static_cast<std::size_t>(island.row_face[r])];
+    const Eigen::Vector3d on_face = island.rows[r].frame.transpose() * report.impulses[r];
+    impulses[static_cast<std::size_t>(c.partner)] += pointWrench(-on_face, c.lever);
+  }
+}
+
+std::vector<LaggedFaceImpulse> laggedFaceImpulses(const NodeContactIsland& island,
+                                                  const std::vector<FaceContact>& faces,
+                                                  const std::vector<RigidPartner>& partners,
+                                                  const SapReport& report) {
+  std::vector<LaggedFaceImpulse> lagged;
+  for (std::size_t r = 0; r < island.row_face.size(); ++r) {
+    const double gamma_n = report.impulses[r].z();
+    if (island.row_face[r] < 0 || !(gamma_n > 0)) continue;
+    const FaceContact& c = faces[static_cast<std::size_t>(island.row_face[r])];
+    lagged.push_back({partners[static_cast<std::size_t>(c.partner)].object, c.lever, gamma_n});
+  }
+  return lagged;
+}
+
+CarriedContacts carriedContacts(const NodeContactIsland& island,
+                                const std::vector<NodeContact>& contacts,
+                                const std::vector<FaceContact>& faces,
+                                const std::vector<RigidPartner>& partners,
+                                const SapReport& report) {
+  CarriedContacts carried;
+  for (std::size_t r = 0; r < island.rows.size(); ++r) {
+    const Eigen::Vector3d& gamma = report.impulses[r];
+    if (!(gamma.z() > 0)) continue;
+    const ContactRow& row = island.rows[r];
+    const bool stick = insideDisk(row, gamma);
+    const Eigen::Vector3d impulse = row.frame.transpose() * gamma;
+    if (island.row_contact[r] >= 0) {
+      const NodeContact& c = contacts[static_cast<std::size_t>(island.row_contact[r])];
+      carried.nodes.push_back({c.node, partners[static_cast<std::size_t>(c.partner)].object,
+                               stick ? NodeContact::State::kStick : NodeContact::State::kSlide,
+                               impulse, c.normal});
+    } else if (r < island.row_face.size() && island.row_face[r] >= 0) {
+      const FaceContact& c = faces[static_cast<std::size_t>(island.row_face[r])];
+      carried.faces.push_back({c.key, partners[static_cast<std::size_t>(c.partner)].object,
+                               stick ? FaceContact::State::kStick : FaceContact::State::kSlide,
+                               impulse, 0});
+    }
+  }
+  return carried;
+}
+
+}  // namespace torsion::sap
