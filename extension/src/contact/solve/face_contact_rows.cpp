@@ -6,19 +6,28 @@ namespace torsion::sap {
 
 namespace {
 
-double laggedFor(const std::vector<LaggedFaceImpulse>& lagged, const btCollisionObject* object,
-                 const Eigen::Vector3d& lever, double match_radius) {
-  double nearest = match_radius;
-  double impulse = 0;
+// Each remembered impulse goes to the face contact of the same object whose lever is nearest,
+// within match_radius: the total is conserved (two rows at one corner do not both take the
+// corner's impulse, and two remembered rows of one feature add up in the row that takes it).
+std::vector<double> transferLagged(const std::vector<FaceContact>& faces,
+                                   const std::vector<RigidPartner>& partners,
+                                   const std::vector<LaggedFaceImpulse>& lagged,
+                                   double match_radius) {
+  std::vector<double> impulses(faces.size(), 0.0);
   for (const LaggedFaceImpulse& l : lagged) {
-    if (l.object != object) continue;
-    const double d = (l.lever - lever).norm();
-    if (d <= nearest) {
-      nearest = d;
-      impulse = l.normal_impulse;
+    double nearest = match_radius;
+    std::size_t taker = faces.size();
+    for (std::size_t i = 0; i < faces.size(); ++i) {
+      if (partners[static_cast<std::size_t>(faces[i].partner)].object != l.object) continue;
+      const double d = (faces[i].lever - l.lever).norm();
+      if (d <= nearest) {
+        nearest = d;
+        taker = i;
+      }
     }
+    if (taker < faces.size()) impulses[taker] += l.normal_impulse;
   }
-  return impulse;
+  return impulses;
 }
 
 ContactRow makeFaceRow(const FaceContact& c, const RigidPartner& k, int fem_body, int rigid_body,
@@ -52,11 +61,12 @@ void addFaceContactRows(NodeContactIsland& island, const std::vector<FaceContact
                         const std::vector<LaggedFaceImpulse>& lagged, double match_radius,
                         const RowDefaults& defaults, double dt) {
   island.row_face.resize(island.rows.size(), -1);
+  const std::vector<double> transferred = transferLagged(faces, partners, lagged, match_radius);
   for (std::size_t i = 0; i < faces.size(); ++i) {
     const FaceContact& c = faces[i];
     const auto p = static_cast<std::size_t>(c.partner);
     ContactRow row = makeFaceRow(c, partners[p], fem_body, island.partner_body[p], defaults, dt);
-    row.lagged_normal_impulse = laggedFor(lagged, partners[p].object, c.lever, match_radius);
+    row.lagged_normal_impulse = transferred[i];
     island.rows.push_back(std::move(row));
     island.row_contact.push_back(-1);
     island.row_face.push_back(static_cast<int>(i));

@@ -17,11 +17,13 @@
 // Lagged normal impulses are keyed by the rigid object and the rigid feature point (its lever,
 // the point minus the centre of mass, world frame at the step's start), not by the triangle: a
 // corner or edge sliding onto the neighbouring triangle is the same feature at the same lever, so
-// it keeps its impulse (and its friction bound). A remembered impulse goes to the contact of the
-// same object whose lever is nearest, within `match_radius` (the caller's choice: half the mesh
-// spacing keeps neighbouring points of one edge apart). Levers in the world frame: a partner that
-// turns by more than match_radius / |lever| in one step loses the match for that step (its face
-// rows start without friction, as new contacts do).
+// it keeps its impulse (and its friction bound). Each remembered impulse goes to the one contact of
+// the same object whose lever is nearest, within `match_radius` (the caller's choice: half the
+// mesh spacing keeps neighbouring points of one edge apart), and impulses going to one contact
+// add up: the total is conserved, so two triangles meeting at a corner do not both take the
+// corner's impulse (which gave the sliding box +6 % friction). Levers in the world frame: a partner
+// that turns by more than match_radius / |lever| in one step loses the match for that step (its
+// face rows start without friction, as new contacts do).
 
 #include <Eigen/Core>
 #include <vector>
@@ -43,7 +45,7 @@ struct LaggedFaceImpulse {
 
 /// Appends one row per face contact in `faces` to `island` (built by buildNodeContactIsland from
 /// the same `partners`), its index in `faces` in island.row_face, with lagged normal impulses from
-/// `lagged` matched within `match_radius` (m).
+/// `lagged`, each given to the contact of nearest lever within `match_radius` (m).
 void addFaceContactRows(NodeContactIsland& island, const std::vector<FaceContact>& faces,
                         const std::vector<RigidPartner>& partners, int fem_body,
                         const std::vector<LaggedFaceImpulse>& lagged, double match_radius,
