@@ -8,7 +8,7 @@
 // f_2], and the tangent dP/dF is the 9x9 matrix A(i, j) = d vec(P)_i / d vec(F)_j (symmetric: it
 // is the Hessian of Psi).
 //
-// Stable neo-Hookean (Smith, de Goes & Kim 2018, eqs. 14-16), shifted Lame parameters mu', l':
+// Stable neo-Hookean (Smith, de Goes & Kim 2018), shifted Lame parameters mu', l':
 //   Psi = mu'/2 (I_C - 3) + l'/2 (J - alpha)^2 [- mu'/2 log(I_C + 1)] - Psi_rest
 //   without the log term: mu' = mu,       l' = lambda + mu,       alpha = 1 + mu'/l'
 //   with the log term:    mu' = 4 mu / 3, l' = lambda + 5 mu / 6, alpha = 1 + 3 mu' / (4 l')
@@ -44,7 +44,7 @@ struct StableNeoHookean {
   double mu = 0;
   double lambda = 0;
   double alpha = 1;
-  bool log_term = false;  ///< with -mu'/2 log(I_C + 1) (Smith et al. 2018, eq. 14)
+  bool log_term = false;  ///< with -mu'/2 log(I_C + 1) (Smith et al. 2018)
   double rest_energy = 0;
 
   /// From Young's modulus (Pa) and Poisson's ratio in [0, 0.5).
