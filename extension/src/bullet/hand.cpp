@@ -47,10 +47,10 @@ Hand::Hand(FemBody& body, std::string name, HandSettings settings)
   assert(settings.validate().ok());
 }
 
-Result<int> Hand::grab(const Frame& unchecked, double now) {
-  Result<Frame> checked = checkedFrame(unchecked, label() + ": the frame");
-  if (!checked) return checked.error();
-  const Frame& frame = checked.value();
+Result<int> Hand::grab(const Frame& frame, double now) {
+  // Checked, not normalised: the frame is used as given, bit for bit.
+  if (Result<Frame> checked = checkedFrame(frame, label() + ": the frame"); !checked)
+    return checked.error();
   release();
   selection_ = selectGrabbedPatch(body_->model().mesh(), body_->state().positions, frame);
   if (selection_.status != HandSelectionStatus::kGrabbed) {
@@ -77,9 +77,10 @@ FrameMotion followPursuit(std::shared_ptr<HandPursuit> pursuit) {
 }
 
 Status Hand::moveTo(const Frame& frame) {
-  Result<Frame> checked = checkedFrame(frame, label() + ": the frame");
-  if (!checked) return checked.error();
-  pursuit_->goal = checked.value();
+  // Checked, not normalised: the goal is the frame as given, bit for bit.
+  if (Result<Frame> checked = checkedFrame(frame, label() + ": the frame"); !checked)
+    return checked.error();
+  pursuit_->goal = frame;
   return Ok{};
 }
 
