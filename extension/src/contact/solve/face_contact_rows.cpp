@@ -38,15 +38,7 @@ ContactRow makeFaceRow(const FaceContact& c, const RigidPartner& k, int fem_body
     const double w = c.weights[static_cast<Eigen::Index>(j)];
     if (w > 0) row.terms.push_back(nodeTerm(fem_body, c.nodes[j], w, row.frame));
   }
-  if (rigid_body >= 0) {
-    row.terms.push_back(rigidPointTerm(rigid_body, c.lever, -1.0, row.frame));
-  } else {
-    row.velocity_offset = -(row.frame * pointVelocity(k.velocity, c.lever));
-  }
-  row.mu = c.friction;
-  row.stiffness = defaults.stiffness;
-  row.dissipation_time = defaults.dissipation_steps * dt;
-  row.gap = c.gap;
+  completeRigidSide(row, c.lever, k, rigid_body, c.friction, c.gap, defaults, dt);
   return row;
 }
 

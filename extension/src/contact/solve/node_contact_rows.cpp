@@ -19,19 +19,25 @@ ContactRow makeRow(const NodeContact& c, const RigidPartner& k, int fem_body, in
   ContactRow row;
   row.frame = contactFrame(c.normal);
   row.terms.push_back(nodeTerm(fem_body, c.node, 1.0, row.frame));
-  if (rigid_body >= 0) {
-    row.terms.push_back(rigidPointTerm(rigid_body, c.lever, -1.0, row.frame));
-  } else {
-    row.velocity_offset = -(row.frame * pointVelocity(k.velocity, c.lever));
-  }
-  row.mu = c.friction;
-  row.stiffness = defaults.stiffness;
-  row.dissipation_time = defaults.dissipation_steps * dt;
-  row.gap = c.gap;
+  completeRigidSide(row, c.lever, k, rigid_body, c.friction, c.gap, defaults, dt);
   return row;
 }
 
 }  // namespace
+
+void completeRigidSide(ContactRow& row, const Eigen::Vector3d& lever, const RigidPartner& partner,
+                       int rigid_body, double friction, double gap, const RowDefaults& defaults,
+                       double dt) {
+  if (rigid_body >= 0) {
+    row.terms.push_back(rigidPointTerm(rigid_body, lever, -1.0, row.frame));
+  } else {
+    row.velocity_offset = -(row.frame * pointVelocity(partner.velocity, lever));
+  }
+  row.mu = friction;
+  row.stiffness = defaults.stiffness;
+  row.dissipation_time = defaults.dissipation_steps * dt;
+  row.gap = gap;
+}
 
 NodeContactIsland buildNodeContactIsland(const std::vector<NodeContact>& contacts,
                                          const std::vector<RigidPartner>& partners, int fem_body,

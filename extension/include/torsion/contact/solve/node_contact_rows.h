@@ -39,6 +39,14 @@ struct RowDefaults {
   double dissipation_steps = 1.0 / 3.141592653589793;
 };
 
+/// What a row against a rigid partner holds whatever its FEM side (one node, or a triangle's
+/// nodes): the partner's point term at `lever` when it is an island body (`rigid_body` >= 0),
+/// else its point's velocity as the row's offset (static, kinematic); the friction, the defaults'
+/// compliance and the gap. `row.frame` must be set.
+void completeRigidSide(ContactRow& row, const Eigen::Vector3d& lever, const RigidPartner& partner,
+                       int rigid_body, double friction, double gap, const RowDefaults& defaults,
+                       double dt);
+
 /// The node contacts' next-step memory: the normal impulse of each solved row, by node and
 /// rigid object (N s).
 struct LaggedImpulse {
