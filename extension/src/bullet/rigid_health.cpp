@@ -53,13 +53,16 @@ std::optional<RigidBodyFault> findUnhealthyRigidBody(const std::vector<NamedRigi
 }
 
 std::optional<RigidBodyFault> findUnhealthyRigidBody(const btDynamicsWorld& world) {
-  std::vector<NamedRigidBody> bodies;
+  // The FEM solver calls this every substep: no list and no names unless a body is at fault.
   const btCollisionObjectArray& objects = world.getCollisionObjectArray();
   for (int i = 0; i < objects.size(); ++i) {
-    if (const btRigidBody* body = btRigidBody::upcast(objects[i]))
-      bodies.push_back({"#" + std::to_string(i), body});
+    const btRigidBody* body = btRigidBody::upcast(objects[i]);
+    if (body == nullptr) continue;
+    if (std::string fault = faultOf(*body); !fault.empty()) {
+      return findUnhealthyRigidBody({{"#" + std::to_string(i), body}});
+    }
   }
-  return findUnhealthyRigidBody(bodies);
+  return std::nullopt;
 }
 
 }  // namespace torsion
