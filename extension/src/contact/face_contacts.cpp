@@ -6,6 +6,7 @@
 #include <limits>
 
 #include "torsion/contact/face_distance.h"
+#include "torsion/contact/query/feature_contacts.h"
 #include "torsion/contact/shape_distance.h"
 
 namespace torsion {
@@ -109,6 +110,7 @@ void FaceContactSet::beginStep(const std::vector<RigidPartner>& partners) {
     previous_[{c.key, partners[static_cast<size_t>(c.partner)].object}] = {c.state, carried};
   }
   contacts_.clear();
+  features_.clear();
   index_.clear();
 }
 
@@ -129,6 +131,9 @@ void FaceContactSet::detect(const FemState& state, const NodeConstraints& held,
                             const RigidPartner& p, double friction) {
   ++stamp_;
   const Eigen::Vector3d pad = Eigen::Vector3d::Constant(reach);
+  const std::optional<PolyhedronFeatures> polyhedron = polyhedronFeatures(shape, transform);
+  std::optional<FeatureContactCollector> features;
+  if (polyhedron && !p.supported) features.emplace(*polyhedron, reach, partner, p, friction);
   for (int node : nearby_nodes) {
     for (int k = node_triangle_start_[static_cast<size_t>(node)];
          k < node_triangle_start_[static_cast<size_t>(node) + 1]; ++k) {
@@ -145,6 +150,7 @@ void FaceContactSet::detect(const FemState& state, const NodeConstraints& held,
       for (int node_id : tri)
         all_held = all_held && held.kind(node_id) == NodeConstraints::Kind::kFull;
       if (all_held && !p.dynamic) continue;
+      if (features) features->addTriangle(tri, a, b, c);
       // A supported partner (resting on the ground: coupled explicitly, one step late) gets node
       // contacts only. Face contacts at its edges, with their levers and oblique normals, spun a
       // box squeezed under a deformable faster each step through that explicit coupling (its
@@ -202,6 +208,7 @@ void FaceContactSet::detect(const FemState& state, const NodeConstraints& held,
       contacts_.push_back(fc);
     }
   }
+  if (features) features->appendTo(features_);
 }
 
 std::vector<FaceContact::State> FaceContactSet::states() const {

@@ -87,6 +87,10 @@ class FaceContactSet {
               const btTransform& transform, const Eigen::Vector3d& lo, const Eigen::Vector3d& hi,
               double reach, double dt, int partner, const RigidPartner& p, double friction);
   const std::vector<FaceContact>& contacts() const { return contacts_; }
+  /// The contacts of polyhedral shapes' corners and edges (query/feature_contacts.h) found by
+  /// this step's detect(), for the convex island solve (contact/solve/): the contacts() above
+  /// are what today's solver uses.
+  const std::vector<FaceContact>& featureContacts() const { return features_; }
   /// The contacts, for a solve that sets their states and impulses itself (the contact-space
   /// solve, rigid_contact_coulomb.cpp).
   std::vector<FaceContact>& mutableContacts() { return contacts_; }
@@ -158,6 +162,7 @@ class FaceContactSet {
   std::vector<int> triangle_stamp_;                        // per triangle: last detect seen
   int stamp_ = 0;
   std::vector<FaceContact> contacts_;
+  std::vector<FaceContact> features_;
   std::map<std::pair<std::array<int, 3>, int>, int> index_;  // (key, partner) -> contact
   struct Remembered {
     FaceContact::State state;

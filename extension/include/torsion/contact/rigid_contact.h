@@ -255,6 +255,8 @@ class RigidContactSolver {
 
   const std::vector<NodeContact>& contacts() const { return contacts_; }
   const std::vector<FaceContact>& faceContacts() const { return faces_.contacts(); }
+  /// Polyhedral partners' corner and edge contacts (FaceContactSet::featureContacts).
+  const std::vector<FaceContact>& featureContacts() const { return faces_.featureContacts(); }
   const std::vector<RigidPartner>& partners() const { return partners_; }
   const ContactStepStats& stats() const { return stats_; }
 

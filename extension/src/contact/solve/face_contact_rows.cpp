@@ -2,6 +2,8 @@
 
 #include <cstddef>
 
+#include "torsion/contact/query/feature_contacts.h"
+
 namespace torsion::sap {
 
 namespace {
@@ -47,6 +49,16 @@ bool insideDisk(const ContactRow& row, const Eigen::Vector3d& gamma) {
 }
 
 }  // namespace
+
+std::vector<FaceContact> islandFaceContacts(const RigidContactSolver& contacts) {
+  std::vector<FaceContact> faces = contacts.featureContacts();
+  for (const FaceContact& c : contacts.faceContacts()) {
+    const btCollisionObject* object =
+        contacts.partners()[static_cast<std::size_t>(c.partner)].object;
+    if (!hasPolyhedronFeatures(*object->getCollisionShape())) faces.push_back(c);
+  }
+  return faces;
+}
 
 void addFaceContactRows(NodeContactIsland& island, const std::vector<FaceContact>& faces,
                         const std::vector<RigidPartner>& partners, int fem_body,

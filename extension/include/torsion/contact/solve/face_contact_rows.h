@@ -43,6 +43,11 @@ struct LaggedFaceImpulse {
   double normal_impulse = 0;                        ///< N s
 };
 
+/// The face contacts an island solve takes from detection: the corner and edge contacts of
+/// polyhedral partners (boxes, convex hulls: query/feature_contacts.h) and the nearest-point
+/// contacts of every other shape (spheres, capsules, triangle meshes: face_distance.h).
+std::vector<FaceContact> islandFaceContacts(const RigidContactSolver& contacts);
+
 /// Appends one row per face contact in `faces` to `island` (built by buildNodeContactIsland from
 /// the same `partners`), its index in `faces` in island.row_face, with lagged normal impulses from
 /// `lagged`, each given to the contact of nearest lever within `match_radius` (m).
