@@ -104,7 +104,7 @@ def box_on_a_tilted_slab(degrees, friction_solve):
     return box.position[0] - x0
 
 
-@pytest.mark.parametrize("friction_solve", ["auto", "active_set", "contact_space"])
+@pytest.mark.parametrize("friction_solve", ["auto", "active_set", "contact_space", "convex"])
 def test_a_box_on_a_soft_slab_holds_below_the_friction_angle_and_slides_as_coulomb_above(
         friction_solve):
     # atan(0.5) = 26.6 deg. 20 deg below: held (the landing's slip and the slab's shear only).
@@ -124,5 +124,5 @@ def test_friction_solve_names_what_it_accepts():
     for name in ("active_set", "contact_space", "auto"):
         body.friction_solve = name
         assert body.friction_solve == name
-    with pytest.raises(ValueError, match="auto.*active_set.*contact_space.*exact"):
+    with pytest.raises(ValueError, match="auto.*active_set.*contact_space.*convex.*exact"):
         body.friction_solve = "exact"

@@ -23,7 +23,8 @@ TEST(SceneFrictionSolveKey, DefaultsToAutoAndReadsEachSolve) {
   for (const auto& [name, expected] :
        {std::pair{"auto", ContactSettings::FrictionSolve::kAuto},
         std::pair{"active_set", ContactSettings::FrictionSolve::kActiveSet},
-        std::pair{"contact_space", ContactSettings::FrictionSolve::kContactSpace}}) {
+        std::pair{"contact_space", ContactSettings::FrictionSolve::kContactSpace},
+        std::pair{"convex", ContactSettings::FrictionSolve::kConvex}}) {
     Result<SceneSpec> spec = parseScene(
         sceneWith(" \"friction_solve\": \"" + std::string(name) + "\","), "s.json", "/base");
     ASSERT_TRUE(spec.ok()) << spec.error().message;
@@ -35,7 +36,8 @@ TEST(SceneFrictionSolveKey, AnUnknownSolveOrWrongTypeNamesTheKey) {
   EXPECT_TRUE(
       test::failsWith(parseScene(sceneWith(R"( "friction_solve": "exact",)"), "s.json", "/base"),
                       {"s.json: bodies[0].friction_solve",
-                       "'exact' is not a friction solve (auto, active_set or contact_space)"}));
+                       "'exact' is not a friction solve (auto, active_set, contact_space or "
+                       "convex)"}));
   EXPECT_TRUE(test::failsWith(parseScene(sceneWith(R"( "friction_solve": 1,)"), "s.json", "/base"),
                               {"s.json: bodies[0].friction_solve", "string"}));
 }

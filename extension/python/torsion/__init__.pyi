@@ -87,7 +87,7 @@ class Body:
     external_forces: npt.NDArray[np.float64]  # (n, 3) N, copy
     kinetic_energy: float  # J, end of the last step
     solver_iterations: int  # CG iterations of the last step
-    friction_solve: str  # "auto" (default), "contact_space" or "active_set"
+    friction_solve: str  # "auto" (default), "contact_space", "active_set" or "convex"
     def set_material(self, material: Material) -> None: ...
     def set_external_forces(self, forces: ArrayLike) -> None: ...  # (n, 3) N, kept every step
     def set_velocity(self, velocity: ArrayLike) -> None: ...  # (3,) m/s, every node

@@ -24,7 +24,7 @@ constexpr char kMagic[8] = {'T', 'R', 'S', 'N', 'C', 'K', 'P', 'T'};
 // 4: the node contacts' normals (the plane a contact keeps while its node stays over it).
 // 5: the payload's hash is the standard FNV-1a (torsion/fnv1a.h); 4 used an offset basis one
 //    digit short of it.
-constexpr std::uint32_t kVersion = 5;
+constexpr std::uint32_t kVersion = 6;
 constexpr size_t kHeaderSize = sizeof(kMagic) + 4 + 8 + 8;
 
 class Writer {
@@ -357,6 +357,12 @@ void writeBody(Writer& w, FemWorld& world, const FemBody& body, const FemBodyChe
     w.vec3(f.multiplier);
     w.i32(f.stalls);
   }
+  w.u32(carried.features.size());
+  for (const CarriedContacts::Feature& f : carried.features) {
+    w.i32(collisionObjectIndex(world, f.object));
+    w.vec3(f.lever);
+    w.f64(f.normal_impulse);
+  }
 
   w.u8(c.self_contact);
   const SelfContactSettings& s = c.self_contact_settings;
@@ -490,6 +496,13 @@ Result<FemBodyCheckpoint> readBody(Reader& r, FemWorld& world, FemBody& body,
     f.state = r.enumeration(FaceContact::State::kStick);
     f.multiplier = r.vec3();
     f.stalls = r.i32();
+  }
+  carried.features.resize(r.count(36));
+  for (CarriedContacts::Feature& f : carried.features) {
+    f.object = objectAt(r.i32());
+    f.lever = r.vec3();
+    f.normal_impulse = r.f64();
+    if (!std::isfinite(f.normal_impulse) || !f.lever.allFinite()) r.fail();
   }
   auto contacts = std::make_shared<RigidContactSolver>(*now.contacts);
   contacts->replaceModel(c.model);

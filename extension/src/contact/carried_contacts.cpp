@@ -18,6 +18,7 @@ CarriedContacts RigidContactSolver::carriedContacts() const {
     carried.faces.push_back(
         {c.key, partners_[static_cast<size_t>(c.partner)].object, c.state, c.multiplier, c.stalls});
   }
+  carried.features = lagged_features_;
   return carried;
 }
 
@@ -56,6 +57,7 @@ void RigidContactSolver::restoreCarriedContacts(const CarriedContacts& carried) 
     faces.push_back(c);
   }
   faces_.restoreContacts(std::move(faces));
+  lagged_features_ = carried.features;
 }
 
 }  // namespace torsion

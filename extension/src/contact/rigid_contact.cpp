@@ -21,6 +21,8 @@ const char* frictionSolveName(ContactSettings::FrictionSolve solve) {
       return "active_set";
     case ContactSettings::FrictionSolve::kContactSpace:
       return "contact_space";
+    case ContactSettings::FrictionSolve::kConvex:
+      return "convex";
     case ContactSettings::FrictionSolve::kAuto:
       break;
   }
@@ -30,7 +32,7 @@ const char* frictionSolveName(ContactSettings::FrictionSolve solve) {
 std::optional<ContactSettings::FrictionSolve> frictionSolveFromName(const std::string& name) {
   for (ContactSettings::FrictionSolve solve :
        {ContactSettings::FrictionSolve::kAuto, ContactSettings::FrictionSolve::kActiveSet,
-        ContactSettings::FrictionSolve::kContactSpace}) {
+        ContactSettings::FrictionSolve::kContactSpace, ContactSettings::FrictionSolve::kConvex}) {
     if (name == frictionSolveName(solve)) return solve;
   }
   return std::nullopt;
@@ -107,6 +109,8 @@ LinearSolveReport RigidContactSolver::solve(const SystemOperator& op,
                                             const Eigen::VectorXd& b,
                                             const SolverSettings& settings, Eigen::VectorXd& v) {
   base_ = &constraints;
+  if (settings_.friction_solve == ContactSettings::FrictionSolve::kConvex)
+    return solveConvex(op, constraints, b, v);
   numberRigidUnknowns();
   stats_.coulomb_fell_back = false;
   stats_.in_contact_space = solvesInContactSpace(op);

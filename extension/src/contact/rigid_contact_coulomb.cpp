@@ -23,6 +23,8 @@ bool RigidContactSolver::solvesInContactSpace(const SystemOperator& op) const {
       return false;
     case ContactSettings::FrictionSolve::kContactSpace:
       return true;
+    case ContactSettings::FrictionSolve::kConvex:  // solveConvex, never here
+      return false;
     case ContactSettings::FrictionSolve::kAuto:
       break;
   }

@@ -287,11 +287,11 @@ void RigidContactSolver::findContacts(const FemState& state, const NodeConstrain
       if (anchors_.anchored(i) && constraints.kind(i) != NodeConstraints::Kind::kFull) continue;
       const Eigen::Vector3d x = state.position(i);
       if ((x.array() < node_lo.array()).any() || (x.array() > node_hi.array()).any()) continue;
-      addNodeContact(state, constraints, *object, transform, i, reach, dt);
+      addNodeContact(state, constraints, *object, transform, i, reach, lookahead(dt));
     }
     const int partner = partnerIndex(object);
     faces_.detect(state, constraints, collector.nodes, *shape, transform, toEigen(lo), toEigen(hi),
-                  reach, dt, partner, partners_[static_cast<size_t>(partner)],
+                  reach, lookahead(dt), partner, partners_[static_cast<size_t>(partner)],
                   settings_.friction * toDouble(object->getFriction()));
   }
 }
@@ -299,7 +299,7 @@ void RigidContactSolver::findContacts(const FemState& state, const NodeConstrain
 void RigidContactSolver::addNodeContact(const FemState& state, const NodeConstraints& constraints,
                                         const btCollisionObject& object,
                                         const btTransform& transform, int i, double reach,
-                                        double dt) {
+                                        double lookahead_time) {
   const btSoftBody& sb = *soft_body_;
   const btCollisionShape& shape = *object.getCollisionShape();
   const Eigen::Vector3d x = state.position(i);
@@ -319,7 +319,8 @@ void RigidContactSolver::addNodeContact(const FemState& state, const NodeConstra
   c.lever = x - sp->distance * sp->normal - partners_[static_cast<size_t>(c.partner)].com;
   c.friction = settings_.friction * toDouble(object.getFriction());
   c.held = held;
-  chooseSupportPlane(shape, transform, x, state.velocity(i), -toEigen(sb.m_nodes[i].m_n), dt, c);
+  chooseSupportPlane(shape, transform, x, state.velocity(i), -toEigen(sb.m_nodes[i].m_n),
+                     lookahead_time, c);
   keepPreviousPlane(shape, transform, x, -toEigen(sb.m_nodes[i].m_n), object, c);
   // One contact per free node: the deepest.
   if (!held) {

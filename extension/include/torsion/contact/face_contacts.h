@@ -81,7 +81,8 @@ class FaceContactSet {
   /// triangle's corner is left to the node contact; a face all of whose nodes are held is left
   /// out unless the partner is dynamic (held nodes push, never yield); a face that the predicted
   /// motion over `dt` (s) would rather hold against the shape's supporting plane facing it (a
-  /// triangle just ahead of a sliding box's edge) is left to its nodes.
+  /// triangle just ahead of a sliding box's edge) is left to its nodes (`dt`: the solve's
+  /// look-ahead, RigidContactSolver::lookahead).
   void detect(const FemState& state, const NodeConstraints& held,
               const std::vector<int>& nearby_nodes, const btCollisionShape& shape,
               const btTransform& transform, const Eigen::Vector3d& lo, const Eigen::Vector3d& hi,

@@ -91,7 +91,10 @@ struct ContactSettings {
   /// active set otherwise, so a large body on the ground does not pay for a factorisation each
   /// step. A body in FEM-FEM contact (whose pair penalties the factor does not hold) always uses
   /// the active set.
-  enum class FrictionSolve { kActiveSet, kContactSpace, kAuto };
+  /// kConvex: one convex solve (SAP, docs/contact-solve.md) of the body with its dynamic rigid
+  /// partners, node and face contacts as rows; not yet with anchors (refused with an error) nor
+  /// in FEM-FEM contact (such a body takes the active set, as for kContactSpace).
+  enum class FrictionSolve { kActiveSet, kContactSpace, kAuto, kConvex };
   FrictionSolve friction_solve = FrictionSolve::kAuto;
   /// m/s: the contact-space solve iterates until every contact satisfies Coulomb's law to this;
   /// a step that ends its sweeps within coulomb_acceptable counts as converged.
@@ -113,7 +116,7 @@ struct ContactSettings {
 };
 
 /// The names scene files and Python use for ContactSettings::FrictionSolve: "auto",
-/// "active_set", "contact_space".
+/// "active_set", "contact_space", "convex".
 const char* frictionSolveName(ContactSettings::FrictionSolve solve);
 /// The solve `name` names, or nullopt.
 std::optional<ContactSettings::FrictionSolve> frictionSolveFromName(const std::string& name);
@@ -194,8 +197,16 @@ struct CarriedContacts {
     Eigen::Vector3d multiplier = Eigen::Vector3d::Zero();
     int stalls = 0;
   };
+  /// The convex solve's memory of a face row (FrictionSolve::kConvex): the normal impulse of the
+  /// rigid feature at `lever` of `object` (contact/solve/face_contact_rows.h).
+  struct Feature {
+    const btCollisionObject* object = nullptr;
+    Eigen::Vector3d lever = Eigen::Vector3d::Zero();  ///< m, the feature point minus the com
+    double normal_impulse = 0;                        ///< N s
+  };
   std::vector<Node> nodes;
   std::vector<Face> faces;
+  std::vector<Feature> features;
 };
 
 class RigidContactSolver {
@@ -273,7 +284,7 @@ class RigidContactSolver {
   void findContacts(const FemState& state, const NodeConstraints& constraints, double dt);
   void addNodeContact(const FemState& state, const NodeConstraints& constraints,
                       const btCollisionObject& object, const btTransform& transform, int node,
-                      double reach, double dt);
+                      double reach, double lookahead_time);
   void addAnchorContacts(const FemState& state, const NodeConstraints& constraints);
   void dropUntouchedPartners();
   void warmStartActiveSet();
@@ -309,6 +320,14 @@ class RigidContactSolver {
   void restoreSolvedStates();
   void collectImpulses();
   void solveHeld(const Eigen::VectorXd& v, double dt);  // rigid_contact_held.cpp
+
+  // The convex solve (rigid_contact_convex.cpp).
+  LinearSolveReport solveConvex(const SystemOperator& op, const NodeConstraints& constraints,
+                                const Eigen::VectorXd& b, Eigen::VectorXd& v);
+  /// s: how far ahead detection predicts a node's motion to choose its plane: the step, and for
+  /// the convex solve the step plus its rows' dissipation time (a row engages at
+  /// phi0 + (dt + tau_d) v_n < 0).
+  double lookahead(double dt) const;
   void measureEndGaps(const Eigen::VectorXd& v);
 
   // The reduced system q = (u, V) (rigid_contact_reduced_system.cpp).
@@ -387,6 +406,7 @@ class RigidContactSolver {
   std::vector<std::pair<NodeContact::State, Eigen::Vector3d>> solved_states_;
   std::vector<FaceContact::State> solved_face_states_;
   std::vector<const btCollisionObject*> previous_sliding_;  // bodies sliding at the last step's end
+  std::vector<CarriedContacts::Feature> lagged_features_;  // the convex solve's face rows, last step
   const NodeConstraints* base_ = nullptr;
   double dt_ = 0;
   int dynamic_count_ = 0;

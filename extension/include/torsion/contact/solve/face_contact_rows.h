@@ -37,11 +37,7 @@
 namespace torsion::sap {
 
 /// A face row's next-step memory: the normal impulse of the rigid feature at `lever` of `object`.
-struct LaggedFaceImpulse {
-  const btCollisionObject* object = nullptr;
-  Eigen::Vector3d lever = Eigen::Vector3d::Zero();  ///< m, the feature point minus the com
-  double normal_impulse = 0;                        ///< N s
-};
+using LaggedFaceImpulse = CarriedContacts::Feature;
 
 /// The face contacts an island solve takes from detection: the corner and edge contacts of
 /// polyhedral partners (boxes, convex hulls: query/feature_contacts.h) and the nearest-point

@@ -1,0 +1,178 @@
+// The convex contact solve of one FEM body and its rigid partners (ContactSettings::FrictionSolve
+// ::kConvex, docs/contact-solve.md): this step's detection as one SAP island, solved once; the
+// answer written back where detection, the rigid partners' finish() and the checkpoints read it.
+
+#include <algorithm>
+#include <cmath>
+#include <cstddef>
+#include <vector>
+
+#include "torsion/contact/rigid_contact.h"
+#include "torsion/contact/solve/face_contact_rows.h"
+#include "torsion/contact/solve/fem_island_body.h"
+#include "torsion/contact/solve/node_contact_rows.h"
+#include "torsion/contact/solve/sap_problem.h"
+#include "torsion/contact/solve/sap_solver.h"
+
+namespace torsion {
+
+namespace {
+
+// Half the mean edge of the rest surface: a face row's lagged impulse follows its rigid feature
+// within this (face_contact_rows.h), far enough for a step's slide, short of the next feature.
+double featureMatchRadius(const TetMesh& mesh) {
+  double sum = 0;
+  int edges = 0;
+  const std::vector<Eigen::Vector3d>& x = mesh.restPositions();
+  for (const Triangle& t : mesh.surfaceTriangles()) {
+    for (std::size_t k = 0; k < 3; ++k) {
+      sum += (x[static_cast<std::size_t>(t[k])] - x[static_cast<std::size_t>(t[(k + 1) % 3])])
+                 .norm();
+      ++edges;
+    }
+  }
+  return edges > 0 ? 0.5 * sum / edges : 0.0;
+}
+
+// A partner's rows together carrying less than this share of the normal impulse the solve gave
+// them had too small a friction bound (contacts new to the solve: a landing): solved again.
+constexpr double kLaggedShare = 0.5;
+constexpr int kMaxFrictionRefinements = 2;
+
+// The partner of each row (node or face row).
+std::vector<int> rowPartners(const sap::NodeContactIsland& island,
+                             const std::vector<NodeContact>& contacts,
+                             const std::vector<FaceContact>& faces) {
+  std::vector<int> partner(island.rows.size(), -1);
+  for (std::size_t r = 0; r < island.rows.size(); ++r) {
+    if (island.row_contact[r] >= 0) {
+      partner[r] = contacts[static_cast<std::size_t>(island.row_contact[r])].partner;
+    } else if (r < island.row_face.size() && island.row_face[r] >= 0) {
+      partner[r] = faces[static_cast<std::size_t>(island.row_face[r])].partner;
+    }
+  }
+  return partner;
+}
+
+// The lagged model bounds each row's friction by mu times its last normal impulse; a contact new
+// to the solve has none, so a box landing on a slope slides freely in its first steps (+12 % of
+// Coulomb's distance on the soft incline). Where a partner's rows took less than kLaggedShare of
+// the normal impulse the solve gave them, each row's bound is raised to the impulse just found,
+// and the island is solved again: a fixed point of mu gamma_n, reached for the rows that need it.
+// Returns whether any bound was raised.
+bool raiseFrictionBounds(sap::NodeContactIsland& island, const std::vector<int>& row_partner,
+                         std::size_t partner_count, const sap::SapReport& report) {
+  std::vector<double> lagged(partner_count, 0.0), solved(partner_count, 0.0);
+  for (std::size_t r = 0; r < island.rows.size(); ++r) {
+    const auto k = static_cast<std::size_t>(row_partner[r]);
+    lagged[k] += island.rows[r].lagged_normal_impulse;
+    solved[k] += std::max(0.0, report.impulses[r].z());
+  }
+  bool raised = false;
+  for (std::size_t r = 0; r < island.rows.size(); ++r) {
+    const auto k = static_cast<std::size_t>(row_partner[r]);
+    if (!(lagged[k] < kLaggedShare * solved[k]) || island.rows[r].mu == 0) continue;
+    const double gamma_n = report.impulses[r].z();
+    if (gamma_n > island.rows[r].lagged_normal_impulse) {
+      island.rows[r].lagged_normal_impulse = gamma_n;
+      raised = true;
+    }
+  }
+  return raised;
+}
+
+}  // namespace
+
+double RigidContactSolver::lookahead(double dt) const {
+  if (settings_.friction_solve != ContactSettings::FrictionSolve::kConvex) return dt;
+  return dt * (1 + sap::RowDefaults{}.dissipation_steps);
+}
+
+LinearSolveReport RigidContactSolver::solveConvex(const SystemOperator& op,
+                                                  const NodeConstraints& constraints,
+                                                  const Eigen::VectorXd& b, Eigen::VectorXd& v) {
+  if (std::any_of(contacts_.begin(), contacts_.end(),
+                  [](const NodeContact& c) { return c.anchored; }))
+    return brokenDown({}, "the convex contact solve does not take anchors yet");
+  const sap::RowDefaults defaults;
+  // Last step's normal impulses: the friction bounds of the lagged model.
+  std::vector<sap::LaggedImpulse> lagged_nodes;
+  for (std::size_t k = 0; k < previous_active_.size(); ++k) {
+    const double gamma_n = previous_normal_[k].dot(previous_impulse_[k]);
+    if (gamma_n > 0)
+      lagged_nodes.push_back({previous_active_[k].first, previous_active_[k].second, gamma_n});
+  }
+  sap::NodeContactIsland island =
+      sap::buildNodeContactIsland(contacts_, partners_, 0, lagged_nodes, defaults, dt_);
+  const std::vector<FaceContact> faces = sap::islandFaceContacts(*this);
+  sap::addFaceContactRows(island, faces, partners_, 0, lagged_features_,
+                          featureMatchRadius(model_->mesh()), defaults, dt_);
+  const sap::FemIslandBody fem(op, constraints, b);
+  const std::vector<int> row_partner = rowPartners(island, contacts_, faces);
+  Result<sap::SapProblem> created =
+      sap::SapProblem::create(sap::islandBodies(fem, island), island.rows, dt_);
+  if (!created) return brokenDown({}, "the contact rows do not form a valid problem");
+  Eigen::VectorXd x(created.value().dofs());
+  x.head(v.size()) = v;
+  for (std::size_t k = 0; k < partners_.size(); ++k) {
+    const int body = island.partner_body[k];
+    if (body >= 0) x.segment<6>(created.value().bodyOffset(body)) = partners_[k].entry_velocity;
+  }
+  sap::SapReport report = sap::SapSolver().solve(created.value(), x);
+  int newton = report.newton_iterations;
+  for (int round = 0; round < kMaxFrictionRefinements && report.converged &&
+                      raiseFrictionBounds(island, row_partner, partners_.size(), report);
+       ++round) {
+    created = sap::SapProblem::create(sap::islandBodies(fem, island), island.rows, dt_);
+    if (!created) return brokenDown({}, "the contact rows do not form a valid problem");
+    report = sap::SapSolver().solve(created.value(), x);  // from the last solution
+    newton += report.newton_iterations;
+  }
+  const sap::SapProblem& problem = created.value();
+  v = x.head(v.size());
+
+  // The partners: a dynamic one's twist is the island's; every one's impulse (what finish()
+  // gives supported bodies and multibody links) is the wrench of its rows.
+  std::vector<Vector6d> impulses = sap::partnerImpulses(island, contacts_, partners_, report);
+  sap::addFacePartnerImpulses(island, faces, report, impulses);
+  for (std::size_t k = 0; k < partners_.size(); ++k) {
+    partners_[k].impulse = impulses[k];
+    const int body = island.partner_body[k];
+    if (body >= 0) partners_[k].velocity = x.segment<6>(problem.bodyOffset(body));
+  }
+  // The rows' states and impulses, where detection's memory, the statistics and the checkpoints
+  // read them.
+  stats_.active = stats_.face_active = stats_.sticking = 0;
+  stats_.normal_impulse = 0;
+  stats_.max_end_penetration = 0;
+  for (std::size_t r = 0; r < island.rows.size(); ++r) {
+    const Eigen::Vector3d& gamma = report.impulses[r];
+    const double end_gap = island.rows[r].gap + dt_ * report.contact_velocities[r].z();
+    stats_.max_end_penetration = std::max(stats_.max_end_penetration, -end_gap);
+    const bool active = gamma.z() > 0;
+    const bool stick = report.states[r] == sap::ContactState::kStick;
+    if (active) {
+      ++stats_.active;
+      stats_.normal_impulse += gamma.z();
+      if (stick) ++stats_.sticking;
+      if (island.row_contact[r] < 0) ++stats_.face_active;
+    }
+    if (island.row_contact[r] < 0) continue;
+    NodeContact& c = contacts_[static_cast<std::size_t>(island.row_contact[r])];
+    c.impulse = island.rows[r].frame.transpose() * gamma;
+    c.normal_impulse = gamma.z();
+    c.state = !active ? NodeContact::State::kInactive
+                      : (stick ? NodeContact::State::kStick : NodeContact::State::kSlide);
+  }
+  lagged_features_ = sap::laggedFaceImpulses(island, faces, partners_, report);
+  stats_.active_set_iterations = newton;
+  stats_.active_set_converged = report.converged;
+
+  LinearSolveReport out;
+  out.iterations = report.cg_iterations;
+  out.converged = true;  // the linear solves inside Newton; the contact solve's own verdict is
+                         // stats().active_set_converged
+  return out;
+}
+
+}  // namespace torsion
