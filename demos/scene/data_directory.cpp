@@ -33,6 +33,15 @@ std::optional<std::string> searchUpwards(const fs::path& file, int levels) {
   return std::nullopt;
 }
 
+// A wheel (`pip install`) keeps the data inside the package, beside the module:
+// <site>/torsion/data.
+std::optional<std::string> besideObject(const fs::path& object) {
+  std::error_code ec;
+  const fs::path candidate = object.parent_path() / "data";
+  if (fs::is_directory(candidate / "demos" / "scenes", ec)) return candidate.string();
+  return std::nullopt;
+}
+
 }  // namespace
 
 std::optional<std::string> dataDirectory() {
@@ -40,6 +49,7 @@ std::optional<std::string> dataDirectory() {
   // A shared object first (its prefix is the package's even when the program is python3), then
   // the running program. Five levels: <prefix>/lib/python3/dist-packages/torsion/ is the deepest.
   if (const fs::path object = loadedObject(); !object.empty()) {
+    if (auto found = besideObject(object)) return found;
     if (auto found = searchUpwards(object, 6)) return found;
   }
   const fs::path program = fs::read_symlink("/proc/self/exe", ec);

@@ -3,6 +3,7 @@
 import csv
 import json
 import os
+import pathlib
 import stat
 import subprocess
 
@@ -28,6 +29,18 @@ def test_a_demo_scene_name_and_its_path_build_the_same_world(scenes):
     assert np.array_equal(by_name.body("cylinder").positions, by_path.body("cylinder").positions)
     assert by_name.time == pytest.approx(0.05, rel=BULLET_RTOL)
     assert by_name.step_count == 5 and by_name.dt == 0.01 and by_name.scene_steps == 6484
+
+
+def test_data_path_is_the_folder_scene_names_are_found_in(scenes, monkeypatch):
+    # In the build tree: <build>/share/torsion, whose demos/scenes is the source tree's.
+    monkeypatch.delenv("TORSION_SCENE_PATH", raising=False)
+    data = torsion.data_path()
+    package = pathlib.Path(torsion.__file__).resolve().parent
+    assert data == package.parent.parent / "share" / "torsion"
+    assert (data / "demos" / "scenes").resolve() == scenes.resolve()
+    assert (data / "assets" / "meshes" / "cylinder_2430.node").is_file()
+    with pytest.raises(torsion.SceneError, match=str(data / "demos" / "scenes")):
+        torsion.World.from_scene("no_such_scene")
 
 
 def test_body_arrays_have_the_meshs_shapes_and_are_read_only_views(assets):

@@ -30,6 +30,19 @@ def test_every_public_class_member_is_in_the_stubs_and_every_stub_member_exists(
         assert runtime == listed, (name, runtime ^ listed)
 
 
+def test_every_name_the_package_exports_is_in_the_stubs_and_every_stub_name_exists():
+    tree = ast.parse((pathlib.Path(torsion.__file__).parent / "__init__.pyi").read_text())
+    listed = set()
+    for node in tree.body:
+        if isinstance(node, (ast.ClassDef, ast.FunctionDef)):
+            listed.add(node.name)
+        elif isinstance(node, ast.AnnAssign):
+            listed.add(node.target.id)
+    assert set(torsion.__all__) == listed, set(torsion.__all__) ^ listed
+    for name in torsion.__all__:
+        assert hasattr(torsion, name), name
+
+
 def test_every_public_binding_has_a_docstring():
     for name in PUBLIC_CLASSES:
         cls = getattr(torsion, name)
@@ -37,3 +50,4 @@ def test_every_public_binding_has_a_docstring():
     for method in ["from_scene", "step", "save_state", "restore_state", "add_body", "add_node_set",
                    "add_hand", "add_rigid_body", "add_ground", "render", "write_vtk"]:
         assert getattr(torsion.World, method).__doc__, method
+    assert torsion.data_path.__doc__

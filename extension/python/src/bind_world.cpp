@@ -172,7 +172,8 @@ void bindWorld(py::module_& m) {
           py::arg("scene"), py::arg("threads") = -1, py::kw_only(), py::arg("devices") = py::none(),
           py::arg("haptics") = "", py::arg("allow_remote_devices") = false,
           "A scene file, or a demo scene's name (resolved like `torsion run NAME`: "
-          "$TORSION_SCENE_PATH, then the source tree's demos/scenes). threads < 0: the scene's. "
+          "$TORSION_SCENE_PATH, then demos/scenes of torsion.data_path()). threads < 0: the "
+          "scene's. "
           "devices: {hand: 'TYPE[:ARG]'} or ['HAND=TYPE[:ARG]'], as `torsion run --device` "
           "(scripted:FILE, replay:CSV, network:[HOST:]PORT, spacemouse); haptics: 'lockstep' or "
           "'threaded' (--haptics); allow_remote_devices: --allow-remote-device.")

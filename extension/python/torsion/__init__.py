@@ -9,6 +9,9 @@
 See docs/python.md for the API by example, views vs copies and threading.
 """
 
+import pathlib
+
+from . import _torsion
 from .errors import Error, MeshError, SceneError, UnstableError
 from ._torsion import (
     Body,
@@ -26,4 +29,23 @@ from ._torsion import (
 __all__ = [
     "Body", "Error", "Frame", "Hand", "Material", "MeshError", "NodeSet", "RigidBody",
     "SceneError", "State", "UnstableError", "World", "__version__", "bullet_precision",
+    "data_path",
 ]
+
+
+def data_path() -> pathlib.Path:
+    """The folder of the data the package comes with: demos/scenes/*.json (the scenes that
+    World.from_scene finds by name) and assets/ (the meshes, trajectories and .bullet files
+    they refer to).
+
+    Installed by pip: torsion/data inside the package. Installed by `cmake --install`:
+    <prefix>/share/torsion. In a build tree: <build>/share/torsion, links into the source tree.
+    FileNotFoundError when the module has none of these beside it.
+    """
+    found = _torsion._data_directory()
+    if found is None:
+        raise FileNotFoundError(
+            "torsion.data_path: no data folder beside the module " + _torsion.__file__ +
+            " (torsion/data, or share/torsion above it)")
+    return pathlib.Path(found)
+

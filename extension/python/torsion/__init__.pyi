@@ -1,6 +1,7 @@
 # Type stubs of the torsion package. Units are SI throughout: m, s, kg, N, N m, Pa, rad.
 # Arrays are numpy float64 unless said otherwise; "view" means a read-only array over the
 # solver's own storage that changes as the world steps (copy() it to keep a moment).
+import pathlib
 from typing import Optional, Sequence, Union
 
 import numpy as np
@@ -8,6 +9,8 @@ import numpy.typing as npt
 
 __version__: str
 bullet_precision: str  # "double" or "float": the btScalar of the Bullet the module links
+
+def data_path() -> pathlib.Path: ...  # demos/scenes and assets: torsion/data when pip installed it
 
 ArrayLike = npt.ArrayLike
 FrameLike = Union["Frame", npt.ArrayLike]  # a Frame or a 4x4 homogeneous matrix
