@@ -29,6 +29,9 @@ packages=(
   tetgen
   # the Python package (`import torsion`), its tests and examples
   python3-dev pybind11-dev python3-numpy python3-pytest python3-matplotlib
+  # `pip install --no-build-isolation .` into a virtual environment (scikit-build runs CMake), and
+  # `python3 -m build --wheel --no-isolation`; tests/python/pip_install_check.py does both
+  python3-venv python3-skbuild python3-build
   # the ParaView series: zlib compresses it; the series tests read it back with meshio and VTK
   zlib1g-dev python3-meshio python3-vtk9
   # instruction counts per step (tests/bench/bench_python_step.py --instructions: callgrind)
