@@ -50,4 +50,9 @@ def test_every_public_binding_has_a_docstring():
     for method in ["from_scene", "step", "save_state", "restore_state", "add_body", "add_node_set",
                    "add_hand", "add_rigid_body", "add_ground", "render", "write_vtk"]:
         assert getattr(torsion.World, method).__doc__, method
+    for method in ["set_pose", "set_velocity", "apply_force", "apply_torque",
+                   "set_kinematic_target"]:
+        assert getattr(torsion.RigidBody, method).__doc__, method
+    for prop in ["gravity", "dt"]:
+        assert getattr(torsion.World, prop).__doc__, prop
     assert torsion.data_path.__doc__

@@ -3,6 +3,8 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
+
 #include "torsion/bt_conversions.h"
 #include "torsion/mesh/box_mesh.h"
 
@@ -64,6 +66,40 @@ TEST(FemWorld, CantileverSagsAndRigidBoxFallsBesideIt) {
   const double t = world.time();
   EXPECT_NEAR(box->getWorldTransform().getOrigin().z(), 10 - 0.5 * 9.81 * t * t,
               0.5 * 9.81 * t * settings.solver.time_step + 1e-9);
+}
+
+TEST(FemWorld, SetGravityPullsFemAndRigidBodiesAsleepOrAddedLaterTheNewWay) {
+  WorldSettings settings;
+  settings.gravity = Eigen::Vector3d::Zero();
+  FemWorld world(settings);
+  FemBody* body = world.addBody("beam", beam(), Material{}).value();
+  btTransform start;
+  start.setIdentity();
+  start.setOrigin(btVector3(20, 0, 10));  // far from the beam: no contact
+  btRigidBody* box =
+      world.addRigidBody(std::make_unique<btBoxShape>(btVector3(0.5, 0.5, 0.5)), 1.0, start);
+  box->setActivationState(ISLAND_SLEEPING);
+
+  EXPECT_FALSE(world.setGravity(Eigen::Vector3d(0, 0, std::nan(""))).ok());
+  EXPECT_EQ(world.settings().gravity, Eigen::Vector3d::Zero());
+  const Eigen::Vector3d g(0, 0, -5);
+  ASSERT_TRUE(world.setGravity(g).ok());
+  EXPECT_EQ(world.settings().gravity, g);
+  start.setOrigin(btVector3(-20, 0, 10));
+  btRigidBody* later =
+      world.addRigidBody(std::make_unique<btBoxShape>(btVector3(0.5, 0.5, 0.5)), 1.0, start);
+  EXPECT_EQ(toEigen(later->getGravity()), g);
+
+  const WorldStepReport r = world.step();
+  ASSERT_TRUE(r.ok) << r.message;
+  // One step from rest: v = g dt, for the sleeping box (woken) and the free FEM body alike (a
+  // rigid motion: no elastic or damping force; the FEM's within the CG's relative tolerance).
+  const double dt = settings.solver.time_step;
+  EXPECT_NEAR(box->getLinearVelocity().z(), g.z() * dt, 1e-6);
+  EXPECT_NEAR(later->getLinearVelocity().z(), g.z() * dt, 1e-6);
+  const double cg = settings.solver.tolerance * std::abs(g.z() * dt);
+  for (int i = 0; i < body->model().nodeCount(); ++i)
+    EXPECT_NEAR(body->state().velocity(i).z(), g.z() * dt, cg) << "node " << i;
 }
 
 TEST(FemWorld, PoseMovesTheRestShape) {

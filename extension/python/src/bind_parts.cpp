@@ -4,6 +4,7 @@
 #include "frame_data.h"
 #include "handles.h"
 #include "py_convert.h"
+#include "py_rigid.h"
 #include "torsion/fem/corotated_element.h"
 #include "torsion/format_number.h"
 #include "torsion/haptics/patch_stiffness.h"
@@ -47,6 +48,19 @@ py::array_t<double> rigidPose(const btRigidBody& body, bool rotation) {
                        static_cast<double>(t.getOrigin().y()),
                        static_cast<double>(t.getOrigin().z())};
   return vectorArray(p, 3);
+}
+
+std::string who(const RigidHandle& r, const char* call) {
+  return std::string(call) + " '" + r.name + "'";
+}
+
+// A pose given as position and quaternion, each checked with the call and body in its message.
+Frame rigidFrame(const RigidHandle& r, const char* call, py::handle position,
+                 py::handle quaternion) {
+  Frame frame;
+  frame.origin = toVector3(position, (who(r, call) + ": position").c_str());
+  frame.rotation = toQuaternion(quaternion, (who(r, call) + ": quaternion").c_str());
+  return frame;
 }
 
 py::array_t<double> btArray(const btVector3& v) {
@@ -336,7 +350,102 @@ void bindParts(py::module_& m) {
             const double inverse = static_cast<double>(r.body->getInvMass());
             return inverse > 0 ? 1 / inverse : 0.0;
           },
-          "kg (0: static or kinematic)");
+          "kg (0: static or kinematic)")
+      .def_property_readonly(
+          "kind", [](const R& r) { return rigidKindName(rigidKind(*r.world, *r.body)); },
+          "\"dynamic\" (mass > 0), \"static\" (mass 0) or \"kinematic\" (following its scene "
+          "file's script, or the targets of set_kinematic_target)")
+      .def(
+          "set_pose",
+          [](const R& r, py::object position, py::object quaternion) {
+            const Frame pose = rigidFrame(r, "set_pose", position, quaternion);
+            WorldGuard guard(*r.world, WorldGuard::kWrite);
+            if (Status s = setRigidPose(*r.world, r.name, *r.body, pose); !s)
+              throw py::value_error(s.error().message);
+          },
+          py::arg("position"), py::arg("quaternion") = py::make_tuple(0.0, 0.0, 0.0, 1.0),
+          "Moves the body now: its centre of mass to position (3,) m, its orientation to "
+          "quaternion (4,) (x, y, z, w; normalised), velocities kept. A kinematic body stays "
+          "there. Not for a body its scene file scripts.")
+      .def(
+          "set_velocity",
+          [](const R& r, py::object linear, py::object angular) {
+            if (linear.is_none() && angular.is_none())
+              throw py::value_error(who(r, "set_velocity") + ": give linear, angular or both");
+            std::optional<Eigen::Vector3d> v, w;
+            if (!linear.is_none())
+              v = toVector3(linear, (who(r, "set_velocity") + ": linear").c_str());
+            if (!angular.is_none())
+              w = toVector3(angular, (who(r, "set_velocity") + ": angular").c_str());
+            WorldGuard guard(*r.world, WorldGuard::kWrite);
+            if (Status s = setRigidVelocity(*r.world, r.name, *r.body, v, w); !s)
+              throw py::value_error(s.error().message);
+          },
+          py::arg("linear") = py::none(), py::arg("angular") = py::none(),
+          "Sets the velocity of a dynamic body now: linear (3,) m/s, angular (3,) rad/s about "
+          "world axes; one left out is kept. Speeds up to 1e6 m/s, spins up to 1e6 rad/s.")
+      .def(
+          "apply_force",
+          [](const R& r, py::object force, py::object point) {
+            const Eigen::Vector3d f = toVector3(force, (who(r, "apply_force") + ": force").c_str());
+            std::optional<Eigen::Vector3d> at;
+            if (!point.is_none())
+              at = toVector3(point, (who(r, "apply_force") + ": point").c_str());
+            WorldGuard guard(*r.world, WorldGuard::kWrite);
+            if (Status s = applyRigidLoad(*r.world, "apply_force", r.name, *r.body, f, at,
+                                          Eigen::Vector3d::Zero());
+                !s) {
+              throw py::value_error(s.error().message);
+            }
+          },
+          py::arg("force"), py::arg("point") = py::none(),
+          "Adds force (3,) N to a dynamic body for the next step only, acting at point (3,) m in "
+          "world coordinates (default: the centre of mass; elsewhere it adds its torque about "
+          "it). Calls before one step add up.")
+      .def(
+          "apply_torque",
+          [](const R& r, py::object torque) {
+            const Eigen::Vector3d t =
+                toVector3(torque, (who(r, "apply_torque") + ": torque").c_str());
+            WorldGuard guard(*r.world, WorldGuard::kWrite);
+            if (Status s = applyRigidLoad(*r.world, "apply_torque", r.name, *r.body,
+                                          Eigen::Vector3d::Zero(), std::nullopt, t);
+                !s) {
+              throw py::value_error(s.error().message);
+            }
+          },
+          py::arg("torque"),
+          "Adds torque (3,) N m about world axes to a dynamic body for the next step only.")
+      .def_property_readonly(
+          "applied_force",
+          [](const R& r) {
+            WorldGuard guard(*r.world);
+            const Wrench load = r.world->queuedLoad(*r.body);
+            return vectorArray(load.force.data(), 3);
+          },
+          "(3,) N: the force queued for the next step (apply_force), a copy")
+      .def_property_readonly(
+          "applied_torque",
+          [](const R& r) {
+            WorldGuard guard(*r.world);
+            const Wrench load = r.world->queuedLoad(*r.body);
+            return vectorArray(load.torque.data(), 3);
+          },
+          "(3,) N m about the centre of mass: the torque queued for the next step (apply_torque, "
+          "and apply_force away from the centre of mass), a copy")
+      .def(
+          "set_kinematic_target",
+          [](const R& r, py::object position, py::object quaternion) {
+            const Frame target = rigidFrame(r, "set_kinematic_target", position, quaternion);
+            WorldGuard guard(*r.world, WorldGuard::kWrite);
+            if (Status s = setKinematicTarget(*r.world, r.name, *r.body, target); !s)
+              throw py::value_error(s.error().message);
+          },
+          py::arg("position"), py::arg("quaternion") = py::make_tuple(0.0, 0.0, 0.0, 1.0),
+          "The pose (position (3,) m, quaternion (4,) x, y, z, w) a body of mass 0 reaches at "
+          "the end of the next step, moving at the velocity that takes it there in dt (what "
+          "contacts feel); it stays there until the next target. A static body becomes "
+          "kinematic at its first target.");
 }
 
 }  // namespace torsion::python

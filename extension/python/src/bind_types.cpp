@@ -29,15 +29,6 @@ py::array_t<double> quaternionArray(const Eigen::Quaterniond& q) {
   return vectorArray(xyzw, 4);
 }
 
-Eigen::Quaterniond toQuaternion(py::handle value) {
-  auto a = toFloatArray(value, "quaternion");
-  if (a.size() != 4) throw py::value_error("quaternion: expected 4 numbers (x, y, z, w)");
-  Eigen::Quaterniond q(a.data()[3], a.data()[0], a.data()[1], a.data()[2]);
-  if (!q.coeffs().allFinite()) throw py::value_error("quaternion: must be finite");
-  if (!(q.norm() > 1e-12)) throw py::value_error("quaternion: zero length");
-  return q.normalized();
-}
-
 }  // namespace
 
 void bindTypes(py::module_& m) {
@@ -47,7 +38,7 @@ void bindTypes(py::module_& m) {
       .def(py::init([](py::object position, py::object quaternion) {
              Frame f;
              f.origin = toVector3(position, "position");
-             f.rotation = toQuaternion(quaternion);
+             f.rotation = toQuaternion(quaternion, "quaternion");
              return f;
            }),
            py::arg("position") = py::make_tuple(0.0, 0.0, 0.0),

@@ -213,8 +213,23 @@ void bindWorld(py::module_& m) {
       .def_property_readonly(
           "time", [](PyWorld& w) { return w.world().time(); }, "s")
       .def_property_readonly("step_count", [](PyWorld& w) { return w.world().stepCount(); })
-      .def_property_readonly(
-          "dt", [](PyWorld& w) { return w.world().settings().solver.time_step; }, "s")
+      .def_property(
+          "dt", [](PyWorld& w) { return w.world().settings().solver.time_step; },
+          [](PyWorld& w, double dt) {
+            WorldGuard guard(w, WorldGuard::kWrite);
+            if (Status s = w.setTimeStep(dt); !s) throw py::value_error(s.error().message);
+          },
+          "s: the time step of the next steps, settable between steps (within [1e-6, 1] s; not "
+          "with device hands); the clock goes on from where it is.")
+      .def_property(
+          "gravity", [](PyWorld& w) { return vectorArray(w.world().settings().gravity.data(), 3); },
+          [](PyWorld& w, py::object gravity) {
+            const Eigen::Vector3d g = toVector3(gravity, "gravity");
+            WorldGuard guard(w, WorldGuard::kWrite);
+            if (Status s = w.setGravity(g); !s) throw py::value_error(s.error().message);
+          },
+          "(3,) m/s^2, a copy: the gravity of the next steps on FEM and dynamic rigid bodies, "
+          "settable between steps (magnitude at most 1e6 m/s^2).")
       .def_property_readonly(
           "scene_steps", [](PyWorld& w) { return w.scene().spec.steps; },
           "The scene file's step count (what `torsion run` takes)")

@@ -125,6 +125,15 @@ Eigen::Vector3d toVector3(py::handle value, const char* what) {
   return v;
 }
 
+Eigen::Quaterniond toQuaternion(py::handle value, const char* what) {
+  auto a = toFloatArray(value, what);
+  if (a.size() != 4) throw py::value_error(std::string(what) + ": expected 4 numbers (x, y, z, w)");
+  Eigen::Quaterniond q(a.data()[3], a.data()[0], a.data()[1], a.data()[2]);
+  if (!q.coeffs().allFinite()) throw py::value_error(std::string(what) + ": must be finite");
+  if (!(q.norm() > 1e-12)) throw py::value_error(std::string(what) + ": zero length");
+  return q.normalized();
+}
+
 Eigen::VectorXd toNodeVectors(py::handle value, py::ssize_t expected, const char* what) {
   auto a = toFloatArray(value, what);
   if (a.ndim() != 2 || a.shape(1) != 3 || (expected >= 0 && a.shape(0) != expected)) {

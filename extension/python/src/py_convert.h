@@ -6,6 +6,7 @@
 #include <pybind11/pybind11.h>
 
 #include <Eigen/Core>
+#include <Eigen/Geometry>
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -66,6 +67,9 @@ double finite(double value, const char* what);
 
 /// A 3-vector from any sequence of three finite numbers; ValueError naming `what` otherwise.
 Eigen::Vector3d toVector3(py::handle value, const char* what);
+/// A rotation from four finite numbers (x, y, z, w), not all zero, normalised; ValueError naming
+/// `what` otherwise.
+Eigen::Quaterniond toQuaternion(py::handle value, const char* what);
 /// An (n, 3) array of finite floats from `value`, with n rows checked when expected >= 0.
 Eigen::VectorXd toNodeVectors(py::handle value, py::ssize_t expected, const char* what);
 

@@ -6,6 +6,7 @@
 #include "json_reader.h"
 #include "scene_haptics.h"
 #include "scene_parser.h"
+#include "torsion/bt_conversions.h"
 #include "torsion/bullet/checkpoint_io.h"
 #include "torsion/bullet/rigid_health.h"
 #include "torsion/format_number.h"
@@ -141,8 +142,10 @@ Result<Ok> PyWorld::step(int n, FailureKind* kind, const std::function<bool()>& 
       const int good_steps = world().stepCount() - 1 - anchor_step_;
       const PyWorldState anchor = std::move(*anchor_);
       (void)restoreState(anchor);
-      for (int k = 0; k < good_steps; ++k)
+      for (int k = 0; k < good_steps; ++k) {
+        applyRigidInputs(k == 0 ? anchor_loads_ : std::vector<RigidLoad>{});
         (void)scene::stepScene(*scene_);
+      }
     }
     failure_ = std::move(message);
     anchor_.reset();
@@ -154,8 +157,11 @@ Result<Ok> PyWorld::step(int n, FailureKind* kind, const std::function<bool()>& 
       if (state) {
         anchor_ = std::move(state).value();
         anchor_step_ = world().stepCount();
+        anchor_loads_ = loads_;
       }
     }
+    applyRigidInputs(loads_);
+    loads_.clear();
     Result<WorldStepReport> stepped = scene::stepScene(*scene_);
     if (!stepped) {
       *kind = FailureKind::kScene;  // a scripted grab that missed: the scene's fault, not fatal
@@ -171,6 +177,63 @@ Result<Ok> PyWorld::step(int n, FailureKind* kind, const std::function<bool()>& 
     if (interrupted && interrupted()) break;
   }
   return Ok{};
+}
+
+void PyWorld::applyRigidInputs(const std::vector<RigidLoad>& loads) {
+  for (const KinematicTarget& t : targets_) {
+    if (btMotionState* motion = t.body->getMotionState()) {
+      motion->setWorldTransform(t.target);
+    } else {
+      t.body->setWorldTransform(t.target);  // without a motion state Bullet reads this one
+    }
+  }
+  for (const RigidLoad& l : loads) {
+    l.body->applyCentralForce(toBt(l.load.force));
+    l.body->applyTorque(toBt(l.load.torque));
+    l.body->activate(true);
+  }
+}
+
+const scene::SceneRigidBody* PyWorld::sceneRigidBody(const btRigidBody& body) const {
+  for (const scene::SceneRigidBody& r : scene_->rigid_bodies) {
+    if (r.body == &body) return &r;
+  }
+  return nullptr;
+}
+
+void PyWorld::queueLoad(btRigidBody& body, const Wrench& load) {
+  for (RigidLoad& queued : loads_) {
+    if (queued.body == &body) {
+      queued.load.force += load.force;
+      queued.load.torque += load.torque;
+      return;
+    }
+  }
+  loads_.push_back({&body, load});
+}
+
+Wrench PyWorld::queuedLoad(const btRigidBody& body) const {
+  for (const RigidLoad& queued : loads_) {
+    if (queued.body == &body) return queued.load;
+  }
+  return {};
+}
+
+void PyWorld::setKinematicTarget(btRigidBody& body, const btTransform& target) {
+  for (KinematicTarget& t : targets_) {
+    if (t.body == &body) {
+      t.target = target;
+      return;
+    }
+  }
+  targets_.push_back({&body, target});
+}
+
+const btTransform* PyWorld::kinematicTarget(const btRigidBody& body) const {
+  for (const KinematicTarget& t : targets_) {
+    if (t.body == &body) return &t.target;
+  }
+  return nullptr;
 }
 
 Result<FemBody*> PyWorld::addBody(const std::string& name, const TetMesh& mesh,
@@ -242,6 +305,25 @@ Result<btRigidBody*> PyWorld::addRigidBody(const scene::RigidBodySpec& spec, boo
   btRigidBody* body = added.body;
   if (!ground) scene_->rigid_bodies.push_back(std::move(added));
   return body;
+}
+
+Status PyWorld::setGravity(const Eigen::Vector3d& gravity) {
+  if (Status bounded = scene::checkGravity(gravity); !bounded)
+    return Error{"gravity: " + bounded.error().message};
+  if (Status set = world().setGravity(gravity); !set) return set;
+  return Ok{};
+}
+
+Status PyWorld::setTimeStep(double dt) {
+  if (scene_->haptics) {
+    return Error{"dt: the scene's device hands run haptic loops at the dt they started with (" +
+                 formatNumber(world().settings().solver.time_step) + " s)"};
+  }
+  SolverSettings solver = world().settings().solver;
+  solver.time_step = dt;
+  if (Status set = world().setSolverSettings(solver); !set)
+    return Error{"dt: " + set.error().message};
+  return Ok{};
 }
 
 Result<PyWorldState> PyWorld::saveState() {

@@ -15,6 +15,7 @@
 #include "scene_builder.h"
 #include "torsion/bullet/fem_world.h"
 #include "torsion/bullet/hand.h"
+#include "torsion/constraints/carried_nodes.h"
 #include "torsion/result.h"
 
 namespace torsion::python {
@@ -81,6 +82,14 @@ class PyWorld {
   /// add_rigid_body / add_ground argument and its value).
   Result<btRigidBody*> addRigidBody(const scene::RigidBodySpec& spec, bool ground);
 
+  /// Gravity for the next steps, m/s^2 (FEM and dynamic rigid bodies): finite, magnitude at most
+  /// a scene file's bound (scene::checkGravity). Errors change nothing.
+  Status setGravity(const Eigen::Vector3d& gravity);
+  /// dt for the next steps, s, within SolverSettings' bounds; the clock goes on from where it is.
+  /// Errors, changing nothing: out of bounds; a world whose scene runs device hands (their
+  /// haptic loops keep the dt they started with).
+  Status setTimeStep(double dt);
+
   Result<PyWorldState> saveState();
   /// Back to `state`; a state of bytes alone is read for this world first (errors: corrupted
   /// bytes, or a world other than the one saved).
@@ -95,14 +104,41 @@ class PyWorld {
   /// Serialises the calls that change the world against a step running without the GIL.
   std::mutex& busy() { return busy_; }
 
+  /// The scene's record of one of this world's rigid bodies, or null (the ground).
+  const scene::SceneRigidBody* sceneRigidBody(const btRigidBody& body) const;
+
+  /// Python's inputs to rigid bodies (py_rigid.h), handed to Bullet before each step: a load
+  /// (force N, torque N m about the centre of mass) for the next step only, added to what is
+  /// already queued; and a kinematic target, kept until the next one.
+  void queueLoad(btRigidBody& body, const Wrench& load);
+  /// What is queued for `body`'s next step (zero when nothing is).
+  Wrench queuedLoad(const btRigidBody& body) const;
+  void setKinematicTarget(btRigidBody& body, const btTransform& target);
+  /// The pose Python set as `body`'s kinematic target, or null.
+  const btTransform* kinematicTarget(const btRigidBody& body) const;
+
  private:
+  struct RigidLoad {
+    btRigidBody* body = nullptr;
+    Wrench load;
+  };
+  struct KinematicTarget {
+    btRigidBody* body = nullptr;
+    btTransform target;
+  };
   PyWorld() = default;
+  /// Before a step: every kinematic target to its body's motion state (where Bullet reads it),
+  /// and `loads` to Bullet's force accumulators (which it clears after the step).
+  void applyRigidInputs(const std::vector<RigidLoad>& loads);
   std::unique_ptr<scene::BuiltScene> scene_;
   std::vector<std::unique_ptr<Hand>> own_hands_;
   std::string failure_;  // set by the first failed step; the world does not go on after it
   static constexpr int kAnchorEvery = 64;  // steps between rewind checkpoints (step())
   std::optional<PyWorldState> anchor_;     // where a failed step rewinds to and replays from
   int anchor_step_ = 0;                    // world().stepCount() at anchor_
+  std::vector<RigidLoad> loads_;           // queued for the next step
+  std::vector<RigidLoad> anchor_loads_;    // those the step from anchor_ took: replayed with it
+  std::vector<KinematicTarget> targets_;   // set from Python, handed to Bullet before each step
   std::mutex busy_;
 };
 

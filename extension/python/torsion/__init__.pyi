@@ -126,6 +126,17 @@ class RigidBody:
     linear_velocity: npt.NDArray[np.float64]  # (3,) m/s
     angular_velocity: npt.NDArray[np.float64]  # (3,) rad/s
     mass: float  # kg, 0 when static or kinematic
+    kind: str  # "dynamic" (mass > 0), "static" (mass 0) or "kinematic" (scripted or targeted)
+    applied_force: npt.NDArray[np.float64]  # (3,) N queued for the next step, a copy
+    applied_torque: npt.NDArray[np.float64]  # (3,) N m about the centre of mass, queued, a copy
+    # Steering between steps; a bad argument raises ValueError/TypeError and changes nothing.
+    def set_pose(self, position: ArrayLike, quaternion: ArrayLike = (0, 0, 0, 1)) -> None: ...
+    def set_velocity(self, linear: Optional[ArrayLike] = None,
+                     angular: Optional[ArrayLike] = None) -> None: ...  # dynamic bodies; m/s, rad/s
+    def apply_force(self, force: ArrayLike, point: Optional[ArrayLike] = None) -> None: ...  # N, next step
+    def apply_torque(self, torque: ArrayLike) -> None: ...  # N m, next step only
+    def set_kinematic_target(self, position: ArrayLike,
+                             quaternion: ArrayLike = (0, 0, 0, 1)) -> None: ...  # mass-0 bodies
 
 class World:
     def __init__(self, gravity: ArrayLike = (0, 0, -9.81), dt: float = 0.01,
@@ -138,7 +149,11 @@ class World:
     def step(self, n: int = 1) -> None: ...  # releases the GIL; Ctrl-C stops it between steps
     time: float  # s
     step_count: int
-    dt: float  # s
+    dt: float  # s; settable between steps, in [1e-6, 1] (not with device hands)
+    @property
+    def gravity(self) -> npt.NDArray[np.float64]: ...  # (3,) m/s^2, a copy
+    @gravity.setter
+    def gravity(self, value: ArrayLike) -> None: ...  # between steps; magnitude <= 1e6 m/s^2
     scene_steps: int
     bodies: list[Body]
     node_sets: list[NodeSet]

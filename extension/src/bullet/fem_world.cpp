@@ -137,4 +137,26 @@ Status FemWorld::setSolverSettings(const SolverSettings& solver) {
   return Ok{};
 }
 
+Status FemWorld::setGravity(const Eigen::Vector3d& gravity) {
+  const btVector3 g = toBt(gravity);
+  if (!gravity.allFinite() || !toEigen(g).allFinite())
+    return Error{"world: gravity must be finite"};
+  settings_.gravity = gravity;
+  // btDiscreteDynamicsWorld::setGravity skips bodies asleep, which would wake up under the old
+  // gravity: every dynamic body gets it here, and wakes to feel it.
+  world_->setGravity(g);
+  world_->getWorldInfo().m_gravity = g;
+  btCollisionObjectArray& objects = world_->getCollisionObjectArray();
+  for (int i = 0; i < objects.size(); ++i) {
+    btRigidBody* rigid = btRigidBody::upcast(objects[i]);
+    if (rigid == nullptr || rigid->isStaticOrKinematicObject() ||
+        (rigid->getFlags() & BT_DISABLE_WORLD_GRAVITY) != 0) {
+      continue;
+    }
+    rigid->setGravity(g);
+    rigid->activate(true);
+  }
+  return Ok{};
+}
+
 }  // namespace torsion

@@ -91,6 +91,11 @@ class FemWorld {
   /// leaving the settings as they were: invalid settings, or a different thread count (the
   /// worker pool is made once per world).
   Status setSolverSettings(const SolverSettings& solver);
+  /// Live edit between steps: the next steps pull the FEM bodies and every dynamic rigid body of
+  /// bulletWorld() with `gravity` (m/s^2), also bodies asleep (they are woken) and bodies added
+  /// later; a body flagged BT_DISABLE_WORLD_GRAVITY keeps its own. Errors, changing nothing: not
+  /// finite.
+  Status setGravity(const Eigen::Vector3d& gravity);
 
   /// Everything the next steps read: FEM bodies (their warm starts and node groups), the clock,
   /// the rigid bodies' poses and velocities. Not in it: hands (Hand::checkpoint) and Bullet's
