@@ -190,8 +190,9 @@ def main():
         sys.exit(f"torsion.__version__ is {version!r}, expected {args.version!r}")
 
     # The wheel `python -m build` makes (python3-build): the package and its data, nothing else.
-    times["wheel"] = run([python, "-m", "build", "--wheel", "--no-isolation", "--outdir", dist, "."],
-                         "python -m build --wheel --no-isolation", cwd=copy, env=env)
+    times["wheel"] = run(
+        [python, "-m", "build", "--wheel", "--no-isolation", "--outdir", dist, "."],
+        "python -m build --wheel --no-isolation", cwd=copy, env=env)
     wheels = list(dist.glob("torsion-*.whl"))
     if len(wheels) != 1:
         sys.exit(f"{dist}: expected one torsion wheel, found {wheels}")

@@ -5,7 +5,8 @@ import pathlib
 
 import torsion
 
-PUBLIC_CLASSES = ["Frame", "Material", "State", "Body", "NodeSet", "Hand", "RigidBody", "World"]
+PUBLIC_CLASSES = ["Frame", "Material", "State", "Body", "NodeSet", "Hand", "RigidBody", "World",
+                  "Contacts"]
 
 
 def stub_classes():
@@ -48,7 +49,7 @@ def test_every_public_binding_has_a_docstring():
         cls = getattr(torsion, name)
         assert cls.__doc__, name
     for method in ["from_scene", "step", "save_state", "restore_state", "add_body", "add_node_set",
-                   "add_hand", "add_rigid_body", "add_ground", "render", "write_vtk"]:
+                   "add_hand", "add_rigid_body", "add_ground", "render", "write_vtk", "contacts"]:
         assert getattr(torsion.World, method).__doc__, method
     for method in ["set_pose", "set_velocity", "apply_force", "apply_torque",
                    "set_kinematic_target"]:

@@ -10,6 +10,7 @@
 #include "frame_data.h"
 #include "handles.h"
 #include "offscreen.h"
+#include "py_contacts.h"
 #include "py_convert.h"
 #include "scene_builder.h"
 #include "torsion/format_number.h"
@@ -123,6 +124,50 @@ scene::RigidBodySpec::Shape toShape(const std::string& name) {
 }  // namespace
 
 void bindWorld(py::module_& m) {
+  py::class_<ContactList>(m, "Contacts",
+                          "The contacts of a world's last step (World.contacts()): row k of each "
+                          "array is one contact between body_a[k] and body_b[k].")
+      .def("__len__", &ContactList::size)
+      .def_readonly("body_a", &ContactList::body_a,
+                    "list of names: the FEM body in FEM-rigid contact, else Bullet's first body")
+      .def_readonly("body_b", &ContactList::body_b,
+                    "list of names: the rigid body (\"ground\" for the ground plane)")
+      .def_property_readonly(
+          "points",
+          [](const ContactList& c) {
+            return copyArray(c.points.data(), static_cast<py::ssize_t>(c.size()), 3);
+          },
+          "(k, 3) m: the contact point on A at the end of the step (an FEM node, a point of an "
+          "FEM face, Bullet's point on A)")
+      .def_property_readonly(
+          "normals",
+          [](const ContactList& c) {
+            return copyArray(c.normals.data(), static_cast<py::ssize_t>(c.size()), 3);
+          },
+          "(k, 3): unit, from B towards A (PyBullet's contactNormalOnB)")
+      .def_property_readonly(
+          "impulses",
+          [](const ContactList& c) {
+            return copyArray(c.impulses.data(), static_cast<py::ssize_t>(c.size()), 3);
+          },
+          "(k, 3) N s: the impulse B gave A over the step, friction included; / dt: the mean force")
+      .def_property_readonly(
+          "normal_impulses",
+          [](const ContactList& c) {
+            py::array_t<double> out(static_cast<py::ssize_t>(c.size()));
+            for (size_t k = 0; k < c.size(); ++k) {
+              double dot = 0;
+              for (size_t a = 0; a < 3; ++a)
+                dot += c.impulses[3 * k + a] * c.normals[3 * k + a];
+              out.mutable_at(static_cast<py::ssize_t>(k)) = dot;
+            }
+            return out;
+          },
+          "(k,) N s: impulses . normals, >= 0 where the bodies push each other apart")
+      .def("__repr__", [](const ContactList& c) {
+        return "<torsion.Contacts: " + std::to_string(c.size()) + " contacts>";
+      });
+
   py::class_<PyWorld>(m, "World", "Bullet world with FEM soft bodies, hands and rigid bodies.")
       .def(py::init([](py::object gravity, double dt, double tolerance, int max_iterations,
                        const std::string& linear_solver, int threads, double max_speed) {
@@ -296,6 +341,15 @@ void bindWorld(py::module_& m) {
             throw py::key_error("no rigid body named '" + name + "'");
           },
           py::arg("name"))
+      .def(
+          "contacts",
+          [](PyWorld& w) {
+            WorldGuard guard(w);
+            return lastStepContacts(w);
+          },
+          "The contacts of the last step (PyBullet's getContactPoints): FEM bodies against rigid "
+          "bodies and rigid bodies against each other, not FEM against FEM. Empty before the "
+          "first step and after restore_state until the next step. A copy.")
       .def(
           "save_state",
           [](PyWorld& w) {

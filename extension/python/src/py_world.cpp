@@ -145,6 +145,7 @@ Result<Ok> PyWorld::step(int n, FailureKind* kind, const std::function<bool()>& 
       for (int k = 0; k < good_steps; ++k) {
         applyRigidInputs(k == 0 ? anchor_loads_ : std::vector<RigidLoad>{});
         (void)scene::stepScene(*scene_);
+        stepped_ = true;
       }
     }
     failure_ = std::move(message);
@@ -163,6 +164,7 @@ Result<Ok> PyWorld::step(int n, FailureKind* kind, const std::function<bool()>& 
     applyRigidInputs(loads_);
     loads_.clear();
     Result<WorldStepReport> stepped = scene::stepScene(*scene_);
+    if (stepped) stepped_ = true;
     if (!stepped) {
       *kind = FailureKind::kScene;  // a scripted grab that missed: the scene's fault, not fatal
       anchor_.reset();
@@ -400,6 +402,7 @@ Status PyWorld::restoreState(const PyWorldState& state) {
     scene_->hands[h].released = state.released[h];
   failure_ = state.failure;
   anchor_.reset();
+  stepped_ = false;
   return Ok{};
 }
 

@@ -104,6 +104,10 @@ class PyWorld {
   /// Serialises the calls that change the world against a step running without the GIL.
   std::mutex& busy() { return busy_; }
 
+  /// Whether the solvers' contact lists describe the world as it is: a step was taken since it
+  /// was built or last restored (py_contacts.h).
+  bool stepped() const { return stepped_; }
+
   /// The scene's record of one of this world's rigid bodies, or null (the ground).
   const scene::SceneRigidBody* sceneRigidBody(const btRigidBody& body) const;
 
@@ -139,6 +143,7 @@ class PyWorld {
   std::vector<RigidLoad> loads_;           // queued for the next step
   std::vector<RigidLoad> anchor_loads_;    // those the step from anchor_ took: replayed with it
   std::vector<KinematicTarget> targets_;   // set from Python, handed to Bullet before each step
+  bool stepped_ = false;                   // stepped(): reset by restoreState
   std::mutex busy_;
 };
 

@@ -15,6 +15,7 @@ from . import _torsion
 from .errors import Error, MeshError, SceneError, UnstableError
 from ._torsion import (
     Body,
+    Contacts,
     Frame,
     Hand,
     Material,
@@ -27,7 +28,7 @@ from ._torsion import (
 )
 
 __all__ = [
-    "Body", "Error", "Frame", "Hand", "Material", "MeshError", "NodeSet", "RigidBody",
+    "Body", "Contacts", "Error", "Frame", "Hand", "Material", "MeshError", "NodeSet", "RigidBody",
     "SceneError", "State", "UnstableError", "World", "__version__", "bullet_precision",
     "data_path",
 ]

@@ -138,6 +138,17 @@ class RigidBody:
     def set_kinematic_target(self, position: ArrayLike,
                              quaternion: ArrayLike = (0, 0, 0, 1)) -> None: ...  # mass-0 bodies
 
+class Contacts:
+    """The contacts of a world's last step (World.contacts()); row k is one contact of
+    body_a[k] with body_b[k]. FEM-rigid (A the FEM body) and rigid-rigid; not FEM-FEM."""
+    body_a: list[str]
+    body_b: list[str]  # a rigid body's name, "ground" for the ground plane
+    points: npt.NDArray[np.float64]  # (k, 3) m, on A at the end of the step
+    normals: npt.NDArray[np.float64]  # (k, 3) unit, from B towards A
+    impulses: npt.NDArray[np.float64]  # (k, 3) N s, what B gave A over the step
+    normal_impulses: npt.NDArray[np.float64]  # (k,) N s, impulses . normals
+    def __len__(self) -> int: ...
+
 class World:
     def __init__(self, gravity: ArrayLike = (0, 0, -9.81), dt: float = 0.01,
                  tolerance: float = 1e-4, max_iterations: int = 300,
@@ -163,6 +174,7 @@ class World:
     def node_set(self, name: str) -> NodeSet: ...
     def hand(self, name: str) -> Hand: ...
     def rigid_body(self, name: str) -> RigidBody: ...
+    def contacts(self) -> Contacts: ...  # the last step's; empty after restore_state until a step
     def save_state(self) -> State: ...
     def restore_state(self, state: State) -> None: ...
     def add_body(self, name: str, mesh: Optional[str] = None, *, nodes: Optional[ArrayLike] = None,
