@@ -92,10 +92,11 @@ FemBody* addHangingBlock(FemSoftBodySolver& fem) {
       .value();
 }
 
-TEST(Anchors, ALightFreeBodyPulledByASoftBarConservesMomentumAndStaysStable) {
+void pullALightFreeBodyWithASoftBar(ContactSettings::FrictionSolve friction_solve) {
   MultibodyWorld user(btVector3(0, 0, 0));  // no external force
   solveTightly(user.fem);
   FemBody* bar = addBar(user.fem);  // 1 kg
+  bar->contacts().settings().friction_solve = friction_solve;
   const double mass = 0.01;         // a hundred times lighter than the bar
   btRigidBody* box = user.addRigid(std::make_unique<btBoxShape>(btVector3(0.025, 0.025, 0.025)),
                                    mass, btVector3(0.425, 0, 0));
@@ -122,12 +123,23 @@ TEST(Anchors, ALightFreeBodyPulledByASoftBarConservesMomentumAndStaysStable) {
   EXPECT_LT(worst_anchor, 1e-3) << "the anchored nodes stay on the box";
 }
 
+TEST(Anchors, ALightFreeBodyPulledByASoftBarConservesMomentumAndStaysStable) {
+  pullALightFreeBodyWithASoftBar(ContactSettings::FrictionSolve::kActiveSet);
+}
+
+// The anchors as bilateral rows of the convex solve (docs/contact-solve.md), the box one of the
+// island's bodies.
+TEST(Anchors, ALightFreeBodyPulledByASoftBarConservesMomentumInTheConvexSolve) {
+  pullALightFreeBodyWithASoftBar(ContactSettings::FrictionSolve::kConvex);
+}
+
 // Bullet's pivot is solved before the FEM step, with the bob alone: the block's pull reaches it a
 // step late, so the bob must not be much lighter than what hangs from it (a multibody's joints
 // are inside the solve: the next test's bob is twenty times lighter).
-TEST(Anchors, ASoftBlockOnARigidPendulumSwingsWithoutGainingEnergy) {
+void swingOnARigidPendulum(ContactSettings::FrictionSolve friction_solve) {
   MultibodyWorld user(btVector3(0, 0, 0));
   FemBody* block = addHangingBlock(user.fem);  // 1 kg
+  block->contacts().settings().friction_solve = friction_solve;
   const double mass = 1.0;
   btRigidBody* bob = user.addRigid(std::make_unique<btBoxShape>(btVector3(0.05, 0.05, 0.025)), mass,
                                    btVector3(0, 0, -0.475));
@@ -162,6 +174,14 @@ TEST(Anchors, ASoftBlockOnARigidPendulumSwingsWithoutGainingEnergy) {
   EXPECT_LT(peak, 1.05 * energy) << "kinetic energy must not grow (the deformation stores some)";
   EXPECT_LT(worst_anchor, 2e-3);
   EXPECT_LT(worst_rod, 0.01) << "Bullet's pivot holds the light bob against the heavy block";
+}
+
+TEST(Anchors, ASoftBlockOnARigidPendulumSwingsWithoutGainingEnergy) {
+  swingOnARigidPendulum(ContactSettings::FrictionSolve::kActiveSet);
+}
+
+TEST(Anchors, ASoftBlockOnARigidPendulumSwingsWithoutGainingEnergyInTheConvexSolve) {
+  swingOnARigidPendulum(ContactSettings::FrictionSolve::kConvex);
 }
 
 void swingOnALightMultibodyPendulum(ContactSettings::FrictionSolve friction_solve) {
@@ -219,7 +239,7 @@ TEST(Anchors, ASoftBlockOnALightMultibodyPendulumSwingsWithoutGainingEnergyInCon
   swingOnALightMultibodyPendulum(ContactSettings::FrictionSolve::kContactSpace);
 }
 
-TEST(Anchors, NodesAnchoredToAKinematicBodyFollowItExactly) {
+void followAKinematicBody(ContactSettings::FrictionSolve friction_solve) {
   MultibodyWorld user(btVector3(0, 0, -9.81));
   Material material;
   material.youngs_modulus = 1e5;
@@ -228,6 +248,7 @@ TEST(Anchors, NodesAnchoredToAKinematicBodyFollowItExactly) {
           .addBody("block", makeBoxTetMesh({-0.05, -0.05, -0.1}, {0.05, 0.05, 0}, 3, 3, 3).value(),
                    material)
           .value();
+  block->contacts().settings().friction_solve = friction_solve;
   btRigidBody* plate = user.addRigid(std::make_unique<btBoxShape>(btVector3(0.08, 0.08, 0.01)), 0,
                                      btVector3(0, 0, 0.01));
   plate->setCollisionFlags(plate->getCollisionFlags() | btCollisionObject::CF_KINEMATIC_OBJECT);
@@ -255,6 +276,14 @@ TEST(Anchors, NodesAnchoredToAKinematicBodyFollowItExactly) {
   // The block hangs from the plate: it sags under its weight, it does not fall.
   EXPECT_GT(block->state().position(0).z(),
             static_cast<double>(plate->getWorldTransform().getOrigin().z()) - 0.2);
+}
+
+TEST(Anchors, NodesAnchoredToAKinematicBodyFollowItExactly) {
+  followAKinematicBody(ContactSettings::FrictionSolve::kActiveSet);
+}
+
+TEST(Anchors, NodesAnchoredToAKinematicBodyFollowItExactlyInTheConvexSolve) {
+  followAKinematicBody(ContactSettings::FrictionSolve::kConvex);
 }
 
 TEST(Anchors, ASoftBarAnchoredToAFreeMultibodyConservesMomentum) {

@@ -91,9 +91,6 @@ double RigidContactSolver::lookahead(double dt) const {
 LinearSolveReport RigidContactSolver::solveConvex(const SystemOperator& op,
                                                   const NodeConstraints& constraints,
                                                   const Eigen::VectorXd& b, Eigen::VectorXd& v) {
-  if (std::any_of(contacts_.begin(), contacts_.end(),
-                  [](const NodeContact& c) { return c.anchored; }))
-    return brokenDown({}, "the convex contact solve does not take anchors yet");
   const sap::RowDefaults defaults;
   // Last step's normal impulses: the friction bounds of the lagged model.
   std::vector<sap::LaggedImpulse> lagged_nodes;
@@ -161,6 +158,7 @@ LinearSolveReport RigidContactSolver::solveConvex(const SystemOperator& op,
     NodeContact& c = contacts_[static_cast<std::size_t>(island.row_contact[r])];
     c.impulse = island.rows[r].frame.transpose() * gamma;
     c.normal_impulse = gamma.z();
+    if (c.anchored) continue;  // sticks for good, pulling or pushing
     c.state = !active ? NodeContact::State::kInactive
                       : (stick ? NodeContact::State::kStick : NodeContact::State::kSlide);
   }

@@ -189,5 +189,59 @@ TEST(SapParticle, FrictionlessKeepsItsTangentialSpeed) {
   EXPECT_NEAR(run.position_z, -kMass * test::kGravity / kStiffness, 1e-3 * 9.81e-6);
 }
 
+
+// A particle held to a fixed point by a bilateral row (an anchor, ContactRow::bilateral): the row
+// pulls as well as pushes. Hanging under gravity it settles m g / k below the point with the row
+// carrying m g dt; displaced 1 cm sideways without gravity, it returns as the critically damped
+// spring-damper (tau_d = 2 sqrt(m / k)): no overshoot, within 1 um in 0.1 s.
+struct AnchoredRun {
+  Eigen::Vector3d x = Eigen::Vector3d::Zero();
+  Eigen::Vector3d impulse = Eigen::Vector3d::Zero();  // N s on the particle, world, last step
+  double overshoot = 0;                               // m, furthest past the point along x
+};
+
+AnchoredRun runAnchored(const Eigen::Vector3d& start, double gravity, int steps) {
+  Eigen::Vector3d x = start, v = Eigen::Vector3d::Zero();
+  AnchoredRun run;
+  SapSolver solver;
+  for (int step = 0; step < steps; ++step) {
+    const Eigen::Vector3d drift = -x;  // the fixed point is the origin
+    const double distance = drift.norm();
+    ContactRow row;
+    row.frame = contactFrame(distance > 0 ? Eigen::Vector3d(drift / distance)
+                                          : Eigen::Vector3d::UnitZ());
+    row.terms.push_back(nodeTerm(0, 0, 1.0, row.frame));
+    row.bilateral = true;
+    row.stiffness = kStiffness;
+    row.dissipation_time = kTauD;
+    row.gap = -distance;
+    MatrixBody particle(test::massMatrix({kMass}),
+                        kMass * v + kDt * Eigen::Vector3d(0, 0, -kMass * gravity));
+    const SapProblem problem = SapProblem::create({&particle}, {row}, kDt).value();
+    Eigen::VectorXd next = v;
+    const SapReport report = solver.solve(problem, next);
+    EXPECT_TRUE(report.converged) << report.message;
+    EXPECT_EQ(report.states[0], ContactState::kStick);
+    run.impulse = row.frame.transpose() * report.impulses[0];
+    v = next;
+    x += kDt * v;
+    run.overshoot = std::max(run.overshoot, -x.x());
+  }
+  run.x = x;
+  return run;
+}
+
+TEST(SapParticle, AnAnchoredParticleHangsAtItsSpringsDeflection) {
+  const AnchoredRun run = runAnchored(Eigen::Vector3d::Zero(), test::kGravity, 1000);
+  EXPECT_NEAR(run.x.z(), -kMass * test::kGravity / kStiffness, 1e-9);
+  EXPECT_NEAR(run.x.head<2>().norm(), 0.0, 1e-12);
+  EXPECT_NEAR(run.impulse.z(), kMass * test::kGravity * kDt, 1e-6 * kMass * test::kGravity * kDt);
+}
+
+TEST(SapParticle, AnAnchoredParticlePulledAsideReturnsWithoutOvershoot) {
+  const AnchoredRun run = runAnchored(Eigen::Vector3d(0.01, 0, 0), 0.0, 100);
+  EXPECT_LT(run.x.norm(), 1e-6);
+  EXPECT_LT(run.overshoot, 1e-4);  // 1 % of the pull
+}
 }  // namespace
 }  // namespace torsion::sap

@@ -92,8 +92,8 @@ struct ContactSettings {
   /// step. A body in FEM-FEM contact (whose pair penalties the factor does not hold) always uses
   /// the active set.
   /// kConvex: one convex solve (SAP, docs/contact-solve.md) of the body with its dynamic rigid
-  /// partners, node and face contacts as rows; not yet with anchors (refused with an error) nor
-  /// in FEM-FEM contact (such a body takes the active set, as for kContactSpace).
+  /// partners, node and face contacts and anchors as rows; a body in FEM-FEM contact is driven by
+  /// the island's solve around it.
   enum class FrictionSolve { kActiveSet, kContactSpace, kAuto, kConvex };
   FrictionSolve friction_solve = FrictionSolve::kAuto;
   /// m/s: the contact-space solve iterates until every contact satisfies Coulomb's law to this;

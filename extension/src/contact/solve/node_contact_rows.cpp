@@ -54,13 +54,17 @@ NodeContactIsland buildNodeContactIsland(const std::vector<NodeContact>& contact
   }
   for (std::size_t i = 0; i < contacts.size(); ++i) {
     const NodeContact& c = contacts[i];
-    if (c.anchored) continue;
     const auto p = static_cast<std::size_t>(c.partner);
     // A held node against a prescribed partner: both sides' motions are given, the row has
     // nothing to act on (and no mobility, w = 0, to regularise its impulse with).
     if (c.held && island.partner_body[p] < 0) continue;
     ContactRow row = makeRow(c, partners[p], fem_body, island.partner_body[p], defaults, dt);
-    row.lagged_normal_impulse = laggedFor(lagged, c.node, partners[p].object);
+    if (c.anchored) {
+      row.bilateral = true;
+      row.mu = 0;
+    } else {
+      row.lagged_normal_impulse = laggedFor(lagged, c.node, partners[p].object);
+    }
     island.rows.push_back(std::move(row));
     island.row_contact.push_back(static_cast<int>(i));
   }

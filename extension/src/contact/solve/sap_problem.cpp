@@ -39,6 +39,13 @@ const char* toString(ContactState state) {
 
 RowResponse projectImpulse(const RowModel& m, const Eigen::Vector3d& vc) {
   RowResponse out;
+  if (m.bilateral) {
+    out.gamma = (Eigen::Vector3d(0, 0, m.v_hat) - vc) / m.rn;
+    out.g = Eigen::Matrix3d::Identity() / m.rn;
+    out.cost = 0.5 * m.rn * out.gamma.squaredNorm();
+    out.state = ContactState::kStick;
+    return out;
+  }
   // The lagged model (sap_problem.h): the compliant normal law, friction on the disk of radius r.
   const double yn = (m.v_hat - vc(2)) / m.rn;
   if (yn > 0) {
@@ -162,6 +169,7 @@ RowModel SapProblem::makeModel(const ContactRow& row, double dt,
   m.rn = std::max(parameters.beta * parameters.beta / (4 * kSapPi * kSapPi) * m.w, rn_physical);
   m.rt = parameters.sigma * m.w;
   m.v_hat = -row.gap / (dt + row.dissipation_time);
+  m.bilateral = row.bilateral;
   return m;
 }
 

@@ -51,6 +51,11 @@ struct ContactRow {
   /// The part of v_c that no island dof moves (m/s, contact frame): the motion of a kinematic
   /// partner's point (a moving hand, a conveyor), entered as B's minus A's. v_c = J v + this.
   Eigen::Vector3d velocity_offset = Eigen::Vector3d::Zero();
+  /// An equality, not a contact (an anchor: a node held to a rigid point): the impulse is
+  /// (v_hat - v_c) / R_n in all three directions, pulling as well as pushing, without a friction
+  /// bound; `gap` is minus the drift along the normal (the frame's n points the drift's way), mu
+  /// and the lagged impulse are not used (sap_problem.h).
+  bool bilateral = false;
 };
 
 /// A right-handed frame with rows (t1, t2, n) for unit `normal`; t1 is the normal crossed with the

@@ -67,8 +67,9 @@ struct NodeContactIsland {
   std::vector<int> row_face;
 };
 
-/// Builds the rows for `contacts` (active or not: every detected node contact, except anchors and
-/// held nodes against prescribed partners, whose rows have no unknown to act on) of FEM island
+/// Builds the rows for `contacts` (active or not: every detected node contact, except held nodes
+/// against prescribed partners, whose rows have no unknown to act on; an anchor's row is
+/// bilateral) of FEM island
 /// body `fem_body` against `partners`, with lagged normal
 /// impulses from `lagged` (0 for a contact not in it) and parameters `defaults` at step dt.
 NodeContactIsland buildNodeContactIsland(const std::vector<NodeContact>& contacts,

@@ -58,6 +58,10 @@
 // (gamma_n = 0 and r = 0: gamma = 0, G = 0). A row with r > 0 exerts its friction even in a step
 // where its normal impulse falls to zero (the lag: at most mu gamma_n^lag, for one step).
 //
+// A bilateral row (ContactRow::bilateral, an anchor) is the same spring-damper in all three
+// directions and both signs: gamma = (v_hat - v_c) / R_n with v_hat = (0, 0, -phi0 / (dt + tau_d)),
+// G = I / R_n, ell = 1/2 R_n |gamma|^2, state stick. Convex and C1 as the contacts are.
+//
 // Prescribed dofs (island_body.h) are held at their values: the unknowns are the free dofs, the
 // gradient and every Newton direction filtered by S.
 
@@ -92,6 +96,7 @@ struct RowModel {
   double rn = 0;      ///< R_n, m/(N s)
   double v_hat = 0;   ///< v_hat_n, m/s
   double w = 0;       ///< the Delassus estimate w_i, m/(N s)
+  bool bilateral = false;
 };
 
 /// The projection at one contact velocity.
