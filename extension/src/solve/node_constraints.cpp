@@ -23,6 +23,12 @@ void NodeConstraints::prescribeDirection(int node, const Eigen::Vector3d& direct
   velocity_.segment<3>(3 * node) = speed * direction;
 }
 
+NodeConstraints NodeConstraints::homogeneous() const {
+  NodeConstraints zero = *this;
+  zero.velocity_.setZero();
+  return zero;
+}
+
 int NodeConstraints::constrainedCount() const {
   int count = 0;
   for (Kind k : kind_)

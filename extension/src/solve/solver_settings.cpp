@@ -22,6 +22,12 @@ Status SolverSettings::validate() const {
                  ": must be >= 0"};
   if (threads < 0) return Error{"solver: threads = " + std::to_string(threads) + ": must be >= 0"};
   if (!(max_speed > 0)) return Error{"solver: max_speed must be > 0 m/s"};
+  if (!(std::isfinite(newton_tolerance) && newton_tolerance > 0 && newton_tolerance < 1))
+    return Error{"solver: newton_tolerance = " + formatNumber(newton_tolerance) +
+                 ": must be in (0, 1)"};
+  if (newton_max_iterations < 1)
+    return Error{"solver: newton_max_iterations = " + std::to_string(newton_max_iterations) +
+                 ": must be >= 1"};
   return Ok{};
 }
 

@@ -190,8 +190,62 @@ void SystemOperator::buildPattern() {
   assembled_ = false;
 }
 
+void SystemOperator::setElementStiffnesses(const std::vector<TetStiffness>* stiffnesses) {
+  assert((stiffnesses == nullptr || model_->elementKind() == ElementKind::kTet4) &&
+         "element stiffnesses are tet4 matrices");
+  element_stiffnesses_ = stiffnesses;
+  assembled_ = false;
+}
+
+void SystemOperator::setLaggedStiffness(const std::vector<Eigen::Matrix3d>* blocks, double weight) {
+  if (blocks == nullptr && lagged_blocks_ == nullptr) return;  // K as it was
+  lagged_blocks_ = blocks;
+  lagged_weight_ = weight;
+  assembled_ = false;
+}
+
+void SystemOperator::multiplyBlocks(const std::vector<Eigen::Matrix3d>& blocks,
+                                    const Eigen::VectorXd& y, Eigen::VectorXd& out) const {
+  out.resize(y.size());
+  system_kernels::ProductInput in = productInput(y, out, 0.0, 1.0);
+  in.blocks = blocks.data()->data();
+  parallel_.forRange(model_->nodeCount(), kNodeGrain,
+                     [&](int begin, int end) { kernels_->block_product(in, begin, end); });
+}
+
+void SystemOperator::assembleElementStiffnesses() const {
+  // Row n holds the blocks (n, b >= n) of every element of n: written by row n alone.
+  const std::vector<TetStiffness>& stiffness = *element_stiffnesses_;
+  parallel_.forRange(model_->nodeCount(), kNodeGrain, [&](int begin, int end) {
+    for (size_t row = static_cast<size_t>(begin); row < static_cast<size_t>(end); ++row) {
+      for (int s = row_offsets_[row]; s < row_offsets_[row + 1]; ++s)
+        block_values_[static_cast<size_t>(s)].setZero();
+      for (int k = node_offsets_[row]; k < node_offsets_[row + 1]; ++k) {
+        const int entry = node_entries_[static_cast<size_t>(k)];
+        const TetStiffness& K = stiffness[static_cast<size_t>(entry / 4)];
+        const int a = entry % 4;
+        for (int b = 0; b < 4; ++b) {
+          const int slot = entry_slots_[4 * static_cast<size_t>(k) + static_cast<size_t>(b)];
+          if (slot >= 0) block_values_[static_cast<size_t>(slot)] += K.block<3, 3>(3 * a, 3 * b);
+        }
+      }
+    }
+  });
+}
+
 void SystemOperator::assemble() const {
   if (assembled_) return;
+  if (element_stiffnesses_ != nullptr) {
+    assembleElementStiffnesses();
+    for (const SlotBlock& addition : stiffness_additions_)
+      block_values_[static_cast<size_t>(addition.slot)] += addition.block;
+    if (lagged_blocks_ != nullptr) {
+      for (size_t s = 0; s < block_values_.size(); ++s)
+        block_values_[s] += lagged_weight_ * (*lagged_blocks_)[s];
+    }
+    assembled_ = true;
+    return;
+  }
   const double mu = model_->material().mu();
   // With nodal pressure the blocks hold the deviatoric part only (nodal_pressure.h): the same
   // formula with lambda replaced by -2 mu / 3; the volumetric part is applied in factored form.

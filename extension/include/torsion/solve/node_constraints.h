@@ -34,6 +34,9 @@ class NodeConstraints {
   bool isConstrained(int node) const { return kind(node) != Kind::kFree; }
   int constrainedCount() const;
 
+  /// The same constraints with every prescribed value zero (a Newton correction's: the iterate
+  /// already meets the prescriptions).
+  NodeConstraints homogeneous() const;
   /// Velocity with every prescribed component set to its prescribed value and free components
   /// taken from `free_velocity` (3n).
   void impose(Eigen::VectorXd& velocity) const;

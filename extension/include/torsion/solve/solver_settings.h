@@ -49,6 +49,13 @@ struct SolverSettings {
   int threads = 0;  ///< worker threads; 0: all cores
   /// A node faster than this (m/s) means the simulation blew up; the run stops.
   double max_speed = 1e3;
+  /// Hyperelastic bodies (Material::law): the step's Newton solve stops when the free part of
+  /// its residual (the momentum balance of backward Euler, N s) falls to newton_tolerance times
+  /// its scale: |S(b - A v_prescribed)| of the step's first linear system (the reference the CG
+  /// tolerance uses) plus dt |f(x_n)| (the elastic forces at the step's start, reactions
+  /// included). Stopping at the cap within 10x is a warning; above, the step failed.
+  double newton_tolerance = 1e-6;
+  int newton_max_iterations = 30;  ///< Newton iterations (linear solves) per step, cap
 
   Status validate() const;
 };

@@ -28,6 +28,7 @@
 #include <vector>
 
 #include "torsion/fem/fem_model.h"
+#include "torsion/fem/volume_barrier.h"
 #include "torsion/solve/added_operator_term.h"
 #include "torsion/solve/parallel.h"
 
@@ -79,6 +80,17 @@ class SystemOperator {
   /// tets below its threshold, fem/volume_barrier.h): they enter every product, the diagonal
   /// blocks and stiffnessBlocks(). Added in the given order, so K stays deterministic.
   void setStiffnessAdditions(std::vector<SlotBlock> additions);
+  /// Hyperelastic tet4 bodies (fem/hyperelastic.h; not owned, nullptr for the corotated
+  /// assembly): K is assembled from these 12x12 element stiffnesses, one per element, instead of
+  /// from the rotations, per block row over the row node's elements in ascending order (identical
+  /// for any thread count). Marks K stale: call again whenever their values change.
+  void setElementStiffnesses(const std::vector<TetStiffness>* stiffnesses);
+  /// Blocks in this operator's pattern (not owned; nullptr: none) added to K, times `weight`,
+  /// after each assembly: a hyperelastic step's stiffness damping, lagged at the step's start.
+  void setLaggedStiffness(const std::vector<Eigen::Matrix3d>* blocks, double weight);
+  /// out = B y for blocks B in this operator's pattern (e.g. a copy of stiffnessBlocks()).
+  void multiplyBlocks(const std::vector<Eigen::Matrix3d>& blocks, const Eigen::VectorXd& y,
+                      Eigen::VectorXd& out) const;
   /// The slot of the stored block K(row, column), row <= column, or -1 when the pattern has none
   /// (the two nodes share no element).
   int blockSlot(int row, int column) const;
@@ -165,6 +177,8 @@ class SystemOperator {
   void buildPatches();
   // Fills block_values_ from this step's rotations (if stale).
   void assemble() const;
+  // Fills block_values_ from element_stiffnesses_.
+  void assembleElementStiffnesses() const;
   // tet10: the terms of every block (a, b) (system_kernels::BlockTerm), once per operator.
   void buildTet10Terms();
 
@@ -173,6 +187,9 @@ class SystemOperator {
   std::vector<Eigen::Matrix3d> rotations_;
   const AddedOperatorTerm* added_term_ = nullptr;
   std::vector<SlotBlock> stiffness_additions_;
+  const std::vector<TetStiffness>* element_stiffnesses_ = nullptr;
+  const std::vector<Eigen::Matrix3d>* lagged_blocks_ = nullptr;
+  double lagged_weight_ = 0;
   double mass_coefficient_ = 1;
   double stiffness_coefficient_ = 0;
 
