@@ -397,6 +397,9 @@ Result<FemBodyCheckpoint> readBody(Reader& r, FemWorld& world, FemBody& body,
   // they stay the body's own.
   material.barrier_threshold = model.material().barrier_threshold;
   material.barrier_stiffness = model.material().barrier_stiffness;
+  // Nor the constitutive law (no live edit changes it).
+  material.law = model.material().law;
+  material.mooney_rivlin_c2_fraction = model.material().mooney_rivlin_c2_fraction;
   if (!r.ok()) return unreadable(r);
   if (nodes != static_cast<size_t>(model.nodeCount()) ||
       elements != static_cast<size_t>(model.elementCount()) || kind != model.elementKind() ||

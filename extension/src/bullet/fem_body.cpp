@@ -189,6 +189,16 @@ bool FemBody::prepare(const StepContext& ctx, const AddedOperatorTerm* island_te
   // Its solve runs whenever it is on, candidates or not: it looks again along the solved motion.
   const bool self = self_contact_ != nullptr;
   if (self) self_contact_->detect(state_, constraints_, dt);
+  if (model_->material().hyperelastic() && (rigid_contact_ || self || island_term != nullptr)) {
+    // The Newton step has no contact solve yet: refused, never stepped without its contacts.
+    last_report_ = StepReport{};
+    last_report_.health = StepHealth::kSolverFailed;
+    last_report_.message = std::string(
+                               "contact is solved for corotated bodies only; this body's "
+                               "law is ") +
+                           toString(model_->material().law) + " (docs/materials.md)";
+    return false;
+  }
   added_terms_.set(self ? &self_contact_->term() : nullptr, island_term);
   if (self || island_term != nullptr) stepper_.setAddedOperatorTerm(&added_terms_);
   last_report_ = stepper_.prepare(state_, constraints_, step_forces_, dt);

@@ -17,6 +17,26 @@ std::optional<VolumetricStrain> parseVolumetricStrain(const std::string& name) {
   return std::nullopt;
 }
 
+const char* toString(MaterialLaw law) {
+  switch (law) {
+    case MaterialLaw::kCorotated:
+      return "corotated";
+    case MaterialLaw::kStableNeoHookean:
+      return "stable_neo_hookean";
+    case MaterialLaw::kMooneyRivlin:
+      return "mooney_rivlin";
+  }
+  return "?";
+}
+
+std::optional<MaterialLaw> parseMaterialLaw(const std::string& name) {
+  for (MaterialLaw law :
+       {MaterialLaw::kCorotated, MaterialLaw::kStableNeoHookean, MaterialLaw::kMooneyRivlin}) {
+    if (name == toString(law)) return law;
+  }
+  return std::nullopt;
+}
+
 Status Material::validate() const {
   auto bad = [](const char* field, double value, const char* rule) {
     return Error{std::string("material: ") + field + " = " + formatNumber(value) + ": " + rule};
@@ -35,6 +55,14 @@ Status Material::validate() const {
     return bad("barrier_threshold", barrier_threshold, "must be in [0, 1)");
   if (!(std::isfinite(barrier_stiffness) && barrier_stiffness >= 0))
     return bad("barrier_stiffness", barrier_stiffness, "must be >= 0");
+  const double c2 = mooney_rivlin_c2_fraction;
+  if (!(std::isfinite(c2) && c2 >= 0 && c2 <= 1))
+    return bad("mooney_rivlin_c2_fraction", c2, "must be in [0, 1]");
+  if (law == MaterialLaw::kMooneyRivlin && c2 == 1 && poisson_ratio == 0) {
+    return bad("mooney_rivlin_c2_fraction", c2,
+               "must be below 1 at poisson_ratio = 0 (the volumetric modulus lambda + 2 C1 would "
+               "be 0)");
+  }
   return Ok{};
 }
 

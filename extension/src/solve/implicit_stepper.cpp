@@ -4,6 +4,7 @@
 #include <cmath>
 #include <sstream>
 
+#include "hyperelastic_pass.h"
 #include "system_operator_kernels.h"
 #include "torsion/fem/corotated_element.h"
 #include "torsion/fem/nodal_pressure.h"
@@ -42,6 +43,7 @@ ImplicitStepper::ImplicitStepper(std::shared_ptr<const FemModel> model,
       settings_(settings),
       parallel_(parallel),
       system_(model_, parallel),
+      hyperelastic_(std::make_unique<HyperelasticPass>()),
       last_dt_(settings.time_step) {
   element_forces_.resize(static_cast<size_t>(model_->elementCount()) *
                          static_cast<size_t>(model_->nodesPerElement()));
@@ -51,6 +53,9 @@ ImplicitStepper::ImplicitStepper(std::shared_ptr<const FemModel> model,
 ImplicitStepper::~ImplicitStepper() = default;
 
 double ImplicitStepper::computeElasticForces(FemState& state) {
+  if (model_->material().hyperelastic()) return computeHyperelasticForces(state);
+  system_.setElementStiffnesses(nullptr);  // a live edit may have left the hyperelastic law
+  system_.setLaggedStiffness(nullptr, 0.0);
   const double mu = model_->material().mu();
   const double lambda = model_->material().lambda();
   const std::vector<int>& nodes = model_->elementNodes();
@@ -215,6 +220,13 @@ StepReport ImplicitStepper::prepare(FemState& state, const NodeConstraints& cons
   // Non-finite b ends the step here: the system and the warm start's history stay the last step's.
   if (!buildRightHandSide(state, external_forces, dt, report)) return report;
   prepareSystem(state, dt);
+  newton_ = NewtonReport{};
+  if (model_->material().hyperelastic()) {
+    start_positions_ = state.positions;
+    start_velocities_ = state.velocities;
+    step_external_forces_ = external_forces;
+    newton_constraints_ = constraints.homogeneous();
+  }
   return report;
 }
 
@@ -233,7 +245,9 @@ void ImplicitStepper::finish(FemState& state, const Eigen::Ref<const Eigen::Vect
   // v' stays in velocity_next_: the internal forces and the next warm start read it.
   if (velocities.data() != velocity_next_.data()) velocity_next_ = velocities;
   integratePositions(state, last_dt_);
+  report.newton = newton_;
   checkHealth(state, report);
+  if (!isFatal(report.health)) judgeNewton(report);
 }
 
 bool ImplicitStepper::buildRightHandSide(const FemState& state,
@@ -272,6 +286,7 @@ void ImplicitStepper::prepareSystem(const FemState& state, double dt) {
 }
 
 LinearSolveReport ImplicitStepper::solve() {
+  if (model_->material().hyperelastic()) return solveNewton();
   if (settings_.linear_solver == LinearSolverKind::kCholmod) {
     if (!cholmod_) cholmod_ = std::make_unique<CholmodSolver>();
     return cholmod_->solve(system_, *constraints_, rhs_, velocity_next_);

@@ -102,7 +102,9 @@ class FemBody {
   /// cleared, so Bullet's collision detection runs on this step's motion.
   void predict(double dt);
   /// The FEM step from ctx.time to ctx.endTime(): prepare(), the body's own solve (its contact
-  /// solve, or the stepper's CG / CHOLMOD without contacts), finish().
+  /// solve, or the stepper's CG / CHOLMOD without contacts), finish(). A hyperelastic body
+  /// (Material::law) that touches anything (rigid contacts or anchors, self-contact, another FEM
+  /// body) fails its step (StepHealth::kSolverFailed): its Newton step has no contact solve.
   const StepReport& advance(const StepContext& ctx);
 
   // ---- the same step in stages (FemContactIslands solves several bodies' systems together) ----

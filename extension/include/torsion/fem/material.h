@@ -22,6 +22,18 @@ enum class VolumetricStrain {
 const char* toString(VolumetricStrain kind);
 std::optional<VolumetricStrain> parseVolumetricStrain(const std::string& name);
 
+/// The constitutive law of a body (docs/materials.md). The corotated linear law steps with one
+/// linearised backward-Euler solve; the hyperelastic laws (tet4, per-element volumetric strain
+/// only) with a Newton solve of the step's incremental potential (solve/implicit_stepper.h).
+enum class MaterialLaw {
+  kCorotated,         ///< corotated linear elasticity (Mueller & Gross 2004), the default
+  kStableNeoHookean,  ///< stable neo-Hookean (Smith, de Goes & Kim 2018), no log term
+  kMooneyRivlin,      ///< compressible Mooney-Rivlin, C2 / (C1 + C2) = mooney_rivlin_c2_fraction
+};
+/// "corotated", "stable_neo_hookean" or "mooney_rivlin" (the scene key's values).
+const char* toString(MaterialLaw law);
+std::optional<MaterialLaw> parseMaterialLaw(const std::string& name);
+
 struct Material {
   double youngs_modulus = 1e5;  ///< E, Pa
   double poisson_ratio = 0.3;   ///< nu, in [0, 0.5)
@@ -39,6 +51,13 @@ struct Material {
   double barrier_threshold = 0.3;
   /// The barrier's pressure at J = 0 in units of the bulk modulus (k = barrier_stiffness kappa).
   double barrier_stiffness = 30.0;
+  /// The constitutive law; E and nu give its small-strain moduli whichever it is.
+  MaterialLaw law = MaterialLaw::kCorotated;
+  /// Mooney-Rivlin only: C2 / (C1 + C2) in [0, 1] (0: neo-Hookean at J = 1); needs nu > 0 at 1.
+  double mooney_rivlin_c2_fraction = 0.5;
+
+  /// True for the laws stepped by Newton's method (everything but kCorotated).
+  bool hyperelastic() const { return law != MaterialLaw::kCorotated; }
 
   /// Lame's first parameter lambda = E nu / ((1 + nu)(1 - 2 nu)), Pa.
   double lambda() const {

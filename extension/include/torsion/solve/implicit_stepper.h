@@ -25,6 +25,21 @@
 //
 // Internal forces at the end of the step (what the body exerts on whatever holds its nodes) are
 // available afterwards, linearised: f_int = f(x) - (dt + beta) K v'.
+//
+// Hyperelastic bodies (Material::law; docs/materials.md, "Time step") take the same stages with
+// the hyperelastic element pass (positive semi-definite per-tet stiffness, K assembled from it),
+// and solve() is a Newton solve of backward Euler's incremental potential in v (x = x_n + dt v)
+//   Phi(v) = 1/2 |v - v_n|_M^2 + dt/2 v^T C v - dt f_ext . v + Psi(x_n + dt v),
+//   C = alpha M + beta K_n (K_n: the stiffness at the step's start),
+// whose minimiser is the backward-Euler step M (v - v_n) = dt (f(x) + f_ext - C v). Iteration 0
+// is the prepared linearised step (taken in full, so prescribed nodes land on their targets);
+// each further iteration solves (M (1 + dt alpha) + dt beta K_n + dt^2 K(x)) dv = S r(v) with the
+// prescribed components of dv zero (the same CG or CHOLMOD), K(x) the exact Hessian or, where
+// that system is not positive definite, the projected one, and backtracks along dv until Phi
+// decreases enough (Armijo). It stops when |S r| <= newton_tolerance (|S(b - A v_prescribed)| +
+// dt |f(x_n)|) (SolverSettings); StepReport::newton says how it went, and an unconverged step is a warning
+// within 10x the tolerance and fatal above. Internal forces are then exact at the end of the step:
+// f_int = f(x') - beta K_n v'.
 
 #include <Eigen/Core>
 #include <memory>
@@ -42,6 +57,22 @@
 namespace torsion {
 
 class CholmodSolver;
+class HyperelasticPass;
+
+/// The Newton solve of a hyperelastic body's step (all zero for corotated bodies).
+struct NewtonReport {
+  int iterations = 0;  ///< linear solves, the prepared one included
+  /// |S r| of the accepted iterate over its scale, |S(b - A v_prescribed)| of the step's first
+  /// system plus dt |f(x_n)| (SolverSettings::newton_tolerance).
+  double relative_residual = 0;
+  bool converged = true;
+  int line_search_cuts = 0;  ///< step halvings, over all iterations
+  /// Iterations whose direction took the projected Hessian (the exact one was not positive
+  /// definite on the free dofs, or gave no descent).
+  int projected_iterations = 0;
+  /// The line search found no decrease of Phi along a direction (then converged is false).
+  bool line_search_failed = false;
+};
 
 enum class StepHealth {
   kOk,
@@ -59,7 +90,8 @@ inline bool isFatal(StepHealth h) {
 }
 
 struct StepReport {
-  LinearSolveReport solve;
+  LinearSolveReport solve;  ///< hyperelastic bodies: every Newton iteration's solves together
+  NewtonReport newton;
   double elastic_energy = 0;  ///< J, at the start of the step (the volume barrier's included)
   /// Tets below the volume barrier's threshold at the start of the step (fem/volume_barrier.h).
   int barrier_tets = 0;
@@ -159,6 +191,26 @@ class ImplicitStepper {
   // Stage 2's volume barrier (fem/volume_barrier.h): adds its forces to elastic_forces_ and its
   // stiffness to K for the tets of mesh() below the threshold; returns its energy, J.
   double addVolumeBarrier(const FemState& state);
+  // Stages 1-2 of a hyperelastic body: energy, forces and element stiffnesses at `state`
+  // (src/solve/implicit_stepper_newton.cpp, as are the functions below up to the next comment).
+  double computeHyperelasticForces(const FemState& state);
+  // Stage 4 of a hyperelastic body: the Newton solve, v' into velocity_next_.
+  LinearSolveReport solveNewton();
+  // A linear solve by settings_.linear_solver of A v = b under `constraints`.
+  LinearSolveReport linearSolve(const NodeConstraints& constraints, const Eigen::VectorXd& b,
+                                Eigen::VectorXd& v);
+  // Forces at x_n + dt v, newton_residual_ = r(v); returns Phi(v).
+  double evaluateIterate(const Eigen::VectorXd& v);
+  // Phi at v from the elastic energy there and the step's quadratic terms.
+  double incrementalPotential(const Eigen::VectorXd& v, double elastic_energy,
+                              const Eigen::VectorXd& lagged_v) const;
+  // A Newton direction dv at the iterate (trial_ holds its positions): S r solved with the exact
+  // Hessian, or the projected one where that is not positive definite.
+  LinearSolveReport newtonDirection(const Eigen::VectorXd& free_residual, Eigen::VectorXd& dv);
+  // Backtracks along dv from v (Phi(v) = phi); on success v and phi move to the accepted point.
+  bool lineSearch(Eigen::VectorXd& v, const Eigen::VectorXd& dv, double& phi);
+  // Stage 6's verdict on the Newton solve, into report.
+  void judgeNewton(StepReport& report) const;
   // Stage 3: rhs_. False (and report's health and message set) when b is not finite.
   bool buildRightHandSide(const FemState& state, const Eigen::VectorXd& external_forces, double dt,
                           StepReport& report);
@@ -190,6 +242,15 @@ class ImplicitStepper {
   // Per tet of mesh(): J = det F this step (volume barrier); how many are below its threshold.
   std::vector<double> volume_ratio_;
   int barrier_tets_ = 0;
+  // Hyperelastic bodies: the element pass; the step's start (x_n, v_n), external forces and
+  // homogeneous constraints; the stiffness at the start (for beta); the iterate's forces, residual
+  // and K_n v; the Newton report of the last solve.
+  std::unique_ptr<HyperelasticPass> hyperelastic_;
+  Eigen::VectorXd start_positions_, start_velocities_, step_external_forces_;
+  NodeConstraints newton_constraints_;
+  std::vector<Eigen::Matrix3d> start_stiffness_;
+  Eigen::VectorXd iterate_forces_, newton_residual_, lagged_product_, trial_;
+  NewtonReport newton_;
   bool internal_forces_valid_ = false;
   double last_dt_;  // s, dt of the last step (the internal forces' linearisation uses it)
 };

@@ -1,0 +1,210 @@
+// The hyperelastic half of ImplicitStepper (solve/implicit_stepper.h): the element pass at the
+// step's start and the Newton solve of the incremental potential.
+#include <cmath>
+#include <limits>
+#include <sstream>
+
+#include "hyperelastic_pass.h"
+#include "torsion/solve/cholmod_solver.h"
+#include "torsion/solve/implicit_stepper.h"
+
+namespace torsion {
+
+namespace {
+// Armijo's sufficient-decrease fraction and the line search's halvings before it gives up.
+constexpr double kArmijo = 1e-4;
+constexpr int kMaxHalvings = 12;
+// Phi is a sum of thousands of terms: differences below this fraction of its terms' magnitude are
+// rounding, and a step whose predicted decrease is that small is taken in full.
+constexpr double kEnergyRounding = 1e-11;
+// Forces below this fraction of mu V^(2/3) (the force a unit strain gives the body) are rounding:
+// a residual that small has converged whatever the step's scale (a body at rest has none).
+constexpr double kForceRounding = 1e-12;
+
+void addSolve(LinearSolveReport& total, const LinearSolveReport& solve) {
+  total.iterations += solve.iterations;
+  total.relative_residual = std::max(total.relative_residual, solve.relative_residual);
+  total.converged = total.converged && solve.converged;
+  if (solve.breakdown) {
+    total.breakdown = true;
+    total.breakdown_reason = solve.breakdown_reason;
+  }
+}
+}  // namespace
+
+double ImplicitStepper::computeHyperelasticForces(const FemState& state) {
+  const double energy = hyperelastic_->evaluate(*model_, state.positions, parallel_, true);
+  barrier_tets_ = hyperelastic_->barrierTets();
+  system_.setStiffnessAdditions({});
+  system_.setLaggedStiffness(nullptr, 0.0);
+  system_.setElementStiffnesses(&hyperelastic_->elementStiffnesses());
+  system_.gather(hyperelastic_->elementForces(), 1.0, elastic_forces_);
+  return energy;
+}
+
+LinearSolveReport ImplicitStepper::linearSolve(const NodeConstraints& constraints,
+                                               const Eigen::VectorXd& b, Eigen::VectorXd& v) {
+  if (settings_.linear_solver == LinearSolverKind::kCholmod) {
+    if (!cholmod_) cholmod_ = std::make_unique<CholmodSolver>();
+    return cholmod_->solve(system_, constraints, b, v);
+  }
+  return cg_.solve(system_, constraints, b, settings_, v);
+}
+
+double ImplicitStepper::incrementalPotential(const Eigen::VectorXd& v, double elastic_energy,
+                                             const Eigen::VectorXd& lagged_v) const {
+  const Material& material = model_->material();
+  const std::vector<double>& mass = model_->nodeMasses();
+  double inertia = 0, mass_damping = 0;
+  for (int i = 0; i < model_->nodeCount(); ++i) {
+    const double m = mass[static_cast<size_t>(i)];
+    inertia += m * (v.segment<3>(3 * i) - start_velocities_.segment<3>(3 * i)).squaredNorm();
+    mass_damping += m * v.segment<3>(3 * i).squaredNorm();
+  }
+  double damping = material.mass_damping * mass_damping;
+  if (material.stiffness_damping > 0) damping += material.stiffness_damping * v.dot(lagged_v);
+  return 0.5 * inertia + 0.5 * last_dt_ * damping - last_dt_ * step_external_forces_.dot(v) +
+         elastic_energy;
+}
+
+double ImplicitStepper::evaluateIterate(const Eigen::VectorXd& v) {
+  const Material& material = model_->material();
+  const double dt = last_dt_;
+  trial_ = start_positions_ + dt * v;
+  const double energy = hyperelastic_->evaluate(*model_, trial_, parallel_, false);
+  system_.gather(hyperelastic_->elementForces(), 1.0, iterate_forces_);
+  if (material.stiffness_damping > 0) {
+    system_.multiplyBlocks(start_stiffness_, v, lagged_product_);
+  } else {
+    lagged_product_.setZero(v.size());
+  }
+  // r = -grad Phi = M (v_n - v) - dt alpha M v - dt beta K_n v + dt (f(x) + f_ext)
+  const std::vector<double>& mass = model_->nodeMasses();
+  newton_residual_.resize(v.size());
+  for (int i = 0; i < model_->nodeCount(); ++i) {
+    const double m = mass[static_cast<size_t>(i)];
+    newton_residual_.segment<3>(3 * i) =
+        m * (start_velocities_.segment<3>(3 * i) - v.segment<3>(3 * i)) -
+        (dt * material.mass_damping * m) * v.segment<3>(3 * i) +
+        dt * (iterate_forces_.segment<3>(3 * i) + step_external_forces_.segment<3>(3 * i) -
+              material.stiffness_damping * lagged_product_.segment<3>(3 * i));
+  }
+  return incrementalPotential(v, energy, lagged_product_);
+}
+
+bool ImplicitStepper::lineSearch(Eigen::VectorXd& v, const Eigen::VectorXd& dv, double& phi) {
+  const double slope = newton_residual_.dot(dv);  // -dPhi/dt at t = 0
+  if (!(slope > 0)) return false;                 // not a descent direction
+  const bool damped = model_->material().stiffness_damping > 0;
+  Eigen::VectorXd lagged_dv;
+  if (damped) system_.multiplyBlocks(start_stiffness_, dv, lagged_dv);
+  double t = 1;
+  for (int halving = 0; halving <= kMaxHalvings; ++halving, t *= 0.5) {
+    const Eigen::VectorXd candidate = v + t * dv;
+    trial_ = start_positions_ + last_dt_ * candidate;
+    const double energy = hyperelastic_->energy(*model_, trial_, parallel_);
+    const Eigen::VectorXd lagged =
+        damped ? Eigen::VectorXd(lagged_product_ + t * lagged_dv) : Eigen::VectorXd();
+    const double trial_phi = incrementalPotential(candidate, energy, damped ? lagged : trial_);
+    const double rounding = kEnergyRounding * (std::abs(phi) + std::abs(energy));
+    if (std::isfinite(trial_phi) && trial_phi <= phi - kArmijo * t * slope + rounding) {
+      v = candidate;
+      newton_.line_search_cuts += halving;
+      phi = evaluateIterate(v);
+      return true;
+    }
+  }
+  newton_.line_search_cuts += kMaxHalvings;
+  return false;
+}
+
+LinearSolveReport ImplicitStepper::newtonDirection(const Eigen::VectorXd& free_residual,
+                                                   Eigen::VectorXd& dv) {
+  // The exact Hessian first: where the step's system is positive definite with it (the usual case;
+  // element Hessians are indefinite under finite shear, their sum plus M / dt^2 rarely is) Newton
+  // converges quadratically, where the projected one converges only linearly (measured: 20-30
+  // iterations for a quarter turn of the statics twist, docs/materials.md). Where the system is
+  // not positive definite (the factorisation or CG breaks down) or dv is no descent direction,
+  // the projected Hessian, positive semi-definite per element.
+  hyperelastic_->evaluate(*model_, trial_, parallel_, true, false);
+  system_.setElementStiffnesses(&hyperelastic_->elementStiffnesses());
+  dv.setZero(free_residual.size());
+  LinearSolveReport exact = linearSolve(newton_constraints_, free_residual, dv);
+  if (!exact.breakdown && dv.allFinite() && newton_residual_.dot(dv) > 0) return exact;
+  ++newton_.projected_iterations;
+  hyperelastic_->evaluate(*model_, trial_, parallel_, true, true);
+  system_.setElementStiffnesses(&hyperelastic_->elementStiffnesses());
+  dv.setZero(free_residual.size());
+  LinearSolveReport projected = linearSolve(newton_constraints_, free_residual, dv);
+  projected.iterations += exact.iterations;
+  return projected;
+}
+
+LinearSolveReport ImplicitStepper::solveNewton() {
+  const Material& material = model_->material();
+  const double dt = last_dt_;
+  // The residual scale: the first system's |S(b - A v_prescribed)| (what the step must move, as
+  // the CG measures it) plus dt |f(x_n)| (the impulse of the elastic forces now, reactions on held
+  // nodes included, which stays the scale of a body held still in a deformed equilibrium).
+  Eigen::VectorXd prescribed = Eigen::VectorXd::Zero(rhs_.size());
+  constraints_->impose(prescribed);
+  system_.multiply(prescribed, scratch_);
+  Eigen::VectorXd free_rhs = rhs_ - scratch_;
+  constraints_->filter(free_rhs);
+  const double reference = free_rhs.norm() + dt * elastic_forces_.norm();
+  const double rest_volume = model_->totalMass() / material.density;
+  const double rounding =
+      kForceRounding * dt * material.mu() * std::cbrt(rest_volume * rest_volume);
+  // Iteration 0: the prepared linearised step at x_n, in full.
+  LinearSolveReport total = linearSolve(*constraints_, rhs_, velocity_next_);
+  newton_.iterations = 1;
+  if (material.stiffness_damping > 0) start_stiffness_ = system_.stiffnessBlocks();
+  system_.setCoefficients(1.0 + dt * material.mass_damping, dt * dt);
+  system_.setLaggedStiffness(material.stiffness_damping > 0 ? &start_stiffness_ : nullptr,
+                             material.stiffness_damping / dt);
+  Eigen::VectorXd& v = velocity_next_;
+  double phi = evaluateIterate(v);
+  Eigen::VectorXd dv, free_residual;
+  while (!total.breakdown) {
+    free_residual = newton_residual_;
+    newton_constraints_.filter(free_residual);
+    const double residual = free_residual.norm();
+    newton_.relative_residual = reference > 0 ? residual / reference : residual;
+    newton_.converged = residual <= settings_.newton_tolerance * reference + rounding;
+    if (newton_.converged || newton_.iterations >= settings_.newton_max_iterations) break;
+    addSolve(total, newtonDirection(free_residual, dv));
+    ++newton_.iterations;
+    if (total.breakdown) break;
+    if (!lineSearch(v, dv, phi)) {
+      newton_.line_search_failed = true;
+      break;
+    }
+  }
+  if (total.breakdown) newton_.converged = false;
+  // Exact internal forces at the end of the step: f(x') - beta K_n v'.
+  internal_forces_ = iterate_forces_ - material.stiffness_damping * lagged_product_;
+  internal_forces_valid_ = true;
+  return total;
+}
+
+void ImplicitStepper::judgeNewton(StepReport& report) const {
+  const NewtonReport& n = report.newton;
+  if (n.converged) return;
+  std::ostringstream s;
+  s << "Newton solve "
+    << (n.line_search_failed ? "stalled (no decrease along its direction)"
+                             : "stopped at its iteration cap")
+    << " after " << n.iterations << " iterations at relative residual " << n.relative_residual
+    << " (newton_tolerance " << settings_.newton_tolerance << ", newton_max_iterations "
+    << settings_.newton_max_iterations << ")";
+  const bool close = n.relative_residual <= 10 * settings_.newton_tolerance;
+  if (close) {
+    if (report.health == StepHealth::kOk) report.health = StepHealth::kSolverNotConverged;
+  } else {
+    report.health = StepHealth::kSolverFailed;
+    s << ": the step is not a backward-Euler step; reduce dt or raise newton_max_iterations";
+  }
+  report.message += (report.message.empty() ? "" : "; ") + s.str();
+}
+
+}  // namespace torsion
