@@ -68,6 +68,19 @@ Material readMaterial(const JsonObject& m) {
     m.fail("volumetric_strain",
            "'" + volumetric + "' is not a volumetric strain (element or nodal_average)");
   }
+  const std::string law = m.string("law", toString(material.law));
+  if (auto kind = parseMaterialLaw(law)) {
+    material.law = *kind;
+  } else {
+    m.fail("law",
+           "'" + law + "' is not a material law (corotated, stable_neo_hookean or mooney_rivlin)");
+  }
+  material.mooney_rivlin_c2_fraction =
+      m.number("mooney_rivlin_c2_fraction", material.mooney_rivlin_c2_fraction);
+  if (material.hyperelastic() && material.volumetric_strain == VolumetricStrain::kNodalAverage) {
+    m.fail("volumetric_strain", std::string("nodal_average is a corotated option (law ") +
+                                    toString(material.law) + " takes element)");
+  }
   m.finish();
   Status valid = material.validate();
   if (!valid) failValidation(m, "material", valid.error());
@@ -338,6 +351,10 @@ BodySpec readBody(const JsonObject& b, const SceneSpec& scene, const std::string
   if (body.element == ElementKind::kTet10 &&
       body.material.volumetric_strain == VolumetricStrain::kNodalAverage) {
     b.fail("material", "volumetric_strain nodal_average is a tet4 option (tet10 does not lock)");
+  }
+  if (body.element == ElementKind::kTet10 && body.material.hyperelastic()) {
+    b.fail("material",
+           std::string("law ") + toString(body.material.law) + " is stepped on tet4 elements only");
   }
   if (b.has("self_contact")) {
     const JsonObject c = b.object("self_contact");
