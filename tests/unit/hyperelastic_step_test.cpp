@@ -8,6 +8,7 @@
 
 #include <Eigen/Geometry>
 
+#include "torsion/bullet/fem_world.h"
 #include "torsion/fem/corotated_element.h"
 #include "torsion/fem/hyperelastic.h"
 #include "torsion/mesh/box_mesh.h"
@@ -222,6 +223,41 @@ TEST(HyperelasticStep, UnconvergedNewtonIsReported) {
   EXPECT_FALSE(s.report.newton.converged);
   EXPECT_NE(s.report.health, StepHealth::kOk);
   EXPECT_NE(s.report.message.find("Newton"), std::string::npos) << s.report.message;
+}
+
+// In a world: a hanging hyperelastic bar steps with its top held; dropped onto the ground it fails
+// its step at the first contact, naming the law (no contact solve for it yet), instead of falling
+// through or being stepped without its contacts.
+TEST(HyperelasticStep, ContactEndsTheStepAsAFailureNamingTheLaw) {
+  const TetMesh mesh =
+      makeBoxTetMesh(Eigen::Vector3d(0, 0, 0), Eigen::Vector3d(0.2, 0.2, 0.4), 2, 2, 4).value();
+  {
+    FemWorld world{WorldSettings{}};
+    FemBody* bar = world.addBody("bar", mesh, rubber(MaterialLaw::kStableNeoHookean)).value();
+    std::vector<int> top;
+    for (int i = 0; i < mesh.nodeCount(); ++i)
+      if (mesh.restPositions()[static_cast<size_t>(i)].z() > 0.4 - 1e-9) top.push_back(i);
+    bar->carryNodes(
+        "top", top, [](double) { return Frame{}; }, 0);
+    for (int k = 0; k < 20; ++k) {
+      const WorldStepReport r = world.step();
+      ASSERT_TRUE(r.ok) << r.message;
+    }
+    EXPECT_TRUE(bar->lastReport().newton.converged);
+    EXPECT_LT(bar->state().positions.minCoeff(), -1e-4) << "it sags under gravity";
+  }
+  FemWorld world{WorldSettings{}};
+  Frame above;
+  above.origin = Eigen::Vector3d(0, 0, 0.05);
+  world.addBody("bar", mesh, rubber(MaterialLaw::kMooneyRivlin), above).value();
+  world.addRigidBody(std::make_unique<btStaticPlaneShape>(btVector3(0, 0, 1), 0), 0.0,
+                     btTransform::getIdentity());
+  WorldStepReport r;
+  for (int k = 0; k < 100 && r.ok; ++k)
+    r = world.step();
+  EXPECT_FALSE(r.ok);
+  EXPECT_NE(r.message.find("corotated bodies only"), std::string::npos) << r.message;
+  EXPECT_NE(r.message.find("mooney_rivlin"), std::string::npos) << r.message;
 }
 
 }  // namespace

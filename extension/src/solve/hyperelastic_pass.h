@@ -6,6 +6,7 @@
 // Private to the implicit step (solve/implicit_stepper.h).
 
 #include <Eigen/Core>
+#include <utility>
 #include <vector>
 
 #include "torsion/fem/fem_model.h"
@@ -41,12 +42,16 @@ class HyperelasticPass {
   const std::vector<Eigen::Vector3d>& elementForces() const { return forces_; }
   /// One per tet: d2E/dx2, N/m (the last evaluate() with stiffness).
   const std::vector<TetStiffness>& elementStiffnesses() const { return stiffness_; }
+  /// Keeps the last evaluate()'s stiffnesses as the step's start stiffnesses (a swap, no copy);
+  /// the next evaluate() with stiffness writes elsewhere.
+  void keepAsStartStiffnesses() { std::swap(stiffness_, start_stiffness_); }
+  const std::vector<TetStiffness>& startStiffnesses() const { return start_stiffness_; }
   /// Tets below the volume barrier's threshold at the last evaluate().
   int barrierTets() const { return barrier_tets_; }
 
  private:
   std::vector<Eigen::Vector3d> forces_;
-  std::vector<TetStiffness> stiffness_;
+  std::vector<TetStiffness> stiffness_, start_stiffness_;
   std::vector<double> energy_;
   std::vector<unsigned char> in_barrier_;
   int barrier_tets_ = 0;

@@ -37,7 +37,8 @@ double ImplicitStepper::computeHyperelasticForces(const FemState& state) {
   barrier_tets_ = hyperelastic_->barrierTets();
   system_.setStiffnessAdditions({});
   system_.setLaggedStiffness(nullptr, 0.0);
-  system_.setElementStiffnesses(&hyperelastic_->elementStiffnesses());
+  hyperelastic_->keepAsStartStiffnesses();
+  system_.setElementStiffnesses(&hyperelastic_->startStiffnesses());
   system_.gather(hyperelastic_->elementForces(), 1.0, elastic_forces_);
   return energy;
 }
@@ -181,6 +182,12 @@ LinearSolveReport ImplicitStepper::solveNewton() {
     }
   }
   if (total.breakdown) newton_.converged = false;
+  // The operator goes back to the step's first system (K_n, as a corotated body's holds its
+  // step's K): what a later query of it (PatchStiffness, the haptic K_h) linearises about.
+  system_.setElementStiffnesses(&hyperelastic_->startStiffnesses());
+  system_.setLaggedStiffness(nullptr, 0.0);
+  system_.setCoefficients(1.0 + dt * material.mass_damping,
+                          dt * dt + dt * material.stiffness_damping);
   // Exact internal forces at the end of the step: f(x') - beta K_n v'.
   internal_forces_ = iterate_forces_ - material.stiffness_damping * lagged_product_;
   internal_forces_valid_ = true;

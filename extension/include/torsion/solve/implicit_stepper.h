@@ -37,9 +37,10 @@
 // prescribed components of dv zero (the same CG or CHOLMOD), K(x) the exact Hessian or, where
 // that system is not positive definite, the projected one, and backtracks along dv until Phi
 // decreases enough (Armijo). It stops when |S r| <= newton_tolerance (|S(b - A v_prescribed)| +
-// dt |f(x_n)|) (SolverSettings); StepReport::newton says how it went, and an unconverged step is a warning
-// within 10x the tolerance and fatal above. Internal forces are then exact at the end of the step:
-// f_int = f(x') - beta K_n v'.
+// dt |f(x_n)|) (SolverSettings); StepReport::newton says how it went, and an unconverged step is
+// a warning within 10x the tolerance and fatal above. Internal forces are then exact at the end
+// of the step, f_int = f(x') - beta K_n v', and the operator (system()) holds the step's first
+// system again, with K_n.
 
 #include <Eigen/Core>
 #include <memory>
