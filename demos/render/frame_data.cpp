@@ -4,14 +4,41 @@
 #include <cmath>
 
 #include "torsion/fem/corotated_element.h"
+#include "torsion/fem/hyperelastic.h"
 
 namespace torsion::render {
+
+namespace {
+
+double vonMises(const Eigen::Matrix3d& s) {
+  const double vm2 =
+      0.5 * ((s(0, 0) - s(1, 1)) * (s(0, 0) - s(1, 1)) + (s(1, 1) - s(2, 2)) * (s(1, 1) - s(2, 2)) +
+             (s(2, 2) - s(0, 0)) * (s(2, 2) - s(0, 0))) +
+      3 * (s(0, 1) * s(0, 1) + s(1, 2) * s(1, 2) + s(0, 2) * s(0, 2));
+  return std::sqrt(std::max(0.0, vm2));
+}
+
+// The Cauchy stress of a hyperelastic law, sigma = P F^T / J (P F^T at J <= 0: an inverted tet
+// has no Cauchy stress, its Kirchhoff stress still shows the load).
+template <class Law>
+Eigen::Matrix3d cauchyStress(const Law& law, const Eigen::Matrix3d& F) {
+  const double J = F.determinant();
+  const Eigen::Matrix3d tau = firstPiola(law, F) * F.transpose();
+  return J > 0 ? Eigen::Matrix3d(tau / J) : tau;
+}
+
+}  // namespace
 
 std::vector<double> tetVonMises(const FemBody& body) {
   const FemModel& model = body.model();
   const TetMesh& mesh = model.mesh();
   const FemState& state = body.state();
-  const double mu = model.material().mu(), lambda = model.material().lambda();
+  const Material& material = model.material();
+  const double mu = material.mu(), lambda = material.lambda();
+  const StableNeoHookean neo_hookean =
+      StableNeoHookean::fromYoungPoisson(material.youngs_modulus, material.poisson_ratio);
+  const MooneyRivlin mooney_rivlin = MooneyRivlin::fromYoungPoisson(
+      material.youngs_modulus, material.poisson_ratio, material.mooney_rivlin_c2_fraction);
   std::vector<double> result(static_cast<size_t>(mesh.tetCount()));
   for (int t = 0; t < mesh.tetCount(); ++t) {
     const Tet& tet = mesh.tets()[static_cast<size_t>(t)];
@@ -20,6 +47,14 @@ std::vector<double> tetVonMises(const FemBody& body) {
       x[static_cast<size_t>(a)] = state.position(tet[static_cast<size_t>(a)]);
     const Eigen::Matrix3d F =
         deformationGradient(x, model.tetRestData()[static_cast<size_t>(t)].rest_shape_inverse);
+    if (material.law == MaterialLaw::kStableNeoHookean) {
+      result[static_cast<size_t>(t)] = vonMises(cauchyStress(neo_hookean, F));
+      continue;
+    }
+    if (material.law == MaterialLaw::kMooneyRivlin) {
+      result[static_cast<size_t>(t)] = vonMises(cauchyStress(mooney_rivlin, F));
+      continue;
+    }
     // The rotation of the element the tet belongs to (tet10: the sub-tet's element).
     const size_t element = static_cast<size_t>(model.elementOfTet(t));
     const Eigen::Matrix3d R = element < state.element_rotations.size()
@@ -27,12 +62,8 @@ std::vector<double> tetVonMises(const FemBody& body) {
                                   : Eigen::Matrix3d::Identity();
     const Eigen::Matrix3d RtF = R.transpose() * F;
     const Eigen::Matrix3d eps = 0.5 * (RtF + RtF.transpose()) - Eigen::Matrix3d::Identity();
-    const Eigen::Matrix3d s = 2 * mu * eps + lambda * eps.trace() * Eigen::Matrix3d::Identity();
-    const double vm2 = 0.5 * ((s(0, 0) - s(1, 1)) * (s(0, 0) - s(1, 1)) +
-                              (s(1, 1) - s(2, 2)) * (s(1, 1) - s(2, 2)) +
-                              (s(2, 2) - s(0, 0)) * (s(2, 2) - s(0, 0))) +
-                       3 * (s(0, 1) * s(0, 1) + s(1, 2) * s(1, 2) + s(0, 2) * s(0, 2));
-    result[static_cast<size_t>(t)] = std::sqrt(std::max(0.0, vm2));
+    result[static_cast<size_t>(t)] =
+        vonMises(2 * mu * eps + lambda * eps.trace() * Eigen::Matrix3d::Identity());
   }
   return result;
 }

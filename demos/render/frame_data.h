@@ -72,8 +72,9 @@ struct FrameData {
   scene::CameraSpec camera;          ///< the scene's camera wishes (frameCamera)
 };
 
-/// Von Mises stress of the corotated linear material per tet, Pa: sigma = 2 mu eps +
-/// lambda tr(eps) I with eps = sym(R^T F) - I, R the tet's rotation of the last step.
+/// Von Mises stress per tet, Pa: of the corotated linear material, sigma = 2 mu eps +
+/// lambda tr(eps) I with eps = sym(R^T F) - I, R the tet's rotation of the last step; of a
+/// hyperelastic law (Material::law), its Cauchy stress P F^T / J.
 std::vector<double> tetVonMises(const FemBody& body);
 
 /// The smallest of 1, 2, 2.5, 5 times a power of ten that is >= value (> 0): a legend's top.
