@@ -147,3 +147,22 @@ def test_an_empty_world_steps_and_refuses_to_write_a_mesh_it_does_not_have(tmp_p
         world.write_vtk(str(tmp_path / "x.vtk"))
     with pytest.raises(KeyError):
         world.body("nothing")
+
+
+def test_a_hyperelastic_law_is_chosen_by_name_and_steps(assets):
+    mooney = torsion.Material(nu=0.45, law="mooney_rivlin", mooney_rivlin_c2_fraction=0.25)
+    assert mooney.law == "mooney_rivlin" and mooney.mooney_rivlin_c2_fraction == 0.25
+    assert torsion.Material().law == "corotated"
+    with pytest.raises(ValueError, match="law"):
+        torsion.Material(law="neo")
+    with pytest.raises(ValueError, match="mooney_rivlin_c2_fraction"):
+        torsion.Material(law="mooney_rivlin", mooney_rivlin_c2_fraction=2.0)
+    # Falling freely (nothing to touch), the body moves as a rigid one: backward Euler drops it
+    # by g dt^2 k (k + 1) / 2 in k steps.
+    world = torsion.World(threads=1)
+    body = world.add_body("c", str(assets / "cylinder_2430.node"),
+                          material=torsion.Material(nu=0.45, law="stable_neo_hookean"))
+    z0 = body.positions[:, 2].mean()
+    world.step(10)
+    drop = z0 - body.positions[:, 2].mean()
+    assert drop == pytest.approx(9.81 * 0.01**2 * 10 * 11 / 2, rel=1e-5)  # backward Euler

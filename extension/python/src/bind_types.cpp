@@ -83,7 +83,8 @@ void bindTypes(py::module_& m) {
   py::class_<Material>(m, "Material", "Linear elastic material, SI units.")
       .def(py::init([](double E, double nu, double rho, double mass_damping,
                        double stiffness_damping, const std::string& volumetric_strain,
-                       double barrier_threshold, double barrier_stiffness) {
+                       double barrier_threshold, double barrier_stiffness, const std::string& law,
+                       double mooney_rivlin_c2_fraction) {
              Material mat;
              mat.youngs_modulus = E;
              mat.poisson_ratio = nu;
@@ -98,6 +99,14 @@ void bindTypes(py::module_& m) {
              mat.volumetric_strain = *kind;
              mat.barrier_threshold = barrier_threshold;
              mat.barrier_stiffness = barrier_stiffness;
+             std::optional<MaterialLaw> law_kind = parseMaterialLaw(law);
+             if (!law_kind) {
+               throw py::value_error("material: law '" + law +
+                                     "': expected 'corotated', 'stable_neo_hookean' or "
+                                     "'mooney_rivlin'");
+             }
+             mat.law = *law_kind;
+             mat.mooney_rivlin_c2_fraction = mooney_rivlin_c2_fraction;
              if (Status valid = mat.validate(); !valid)
                throw py::value_error(valid.error().message);
              return mat;
@@ -107,10 +116,14 @@ void bindTypes(py::module_& m) {
            py::arg("volumetric_strain") = "element",
            py::arg("barrier_threshold") = Material{}.barrier_threshold,
            py::arg("barrier_stiffness") = Material{}.barrier_stiffness,
+           py::arg("law") = "corotated",
+           py::arg("mooney_rivlin_c2_fraction") = Material{}.mooney_rivlin_c2_fraction,
            "E: Young's modulus, Pa; nu: Poisson's ratio in [0, 0.5); rho: density, kg/m^3; "
            "mass_damping: 1/s; stiffness_damping: s; barrier_threshold: the volume ratio J below "
            "which the volume barrier against inverted tets acts, in [0, 1), 0 turns it off; "
-           "barrier_stiffness: its pressure at J = 0 in bulk moduli.")
+           "barrier_stiffness: its pressure at J = 0 in bulk moduli; law: 'corotated', "
+           "'stable_neo_hookean' or 'mooney_rivlin' (hyperelastic: tet4, no contact; "
+           "docs/materials.md); mooney_rivlin_c2_fraction: C2 / (C1 + C2) in [0, 1].")
       .def_readonly("E", &Material::youngs_modulus, "Young's modulus, Pa")
       .def_readonly("nu", &Material::poisson_ratio, "Poisson's ratio")
       .def_readonly("rho", &Material::density, "density, kg/m^3")
@@ -122,6 +135,9 @@ void bindTypes(py::module_& m) {
                     "volume ratio J below which the volume barrier acts (0: off)")
       .def_readonly("barrier_stiffness", &Material::barrier_stiffness,
                     "the barrier's pressure at J = 0, in bulk moduli")
+      .def_property_readonly("law", [](const Material& mat) { return toString(mat.law); })
+      .def_readonly("mooney_rivlin_c2_fraction", &Material::mooney_rivlin_c2_fraction,
+                    "C2 / (C1 + C2) of the Mooney-Rivlin law")
       .def_property_readonly("shear_modulus", &Material::mu, "G, Pa")
       .def("__repr__", [](const Material& mat) {
         return "Material(E=" + std::to_string(mat.youngs_modulus) +

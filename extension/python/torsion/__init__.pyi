@@ -51,11 +51,14 @@ class Material:
     """Linear elastic material: E (Pa), nu, rho (kg/m^3), mass_damping (1/s),
     stiffness_damping (s), volumetric_strain "element" | "nodal_average", and the volume
     barrier against inverted tets: barrier_threshold (J below which it acts, 0: off),
-    barrier_stiffness (its pressure at J = 0, in bulk moduli)."""
+    barrier_stiffness (its pressure at J = 0, in bulk moduli); law "corotated" |
+    "stable_neo_hookean" | "mooney_rivlin" (hyperelastic: tet4, no contact) and
+    mooney_rivlin_c2_fraction (C2 / (C1 + C2))."""
     def __init__(self, E: float = 1e5, nu: float = 0.3, rho: float = 1000.0,
                  mass_damping: float = 0.0, stiffness_damping: float = 0.01,
                  volumetric_strain: str = "element", barrier_threshold: float = 0.3,
-                 barrier_stiffness: float = 30.0) -> None: ...
+                 barrier_stiffness: float = 30.0, law: str = "corotated",
+                 mooney_rivlin_c2_fraction: float = 0.5) -> None: ...
     E: float
     nu: float
     rho: float
@@ -64,6 +67,8 @@ class Material:
     volumetric_strain: str
     barrier_threshold: float
     barrier_stiffness: float
+    law: str
+    mooney_rivlin_c2_fraction: float
     shear_modulus: float  # Pa
 
 class State:
