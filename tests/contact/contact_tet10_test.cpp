@@ -228,5 +228,30 @@ TEST(ContactTet10, ABoxLandingOnASlabInContactSpaceConvergesEveryStep) {
   EXPECT_LT(run.off_centre, 1e-3);
 }
 
+// The resting box of BoxRestsOnSlabWithConvergedSag on the same tet10 slab, solved by the convex
+// solve (docs/contact-solve.md, "The convex solve in the step"): every step converges, the box
+// rests above the slab, centred, and its sag is the slab's static equilibrium on the same mesh.
+// 2 s: the landing and the settling.
+TEST(ContactTet10, ABoxRestsOnATet10SlabInTheConvexSolve) {
+  PunchProblem p;
+  p.punch_half_width = 0.27;
+  p.load = 20 * kGravity;
+  p.material = softMaterial(2e4, 100);
+  const double row = p.punch_half_width - 0.001;
+  const RestingBoxRun run = runRestingBox(p, 8, 2, ElementKind::kTet10, 2.0, row,
+                                          ContactSettings::FrictionSolve::kConvex);
+  const PunchSolution same_mesh = staticPunchSag(p, 8, 2, ElementKind::kTet10, row);
+  std::cout << "[figures] box on tet10 slab, convex solve: sag " << run.sag << " m, static "
+            << same_mesh.sag << " m, worst penetration " << run.worst_penetration
+            << " m, speed " << run.box_speed << " m/s, off centre " << run.off_centre
+            << " m, Newton iterations max " << run.most_active_set_iterations
+            << ", unconverged steps " << run.unconverged_steps << "\n";
+  EXPECT_EQ(run.unconverged_steps, 0);
+  EXPECT_LT(run.box_speed, 1e-3);
+  EXPECT_LT(run.off_centre, 1e-3);
+  EXPECT_LT(run.worst_penetration, 1e-4);
+  EXPECT_NEAR(run.sag, same_mesh.sag, 0.02 * same_mesh.sag);
+}
+
 }  // namespace
 }  // namespace torsion::test
