@@ -21,7 +21,7 @@ constexpr int kMaxStalls = 3;
 // interpolated distances to be a contact of its own (round-off on flat-on-flat is far below).
 constexpr double kDuplicateMargin = 1e-3;
 constexpr int kMaxSwitches = 1;
-constexpr int kMaxFrictionRefinements = 8;
+constexpr int kMaxFaceFrictionRefinements = 8;
 // m/s: a sliding face carried past the body faster than this by its friction sticks at once.
 constexpr double kCarriedPastSpeed = 0.01;
 // m: round-off between the nearest pair's and a supporting plane's predicted end gaps.
@@ -408,7 +408,7 @@ bool FaceContactSet::update(const Eigen::VectorXd& v, const std::vector<RigidPar
         c.state = FaceContact::State::kStick;
         ++c.switches;
       } else if (applied_friction - magnitude > 1e-2 * bound &&
-                 c.friction_refinements++ < kMaxFrictionRefinements) {
+                 c.friction_refinements++ < kMaxFaceFrictionRefinements) {
         again = true;
       }
       if (c.state != before || violation > gap_tolerance) again = true;
@@ -440,10 +440,10 @@ bool FaceContactSet::update(const Eigen::VectorXd& v, const std::vector<RigidPar
     // A sliding face's friction was set from the multiplier of the solve before; its normal
     // impulse in this solve (Lambda - rho h) can differ by rho times an end gap still within the
     // gap tolerance, a large part of a light body's weight on a soft slab. Until they agree
-    // within 1 % (or kMaxFrictionRefinements solves) the loop goes on, as for node friction.
+    // within 1 % (or kMaxFaceFrictionRefinements solves) the loop goes on, as for node friction.
     if (c.state == FaceContact::State::kSlide && before == FaceContact::State::kSlide &&
         c.friction > 0 && std::abs(bound - applied_friction) > 1e-2 * bound &&
-        c.friction_refinements++ < kMaxFrictionRefinements)
+        c.friction_refinements++ < kMaxFaceFrictionRefinements)
       again = true;
   }
   setSlipResistance(v, partners);

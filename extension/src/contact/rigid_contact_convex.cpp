@@ -36,8 +36,8 @@ double featureMatchRadius(const TetMesh& mesh) {
 
 // A partner's rows together carrying less than this share of the normal impulse the solve gave
 // them had too small a friction bound (contacts new to the solve: a landing): solved again.
-constexpr double kLaggedShare = 0.5;
-constexpr int kMaxFrictionRefinements = 2;
+constexpr double kLaggedShareToRaise = 0.5;
+constexpr int kMaxFrictionBoundRaises = 2;
 
 // The partner of each row (node or face row).
 std::vector<int> rowPartners(const sap::NodeContactIsland& island,
@@ -56,7 +56,7 @@ std::vector<int> rowPartners(const sap::NodeContactIsland& island,
 
 // The lagged model bounds each row's friction by mu times its last normal impulse; a contact new
 // to the solve has none, so a box landing on a slope slides freely in its first steps (+12 % of
-// Coulomb's distance on the soft incline). Where a partner's rows took less than kLaggedShare of
+// Coulomb's distance on the soft incline). Where a partner's rows took less than kLaggedShareToRaise of
 // the normal impulse the solve gave them, each row's bound is raised to the impulse just found,
 // and the island is solved again: a fixed point of mu gamma_n, reached for the rows that need it.
 // Returns whether any bound was raised.
@@ -71,7 +71,7 @@ bool raiseFrictionBounds(sap::NodeContactIsland& island, const std::vector<int>&
   bool raised = false;
   for (std::size_t r = 0; r < island.rows.size(); ++r) {
     const auto k = static_cast<std::size_t>(row_partner[r]);
-    if (!(lagged[k] < kLaggedShare * solved[k]) || island.rows[r].mu == 0) continue;
+    if (!(lagged[k] < kLaggedShareToRaise * solved[k]) || island.rows[r].mu == 0) continue;
     const double gamma_n = report.impulses[r].z();
     if (gamma_n > island.rows[r].lagged_normal_impulse) {
       island.rows[r].lagged_normal_impulse = gamma_n;
@@ -117,7 +117,7 @@ LinearSolveReport RigidContactSolver::solveConvex(const SystemOperator& op,
   }
   sap::SapReport report = sap::SapSolver().solve(created.value(), x);
   int newton = report.newton_iterations;
-  for (int round = 0; round < kMaxFrictionRefinements && report.converged &&
+  for (int round = 0; round < kMaxFrictionBoundRaises && report.converged &&
                       raiseFrictionBounds(island, row_partner, partners_.size(), report);
        ++round) {
     created = sap::SapProblem::create(sap::islandBodies(fem, island), island.rows, dt_);

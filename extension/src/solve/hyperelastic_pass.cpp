@@ -5,7 +5,7 @@
 namespace torsion {
 
 namespace {
-constexpr int kTetGrain = 128;
+constexpr int kHyperelasticTetGrain = 128;
 
 std::array<Eigen::Vector3d, 4> tetPositions(const Eigen::VectorXd& positions,
                                             const std::vector<int>& nodes, size_t t) {
@@ -58,7 +58,7 @@ double HyperelasticPass::evaluate(const FemModel& model, const Eigen::VectorXd& 
   energy_.resize(tets);
   in_barrier_.assign(tets, 0);
   if (stiffness) stiffness_.resize(tets);
-  parallel.forRange(static_cast<int>(tets), kTetGrain, [&](int begin, int end) {
+  parallel.forRange(static_cast<int>(tets), kHyperelasticTetGrain, [&](int begin, int end) {
     for (size_t t = static_cast<size_t>(begin); t < static_cast<size_t>(end); ++t) {
       const std::array<Eigen::Vector3d, 4> x = tetPositions(positions, nodes, t);
       // The stiffness (a 9x9 eigen-decomposition) only when asked: forces are the cheap part.
@@ -104,7 +104,7 @@ double HyperelasticPass::energy(const FemModel& model, const Eigen::VectorXd& po
   const std::vector<int>& nodes = model.elementNodes();
   const std::vector<TetRestData>& rest = model.tetRestData();
   energy_.resize(rest.size());
-  parallel.forRange(static_cast<int>(rest.size()), kTetGrain, [&](int begin, int end) {
+  parallel.forRange(static_cast<int>(rest.size()), kHyperelasticTetGrain, [&](int begin, int end) {
     for (size_t t = static_cast<size_t>(begin); t < static_cast<size_t>(end); ++t) {
       const Eigen::Matrix3d F =
           deformationGradient(tetPositions(positions, nodes, t), rest[t].rest_shape_inverse);
