@@ -289,6 +289,83 @@ TEST(CheckpointIo, AnotherWorldIsNamedAsSuch) {
       << read.error().message;
 }
 
+// A world like the rig's but for one difference, which the refusal must name.
+struct OtherWorld {
+  OtherWorld() : world(test::checkpointWorldSettings()) {}
+  FemBody* add(const std::string& name, double x = 0) {
+    Material material;
+    material.youngs_modulus = 2e4;
+    return world
+        .addBody(name,
+                 makeBoxTetMesh({x - 0.2, -0.2, 0.02}, {x + 0.2, 0.2, 0.42}, 2, 2, 2).value(),
+                 material)
+        .value();
+  }
+  FemWorld world;
+};
+
+std::string refusal(const std::string& bytes, FemWorld& world, const std::vector<Hand*>& hands) {
+  Result<StoredCheckpoint> read = readCheckpoint(bytes, world, hands);
+  return read.ok() ? std::string("(read)") : read.error().message;
+}
+
+TEST(CheckpointIo, AnotherWorldsCheckpointInMemoryIsRefusedAsSuch) {
+  BlockRig rig;
+  rig.step();
+  OtherWorld other;  // the rig's block and slab, but another world's
+  other.add("block");
+  btTransform slab;
+  slab.setIdentity();
+  slab.setOrigin(btVector3(0, 0, btScalar(-0.5)));
+  other.world.addRigidBody(std::make_unique<btBoxShape>(btVector3(2, 2, btScalar(0.5))), 0.0, slab);
+  const Status restored = other.world.restore(rig.world_.checkpoint());
+  ASSERT_FALSE(restored.ok());
+  EXPECT_NE(restored.error().message.find("not in this world (removed since, or the checkpoint is "
+                                          "another world's"),
+            std::string::npos)
+      << restored.error().message;
+}
+
+TEST(CheckpointIo, AWorldWithoutTheHandIsToldTheHandItLacks) {
+  BlockRig rig;
+  rig.step();
+  OtherWorld other;
+  other.add("block");
+  EXPECT_EQ(refusal(rig.save(), other.world, {}),
+            "the checkpoint was saved from another world: it has 1 hand (the first 'hand' on "
+            "body 'block'), this world none");
+}
+
+TEST(CheckpointIo, AWorldWithAnExtraBodyIsToldWhichBody) {
+  BlockRig rig;
+  rig.step();
+  OtherWorld other;
+  FemBody* block = other.add("block");
+  other.add("extra", 2.0);
+  Hand hand(*block);
+  EXPECT_EQ(refusal(rig.save(), other.world, {&hand}),
+            "the checkpoint was saved from another world: it has 1 FEM body: 'block'; this "
+            "world also has 'extra'");
+}
+
+TEST(CheckpointIo, AWorldWithoutASavedBodyIsToldItsNameAndItsOwnBodies) {
+  BlockRig rig;
+  rig.step();
+  OtherWorld other;
+  FemBody* cube = other.add("cube");
+  Hand hand(*cube, "hand");
+  EXPECT_EQ(refusal(rig.save(), other.world, {&hand}),
+            "the checkpoint was saved from another world: its hand 0 is 'hand' on body 'block', "
+            "here 'hand' on body 'cube'");
+  OtherWorld handless;
+  handless.add("cube");
+  BlockRig plain;
+  const std::string bytes = test::saveBytes(plain.world_, {}, "x");
+  EXPECT_EQ(refusal(bytes, handless.world, {}),
+            "the checkpoint was saved from another world: its body 'block' is not in this world "
+            "(1 FEM body: 'cube')");
+}
+
 }  // namespace
 }  // namespace torsion
 

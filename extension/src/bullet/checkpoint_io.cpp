@@ -377,6 +377,21 @@ void writeBody(Writer& w, FemWorld& world, const FemBody& body, const FemBodyChe
   writeReport(w, c.last_report);
 }
 
+// "1 hand", "2 hands", "none".
+std::string counted(size_t n, const std::string& one, const std::string& many = "") {
+  if (n == 0) return "none";
+  if (n == 1) return "1 " + one;
+  return std::to_string(n) + " " + (many.empty() ? one + "s" : many);
+}
+
+// ": 'a', 'b'" (nothing for an empty list): the parts a message names.
+std::string listed(const std::vector<std::string>& parts) {
+  std::string out;
+  for (const std::string& part : parts)
+    out += (out.empty() ? ": " : ", ") + part;
+  return out;
+}
+
 std::string anotherWorld(const std::string& why) {
   return "the checkpoint was saved from another world: " + why;
 }
@@ -676,8 +691,20 @@ Result<StoredCheckpoint> readCheckpoint(std::string_view bytes, FemWorld& world,
   const size_t hand_count = r.count(8);
   if (!r.ok()) return unreadable(r);
   if (hand_count != hands.size()) {
-    return Error{anotherWorld("it has " + std::to_string(hand_count) + " hands, this world " +
-                              std::to_string(hands.size()))};
+    std::vector<std::string> here;
+    here.reserve(hands.size());
+    for (const Hand* hand : hands)
+      here.push_back("'" + hand->name() + "' on body '" + hand->body().name() + "'");
+    // A hand's record starts with its name and body's: the first can be read (the others lie
+    // behind its data).
+    std::string first;
+    if (hand_count > 0) {
+      Reader peek = r;
+      const std::string name = peek.str(), body = peek.str();
+      if (peek.ok()) first = " (the first '" + name + "' on body '" + body + "')";
+    }
+    return Error{anotherWorld("it has " + counted(hand_count, "hand") + first + ", this world " +
+                              counted(hands.size(), "hand") + listed(here))};
   }
   for (size_t h = 0; h < hand_count; ++h) {
     const std::string name = r.str(), body = r.str();
@@ -708,18 +735,37 @@ Result<StoredCheckpoint> readCheckpoint(std::string_view bytes, FemWorld& world,
 
   const size_t body_count = r.count(8);
   if (!r.ok()) return unreadable(r);
-  if (body_count != world.bodies().size()) {
-    return Error{anotherWorld("it has " + std::to_string(body_count) + " FEM bodies, this world " +
-                              std::to_string(world.bodies().size()))};
-  }
+  std::vector<std::string> names_here;
+  names_here.reserve(world.bodies().size());
+  for (const auto& body : world.bodies())
+    names_here.push_back("'" + body->name() + "'");
+  // Matched by name, each read onto its body here (a record cannot be skipped unread): a saved
+  // body missing here is named when it comes, bodies here that were not saved at the end.
   for (size_t b = 0; b < body_count; ++b) {
     const std::string name = r.str();
     if (!r.ok()) return unreadable(r);
     FemBody* body = world.body(name);
-    if (body == nullptr) return Error{anotherWorld("this world has no body '" + name + "'")};
+    if (body == nullptr) {
+      return Error{anotherWorld("its body '" + name + "' is not in this world (" +
+                                counted(world.bodies().size(), "FEM body", "FEM bodies") +
+                                listed(names_here) + ")")};
+    }
     Result<FemBodyCheckpoint> saved = readBody(r, world, *body, hands, stored.hands);
     if (!saved) return saved.error();
     fem.bodies.emplace_back(body, std::move(saved).value());
+  }
+  if (body_count != world.bodies().size()) {
+    std::vector<std::string> unsaved, saved;
+    for (const auto& body : world.bodies()) {
+      const bool in_checkpoint =
+          std::any_of(fem.bodies.begin(), fem.bodies.end(),
+                      [&body](const auto& entry) { return entry.first == body.get(); });
+      (in_checkpoint ? saved : unsaved).push_back("'" + body->name() + "'");
+    }
+    if (unsaved.empty()) return unreadable(r);  // a body saved twice
+    return Error{anotherWorld("it has " + counted(body_count, "FEM body", "FEM bodies") +
+                              listed(saved) + "; this world also has " +
+                              listed(unsaved).substr(2))};
   }
 
   const size_t pair_count = r.count(16);

@@ -167,7 +167,10 @@ Status FemSoftBodySolver::restore(const FemCheckpoint& c) {
   for (const auto& [body, saved] : c.bodies) {
     if (std::none_of(bodies_.begin(), bodies_.end(),
                      [body = body](const std::unique_ptr<FemBody>& b) { return b.get() == body; }))
-      return Error{"restore: a body of the checkpoint has been removed since"};
+      return Error{
+          "restore: a body of the checkpoint is not in this world (removed since, or the "
+          "checkpoint is another world's; readCheckpoint reads its bytes for this world, naming "
+          "what differs)"};
   }
   for (const auto& [body, saved] : c.bodies)
     const_cast<FemBody*>(body)->restore(saved);
