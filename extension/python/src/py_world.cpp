@@ -1,6 +1,10 @@
 #include "py_world.h"
 
+#include <atomic>
 #include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <sstream>
 
 #include "arithmetic_bounds.h"
 #include "json_reader.h"
@@ -115,14 +119,35 @@ Result<std::unique_ptr<PyWorld>> PyWorld::fromScene(const std::string& name_or_p
   }
   std::unique_ptr<PyWorld> world(new PyWorld());
   world->scene_ = std::move(built).value();
+  world->scene_source_ = name_or_path;
+  world->scene_threads_ = threads;
+  world->devices_overridden_ = !devices.devices.empty() || !devices.haptics.empty();
+  world->recordBuiltMaterials();
   return world;
 }
 
-PyWorld::PyWorld(const WorldSettings& settings) : scene_(std::make_unique<scene::BuiltScene>()) {
+namespace {
+
+std::uint64_t nextWorldId() {
+  static std::atomic<std::uint64_t> next{1};
+  return next++;
+}
+
+}  // namespace
+
+PyWorld::PyWorld() : id_(nextWorldId()) {}
+
+PyWorld::PyWorld(const WorldSettings& settings)
+    : scene_(std::make_unique<scene::BuiltScene>()), id_(nextWorldId()) {
   scene_->spec.file = "<python>";
   scene_->spec.name = "python";
   scene_->spec.world = settings;
   scene_->world = std::make_unique<FemWorld>(settings);
+}
+
+void PyWorld::recordBuiltMaterials() {
+  for (const auto& body : world().bodies())
+    built_materials_.try_emplace(body->name(), body->model().material());
 }
 
 Result<Ok> PyWorld::step(int n, FailureKind* kind, const std::function<bool()>& interrupted) {
@@ -242,7 +267,12 @@ Result<FemBody*> PyWorld::addBody(const std::string& name, const TetMesh& mesh,
                                   const Material& material, const Frame& pose,
                                   ElementKind element) {
   if (Status s = checkName("body", name, false); !s) return s.error();
-  return world().addBody(name, mesh, material, pose, element);
+  Result<FemBody*> body = world().addBody(name, mesh, material, pose, element);
+  if (body) {
+    parts_added_ = true;
+    recordBuiltMaterials();
+  }
+  return body;
 }
 
 Result<int> PyWorld::addNodeSet(const std::string& name, FemBody& body, std::vector<int> nodes,
@@ -266,6 +296,7 @@ Result<int> PyWorld::addNodeSet(const std::string& name, FemBody& body, std::vec
   handle.group = body.carryNodes(name, std::move(nodes),
                                  FrameMotion([](double) { return Frame{}; }), world().time());
   scene_->node_sets.push_back(handle);
+  parts_added_ = true;
   return static_cast<int>(scene_->node_sets.size()) - 1;
 }
 
@@ -276,6 +307,7 @@ Result<Hand*> PyWorld::addHand(FemBody& body, const std::string& name,
     taken = taken || hand->name() == name;
   if (Status s = checkName("hand", name, taken); !s) return s.error();
   own_hands_.push_back(std::make_unique<Hand>(body, name, settings));
+  parts_added_ = true;
   return own_hands_.back().get();
 }
 
@@ -306,6 +338,7 @@ Result<btRigidBody*> PyWorld::addRigidBody(const scene::RigidBodySpec& spec, boo
   scene::SceneRigidBody added = scene::addSceneRigidBody(world(), spec);
   btRigidBody* body = added.body;
   if (!ground) scene_->rigid_bodies.push_back(std::move(added));
+  parts_added_ = true;
   return body;
 }
 
@@ -343,23 +376,87 @@ Result<PyWorldState> PyWorld::saveState() {
   state.node_set_count = scene_->node_sets.size();
   state.failure = failure_;
   state.time = state.world.fem.time;
+  state.source = id_;
   return state;
 }
 
+namespace {
+
+// The material values a body is built with, as a line of the Python fields: "E nu rho
+// mass_damping stiffness_damping volumetric_strain barrier_threshold barrier_stiffness", each
+// number in hexadecimal floating point (exact).
+std::string materialLine(const Material& m) {
+  std::string line;
+  for (double v :
+       {m.youngs_modulus, m.poisson_ratio, m.density, m.mass_damping, m.stiffness_damping}) {
+    char text[40];
+    std::snprintf(text, sizeof text, "%a ", v);
+    line += text;
+  }
+  line += toString(m.volumetric_strain);
+  for (double v : {m.barrier_threshold, m.barrier_stiffness}) {
+    char text[40];
+    std::snprintf(text, sizeof text, " %a", v);
+    line += text;
+  }
+  return line;
+}
+
+// What differs between the materials a body was built with in the saved world (`saved`, a
+// materialLine) and here (`here`), e.g. "E 100000 Pa in the checkpoint, 200000 Pa here".
+std::string materialDifference(const std::string& saved, const Material& here) {
+  std::istringstream in(saved);
+  std::string field[8];
+  for (std::string& f : field)
+    in >> f;
+  const char* names[] = {"E", "nu", "rho", "mass_damping", "stiffness_damping"};
+  const char* units[] = {" Pa", "", " kg/m^3", " 1/s", " s"};
+  const double values[] = {here.youngs_modulus, here.poisson_ratio, here.density, here.mass_damping,
+                           here.stiffness_damping};
+  std::string out;
+  auto add = [&out](const std::string& part) { out += (out.empty() ? "" : ", ") + part; };
+  for (int k = 0; k < 5; ++k) {
+    const double was = std::strtod(field[k].c_str(), nullptr);
+    if (was != values[k]) {
+      add(std::string(names[k]) + " " + formatNumber(was) + units[k] + " in the checkpoint, " +
+          formatNumber(values[k]) + units[k] + " here");
+    }
+  }
+  if (field[5] != toString(here.volumetric_strain))
+    add("volumetric_strain " + field[5] + " in the checkpoint, " +
+        toString(here.volumetric_strain) + " here");
+  const double barrier[] = {here.barrier_threshold, here.barrier_stiffness};
+  const char* barrier_names[] = {"barrier_threshold", "barrier_stiffness"};
+  for (int k = 0; k < 2; ++k) {
+    const double was = std::strtod(field[6 + k].c_str(), nullptr);
+    if (was != barrier[k]) {
+      add(std::string(barrier_names[k]) + " " + formatNumber(was) + " in the checkpoint, " +
+          formatNumber(barrier[k]) + " here");
+    }
+  }
+  return out.empty() ? "its material differs" : out;
+}
+
+}  // namespace
+
 // PyWorldState's own fields travel as the checkpoint's extra bytes: "<node sets>\n<released
-// flags as 0 and 1>\n<failure>".
+// flags as 0 and 1>\n<body count>\n<per body: name\n materialLine\n><failure>".
 std::string PyWorld::serialize(const PyWorldState& state) {
   std::string extra = std::to_string(state.node_set_count) + "\n";
   for (bool released : state.released)
     extra += released ? '1' : '0';
-  extra += "\n" + state.failure;
+  extra += "\n" + std::to_string(built_materials_.size()) + "\n";
+  for (const auto& [name, material] : built_materials_)
+    extra += name + "\n" + materialLine(material) + "\n";
+  extra += state.failure;
   return writeCheckpoint(world(), state.world, hands(), state.hands, extra);
 }
 
 namespace {
 
 Result<PyWorldState> deserialize(const std::string& bytes, FemWorld& world,
-                                 const std::vector<Hand*>& hands, size_t scene_hands) {
+                                 const std::vector<Hand*>& hands, size_t scene_hands,
+                                 const std::map<std::string, Material>& built_materials) {
   Result<StoredCheckpoint> stored = readCheckpoint(bytes, world, hands);
   if (!stored) return Error{"restore_state: " + stored.error().message};
   PyWorldState state;
@@ -377,18 +474,49 @@ Result<PyWorldState> deserialize(const std::string& bytes, FemWorld& world,
   state.node_set_count = std::stoul(counted);
   for (size_t k = first + 1; k < second; ++k)
     state.released.push_back(extra[k] == '1');
-  if (state.released.size() != scene_hands)
-    return Error{"restore_state: the checkpoint was saved from another world: other scene hands"};
-  state.failure = extra.substr(second + 1);
+  if (state.released.size() != scene_hands) {
+    return Error{"restore_state: the checkpoint was saved from another world: it has " +
+                 std::to_string(state.released.size()) + " scene hands, this world " +
+                 std::to_string(scene_hands)};
+  }
+  // The bodies' materials as built; readCheckpoint has matched the bodies by name.
+  std::istringstream lines(extra.substr(second + 1));
+  std::string line;
+  size_t bodies = 0;
+  if (!std::getline(lines, line) || line.empty() ||
+      line.find_first_not_of("0123456789") != std::string::npos) {
+    return Error{"restore_state: the checkpoint is corrupted (its Python fields)"};
+  }
+  bodies = std::stoul(line);
+  for (size_t b = 0; b < bodies; ++b) {
+    std::string name, material;
+    if (!std::getline(lines, name) || !std::getline(lines, material))
+      return Error{"restore_state: the checkpoint is corrupted (its Python fields)"};
+    const auto here = built_materials.find(name);
+    if (here == built_materials.end()) continue;  // readCheckpoint names a missing body
+    if (material != materialLine(here->second)) {
+      return Error{"restore_state: the checkpoint was saved from another world: body '" + name +
+                   "' was built with another material (" +
+                   materialDifference(material, here->second) + ")"};
+    }
+  }
+  const std::streamoff read = lines.tellg();
+  state.failure = read < 0 ? std::string() : extra.substr(second + 1 + static_cast<size_t>(read));
   return state;
 }
 
 }  // namespace
 
 Status PyWorld::restoreState(const PyWorldState& state) {
-  if (!state.in_memory) {
-    Result<PyWorldState> read = deserialize(state.bytes, world(), hands(), scene_->hands.size());
+  // A state of another world (or one unpickled) is read from its bytes for this world: its
+  // in-memory part points into the world that saved it, and reading names what differs.
+  if (!state.in_memory || state.source != id_) {
+    if (state.bytes.empty())
+      return Error{"restore_state: the state was saved from another world and holds no bytes"};
+    Result<PyWorldState> read =
+        deserialize(state.bytes, world(), hands(), scene_->hands.size(), built_materials_);
     if (!read) return read.error();
+    read.value().source = id_;
     return restoreState(read.value());
   }
   std::vector<Hand*> all = hands();

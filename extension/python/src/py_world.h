@@ -4,7 +4,9 @@
 // on purpose: the bindings (bind_*.cpp) translate its errors into exceptions and its storage into
 // numpy arrays.
 
+#include <cstdint>
 #include <functional>
+#include <map>
 #include <memory>
 #include <mutex>
 #include <optional>
@@ -40,6 +42,9 @@ struct PyWorldState {
   std::vector<bool> released;         ///< per scene hand: let go for good (driveHands)
   size_t node_set_count = 0;
   std::string failure;
+  /// The world that saved it (PyWorld::id()); the in-memory part refers to that world's parts, so
+  /// another world reads `bytes` instead.
+  std::uint64_t source = 0;
 };
 
 class PyWorld {
@@ -54,6 +59,19 @@ class PyWorld {
   explicit PyWorld(const WorldSettings& settings);
 
   scene::BuiltScene& scene() { return *scene_; }
+  /// Unique among the worlds of this process (never reused), for PyWorldState::source.
+  std::uint64_t id() const { return id_; }
+  /// What from_scene was given (a scene's name or path), or empty for a world built in code.
+  const std::string& sceneSource() const { return scene_source_; }
+  /// from_scene's threads argument.
+  int sceneThreads() const { return scene_threads_; }
+  /// Whether Python added bodies, node sets, hands or rigid bodies (then the scene alone does not
+  /// describe the world).
+  bool partsAdded() const { return parts_added_; }
+  /// Whether from_scene was given devices or a haptics mode.
+  bool devicesOverridden() const { return devices_overridden_; }
+  /// Whether Python set a rigid body's kinematic target (a checkpoint holds poses, not targets).
+  bool hasKinematicTargets() const { return !targets_.empty(); }
   FemWorld& world() { return *scene_->world; }
 
   /// n steps (scripted hands driven, device hands through their haptics, as `torsion run`).
@@ -130,11 +148,20 @@ class PyWorld {
     btRigidBody* body = nullptr;
     btTransform target;
   };
-  PyWorld() = default;
+  PyWorld();
   /// Before a step: every kinematic target to its body's motion state (where Bullet reads it),
   /// and `loads` to Bullet's force accumulators (which it clears after the step).
   void applyRigidInputs(const std::vector<RigidLoad>& loads);
+  /// Every body's material as built (set_material changes the live one), by body name: a state
+  /// restores into a world whose bodies were built as the saved world's were.
+  void recordBuiltMaterials();
   std::unique_ptr<scene::BuiltScene> scene_;
+  std::uint64_t id_ = 0;
+  std::string scene_source_;
+  int scene_threads_ = -1;
+  bool parts_added_ = false;
+  bool devices_overridden_ = false;
+  std::map<std::string, Material> built_materials_;
   std::vector<std::unique_ptr<Hand>> own_hands_;
   std::string failure_;  // set by the first failed step; the world does not go on after it
   static constexpr int kAnchorEvery = 64;  // steps between rewind checkpoints (step())
