@@ -121,6 +121,68 @@ scene::RigidBodySpec::Shape toShape(const std::string& name) {
   throw py::value_error("shape '" + name + "': expected 'box', 'sphere' or 'capsule'");
 }
 
+// A World's pickled form: what rebuilds it from its scene and puts it where it was,
+// (scene, threads, gravity, dt, [(body, friction_solve)], state bytes). Only a world its scene
+// describes pickles: one Python added parts to, drives devices in, or set kinematic targets in
+// is refused with what stands in the way.
+py::tuple worldDescription(PyWorld& w) {
+  const std::string cannot = "cannot pickle this torsion.World: ";
+  if (w.sceneSource().empty()) {
+    throw py::type_error(cannot +
+                         "it was built in code; send the function (and arguments) that builds "
+                         "it, and a State (save_state) to put it where it was");
+  }
+  if (w.partsAdded())
+    throw py::type_error(cannot +
+                         "Python added bodies, node sets, hands or rigid bodies to its "
+                         "scene; send the function that builds it, and a State");
+  if (w.devicesOverridden())
+    throw py::type_error(cannot + "it drives devices (devices= or haptics= of from_scene)");
+  if (w.hasKinematicTargets())
+    throw py::type_error(cannot +
+                         "a rigid body has a kinematic target, which a state does not hold");
+  Result<PyWorldState> state = w.saveState();
+  if (!state) throw py::type_error(cannot + state.error().message);
+  // A demo scene's name travels as it is (each machine finds it in its own data folder); a path
+  // as an absolute one, so that the unpickling process's working folder does not matter.
+  std::string scene = w.sceneSource();
+  if (scene.find('/') != std::string::npos || std::filesystem::exists(scene))
+    scene = std::filesystem::absolute(w.scene().spec.file).lexically_normal().string();
+  py::list friction;
+  for (const auto& body : w.world().bodies())
+    friction.append(py::make_tuple(body->name(),
+                                   frictionSolveName(body->contacts().settings().friction_solve)));
+  const WorldSettings& settings = w.world().settings();
+  const Eigen::Vector3d& g = settings.gravity;
+  return py::make_tuple(scene, w.sceneThreads(), py::make_tuple(g.x(), g.y(), g.z()),
+                        settings.solver.time_step, friction, py::bytes(w.serialize(state.value())));
+}
+
+std::unique_ptr<PyWorld> worldFromDescription(const py::tuple& t) {
+  if (t.size() != 6) throw py::value_error("torsion.World: bad pickle (6 fields expected)");
+  FailureKind kind;
+  Result<std::unique_ptr<PyWorld>> built =
+      PyWorld::fromScene(t[0].cast<std::string>(), t[1].cast<int>(), {}, &kind);
+  if (!built) raise(kind, built.error().message);
+  PyWorld& w = *built.value();
+  if (Status s = w.setGravity(toVector3(t[2], "gravity")); !s)
+    throw py::value_error(s.error().message);
+  if (Status s = w.setTimeStep(t[3].cast<double>()); !s) throw py::value_error(s.error().message);
+  for (auto item : t[4].cast<py::list>()) {
+    auto pair = item.cast<py::tuple>();
+    FemBody* body = w.world().body(pair[0].cast<std::string>());
+    const auto solve = frictionSolveFromName(pair[1].cast<std::string>());
+    if (body == nullptr || !solve)
+      throw py::value_error("torsion.World: the pickle names another scene's bodies");
+    body->contacts().settings().friction_solve = *solve;
+  }
+  PyWorldState state;
+  state.in_memory = false;
+  state.bytes = t[5].cast<std::string>();
+  if (Status s = w.restoreState(state); !s) throw py::value_error(s.error().message);
+  return std::move(built).value();
+}
+
 }  // namespace
 
 void bindWorld(py::module_& m) {
@@ -222,6 +284,12 @@ void bindWorld(py::module_& m) {
           "devices: {hand: 'TYPE[:ARG]'} or ['HAND=TYPE[:ARG]'], as `torsion run --device` "
           "(scripted:FILE, replay:CSV, network:[HOST:]PORT, spacemouse); haptics: 'lockstep' or "
           "'threaded' (--haptics); allow_remote_devices: --allow-remote-device.")
+      .def(py::pickle(
+          [](PyWorld& w) {
+            WorldGuard guard(w);
+            return worldDescription(w);
+          },
+          &worldFromDescription))
       .def(
           "step",
           [](PyWorld& w, int n) {

@@ -46,6 +46,10 @@ class Frame:
     @property
     def quaternion(self) -> npt.NDArray[np.float64]: ...  # (4,) x, y, z, w
     def matrix(self) -> npt.NDArray[np.float64]: ...  # (4, 4)
+    def __eq__(self, other: object) -> bool: ...  # the same doubles
+    def __hash__(self) -> int: ...
+    def __getstate__(self) -> tuple[tuple[float, float, float], tuple[float, float, float, float]]: ...
+    def __setstate__(self, state: tuple[tuple[float, float, float], tuple[float, float, float, float]]) -> None: ...
 
 class Material:
     """Linear elastic material: E (Pa), nu, rho (kg/m^3), mass_damping (1/s),
@@ -70,6 +74,11 @@ class Material:
     law: str
     mooney_rivlin_c2_fraction: float
     shear_modulus: float  # Pa
+    def __eq__(self, other: object) -> bool: ...  # the same values
+    def __hash__(self) -> int: ...
+    # the constructor's arguments in order
+    def __getstate__(self) -> tuple[float, float, float, float, float, str, float, float]: ...
+    def __setstate__(self, state: tuple[float, float, float, float, float, str, float, float]) -> None: ...
 
 class State:
     """A world at a moment (World.save_state); picklable (versioned checkpoint bytes)."""
@@ -162,6 +171,12 @@ class World:
     def from_scene(scene: str, threads: int = -1, *,
                    devices: Union[dict[str, str], Sequence[str], None] = None,
                    haptics: str = "", allow_remote_devices: bool = False) -> World: ...
+    # A world from a scene pickles as (scene, threads, gravity, dt, [(body, friction_solve)],
+    # state bytes); TypeError for one built or extended in code, with devices or kinematic targets
+    def __getstate__(self) -> tuple[str, int, tuple[float, float, float], float,
+                                    list[tuple[str, str]], bytes]: ...
+    def __setstate__(self, state: tuple[str, int, tuple[float, float, float], float,
+                                        list[tuple[str, str]], bytes]) -> None: ...
     def step(self, n: int = 1) -> None: ...  # releases the GIL; Ctrl-C stops it between steps
     time: float  # s
     step_count: int
