@@ -29,6 +29,8 @@ packages=(
   tetgen
   # the Python package (`import torsion`), its tests and examples
   python3-dev pybind11-dev python3-numpy python3-pytest python3-matplotlib
+  # examples/python/dask_sweep.py: a sweep fanned out over Dask's distributed scheduler
+  python3-distributed
   # `pip install --no-build-isolation .` into a virtual environment (scikit-build runs CMake), and
   # `python3 -m build --wheel --no-isolation`; tests/python/pip_install_check.py does both
   python3-venv python3-skbuild python3-build
