@@ -336,6 +336,22 @@ TEST(CheckpointIo, AWorldWithoutTheHandIsToldTheHandItLacks) {
             "body 'block'), this world none");
 }
 
+TEST(CheckpointIo, AWorldWithAHandOrABodyTheCheckpointLacksIsToldWhich) {
+  FemWorld empty(test::checkpointWorldSettings());
+  const std::string nothing = test::saveBytes(empty, {});
+  OtherWorld other;
+  FemBody* block = other.add("block");
+  EXPECT_EQ(refusal(nothing, other.world, {}),
+            "the checkpoint was saved from another world: it has no FEM body, this world 'block'");
+  OtherWorld plain;
+  plain.add("block");
+  const std::string handless = test::saveBytes(plain.world, {});
+  Hand hand(*block);
+  EXPECT_EQ(refusal(handless, other.world, {&hand}),
+            "the checkpoint was saved from another world: it has no hand, this world 1 hand: "
+            "'hand' on body 'block'");
+}
+
 TEST(CheckpointIo, AWorldWithAnExtraBodyIsToldWhichBody) {
   BlockRig rig;
   rig.step();

@@ -703,8 +703,9 @@ Result<StoredCheckpoint> readCheckpoint(std::string_view bytes, FemWorld& world,
       const std::string name = peek.str(), body = peek.str();
       if (peek.ok()) first = " (the first '" + name + "' on body '" + body + "')";
     }
-    return Error{anotherWorld("it has " + counted(hand_count, "hand") + first + ", this world " +
-                              counted(hands.size(), "hand") + listed(here))};
+    return Error{anotherWorld("it has " +
+                              (hand_count == 0 ? "no hand" : counted(hand_count, "hand")) + first +
+                              ", this world " + counted(hands.size(), "hand") + listed(here))};
   }
   for (size_t h = 0; h < hand_count; ++h) {
     const std::string name = r.str(), body = r.str();
@@ -763,6 +764,8 @@ Result<StoredCheckpoint> readCheckpoint(std::string_view bytes, FemWorld& world,
       (in_checkpoint ? saved : unsaved).push_back("'" + body->name() + "'");
     }
     if (unsaved.empty()) return unreadable(r);  // a body saved twice
+    if (body_count == 0)
+      return Error{anotherWorld("it has no FEM body, this world " + listed(unsaved).substr(2))};
     return Error{anotherWorld("it has " + counted(body_count, "FEM body", "FEM bodies") +
                               listed(saved) + "; this world also has " +
                               listed(unsaved).substr(2))};
