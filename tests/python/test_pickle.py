@@ -1,5 +1,6 @@
 """What a program hands to another process pickles: Material, Frame, and a World loaded from a
-scene (as its scene and its state); each copy steps bit for bit as the original."""
+scene (as its scene and its state), each copy stepping bit for bit as the original; and Contacts,
+a result a worker sends back."""
 
 import math
 import pickle
@@ -107,3 +108,15 @@ def test_a_world_its_scene_does_not_describe_refuses_to_pickle_saying_why():
     extended.add_hand("another", "cylinder")
     with pytest.raises(TypeError, match="Python added"):
         pickle.dumps(extended)
+
+
+def test_contacts_pickle_with_every_array_as_it_was():
+    world = torsion.World.from_scene("drop", threads=1)
+    world.step(80)  # resting on the ground
+    contacts = world.contacts()
+    assert len(contacts) > 0
+    copy = pickle.loads(pickle.dumps(contacts))
+    assert len(copy) == len(contacts)
+    assert (copy.body_a, copy.body_b) == (contacts.body_a, contacts.body_b)
+    for name in ["points", "normals", "impulses", "normal_impulses"]:
+        assert np.array_equal(getattr(copy, name), getattr(contacts, name)), name

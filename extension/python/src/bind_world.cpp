@@ -190,6 +190,25 @@ void bindWorld(py::module_& m) {
                           "The contacts of a world's last step (World.contacts()): row k of each "
                           "array is one contact between body_a[k] and body_b[k].")
       .def("__len__", &ContactList::size)
+      // Pickled as its lists (a worker's result travels back to the program that gathers it).
+      .def(py::pickle(
+          [](const ContactList& c) {
+            return py::make_tuple(c.body_a, c.body_b, c.points, c.normals, c.impulses);
+          },
+          [](const py::tuple& t) {
+            if (t.size() != 5) throw py::value_error("torsion.Contacts: bad pickle");
+            ContactList c;
+            c.body_a = t[0].cast<std::vector<std::string>>();
+            c.body_b = t[1].cast<std::vector<std::string>>();
+            c.points = t[2].cast<std::vector<double>>();
+            c.normals = t[3].cast<std::vector<double>>();
+            c.impulses = t[4].cast<std::vector<double>>();
+            const size_t n = c.body_a.size();
+            if (c.body_b.size() != n || c.points.size() != 3 * n || c.normals.size() != 3 * n ||
+                c.impulses.size() != 3 * n)
+              throw py::value_error("torsion.Contacts: bad pickle (sizes differ)");
+            return c;
+          }))
       .def_readonly("body_a", &ContactList::body_a,
                     "list of names: the FEM body in FEM-rigid contact, else Bullet's first body")
       .def_readonly("body_b", &ContactList::body_b,

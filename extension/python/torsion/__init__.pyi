@@ -162,6 +162,9 @@ class Contacts:
     impulses: npt.NDArray[np.float64]  # (k, 3) N s, what B gave A over the step
     normal_impulses: npt.NDArray[np.float64]  # (k,) N s, impulses . normals
     def __len__(self) -> int: ...
+    # (body_a, body_b, points, normals, impulses), the arrays flattened to lists of floats
+    def __getstate__(self) -> tuple[list[str], list[str], list[float], list[float], list[float]]: ...
+    def __setstate__(self, state: tuple[list[str], list[str], list[float], list[float], list[float]]) -> None: ...
 
 class World:
     def __init__(self, gravity: ArrayLike = (0, 0, -9.81), dt: float = 0.01,
