@@ -137,7 +137,7 @@ class FemSoftBodySolver : public btSoftBodySolver {
   FemCheckpoint checkpoint();
   /// Back to `checkpoint`: the FEM steps that follow are bit for bit the ones that followed it,
   /// given the same world around the bodies. Bodies added since are left as they are. Errors,
-  /// changing nothing: a body of the checkpoint has been removed since.
+  /// changing nothing: a body of the checkpoint is not here (removed, or another world's).
   Status restore(const FemCheckpoint& checkpoint);
 
   // ---- health, warnings, settings ----
