@@ -18,6 +18,9 @@ namespace {
 
 constexpr double kHalf = 0.1;    // m, the box's half side
 constexpr double kReach = 0.01;  // m
+// m: the geometry is exact up to the rounding of Bullet's poses and vertices (btScalar): 1e-12 in
+// double, a few float ulps of the 0.2 m scale (1.2e-7 relative) in float.
+constexpr double kTol = sizeof(btScalar) == sizeof(double) ? 1e-12 : 1e-7;
 
 /// A flat square grid in z = 0 (outward normal +z), `cells` x `cells` of side `cell`, centred at
 /// the origin, each square split along a diagonal.
@@ -86,15 +89,15 @@ TEST(FeatureContacts, BoxOnFlatSurfaceMeetsItAlongItsBottomOnly) {
       const std::vector<FaceContact> contacts = collect(box, pose, s);
       int corners = 0, crossings = 0;
       for (const FaceContact& c : contacts) {
-        EXPECT_NEAR(c.gap, height, 1e-12) << yaw;
-        EXPECT_LT((c.normal - Eigen::Vector3d(0, 0, -1)).norm(), 1e-12) << yaw;
-        EXPECT_NEAR(c.weights.sum(), 1.0, 1e-12);
+        EXPECT_NEAR(c.gap, height, kTol) << yaw;
+        EXPECT_LT((c.normal - Eigen::Vector3d(0, 0, -1)).norm(), kTol) << yaw;
+        EXPECT_NEAR(c.weights.sum(), 1.0, kTol);
         // The rigid point is on the box's bottom face, right above the face point.
         const Eigen::Vector3d rigid = toEigen(pose.getOrigin()) + c.lever;
-        EXPECT_NEAR(rigid.z(), height, 1e-12);
-        EXPECT_LT((rigid - facePoint(c, s) - Eigen::Vector3d(0, 0, height)).norm(), 1e-12);
+        EXPECT_NEAR(rigid.z(), height, kTol);
+        EXPECT_LT((rigid - facePoint(c, s) - Eigen::Vector3d(0, 0, height)).norm(), kTol);
         const Eigen::Vector3d local = toEigen(pose.getBasis()).transpose() * c.lever;
-        EXPECT_NEAR(std::max(std::abs(local.x()), std::abs(local.y())), kHalf, 1e-12);
+        EXPECT_NEAR(std::max(std::abs(local.x()), std::abs(local.y())), kHalf, kTol);
         (c.weights.minCoeff() == 0 ? crossings : corners) += 1;
       }
       EXPECT_EQ(corners, 4) << yaw;
@@ -129,12 +132,12 @@ TEST(FeatureContacts, BoxEdgesRestOnARidgeBetweenNodes) {
   const std::vector<FaceContact> contacts = collect(box, pose, s);
   ASSERT_EQ(contacts.size(), 2u);
   for (const FaceContact& c : contacts) {
-    EXPECT_NEAR(c.gap, 2e-3, 1e-12);
-    EXPECT_LT((c.normal - Eigen::Vector3d(0, 0, -1)).norm(), 1e-12);
-    EXPECT_NEAR(std::abs(c.lever.y()), kHalf, 1e-12);
-    EXPECT_NEAR(c.lever.x(), 0.0, 1e-12);
+    EXPECT_NEAR(c.gap, 2e-3, kTol);
+    EXPECT_LT((c.normal - Eigen::Vector3d(0, 0, -1)).norm(), kTol);
+    EXPECT_NEAR(std::abs(c.lever.y()), kHalf, kTol);
+    EXPECT_NEAR(c.lever.x(), 0.0, kTol);
     EXPECT_EQ(c.weights.z(), 0.0);  // on the ridge's edge, between its two nodes
-    EXPECT_NEAR(facePoint(c, s).y(), c.lever.y(), 1e-12);
+    EXPECT_NEAR(facePoint(c, s).y(), c.lever.y(), kTol);
   }
 }
 
@@ -162,9 +165,9 @@ TEST(FeatureContacts, ConvexHullOfABoxMeetsTheSurfaceAsTheBox) {
   const std::vector<FaceContact> of_hull = sorted(collect(hull, pose, s));
   ASSERT_EQ(of_box.size(), of_hull.size());
   for (size_t i = 0; i < of_box.size(); ++i) {
-    EXPECT_LT((of_box[i].lever - of_hull[i].lever).norm(), 1e-12);
-    EXPECT_NEAR(of_box[i].gap, of_hull[i].gap, 1e-12);
-    EXPECT_LT((of_box[i].normal - of_hull[i].normal).norm(), 1e-12);
+    EXPECT_LT((of_box[i].lever - of_hull[i].lever).norm(), kTol);
+    EXPECT_NEAR(of_box[i].gap, of_hull[i].gap, kTol);
+    EXPECT_LT((of_box[i].normal - of_hull[i].normal).norm(), kTol);
   }
 }
 

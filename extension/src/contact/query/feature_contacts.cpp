@@ -137,12 +137,13 @@ std::optional<PolyhedronFeatures> polyhedronFeatures(const btCollisionShape& sha
   }
   if (shape.getShapeType() == CONVEX_HULL_SHAPE_PROXYTYPE) {
     const auto& hull_shape = static_cast<const btConvexHullShape&>(shape);
-    btConvexHullComputer hull;
+    // Fewer than four points have no volume (and an empty hull has no point array at all).
+    if (hull_shape.getNumPoints() < 4) return std::nullopt;
     const btVector3* points = hull_shape.getUnscaledPoints();
     std::vector<btVector3> scaled(static_cast<size_t>(hull_shape.getNumPoints()));
     for (size_t i = 0; i < scaled.size(); ++i)
       scaled[i] = points[i] * hull_shape.getLocalScaling();
-    if (scaled.size() < 4) return std::nullopt;
+    btConvexHullComputer hull;
     hull.compute(scaled.front().m_floats, static_cast<int>(sizeof(btVector3)),
                  static_cast<int>(scaled.size()), 0, 0);
     if (hull.vertices.size() < 4) return std::nullopt;
