@@ -372,7 +372,8 @@ BodySpec readBody(const JsonObject& b, const SceneSpec& scene, const std::string
     body.friction_solve = *solve;
   } else {
     b.fail("friction_solve",
-           "'" + friction_solve + "' is not a friction solve (auto, active_set, contact_space or convex)");
+           "'" + friction_solve +
+               "' is not a friction solve (auto, active_set, contact_space or convex)");
   }
   b.finish();
   return body;

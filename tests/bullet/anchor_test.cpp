@@ -97,7 +97,7 @@ void pullALightFreeBodyWithASoftBar(ContactSettings::FrictionSolve friction_solv
   solveTightly(user.fem);
   FemBody* bar = addBar(user.fem);  // 1 kg
   bar->contacts().settings().friction_solve = friction_solve;
-  const double mass = 0.01;         // a hundred times lighter than the bar
+  const double mass = 0.01;  // a hundred times lighter than the bar
   btRigidBody* box = user.addRigid(std::make_unique<btBoxShape>(btVector3(0.025, 0.025, 0.025)),
                                    mass, btVector3(0.425, 0, 0));
   const std::vector<int> end =

@@ -117,8 +117,9 @@ TEST(CheckpointIo, BytesCarryTheConvexSolvesFaceRowsAndContinueBitForBit) {
     BoxRig() : world(test::checkpointWorldSettings()) {
       Material material;
       material.youngs_modulus = 5e4;
-      slab = world.addBody("slab", makeBoxTetMesh({-0.3, -0.3, 0}, {0.3, 0.3, 0.1}, 5, 5, 2).value(),
-                           material)
+      slab = world
+                 .addBody("slab", makeBoxTetMesh({-0.3, -0.3, 0}, {0.3, 0.3, 0.1}, 5, 5, 2).value(),
+                          material)
                  .value();
       slab->contacts().settings().friction_solve = ContactSettings::FrictionSolve::kConvex;
       test::holdBase(*slab);
@@ -296,8 +297,7 @@ struct OtherWorld {
     Material material;
     material.youngs_modulus = 2e4;
     return world
-        .addBody(name,
-                 makeBoxTetMesh({x - 0.2, -0.2, 0.02}, {x + 0.2, 0.2, 0.42}, 2, 2, 2).value(),
+        .addBody(name, makeBoxTetMesh({x - 0.2, -0.2, 0.02}, {x + 0.2, 0.2, 0.42}, 2, 2, 2).value(),
                  material)
         .value();
   }

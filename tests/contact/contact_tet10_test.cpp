@@ -242,8 +242,8 @@ TEST(ContactTet10, ABoxRestsOnATet10SlabInTheConvexSolve) {
                                           ContactSettings::FrictionSolve::kConvex);
   const PunchSolution same_mesh = staticPunchSag(p, 8, 2, ElementKind::kTet10, row);
   std::cout << "[figures] box on tet10 slab, convex solve: sag " << run.sag << " m, static "
-            << same_mesh.sag << " m, worst penetration " << run.worst_penetration
-            << " m, speed " << run.box_speed << " m/s, off centre " << run.off_centre
+            << same_mesh.sag << " m, worst penetration " << run.worst_penetration << " m, speed "
+            << run.box_speed << " m/s, off centre " << run.off_centre
             << " m, Newton iterations max " << run.most_active_set_iterations
             << ", unconverged steps " << run.unconverged_steps << "\n";
   EXPECT_EQ(run.unconverged_steps, 0);

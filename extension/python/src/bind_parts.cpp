@@ -198,7 +198,8 @@ void bindParts(py::module_& m) {
             const auto solve = frictionSolveFromName(how);
             if (!solve)
               throw py::value_error(
-                  "friction_solve: expected \"auto\", \"active_set\", \"contact_space\" or \"convex\", got "
+                  "friction_solve: expected \"auto\", \"active_set\", \"contact_space\" or "
+                  "\"convex\", got "
                   "\"" +
                   how + "\"");
             WorldGuard guard(*b.world, WorldGuard::kWrite);

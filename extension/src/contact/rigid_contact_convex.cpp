@@ -26,8 +26,8 @@ double featureMatchRadius(const TetMesh& mesh) {
   const std::vector<Eigen::Vector3d>& x = mesh.restPositions();
   for (const Triangle& t : mesh.surfaceTriangles()) {
     for (std::size_t k = 0; k < 3; ++k) {
-      sum += (x[static_cast<std::size_t>(t[k])] - x[static_cast<std::size_t>(t[(k + 1) % 3])])
-                 .norm();
+      sum +=
+          (x[static_cast<std::size_t>(t[k])] - x[static_cast<std::size_t>(t[(k + 1) % 3])]).norm();
       ++edges;
     }
   }

@@ -189,7 +189,6 @@ TEST(SapParticle, FrictionlessKeepsItsTangentialSpeed) {
   EXPECT_NEAR(run.position_z, -kMass * test::kGravity / kStiffness, 1e-3 * 9.81e-6);
 }
 
-
 // A particle held to a fixed point by a bilateral row (an anchor, ContactRow::bilateral): the row
 // pulls as well as pushes. Hanging under gravity it settles m g / k below the point with the row
 // carrying m g dt; displaced 1 cm sideways without gravity, it returns as the critically damped
@@ -208,8 +207,8 @@ AnchoredRun runAnchored(const Eigen::Vector3d& start, double gravity, int steps)
     const Eigen::Vector3d drift = -x;  // the fixed point is the origin
     const double distance = drift.norm();
     ContactRow row;
-    row.frame = contactFrame(distance > 0 ? Eigen::Vector3d(drift / distance)
-                                          : Eigen::Vector3d::UnitZ());
+    row.frame =
+        contactFrame(distance > 0 ? Eigen::Vector3d(drift / distance) : Eigen::Vector3d::UnitZ());
     row.terms.push_back(nodeTerm(0, 0, 1.0, row.frame));
     row.bilateral = true;
     row.stiffness = kStiffness;

@@ -406,7 +406,8 @@ class RigidContactSolver {
   std::vector<std::pair<NodeContact::State, Eigen::Vector3d>> solved_states_;
   std::vector<FaceContact::State> solved_face_states_;
   std::vector<const btCollisionObject*> previous_sliding_;  // bodies sliding at the last step's end
-  std::vector<CarriedContacts::Feature> lagged_features_;  // the convex solve's face rows, last step
+  std::vector<CarriedContacts::Feature>
+      lagged_features_;  // the convex solve's face rows, last step
   const NodeConstraints* base_ = nullptr;
   double dt_ = 0;
   int dynamic_count_ = 0;

@@ -10,6 +10,7 @@
 #include <set>
 
 #include "torsion/bt_conversions.h"
+#include "torsion/contact/surface_candidates.h"
 
 namespace torsion {
 
@@ -22,18 +23,6 @@ constexpr double kParallelSine = 1e-2;
 // is a single direction; a box's bottom edge tilted by less than this from it still meets the
 // edges it crosses.
 constexpr double kConeTolerance = 0.2;
-
-// Barycentric coordinates of p (in the plane of a, b, c) with respect to the triangle.
-Eigen::Vector3d barycentric(const Eigen::Vector3d& p, const Eigen::Vector3d& a,
-                            const Eigen::Vector3d& b, const Eigen::Vector3d& c) {
-  const Eigen::Vector3d e0 = b - a, e1 = c - a, d = p - a;
-  const double d00 = e0.dot(e0), d01 = e0.dot(e1), d11 = e1.dot(e1);
-  const double d20 = d.dot(e0), d21 = d.dot(e1);
-  const double det = d00 * d11 - d01 * d01;
-  const double v = (d11 * d20 - d01 * d21) / det;
-  const double w = (d00 * d21 - d01 * d20) / det;
-  return {1 - v - w, v, w};
-}
 
 // Parameters (s, t) of the closest points p0 + s (p1 - p0) and q0 + t (q1 - q0) of two lines
 // that are not parallel.
@@ -197,7 +186,7 @@ void FeatureContactCollector::addCorner(int vertex, const Triangle& tri,
   // The shape lies on the triangle's outer side: a corner of a shape beside the body is not
   // over the triangle's plane's extension.
   if ((features_.centre - corner).dot(outward) <= 0) return;
-  Eigen::Vector3d w = barycentric(corner - height * outward, x[0], x[1], x[2]);
+  const Eigen::Vector3d w = projectionWeights(corner - height * outward, x[0], x[1], x[2]);
   if (w.minCoeff() < 0) return;
   const auto found = corners_.find(vertex);
   if (found != corners_.end() && found->second.gap >= gap) return;
