@@ -108,8 +108,9 @@ LinearSolveReport RigidContactSolver::solveConvex(const SystemOperator& op,
   sap::NodeContactIsland island =
       sap::buildNodeContactIsland(contacts_, partners_, 0, lagged_nodes, defaults, dt_);
   const std::vector<FaceContact> faces = sap::islandFaceContacts(*this);
-  sap::addFaceContactRows(island, faces, partners_, 0, lagged_features_,
-                          featureMatchRadius(model_->mesh()), defaults, dt_);
+  if (feature_match_radius_ < 0) feature_match_radius_ = featureMatchRadius(model_->mesh());
+  sap::addFaceContactRows(island, faces, partners_, 0, lagged_features_, feature_match_radius_,
+                          defaults, dt_);
   const sap::FemIslandBody fem(op, constraints, b);
   const std::vector<int> row_partner = rowPartners(island, contacts_, faces);
   Result<sap::SapProblem> created =

@@ -407,7 +407,8 @@ class RigidContactSolver {
   std::vector<FaceContact::State> solved_face_states_;
   std::vector<const btCollisionObject*> previous_sliding_;  // bodies sliding at the last step's end
   std::vector<CarriedContacts::Feature>
-      lagged_features_;  // the convex solve's face rows, last step
+      lagged_features_;               // the convex solve's face rows, last step
+  double feature_match_radius_ = -1;  // m, set at the first convex solve (the rest mesh's)
   const NodeConstraints* base_ = nullptr;
   double dt_ = 0;
   int dynamic_count_ = 0;
