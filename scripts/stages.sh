@@ -40,3 +40,16 @@ build() {
   shift
   cmake --build "$dir" -j"${jobs:-2}" "$@" -- --quiet
 }
+
+# seed_test_costs DIR FILE: a build tree that has never run its tests starts from the test times
+# of an earlier run (FILE, CTest's own cost-file format), so that `ctest -j` starts the longest
+# tests first instead of finding them in the last minute with one core idle. A tree that has run
+# its tests keeps its own, newer times. Refresh FILE from a full run with
+#   cp DIR/Testing/Temporary/CTestCostData.txt FILE
+seed_test_costs() {
+  local costs="$1/Testing/Temporary/CTestCostData.txt"
+  if [ ! -s "$costs" ]; then
+    mkdir -p "$(dirname "$costs")"
+    cp "$2" "$costs"
+  fi
+}
