@@ -8,6 +8,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <iostream>
 #include <limits>
 
 #include "torsion/bt_conversions.h"
@@ -227,6 +228,168 @@ TEST(UserWorld, BulletClothFallingOnAnFemBodyIsRefusedByNameNotPassedThrough) {
     user.world.removeSoftBody(cloth);
     delete cloth;
   }
+}
+
+// The reported case: a Bullet cloth (1.2 x 1.2 m, 17 x 17 nodes 0.075 m apart, margin 0.02 m)
+// dropped onto two coarse FEM blocks (0.3 m, 2 x 2 x 2 cells, 0.525 m apart), their bases held.
+// Every block node lies half a cloth spacing off the cloth's nodes in x and in y (0.053 m away):
+// cloth nodes land on the middle of the blocks' faces, far from every block node, so a test of
+// nodes against nodes alone sees nothing and the cloth falls through.
+struct ClothOverBlocks {
+  UserWorld user;
+  btSoftBody* cloth = nullptr;
+  static constexpr double kTop = 0.3;  // m, the blocks' top faces
+
+  ClothOverBlocks(double height, const btVector3& gravity) : user(gravity) {
+    for (const auto& [name, x] :
+         {std::pair<const char*, double>{"left", -0.4125}, {"right", 0.4125}}) {
+      FemBody* block =
+          user.fem
+              .addBody(
+                  name,
+                  makeBoxTetMesh({x - 0.15, -0.1125, 0}, {x + 0.15, 0.1875, kTop}, 2, 2, 2).value(),
+                  Material{})
+              .value();
+      block->carryNodes(
+          "base", nodesWhere(*block, [](const Eigen::Vector3d& p) { return p.z() < 1e-9; }),
+          [](double) { return Frame{}; }, 0.0);
+    }
+    const auto z = btScalar(kTop + height);
+    const auto h = btScalar(0.6);
+    cloth = btSoftBodyHelpers::CreatePatch(user.world.getWorldInfo(), btVector3(-h, -h, z),
+                                           btVector3(h, -h, z), btVector3(-h, h, z),
+                                           btVector3(h, h, z), 17, 17, 0, true);
+    cloth->getCollisionShape()->setMargin(btScalar(0.02));
+    cloth->setTotalMass(btScalar(1));
+    user.world.addSoftBody(cloth);
+  }
+  ~ClothOverBlocks() {
+    user.world.removeSoftBody(cloth);
+    delete cloth;
+  }
+  double lowestClothZ() const {
+    double z = 1e9;
+    for (int i = 0; i < cloth->m_nodes.size(); ++i)
+      z = std::min(z, static_cast<double>(cloth->m_nodes[i].m_x.z()));
+    return z;
+  }
+  // Whether Bullet's broadphase pairs the cloth with the block (so the solver is asked).
+  bool paired(const char* block) {
+    return user.world.getPairCache()->findPair(
+               cloth->getBroadphaseHandle(),
+               user.fem.body(block)->softBody()->getBroadphaseHandle()) != nullptr;
+  }
+};
+
+TEST(UserWorld, BulletClothDroppedOnCoarseFemBlocksIsReportedBeforeItPassesThrough) {
+  for (UnsupportedContact policy : {UnsupportedContact::kError, UnsupportedContact::kWarn}) {
+    // Dropped from 0.3 m above the blocks: a fall of 0.25 s, about 60 steps of 1/240 s.
+    ClothOverBlocks scene(0.3, btVector3(0, 0, btScalar(-9.81)));
+    scene.user.fem.setUnsupportedContact(policy);
+    // One FEM step per call; the steps at which the cloth's lowest node came within 5 cm of the
+    // blocks' top and reached it.
+    std::int64_t near = 0, reached = 0;
+    for (int step = 0; step < 240; ++step) {
+      scene.user.world.stepSimulation(btScalar(1 / 240.), 0);
+      const double lowest = scene.lowestClothZ();
+      if (near == 0 && lowest <= ClothOverBlocks::kTop + 0.05) near = scene.user.fem.stepCount();
+      if (reached == 0 && lowest <= ClothOverBlocks::kTop) reached = scene.user.fem.stepCount();
+      if (policy == UnsupportedContact::kError && !scene.user.fem.status().ok) break;
+    }
+    if (policy == UnsupportedContact::kError) {
+      ASSERT_FALSE(scene.user.fem.status().ok) << "the cloth fell through the blocks unreported";
+      const std::string& message = scene.user.fem.status().message;
+      EXPECT_NE(message.find("FEM body '"), std::string::npos) << message;
+      EXPECT_NE(message.find("Bullet soft body"), std::string::npos) << message;
+      // Said when they met: not while the cloth was still 5 cm above the blocks, and no later
+      // than the step at which its lowest node reached their top.
+      const std::int64_t failed = scene.user.fem.status().failed_step;
+      EXPECT_GT(near, 0);
+      EXPECT_GT(failed, near) << message;
+      EXPECT_TRUE(reached == 0 || failed <= reached)
+          << "reported at step " << failed << ", the cloth reached the top at step " << reached;
+      std::cout << "[ reported  ] at step " << failed << " (5 cm above at step " << near
+                << "): " << message << "\n";
+    } else {
+      EXPECT_TRUE(scene.user.fem.status().ok) << scene.user.fem.status().message;
+      EXPECT_EQ(scene.user.fem.stepCount(), 240) << "the run goes on";
+      EXPECT_LT(scene.lowestClothZ(), 0) << "the cloth passes through, as warned";
+      ASSERT_EQ(scene.user.fem.warnings().size(), 2u) << "one warning for each block";
+      int left = 0, right = 0;
+      for (const std::string& w : scene.user.fem.warnings()) {
+        left += w.find("FEM body 'left'") != std::string::npos;
+        right += w.find("FEM body 'right'") != std::string::npos;
+        EXPECT_NE(w.find("Bullet soft body"), std::string::npos) << w;
+      }
+      EXPECT_EQ(left, 1);
+      EXPECT_EQ(right, 1);
+    }
+  }
+}
+
+TEST(UserWorld, BulletClothHoveringJustAboveFemBlocksIsNotReported) {
+  // No gravity: the cloth stays 5 cm above the blocks, inside the broadphase's reach (the boxes
+  // grow by the margins and Bullet's contact threshold) but 3 cm clear of both margins.
+  ClothOverBlocks scene(0.05, btVector3(0, 0, 0));
+  for (int step = 0; step < 100; ++step)
+    scene.user.world.stepSimulation(btScalar(1 / 240.), 0);
+  EXPECT_TRUE(scene.paired("left")) << "the broadphase must pair them for the test to mean much";
+  EXPECT_TRUE(scene.paired("right"));
+  EXPECT_TRUE(scene.user.fem.status().ok) << scene.user.fem.status().message;
+  EXPECT_TRUE(scene.user.fem.warnings().empty()) << scene.user.fem.warnings().front();
+  EXPECT_NEAR(scene.lowestClothZ(), ClothOverBlocks::kTop + 0.05, 1e-6);
+}
+
+TEST(UserWorld, FemBlockCornerPushedUpThroughATautBulletClothIsReported) {
+  // The symmetric case: an FEM node (a cube's corner, pointing up) meets the middle of a cloth
+  // face, 0.036 m and more from every cloth node. The cloth is held by its rim, no gravity.
+  UserWorld user(btVector3(0, 0, 0));
+  const btScalar z(0.5);
+  btSoftBody* cloth = btSoftBodyHelpers::CreatePatch(
+      user.world.getWorldInfo(), btVector3(btScalar(-0.5), btScalar(-0.5), z),
+      btVector3(btScalar(0.5), btScalar(-0.5), z), btVector3(btScalar(-0.5), btScalar(0.5), z),
+      btVector3(btScalar(0.5), btScalar(0.5), z), 10, 10, 0, true);
+  cloth->getCollisionShape()->setMargin(btScalar(0.02));
+  cloth->setTotalMass(btScalar(1));
+  for (int i = 0; i < cloth->m_nodes.size(); ++i) {
+    const btVector3& p = cloth->m_nodes[i].m_x;
+    if (std::abs(p.x()) > btScalar(0.49) || std::abs(p.y()) > btScalar(0.49)) cloth->setMass(i, 0);
+  }
+  user.world.addSoftBody(cloth);
+
+  // A 0.3 m cube turned corner-up, its top corner 0.3 m under the cloth, pushed up at 1 m/s.
+  const Eigen::Quaterniond up = Eigen::Quaterniond::FromTwoVectors(
+      Eigen::Vector3d(1, 1, 1).normalized(), Eigen::Vector3d::UnitZ());
+  const Eigen::Vector3d corner = up * Eigen::Vector3d(0.15, 0.15, 0.15);
+  const Eigen::Vector3d target(0.01, 0.02, 0.5 - 0.3);
+  FemBody* cube =
+      user.fem
+          .addBody("cube",
+                   makeBoxTetMesh({-0.15, -0.15, -0.15}, {0.15, 0.15, 0.15}, 2, 2, 2).value(),
+                   Material{}, Frame{target - corner, up})
+          .value();
+  ASSERT_TRUE(cube->setVelocity(Eigen::Vector3d(0, 0, 1)).ok());
+  int top = 0;
+  for (int i = 0; i < cube->model().nodeCount(); ++i) {
+    if (cube->state().position(i).z() > cube->state().position(top).z()) top = i;
+  }
+  // 80 steps: the corner ends 3 cm through the cloth, the cube's next nodes (8.7 cm below the
+  // corner) still under it. The step at which the corner came within 5 cm of the cloth.
+  std::int64_t near = 0;
+  for (int step = 0; step < 80 && user.fem.status().ok; ++step) {
+    user.world.stepSimulation(btScalar(1 / 240.), 0);
+    if (near == 0 && cube->state().position(top).z() >= 0.45) near = user.fem.stepCount();
+  }
+  ASSERT_FALSE(user.fem.status().ok) << "the corner went through the cloth unreported";
+  EXPECT_NE(user.fem.status().message.find("FEM body 'cube'"), std::string::npos)
+      << user.fem.status().message;
+  // Not before the corner came near; at the latest at step 72, when it crossed the cloth (0.3 m
+  // at 1/240 m per step).
+  EXPECT_GT(near, 0);
+  EXPECT_GT(user.fem.status().failed_step, near) << user.fem.status().message;
+  EXPECT_LE(user.fem.status().failed_step, 72) << user.fem.status().message;
+  user.world.removeSoftBody(cloth);
+  delete cloth;
 }
 
 // Two FEM balls, 0.5 m apart, then one thrown at the other: with contact between FEM bodies on

@@ -7,6 +7,7 @@
 #include <cmath>
 #include <sstream>
 
+#include "soft_body_touch.h"
 #include "torsion/bt_conversions.h"
 #include "torsion/bullet/rigid_health.h"
 
@@ -14,9 +15,13 @@ namespace torsion {
 
 namespace {
 
-// Whether the broadphase pair really touches: some node of one within both bodies' margins of a
-// node of the other (Bullet's node trees, whose leaves are the nodes' boxes grown by the margin).
-// Bounding boxes alone overlap long before bodies touch (a ball over a slab's corner).
+// Whether two FEM bodies' broadphase pair really touches: some node of one within both bodies'
+// margins of a node of the other (their node trees, rebuilt by FemBody::predict each step, whose
+// leaves are the nodes' boxes grown by the margin). Bounding boxes alone overlap long before bodies
+// touch (a ball over a slab's corner). Not for Bullet's own soft bodies: their node boxes are
+// updated lazily (a cloth's keep the 0.25 m default margin they were made with until its nodes move
+// out of them), and a cloth node can land on a coarse FEM face far from every FEM node
+// (SoftBodyTouch).
 bool nodesTouch(btSoftBody& a, btSoftBody& b) {
   struct Probe : btDbvt::ICollide {
     bool hit = false;
@@ -65,7 +70,8 @@ Result<FemSoftBodySolver*> attachTo(World& world) {
 FemSoftBodySolver::FemSoftBodySolver(const SolverSettings& settings)
     : settings_(settings),
       parallel_(settings.threads),
-      fem_contact_(std::make_unique<FemContactIslands>(BodyContactSettings{})) {}
+      fem_contact_(std::make_unique<FemContactIslands>(BodyContactSettings{})),
+      soft_touch_(std::make_unique<SoftBodyTouch>()) {}
 
 // The world uses this solver until it is destroyed, and destroys its collision objects' broadphase
 // proxies then: the world must go first (documented), so here the bodies are only freed.
@@ -134,6 +140,7 @@ void FemSoftBodySolver::removeBody(FemBody* body) {
   if (it == bodies_.end()) return;
   remove_from_world_((*it)->softBody());
   if (fem_contact_) fem_contact_->forget(body);
+  soft_touch_->forget(body);
   bodies_.erase(it);
 }
 
@@ -229,6 +236,7 @@ void FemSoftBodySolver::optimize(btAlignedObjectArray<btSoftBody*>& soft_bodies,
   for (int i = 0; i < soft_bodies.size(); ++i) {
     if (femBodyOf(soft_bodies[i]) == nullptr) bullet_bodies_.push_back(soft_bodies[i]);
   }
+  soft_touch_->keepOnly(bullet_bodies_);
   bullet_solver_.optimize(bullet_bodies_, force_update);
 }
 
@@ -241,6 +249,7 @@ void FemSoftBodySolver::predictMotion(btScalar solver_dt) {
       body->predict(dt);
   }
   if (fem_contact_) fem_contact_->beginSubstep();
+  soft_touch_->beginSubstep();
   bullet_solver_.predictMotion(solver_dt);
 }
 
@@ -333,7 +342,15 @@ void FemSoftBodySolver::processCollision(btSoftBody* a, btSoftBody* b) {
     fem_contact_->notePair(femBodyOf(a), femBodyOf(b));
     return;
   }
-  if (a != b && nodesTouch(*a, *b)) unsupportedPair(a, b);
+  if (a == b || reported_pairs_.count(std::minmax<const btSoftBody*>(a, b)) != 0) return;
+  if (a_fem && b_fem) {
+    if (nodesTouch(*a, *b)) unsupportedPair(a, b);
+    return;
+  }
+  // One of Bullet's soft bodies: the geometric test (soft_body_touch.h), after Bullet's own
+  // prediction of its motion (m_q -> m_x) and FemBody::predict's of ours.
+  FemBody* fem = a_fem ? femBodyOf(a) : femBodyOf(b);
+  if (soft_touch_->touches(*fem, a_fem ? *b : *a)) unsupportedPair(a, b);
 }
 
 std::string FemSoftBodySolver::describe(const btSoftBody* soft) const {

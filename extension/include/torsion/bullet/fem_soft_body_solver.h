@@ -55,6 +55,8 @@ class btSoftMultiBodyDynamicsWorld;
 
 namespace torsion {
 
+class SoftBodyTouch;
+
 /// Told before and after every FEM step, on the simulation thread, inside stepSimulation (hands
 /// driven by devices use it: haptics/haptic_runtime.h).
 class StepListener {
@@ -192,6 +194,7 @@ class FemSoftBodySolver : public btSoftBodySolver {
 
   std::vector<std::unique_ptr<FemBody>> bodies_;
   std::unique_ptr<FemContactIslands> fem_contact_;  // nullptr: FEM-FEM contact off
+  std::unique_ptr<SoftBodyTouch> soft_touch_;       // whether Bullet's soft bodies touch ours
   std::vector<StepListener*> listeners_;
 
   double time_ = 0;
