@@ -69,7 +69,7 @@ configure build-tsan "${sanitizer_flags[@]}" "${fast_only[@]}" -DTORSION_TSAN=ON
 build build-tsan --target torsion_device_tests torsion_bullet_tests
 TSAN_OPTIONS="halt_on_error=1 second_deadlock_stack=1" \
   ctest --test-dir build-tsan -j"$jobs" --output-on-failure \
-  -R "HapticLoop|TripleBuffer|NetworkDevice|PluginDevice|UserWorldHaptics"
+  -R "HapticLoop|TripleBuffer|NetworkDevice|NetworkPeer|PacketAuthentication|PluginDevice|WrenchWatchdog|WrenchSafety|SafetyFilter|ReadingCheck|Passivity|UserWorldHaptics"
 
 # One build for two things only it can catch: memory and undefined-behaviour errors (ASan, UBSan,
 # the fuzzers), and float Bullet (Debian's default btScalar, the one most programs link): the

@@ -1,38 +1,22 @@
 #pragma once
-// A scene's "bullet_file": rigid bodies (shapes, masses, poses, velocities, friction) and their
-// constraints from a file Bullet wrote with its serializer (btDiscreteDynamicsWorld::serialize),
-// loaded by Bullet's own btBulletWorldImporter into the scene's world, beside its FEM bodies.
+// A scene's "bullet_file": the rigid bodies of a file Bullet's serializer wrote, read by Bullet's
+// own btBulletWorldImporter in a child process of its own (isolated_call.h), because that reader
+// is not memory-safe on a malformed file. Only a description of the bodies comes back, in the
+// scene file's own rigid_bodies form, and the scene parser reads it with the same checks as a
+// scene file's rigid_bodies (names, shapes, masses, poses): a malformed or hostile .bullet file
+// ends as an error naming it, never as a crash, a hang or garbage in the world.
 
-#include <memory>
+#include <nlohmann/json.hpp>
 #include <string>
-#include <vector>
 
-#include "rigid_body_builder.h"
-#include "torsion/bullet/fem_world.h"
 #include "torsion/result.h"
-
-class btBulletWorldImporter;
 
 namespace torsion::scene {
 
-class BulletFileImport {
- public:
-  /// Loads `path` into `world`. The scene's gravity stays the world's (a .bullet file carries
-  /// its own, which the importer would impose). The bodies are named after their names in the
-  /// file, else "<file stem>_<index>". Errors: the file is missing, not a .bullet file, or holds
-  /// no rigid body.
-  static Result<std::shared_ptr<BulletFileImport>> load(const std::string& path, FemWorld& world);
-  ~BulletFileImport();
-  BulletFileImport(const BulletFileImport&) = delete;
-  BulletFileImport& operator=(const BulletFileImport&) = delete;
-
-  /// The imported rigid bodies (static ones too), in file order, named.
-  std::vector<SceneRigidBody>& bodies() { return bodies_; }
-
- private:
-  BulletFileImport() = default;
-  std::unique_ptr<btBulletWorldImporter> importer_;
-  std::vector<SceneRigidBody> bodies_;
-};
+/// The rigid bodies of the .bullet file at `path` as {"rigid_bodies": [...]}
+/// (bullet_file_reader.h). Errors: the file is missing or not a regular file, Bullet's reader
+/// refuses it, crashes on it, hangs (20 s) or needs more than 2 GiB for it, and those of
+/// bulletFileBodiesJson.
+Result<nlohmann::json> importBulletFile(const std::string& path);
 
 }  // namespace torsion::scene

@@ -1,37 +1,11 @@
 #include "scene_builder.h"
 
 #include "arithmetic_bounds.h"
-#include "bullet_file_import.h"
 #include "scene_haptics.h"
 #include "torsion/format_number.h"
 #include "torsion/mesh/mesh_io.h"
 
 namespace torsion::scene {
-
-namespace {
-
-// A rigid body from a .bullet file, named by the file: its name must not give it another body's
-// files (the scene's own rigid bodies are checked at load, scene_parser.cpp). A series names a
-// FEM body's files "<name>_<step>.vtu" and a rigid body's "rigid_<name>_<step>.vtu"; rigid.csv's
-// columns are "<name>.x" and so on.
-Status checkImportedName(const std::string& name, const SceneSpec& spec,
-                         const std::vector<SceneRigidBody>& earlier) {
-  for (const BodySpec& body : spec.bodies) {
-    if (body.name == "rigid_" + name)
-      return Error{"rigid body '" + name + "' and FEM body '" + body.name +
-                   "' would write the same series files (series/rigid_" + name +
-                   "_<step>.vtu): rename one"};
-  }
-  for (const SceneRigidBody& other : earlier) {
-    if (other.name == name)
-      return Error{"rigid body '" + name +
-                   "' is named twice: both would write its columns of rigid.csv and its series "
-                   "files"};
-  }
-  return Ok{};
-}
-
-}  // namespace
 
 std::vector<int> selectNodes(const TetMesh& mesh, const NodeSelection& selection) {
   std::vector<int> nodes;
@@ -159,17 +133,6 @@ Result<std::unique_ptr<BuiltScene>> buildScene(SceneSpec spec, int threads_overr
   for (const RigidBodySpec& r : spec.rigid_bodies)
     built->rigid_bodies.push_back(addSceneRigidBody(world, r));
   if (spec.ground) addSceneRigidBody(world, *spec.ground);
-  if (!spec.bullet_file.empty()) {
-    Result<std::shared_ptr<BulletFileImport>> imported =
-        BulletFileImport::load(spec.bullet_file, world);
-    if (!imported) return Error{spec.file + ": bullet_file: " + imported.error().message};
-    built->bullet_import = std::move(imported).value();
-    for (SceneRigidBody& body : built->bullet_import->bodies()) {
-      if (Status named = checkImportedName(body.name, spec, built->rigid_bodies); !named)
-        return Error{spec.file + ": bullet_file: " + named.error().message};
-      built->rigid_bodies.push_back(std::move(body));
-    }
-  }
   built->spec = std::move(spec);
   for (const SceneHand& h : built->hands) {
     if (!h.spec.device) continue;

@@ -32,17 +32,12 @@ struct SceneHand {
 
 class SceneHaptics;  // scene_haptics.h
 
-class BulletFileImport;  // bullet_file_import.h
-
 struct BuiltScene {
   SceneSpec spec;
   /// rigid_bodies[] in file order (not the ground). Declared before `world`, so the kinematic
   /// bodies' motion states outlive the world that points to them.
   std::vector<SceneRigidBody> rigid_bodies;
   std::unique_ptr<FemWorld> world;
-  /// What the scene's .bullet file brought (null when none). It owns those rigid bodies and
-  /// removes them from the world when destroyed: declared after `world`, so it goes first.
-  std::shared_ptr<BulletFileImport> bullet_import;
   std::vector<NodeSetHandle> node_sets;
   std::vector<SceneHand> hands;
   std::vector<std::string> warnings;  ///< from mesh loading

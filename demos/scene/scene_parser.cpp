@@ -3,6 +3,7 @@
 #include <filesystem>
 
 #include "arithmetic_bounds.h"
+#include "bullet_file_import.h"
 #include "camera_spec.h"
 #include "device_parser.h"
 #include "json_reader.h"
@@ -412,24 +413,37 @@ HandSpec readSceneHand(const JsonObject& h, const SceneSpec& scene,
   return hand;
 }
 
-// Rigid bodies, the ground, a .bullet file and the camera.
-void readSurroundings(const JsonObject& root, const std::string& base_directory, SceneSpec& scene) {
-  for (const JsonObject& r : root.objects("rigid_bodies")) {
-    scene.rigid_bodies.push_back(readRigidBody(r, scene.rigid_bodies));
-    // The series names a rigid body's files "rigid_<name>_<step>.vtu", a FEM body's
-    // "<name>_<step>.vtu" (docs/outputs.md): FEM body "rigid_X" and rigid body "X" would share
-    // them.
-    const std::string& name = scene.rigid_bodies.back().name;
-    for (const BodySpec& body : scene.bodies) {
-      if (body.name == "rigid_" + name)
-        r.fail("name", "rigid body '" + name + "' and FEM body '" + body.name +
-                           "' would write the same series files (series/rigid_" + name +
-                           "_<step>.vtu): rename one");
-    }
+// A rigid body of rigid_bodies or of the .bullet file, checked against those read before it.
+void readSceneRigidBody(const JsonObject& r, SceneSpec& scene) {
+  scene.rigid_bodies.push_back(readRigidBody(r, scene.rigid_bodies));
+  // The series names a rigid body's files "rigid_<name>_<step>.vtu", a FEM body's
+  // "<name>_<step>.vtu" (docs/outputs.md): FEM body "rigid_X" and rigid body "X" would share
+  // them.
+  const std::string& name = scene.rigid_bodies.back().name;
+  for (const BodySpec& body : scene.bodies) {
+    if (body.name == "rigid_" + name)
+      r.fail("name", "rigid body '" + name + "' and FEM body '" + body.name +
+                         "' would write the same series files (series/rigid_" + name +
+                         "_<step>.vtu): rename one");
   }
+}
+
+// Rigid bodies, the ground, a .bullet file's rigid bodies and the camera.
+void readSurroundings(const JsonObject& root, const std::string& base_directory, SceneSpec& scene) {
+  for (const JsonObject& r : root.objects("rigid_bodies"))
+    readSceneRigidBody(r, scene);
   if (root.has("ground")) scene.ground = readGround(root.object("ground"));
-  if (root.has("bullet_file"))
+  if (root.has("bullet_file")) {
     scene.bullet_file = resolved(root.string("bullet_file"), base_directory);
+    Result<nlohmann::json> imported = importBulletFile(scene.bullet_file);
+    if (!imported) root.fail("bullet_file", imported.error().message);
+    // Its faults read "<scene>: bullet_file: <file>: rigid_bodies[k].<key>: ...".
+    const std::string where = scene.file + ": bullet_file: " + scene.bullet_file;
+    const JsonObject file(imported.value(), "", where);
+    for (const JsonObject& r : file.objects("rigid_bodies"))
+      readSceneRigidBody(r, scene);
+    file.finish();
+  }
   scene.camera = readCameraSpec(root);
 }
 

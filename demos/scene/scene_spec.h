@@ -132,10 +132,11 @@ struct SceneSpec {
   std::vector<BodySpec> bodies;
   std::vector<NodeSetSpec> node_sets;
   std::vector<HandSpec> hands;
+  /// rigid_bodies[], then the .bullet file's bodies (bullet_file_import.h), in file order.
   std::vector<RigidBodySpec> rigid_bodies;
   std::optional<RigidBodySpec> ground;  ///< a static plane, from the top-level "ground"
-  /// Rigid bodies (and their constraints) from a Bullet .bullet file, resolved against the scene
-  /// file's directory; empty: none.
+  /// The .bullet file whose rigid bodies follow rigid_bodies[] in `rigid_bodies`, resolved
+  /// against the scene file's directory; empty: none.
   std::string bullet_file;
   CameraSpec camera;  ///< how pictures look at the scene (camera_spec.h)
   /// "fem_contact": contact between FEM bodies (docs/contact.md): {"enabled" (default true),
