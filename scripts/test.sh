@@ -7,7 +7,8 @@
 #      direct solver works without CHOLMOD);
 #   4. every CTest test of build/;
 #   5. clang-tidy over extension/ and device/;
-#   6. ThreadSanitizer (build-tsan/): the haptic loop's thread, its buffers, the runtime;
+#   6. ThreadSanitizer (build-tsan/): the haptic loop's thread, its buffers, the runtime, and the
+#      device fault cases (bad readings, dead peers, hung plug-ins, watchdogs);
 #   7. ASan + UBSan on float Bullet (build-asan/, clang): the fast tests and the fuzzers.
 # Every build compiles through ccache (scripts/ccache_env.sh): on a machine that built the same
 # tree before, the builds take seconds. Each stage's wall time and the cache's hits and misses
@@ -63,7 +64,7 @@ configure build-tidy -DCMAKE_BUILD_TYPE=Release "${unity[@]}" -DTORSION_PCH=OFF 
   -DTORSION_BUILD_TESTS=OFF -DTORSION_BUILD_BENCHMARKS=OFF
 bash scripts/clang_tidy.sh build-tidy
 
-stage "ThreadSanitizer build (build-tsan/, clang): the haptic loop's thread, its buffers, the runtime"
+stage "ThreadSanitizer build (build-tsan/, clang): the haptic loop, its buffers, the runtime, device faults"
 configure build-tsan "${sanitizer_flags[@]}" "${fast_only[@]}" -DTORSION_TSAN=ON \
   -DTORSION_BUILD_DEMOS=OFF
 build build-tsan --target torsion_device_tests torsion_bullet_tests
