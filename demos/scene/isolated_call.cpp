@@ -25,6 +25,10 @@
 #endif
 #endif
 
+#ifdef TORSION_ISOLATED_SANITIZED
+#include <sanitizer/common_interface_defs.h>
+#endif
+
 namespace torsion::scene {
 
 namespace {
@@ -61,10 +65,18 @@ void writeAll(int fd, const char* data, std::size_t size) {
     dup2(null, STDOUT_FILENO);
     dup2(null, STDERR_FILENO);
   }
-  // The parent's stop handlers (Ctrl-C, SIGTERM) set a flag the child never reads: a stop kills
-  // the child at once instead, and the parent reports it.
-  for (int sig : {SIGINT, SIGTERM, SIGHUP, SIGPIPE})
+  // The parent's handlers are not the child's. Its stop handlers (Ctrl-C, SIGTERM) set a flag the
+  // child never reads: a stop kills the child at once instead, and the parent reports it. Its crash
+  // handlers (Python's faulthandler, a crash reporter, libFuzzer's) would report the child's crash
+  // as the parent's: the child dies by the signal, and the parent says so.
+  for (int sig :
+       {SIGINT, SIGTERM, SIGHUP, SIGPIPE, SIGSEGV, SIGBUS, SIGABRT, SIGFPE, SIGILL, SIGTRAP})
     std::signal(sig, SIG_DFL);
+#ifdef TORSION_ISOLATED_SANITIZED
+  // A sanitizer's report ends the child through its death callbacks (libFuzzer's writes a crash
+  // file for the parent's input): none in the child, the report alone (to /dev/null) and exit 1.
+  __sanitizer_set_death_callback(nullptr);
+#endif
   const rlimit cpu{static_cast<rlim_t>(limits.cpu_seconds),
                    static_cast<rlim_t>(limits.cpu_seconds)};
   setrlimit(RLIMIT_CPU, &cpu);
