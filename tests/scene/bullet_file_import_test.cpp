@@ -104,16 +104,17 @@ TEST(BulletFileImport, TheShippedFileGivesItsBodiesAsSceneRigidBodies) {
   ASSERT_EQ(bodies.size(), 4u);
   EXPECT_EQ(bodies[0].name, "boxes_0");
   EXPECT_EQ(bodies[0].mass, 0.0);
-  // A box's collision margin is a float in the file (btConvexInternalShapeData): its half extents
-  // come back within float rounding of the margin.
-  EXPECT_NEAR((bodies[0].half_extents - Eigen::Vector3d(3, 3, 0.5)).norm(), 0, 1e-7);
-  EXPECT_NEAR(bodies[0].pose.origin.z(), -0.5, 1e-12);
+  // Within float rounding: a box's collision margin is a float in the file
+  // (btConvexInternalShapeData), and float Bullet reads the file's doubles into floats.
+  const double rounding = 1e-6;
+  EXPECT_NEAR((bodies[0].half_extents - Eigen::Vector3d(3, 3, 0.5)).norm(), 0, rounding);
+  EXPECT_NEAR(bodies[0].pose.origin.z(), -0.5, rounding);
   const double heights[] = {0.8, 1.1, 1.4};
   for (size_t k = 1; k < 4; ++k) {
     EXPECT_EQ(bodies[k].shape, RigidBodySpec::Shape::kBox);
     EXPECT_GT(bodies[k].mass, 0.0) << k;
-    EXPECT_NEAR((bodies[k].half_extents - Eigen::Vector3d::Constant(0.1)).norm(), 0, 1e-7);
-    EXPECT_NEAR(bodies[k].pose.origin.z(), heights[k - 1], 1e-12) << k;
+    EXPECT_NEAR((bodies[k].half_extents - Eigen::Vector3d::Constant(0.1)).norm(), 0, rounding);
+    EXPECT_NEAR(bodies[k].pose.origin.z(), heights[k - 1], rounding) << k;
   }
 }
 
