@@ -62,10 +62,12 @@ std::vector<int> rowPartners(const sap::NodeContactIsland& island,
 // incline), and after an impact the bound is the impact's (a box landing while it slides is
 // braked by mu times its impact for one more step). Where a partner's rows together carried a
 // normal impulse outside [1/1.1, 1.1] times the one the solve gave them, each row's bound becomes
-// the impulse just found, and the island is solved again: a fixed point of mu gamma_n, reached
-// for the partners that need it. Returns whether any bound changed.
-bool matchFrictionBounds(sap::NodeContactIsland& island, const std::vector<int>& row_partner,
-                         std::size_t partner_count, const sap::SapReport& report) {
+// the impulse just found, in the island's rows and in the problem (whose other data do not
+// depend on it), and the island is solved again: a fixed point of mu gamma_n, reached for the
+// partners that need it. Returns whether any bound changed.
+bool matchFrictionBounds(sap::NodeContactIsland& island, sap::SapProblem& problem,
+                         const std::vector<int>& row_partner, std::size_t partner_count,
+                         const sap::SapReport& report) {
   std::vector<double> lagged(partner_count, 0.0), solved(partner_count, 0.0);
   for (std::size_t r = 0; r < island.rows.size(); ++r) {
     const auto k = static_cast<std::size_t>(row_partner[r]);
@@ -81,6 +83,7 @@ bool matchFrictionBounds(sap::NodeContactIsland& island, const std::vector<int>&
     const double gamma_n = std::max(0.0, report.impulses[r].z());
     if (gamma_n != island.rows[r].lagged_normal_impulse) {
       island.rows[r].lagged_normal_impulse = gamma_n;
+      problem.setLaggedNormalImpulse(static_cast<int>(r), gamma_n);  // >= 0 and finite
       changed = true;
     }
   }
@@ -122,14 +125,15 @@ LinearSolveReport RigidContactSolver::solveConvex(const SystemOperator& op,
     const int body = island.partner_body[k];
     if (body >= 0) x.segment<6>(created.value().bodyOffset(body)) = partners_[k].entry_velocity;
   }
-  sap::SapReport report = sap::SapSolver().solve(created.value(), x);
+  // One solver for the rounds: its workspace is sized once.
+  sap::SapSolver solver;
+  sap::SapReport report = solver.solve(created.value(), x);
   int newton = report.newton_iterations;
-  for (int round = 0; round < kMaxFrictionBoundRounds && report.converged &&
-                      matchFrictionBounds(island, row_partner, partners_.size(), report);
+  for (int round = 0;
+       round < kMaxFrictionBoundRounds && report.converged &&
+       matchFrictionBounds(island, created.value(), row_partner, partners_.size(), report);
        ++round) {
-    created = sap::SapProblem::create(sap::islandBodies(fem, island), island.rows, dt_);
-    if (!created) return brokenDown({}, "the contact rows do not form a valid problem");
-    report = sap::SapSolver().solve(created.value(), x);  // from the last solution
+    report = solver.solve(created.value(), x);  // from the last solution
     newton += report.newton_iterations;
   }
   const sap::SapProblem& problem = created.value();

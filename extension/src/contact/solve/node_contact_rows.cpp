@@ -1,15 +1,30 @@
 #include "torsion/contact/solve/node_contact_rows.h"
 
+#include <algorithm>
 #include <cstddef>
 
 namespace torsion::sap {
 
 namespace {
 
-double laggedFor(const std::vector<LaggedImpulse>& lagged, int node,
-                 const btCollisionObject* object) {
-  for (const LaggedImpulse& l : lagged) {
-    if (l.node == node && l.object == object) return l.normal_impulse;
+// The lagged impulses ordered by node (stably: among one node's, as given), so that each
+// contact finds the first of its node and object by a binary search rather than a scan.
+std::vector<std::size_t> byNode(const std::vector<LaggedImpulse>& lagged) {
+  std::vector<std::size_t> order(lagged.size());
+  for (std::size_t k = 0; k < order.size(); ++k)
+    order[k] = k;
+  std::stable_sort(order.begin(), order.end(), [&lagged](std::size_t a, std::size_t b) {
+    return lagged[a].node < lagged[b].node;
+  });
+  return order;
+}
+
+double laggedFor(const std::vector<LaggedImpulse>& lagged, const std::vector<std::size_t>& order,
+                 int node, const btCollisionObject* object) {
+  auto it = std::lower_bound(order.begin(), order.end(), node,
+                             [&lagged](std::size_t k, int n) { return lagged[k].node < n; });
+  for (; it != order.end() && lagged[*it].node == node; ++it) {
+    if (lagged[*it].object == object) return lagged[*it].normal_impulse;
   }
   return 0;
 }
@@ -45,6 +60,7 @@ NodeContactIsland buildNodeContactIsland(const std::vector<NodeContact>& contact
                                          const RowDefaults& defaults, double dt) {
   NodeContactIsland island;
   island.partner_body.assign(partners.size(), -1);
+  const std::vector<std::size_t> lagged_order = byNode(lagged);
   for (std::size_t p = 0; p < partners.size(); ++p) {
     const RigidPartner& k = partners[p];
     if (!k.dynamic || k.link != nullptr) continue;
@@ -63,7 +79,7 @@ NodeContactIsland buildNodeContactIsland(const std::vector<NodeContact>& contact
       row.bilateral = true;
       row.mu = 0;
     } else {
-      row.lagged_normal_impulse = laggedFor(lagged, c.node, partners[p].object);
+      row.lagged_normal_impulse = laggedFor(lagged, lagged_order, c.node, partners[p].object);
     }
     island.rows.push_back(std::move(row));
     island.row_contact.push_back(static_cast<int>(i));

@@ -23,6 +23,30 @@ DiagonalBlock inverseOnFreeDofs(const DiagonalBlock& d, const DiagonalBlock& s) 
   return s * inverse * s;
 }
 
+// y = M x for an N x K block, each row summed left to right: the order Eigen's product of the
+// run-time-sized blocks sums in (and its fixed-size product does not, for 3 rows), so the
+// results are bit for bit those of `block * x`, without the product's size dispatch.
+template <int N, int K, typename Block>
+inline void blockProduct(const Block& m, const double* x, double* y) {
+  for (int i = 0; i < N; ++i) {
+    double sum = m(i, 0) * x[0];
+    for (int k = 1; k < K; ++k)
+      sum += m(i, k) * x[k];
+    y[i] = sum;
+  }
+}
+
+// y += M^T f for a 3 x K block, each entry summed over the 3 rows in order (as `block^T * f`).
+template <int K, typename Block>
+inline void addTransposeProduct(const Block& m, const Eigen::Vector3d& f, double* y) {
+  for (int k = 0; k < K; ++k) {
+    double sum = m(0, k) * f(0);
+    sum += m(1, k) * f(1);
+    sum += m(2, k) * f(2);
+    y[k] += sum;
+  }
+}
+
 }  // namespace
 
 const char* toString(ContactState state) {
@@ -112,12 +136,14 @@ void SapProblem::collectBlocks() {
       blocks_.push_back(body.diagonalBlock(k));
       projectors_.push_back(body.freeProjector(k));
       block_offsets_.push_back(offset + k * body.blockSize());
+      free_inverses_.push_back(inverseOnFreeDofs(blocks_.back(), projectors_.back()));
       const Eigen::VectorXd diagonal = blocks_.back().diagonal();
       inverse_sqrt_diagonal_.segment(block_offsets_.back(), body.blockSize()) =
           diagonal.cwiseSqrt().cwiseInverse();
     }
   }
   block_starts_.push_back(static_cast<int>(blocks_.size()));
+  touched_.assign(blocks_.size(), 0);
   body_in_.resize(bodies_.size());
   body_out_.resize(bodies_.size());
 }
@@ -157,7 +183,7 @@ RowModel SapProblem::makeModel(const ContactRow& row, double dt,
   Eigen::Matrix3d w_block = Eigen::Matrix3d::Zero();
   for (const ContactTerm& term : row.terms) {
     const auto k = static_cast<size_t>(termBlock(term));
-    w_block += term.block * inverseOnFreeDofs(blocks_[k], projectors_[k]) * term.block.transpose();
+    w_block += term.block * free_inverses_[k] * term.block.transpose();
   }
   RowModel m;
   m.mu = row.mu;
@@ -171,6 +197,14 @@ RowModel SapProblem::makeModel(const ContactRow& row, double dt,
   m.v_hat = -row.gap / (dt + row.dissipation_time);
   m.bilateral = row.bilateral;
   return m;
+}
+
+bool SapProblem::setLaggedNormalImpulse(int i, double impulse) {
+  if (!(impulse >= 0) || !std::isfinite(impulse)) return false;
+  const auto k = static_cast<size_t>(i);
+  rows_[k].lagged_normal_impulse = impulse;
+  models_[k].radius = rows_[k].mu * impulse;  // as makeModel
+  return true;
 }
 
 void SapProblem::multiplyA(const Eigen::VectorXd& x, Eigen::VectorXd& out) const {
@@ -189,14 +223,35 @@ Eigen::Vector3d SapProblem::rowVelocity(int i, const Eigen::VectorXd& v) const {
 
 Eigen::Vector3d SapProblem::multiplyRow(int i, const Eigen::VectorXd& x) const {
   Eigen::Vector3d product = Eigen::Vector3d::Zero();
-  for (const ContactTerm& term : row(i).terms)
-    product += term.block * x.segment(termOffset(term), term.block.cols());
+  // The two term widths as fixed-size products: the same sums in the same order as the
+  // run-time-sized product, without its size dispatch.
+  for (const ContactTerm& term : row(i).terms) {
+    const int offset = termOffset(term);
+    Eigen::Vector3d part;
+    if (term.block.cols() == 3) {
+      blockProduct<3, 3>(term.block, x.data() + offset, part.data());
+      product += part;
+    } else if (term.block.cols() == 6) {
+      blockProduct<3, 6>(term.block, x.data() + offset, part.data());
+      product += part;
+    } else {
+      product += term.block * x.segment(offset, term.block.cols());
+    }
+  }
   return product;
 }
 
 void SapProblem::addRowTranspose(int i, const Eigen::Vector3d& f, Eigen::VectorXd& out) const {
-  for (const ContactTerm& term : row(i).terms)
-    out.segment(termOffset(term), term.block.cols()) += term.block.transpose() * f;
+  for (const ContactTerm& term : row(i).terms) {
+    const int offset = termOffset(term);
+    if (term.block.cols() == 3) {
+      addTransposeProduct<3>(term.block, f, out.data() + offset);
+    } else if (term.block.cols() == 6) {
+      addTransposeProduct<6>(term.block, f, out.data() + offset);
+    } else {
+      out.segment(offset, term.block.cols()) += term.block.transpose() * f;
+    }
+  }
 }
 
 void SapProblem::filter(Eigen::VectorXd& x) const {
@@ -251,7 +306,21 @@ void SapProblem::multiplyHessian(const SapEvaluation& e, const Eigen::VectorXd& 
 void SapProblem::preconditionerBlocks(const SapEvaluation* e, std::vector<DiagonalBlock>& inverse,
                                       bool use_bodies) const {
   // Blocks of a body with its own preconditioner are not used (applyPreconditioner): left as A's.
-  inverse = blocks_;
+  // A block no row acts on is A's block inverted on its free dofs, made once (free_inverses_);
+  // only the blocks rows act on are summed and inverted again, the same sums in the same order.
+  for (int i = 0; i < rowCount() && e != nullptr; ++i) {
+    if (e->rows[static_cast<size_t>(i)].state == ContactState::kSeparated) continue;
+    for (const ContactTerm& term : row(i).terms)
+      touched_[static_cast<size_t>(termBlock(term))] = 1;
+  }
+  inverse.resize(blocks_.size());
+  for (size_t b = 0; b < bodies_.size(); ++b) {
+    const bool own = use_bodies && bodies_[b]->hasPreconditioner();
+    for (int k = block_starts_[b]; k < block_starts_[b + 1]; ++k) {
+      const auto j = static_cast<size_t>(k);
+      inverse[j] = own || touched_[j] != 0 ? blocks_[j] : free_inverses_[j];
+    }
+  }
   for (int i = 0; i < rowCount() && e != nullptr; ++i) {
     const RowResponse& r = e->rows[static_cast<size_t>(i)];
     if (r.state == ContactState::kSeparated) continue;
@@ -259,10 +328,12 @@ void SapProblem::preconditionerBlocks(const SapEvaluation* e, std::vector<Diagon
       inverse[static_cast<size_t>(termBlock(term))] += term.block.transpose() * r.g * term.block;
   }
   for (size_t b = 0; b < bodies_.size(); ++b) {
-    if (use_bodies && bodies_[b]->hasPreconditioner()) continue;
+    const bool own = use_bodies && bodies_[b]->hasPreconditioner();
     for (int k = block_starts_[b]; k < block_starts_[b + 1]; ++k) {
       const auto j = static_cast<size_t>(k);
-      inverse[j] = inverseOnFreeDofs(inverse[j], projectors_[j]);
+      if (touched_[j] == 0) continue;
+      touched_[j] = 0;
+      if (!own) inverse[j] = inverseOnFreeDofs(inverse[j], projectors_[j]);
     }
   }
 }
@@ -287,7 +358,14 @@ void SapProblem::applyPreconditioner(const std::vector<DiagonalBlock>& inverse,
     for (int k = block_starts_[b]; k < block_starts_[b + 1]; ++k) {
       const auto j = static_cast<size_t>(k);
       const auto n = inverse[j].rows();
-      out.segment(block_offsets_[j], n) = inverse[j] * r.segment(block_offsets_[j], n);
+      const int o = block_offsets_[j];
+      if (n == 3) {
+        blockProduct<3, 3>(inverse[j], r.data() + o, out.data() + o);
+      } else if (n == 6) {
+        blockProduct<6, 6>(inverse[j], r.data() + o, out.data() + o);
+      } else {
+        out.segment(o, n) = inverse[j] * r.segment(o, n);
+      }
     }
   }
 }

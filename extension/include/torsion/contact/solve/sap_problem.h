@@ -135,6 +135,11 @@ class SapProblem {
   int rowCount() const { return static_cast<int>(rows_.size()); }
   const ContactRow& row(int i) const { return rows_[static_cast<size_t>(i)]; }
   const RowModel& model(int i) const { return models_[static_cast<size_t>(i)]; }
+  /// Sets row i's lagged normal impulse (N s, finite, >= 0) and with it the radius of its
+  /// friction disk, r = mu gamma_n^lag: the rest of the row's model does not depend on it, so the
+  /// problem is the one create() makes from the changed row (a re-solve with matched friction
+  /// bounds, rigid_contact_convex.cpp). Returns false, changing nothing, on an invalid impulse.
+  bool setLaggedNormalImpulse(int i, double impulse);
   /// The first island dof of body `body`.
   int bodyOffset(int body) const { return body_offsets_[static_cast<size_t>(body)]; }
   const Eigen::VectorXd& momentum() const { return momentum_; }
@@ -188,6 +193,10 @@ class SapProblem {
   std::vector<int> block_offsets_;         // first island dof of each block
   std::vector<DiagonalBlock> blocks_;      // A's diagonal blocks
   std::vector<DiagonalBlock> projectors_;  // S per block
+  // S (S A_kk S + I - S)^-1 S per block, made once: block-Jacobi's block wherever no row acts.
+  std::vector<DiagonalBlock> free_inverses_;
+  // Per block: whether a row acting on it enters preconditionerBlocks (scratch, kept zero).
+  mutable std::vector<char> touched_;
   int dofs_ = 0;
   Eigen::VectorXd momentum_;
   Eigen::VectorXd inverse_sqrt_diagonal_;
