@@ -128,13 +128,16 @@ LinearSolveReport RigidContactSolver::solveConvex(const SystemOperator& op,
   // One solver for the rounds: its workspace is sized once.
   sap::SapSolver solver;
   sap::SapReport report = solver.solve(created.value(), x);
+  // Every round's iterations count: the statistics say what the step cost.
   int newton = report.newton_iterations;
+  int cg = report.cg_iterations;
   for (int round = 0;
        round < kMaxFrictionBoundRounds && report.converged &&
        matchFrictionBounds(island, created.value(), row_partner, partners_.size(), report);
        ++round) {
     report = solver.solve(created.value(), x);  // from the last solution
     newton += report.newton_iterations;
+    cg += report.cg_iterations;
   }
   const sap::SapProblem& problem = created.value();
   v = x.head(v.size());
@@ -178,7 +181,7 @@ LinearSolveReport RigidContactSolver::solveConvex(const SystemOperator& op,
   stats_.active_set_converged = report.converged;
 
   LinearSolveReport out;
-  out.iterations = report.cg_iterations;
+  out.iterations = cg;
   out.converged = true;  // the linear solves inside Newton; the contact solve's own verdict is
                          // stats().active_set_converged
   return out;
