@@ -563,7 +563,7 @@ PY
       -e 's/"slab"/"rigid_boxes_1"/g' "$scenes/bullet_boxes.json" > boxes.json
     run "$torsion" run boxes.json --out out --steps 2
     expect_rc 1
-    expect_out "^error: boxes.json: bullet_file: rigid body 'boxes_1' and FEM body 'rigid_boxes_1' would write the same series files"
+    expect_out "^error: boxes.json: bullet_file: .*/boxes.bullet: rigid_bodies\[1\].name: rigid body 'boxes_1' and FEM body 'rigid_boxes_1' would write the same series files"
     [[ ! -e out ]] || fail "nothing may be written for a bad scene"
     ;;
   stale_temporaries_removed)
