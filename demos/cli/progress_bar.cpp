@@ -13,6 +13,9 @@ void ProgressBar::update(int done, int total, double rate) {
   const double fraction = total > 0 ? double(done) / total : 1.0;
   const double eta = rate > 0 ? (total - done) / rate : 0.0;
   if (terminal_) {
+    const auto now = std::chrono::steady_clock::now();
+    if (drawn_ && done < total && now - last_drawn_ < std::chrono::milliseconds(100)) return;
+    last_drawn_ = now;
     constexpr int kWidth = 30;
     const int filled = static_cast<int>(fraction * kWidth);
     std::string bar(static_cast<size_t>(filled), '=');

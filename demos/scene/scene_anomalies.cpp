@@ -35,6 +35,8 @@ SceneAnomalies::SceneAnomalies(const FemWorld& world) {
   for (const auto& body : world.bodies()) {
     body_names_.push_back(body->name());
     monitors_.emplace_back();
+    counters_.emplace_back(body->model());
+    counted_models_.push_back(&body->model());
   }
 }
 
@@ -42,7 +44,12 @@ bool SceneAnomalies::observe(const FemWorld& world, int step) {
   bool started = false;
   for (size_t b = 0; b < monitors_.size(); ++b) {
     const FemBody& body = *world.bodies()[b];
-    const StepObservation o = observeStep(body.model(), body.state().positions, body.lastReport());
+    if (counted_models_[b] != &body.model()) {
+      counters_[b] = InvertedTetCounter(body.model());
+      counted_models_[b] = &body.model();
+    }
+    const StepObservation o =
+        observeStep(counters_[b], body.model(), body.state().positions, body.lastReport());
     for (AnomalyKind kind : monitors_[b].observe(step, o)) {
       const std::string line = "body '" + body_names_[b] + "', step " + std::to_string(step) +
                                ": " + describe(kind, monitors_[b].anomalies().back(), o);

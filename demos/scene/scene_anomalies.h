@@ -28,6 +28,10 @@ class SceneAnomalies {
  private:
   std::vector<std::string> body_names_;
   std::vector<StepAnomalyMonitor> monitors_;
+  // Per body: the inverted-tet counter and the model it was made for (a live material edit
+  // makes a new model: its counter is made again).
+  std::vector<InvertedTetCounter> counters_;
+  std::vector<const FemModel*> counted_models_;
   std::string first_warning_;
 };
 

@@ -1,12 +1,12 @@
 #include "scene_runner.h"
 
 #include <algorithm>
+#include <charconv>
 #include <chrono>
 #include <csignal>
 #include <filesystem>
 #include <nlohmann/json.hpp>
 #include <optional>
-#include <sstream>
 
 #include "run_directory.h"
 #include "run_provenance.h"
@@ -48,21 +48,49 @@ Status writeFinalMesh(const FemBody& body, const Eigen::VectorXd& positions, con
   return writeTextFile(path, formatVtk(mesh, x, fields, body.name()));
 }
 
+// CSV values as a stream with precision(10) writes them ("%.10g"; std::to_chars with a precision
+// is printf's %.*g in the C locale), without a stream per row.
+void appendValue(std::string& row, double value) {
+  char text[40];
+  const std::to_chars_result r =
+      std::to_chars(text, text + sizeof text, value, std::chars_format::general, 10);
+  row.push_back(',');
+  row.append(text, r.ptr);
+}
+
+void appendValue(std::string& row, long value) {
+  char text[24];
+  const std::to_chars_result r = std::to_chars(text, text + sizeof text, value);
+  row.push_back(',');
+  row.append(text, r.ptr);
+}
+
+// "step,time": the start of every row.
+void startRow(std::string& row, int step, double time) {
+  row.clear();
+  appendValue(row, static_cast<long>(step));
+  row.erase(0, 1);  // no comma before the first value
+  appendValue(row, time);
+}
+
+void appendWrench(std::string& row, const Wrench& w) {
+  for (double value :
+       {w.force.x(), w.force.y(), w.force.z(), w.torque.x(), w.torque.y(), w.torque.z()})
+    appendValue(row, value);
+}
+
 // Per step: each rigid body's centre of mass, orientation quaternion and linear velocity.
-std::string rigidRow(const BuiltScene& scene, int step, double time) {
-  std::ostringstream csv;
-  csv.precision(10);
-  csv << step << "," << time;
+void rigidRow(const BuiltScene& scene, int step, double time, std::string& row) {
+  startRow(row, step, time);
   for (const SceneRigidBody& r : scene.rigid_bodies) {
     const btTransform& t = r.body->getCenterOfMassTransform();
     const btQuaternion q = t.getRotation();
     const btVector3& v = r.body->getLinearVelocity();
-    csv << "," << t.getOrigin().x() << "," << t.getOrigin().y() << "," << t.getOrigin().z() << ","
-        << q.x() << "," << q.y() << "," << q.z() << "," << q.w() << "," << v.x() << "," << v.y()
-        << "," << v.z();
+    for (btScalar value : {t.getOrigin().x(), t.getOrigin().y(), t.getOrigin().z(), q.x(), q.y(),
+                           q.z(), q.w(), v.x(), v.y(), v.z()})
+      appendValue(row, static_cast<double>(value));
   }
-  csv << "\n";
-  return csv.str();
+  row.push_back('\n');
 }
 
 // FEM-rigid contact figures over the run (docs/contact.md), summed over the FEM bodies per step.
@@ -337,34 +365,28 @@ class Run {
     iteration_sum_ += iterations;
     iteration_max_ = std::max(iteration_max_, iterations);
 
-    std::ostringstream wrench;
-    wrench.precision(10);
-    wrench << report.step << "," << world_.time();
-    for (const NodeSetHandle& s : scene_.node_sets) {
-      const Wrench w = s.body->groupWrench(s.group, s.wrench_about);
-      wrench << "," << w.force.x() << "," << w.force.y() << "," << w.force.z() << ","
-             << w.torque.x() << "," << w.torque.y() << "," << w.torque.z();
-    }
-    for (const SceneHand& h : scene_.hands) {  // about the hand's origin O; zero when not holding
-      const Wrench w = h.hand->wrench();
-      wrench << "," << w.force.x() << "," << w.force.y() << "," << w.force.z() << ","
-             << w.torque.x() << "," << w.torque.y() << "," << w.torque.z();
-    }
-    wrench << "\n";
-    if (Status s = wrench_csv_.row(wrench.str()); !s) return s;
+    // The wrenches of the node sets (their rows of the internal forces only) and of the hands.
+    startRow(row_, report.step, world_.time());
+    for (const NodeSetHandle& s : scene_.node_sets)
+      appendWrench(row_, s.body->groupWrench(s.group, s.wrench_about));
+    for (const SceneHand& h : scene_.hands)  // about the hand's origin O; zero when not holding
+      appendWrench(row_, h.hand->wrench());
+    row_.push_back('\n');
+    if (Status s = wrench_csv_.row(row_); !s) return s;
 
-    std::ostringstream energy;
-    energy.precision(10);
-    energy << report.step << "," << world_.time();
+    startRow(row_, report.step, world_.time());
     for (const auto& body : world_.bodies()) {
       // kinetic at the end of the step; elastic at its start (the stepper's by-product)
-      energy << "," << body->lastReport().kinetic_energy << ","
-             << body->lastReport().elastic_energy;
+      appendValue(row_, body->lastReport().kinetic_energy);
+      appendValue(row_, body->lastReport().elastic_energy);
     }
-    energy << "," << iterations << "," << residual << "\n";
-    if (Status s = energy_csv_.row(energy.str()); !s) return s;
+    appendValue(row_, static_cast<long>(iterations));
+    appendValue(row_, residual);
+    row_.push_back('\n');
+    if (Status s = energy_csv_.row(row_); !s) return s;
     if (rigid_csv_.isOpen()) {
-      if (Status s = rigid_csv_.row(rigidRow(scene_, report.step, world_.time())); !s) return s;
+      rigidRow(scene_, report.step, world_.time(), row_);
+      if (Status s = rigid_csv_.row(row_); !s) return s;
     }
     contact_totals_.add(world_);
     return Ok{};
@@ -465,6 +487,7 @@ class Run {
   std::vector<NamedRigidBody> rigid_bodies_;
   std::optional<RunDirectory> dir_;
   CsvOutput wrench_csv_, energy_csv_, rigid_csv_;
+  std::string row_;  // the CSV row being formatted (its capacity kept across steps)
   std::vector<Eigen::VectorXd> last_good_;
   RunOutcome outcome_;
   std::chrono::steady_clock::time_point run_start_;

@@ -5,7 +5,9 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/Geometry>
+#include <limits>
 #include <memory>
+#include <random>
 
 #include "torsion/mesh/box_mesh.h"
 
@@ -46,6 +48,50 @@ TEST(MeasureDeformation, CountsInvertedTetsAndFindsTheWorst) {
   EXPECT_EQ(mirrored.inverted_tets, mesh.value().tetCount());
   EXPECT_NEAR(mirrored.max_strain, 2, 1e-9);
   EXPECT_GE(mirrored.max_strain_tet, 0);
+}
+
+TEST(InvertedTetCounter, JudgesEveryTetAsDetFDoesDownToNearlyFlatTets) {
+  // The triple-product shortcut must never disagree with !(det F > 0), however close to flat a
+  // tet is or however the body is scaled: nodes pulled onto (and just across) a face's plane.
+  Result<TetMesh> mesh = makeBoxTetMesh(Eigen::Vector3d::Zero(), Eigen::Vector3d::Ones(), 3, 3, 3);
+  ASSERT_TRUE(mesh.ok());
+  auto model = FemModel::create(std::make_shared<const TetMesh>(mesh.value()), Material{});
+  ASSERT_TRUE(model.ok());
+  const FemModel& m = *model.value();
+  const InvertedTetCounter counter(m);
+  const int n = mesh.value().nodeCount();
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<double> jitter(-1, 1);
+  std::uniform_int_distribution<int> pick_tet(0, mesh.value().tetCount() - 1);
+  for (int trial = 0; trial < 400; ++trial) {
+    Eigen::VectorXd x(3 * n);
+    const double amplitude = trial % 4 == 0 ? 0.6 : 0.05;  // some runs with many inversions
+    for (int i = 0; i < n; ++i) {
+      x.segment<3>(3 * i) = mesh.value().restPositions()[static_cast<size_t>(i)] +
+                            amplitude * Eigen::Vector3d(jitter(rng), jitter(rng), jitter(rng));
+    }
+    // A few tets made flat to within a few ulps: a node moved onto the plane of the other three.
+    for (int k = 0; k < 5; ++k) {
+      const Tet& tet = mesh.value().tets()[static_cast<size_t>(pick_tet(rng))];
+      const Eigen::Vector3d a = x.segment<3>(3 * tet[0]), b = x.segment<3>(3 * tet[1]),
+                            c = x.segment<3>(3 * tet[2]);
+      const Eigen::Vector3d normal = (b - a).cross(c - a).normalized();
+      Eigen::Vector3d d = x.segment<3>(3 * tet[3]);
+      d -= (normal.dot(d - a) + 1e-16 * jitter(rng)) * normal;
+      x.segment<3>(3 * tet[3]) = d;
+    }
+    const double scale = trial % 3 == 0 ? 1e-90 : (trial % 3 == 1 ? 1.0 : 1e90);
+    x *= scale;
+    EXPECT_EQ(counter.count(m, x), measureDeformation(m, x).inverted_tets) << "trial " << trial;
+    EXPECT_EQ(countInvertedTets(m, x), measureDeformation(m, x).inverted_tets);
+  }
+  // Non-finite positions count as inverted, as det F does.
+  Eigen::VectorXd x(3 * n);
+  for (int i = 0; i < n; ++i)
+    x.segment<3>(3 * i) = mesh.value().restPositions()[static_cast<size_t>(i)];
+  x(0) = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_EQ(counter.count(m, x), measureDeformation(m, x).inverted_tets);
+  EXPECT_GT(counter.count(m, x), 0);
 }
 
 }  // namespace

@@ -68,6 +68,77 @@ TEST(FemWorld, CantileverSagsAndRigidBoxFallsBesideIt) {
               0.5 * 9.81 * t * settings.solver.time_step + 1e-9);
 }
 
+// A body alone in the world skips its node tree and normals (nothing can touch it); when a rigid
+// body arrives, the first step brings them up to date, and the fall onto it is bit for bit the
+// fall of a world that refreshed them every step (one with a far box from the start).
+TEST(FemWorld, ALoneBodyCatchesUpItsContactDataWhenSomethingArrives) {
+  auto fall = [](bool far_box_from_start) {
+    WorldSettings settings;
+    auto world = std::make_unique<FemWorld>(settings);
+    Frame pose;
+    pose.origin = Eigen::Vector3d(0, 0, 0.3);
+    FemBody* body = world->addBody("beam", beam(), Material{}, pose).value();
+    // Turning, so that its normals change while it is alone.
+    EXPECT_TRUE(body->setRigidVelocity(Eigen::Vector3d::Zero(), Eigen::Vector3d(0.6, 0.4, 0)).ok());
+    btTransform at;
+    at.setIdentity();
+    if (far_box_from_start) {
+      at.setOrigin(btVector3(500, 0, 0));
+      world->addRigidBody(std::make_unique<btBoxShape>(btVector3(1, 1, 1)), 0.0, at);
+    }
+    for (int k = 0; k < 10; ++k)
+      EXPECT_TRUE(world->step().ok);
+    at.setOrigin(btVector3(2, 0.5, -0.5));  // a static slab whose top is z = 0
+    world->addRigidBody(std::make_unique<btBoxShape>(btVector3(5, 5, 0.5)), 0.0, at);
+    int touching_steps = 0;
+    for (int k = 0; k < 40; ++k) {
+      EXPECT_TRUE(world->step().ok);
+      if (body->contacts().stats().active > 0) ++touching_steps;
+    }
+    EXPECT_GT(touching_steps, 0);  // it landed
+    return world;
+  };
+  const std::unique_ptr<FemWorld> lone = fall(false);
+  const std::unique_ptr<FemWorld> never_lone = fall(true);
+  const FemBody& a = *lone->bodies().front();
+  const FemBody& b = *never_lone->bodies().front();
+  for (int i = 0; i < a.model().nodeCount(); ++i) {
+    for (int c = 0; c < 3; ++c)
+      ASSERT_EQ(a.state().position(i)(c), b.state().position(i)(c)) << "node " << i;
+  }
+}
+
+// The normals a lone body left stale are those of its nodes again as soon as a step is for contact.
+TEST(FemWorld, ALoneBodysNormalsAreRefreshedByTheFirstStepForContact) {
+  auto turning = [](bool far_box) {
+    auto world = std::make_unique<FemWorld>(WorldSettings{});
+    FemBody* body = world->addBody("beam", beam(), Material{}).value();
+    EXPECT_TRUE(body->setRigidVelocity(Eigen::Vector3d::Zero(), Eigen::Vector3d(0.6, 0.4, 0)).ok());
+    if (far_box) {
+      btTransform at;
+      at.setIdentity();
+      at.setOrigin(btVector3(500, 0, 0));
+      world->addRigidBody(std::make_unique<btBoxShape>(btVector3(1, 1, 1)), 0.0, at);
+    }
+    for (int k = 0; k < 10; ++k)
+      EXPECT_TRUE(world->step().ok);
+    return world;
+  };
+  const std::unique_ptr<FemWorld> lone = turning(false);
+  const std::unique_ptr<FemWorld> never_lone = turning(true);
+  btSoftBody& stale = *lone->bodies().front()->softBody();
+  const btSoftBody& fresh = *never_lone->bodies().front()->softBody();
+  auto sameNormals = [&] {
+    for (int i = 0; i < stale.m_nodes.size(); ++i) {
+      if (!(stale.m_nodes[i].m_n == fresh.m_nodes[i].m_n)) return false;
+    }
+    return true;
+  };
+  EXPECT_FALSE(sameNormals());  // still those of the rest shape
+  lone->bodies().front()->predict(0.01, /*for_contact=*/true);
+  EXPECT_TRUE(sameNormals());
+}
+
 TEST(FemWorld, SetGravityPullsFemAndRigidBodiesAsleepOrAddedLaterTheNewWay) {
   WorldSettings settings;
   settings.gravity = Eigen::Vector3d::Zero();

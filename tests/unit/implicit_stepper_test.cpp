@@ -95,6 +95,31 @@ TEST(ImplicitStepper, InternalForcesConserveMomentum) {
   EXPECT_LT((momentum() - p0).norm(), 1e-6 * (p0.norm() + model->totalMass() * 0.5));
 }
 
+TEST(ImplicitStepper, InternalForcesAtNodesAreTheWholeVectorsRowsBitForBit) {
+  // A node group's wrench reads internalForcesAt(): only its rows of K v, the same bits.
+  auto model = beamModel();
+  Parallel parallel(1);
+  ImplicitStepper stepper(model, tight(), parallel);
+  FemState state = FemState::atRest(*model);
+  std::mt19937 rng(5);
+  std::normal_distribution<double> n(0, 0.5);
+  for (int i = 0; i < state.velocities.size(); ++i)
+    state.velocities[i] = n(rng);
+  NodeConstraints constraints(model->nodeCount());
+  constraints.prescribeVelocity(0, Eigen::Vector3d::Zero());
+  const Eigen::VectorXd zero = Eigen::VectorXd::Zero(3 * model->nodeCount());
+  const std::vector<int> nodes = {0, 7, 3, 44, model->nodeCount() - 1};
+  for (int k = 0; k < 5; ++k) {
+    ASSERT_FALSE(isFatal(stepper.step(state, constraints, zero).health));
+    const Eigen::VectorXd rows = stepper.internalForcesAt(nodes);  // before internalForces()
+    const Eigen::VectorXd& whole = stepper.internalForces();
+    for (int node : nodes) {
+      for (int a = 0; a < 3; ++a)
+        EXPECT_EQ(rows(3 * node + a), whole(3 * node + a)) << "step " << k << " node " << node;
+    }
+  }
+}
+
 TEST(ImplicitStepper, TotalEnergyNeverRisesWithDamping) {
   auto model = beamModel();
   Parallel parallel(1);

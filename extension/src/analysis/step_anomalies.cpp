@@ -21,8 +21,13 @@ const char* toString(AnomalyKind kind) {
 
 StepObservation observeStep(const FemModel& model, const Eigen::VectorXd& positions,
                             const StepReport& report) {
+  return observeStep(InvertedTetCounter(model), model, positions, report);
+}
+
+StepObservation observeStep(const InvertedTetCounter& counter, const FemModel& model,
+                            const Eigen::VectorXd& positions, const StepReport& report) {
   StepObservation o;
-  o.inverted_elements = countInvertedTets(model, positions);
+  o.inverted_elements = counter.count(model, positions);
   o.kinetic_energy = report.kinetic_energy;
   o.elastic_energy = report.elastic_energy;
   o.max_speed = report.max_speed;

@@ -53,7 +53,8 @@ void FemBody::releaseGroup(int group) {
 }
 
 Wrench FemBody::groupWrench(int group, const Eigen::Vector3d& point) {
-  return groups_[static_cast<size_t>(group)]->wrenchOn(stepper_.internalForces(), state_, point);
+  const CarriedNodes& carried = *groups_[static_cast<size_t>(group)];
+  return carried.wrenchOn(stepper_.internalForcesAt(carried.nodes()), state_, point);
 }
 
 Result<int> FemBody::anchorNodes(std::vector<int> nodes, btCollisionObject* object) {
@@ -146,8 +147,13 @@ Status FemBody::setMaterial(const Material& material) {
   return Ok{};
 }
 
-void FemBody::predict(double dt) {
+void FemBody::predict(double dt, bool for_contact) {
   btSoftBody& sb = *soft_body_;
+  for_contact_ = for_contact;
+  if (for_contact && normals_stale_) {  // from m_x = x_n, as refreshSurface() would have
+    sb.updateNormals();
+    normals_stale_ = false;
+  }
   sb.m_sst.sdt = toBtScalar(dt);
   sb.m_sst.isdt = toBtScalar(1 / dt);
   sb.m_sst.velmrg = toBtScalar(3 * dt);
@@ -159,7 +165,7 @@ void FemBody::predict(double dt) {
     node.m_v = toBt(state_.velocity(i));
     node.m_x = toBt(state_.position(i) + dt * state_.velocity(i));
   }
-  sb.updateNodeTree(true, true);
+  if (for_contact) sb.updateNodeTree(true, true);  // a refit: a function of m_x, m_v, dt only
   sb.updateBounds();
   sb.m_rcontacts.resizeNoInitialize(0);
   sb.m_scontacts.resizeNoInitialize(0);
@@ -301,6 +307,15 @@ void FemBody::restore(const FemBodyCheckpoint& c) {
   }
   last_report_ = c.last_report;
   writeBack();
+}
+
+void FemBody::refreshSurface() {
+  if (for_contact_) {
+    soft_body_->updateNormals();
+  } else {
+    normals_stale_ = true;
+  }
+  soft_body_->updateBounds();
 }
 
 void FemBody::writeBack() {

@@ -245,8 +245,13 @@ void FemSoftBodySolver::predictMotion(btScalar solver_dt) {
   // predicts the motion that collision detection looks along.
   const double dt = static_cast<double>(solver_dt);
   if (status_.ok) {
+    // A body alone in the world, without anchors, cannot touch anything this step: its node tree
+    // and normals (read only by contact detection) wait until something can.
+    const bool alone = bodies_.size() == 1 && world_ != nullptr &&
+                       world_->getNumCollisionObjects() == 1 &&
+                       bodies_.front()->contacts().anchors().empty();
     for (const auto& body : bodies_)
-      body->predict(dt);
+      body->predict(dt, !alone);
   }
   if (fem_contact_) fem_contact_->beginSubstep();
   soft_touch_->beginSubstep();
@@ -313,10 +318,8 @@ void FemSoftBodySolver::solveConstraints(btScalar solver_dt) {
 }
 
 void FemSoftBodySolver::updateSoftBodies() {
-  for (const auto& body : bodies_) {
-    body->softBody()->updateNormals();
-    body->softBody()->updateBounds();
-  }
+  for (const auto& body : bodies_)
+    body->refreshSurface();
   bullet_solver_.updateSoftBodies();
 }
 

@@ -355,6 +355,19 @@ const Eigen::VectorXd& ImplicitStepper::internalForces() {
   return internal_forces_;
 }
 
+const Eigen::VectorXd& ImplicitStepper::internalForcesAt(const std::vector<int>& nodes) {
+  if (velocity_next_.size() != 3 * model_->nodeCount() || internal_forces_valid_)
+    return internalForces();
+  system_.multiplyStiffnessRows(velocity_next_, nodes, node_scratch_);
+  node_forces_.resize(3 * model_->nodeCount());
+  const double scale = last_dt_ + model_->material().stiffness_damping;  // as internalForces()
+  for (int node : nodes) {
+    node_forces_.segment<3>(3 * node) =
+        elastic_forces_.segment<3>(3 * node) - scale * node_scratch_.segment<3>(3 * node);
+  }
+  return node_forces_;
+}
+
 ImplicitStepper::Memory ImplicitStepper::memory() {
   Memory m;
   m.internal_forces = internalForces();  // now, while K is the last step's

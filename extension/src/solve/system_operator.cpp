@@ -435,6 +435,19 @@ void SystemOperator::multiplyStiffness(const Eigen::VectorXd& y, Eigen::VectorXd
   apply(y, out, 0.0, 1.0);
 }
 
+void SystemOperator::multiplyStiffnessRows(const Eigen::VectorXd& y, const std::vector<int>& rows,
+                                           Eigen::VectorXd& out) const {
+  if (model_->nodalPressure()) {
+    multiplyStiffness(y, out);  // its rows need every tet's pressure increment
+    return;
+  }
+  assemble();
+  out.resize(y.size());
+  const system_kernels::ProductInput in = productInput(y, out, 0.0, 1.0);
+  for (int row : rows)
+    kernels_->block_product(in, row, row + 1);  // the same kernel, row by row: the same bits
+}
+
 void SystemOperator::diagonalBlocks(std::vector<Eigen::Matrix3d>& blocks) const {
   assemble();
   const std::vector<double>& mass = model_->nodeMasses();

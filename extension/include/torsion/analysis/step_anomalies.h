@@ -23,6 +23,7 @@
 #include <deque>
 #include <vector>
 
+#include "torsion/analysis/deformation_metrics.h"
 #include "torsion/fem/fem_model.h"
 #include "torsion/solve/implicit_stepper.h"
 
@@ -74,6 +75,10 @@ struct StepObservation {
 /// The observation of `model`'s body at `positions` (3n) after a step that returned `report`.
 StepObservation observeStep(const FemModel& model, const Eigen::VectorXd& positions,
                             const StepReport& report);
+/// The same with the inverted tets counted by `counter` (made for `model`'s mesh): for a body
+/// observed after every step.
+StepObservation observeStep(const InvertedTetCounter& counter, const FemModel& model,
+                            const Eigen::VectorXd& positions, const StepReport& report);
 
 /// A range of steps in which one kind of anomaly held.
 struct Anomaly {

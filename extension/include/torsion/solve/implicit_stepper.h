@@ -156,6 +156,10 @@ class ImplicitStepper {
 
   /// Elastic + stiffness-damping forces on each node at the end of the last step, 3n, N.
   const Eigen::VectorXd& internalForces();
+  /// internalForces() needed at `nodes` only (a node group's wrench): a 3n vector whose rows at
+  /// those nodes hold bit for bit internalForces()'s values (its other rows are unspecified);
+  /// costs those rows of K v instead of a product while internalForces() is not yet computed.
+  const Eigen::VectorXd& internalForcesAt(const std::vector<int>& nodes);
   /// Elastic forces f(x) at the start of the last step, 3n, N.
   const Eigen::VectorXd& elasticForces() const { return elastic_forces_; }
 
@@ -232,6 +236,7 @@ class ImplicitStepper {
   const NodeConstraints* constraints_ = nullptr;  // the prepared step's (the caller's)
 
   Eigen::VectorXd elastic_forces_, rhs_, velocity_next_, internal_forces_, scratch_;
+  Eigen::VectorXd node_forces_, node_scratch_;   // internalForcesAt()'s rows
   Eigen::VectorXd previous_velocities_;          // v of the step before, for the CG warm start
   std::vector<Eigen::Vector3d> element_forces_;  // N per element (SystemOperator::gather)
   std::vector<double> element_energy_;

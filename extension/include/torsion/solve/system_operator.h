@@ -112,6 +112,11 @@ class SystemOperator {
                          Eigen::VectorXd& out) const;
   /// out = K y.
   void multiplyStiffness(const Eigen::VectorXd& y, Eigen::VectorXd& out) const;
+  /// (K y) at the block rows `rows` only (out sized 3n, its other rows left as they are): bit for
+  /// bit those rows of multiplyStiffness() (with nodal pressure it is multiplyStiffness()). The
+  /// force on a few nodes costs their rows instead of a product.
+  void multiplyStiffnessRows(const Eigen::VectorXd& y, const std::vector<int>& rows,
+                             Eigen::VectorXd& out) const;
   /// out_i = scale * sum of the per-element values of node i (element_values[N e + a] belongs to
   /// node elementNodes()[N e + a], N nodes per element), summed over the node's elements in
   /// ascending order.
