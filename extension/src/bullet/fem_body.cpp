@@ -149,11 +149,6 @@ Status FemBody::setMaterial(const Material& material) {
 
 void FemBody::predict(double dt, bool for_contact) {
   btSoftBody& sb = *soft_body_;
-  for_contact_ = for_contact;
-  if (for_contact && normals_stale_) {  // from m_x = x_n, as refreshSurface() would have
-    sb.updateNormals();
-    normals_stale_ = false;
-  }
   sb.m_sst.sdt = toBtScalar(dt);
   sb.m_sst.isdt = toBtScalar(1 / dt);
   sb.m_sst.velmrg = toBtScalar(3 * dt);
@@ -310,11 +305,8 @@ void FemBody::restore(const FemBodyCheckpoint& c) {
 }
 
 void FemBody::refreshSurface() {
-  if (for_contact_) {
-    soft_body_->updateNormals();
-  } else {
-    normals_stale_ = true;
-  }
+  // Normals every step: a program of the user's may draw the body from Bullet's nodes.
+  soft_body_->updateNormals();
   soft_body_->updateBounds();
 }
 

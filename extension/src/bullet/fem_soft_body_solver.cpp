@@ -246,7 +246,7 @@ void FemSoftBodySolver::predictMotion(btScalar solver_dt) {
   const double dt = static_cast<double>(solver_dt);
   if (status_.ok) {
     // A body alone in the world, without anchors, cannot touch anything this step: its node tree
-    // and normals (read only by contact detection) wait until something can.
+    // (read only by contact detection) waits until something can.
     const bool alone = bodies_.size() == 1 && world_ != nullptr &&
                        world_->getNumCollisionObjects() == 1 &&
                        bodies_.front()->contacts().anchors().empty();

@@ -101,11 +101,11 @@ class FemBody {
   /// Bullet's predictor: m_q = x_n, m_x = x_n + dt v_n, bounds and node tree refreshed, contacts
   /// cleared, so Bullet's collision detection runs on this step's motion. `for_contact` false
   /// (FemSoftBodySolver: the body is the world's only collision object and has no anchor, so
-  /// nothing can touch it this step) leaves the node tree and the node normals, which only contact
-  /// detection reads, as they are; the first step for contact brings both up to date again (each
-  /// is a function of the nodes alone, so the values are those an every-step refresh gives).
+  /// nothing can touch it this step) leaves the node tree, which only contact detection reads, as
+  /// it is; the first step for contact refits it (a function of the nodes and dt alone, so the
+  /// tree is the one an every-step refresh gives).
   void predict(double dt, bool for_contact = true);
-  /// Bullet's end of the step: node normals (unless predict() was not for contact) and bounds.
+  /// Bullet's end of the step: node normals and bounds.
   void refreshSurface();
   /// The FEM step from ctx.time to ctx.endTime(): prepare(), the body's own solve (its contact
   /// solve, or the stepper's CG / CHOLMOD without contacts), finish(). A hyperelastic body
@@ -177,8 +177,6 @@ class FemBody {
   std::unique_ptr<RigidContactSolver> contacts_;
   std::unique_ptr<SelfContactSolver> self_contact_;
   bool rigid_contact_ = false;      // this step found nodes near rigid bodies (prepare)
-  bool for_contact_ = true;         // the last predict() refreshed the node tree (predict)
-  bool normals_stale_ = false;      // the node normals lag the nodes (refreshSurface)
   SummedOperatorTerm added_terms_;  // self-contact and island terms together
   StepReport last_report_;
 };
