@@ -31,8 +31,12 @@ if(TORSION_SANITIZE)
   if(NOT CMAKE_CXX_COMPILER_ID MATCHES "GNU|Clang")
     message(FATAL_ERROR "TORSION_SANITIZE needs GCC or Clang")
   endif()
-  # Global on purpose: every object in the process must be instrumented alike.
-  add_compile_options(-fsanitize=address,undefined -fno-omit-frame-pointer -fno-sanitize-recover=undefined)
+  # Global on purpose: every object in the process must be instrumented alike. UBSan's
+  # object-size check is left out: ASan checks every access against its object's real bounds, and
+  # object-size, a weaker static bound, made clang compile the library's batches a fifth slower
+  # (48 s against 39 s on the largest).
+  add_compile_options(-fsanitize=address,undefined -fno-sanitize=object-size -fno-omit-frame-pointer
+                      -fno-sanitize-recover=undefined)
   add_link_options(-fsanitize=address,undefined)
 endif()
 
