@@ -39,6 +39,7 @@ constexpr char kAnswer = 'A';
 constexpr char kError = 'E';
 constexpr char kOutOfMemory = 'M';
 
+#ifndef TORSION_ISOLATED_SANITIZED
 // The address space this process has mapped (bytes): the child inherits it.
 std::size_t mappedBytes() {
   std::ifstream statm("/proc/self/statm");
@@ -46,6 +47,7 @@ std::size_t mappedBytes() {
   statm >> pages;
   return pages * static_cast<std::size_t>(sysconf(_SC_PAGESIZE));
 }
+#endif
 
 void writeAll(int fd, const char* data, std::size_t size) {
   while (size > 0) {
