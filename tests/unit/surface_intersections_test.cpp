@@ -97,6 +97,21 @@ TEST(TrianglesIntersect, CoplanarOverlapsTouchesAndGaps) {
 }
 
 // A strip of four triangles: only the first and the last share no corner.
+// A segment through the triangle, ending on it, lying in its plane across it, beside it, and a
+// zero-area triangle (meets nothing).
+TEST(SegmentMeetsTriangle, ThroughOnAndInThePlaneMeetBesideAndDegenerateDoNot) {
+  const TriangleCorners t = {Eigen::Vector3d(0, 0, 0), Eigen::Vector3d(1, 0, 0),
+                             Eigen::Vector3d(0, 1, 0)};
+  EXPECT_TRUE(segmentMeetsTriangle({0.2, 0.2, -1}, {0.2, 0.2, 1}, t));
+  EXPECT_TRUE(segmentMeetsTriangle({0.2, 0.2, 1}, {0.2, 0.2, 0}, t));
+  EXPECT_TRUE(segmentMeetsTriangle({-1, 0.2, 0}, {2, 0.2, 0}, t));
+  EXPECT_FALSE(segmentMeetsTriangle({0.8, 0.8, -1}, {0.8, 0.8, 1}, t));
+  EXPECT_FALSE(segmentMeetsTriangle({0.2, 0.2, 1e-12}, {0.2, 0.2, 1}, t));
+  const TriangleCorners flat = {Eigen::Vector3d(0, 0, 0), Eigen::Vector3d(1, 0, 0),
+                                Eigen::Vector3d(2, 0, 0)};
+  EXPECT_FALSE(segmentMeetsTriangle({0.5, 0, -1}, {0.5, 0, 1}, flat));
+}
+
 TEST(FindSurfaceIntersections, SkipsTrianglesThatShareACornerAndFindsCrossings) {
   const std::vector<Triangle> triangles{{0, 1, 2}, {1, 3, 2}, {2, 3, 4}, {3, 5, 4}};
   Eigen::VectorXd x(18);

@@ -227,6 +227,12 @@ bool trianglesIntersect(const TriangleCorners& p, const TriangleCorners& q) {
   return false;
 }
 
+bool segmentMeetsTriangle(const Eigen::Vector3d& a, const Eigen::Vector3d& b,
+                          const TriangleCorners& t) {
+  const int axis = projectionAxis(t);
+  return axis >= 0 && segmentMeetsTriangle(a, b, t, axis);
+}
+
 std::vector<TrianglePair> findSurfaceIntersections(const std::vector<Triangle>& triangles,
                                                    const Eigen::VectorXd& positions) {
   std::vector<TriangleCorners> corners;

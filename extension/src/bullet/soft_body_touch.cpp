@@ -6,6 +6,7 @@
 #include <set>
 
 #include "torsion/analysis/exact_predicates.h"
+#include "torsion/analysis/surface_intersections.h"
 #include "torsion/bt_conversions.h"
 #include "torsion/bullet/fem_body.h"
 #include "torsion/contact/face_distance.h"
@@ -49,19 +50,6 @@ void refresh(Swept& s, const btSoftBody& body, std::uint64_t round) {
 
 bool boxesApart(const Eigen::Vector3d& lo, const Eigen::Vector3d& hi, const Swept& s) {
   return (lo.array() > s.hi.array()).any() || (hi.array() < s.lo.array()).any();
-}
-
-// Whether the segment p0 p1 meets the triangle (a, b, c), its boundary included (exact signs).
-// A segment in the triangle's plane is left to the distance test.
-bool segmentMeetsTriangle(const Eigen::Vector3d& p0, const Eigen::Vector3d& p1,
-                          const Eigen::Vector3d& a, const Eigen::Vector3d& b,
-                          const Eigen::Vector3d& c) {
-  if (orient3dSign(a, b, c, p0) == orient3dSign(a, b, c, p1)) return false;
-  const int e[3] = {orient3dSign(p0, p1, a, b), orient3dSign(p0, p1, b, c),
-                    orient3dSign(p0, p1, c, a)};
-  const bool some_positive = e[0] > 0 || e[1] > 0 || e[2] > 0;
-  const bool some_negative = e[0] < 0 || e[1] < 0 || e[2] < 0;
-  return !(some_positive && some_negative);
 }
 
 // Crossings of the segment p q with the surface at its end positions, mod 2: 1 or 0, or -1 when
@@ -126,7 +114,7 @@ bool nodesMeetTriangles(const Swept& a, const Swept& b, bool b_closed,
         const Eigen::Vector3d v = x->segment<3>(3 * tri[1]);
         const Eigen::Vector3d w = x->segment<3>(3 * tri[2]);
         if ((closestPointOnTriangle(p, u, v, w) - p).squaredNorm() <= r * r) return true;
-        if (segmentMeetsTriangle(p0, p1, u, v, w)) return true;
+        if (segmentMeetsTriangle(p0, p1, {u, v, w})) return true;
       }
     }
     if (b_closed && insideClosedSurface(p1, b, candidates)) return true;

@@ -35,6 +35,11 @@ using TriangleCorners = std::array<Eigen::Vector3d, 3>;
 /// Whether the closed triangles p and q share a point (exact).
 bool trianglesIntersect(const TriangleCorners& p, const TriangleCorners& q);
 
+/// Whether the closed segment ab shares a point with the closed triangle t (exact; a segment in
+/// the triangle's plane included). A zero-area triangle meets nothing.
+bool segmentMeetsTriangle(const Eigen::Vector3d& a, const Eigen::Vector3d& b,
+                          const TriangleCorners& t);
+
 /// Two intersecting triangles, by their indices in the list(s) searched.
 struct TrianglePair {
   int first = 0;   ///< the triangle in the (first) list
