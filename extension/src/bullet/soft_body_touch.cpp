@@ -162,9 +162,8 @@ bool SoftBodyTouch::touches(FemBody& fem, btSoftBody& soft) {
   Swept& s = sweptSoft(soft);
   const Eigen::Vector3d pad = Eigen::Vector3d::Constant(f.margin + s.margin);
   if (soft_touch::boxesApart(s.lo - pad, s.hi + pad, f)) return false;
-  std::vector<int> candidates;
-  return soft_touch::nodesMeetTriangles(s, f, /*b_closed=*/true, candidates) ||
-         soft_touch::nodesMeetTriangles(f, s, /*b_closed=*/false, candidates);
+  return soft_touch::nodesMeetTriangles(s, f, /*b_closed=*/true, candidates_) ||
+         soft_touch::nodesMeetTriangles(f, s, /*b_closed=*/false, candidates_);
 }
 
 void SoftBodyTouch::forget(const FemBody* fem) {

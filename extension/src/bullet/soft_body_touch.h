@@ -61,6 +61,7 @@ class SoftBodyTouch {
   std::map<const FemBody*, std::unique_ptr<Swept>> fem_;
   std::map<const btSoftBody*, std::unique_ptr<Swept>> soft_;
   std::uint64_t round_ = 1;
+  std::vector<int> candidates_;  // the tree queries' answers, reused from pair to pair
 };
 
 }  // namespace torsion
