@@ -105,6 +105,7 @@ struct ContactTotals {
 
   void add(const FemWorld& world) {
     int active = 0;
+    int rigid_rows = 0;
     bool converged = true;
     bool fell_back = false;
     bool in_contact_space = false;
@@ -123,6 +124,9 @@ struct ContactTotals {
       max_penetration = std::max(max_penetration, s.max_penetration);
       active_set_iterations_max = std::max(active_set_iterations_max, s.active_set_iterations);
       converged = converged && s.active_set_converged;
+      rigid_rows += s.rigid_rows;
+      if (body->contacts().settings().friction_solve == ContactSettings::FrictionSolve::kConvex)
+        has_convex = true;
       if (body->contacts().settings().friction_solve !=
           ContactSettings::FrictionSolve::kActiveSet) {
         has_contact_space = true;
@@ -145,6 +149,7 @@ struct ContactTotals {
     ++steps;
     active_sum += active;
     active_max = std::max(active_max, active);
+    rigid_rows_max = std::max(rigid_rows_max, rigid_rows);
     if (!converged) ++unconverged_steps;
     if (fell_back) ++fallback_steps;
     if (in_contact_space) ++contact_space_steps;
@@ -154,6 +159,9 @@ struct ContactTotals {
   // instead.
   bool has_contact_space = false;
   int contact_space_steps = 0;
+  // Bodies on "convex": the most contacts between rigid bodies their islands solved in a step.
+  bool has_convex = false;
+  int rigid_rows_max = 0;
   int fallback_steps = 0;
   // Self-contact (bodies with "self_contact"): summed over bodies, steps counted per body.
   bool has_self_contact = false;
@@ -180,6 +188,7 @@ struct ContactTotals {
       j["contact_space_steps"] = contact_space_steps;
       j["contact_space_fallback_steps"] = fallback_steps;
     }
+    if (has_convex) j["rigid_rows_max"] = rigid_rows_max;
     if (has_self_contact) {
       j["self_contact"] = {{"active_max", self_active_max},
                            {"iterations_max", self_iterations_max},

@@ -98,6 +98,7 @@ bool RigidContactSolver::detect(const FemState& state, const NodeConstraints& co
   findContacts(state, constraints, dt);
   addAnchorContacts(state, constraints);
   dropUntouchedPartners();
+  takeRigidContacts();
   warmStartActiveSet();
   keepFastSliders(contacts_, state, dt_, partners_);
   recordDetectionStats();
@@ -264,6 +265,10 @@ void RigidContactSolver::measureEndGaps(const Eigen::VectorXd& v) {
 }
 
 void RigidContactSolver::finish() {
+  // The island's rigid impulses onto Bullet's points, which now carry them (rigid_contact_rows.h).
+  sap::writeBackRigidImpulses(rigid_group_, rigid_impulses_);
+  rigid_group_ = {};
+  rigid_impulses_.clear();
   links_.applyImpulses(partners_, dt_);
   for (RigidPartner& k : partners_) {
     if (k.link != nullptr) continue;

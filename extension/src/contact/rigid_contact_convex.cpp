@@ -11,6 +11,7 @@
 #include "torsion/contact/solve/face_contact_rows.h"
 #include "torsion/contact/solve/fem_island_body.h"
 #include "torsion/contact/solve/node_contact_rows.h"
+#include "torsion/contact/solve/rigid_contact_rows.h"
 #include "torsion/contact/solve/sap_problem.h"
 #include "torsion/contact/solve/sap_solver.h"
 
@@ -41,19 +42,26 @@ double featureMatchRadius(const TetMesh& mesh) {
 constexpr double kLaggedMismatch = 1.1;
 constexpr int kMaxFrictionBoundRounds = 2;
 
-// The partner of each row (node or face row).
-std::vector<int> rowPartners(const sap::NodeContactIsland& island,
-                             const std::vector<NodeContact>& contacts,
-                             const std::vector<FaceContact>& faces) {
-  std::vector<int> partner(island.rows.size(), -1);
+// The friction-bound group of each row: a node or face row's partner, and for each row between
+// rigid bodies a group of its own, numbered after the partners.
+std::vector<int> rowGroups(const sap::NodeContactIsland& island,
+                           const std::vector<NodeContact>& contacts,
+                           const std::vector<FaceContact>& faces, std::size_t partner_count) {
+  std::vector<int> group(island.rows.size(), -1);
   for (std::size_t r = 0; r < island.rows.size(); ++r) {
     if (island.row_contact[r] >= 0) {
-      partner[r] = contacts[static_cast<std::size_t>(island.row_contact[r])].partner;
+      group[r] = contacts[static_cast<std::size_t>(island.row_contact[r])].partner;
     } else if (r < island.row_face.size() && island.row_face[r] >= 0) {
-      partner[r] = faces[static_cast<std::size_t>(island.row_face[r])].partner;
+      group[r] = faces[static_cast<std::size_t>(island.row_face[r])].partner;
+    } else {
+      group[r] = static_cast<int>(partner_count + r);
     }
   }
-  return partner;
+  return group;
+}
+
+bool isRigidRow(const sap::NodeContactIsland& island, std::size_t r) {
+  return r < island.row_rigid.size() && island.row_rigid[r] >= 0;
 }
 
 // The lagged model bounds each row's friction by mu times its last normal impulse. Where that
@@ -66,9 +74,11 @@ std::vector<int> rowPartners(const sap::NodeContactIsland& island,
 // depend on it), and the island is solved again: a fixed point of mu gamma_n, reached for the
 // partners that need it. Returns whether any bound changed.
 bool matchFrictionBounds(sap::NodeContactIsland& island, sap::SapProblem& problem,
-                         const std::vector<int>& row_partner, std::size_t partner_count,
-                         const sap::SapReport& report) {
-  std::vector<double> lagged(partner_count, 0.0), solved(partner_count, 0.0);
+                         const std::vector<int>& row_partner, const sap::SapReport& report) {
+  if (row_partner.empty()) return false;
+  const auto groups =
+      static_cast<std::size_t>(*std::max_element(row_partner.begin(), row_partner.end()) + 1);
+  std::vector<double> lagged(groups, 0.0), solved(groups, 0.0);
   for (std::size_t r = 0; r < island.rows.size(); ++r) {
     const auto k = static_cast<std::size_t>(row_partner[r]);
     lagged[k] += island.rows[r].lagged_normal_impulse;
@@ -92,6 +102,37 @@ bool matchFrictionBounds(sap::NodeContactIsland& island, sap::SapProblem& proble
 
 }  // namespace
 
+bool RigidContactSolver::islandTakesRigidContacts(btRigidBody& body) const {
+  if (settings_.friction_solve != ContactSettings::FrictionSolve::kConvex) return false;
+  btDispatcher* dispatcher = soft_body_->getWorldInfo()->m_dispatcher;
+  if (dispatcher == nullptr) return false;
+  return sap::gatherRigidContactGroup(
+             *dispatcher, {&body},
+             [this](const btCollisionObject& object) { return startPoseOf(object); })
+      .contains(&body);
+}
+
+void RigidContactSolver::takeRigidContacts() {
+  rigid_group_ = {};
+  rigid_impulses_.clear();
+  if (settings_.friction_solve != ContactSettings::FrictionSolve::kConvex) return;
+  btDispatcher* dispatcher = soft_body_->getWorldInfo()->m_dispatcher;
+  std::vector<btRigidBody*> seeds;
+  for (const RigidPartner& k : partners_) {
+    if (k.body != nullptr && k.link == nullptr && (k.dynamic || k.supported))
+      seeds.push_back(k.body);
+  }
+  if (dispatcher == nullptr || seeds.empty()) return;
+  rigid_group_ = sap::gatherRigidContactGroup(
+      *dispatcher, seeds, [this](const btCollisionObject& object) { return startPoseOf(object); });
+  for (std::size_t b = 0; b < rigid_group_.bodies.size(); ++b) {
+    RigidPartner& k = partners_[static_cast<std::size_t>(partnerIndex(rigid_group_.bodies[b]))];
+    k.dynamic = true;
+    k.supported = false;
+    k.bullet_contact_impulse = rigid_group_.bullet_impulses[b];
+  }
+}
+
 double RigidContactSolver::lookahead(double dt) const {
   if (settings_.friction_solve != ContactSettings::FrictionSolve::kConvex) return dt;
   return dt * (1 + sap::RowDefaults{}.dissipation_steps);
@@ -108,14 +149,19 @@ LinearSolveReport RigidContactSolver::solveConvex(const SystemOperator& op,
     if (gamma_n > 0)
       lagged_nodes.push_back({previous_active_[k].first, previous_active_[k].second, gamma_n});
   }
+  const sap::RigidContactGroup& group = rigid_group_;
   sap::NodeContactIsland island =
       sap::buildNodeContactIsland(contacts_, partners_, 0, lagged_nodes, defaults, dt_);
   const std::vector<FaceContact> faces = sap::islandFaceContacts(*this);
   if (feature_match_radius_ < 0) feature_match_radius_ = featureMatchRadius(model_->mesh());
   sap::addFaceContactRows(island, faces, partners_, 0, lagged_features_, feature_match_radius_,
                           defaults, dt_);
+  std::vector<int> group_body(group.bodies.size());
+  for (std::size_t g = 0; g < group.bodies.size(); ++g)
+    group_body[g] = island.partner_body[static_cast<std::size_t>(partnerIndex(group.bodies[g]))];
+  sap::addRigidContactRows(island, group, group_body, defaults, dt_);
   const sap::FemIslandBody fem(op, constraints, b);
-  const std::vector<int> row_partner = rowPartners(island, contacts_, faces);
+  const std::vector<int> row_partner = rowGroups(island, contacts_, faces, partners_.size());
   Result<sap::SapProblem> created =
       sap::SapProblem::create(sap::islandBodies(fem, island), island.rows, dt_);
   if (!created) return brokenDown({}, "the contact rows do not form a valid problem");
@@ -133,7 +179,7 @@ LinearSolveReport RigidContactSolver::solveConvex(const SystemOperator& op,
   int cg = report.cg_iterations;
   for (int round = 0;
        round < kMaxFrictionBoundRounds && report.converged &&
-       matchFrictionBounds(island, created.value(), row_partner, partners_.size(), report);
+       matchFrictionBounds(island, created.value(), row_partner, report);
        ++round) {
     report = solver.solve(created.value(), x);  // from the last solution
     newton += report.newton_iterations;
@@ -156,7 +202,10 @@ LinearSolveReport RigidContactSolver::solveConvex(const SystemOperator& op,
   stats_.active = stats_.face_active = stats_.sticking = 0;
   stats_.normal_impulse = 0;
   stats_.max_end_penetration = 0;
+  rigid_impulses_ = sap::rigidPointImpulses(island, group, report);  // for finish()
+  stats_.rigid_rows = static_cast<int>(group.points.size());
   for (std::size_t r = 0; r < island.rows.size(); ++r) {
+    if (isRigidRow(island, r)) continue;  // between rigid bodies: not this body's contacts
     const Eigen::Vector3d& gamma = report.impulses[r];
     const double end_gap = island.rows[r].gap + dt_ * report.contact_velocities[r].z();
     stats_.max_end_penetration = std::max(stats_.max_end_penetration, -end_gap);

@@ -118,7 +118,7 @@ int RigidContactSolver::partnerIndex(const btCollisionObject* object) {
     p.inverse_mass_matrix.setZero();
     p.inverse_mass_matrix.topLeftCorner<3, 3>() = Eigen::Matrix3d::Identity() / p.mass;
     p.inverse_mass_matrix.bottomRightCorner<3, 3>() = p.inverse_inertia;
-    if (touchesStaticOrKinematic(*p.body, *soft_body_)) {
+    if (touchesStaticOrKinematic(*p.body, *soft_body_) && !islandTakesRigidContacts(*p.body)) {
       p.dynamic = false;
       p.supported = true;
     }
@@ -245,6 +245,8 @@ void RigidContactSolver::forgetLastStep(double dt) {
   faces_.beginStep(partners_);
   contacts_.clear();
   partners_.clear();
+  rigid_group_ = {};  // a failed step's (its finish() did not run)
+  rigid_impulses_.clear();
   stats_ = ContactStepStats{};
   dt_ = dt;
   dynamic_count_ = 0;

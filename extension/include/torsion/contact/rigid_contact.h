@@ -52,6 +52,7 @@
 #include "torsion/contact/multibody_partner.h"
 #include "torsion/contact/node_anchors.h"
 #include "torsion/contact/rigid_partner.h"
+#include "torsion/contact/solve/rigid_contact_rows.h"
 #include "torsion/fem/fem_model.h"
 #include "torsion/solve/cholmod_solver.h"
 #include "torsion/solve/fem_state.h"
@@ -92,8 +93,9 @@ struct ContactSettings {
   /// step. A body in FEM-FEM contact (whose pair penalties the factor does not hold) always uses
   /// the active set.
   /// kConvex: one convex solve (SAP, docs/contact-solve.md) of the body with its dynamic rigid
-  /// partners, node and face contacts and anchors as rows; a body in FEM-FEM contact is driven by
-  /// the island's solve around it.
+  /// partners and the rigid bodies touching them, node and face contacts, anchors and the rigid
+  /// bodies' contacts (contact/solve/rigid_contact_rows.h) as rows; a body in FEM-FEM contact is
+  /// driven by the island's solve around it.
   enum class FrictionSolve { kActiveSet, kContactSpace, kAuto, kConvex };
   FrictionSolve friction_solve = FrictionSolve::kAuto;
   /// m/s: the contact-space solve iterates until every contact satisfies Coulomb's law to this;
@@ -162,6 +164,9 @@ struct ContactStepStats {
   int active = 0;                 ///< node and face contacts active at the end of the step
   int face_active = 0;            ///< of which face contacts
   int sticking = 0;               ///< of which sticking
+  /// Contact points between rigid bodies solved in this body's island (the convex solve:
+  /// contact/solve/rigid_contact_rows.h); not counted above.
+  int rigid_rows = 0;
   int active_set_iterations = 0;  ///< CG solves this step
   bool active_set_converged = true;
   double normal_impulse = 0;       ///< N s, sum over contacts (>= 0)
@@ -328,6 +333,13 @@ class RigidContactSolver {
   /// the convex solve the step plus its rows' dissipation time (a row engages at
   /// phi0 + (dt + tau_d) v_n < 0).
   double lookahead(double dt) const;
+  /// The convex solve: whether the island takes `body`'s contacts with other rigid objects from
+  /// Bullet this step (contact/solve/rigid_contact_rows.h); then it is never `supported`.
+  bool islandTakesRigidContacts(btRigidBody& body) const;
+  /// The convex solve, at detection: the rigid contacts of the dynamic partners and of the bodies
+  /// touching them, taken from Bullet into rigid_group_; every body of the group becomes a
+  /// dynamic partner.
+  void takeRigidContacts();
   void measureEndGaps(const Eigen::VectorXd& v);
 
   // The reduced system q = (u, V) (rigid_contact_reduced_system.cpp).
@@ -409,6 +421,10 @@ class RigidContactSolver {
   std::vector<CarriedContacts::Feature>
       lagged_features_;               // the convex solve's face rows, last step
   double feature_match_radius_ = -1;  // m, set at the first convex solve (the rest mesh's)
+  // The convex solve's rigid contacts this step (detect to finish; pointers into Bullet's
+  // manifolds, dropped at finish) and the last solve's impulse per point, written back at finish.
+  sap::RigidContactGroup rigid_group_;
+  std::vector<Eigen::Vector3d> rigid_impulses_;
   const NodeConstraints* base_ = nullptr;
   double dt_ = 0;
   int dynamic_count_ = 0;

@@ -23,7 +23,8 @@ struct RigidPartner {
   bool dynamic = false;  ///< velocities solved with the body's; else prescribed
   /// A dynamic body touching a static or kinematic one in Bullet (a box on the ground): solved
   /// as prescribed here, its contact impulse goes to Bullet's rigid solver (one step later), which
-  /// alone knows its other contacts.
+  /// alone knows its other contacts. Never in the convex solve when its island can take those
+  /// contacts as rows (contact/solve/rigid_contact_rows.h).
   bool supported = false;
   double mass = 0;
   Eigen::Matrix3d inertia = Eigen::Matrix3d::Zero();          ///< world, kg m^2 (dynamic)
@@ -36,6 +37,10 @@ struct RigidPartner {
   Vector6d entry_velocity = Vector6d::Zero();  ///< (v, omega) Bullet integrated with
   Vector6d velocity = Vector6d::Zero();        ///< (v, omega) current estimate / result
   Vector6d impulse = Vector6d::Zero();         ///< (force, torque about com) x dt from this body
+  /// The impulse (force, torque about com) of Bullet's contacts with other rigid objects this
+  /// step, which the convex island solves afresh as rows (contact/solve/rigid_contact_rows.h):
+  /// the body's momentum before contact is M entry_velocity less it. Zero otherwise.
+  Vector6d bullet_contact_impulse = Vector6d::Zero();
   int unknown = -1;                            ///< offset of its 6 unknowns in the CG vector
   /// The net normal impulse of this body's contacts over the sum of their pushes, in the last
   /// solve (1 without pulls): Coulomb's bounds of the pushing contacts are scaled by it, so that

@@ -66,7 +66,8 @@ NodeContactIsland buildNodeContactIsland(const std::vector<NodeContact>& contact
     if (!k.dynamic || k.link != nullptr) continue;
     island.partner_body[p] = static_cast<int>(island.rigid_bodies.size()) + 1;
     island.rigid_bodies.push_back(std::make_unique<RigidBody>(
-        k.mass, k.inertia, Eigen::VectorXd(partnerMomentum(k, k.entry_velocity))));
+        k.mass, k.inertia,
+        Eigen::VectorXd(partnerMomentum(k, k.entry_velocity) - k.bullet_contact_impulse)));
   }
   for (std::size_t i = 0; i < contacts.size(); ++i) {
     const NodeContact& c = contacts[i];

@@ -9,7 +9,8 @@
 //   node term    nodeTerm(fem_body, node, +1, R_c), R_c = contactFrame(normal)
 //   dynamic      + rigidPointTerm(partner's RigidBody, lever, -1, R_c): the partner's twist is
 //                  solved with the node's (its b = diag(m, I) times the velocity Bullet integrated
-//                  with: gravity and external forces of the step included)
+//                  with: gravity and external forces of the step included; less the impulses of
+//                  Bullet's rigid contacts that the island solves as rows: rigid_contact_rows.h)
 //   prescribed   (static, kinematic, supported by Bullet's ground, multibody link) velocity_offset
 //                  = -R_c (v + omega x lever): the partner point's known motion
 //
@@ -65,6 +66,9 @@ struct NodeContactIsland {
   /// Per row: its index in the FaceContact list, or -1 (face_contact_rows.h; empty without face
   /// rows).
   std::vector<int> row_face;
+  /// Per row: its point in the RigidContactGroup, or -1 (rigid_contact_rows.h; empty without
+  /// rigid rows).
+  std::vector<int> row_rigid;
 };
 
 /// Builds the rows for `contacts` (active or not: every detected node contact, except held nodes
