@@ -268,6 +268,12 @@ void FemSoftBodySolver::solveConstraints(btScalar solver_dt) {
   ctx.dt = static_cast<double>(solver_dt);
   ctx.index = steps_ + 1;
   ctx.gravity = toEigen(world_->getGravity());
+  for (int c = 0; c < world_->getNumConstraints(); ++c) {
+    const btTypedConstraint& joint = *world_->getConstraint(c);
+    ctx.jointed_bodies.push_back(&joint.getRigidBodyA());
+    ctx.jointed_bodies.push_back(&joint.getRigidBodyB());
+  }
+  std::sort(ctx.jointed_bodies.begin(), ctx.jointed_bodies.end());
 
   for (StepListener* listener : listeners_)
     listener->beforeFemStep(ctx);

@@ -91,7 +91,8 @@ void RigidContactSolver::addCandidate(const btCollisionObject* object) {
 }
 
 bool RigidContactSolver::detect(const FemState& state, const NodeConstraints& constraints,
-                                double dt) {
+                                double dt, const std::vector<const btRigidBody*>& jointed_bodies) {
+  jointed_bodies_ = jointed_bodies;
   rememberActiveContacts();
   forgetLastStep(dt);
   if (candidates_.empty() && anchors_.empty()) return false;

@@ -108,7 +108,8 @@ bool RigidContactSolver::islandTakesRigidContacts(btRigidBody& body) const {
   if (dispatcher == nullptr) return false;
   return sap::gatherRigidContactGroup(
              *dispatcher, {&body},
-             [this](const btCollisionObject& object) { return startPoseOf(object); })
+             [this](const btCollisionObject& object) { return startPoseOf(object); },
+             jointed_bodies_)
       .contains(&body);
 }
 
@@ -124,7 +125,8 @@ void RigidContactSolver::takeRigidContacts() {
   }
   if (dispatcher == nullptr || seeds.empty()) return;
   rigid_group_ = sap::gatherRigidContactGroup(
-      *dispatcher, seeds, [this](const btCollisionObject& object) { return startPoseOf(object); });
+      *dispatcher, seeds, [this](const btCollisionObject& object) { return startPoseOf(object); },
+      jointed_bodies_);
   for (std::size_t b = 0; b < rigid_group_.bodies.size(); ++b) {
     RigidPartner& k = partners_[static_cast<std::size_t>(partnerIndex(rigid_group_.bodies[b]))];
     k.dynamic = true;

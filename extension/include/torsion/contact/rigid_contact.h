@@ -228,8 +228,10 @@ class RigidContactSolver {
   /// Stage 2: a broadphase pair with `object`.
   void addCandidate(const btCollisionObject* object);
   /// Stage 4, before the solve: narrow phase. `constraints` holds the node groups' prescriptions
-  /// (held nodes). Returns whether any node is near a rigid object.
-  bool detect(const FemState& state, const NodeConstraints& constraints, double dt);
+  /// (held nodes); `jointed_bodies` (sorted) the rigid bodies with a joint in the world, whose
+  /// contacts the convex solve leaves to Bullet. Returns whether any node is near a rigid object.
+  bool detect(const FemState& state, const NodeConstraints& constraints, double dt,
+              const std::vector<const btRigidBody*>& jointed_bodies = {});
   /// The linear solve of the step with contacts, on the stepper's prepared system
   /// (ImplicitStepper::prepared(); FemBody::solveContacts).
   LinearSolveReport solve(const SystemOperator& op, const NodeConstraints& constraints,
@@ -424,6 +426,7 @@ class RigidContactSolver {
   // The convex solve's rigid contacts this step (detect to finish; pointers into Bullet's
   // manifolds, dropped at finish) and the last solve's impulse per point, written back at finish.
   sap::RigidContactGroup rigid_group_;
+  std::vector<const btRigidBody*> jointed_bodies_;  // this step's (detect's argument)
   std::vector<Eigen::Vector3d> rigid_impulses_;
   const NodeConstraints* base_ = nullptr;
   double dt_ = 0;

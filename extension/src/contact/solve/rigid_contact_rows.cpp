@@ -15,9 +15,12 @@ namespace {
 
 // A body whose response Bullet's solver computes as the FEM's does: neither asleep, nor jointed,
 // nor scaled by linear or angular factors. Empty when it is, else why not.
-std::string whyBulletKeeps(const btRigidBody& body) {
+std::string whyBulletKeeps(const btRigidBody& body,
+                           const std::vector<const btRigidBody*>& jointed_bodies) {
   if (body.getActivationState() == ISLAND_SLEEPING) return "asleep";
-  if (body.getNumConstraintRefs() > 0) return "it has a joint";
+  if (body.getNumConstraintRefs() > 0 ||
+      std::binary_search(jointed_bodies.begin(), jointed_bodies.end(), &body))
+    return "it has a joint";
   const btVector3 one(1, 1, 1);
   if (body.getLinearFactor() != one || body.getAngularFactor() != one)
     return "its linear or angular factor is not 1";
@@ -61,14 +64,15 @@ struct Component {
   std::string kept;  // why Bullet keeps it, empty when it can be taken
 };
 
-Component componentOf(btRigidBody* seed, const std::vector<UsedManifold>& used) {
+Component componentOf(btRigidBody* seed, const std::vector<UsedManifold>& used,
+                      const std::vector<const btRigidBody*>& jointed_bodies) {
   Component c;
   c.bodies.push_back(seed);
   std::vector<char> taken(used.size(), 0);
   for (std::size_t next = 0; next < c.bodies.size(); ++next) {
     btRigidBody* body = c.bodies[next];
     if (c.kept.empty()) {
-      const std::string why = whyBulletKeeps(*body);
+      const std::string why = whyBulletKeeps(*body, jointed_bodies);
       if (!why.empty()) c.kept = "a rigid body in contact stays with Bullet: " + why;
     }
     for (std::size_t m = 0; m < used.size(); ++m) {
@@ -121,14 +125,15 @@ bool RigidContactGroup::contains(const btRigidBody* body) const {
 
 RigidContactGroup gatherRigidContactGroup(btDispatcher& dispatcher,
                                           const std::vector<btRigidBody*>& seeds,
-                                          const StartPose& start_pose) {
+                                          const StartPose& start_pose,
+                                          const std::vector<const btRigidBody*>& jointed_bodies) {
   RigidContactGroup group;
   const std::vector<UsedManifold> used = usedManifolds(dispatcher);
   std::vector<const UsedManifold*> manifolds;
   std::vector<btRigidBody*> seen;
   for (btRigidBody* seed : seeds) {
     if (std::find(seen.begin(), seen.end(), seed) != seen.end()) continue;
-    const Component c = componentOf(seed, used);
+    const Component c = componentOf(seed, used, jointed_bodies);
     seen.insert(seen.end(), c.bodies.begin(), c.bodies.end());
     if (!c.kept.empty()) {
       group.kept_by_bullet.push_back(c.kept);

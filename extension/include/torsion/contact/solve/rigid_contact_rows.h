@@ -89,13 +89,15 @@ struct RigidContactGroup {
 /// The step's start pose of a collision object (RigidContactSolver::startPoseOf).
 using StartPose = std::function<btTransform(const btCollisionObject&)>;
 
-/// The groups of `seeds` (dynamic rigid bodies) that can be taken, merged: every dynamic body
+/// The groups of `seeds` (dynamic rigid bodies) that can be taken, merged (`jointed_bodies`, sorted:
+/// the bodies with a joint in the world, btDynamicsWorld::getConstraint): every dynamic body
 /// reached from a seed through Bullet's contact points (those Bullet's solver used: distance
 /// within the manifold's processing threshold, both objects responding) and those points. A
 /// component that cannot be taken (above) is left out whole, its reason in kept_by_bullet.
 RigidContactGroup gatherRigidContactGroup(btDispatcher& dispatcher,
                                           const std::vector<btRigidBody*>& seeds,
-                                          const StartPose& start_pose);
+                                          const StartPose& start_pose,
+                                          const std::vector<const btRigidBody*>& jointed_bodies);
 
 /// Appends one row per point of `group` to `island`, `group_body[i]` the island body of the
 /// group's body i; island.row_rigid holds each row's point index (-1 for the rows before).
