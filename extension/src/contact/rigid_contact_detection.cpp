@@ -129,41 +129,73 @@ int RigidContactSolver::partnerIndex(const btCollisionObject* object) {
 }
 
 void RigidContactSolver::chooseSupportPlane(const btCollisionShape& shape,
-                                            const btTransform& transform, const Eigen::Vector3d& x,
-                                            const Eigen::Vector3d& node_velocity,
-                                            const Eigen::Vector3d& into_surface, double dt,
-                                            NodeContact& c) const {
+                                            const btTransform& transform, const FemState& state,
+                                            int node, const Eigen::Vector3d& into_surface,
+                                            double dt, NodeContact& c) const {
   // The contact is linearised on one supporting plane of the (convex) rigid shape: the node must
   // end the step outside it. The nearest feature's plane is exact at the start of the step but
   // not over it: a node on a flat surface just ahead of a sliding box sees the box's front face
   // (a horizontal normal), and the linearised end gap along it, d - v dt, stops the box at the
   // node as at a wall, although the box's bottom edge would pass over it (docs/contact.md,
   // "Sliding over nodes"). The supporting plane facing the soft surface (normal minus the node's
-  // surface normal: the bottom face's plane for a box on a slab) is as valid a bound. Of the two,
+  // surface normal: the bottom face's plane for a box on a slab) is as valid a bound. Of these,
   // the one the predicted motion (the node's velocity, the rigid body's velocity after Bullet's
-  // integration) leaves the larger end gap is taken. At rest they agree or the nearest wins: a
+  // integration) leaves the largest end gap is taken. At rest they agree or the nearest wins: a
   // supporting plane never measures more than the distance.
-  const RigidPartner& k = partners_[static_cast<size_t>(c.partner)];
+  //
+  // The convex solve also tries the plane facing each surface triangle at the node. At an edge
+  // of the soft body the node's normal is the mean of its faces' (diagonal at a slab's end), and
+  // the plane facing it is no better than the nearest: a box sliding off a slab's end met the end
+  // nodes on its front face, as a wall, and was stopped and tipped over (SlabEdge.*). The plane
+  // facing the slab's top lets the box's bottom pass over them.
   if (into_surface.squaredNorm() == 0) return;
-  const std::optional<SurfacePoint> plane = supportPlaneDistance(shape, transform, x, into_surface);
-  if (!plane) return;
+  const Eigen::Vector3d x = state.position(node);
+  const RigidPartner& k = partners_[static_cast<size_t>(c.partner)];
+  const NodeContact nearest = c;
+  const Eigen::Vector3d relative = state.velocity(node) - pointVelocity(k.entry_velocity, c.lever);
+  bool taken = takeFacingPlane(shape, transform, x, into_surface, relative, dt, nearest, c);
+  if (settings_.friction_solve == ContactSettings::FrictionSolve::kConvex) {
+    const std::vector<Triangle>& triangles = model_->mesh().surfaceTriangles();
+    const auto [first, last] = faces_.trianglesOf(node);
+    for (const int* t = first; t != last; ++t) {
+      const Triangle& tri = triangles[static_cast<size_t>(*t)];
+      const Eigen::Vector3d a = state.position(tri[0]);
+      const Eigen::Vector3d normal =
+          (state.position(tri[1]) - a).cross(state.position(tri[2]) - a);
+      if (normal.squaredNorm() == 0) continue;
+      taken = takeFacingPlane(shape, transform, x, -normal.normalized(), relative, dt, nearest,
+                              c) ||
+              taken;
+    }
+  }
+  if (taken) c.swept = true;
+}
+
+bool RigidContactSolver::takeFacingPlane(const btCollisionShape& shape,
+                                         const btTransform& transform, const Eigen::Vector3d& x,
+                                         const Eigen::Vector3d& into,
+                                         const Eigen::Vector3d& relative_velocity, double dt,
+                                         const NodeContact& nearest, NodeContact& c) const {
+  const std::optional<SurfacePoint> plane = supportPlaneDistance(shape, transform, x, into);
+  if (!plane) return false;
+  // Only the motion along the plane predicts which side the node ends on: across it, the rigid
+  // body's predicted velocity carries the step's gravity, which the contacts under it cancel.
+  Eigen::Vector3d slip = relative_velocity;
+  slip -= plane->normal * plane->normal.dot(slip);
+  const double end_nearest = nearest.gap + dt * nearest.normal.dot(slip);
+  const double end_plane = plane->distance;
+  if (end_plane <= end_nearest + kPlaneChoiceMargin) return false;
+  // A plane already taken instead of the nearest: the one of larger end gap.
+  if (c.normal != nearest.normal && end_plane <= c.gap + kPlaneChoiceMargin) return false;
   // Where the node would touch the plane: its foot on the plane, moved onto the shape.
   const Eigen::Vector3d foot = x - plane->distance * plane->normal;
   const std::optional<SurfacePoint> onto = signedDistance(shape, transform, foot, 0);
   const Eigen::Vector3d contact_point =
       onto ? Eigen::Vector3d(foot - onto->distance * onto->normal) : foot;
-  const Eigen::Vector3d lever = contact_point - k.com;
-  // Only the motion along the plane predicts which side the node ends on: across it, the rigid
-  // body's predicted velocity carries the step's gravity, which the contacts under it cancel.
-  Eigen::Vector3d slip = node_velocity - pointVelocity(k.entry_velocity, c.lever);
-  slip -= plane->normal * plane->normal.dot(slip);
-  const double end_nearest = c.gap + dt * c.normal.dot(slip);
-  const double end_plane = plane->distance;
-  if (end_plane <= end_nearest + kPlaneChoiceMargin) return;
   c.normal = plane->normal;
   c.gap = plane->distance;
-  c.lever = lever;
-  c.swept = true;
+  c.lever = contact_point - partners_[static_cast<size_t>(c.partner)].com;
+  return true;
 }
 
 void RigidContactSolver::keepPreviousPlane(const btCollisionShape& shape,
@@ -321,8 +353,7 @@ void RigidContactSolver::addNodeContact(const FemState& state, const NodeConstra
   c.lever = x - sp->distance * sp->normal - partners_[static_cast<size_t>(c.partner)].com;
   c.friction = settings_.friction * toDouble(object.getFriction());
   c.held = held;
-  chooseSupportPlane(shape, transform, x, state.velocity(i), -toEigen(sb.m_nodes[i].m_n),
-                     lookahead_time, c);
+  chooseSupportPlane(shape, transform, state, i, -toEigen(sb.m_nodes[i].m_n), lookahead_time, c);
   keepPreviousPlane(shape, transform, x, -toEigen(sb.m_nodes[i].m_n), object, c);
   // One contact per free node: the deepest.
   if (!held) {

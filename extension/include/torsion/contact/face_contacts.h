@@ -148,6 +148,12 @@ class FaceContactSet {
   /// `gap_tolerance`.
   bool update(const Eigen::VectorXd& v, const std::vector<RigidPartner>& partners, double dt,
               double activation_tolerance, double gap_tolerance);
+  /// The surface triangles of `node` (indices into the mesh's surfaceTriangles()): [first, last).
+  std::pair<const int*, const int*> trianglesOf(int node) const {
+    const auto n = static_cast<std::size_t>(node);
+    return {node_triangles_.data() + node_triangle_start_[n],
+            node_triangles_.data() + node_triangle_start_[n + 1]};
+  }
   /// The end-of-step gap, linearised, of contact `c` with velocities `v` and the partners'.
   double endGap(const FaceContact& c, const Eigen::VectorXd& v,
                 const std::vector<RigidPartner>& partners, double dt) const;

@@ -298,8 +298,16 @@ class RigidContactSolver {
   void recordDetectionStats();
   int partnerIndex(const btCollisionObject* object);
   void chooseSupportPlane(const btCollisionShape& shape, const btTransform& transform,
-                          const Eigen::Vector3d& x, const Eigen::Vector3d& node_velocity,
-                          const Eigen::Vector3d& into_surface, double dt, NodeContact& c) const;
+                          const FemState& state, int node, const Eigen::Vector3d& into_surface,
+                          double dt, NodeContact& c) const;
+  /// Whether contact `c` (found as `nearest`) would rather be linearised on the supporting plane
+  /// facing `into` (a unit direction into the soft surface): over the look-ahead `dt`, with the
+  /// node's velocity relative to the rigid point, the plane leaves a larger end gap than the
+  /// nearest feature's and than a plane `c` took before. Then `c` takes the plane.
+  bool takeFacingPlane(const btCollisionShape& shape, const btTransform& transform,
+                       const Eigen::Vector3d& x, const Eigen::Vector3d& into,
+                       const Eigen::Vector3d& relative_velocity, double dt,
+                       const NodeContact& nearest, NodeContact& c) const;
   void keepPreviousPlane(const btCollisionShape& shape, const btTransform& transform,
                          const Eigen::Vector3d& x, const Eigen::Vector3d& into_surface,
                          const btCollisionObject& object, NodeContact& c) const;
