@@ -87,7 +87,7 @@ TEST(ContactPhysics, BoxRestsOnSlabWithStaticSag) {
   EXPECT_GT(run.contacts, 0);
 }
 
-// The default friction solve ("auto") takes contact space only in the steps where a dynamic rigid
+// The "auto" friction solve takes contact space only in the steps where a dynamic rigid
 // body touches the FEM body: a soft block resting on static ground uses the active set (no
 // factorisation per step for a body on the floor), and a box dropped onto it switches the block to
 // contact space from its landing on, while it rests there.
@@ -97,7 +97,7 @@ TEST(ContactPhysics, AutoFrictionSolveTakesContactSpaceOnlyWhileADynamicBodyTouc
   FemBody* block =
       addBox(world, "block", {-0.3, -0.3, 0.0}, {0.3, 0.3, 0.2}, 3, 3, 1, softMaterial(5e4, 200));
   ASSERT_NE(block, nullptr);
-  ASSERT_EQ(block->contacts().settings().friction_solve, ContactSettings::FrictionSolve::kAuto);
+  block->contacts().settings().friction_solve = ContactSettings::FrictionSolve::kAuto;
   // The box's underside starts 0.2 m above the block: it lands after about 0.2 s.
   btRigidBody* box = world.addRigidBody(std::make_unique<btBoxShape>(btVector3(0.1, 0.1, 0.1)), 2,
                                         at({0.0, 0.0, 0.5}));
@@ -231,7 +231,10 @@ TEST(ContactPhysics, PressedCubeStaysPut) {
             << " m, active-set iterations max " << most_iterations << ", unconverged steps "
             << unconverged << ", cube centre " << c.transpose() << "\n";
   EXPECT_LT(fastest, 0.2);  // the plate moves at 0.1 m/s; the failure this guards moved at 1.9
-  EXPECT_GT(lowest_plate_gap, -1e-4);  // 0.1 mm against a 6 cm press
+  // 0.3 mm against a 6 cm press: the convex solve's near-rigid contacts let a node sink by
+  // gamma_n R_n (dt + tau_d) (docs/contact-solve.md, "Defaults"), and the pressed nodes carry
+  // about a hundred times their weight: 0.20 mm measured (the active set held them to 0).
+  EXPECT_GT(lowest_plate_gap, -3e-4);
   // Pressed, the top follows the plate itself, not its pose one step (1 mm) earlier.
   EXPECT_LT(largest_lag, 1e-5);
   // The active set settles every step (anti-cycling of stick/slide and of the friction).

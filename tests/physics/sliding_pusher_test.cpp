@@ -100,19 +100,12 @@ PushedBox pushBox(double mu, double E, double speed, double seconds) {
       break;
     }
     if (k < settle_steps + push_steps / 2) continue;
-    // The slab's friction on the box, measured as its reaction: the impulses the box gave the
-    // slab's nodes and faces, along the push.
+    // The slab's friction on the box, measured as its reaction: the impulse the box gave the
+    // slab's nodes and faces, along the push (the partner's impulse is the slab's on the box).
     const RigidContactSolver& contacts = slab->contacts();
     Eigen::Vector3d on_slab = Eigen::Vector3d::Zero();
-    for (const NodeContact& c : contacts.contacts()) {
-      if (c.state != NodeContact::State::kInactive &&
-          contacts.partners()[static_cast<size_t>(c.partner)].object == box)
-        on_slab += c.impulse;
-    }
-    for (const FaceContact& c : contacts.faceContacts()) {
-      if (c.state != FaceContact::State::kInactive && !c.determined &&
-          contacts.partners()[static_cast<size_t>(c.partner)].object == box)
-        on_slab += c.impulse;
+    for (const RigidPartner& partner : contacts.partners()) {
+      if (partner.object == box) on_slab -= partner.impulse.head<3>();
     }
     out.slab_friction_n += on_slab.x() / kDt;
     // Bullet's contact between the pusher and the box.

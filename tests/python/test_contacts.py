@@ -72,8 +72,10 @@ def test_fem_rigid_contacts_name_the_body_and_partner_and_push_the_box_up_by_its
                        received + (0, 0, -1.0 * G * DT * 100), atol=1e-9)
     assert received[2] / 100 == pytest.approx(1.0 * G * DT, rel=1e-3)
     contacts = world.contacts()
-    # The box's bottom face pushes down on the slab's top nodes: normals from B (box) to A.
-    assert np.allclose(contacts.normals, (0, 0, -1), atol=1e-3)  # the box tilts by < 1e-3 rad
+    # The box's bottom face pushes down on the slab's top nodes, and its corners on the slab's
+    # triangles: normals from B (box) to A, within the box's tilt (< 1e-3 rad) and the dented
+    # triangles' (< 2e-3 rad).
+    assert np.allclose(contacts.normals, (0, 0, -1), atol=2e-3)
     assert np.all(contacts.normal_impulses > 0)
     assert np.allclose(contacts.normal_impulses,
                        np.einsum("ij,ij->i", contacts.impulses, contacts.normals))

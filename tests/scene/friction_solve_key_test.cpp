@@ -16,10 +16,10 @@ std::string sceneWith(const std::string& entry) {
          R"( "material": {"youngs_modulus": 5e4, "poisson_ratio": 0.3, "density": 300}}]})";
 }
 
-TEST(SceneFrictionSolveKey, DefaultsToAutoAndReadsEachSolve) {
+TEST(SceneFrictionSolveKey, DefaultsToConvexAndReadsEachSolve) {
   Result<SceneSpec> plain = parseScene(sceneWith(""), "s.json", "/base");
   ASSERT_TRUE(plain.ok()) << plain.error().message;
-  EXPECT_EQ(plain.value().bodies[0].friction_solve, ContactSettings::FrictionSolve::kAuto);
+  EXPECT_EQ(plain.value().bodies[0].friction_solve, ContactSettings::FrictionSolve::kConvex);
   for (const auto& [name, expected] :
        {std::pair{"auto", ContactSettings::FrictionSolve::kAuto},
         std::pair{"active_set", ContactSettings::FrictionSolve::kActiveSet},
@@ -44,7 +44,8 @@ TEST(SceneFrictionSolveKey, AnUnknownSolveOrWrongTypeNamesTheKey) {
 
 TEST(SceneFrictionSolveKey, TheBuiltBodyUsesTheSolveTheSceneNames) {
   for (const auto& [entry, expected] :
-       {std::pair{std::string(), ContactSettings::FrictionSolve::kAuto},
+       {std::pair{std::string(), ContactSettings::FrictionSolve::kConvex},
+        std::pair{std::string(R"( "friction_solve": "auto",)"), ContactSettings::FrictionSolve::kAuto},
         std::pair{std::string(R"( "friction_solve": "contact_space",)"),
                   ContactSettings::FrictionSolve::kContactSpace},
         std::pair{std::string(R"( "friction_solve": "active_set",)"),

@@ -44,7 +44,7 @@ void addFemRigidContacts(PyWorld& world, const FemBody& body, ContactList& list)
     if (c.state == NodeContact::State::kInactive || c.anchored) continue;
     add(list, body.name(), partner(c.partner), body.state().position(c.node), c.normal, c.impulse);
   }
-  for (const FaceContact& f : solver.faceContacts()) {
+  for (const FaceContact& f : solver.solvedFaceContacts()) {
     // A determined face sits out: the contacts of its nodes carry its impulse.
     if (f.state == FaceContact::State::kInactive || f.determined) continue;
     Eigen::Vector3d point = Eigen::Vector3d::Zero();

@@ -2,6 +2,7 @@
 // ::kConvex, docs/contact-solve.md): this step's detection as one SAP island, solved once; the
 // answer written back where detection, the rigid partners' finish() and the checkpoints read it.
 
+#include <Eigen/Cholesky>
 #include <algorithm>
 #include <cmath>
 #include <cstddef>
@@ -220,14 +221,24 @@ LinearSolveReport RigidContactSolver::solveConvex(const SystemOperator& op,
   const sap::SapProblem& problem = created.value();
   v = x.head(v.size());
 
-  // The partners: a dynamic one's twist is the island's; every one's impulse (what finish()
-  // gives supported bodies and multibody links) is the wrench of its rows.
+  // The partners: every one's impulse (what finish() gives supported bodies and multibody links)
+  // is the wrench of its rows. A dynamic one's twist is its momentum plus the wrench of every row
+  // on it (the island's J^T gamma), divided by its mass: the island's twist to the solve's
+  // tolerance, and its momentum balance with the impulses the contacts report exact (the
+  // optimality criterion alone leaves a residual of 1e-6 of the momenta).
   std::vector<Vector6d> impulses = sap::partnerImpulses(island, contacts_, partners_, report);
   sap::addFacePartnerImpulses(island, faces, report, impulses);
+  Eigen::VectorXd row_impulses = Eigen::VectorXd::Zero(problem.dofs());
+  for (int i = 0; i < problem.rowCount(); ++i)
+    problem.addRowTranspose(i, report.impulses[static_cast<std::size_t>(i)], row_impulses);
   for (std::size_t k = 0; k < partners_.size(); ++k) {
     partners_[k].impulse = impulses[k];
     const int body = island.partner_body[k];
-    if (body >= 0) partners_[k].velocity = x.segment<6>(problem.bodyOffset(body));
+    if (body < 0) continue;
+    const sap::IslandBody& rigid = *island.rigid_bodies[static_cast<std::size_t>(body - 1)];
+    const Vector6d momentum =
+        rigid.momentum() + row_impulses.segment<6>(problem.bodyOffset(body));
+    partners_[k].velocity = Matrix6d(rigid.diagonalBlock(0)).llt().solve(momentum);
   }
   // The rows' states and impulses, where detection's memory, the statistics and the checkpoints
   // read them.
@@ -258,6 +269,17 @@ LinearSolveReport RigidContactSolver::solveConvex(const SystemOperator& op,
                       : (stick ? NodeContact::State::kStick : NodeContact::State::kSlide);
   }
   lagged_features_ = sap::laggedFaceImpulses(island, faces, partners_, report);
+  solved_faces_ = faces;
+  for (std::size_t r = 0; r < island.row_face.size(); ++r) {
+    if (island.row_face[r] < 0) continue;
+    FaceContact& f = solved_faces_[static_cast<std::size_t>(island.row_face[r])];
+    const Eigen::Vector3d& gamma = report.impulses[r];
+    f.impulse = island.rows[r].frame.transpose() * gamma;  // on the face
+    f.determined = false;
+    f.state = !(gamma.z() > 0) ? FaceContact::State::kInactive
+              : report.states[r] == sap::ContactState::kStick ? FaceContact::State::kStick
+                                                               : FaceContact::State::kSlide;
+  }
   stats_.active_set_iterations = newton;
   stats_.active_set_converged = report.converged;
 

@@ -277,6 +277,7 @@ void RigidContactSolver::forgetLastStep(double dt) {
   faces_.beginStep(partners_);
   contacts_.clear();
   partners_.clear();
+  solved_faces_.clear();
   rigid_group_ = {};  // a failed step's (its finish() did not run)
   rigid_impulses_.clear();
   stats_ = ContactStepStats{};

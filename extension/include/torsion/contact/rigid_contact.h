@@ -97,7 +97,7 @@ struct ContactSettings {
   /// bodies' contacts (contact/solve/rigid_contact_rows.h) as rows; a body in FEM-FEM contact is
   /// driven by the island's solve around it.
   enum class FrictionSolve { kActiveSet, kContactSpace, kAuto, kConvex };
-  FrictionSolve friction_solve = FrictionSolve::kAuto;
+  FrictionSolve friction_solve = FrictionSolve::kConvex;
   /// m/s: the contact-space solve iterates until every contact satisfies Coulomb's law to this;
   /// a step that ends its sweeps within coulomb_acceptable counts as converged.
   double coulomb_tolerance = 1e-7;
@@ -273,6 +273,12 @@ class RigidContactSolver {
 
   const std::vector<NodeContact>& contacts() const { return contacts_; }
   const std::vector<FaceContact>& faceContacts() const { return faces_.contacts(); }
+  /// The face contacts the last solve used, with their states and impulses: the convex solve's
+  /// corner, edge and face rows (solve/face_contact_rows.h), else faceContacts().
+  const std::vector<FaceContact>& solvedFaceContacts() const {
+    return settings_.friction_solve == ContactSettings::FrictionSolve::kConvex ? solved_faces_
+                                                                               : faces_.contacts();
+  }
   /// Polyhedral partners' corner and edge contacts (FaceContactSet::featureContacts).
   const std::vector<FaceContact>& featureContacts() const { return faces_.featureContacts(); }
   const std::vector<RigidPartner>& partners() const { return partners_; }
@@ -433,6 +439,7 @@ class RigidContactSolver {
   double feature_match_radius_ = -1;  // m, set at the first convex solve (the rest mesh's)
   // The convex solve's rigid contacts this step (detect to finish; pointers into Bullet's
   // manifolds, dropped at finish) and the last solve's impulse per point, written back at finish.
+  std::vector<FaceContact> solved_faces_;  // the convex solve's face rows, last solve
   sap::RigidContactGroup rigid_group_;
   std::vector<const btRigidBody*> jointed_bodies_;  // this step's (detect's argument)
   std::vector<Eigen::Vector3d> rigid_impulses_;

@@ -85,4 +85,15 @@ DiagonalBlock RigidBody::diagonalBlock(int /*block*/) const {
   return d;
 }
 
+LinkBody::LinkBody(const Eigen::Matrix<double, 6, 6>& effective_mass, Eigen::VectorXd momentum)
+    : effective_mass_(effective_mass), momentum_(std::move(momentum)) {
+  assert(momentum_.size() == 6);
+}
+
+void LinkBody::multiply(const Eigen::VectorXd& x, Eigen::VectorXd& out) const {
+  out.noalias() = effective_mass_ * x;
+}
+
+DiagonalBlock LinkBody::diagonalBlock(int /*block*/) const { return effective_mass_; }
+
 }  // namespace torsion::sap

@@ -63,11 +63,14 @@ NodeContactIsland buildNodeContactIsland(const std::vector<NodeContact>& contact
   const std::vector<std::size_t> lagged_order = byNode(lagged);
   for (std::size_t p = 0; p < partners.size(); ++p) {
     const RigidPartner& k = partners[p];
-    if (!k.dynamic || k.link != nullptr) continue;
+    if (!k.dynamic) continue;
     island.partner_body[p] = static_cast<int>(island.rigid_bodies.size()) + 1;
-    island.rigid_bodies.push_back(std::make_unique<RigidBody>(
-        k.mass, k.inertia,
-        Eigen::VectorXd(partnerMomentum(k, k.entry_velocity) - k.bullet_contact_impulse)));
+    const Eigen::VectorXd momentum = partnerMomentum(k, k.entry_velocity) - k.bullet_contact_impulse;
+    if (k.link != nullptr) {
+      island.rigid_bodies.push_back(std::make_unique<LinkBody>(k.mass_matrix, momentum));
+    } else {
+      island.rigid_bodies.push_back(std::make_unique<RigidBody>(k.mass, k.inertia, momentum));
+    }
   }
   for (std::size_t i = 0; i < contacts.size(); ++i) {
     const NodeContact& c = contacts[i];

@@ -8,6 +8,8 @@
 //               (fem_island_body.h).
 //   rigid body: A = diag(m I, I_world), b = A twist0 + dt (f, tau); the twist [v; omega] about the
 //               centre of mass, world frame; one 6x6 block.
+//   link:       A = Lambda, a multibody link's effective mass at its reference point, b = A twist0
+//               (multibody_partner.h); one 6x6 block.
 //
 // Prescribed dofs: the filter S (an orthogonal projection onto the free dofs) and the prescribed
 // values. The solve keeps every prescribed component at its value and moves only free ones; a
@@ -89,6 +91,25 @@ class RigidBody final : public IslandBody {
  private:
   double mass_;
   Eigen::Matrix3d inertia_;
+  Eigen::VectorXd momentum_;
+};
+
+/// A multibody link seen through its effective mass Lambda = (J M^-1 J^T)^-1
+/// (contact/multibody_partner.h): the twist [v; omega] at the link's reference point, one 6 x 6
+/// SPD block.
+class LinkBody final : public IslandBody {
+ public:
+  /// momentum = Lambda twist0.
+  LinkBody(const Eigen::Matrix<double, 6, 6>& effective_mass, Eigen::VectorXd momentum);
+
+  int dofs() const override { return 6; }
+  int blockSize() const override { return 6; }
+  void multiply(const Eigen::VectorXd& x, Eigen::VectorXd& out) const override;
+  const Eigen::VectorXd& momentum() const override { return momentum_; }
+  DiagonalBlock diagonalBlock(int block) const override;
+
+ private:
+  Eigen::Matrix<double, 6, 6> effective_mass_;
   Eigen::VectorXd momentum_;
 };
 

@@ -11,7 +11,9 @@
 //                  solved with the node's (its b = diag(m, I) times the velocity Bullet integrated
 //                  with: gravity and external forces of the step included; less the impulses of
 //                  Bullet's rigid contacts that the island solves as rows: rigid_contact_rows.h)
-//   prescribed   (static, kinematic, supported by Bullet's ground, multibody link) velocity_offset
+//   link         + rigidPointTerm(the link's LinkBody, lever, -1, R_c): its twist at the
+//                  reference point solved with the node's, its effective mass behind it
+//   prescribed   (static, kinematic, supported by Bullet's ground, a static link) velocity_offset
 //                  = -R_c (v + omega x lever): the partner point's known motion
 //
 // with mu the pair's coefficient, gap phi0 the contact's gap at the step's start, and k, tau_d
@@ -59,7 +61,8 @@ struct LaggedImpulse {
 /// One FEM body's island: bodies (0: the FEM body; 1.. the dynamic partners), rows, and the
 /// correspondence back to the contacts.
 struct NodeContactIsland {
-  std::vector<std::unique_ptr<RigidBody>> rigid_bodies;  ///< island bodies 1..
+  /// Island bodies 1..: RigidBody for a rigid body, LinkBody for a multibody link.
+  std::vector<std::unique_ptr<IslandBody>> rigid_bodies;
   std::vector<int> partner_body;  ///< per partner: its island body, or -1 (prescribed)
   std::vector<ContactRow> rows;
   std::vector<int> row_contact;  ///< per row: its index in the NodeContact list, or -1
