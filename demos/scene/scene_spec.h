@@ -37,8 +37,9 @@ struct BodySpec {
   /// "self_contact": {"friction", "gap_tolerance", "thickness_factor"}: on when present
   /// (docs/contact.md).
   std::optional<SelfContactSettings> self_contact;
-  /// "friction_solve": "auto" (default) | "contact_space" | "active_set": how the body's contacts
-  /// with rigid bodies decide stick and slide (ContactSettings::friction_solve, docs/contact.md).
+  /// "friction_solve": "convex" (default) | "auto" | "contact_space" | "active_set": how the
+  /// body's contacts with rigid bodies are solved (ContactSettings::friction_solve,
+  /// docs/contact-solve.md).
   ContactSettings::FrictionSolve friction_solve = ContactSettings{}.friction_solve;
 };
 

@@ -205,11 +205,12 @@ void bindParts(py::module_& m) {
             WorldGuard guard(*b.world, WorldGuard::kWrite);
             b.body->contacts().settings().friction_solve = *solve;
           },
-          "How the body's contacts with rigid bodies decide stick, slide and separation: "
-          "\"auto\" (default: contact space in the steps where a dynamic rigid body touches the "
-          "body, the active set otherwise), \"contact_space\" (Coulomb's law solved for all "
-          "contacts at once; a step that does not converge falls back to the active set) or "
-          "\"active_set\" (states switched between linear solves by rules).")
+          "How the body's contacts with rigid bodies are solved: \"convex\" (default: the body, "
+          "the rigid bodies it touches and their contacts as one convex problem, "
+          "docs/contact-solve.md), or the older \"auto\" (contact space in the steps where a "
+          "dynamic rigid body touches the body, the active set otherwise), \"contact_space\" "
+          "(Coulomb's law solved for all contacts at once) or \"active_set\" (states switched "
+          "between linear solves by rules).")
       .def_property_readonly(
           "kinetic_energy", [](const B& b) { return b.body->lastReport().kinetic_energy; },
           "J, at the end of the last step")
