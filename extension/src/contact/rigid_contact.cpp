@@ -5,6 +5,7 @@
 // their stages.
 
 #include "torsion/contact/rigid_contact.h"
+#include "torsion/contact/solve/rigid_contact_rows.h"
 
 #include <LinearMath/btTransformUtil.h>
 

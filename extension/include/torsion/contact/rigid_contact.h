@@ -52,7 +52,7 @@
 #include "torsion/contact/multibody_partner.h"
 #include "torsion/contact/node_anchors.h"
 #include "torsion/contact/rigid_partner.h"
-#include "torsion/contact/solve/rigid_contact_rows.h"
+#include "torsion/contact/solve/rigid_contact_group.h"
 #include "torsion/fem/fem_model.h"
 #include "torsion/solve/cholmod_solver.h"
 #include "torsion/solve/fem_state.h"

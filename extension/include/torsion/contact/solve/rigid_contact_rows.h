@@ -48,43 +48,15 @@
 
 #include <Eigen/Core>
 #include <functional>
-#include <string>
 #include <vector>
 
-#include "torsion/contact/rigid_partner.h"
+#include "torsion/contact/solve/rigid_contact_group.h"
 #include "torsion/contact/solve/sap_solver.h"
 
 namespace torsion::sap {
 
 struct NodeContactIsland;  // node_contact_rows.h
 struct RowDefaults;
-
-/// One contact point Bullet found for a body of the group.
-struct RigidContactPoint {
-  btManifoldPoint* point = nullptr;
-  /// The group's index of Bullet's body A and body B, or -1 for a static or kinematic object.
-  int body_a = -1;
-  int body_b = -1;
-  /// The point on each body less that body's centre of mass at the step's start (m, world).
-  Eigen::Vector3d lever_a = Eigen::Vector3d::Zero();
-  Eigen::Vector3d lever_b = Eigen::Vector3d::Zero();
-  /// A prescribed side's point velocity (m/s, world); zero for a dynamic side.
-  Eigen::Vector3d velocity_a = Eigen::Vector3d::Zero();
-  Eigen::Vector3d velocity_b = Eigen::Vector3d::Zero();
-};
-
-/// The dynamic rigid bodies an island takes from Bullet's rigid solver this step.
-struct RigidContactGroup {
-  std::vector<btRigidBody*> bodies;
-  /// Per body: w_bullet (N s; force, torque about the centre of mass at the step's start).
-  std::vector<Vector6d> bullet_impulses;
-  std::vector<RigidContactPoint> points;
-  /// Why bodies reached from the seeds stay with Bullet (one line each); empty when all were
-  /// taken.
-  std::vector<std::string> kept_by_bullet;
-
-  bool contains(const btRigidBody* body) const;
-};
 
 /// The step's start pose of a collision object (RigidContactSolver::startPoseOf).
 using StartPose = std::function<btTransform(const btCollisionObject&)>;
