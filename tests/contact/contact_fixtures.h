@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <memory>
+#include <vector>
 
 #include "torsion/bt_conversions.h"
 #include "torsion/bullet/fem_world.h"
@@ -54,6 +55,15 @@ inline btRigidBody* addGround(FemWorld& world, double mu) {
                                       0, at({0, 0, 0}));
   g->setFriction(mu);
   return g;
+}
+
+/// Holds the nodes of `body` at z = 0 where they are (a slab's base on the ground).
+inline void holdBase(FemBody& body) {
+  std::vector<int> base;
+  for (int i = 0; i < body.model().nodeCount(); ++i)
+    if (body.state().position(i).z() < 1e-9) base.push_back(i);
+  body.carryNodes(
+      "base", base, [](double) { return Frame{}; }, 0.0);
 }
 
 inline FemBody* addBox(FemWorld& world, const std::string& name, const Eigen::Vector3d& lo,

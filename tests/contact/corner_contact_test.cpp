@@ -29,8 +29,8 @@ CornerRun runCorner(ElementKind element, double youngs_modulus) {
   const double tilt = 30 * 3.141592653589793 / 180;  // gravity leans this far towards the wall
   EXPECT_TRUE(world.setGravity({9.81 * std::sin(tilt), 0, -9.81 * std::cos(tilt)}).ok());
   addGround(world, 0.5);
-  btRigidBody* wall = world.addRigidBody(
-      std::make_unique<btBoxShape>(btVector3(0.1, 0.5, 0.5)), 0.0, at({0.2, 0, 0.5}));
+  btRigidBody* wall = world.addRigidBody(std::make_unique<btBoxShape>(btVector3(0.1, 0.5, 0.5)),
+                                         0.0, at({0.2, 0, 0.5}));
   wall->setFriction(0.5);
   Result<TetMesh> mesh = makeBoxTetMesh({-0.1, -0.1, 0}, {0.1, 0.1, 0.2}, 4, 4, 4);
   EXPECT_TRUE(mesh.ok());

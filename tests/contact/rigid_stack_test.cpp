@@ -19,18 +19,18 @@ namespace torsion::test {
 namespace {
 
 constexpr double kDt = 0.01;
-constexpr double kHalf = 0.1;      // the boxes' half size, m (0.2 m boxes)
-constexpr double kSlabTop = 0.2;   // m
-constexpr double kSettle = 2.0;    // s: every box is at rest well before (about 0.4 s)
+constexpr double kHalf = 0.1;     // the boxes' half size, m (0.2 m boxes)
+constexpr double kSlabTop = 0.2;  // m
+constexpr double kSettle = 2.0;   // s: every box is at rest well before (about 0.4 s)
 
 struct BoxRun {
-  double settled_fastest = 0;   ///< m/s, the fastest box at any step after settling
-  double settled_drift = 0;     ///< m/s, the largest mean speed of a box after settling
-  double deepest_overlap = 0;   ///< m, a stacked box's face into the one below, worst step
-  double settled_overlap = 0;   ///< m, the same after settling
-  double lean = 0;              ///< m, the top box's horizontal offset from the bottom's, end
-  int unconverged_steps = 0;    ///< the slab's contact solve
-  int rigid_rows = 0;           ///< contacts between rigid bodies in the slab's island, end
+  double settled_fastest = 0;  ///< m/s, the fastest box at any step after settling
+  double settled_drift = 0;    ///< m/s, the largest mean speed of a box after settling
+  double deepest_overlap = 0;  ///< m, a stacked box's face into the one below, worst step
+  double settled_overlap = 0;  ///< m, the same after settling
+  double lean = 0;             ///< m, the top box's horizontal offset from the bottom's, end
+  int unconverged_steps = 0;   ///< the slab's contact solve
+  int rigid_rows = 0;          ///< contacts between rigid bodies in the slab's island, end
   bool ok = true;
 };
 
@@ -51,16 +51,12 @@ btRigidBody* addCube(FemWorld& world, const Eigen::Vector3d& centre) {
 
 // A 1 x 1 x 0.2 m slab of E 50 kPa (friction 1: a pair's mu is the box's 0.5), its base held.
 FemBody* addSoftSlab(FemWorld& world) {
-  FemBody* slab =
-      addBox(world, "slab", {-0.5, -0.5, 0}, {0.5, 0.5, kSlabTop}, 8, 8, 2, softMaterial(5e4, 1000));
+  FemBody* slab = addBox(world, "slab", {-0.5, -0.5, 0}, {0.5, 0.5, kSlabTop}, 8, 8, 2,
+                         softMaterial(5e4, 1000));
   if (slab == nullptr) return nullptr;
   slab->contacts().settings().friction = 1.0;
   slab->contacts().settings().friction_solve = ContactSettings::FrictionSolve::kConvex;
-  std::vector<int> base;
-  for (int i = 0; i < slab->model().nodeCount(); ++i)
-    if (slab->state().position(i).z() < 1e-9) base.push_back(i);
-  slab->carryNodes(
-      "base", base, [](double) { return Frame{}; }, 0.0);
+  holdBase(*slab);
   return slab;
 }
 
@@ -171,9 +167,9 @@ TEST(RigidStack, ABoxBridgingTheSlabAndAStaticLedgeStandsStill) {
   FemWorld world(contactSettings(kDt));
   const FemBody* slab = addSoftSlab(world);
   ASSERT_NE(slab, nullptr);
-  btRigidBody* ledge = world.addRigidBody(
-      std::make_unique<btBoxShape>(btVector3(0.2, 0.5, kSlabTop / 2)), 0.0,
-      at({0.5 + 0.2 + 0.002, 0, kSlabTop / 2}));
+  btRigidBody* ledge =
+      world.addRigidBody(std::make_unique<btBoxShape>(btVector3(0.2, 0.5, kSlabTop / 2)), 0.0,
+                         at({0.5 + 0.2 + 0.002, 0, kSlabTop / 2}));
   ledge->setFriction(1.0);
   const std::vector<btRigidBody*> boxes{addCube(world, {0.5, 0, kSlabTop + kHalf + 0.001})};
   const BoxRun run = measure(world, slab, boxes, false, 5.0);

@@ -19,10 +19,10 @@ constexpr double kDt = 0.005;
 constexpr double kHalf = 0.05;  // the box's half size, m
 
 struct EdgeRun {
-  double speed_on_slab = 0;    ///< m/s, horizontal, just before the box reaches the edge
-  double speed_off_slab = 0;   ///< m/s, horizontal, once clear of the slab
-  double fastest_upward = 0;   ///< m/s, the box's largest upward speed over the run
-  double largest_tilt = 0;     ///< rad, about the slide's cross axis
+  double speed_on_slab = 0;   ///< m/s, horizontal, just before the box reaches the edge
+  double speed_off_slab = 0;  ///< m/s, horizontal, once clear of the slab
+  double fastest_upward = 0;  ///< m/s, the box's largest upward speed over the run
+  double largest_tilt = 0;    ///< rad, about the slide's cross axis
   int unconverged_steps = 0;
   bool ok = true;
 };
@@ -38,14 +38,10 @@ EdgeRun runOffTheEdge(ElementKind element, double youngs_modulus, double speed) 
   FemBody* slab = added.value();
   slab->contacts().settings().friction = 0.0;
   slab->contacts().settings().friction_solve = ContactSettings::FrictionSolve::kConvex;
-  std::vector<int> base;
-  for (int i = 0; i < slab->model().nodeCount(); ++i)
-    if (slab->state().position(i).z() < 1e-9) base.push_back(i);
-  slab->carryNodes(
-      "base", base, [](double) { return Frame{}; }, 0.0);
-  btRigidBody* box = world.addRigidBody(
-      std::make_unique<btBoxShape>(btVector3(kHalf, kHalf, kHalf)), 1.0,
-      at({0.1, 0, 0.1 + kHalf + 1e-4}));
+  holdBase(*slab);
+  btRigidBody* box =
+      world.addRigidBody(std::make_unique<btBoxShape>(btVector3(kHalf, kHalf, kHalf)), 1.0,
+                         at({0.1, 0, 0.1 + kHalf + 1e-4}));
   box->setFriction(0.0);
   box->setActivationState(DISABLE_DEACTIVATION);
   box->setLinearVelocity(btVector3(btScalar(speed), 0, 0));
@@ -64,7 +60,7 @@ EdgeRun runOffTheEdge(ElementKind element, double youngs_modulus, double speed) 
     run.fastest_upward = std::max(run.fastest_upward, v.z());
     const Eigen::Matrix3d basis = toEigen(box->getWorldTransform().getBasis());
     run.largest_tilt = std::max(run.largest_tilt, std::asin(std::min(1.0, std::abs(basis(2, 0)))));
-    if (x.x() + kHalf < 0.5) run.speed_on_slab = v.x();     // its front edge still over the slab
+    if (x.x() + kHalf < 0.5) run.speed_on_slab = v.x();  // its front edge still over the slab
     if (x.x() - kHalf > 0.5 + 1e-3) run.speed_off_slab = v.x();  // its back edge clear
     if (x.z() < 0.0) break;
   }

@@ -260,9 +260,9 @@ TEST(Sliding, StiffSlabHoldsTheBoxBelowTheFrictionAngleAndLetsItSlideAbove) {
 // bounded at 2.5 mm, under 3 % of the 1 deg-above slide's distance; the stiff slabs at 10 um.
 TEST(Sliding, BoxHoldsOneDegreeBelowTheFrictionAngleAndSlidesOneDegreeAboveOnEverySlab) {
   // The older solve, on the tet4 slabs only (its tet10 figures: docs/validation.md).
-  expectThresholds({{1e5, 20, ElementKind::kTet4, 1e-3, 0.05},
-                    {1e8, 20, ElementKind::kTet4, 1e-5, 0.05}},
-                   ContactSettings::FrictionSolve::kAuto, "");
+  expectThresholds(
+      {{1e5, 20, ElementKind::kTet4, 1e-3, 0.05}, {1e8, 20, ElementKind::kTet4, 1e-5, 0.05}},
+      ContactSettings::FrictionSolve::kAuto, "");
 }
 
 // The same threshold with the active set (ContactSettings::kActiveSet, the default before "auto",
@@ -273,9 +273,9 @@ TEST(Sliding, BoxHoldsOneDegreeBelowTheFrictionAngleAndSlidesOneDegreeAboveOnEve
 // not the physical bound (docs/contact.md, "Open: the soft slabs at the threshold").
 TEST(Sliding, TheActiveSetOptionHoldsTheStiffThresholdAndNearlyTheSoftOne) {
   // The older solve, on the tet4 slabs only (its tet10 figures: docs/validation.md).
-  expectThresholds({{1e5, 20, ElementKind::kTet4, 5e-3, 0.12},
-                    {1e8, 20, ElementKind::kTet4, 1e-4, 0.05}},
-                   ContactSettings::FrictionSolve::kActiveSet, ", active set");
+  expectThresholds(
+      {{1e5, 20, ElementKind::kTet4, 5e-3, 0.12}, {1e8, 20, ElementKind::kTet4, 1e-4, 0.05}},
+      ContactSettings::FrictionSolve::kActiveSet, ", active set");
 }
 
 // Coulomb's distance whatever the slab: soft (E = 1e5 Pa) and stiff (1e8), node rows 0.2 m (the

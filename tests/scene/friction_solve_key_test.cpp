@@ -45,7 +45,8 @@ TEST(SceneFrictionSolveKey, AnUnknownSolveOrWrongTypeNamesTheKey) {
 TEST(SceneFrictionSolveKey, TheBuiltBodyUsesTheSolveTheSceneNames) {
   for (const auto& [entry, expected] :
        {std::pair{std::string(), ContactSettings::FrictionSolve::kConvex},
-        std::pair{std::string(R"( "friction_solve": "auto",)"), ContactSettings::FrictionSolve::kAuto},
+        std::pair{std::string(R"( "friction_solve": "auto",)"),
+                  ContactSettings::FrictionSolve::kAuto},
         std::pair{std::string(R"( "friction_solve": "contact_space",)"),
                   ContactSettings::FrictionSolve::kContactSpace},
         std::pair{std::string(R"( "friction_solve": "active_set",)"),

@@ -5,7 +5,6 @@
 // their stages.
 
 #include "torsion/contact/rigid_contact.h"
-#include "torsion/contact/solve/rigid_contact_rows.h"
 
 #include <LinearMath/btTransformUtil.h>
 
@@ -13,6 +12,7 @@
 #include <cmath>
 
 #include "torsion/bt_conversions.h"
+#include "torsion/contact/solve/rigid_contact_rows.h"
 
 namespace torsion {
 

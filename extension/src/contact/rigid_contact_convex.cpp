@@ -75,9 +75,9 @@ std::vector<int> rowGroups(const sap::NodeContactIsland& island,
 Vector6d stepStartVelocity(const RigidPartner& k, double dt) {
   Vector6d impulse = k.bullet_contact_impulse;
   if (k.body != nullptr)
-    impulse += dt * (Vector6d() << toEigen(k.body->getTotalForce()),
-                     toEigen(k.body->getTotalTorque()))
-                        .finished();
+    impulse +=
+        dt * (Vector6d() << toEigen(k.body->getTotalForce()), toEigen(k.body->getTotalTorque()))
+                 .finished();
   return k.entry_velocity - partnerResponse(k, impulse);
 }
 
@@ -111,9 +111,9 @@ bool matchFrictionBounds(sap::NodeContactIsland& island, sap::SapProblem& proble
   bool changed = false;
   for (std::size_t r = 0; r < island.rows.size(); ++r) {
     const auto k = static_cast<std::size_t>(row_partner[r]);
-    const bool mismatched =
-        lagged[k] * kLaggedMismatch < solved[k] || lagged[k] > kLaggedMismatch * solved[k] ||
-        unbounded[k] > kNewRowsShare * solved[k];
+    const bool mismatched = lagged[k] * kLaggedMismatch < solved[k] ||
+                            lagged[k] > kLaggedMismatch * solved[k] ||
+                            unbounded[k] > kNewRowsShare * solved[k];
     if (!mismatched || island.rows[r].mu == 0 || island.rows[r].bilateral) continue;
     const double gamma_n = std::max(0.0, report.impulses[r].z());
     if (gamma_n != island.rows[r].lagged_normal_impulse) {
@@ -210,9 +210,8 @@ LinearSolveReport RigidContactSolver::solveConvex(const SystemOperator& op,
   // Every round's iterations count: the statistics say what the step cost.
   int newton = report.newton_iterations;
   int cg = report.cg_iterations;
-  for (int round = 0;
-       round < kMaxFrictionBoundRounds && report.converged &&
-       matchFrictionBounds(island, created.value(), row_partner, report);
+  for (int round = 0; round < kMaxFrictionBoundRounds && report.converged &&
+                      matchFrictionBounds(island, created.value(), row_partner, report);
        ++round) {
     report = solver.solve(created.value(), x);  // from the last solution
     newton += report.newton_iterations;
@@ -236,8 +235,7 @@ LinearSolveReport RigidContactSolver::solveConvex(const SystemOperator& op,
     const int body = island.partner_body[k];
     if (body < 0) continue;
     const sap::IslandBody& rigid = *island.rigid_bodies[static_cast<std::size_t>(body - 1)];
-    const Vector6d momentum =
-        rigid.momentum() + row_impulses.segment<6>(problem.bodyOffset(body));
+    const Vector6d momentum = rigid.momentum() + row_impulses.segment<6>(problem.bodyOffset(body));
     partners_[k].velocity = Matrix6d(rigid.diagonalBlock(0)).llt().solve(momentum);
   }
   // The rows' states and impulses, where detection's memory, the statistics and the checkpoints
@@ -276,9 +274,9 @@ LinearSolveReport RigidContactSolver::solveConvex(const SystemOperator& op,
     const Eigen::Vector3d& gamma = report.impulses[r];
     f.impulse = island.rows[r].frame.transpose() * gamma;  // on the face
     f.determined = false;
-    f.state = !(gamma.z() > 0) ? FaceContact::State::kInactive
+    f.state = !(gamma.z() > 0)                                ? FaceContact::State::kInactive
               : report.states[r] == sap::ContactState::kStick ? FaceContact::State::kStick
-                                                               : FaceContact::State::kSlide;
+                                                              : FaceContact::State::kSlide;
   }
   stats_.active_set_iterations = newton;
   stats_.active_set_converged = report.converged;

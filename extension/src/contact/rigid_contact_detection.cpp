@@ -160,12 +160,11 @@ void RigidContactSolver::chooseSupportPlane(const btCollisionShape& shape,
     for (const int* t = first; t != last; ++t) {
       const Triangle& tri = triangles[static_cast<size_t>(*t)];
       const Eigen::Vector3d a = state.position(tri[0]);
-      const Eigen::Vector3d normal =
-          (state.position(tri[1]) - a).cross(state.position(tri[2]) - a);
+      const Eigen::Vector3d normal = (state.position(tri[1]) - a).cross(state.position(tri[2]) - a);
       if (normal.squaredNorm() == 0) continue;
-      taken = takeFacingPlane(shape, transform, x, -normal.normalized(), relative, dt, nearest,
-                              c) ||
-              taken;
+      taken =
+          takeFacingPlane(shape, transform, x, -normal.normalized(), relative, dt, nearest, c) ||
+          taken;
     }
   }
   if (taken) c.swept = true;

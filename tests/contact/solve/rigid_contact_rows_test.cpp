@@ -2,6 +2,8 @@
 // group takes, undoing Bullet's contact impulses exactly, the rows' geometry, and the write-back.
 // Plain Bullet worlds, no FEM body: the group is what Bullet's step left.
 
+#include "torsion/contact/solve/rigid_contact_rows.h"
+
 #include <btBulletDynamicsCommon.h>
 #include <gtest/gtest.h>
 
@@ -10,12 +12,11 @@
 #include <string>
 #include <vector>
 
+#include "sap_test_support.h"
 #include "torsion/bt_conversions.h"
 #include "torsion/contact/solve/node_contact_rows.h"
-#include "torsion/contact/solve/rigid_contact_rows.h"
 #include "torsion/contact/solve/sap_problem.h"
 #include "torsion/contact/solve/sap_solver.h"
-#include "sap_test_support.h"
 
 namespace torsion::sap {
 namespace {
@@ -32,8 +33,9 @@ struct Column {
     world.setGravity(btVector3(0, 0, btScalar(-kG)));
     add(std::make_unique<btStaticPlaneShape>(btVector3(0, 0, 1), 0), 0, {0, 0, 0});
     for (int k = 0; k < count; ++k)
-      boxes.push_back(add(std::make_unique<btBoxShape>(btVector3(btScalar(0.1), btScalar(0.1), btScalar(0.1))), 1.0,
-                          btVector3(0, 0, btScalar(0.1 + 0.2 * k))));
+      boxes.push_back(
+          add(std::make_unique<btBoxShape>(btVector3(btScalar(0.1), btScalar(0.1), btScalar(0.1))),
+              1.0, btVector3(0, 0, btScalar(0.1 + 0.2 * k))));
   }
   ~Column() {
     for (btTypedConstraint* c : joints)
@@ -66,17 +68,17 @@ struct Column {
     }
     std::sort(jointed.begin(), jointed.end());
     // Bullet has moved the bodies by their velocity: back to the step's start.
-    return gatherRigidContactGroup(*world.getDispatcher(), seeds,
-                                   [](const btCollisionObject& object) {
-                                     const btRigidBody* b = btRigidBody::upcast(&object);
-                                     btTransform start = object.getWorldTransform();
-                                     if (b == nullptr || b->isStaticObject()) return start;
-                                     btTransformUtil::integrateTransform(
-                                         object.getWorldTransform(), -b->getLinearVelocity(),
-                                         -b->getAngularVelocity(), btScalar(kDt), start);
-                                     return start;
-                                   },
-                                   jointed);
+    return gatherRigidContactGroup(
+        *world.getDispatcher(), seeds,
+        [](const btCollisionObject& object) {
+          const btRigidBody* b = btRigidBody::upcast(&object);
+          btTransform start = object.getWorldTransform();
+          if (b == nullptr || b->isStaticObject()) return start;
+          btTransformUtil::integrateTransform(object.getWorldTransform(), -b->getLinearVelocity(),
+                                              -b->getAngularVelocity(), btScalar(kDt), start);
+          return start;
+        },
+        jointed);
   }
 
   btDefaultCollisionConfiguration config;

@@ -159,11 +159,11 @@ inline Eigen::Vector3d tangentialSlip(const NodeContact& c, const Eigen::Vector3
 }
 
 struct ContactStepStats {
-  int candidates = 0;             ///< surface nodes within the detection margin
-  int face_candidates = 0;        ///< surface triangles (or edges) with a face contact candidate
-  int active = 0;                 ///< node and face contacts active at the end of the step
-  int face_active = 0;            ///< of which face contacts
-  int sticking = 0;               ///< of which sticking
+  int candidates = 0;       ///< surface nodes within the detection margin
+  int face_candidates = 0;  ///< surface triangles (or edges) with a face contact candidate
+  int active = 0;           ///< node and face contacts active at the end of the step
+  int face_active = 0;      ///< of which face contacts
+  int sticking = 0;         ///< of which sticking
   /// Contact points between rigid bodies solved in this body's island (the convex solve:
   /// contact/solve/rigid_contact_rows.h); not counted above.
   int rigid_rows = 0;

@@ -94,6 +94,8 @@ void LinkBody::multiply(const Eigen::VectorXd& x, Eigen::VectorXd& out) const {
   out.noalias() = effective_mass_ * x;
 }
 
-DiagonalBlock LinkBody::diagonalBlock(int /*block*/) const { return effective_mass_; }
+DiagonalBlock LinkBody::diagonalBlock(int /*block*/) const {
+  return effective_mass_;
+}
 
 }  // namespace torsion::sap

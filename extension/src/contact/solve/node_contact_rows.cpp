@@ -65,7 +65,8 @@ NodeContactIsland buildNodeContactIsland(const std::vector<NodeContact>& contact
     const RigidPartner& k = partners[p];
     if (!k.dynamic) continue;
     island.partner_body[p] = static_cast<int>(island.rigid_bodies.size()) + 1;
-    const Eigen::VectorXd momentum = partnerMomentum(k, k.entry_velocity) - k.bullet_contact_impulse;
+    const Eigen::VectorXd momentum =
+        partnerMomentum(k, k.entry_velocity) - k.bullet_contact_impulse;
     if (k.link != nullptr) {
       island.rigid_bodies.push_back(std::make_unique<LinkBody>(k.mass_matrix, momentum));
     } else {

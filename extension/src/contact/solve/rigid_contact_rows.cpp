@@ -101,19 +101,18 @@ Component componentOf(btRigidBody* seed, const std::vector<UsedManifold>& used,
 
 // Per side of a point: the group's body, its lever and (prescribed) its point velocity.
 void describeSide(const btCollisionObject* object, const btVector3& on_object,
-                  const std::map<const btRigidBody*, int>& index,
-                  const StartPose& start_pose, int& body, Eigen::Vector3d& lever,
-                  Eigen::Vector3d& velocity) {
+                  const std::map<const btRigidBody*, int>& index, const StartPose& start_pose,
+                  int& body, Eigen::Vector3d& lever, Eigen::Vector3d& velocity) {
   const btRigidBody* rigid = btRigidBody::upcast(object);
   const auto found = rigid != nullptr ? index.find(rigid) : index.end();
   body = found != index.end() ? found->second : -1;
   lever = toEigen(on_object) - toEigen(start_pose(*object).getOrigin());
   velocity.setZero();
   if (body < 0 && rigid != nullptr) {
-    velocity = pointVelocity((Vector6d() << toEigen(rigid->getLinearVelocity()),
-                              toEigen(rigid->getAngularVelocity()))
-                                 .finished(),
-                             lever);
+    velocity = pointVelocity(
+        (Vector6d() << toEigen(rigid->getLinearVelocity()), toEigen(rigid->getAngularVelocity()))
+            .finished(),
+        lever);
   }
 }
 
@@ -152,10 +151,10 @@ RigidContactGroup gatherRigidContactGroup(btDispatcher& dispatcher,
       btManifoldPoint& point = const_cast<btPersistentManifold&>(manifold).getContactPoint(p);
       RigidContactPoint rp;
       rp.point = &point;
-      describeSide(manifold.getBody0(), point.getPositionWorldOnA(), index, start_pose,
-                   rp.body_a, rp.lever_a, rp.velocity_a);
-      describeSide(manifold.getBody1(), point.getPositionWorldOnB(), index, start_pose,
-                   rp.body_b, rp.lever_b, rp.velocity_b);
+      describeSide(manifold.getBody0(), point.getPositionWorldOnA(), index, start_pose, rp.body_a,
+                   rp.lever_a, rp.velocity_a);
+      describeSide(manifold.getBody1(), point.getPositionWorldOnB(), index, start_pose, rp.body_b,
+                   rp.lever_b, rp.velocity_b);
       // Bullet's impulse on A: along +n and its friction directions; on B the opposite.
       const Eigen::Vector3d on_a =
           toEigen(point.m_normalWorldOnB) * toDouble(point.m_appliedImpulse) +
@@ -182,14 +181,14 @@ void addRigidContactRows(NodeContactIsland& island, const RigidContactGroup& gro
     ContactRow row;
     row.frame = contactFrame(toEigen(p.point->m_normalWorldOnB));
     if (p.body_a >= 0) {
-      row.terms.push_back(rigidPointTerm(group_body[static_cast<std::size_t>(p.body_a)],
-                                         p.lever_a, +1.0, row.frame));
+      row.terms.push_back(rigidPointTerm(group_body[static_cast<std::size_t>(p.body_a)], p.lever_a,
+                                         +1.0, row.frame));
     } else {
       row.velocity_offset += row.frame * p.velocity_a;
     }
     if (p.body_b >= 0) {
-      row.terms.push_back(rigidPointTerm(group_body[static_cast<std::size_t>(p.body_b)],
-                                         p.lever_b, -1.0, row.frame));
+      row.terms.push_back(rigidPointTerm(group_body[static_cast<std::size_t>(p.body_b)], p.lever_b,
+                                         -1.0, row.frame));
     } else {
       row.velocity_offset -= row.frame * p.velocity_b;
     }

@@ -61,9 +61,9 @@ struct RowDefaults;
 /// The step's start pose of a collision object (RigidContactSolver::startPoseOf).
 using StartPose = std::function<btTransform(const btCollisionObject&)>;
 
-/// The groups of `seeds` (dynamic rigid bodies) that can be taken, merged (`jointed_bodies`, sorted:
-/// the bodies with a joint in the world, btDynamicsWorld::getConstraint): every dynamic body
-/// reached from a seed through Bullet's contact points (those Bullet's solver used: distance
+/// The groups of `seeds` (dynamic rigid bodies) that can be taken, merged (`jointed_bodies`,
+/// sorted: the bodies with a joint in the world, btDynamicsWorld::getConstraint): every dynamic
+/// body reached from a seed through Bullet's contact points (those Bullet's solver used: distance
 /// within the manifold's processing threshold, both objects responding) and those points. A
 /// component that cannot be taken (above) is left out whole, its reason in kept_by_bullet.
 RigidContactGroup gatherRigidContactGroup(btDispatcher& dispatcher,
