@@ -185,7 +185,7 @@ bool FemBody::prepare(const StepContext& ctx, const AddedOperatorTerm* island_te
   for (int i = 0; i < model_->nodeCount(); ++i)
     step_forces_.segment<3>(3 * i) += model_->nodeMasses()[static_cast<size_t>(i)] * ctx.gravity;
   // Contacts with rigid bodies: unilateral constraints in the same projected solve.
-  rigid_contact_ = contacts_->detect(state_, constraints_, dt, ctx.jointed_bodies);
+  rigid_contact_ = contacts_->detect(state_, constraints_, dt, ctx.joints);
   // Self-contact: an augmented Lagrangian added to the system, around the same solve.
   // Its solve runs whenever it is on, candidates or not: it looks again along the solved motion.
   const bool self = self_contact_ != nullptr;

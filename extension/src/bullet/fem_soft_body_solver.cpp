@@ -253,6 +253,8 @@ void FemSoftBodySolver::predictMotion(btScalar solver_dt) {
     for (const auto& body : bodies_)
       body->predict(dt, !alone);
   }
+  // Bullet's rigid solve comes next: each jointed body's twist before it (joint_ledger.h).
+  if (world_ != nullptr) joint_ledger_.begin(*world_, dt);
   if (fem_contact_) fem_contact_->beginSubstep();
   soft_touch_->beginSubstep();
   bullet_solver_.predictMotion(solver_dt);
@@ -268,12 +270,8 @@ void FemSoftBodySolver::solveConstraints(btScalar solver_dt) {
   ctx.dt = static_cast<double>(solver_dt);
   ctx.index = steps_ + 1;
   ctx.gravity = toEigen(world_->getGravity());
-  for (int c = 0; c < world_->getNumConstraints(); ++c) {
-    const btTypedConstraint& joint = *world_->getConstraint(c);
-    ctx.jointed_bodies.push_back(&joint.getRigidBodyA());
-    ctx.jointed_bodies.push_back(&joint.getRigidBodyB());
-  }
-  std::sort(ctx.jointed_bodies.begin(), ctx.jointed_bodies.end());
+  joint_ledger_.refresh(*world_);
+  ctx.joints = &joint_ledger_;
 
   for (StepListener* listener : listeners_)
     listener->beforeFemStep(ctx);

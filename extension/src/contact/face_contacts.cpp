@@ -128,7 +128,8 @@ void FaceContactSet::detect(const FemState& state, const NodeConstraints& held,
                             const std::vector<int>& nearby_nodes, const btCollisionShape& shape,
                             const btTransform& transform, const Eigen::Vector3d& lo,
                             const Eigen::Vector3d& hi, double reach, double dt, int partner,
-                            const RigidPartner& p, double friction) {
+                            const RigidPartner& p, double friction,
+                            const std::vector<char>& glued) {
   ++stamp_;
   const Eigen::Vector3d pad = Eigen::Vector3d::Constant(reach);
   const std::optional<PolyhedronFeatures> polyhedron = polyhedronFeatures(shape, transform);
@@ -146,9 +147,12 @@ void FaceContactSet::detect(const FemState& state, const NodeConstraints& held,
       const Eigen::Vector3d tlo = a.cwiseMin(b).cwiseMin(c), thi = a.cwiseMax(b).cwiseMax(c);
       if ((tlo.array() > (hi + pad).array()).any() || (thi.array() < (lo - pad).array()).any())
         continue;
-      bool all_held = true;
-      for (int node_id : tri)
+      bool all_held = true, on_glue = false;
+      for (int node_id : tri) {
         all_held = all_held && held.kind(node_id) == NodeConstraints::Kind::kFull;
+        on_glue = on_glue || (!glued.empty() && glued[static_cast<size_t>(node_id)] != 0);
+      }
+      if (on_glue) continue;
       if (all_held && !p.dynamic) continue;
       if (features) features->addTriangle(tri, a, b, c);
       // A supported partner (resting on the ground: coupled explicitly, one step late) gets node

@@ -13,6 +13,7 @@
 
 #include "torsion/bt_conversions.h"
 #include "torsion/contact/solve/rigid_contact_rows.h"
+#include "torsion/contact/solve/rigid_joint_rows.h"
 
 namespace torsion {
 
@@ -92,8 +93,8 @@ void RigidContactSolver::addCandidate(const btCollisionObject* object) {
 }
 
 bool RigidContactSolver::detect(const FemState& state, const NodeConstraints& constraints,
-                                double dt, const std::vector<const btRigidBody*>& jointed_bodies) {
-  jointed_bodies_ = jointed_bodies;
+                                double dt, sap::JointLedger* joints) {
+  joints_ = joints;
   rememberActiveContacts();
   forgetLastStep(dt);
   if (candidates_.empty() && anchors_.empty()) return false;
@@ -269,8 +270,11 @@ void RigidContactSolver::measureEndGaps(const Eigen::VectorXd& v) {
 void RigidContactSolver::finish() {
   // The island's rigid impulses onto Bullet's points, which now carry them (rigid_contact_rows.h).
   sap::writeBackRigidImpulses(rigid_group_, rigid_impulses_);
+  if (joints_ != nullptr) sap::writeBackJointImpulses(rigid_group_, joint_impulses_, *joints_, dt_);
   rigid_group_ = {};
   rigid_impulses_.clear();
+  joint_impulses_.clear();
+  joints_ = nullptr;
   links_.applyImpulses(partners_, dt_);
   for (RigidPartner& k : partners_) {
     if (k.link != nullptr) continue;

@@ -14,6 +14,7 @@
 #include "torsion/contact/solve/fem_island_body.h"
 #include "torsion/contact/solve/node_contact_rows.h"
 #include "torsion/contact/solve/rigid_contact_rows.h"
+#include "torsion/contact/solve/rigid_joint_rows.h"
 #include "torsion/contact/solve/sap_problem.h"
 #include "torsion/contact/solve/sap_solver.h"
 
@@ -81,8 +82,10 @@ Vector6d stepStartVelocity(const RigidPartner& k, double dt) {
   return k.entry_velocity - partnerResponse(k, impulse);
 }
 
+// A row between rigid bodies (a contact point or a joint's row): not the FEM body's contact.
 bool isRigidRow(const sap::NodeContactIsland& island, std::size_t r) {
-  return r < island.row_rigid.size() && island.row_rigid[r] >= 0;
+  return (r < island.row_rigid.size() && island.row_rigid[r] >= 0) ||
+         (r < island.row_joint.size() && island.row_joint[r] >= 0);
 }
 
 // The lagged model bounds each row's friction by mu times its last normal impulse. Where that
@@ -114,7 +117,8 @@ bool matchFrictionBounds(sap::NodeContactIsland& island, sap::SapProblem& proble
     const bool mismatched = lagged[k] * kLaggedMismatch < solved[k] ||
                             lagged[k] > kLaggedMismatch * solved[k] ||
                             unbounded[k] > kNewRowsShare * solved[k];
-    if (!mismatched || island.rows[r].mu == 0 || island.rows[r].bilateral) continue;
+    if (!mismatched || island.rows[r].mu == 0 || island.rows[r].kind != sap::RowKind::kContact)
+      continue;
     const double gamma_n = std::max(0.0, report.impulses[r].z());
     if (gamma_n != island.rows[r].lagged_normal_impulse) {
       island.rows[r].lagged_normal_impulse = gamma_n;
@@ -134,7 +138,7 @@ bool RigidContactSolver::islandTakesRigidContacts(btRigidBody& body) const {
   return sap::gatherRigidContactGroup(
              *dispatcher, {&body},
              [this](const btCollisionObject& object) { return startPoseOf(object); },
-             jointed_bodies_)
+             joints_ != nullptr ? joints_->joints() : std::vector<btTypedConstraint*>{})
       .contains(&body);
 }
 
@@ -149,14 +153,25 @@ void RigidContactSolver::takeRigidContacts() {
       seeds.push_back(k.body);
   }
   if (dispatcher == nullptr || seeds.empty()) return;
-  rigid_group_ = sap::gatherRigidContactGroup(
-      *dispatcher, seeds, [this](const btCollisionObject& object) { return startPoseOf(object); },
-      jointed_bodies_);
+  const sap::StartPose start_pose = [this](const btCollisionObject& object) {
+    return startPoseOf(object);
+  };
+  if (joints_ == nullptr) {
+    rigid_group_ = sap::gatherRigidContactGroup(*dispatcher, seeds, start_pose, {});
+  } else {
+    rigid_group_ = sap::gatherRigidContactGroup(*dispatcher, seeds, start_pose, joints_->joints());
+    sap::addJointRows(rigid_group_, *joints_, start_pose, dt_);
+  }
   for (std::size_t b = 0; b < rigid_group_.bodies.size(); ++b) {
     RigidPartner& k = partners_[static_cast<std::size_t>(partnerIndex(rigid_group_.bodies[b]))];
     k.dynamic = true;
     k.supported = false;
+    // Bullet's contact impulses on the body, and its joint impulses (joint_ledger.h): what the
+    // island solves afresh.
     k.bullet_contact_impulse = rigid_group_.bullet_impulses[b];
+    if (joints_ != nullptr)
+      k.bullet_contact_impulse += joints_->jointImpulse(
+          *rigid_group_.bodies[b], rigid_group_.bullet_impulses[b], k.mass_matrix, dt_);
   }
 }
 
@@ -187,6 +202,7 @@ LinearSolveReport RigidContactSolver::solveConvex(const SystemOperator& op,
   for (std::size_t g = 0; g < group.bodies.size(); ++g)
     group_body[g] = island.partner_body[static_cast<std::size_t>(partnerIndex(group.bodies[g]))];
   sap::addRigidContactRows(island, group, group_body, defaults, dt_);
+  sap::addRigidJointRows(island, group, group_body);
   const sap::FemIslandBody fem(op, constraints, b);
   const std::vector<int> row_partner = rowGroups(island, contacts_, faces, partners_.size());
   Result<sap::SapProblem> created =
@@ -244,6 +260,7 @@ LinearSolveReport RigidContactSolver::solveConvex(const SystemOperator& op,
   stats_.normal_impulse = 0;
   stats_.max_end_penetration = 0;
   rigid_impulses_ = sap::rigidPointImpulses(island, group, report);  // for finish()
+  joint_impulses_ = sap::jointRowImpulses(island, group, report);
   stats_.rigid_rows = static_cast<int>(group.points.size());
   for (std::size_t r = 0; r < island.rows.size(); ++r) {
     if (isRigidRow(island, r)) continue;  // between rigid bodies: not this body's contacts

@@ -87,6 +87,17 @@ bool touchesStaticOrKinematic(const btRigidBody& body, btSoftBody& soft) {
 
 }  // namespace
 
+std::vector<char> RigidContactSolver::gluedTo(const btCollisionObject& object) const {
+  std::vector<char> glued;
+  for (const NodeAnchor& anchor : anchors_.anchors()) {
+    if (anchor.object != &object) continue;
+    glued.resize(static_cast<size_t>(model_->nodeCount()), 0);
+    for (int node : anchor.nodes)
+      glued[static_cast<size_t>(node)] = 1;
+  }
+  return glued;
+}
+
 btTransform RigidContactSolver::startPoseOf(const btCollisionObject& object) const {
   if (std::optional<btTransform> pose = links_.startPose(object)) return *pose;
   return startPose(object, dt_);
@@ -279,6 +290,7 @@ void RigidContactSolver::forgetLastStep(double dt) {
   solved_faces_.clear();
   rigid_group_ = {};  // a failed step's (its finish() did not run)
   rigid_impulses_.clear();
+  joint_impulses_.clear();
   stats_ = ContactStepStats{};
   dt_ = dt;
   dynamic_count_ = 0;
@@ -326,7 +338,7 @@ void RigidContactSolver::findContacts(const FemState& state, const NodeConstrain
     const int partner = partnerIndex(object);
     faces_.detect(state, constraints, collector.nodes, *shape, transform, toEigen(lo), toEigen(hi),
                   reach, lookahead(dt), partner, partners_[static_cast<size_t>(partner)],
-                  settings_.friction * toDouble(object->getFriction()));
+                  settings_.friction * toDouble(object->getFriction()), gluedTo(*object));
   }
 }
 

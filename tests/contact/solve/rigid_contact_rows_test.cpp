@@ -15,6 +15,7 @@
 #include "sap_test_support.h"
 #include "torsion/bt_conversions.h"
 #include "torsion/contact/solve/node_contact_rows.h"
+#include "torsion/contact/solve/rigid_joint_rows.h"
 #include "torsion/contact/solve/sap_problem.h"
 #include "torsion/contact/solve/sap_solver.h"
 
@@ -56,29 +57,28 @@ struct Column {
     shapes.push_back(std::move(shape));
     return bodies.back().get();
   }
+  // Each step as FemSoftBodySolver drives the ledger: begun before Bullet's solve (no damping
+  // here, so before the step is the same).
   void step(int steps) {
-    for (int k = 0; k < steps; ++k)
+    for (int k = 0; k < steps; ++k) {
+      ledger.begin(world, kDt);
       world.stepSimulation(btScalar(kDt), 1, btScalar(kDt));
+    }
+  }
+  static btTransform startPose(const btCollisionObject& object) {
+    const btRigidBody* b = btRigidBody::upcast(&object);
+    btTransform start = object.getWorldTransform();
+    if (b == nullptr || b->isStaticObject()) return start;
+    btTransformUtil::integrateTransform(object.getWorldTransform(), -b->getLinearVelocity(),
+                                        -b->getAngularVelocity(), btScalar(kDt), start);
+    return start;
   }
   RigidContactGroup gather(const std::vector<btRigidBody*>& seeds) {
-    std::vector<const btRigidBody*> jointed;
-    for (int c = 0; c < world.getNumConstraints(); ++c) {
-      jointed.push_back(&world.getConstraint(c)->getRigidBodyA());
-      jointed.push_back(&world.getConstraint(c)->getRigidBodyB());
-    }
-    std::sort(jointed.begin(), jointed.end());
+    std::vector<btTypedConstraint*> world_joints;
+    for (int c = 0; c < world.getNumConstraints(); ++c)
+      world_joints.push_back(world.getConstraint(c));
     // Bullet has moved the bodies by their velocity: back to the step's start.
-    return gatherRigidContactGroup(
-        *world.getDispatcher(), seeds,
-        [](const btCollisionObject& object) {
-          const btRigidBody* b = btRigidBody::upcast(&object);
-          btTransform start = object.getWorldTransform();
-          if (b == nullptr || b->isStaticObject()) return start;
-          btTransformUtil::integrateTransform(object.getWorldTransform(), -b->getLinearVelocity(),
-                                              -b->getAngularVelocity(), btScalar(kDt), start);
-          return start;
-        },
-        jointed);
+    return gatherRigidContactGroup(*world.getDispatcher(), seeds, startPose, world_joints);
   }
 
   btDefaultCollisionConfiguration config;
@@ -91,6 +91,7 @@ struct Column {
   std::vector<btRigidBody*> boxes;
   std::vector<btTypedConstraint*> joints;
   std::vector<std::unique_ptr<btTypedConstraint>> owned_joints;
+  JointLedger ledger;
 };
 
 Vector6d twist(const btRigidBody& body) {
@@ -127,18 +128,113 @@ TEST(RigidContactRows, AGroupTakesTheWholeColumnAndUndoesBulletsImpulsesExactly)
   }
 }
 
-TEST(RigidContactRows, ABodyWithAJointStaysWithBulletWithItsWholeGroup) {
+Matrix6d massMatrix(const btRigidBody& body) {
+  Matrix6d m = Matrix6d::Zero();
+  m.topLeftCorner<3, 3>() = Eigen::Matrix3d::Identity() / toDouble(body.getInvMass());
+  m.bottomRightCorner<3, 3>() = toEigen(body.getInvInertiaTensorWorld()).inverse();
+  return m;
+}
+
+// The top box of a column of two hangs from a point-to-point joint at its top face's centre: the
+// joint joins the group (it no longer leaves it to Bullet), Bullet's joint impulse is undone
+// exactly (joint_ledger.h), the joint's rows are Bullet's at the step's start, and solved with
+// the contacts they hold the pivot.
+TEST(RigidContactRows, AJointedBodyJoinsTheGroupWithItsJointSolvedWithItsContacts) {
   Column column(2);
+  btRigidBody& top = *column.boxes[1];
   column.owned_joints.push_back(
-      std::make_unique<btPoint2PointConstraint>(*column.boxes[1], btVector3(0, 0, btScalar(0.1))));
+      std::make_unique<btPoint2PointConstraint>(top, btVector3(0, 0, btScalar(0.1))));
   column.joints.push_back(column.owned_joints.back().get());
   column.world.addConstraint(column.joints.back());
-  column.step(20);
-  const RigidContactGroup group = column.gather({column.boxes[0]});
-  EXPECT_TRUE(group.bodies.empty());
-  EXPECT_TRUE(group.points.empty());
-  ASSERT_EQ(group.kept_by_bullet.size(), 1u);
-  EXPECT_NE(group.kept_by_bullet[0].find("joint"), std::string::npos) << group.kept_by_bullet[0];
+  column.step(19);
+  std::vector<Vector6d> before;
+  for (const btRigidBody* box : column.boxes)
+    before.push_back(twist(*box));
+  column.step(1);
+  // Inside Bullet's step, where the FEM solve runs, the bodies still carry their forces; the
+  // world has cleared them since.
+  for (btRigidBody* box : column.boxes)
+    box->applyGravity();
+  RigidContactGroup group = column.gather({column.boxes[0]});
+  ASSERT_EQ(group.bodies.size(), 2u) << "the bottom box reaches the top one by contact";
+  EXPECT_TRUE(group.kept_by_bullet.empty());
+  addJointRows(group, column.ledger, Column::startPose, kDt);
+  ASSERT_EQ(group.joints.size(), 1u);
+  ASSERT_EQ(group.joint_rows.size(), 3u);  // a point-to-point joint: three linear rows
+  // Undone, Bullet's contact and joint impulses leave each box with its velocity before the step
+  // plus g dt.
+  std::vector<Vector6d> start(2);
+  for (std::size_t b = 0; b < 2; ++b) {
+    const btRigidBody& body = *group.bodies[b];
+    const Matrix6d m = massMatrix(body);
+    const Vector6d undone = group.bullet_impulses[b] +
+                            column.ledger.jointImpulse(body, group.bullet_impulses[b], m, kDt);
+    start[b] = twist(body) - m.inverse() * undone;
+    Vector6d expected = before[b];
+    expected(2) -= kG * kDt;
+    EXPECT_LT((start[b] - expected).norm(), kBulletRounding) << "box " << b;
+  }
+  // The rows at the step's start: each reads the velocity of the box's pivot along its axis
+  // (v + omega x r, r the pivot's lever at the start pose), and aims at Bullet's error correction.
+  const btTransform pose = Column::startPose(top);
+  const Eigen::Vector3d lever = toEigen(pose.getBasis() * btVector3(0, 0, btScalar(0.1)));
+  const auto top_index = static_cast<int>(
+      std::find(group.bodies.begin(), group.bodies.end(), &top) - group.bodies.begin());
+  Vector6d probe;
+  probe << 0.3, -0.2, 0.1, 0.5, 0.7, -0.4;
+  for (const RigidJointRow& row : group.joint_rows) {
+    EXPECT_EQ(row.body_a, top_index);
+    EXPECT_EQ(row.body_b, -1) << "the world's fixed body";
+    const Eigen::Vector3d point = probe.head<3>() + probe.tail<3>().cross(lever);
+    const Eigen::Vector3d axis = row.jacobian_a.head<3>();
+    EXPECT_NEAR(axis.norm(), 1, 1e-12);
+    EXPECT_NEAR(row.jacobian_a.dot(probe), axis.dot(point), kBulletRounding);
+    EXPECT_LT(std::abs(row.target_velocity), 0.01) << "a joint at rest has little error";
+  }
+  // Solved with the contacts: the pivot holds to the joint rows' compliance, R_n |lambda| per row.
+  NodeContactIsland island;
+  std::vector<int> group_body;
+  for (std::size_t b = 0; b < 2; ++b) {
+    const Matrix6d m = massMatrix(*group.bodies[b]);
+    Eigen::VectorXd momentum = m * start[b];
+    momentum(2) -= kG * kDt * toDouble(1 / group.bodies[b]->getInvMass());
+    island.rigid_bodies.push_back(
+        std::make_unique<RigidBody>(toDouble(1 / group.bodies[b]->getInvMass()),
+                                    Eigen::Matrix3d(m.bottomRightCorner<3, 3>()), momentum));
+    group_body.push_back(static_cast<int>(b));
+  }
+  addRigidContactRows(island, group, group_body, RowDefaults{}, kDt);
+  addRigidJointRows(island, group, group_body);
+  ASSERT_EQ(island.rows.size(), group.points.size() + 3);
+  std::vector<const IslandBody*> bodies;
+  for (const auto& b : island.rigid_bodies)
+    bodies.push_back(b.get());
+  Result<SapProblem> problem = SapProblem::create(bodies, island.rows, kDt);
+  ASSERT_TRUE(problem.ok()) << problem.error().message;
+  Eigen::VectorXd v;
+  SapSolver solver;
+  const SapReport report = solver.solve(problem.value(), v);
+  ASSERT_TRUE(report.converged) << report.message;
+  const std::vector<double> lambda = jointRowImpulses(island, group, report);
+  ASSERT_EQ(lambda.size(), 3u);
+  for (std::size_t i = 0; i < 3; ++i) {
+    const RigidJointRow& row = group.joint_rows[i];
+    const RowModel& m = problem.value().model(static_cast<int>(group.points.size() + i));
+    const double velocity = row.jacobian_a.dot(v.segment<6>(6 * top_index));
+    EXPECT_NEAR(velocity, row.target_velocity - m.rn * lambda[i], 1e-9 + 1e-6 * kG * kDt);
+  }
+  // Written back: the ledger holds the island's joint impulse for the top box, the bottom box has
+  // none.
+  writeBackJointImpulses(group, lambda, column.ledger, kDt);
+  const Vector6d on_top = column.ledger.jointImpulse(top, Vector6d::Zero(), massMatrix(top), kDt);
+  Vector6d expected = Vector6d::Zero();
+  for (std::size_t i = 0; i < 3; ++i)
+    expected += lambda[i] * group.joint_rows[i].jacobian_a;
+  EXPECT_LT((on_top - expected).norm(), 1e-15 + 1e-12 * expected.norm());
+  EXPECT_EQ(column.ledger
+                .jointImpulse(*column.boxes[0], Vector6d::Zero(), massMatrix(*column.boxes[0]), kDt)
+                .norm(),
+            0.0);
 }
 
 // The rows solved alone (no FEM body): every contact obeys the model, no box sinks faster than its

@@ -210,7 +210,7 @@ AnchoredRun runAnchored(const Eigen::Vector3d& start, double gravity, int steps)
     row.frame =
         contactFrame(distance > 0 ? Eigen::Vector3d(drift / distance) : Eigen::Vector3d::UnitZ());
     row.terms.push_back(nodeTerm(0, 0, 1.0, row.frame));
-    row.bilateral = true;
+    row.kind = RowKind::kAnchor;
     row.stiffness = kStiffness;
     row.dissipation_time = kTauD;
     row.gap = -distance;

@@ -97,6 +97,38 @@ TEST(SapProjection, DerivativesMatchFiniteDifferences) {
 }
 
 // R_n from the stiffness until the near-rigid cap, R_t = sigma w, v_hat = -phi0 / (dt + tau_d).
+// A joint row (sap_problem.h): the impulse (v_hat - v_n) / R_n clamped to [lo, hi], nothing
+// along the tangents; G and the cost's slope -gamma against finite differences, the cost C1
+// across the bounds.
+TEST(SapProjection, AJointRowClampsItsImpulseToItsBoundsWithAC1Cost) {
+  RowModel m;
+  m.kind = RowKind::kJoint;
+  m.rn = 2e-3;
+  m.v_hat = 0.01;
+  m.lower = -0.5;
+  m.upper = 2.0;
+  auto at = [&m](double vn) { return projectImpulse(m, Eigen::Vector3d(0.3, -0.2, vn)); };
+  EXPECT_EQ(at(0.0).gamma, Eigen::Vector3d(0, 0, m.upper));  // y = 5, beyond hi
+  EXPECT_EQ(at(0.0).state, ContactState::kSlide);
+  EXPECT_EQ(at(0.009).gamma, Eigen::Vector3d(0, 0, (m.v_hat - 0.009) / m.rn));
+  EXPECT_EQ(at(0.009).state, ContactState::kStick);
+  EXPECT_EQ(at(0.05).gamma.z(), m.lower);
+  const double h = 1e-7;
+  for (double vn : {-0.1, 0.0, 0.0075, 0.009, 0.0105, 0.02, 0.1}) {
+    const RowResponse r = at(vn);
+    EXPECT_EQ(r.gamma.head<2>(), Eigen::Vector2d::Zero());
+    const double slope = (at(vn + h).cost - at(vn - h).cost) / (2 * h);
+    EXPECT_NEAR(slope, -r.gamma.z(), 1e-6 * (1 + std::abs(r.gamma.z()))) << "v_n " << vn;
+    const double dgamma = (at(vn + h).gamma.z() - at(vn - h).gamma.z()) / (2 * h);
+    EXPECT_NEAR(r.g(2, 2), -dgamma, 1e-6 / m.rn) << "v_n " << vn;
+  }
+  // Across each bound the cost meets itself: y = hi at v_n = v_hat - R_n hi.
+  for (double bound : {m.upper, m.lower}) {
+    const double vn = m.v_hat - m.rn * bound;
+    EXPECT_NEAR(at(vn - 1e-12).cost, at(vn + 1e-12).cost, 1e-9);
+  }
+}
+
 TEST(SapProjection, RegularisationFollowsTheCompliance) {
   const double mass = 2.0, dt = 1e-3;
   MatrixBody particle(test::massMatrix({mass}), Eigen::VectorXd::Zero(3));

@@ -44,6 +44,7 @@
 #include "torsion/bullet/fem_contact_islands.h"
 #include "torsion/bullet/step_context.h"
 #include "torsion/constraints/frame.h"
+#include "torsion/contact/solve/joint_ledger.h"
 #include "torsion/mesh/tet_mesh.h"
 #include "torsion/result.h"
 #include "torsion/solve/parallel.h"
@@ -191,6 +192,7 @@ class FemSoftBodySolver : public btSoftBodySolver {
   btDiscreteDynamicsWorld* world_ = nullptr;
   btSoftBodyWorldInfo* world_info_ = nullptr;
   std::function<void(btSoftBody*)> add_to_world_, remove_from_world_;
+  sap::JointLedger joint_ledger_;  // the world's joints, each substep (predictMotion on)
 
   std::vector<std::unique_ptr<FemBody>> bodies_;
   std::unique_ptr<FemContactIslands> fem_contact_;  // nullptr: FEM-FEM contact off

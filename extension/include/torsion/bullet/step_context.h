@@ -6,22 +6,24 @@
 // (dt, maxSubSteps, fixedTimeStep) is one FEM step of that substep's length, and the FEM time is
 // the sum of the substeps taken since the solver joined the world (FemSoftBodySolver).
 
-#include <BulletDynamics/Dynamics/btRigidBody.h>
-
 #include <Eigen/Core>
 #include <cstdint>
-#include <vector>
 
 namespace torsion {
+
+namespace sap {
+class JointLedger;
+}  // namespace sap
 
 struct StepContext {
   double time = 0;         ///< s, the step goes from `time` to `time + dt`
   double dt = 0;           ///< s, this substep's length, as Bullet passed it
   std::int64_t index = 0;  ///< 1-based index of this step among the solver's FEM steps
   Eigen::Vector3d gravity = Eigen::Vector3d::Zero();  ///< m/s^2, the world's gravity this step
-  /// The rigid bodies with a joint (a btTypedConstraint of the world) this step, sorted: Bullet
-  /// keeps their contacts (contact/solve/rigid_contact_rows.h).
-  std::vector<const btRigidBody*> jointed_bodies;
+  /// The world's joints (btTypedConstraint) this substep and what Bullet's solver did with them
+  /// (contact/solve/joint_ledger.h): the convex contact solve takes the joints of the rigid bodies
+  /// it takes. Owned by FemSoftBodySolver; null when the step has no world.
+  sap::JointLedger* joints = nullptr;
 
   double endTime() const { return time + dt; }
 };

@@ -82,11 +82,15 @@ class FaceContactSet {
   /// out unless the partner is dynamic (held nodes push, never yield); a face that the predicted
   /// motion over `dt` (s) would rather hold against the shape's supporting plane facing it (a
   /// triangle just ahead of a sliding box's edge) is left to its nodes (`dt`: the solve's
-  /// look-ahead, RigidContactSolver::lookahead).
+  /// look-ahead, RigidContactSolver::lookahead). A triangle with a node in `glued` (per node,
+  /// non-zero: anchored to this object; empty: none) is left out: where a body is glued to the
+  /// object, the two are one, not in contact (at a large step the object's own corners, within
+  /// reach of the glued face's neighbours, read as deep penetrations and fought the anchors).
   void detect(const FemState& state, const NodeConstraints& held,
               const std::vector<int>& nearby_nodes, const btCollisionShape& shape,
               const btTransform& transform, const Eigen::Vector3d& lo, const Eigen::Vector3d& hi,
-              double reach, double dt, int partner, const RigidPartner& p, double friction);
+              double reach, double dt, int partner, const RigidPartner& p, double friction,
+              const std::vector<char>& glued);
   const std::vector<FaceContact>& contacts() const { return contacts_; }
   /// The contacts of polyhedral shapes' corners and edges (query/feature_contacts.h) found by
   /// this step's detect(), for the convex island solve (contact/solve/): the contacts() above

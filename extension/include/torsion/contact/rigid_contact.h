@@ -60,6 +60,10 @@
 #include "torsion/solve/projected_cg.h"
 #include "torsion/solve/system_operator.h"
 
+namespace torsion::sap {
+class JointLedger;  // solve/joint_ledger.h
+}  // namespace torsion::sap
+
 namespace torsion {
 
 struct ContactSettings {
@@ -228,10 +232,11 @@ class RigidContactSolver {
   /// Stage 2: a broadphase pair with `object`.
   void addCandidate(const btCollisionObject* object);
   /// Stage 4, before the solve: narrow phase. `constraints` holds the node groups' prescriptions
-  /// (held nodes); `jointed_bodies` (sorted) the rigid bodies with a joint in the world, whose
-  /// contacts the convex solve leaves to Bullet. Returns whether any node is near a rigid object.
+  /// (held nodes); `joints` the world's joints this substep (null: none), which the convex solve
+  /// takes with the rigid bodies it takes and updates at finish(). Returns whether any node is
+  /// near a rigid object.
   bool detect(const FemState& state, const NodeConstraints& constraints, double dt,
-              const std::vector<const btRigidBody*>& jointed_bodies = {});
+              sap::JointLedger* joints = nullptr);
   /// The linear solve of the step with contacts, on the stepper's prepared system
   /// (ImplicitStepper::prepared(); FemBody::solveContacts).
   LinearSolveReport solve(const SystemOperator& op, const NodeConstraints& constraints,
@@ -318,6 +323,8 @@ class RigidContactSolver {
                          const Eigen::Vector3d& x, const Eigen::Vector3d& into_surface,
                          const btCollisionObject& object, NodeContact& c) const;
   btTransform startPoseOf(const btCollisionObject& object) const;
+  /// Per node, whether it is anchored to `object` (empty when none is).
+  std::vector<char> gluedTo(const btCollisionObject& object) const;
   void recordAnchorStartPoses();  // node_anchors.cpp
 
   // solve's stages (rigid_contact.cpp; the reduced system in rigid_contact_reduced_system.cpp).
@@ -441,8 +448,9 @@ class RigidContactSolver {
   // manifolds, dropped at finish) and the last solve's impulse per point, written back at finish.
   std::vector<FaceContact> solved_faces_;  // the convex solve's face rows, last solve
   sap::RigidContactGroup rigid_group_;
-  std::vector<const btRigidBody*> jointed_bodies_;  // this step's (detect's argument)
+  sap::JointLedger* joints_ = nullptr;  // this step's (detect's argument; dropped at finish)
   std::vector<Eigen::Vector3d> rigid_impulses_;
+  std::vector<double> joint_impulses_;  // per joint row of rigid_group_, written back at finish
   const NodeConstraints* base_ = nullptr;
   double dt_ = 0;
   int dynamic_count_ = 0;

@@ -81,7 +81,7 @@ NodeContactIsland buildNodeContactIsland(const std::vector<NodeContact>& contact
     if (c.held && island.partner_body[p] < 0) continue;
     ContactRow row = makeRow(c, partners[p], fem_body, island.partner_body[p], defaults, dt);
     if (c.anchored) {
-      row.bilateral = true;
+      row.kind = RowKind::kAnchor;
       row.mu = 0;
     } else {
       row.lagged_normal_impulse = laggedFor(lagged, lagged_order, c.node, partners[p].object);

@@ -13,14 +13,10 @@ namespace torsion::sap {
 
 namespace {
 
-// A body whose response Bullet's solver computes as the FEM's does: neither asleep, nor jointed,
-// nor scaled by linear or angular factors. Empty when it is, else why not.
-std::string whyBulletKeeps(const btRigidBody& body,
-                           const std::vector<const btRigidBody*>& jointed_bodies) {
+// A body whose response Bullet's solver computes as the FEM's does: neither asleep nor scaled by
+// linear or angular factors. Empty when it is, else why not.
+std::string whyBulletKeeps(const btRigidBody& body) {
   if (body.getActivationState() == ISLAND_SLEEPING) return "asleep";
-  if (body.getNumConstraintRefs() > 0 ||
-      std::binary_search(jointed_bodies.begin(), jointed_bodies.end(), &body))
-    return "it has a joint";
   const btVector3 one(1, 1, 1);
   if (body.getLinearFactor() != one || body.getAngularFactor() != one)
     return "its linear or angular factor is not 1";
@@ -56,23 +52,28 @@ std::vector<UsedManifold> usedManifolds(btDispatcher& dispatcher) {
   return used;
 }
 
-// The connected component of `seed` through dynamic bodies: its bodies (the seed first) and the
-// manifolds touching them.
+// The connected component of `seed` through dynamic bodies, by contact and by joint: its bodies
+// (the seed first) and the manifolds touching them.
 struct Component {
   std::vector<btRigidBody*> bodies;
   std::vector<const UsedManifold*> manifolds;
   std::string kept;  // why Bullet keeps it, empty when it can be taken
 };
 
+void addOnce(std::vector<btRigidBody*>& bodies, btRigidBody* body) {
+  if (body != nullptr && std::find(bodies.begin(), bodies.end(), body) == bodies.end())
+    bodies.push_back(body);
+}
+
 Component componentOf(btRigidBody* seed, const std::vector<UsedManifold>& used,
-                      const std::vector<const btRigidBody*>& jointed_bodies) {
+                      const std::vector<btTypedConstraint*>& joints) {
   Component c;
   c.bodies.push_back(seed);
   std::vector<char> taken(used.size(), 0);
   for (std::size_t next = 0; next < c.bodies.size(); ++next) {
     btRigidBody* body = c.bodies[next];
     if (c.kept.empty()) {
-      const std::string why = whyBulletKeeps(*body, jointed_bodies);
+      const std::string why = whyBulletKeeps(*body);
       if (!why.empty()) c.kept = "a rigid body in contact stays with Bullet: " + why;
     }
     for (std::size_t m = 0; m < used.size(); ++m) {
@@ -90,10 +91,11 @@ Component componentOf(btRigidBody* seed, const std::vector<UsedManifold>& used,
             c.kept.empty())
           c.kept = "a rigid contact with rolling or spinning friction stays with Bullet";
       }
-      btRigidBody* reached = dynamicBody(other);
-      if (reached != nullptr &&
-          std::find(c.bodies.begin(), c.bodies.end(), reached) == c.bodies.end())
-        c.bodies.push_back(reached);
+      addOnce(c.bodies, dynamicBody(other));
+    }
+    for (btTypedConstraint* joint : joints) {
+      if (&joint->getRigidBodyA() == body) addOnce(c.bodies, dynamicBody(&joint->getRigidBodyB()));
+      if (&joint->getRigidBodyB() == body) addOnce(c.bodies, dynamicBody(&joint->getRigidBodyA()));
     }
   }
   return c;
@@ -125,14 +127,14 @@ bool RigidContactGroup::contains(const btRigidBody* body) const {
 RigidContactGroup gatherRigidContactGroup(btDispatcher& dispatcher,
                                           const std::vector<btRigidBody*>& seeds,
                                           const StartPose& start_pose,
-                                          const std::vector<const btRigidBody*>& jointed_bodies) {
+                                          const std::vector<btTypedConstraint*>& joints) {
   RigidContactGroup group;
   const std::vector<UsedManifold> used = usedManifolds(dispatcher);
   std::vector<const UsedManifold*> manifolds;
   std::vector<btRigidBody*> seen;
   for (btRigidBody* seed : seeds) {
     if (std::find(seen.begin(), seen.end(), seed) != seen.end()) continue;
-    const Component c = componentOf(seed, used, jointed_bodies);
+    const Component c = componentOf(seed, used, joints);
     seen.insert(seen.end(), c.bodies.begin(), c.bodies.end());
     if (!c.kept.empty()) {
       group.kept_by_bullet.push_back(c.kept);

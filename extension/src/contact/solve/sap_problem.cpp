@@ -63,7 +63,22 @@ const char* toString(ContactState state) {
 
 RowResponse projectImpulse(const RowModel& m, const Eigen::Vector3d& vc) {
   RowResponse out;
-  if (m.bilateral) {
+  if (m.kind == RowKind::kJoint) {
+    // sap_problem.h: the impulse clamped to [lo, hi], its cost linear beyond the bounds.
+    const double y = (m.v_hat - vc(2)) / m.rn;
+    const double gamma = std::clamp(y, m.lower, m.upper);
+    out.gamma(2) = gamma;
+    if (gamma == y) {
+      out.g(2, 2) = 1 / m.rn;
+      out.cost = 0.5 * m.rn * y * y;
+      out.state = ContactState::kStick;
+    } else {
+      out.cost = gamma * m.rn * (y - 0.5 * gamma);
+      out.state = gamma == 0 ? ContactState::kSeparated : ContactState::kSlide;
+    }
+    return out;
+  }
+  if (m.kind == RowKind::kAnchor) {
     out.gamma = (Eigen::Vector3d(0, 0, m.v_hat) - vc) / m.rn;
     out.g = Eigen::Matrix3d::Identity() / m.rn;
     out.cost = 0.5 * m.rn * out.gamma.squaredNorm();
@@ -150,6 +165,16 @@ void SapProblem::collectBlocks() {
 
 Status SapProblem::validate(const ContactRow& row) const {
   if (row.terms.empty()) return Error{"no terms"};
+  if (row.kind == RowKind::kJoint) {
+    if (!std::isfinite(row.target_velocity)) return Error{"joint target velocity is not finite"};
+    if (!(row.lower <= 0) || !(row.upper >= 0))
+      return Error{"joint impulse bounds [" + std::to_string(row.lower) + ", " +
+                   std::to_string(row.upper) + "] do not hold 0"};
+    if (!(row.relative_compliance >= 0) || !std::isfinite(row.relative_compliance))
+      return Error{"joint compliance " + std::to_string(row.relative_compliance) +
+                   " is not finite and >= 0"};
+    return validateTerms(row);
+  }
   if (!(row.mu >= 0)) return Error{"friction coefficient " + std::to_string(row.mu) + " < 0"};
   if (!(row.stiffness > 0)) return Error{"stiffness " + std::to_string(row.stiffness) + " <= 0"};
   if (!(row.dissipation_time >= 0))
@@ -159,6 +184,10 @@ Status SapProblem::validate(const ContactRow& row) const {
   if (!(row.lagged_normal_impulse >= 0) || !std::isfinite(row.lagged_normal_impulse))
     return Error{"lagged normal impulse " + std::to_string(row.lagged_normal_impulse) +
                  " is not finite and >= 0"};
+  return validateTerms(row);
+}
+
+Status SapProblem::validateTerms(const ContactRow& row) const {
   for (const ContactTerm& term : row.terms) {
     if (term.body < 0 || term.body >= static_cast<int>(bodies_.size()))
       return Error{"term on body " + std::to_string(term.body) + ", which is not in the island"};
@@ -186,6 +215,20 @@ RowModel SapProblem::makeModel(const ContactRow& row, double dt,
     w_block += term.block * free_inverses_[k] * term.block.transpose();
   }
   RowModel m;
+  m.kind = row.kind;
+  if (row.kind == RowKind::kJoint) {
+    // One-dimensional: w = W_nn, the target and bounds as given (sap_problem.h).
+    m.w = w_block(2, 2);
+    if (!(m.w > 0)) m.w = 1;  // on prescribed dofs alone: moves nothing, any w will do
+    m.rn = std::max(parameters.joint_beta * parameters.joint_beta / (4 * kSapPi * kSapPi),
+                    row.relative_compliance) *
+           m.w;
+    m.rt = parameters.sigma * m.w;
+    m.v_hat = row.target_velocity;
+    m.lower = row.lower;
+    m.upper = row.upper;
+    return m;
+  }
   m.mu = row.mu;
   m.radius = row.mu * row.lagged_normal_impulse;
   const double rn_physical = 1 / (dt * (dt + row.dissipation_time) * row.stiffness);
@@ -195,7 +238,6 @@ RowModel SapProblem::makeModel(const ContactRow& row, double dt,
   m.rn = std::max(parameters.beta * parameters.beta / (4 * kSapPi * kSapPi) * m.w, rn_physical);
   m.rt = parameters.sigma * m.w;
   m.v_hat = -row.gap / (dt + row.dissipation_time);
-  m.bilateral = row.bilateral;
   return m;
 }
 

@@ -22,12 +22,24 @@
 // sap_problem.h turns them into the regularisation of Castro et al. 2022.
 
 #include <Eigen/Core>
+#include <cstdint>
+#include <limits>
 #include <vector>
 
 namespace torsion::sap {
 
 /// A 3 x k block, k <= 6, stored inline.
 using TermBlock = Eigen::Matrix<double, 3, Eigen::Dynamic, Eigen::ColMajor, 3, 6>;
+
+/// A row's kind. A contact pushes along n and rubs within Coulomb's disk (the lagged model). An
+/// anchor (a node held to a rigid point) is an equality in all three directions, pulling as well
+/// as pushing, without a friction bound; `gap` is minus the drift along the normal (the frame's n
+/// points the drift's way); mu and the lagged impulse are not used. A joint's row (one row of a
+/// Bullet btTypedConstraint: rigid_joint_rows.h) is one-dimensional: only the block's n row is
+/// used (t1 and t2 are zero), its impulse drives J v towards target_velocity and stays within
+/// [lower, upper]; stiffness, dissipation, gap, mu and the lagged impulse are not used
+/// (sap_problem.h).
+enum class RowKind : std::uint8_t { kContact, kAnchor, kJoint };
 
 struct ContactTerm {
   int body = -1;      ///< the island body (index into the problem's bodies)
@@ -51,11 +63,17 @@ struct ContactRow {
   /// The part of v_c that no island dof moves (m/s, contact frame): the motion of a kinematic
   /// partner's point (a moving hand, a conveyor), entered as B's minus A's. v_c = J v + this.
   Eigen::Vector3d velocity_offset = Eigen::Vector3d::Zero();
-  /// An equality, not a contact (an anchor: a node held to a rigid point): the impulse is
-  /// (v_hat - v_c) / R_n in all three directions, pulling as well as pushing, without a friction
-  /// bound; `gap` is minus the drift along the normal (the frame's n points the drift's way), mu
-  /// and the lagged impulse are not used (sap_problem.h).
-  bool bilateral = false;
+  /// What the row is (RowKind): a contact, an anchor or a joint's row.
+  RowKind kind = RowKind::kContact;
+  /// A joint row's velocity target (m/s or rad/s along its Jacobian; RowKind::kJoint).
+  double target_velocity = 0;
+  /// A joint row's impulse bounds (N s or N m s; RowKind::kJoint): -inf/+inf for an equality,
+  /// one of them 0 for a limit, +-the motor's largest impulse for a motor.
+  double lower = -std::numeric_limits<double>::infinity();
+  double upper = std::numeric_limits<double>::infinity();
+  /// A joint row's compliance relative to its Delassus estimate (Bullet's constraint force mixing,
+  /// RowKind::kJoint): R_n >= relative_compliance w. 0 for a rigid joint.
+  double relative_compliance = 0;
 };
 
 /// A right-handed frame with rows (t1, t2, n) for unit `normal`; t1 is the normal crossed with the

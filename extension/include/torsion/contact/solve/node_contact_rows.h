@@ -72,6 +72,9 @@ struct NodeContactIsland {
   /// Per row: its point in the RigidContactGroup, or -1 (rigid_contact_rows.h; empty without
   /// rigid rows).
   std::vector<int> row_rigid;
+  /// Per row: its row in the RigidContactGroup's joint rows, or -1 (rigid_joint_rows.h; empty
+  /// without joint rows).
+  std::vector<int> row_joint;
 };
 
 /// Builds the rows for `contacts` (active or not: every detected node contact, except held nodes

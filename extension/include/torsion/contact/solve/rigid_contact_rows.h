@@ -18,13 +18,15 @@
 // the points always hold the impulses that the bodies' velocities carry: a second FEM body
 // touching the same group in the same step undoes the first's rigid impulses exactly, and
 // Bullet's next solve warm-starts from the island's answer. The group is gathered once per step
-// (at detection) and its pointers into Bullet's manifolds are dropped when the step ends.
+// (at detection) and its pointers into Bullet's manifolds are dropped when the step ends. Its
+// bodies' joint impulses are undone likewise (joint_ledger.h) and their joints solved as rows
+// (rigid_joint_rows.h).
 //
-// A group is the dynamic rigid bodies connected by contact to the seeds (the island's rigid
-// partners), through dynamic rigid bodies; static and kinematic objects end it. A group is taken
-// only when Bullet's step can be undone exactly; otherwise Bullet keeps it (today's explicit
+// A group is the dynamic rigid bodies connected by contact or by joint to the seeds (the island's
+// rigid partners), through dynamic rigid bodies; static and kinematic objects end it. Its joints
+// become rows too (rigid_joint_rows.h). A group is taken
+// only when Bullet's step can be undone exactly; otherwise Bullet keeps it (the explicit
 // coupling), and the reason is reported:
-//   - a body with a joint (btTypedConstraint): its joint impulses are not recorded;
 //   - a body touching a multibody link: Featherstone's solver owns that contact;
 //   - a body asleep (Bullet did not solve it this step), or with linear or angular factors other
 //     than 1 (Bullet's solver scales its response);
@@ -44,6 +46,7 @@
 
 #include <BulletCollision/BroadphaseCollision/btDispatcher.h>
 #include <BulletCollision/NarrowPhaseCollision/btPersistentManifold.h>
+#include <BulletDynamics/ConstraintSolver/btTypedConstraint.h>
 #include <BulletDynamics/Dynamics/btRigidBody.h>
 
 #include <Eigen/Core>
@@ -61,15 +64,15 @@ struct RowDefaults;
 /// The step's start pose of a collision object (RigidContactSolver::startPoseOf).
 using StartPose = std::function<btTransform(const btCollisionObject&)>;
 
-/// The groups of `seeds` (dynamic rigid bodies) that can be taken, merged (`jointed_bodies`,
-/// sorted: the bodies with a joint in the world, btDynamicsWorld::getConstraint): every dynamic
-/// body reached from a seed through Bullet's contact points (those Bullet's solver used: distance
-/// within the manifold's processing threshold, both objects responding) and those points. A
-/// component that cannot be taken (above) is left out whole, its reason in kept_by_bullet.
+/// The groups of `seeds` (dynamic rigid bodies) that can be taken, merged: every dynamic body
+/// reached from a seed through Bullet's contact points (those Bullet's solver used: distance
+/// within the manifold's processing threshold, both objects responding) or through `joints` (the
+/// world's enabled joints), and those points. A component that cannot be taken (above) is left
+/// out whole, its reason in kept_by_bullet. The joints' rows: rigid_joint_rows.h.
 RigidContactGroup gatherRigidContactGroup(btDispatcher& dispatcher,
                                           const std::vector<btRigidBody*>& seeds,
                                           const StartPose& start_pose,
-                                          const std::vector<const btRigidBody*>& jointed_bodies);
+                                          const std::vector<btTypedConstraint*>& joints);
 
 /// Appends one row per point of `group` to `island`, `group_body[i]` the island body of the
 /// group's body i; island.row_rigid holds each row's point index (-1 for the rows before).

@@ -58,9 +58,22 @@
 // (gamma_n = 0 and r = 0: gamma = 0, G = 0). A row with r > 0 exerts its friction even in a step
 // where its normal impulse falls to zero (the lag: at most mu gamma_n^lag, for one step).
 //
-// A bilateral row (ContactRow::bilateral, an anchor) is the same spring-damper in all three
-// directions and both signs: gamma = (v_hat - v_c) / R_n with v_hat = (0, 0, -phi0 / (dt + tau_d)),
-// G = I / R_n, ell = 1/2 R_n |gamma|^2, state stick. Convex and C1 as the contacts are.
+// An anchor row (RowKind::kAnchor) is the same spring-damper in all three directions and both
+// signs: gamma = (v_hat - v_c) / R_n with v_hat = (0, 0, -phi0 / (dt + tau_d)), G = I / R_n,
+// ell = 1/2 R_n |gamma|^2, state stick. Convex and C1 as the contacts are.
+//
+// A joint row (RowKind::kJoint, one row of a Bullet joint) acts along n alone. Its target is
+// Bullet's (v_hat = the row's target velocity: the joint's error times erp / dt, or a motor's
+// speed), its compliance the near-rigid cap or Bullet's constraint force mixing,
+// R_n = max(beta_j^2 / (4 pi^2), cfm) w with w = W_nn and beta_j = 0.1, and its impulse is clamped
+// to the row's bounds [lo, hi] (a limit: one of them 0; a motor: its largest impulse):
+//
+//     y = (v_hat - v_n) / R_n,   gamma_n = clamp(y, lo, hi),   gamma_t = 0
+//     G_nn = 1 / R_n inside (lo, hi), else 0
+//     ell = 1/2 R_n y^2 inside, b R_n y - 1/2 R_n b^2 at a bound b (linear in v_n there)
+//
+// convex and C1 (the two pieces meet with equal value and slope at y = b). A contact's normal law
+// is the case lo = 0, hi = inf. The state reported: stick inside the bounds, slide at one.
 //
 // Prescribed dofs (island_body.h) are held at their values: the unknowns are the free dofs, the
 // gradient and every Newton direction filtered by S.
@@ -83,6 +96,9 @@ struct SapParameters {
   /// R_n >= beta^2 / (4 pi^2) w: a contact stiffer than that acts as one whose period is
   /// beta dt (near-rigid; beta = 1, the paper's value).
   double beta = 1.0;
+  /// beta for joint rows: 0.1, Drake's value for its holonomic constraints
+  /// (SapHolonomicConstraint).
+  double joint_beta = 0.1;
 };
 
 enum class ContactState : std::uint8_t { kStick, kSlide, kSeparated };
@@ -96,7 +112,9 @@ struct RowModel {
   double rn = 0;      ///< R_n, m/(N s)
   double v_hat = 0;   ///< v_hat_n, m/s
   double w = 0;       ///< the Delassus estimate w_i, m/(N s)
-  bool bilateral = false;
+  RowKind kind = RowKind::kContact;
+  double lower = 0;  ///< a joint row's impulse bounds, N s
+  double upper = 0;
 };
 
 /// The projection at one contact velocity.
@@ -179,6 +197,7 @@ class SapProblem {
  private:
   SapProblem() = default;
   Status validate(const ContactRow& row) const;
+  Status validateTerms(const ContactRow& row) const;
   void collectBlocks();
   RowModel makeModel(const ContactRow& row, double dt, const SapParameters& parameters) const;
   // The island dof of a term's first column.
