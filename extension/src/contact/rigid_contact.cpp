@@ -286,7 +286,7 @@ void RigidContactSolver::finish() {
       k.body->activate();
       continue;
     }
-    if (!k.dynamic || k.body == nullptr) continue;
+    if (!k.dynamic || k.body == nullptr || k.applied_by_another_body) continue;
     if (k.velocity == k.entry_velocity) continue;
     // Bullet integrated the pose with entry_velocity; the step's velocity is `velocity`
     // (symplectic Euler with the contact impulse inside the step).

@@ -10,6 +10,7 @@
 
 #include "torsion/bt_conversions.h"
 #include "torsion/contact/rigid_contact.h"
+#include "torsion/contact/solve/convex_rows.h"
 #include "torsion/contact/solve/face_contact_rows.h"
 #include "torsion/contact/solve/fem_island_body.h"
 #include "torsion/contact/solve/node_contact_rows.h"
@@ -37,20 +38,6 @@ double featureMatchRadius(const TetMesh& mesh) {
   }
   return edges > 0 ? 0.5 * sum / edges : 0.0;
 }
-
-// A partner's rows whose last normal impulses (their friction bounds) and this solve's differ by
-// more than this factor either way are solved again with this solve's. At 2 a box landing while
-// it slid lost +7 % more than mu times its normal impulses (its impact decays over three steps,
-// each braked by the one before); at 1.1, -0.4 %. At rest and in steady sliding the two agree.
-constexpr double kLaggedMismatch = 1.1;
-constexpr int kMaxFrictionBoundRounds = 2;
-// A partner whose rows new to the solve (no lagged impulse: no friction) carried more than this
-// share of its normal impulse is solved again with the impulses found, as a mismatch is. A box
-// sliding over a slab meets new nodes and features at its leading edges every step; left without
-// friction for their first step, they took up to 0.3 % off its friction, which the distance 1 deg
-// above the friction angle magnifies 15.7 times: +8.7 % of Coulomb's on a soft tet10 slab, +5.3 %
-// with this.
-constexpr double kNewRowsShare = 0.01;
 
 // The friction-bound group of each row: a node or face row's partner, and for each row between
 // rigid bodies a group of its own, numbered after the partners.
@@ -86,47 +73,6 @@ Vector6d stepStartVelocity(const RigidPartner& k, double dt) {
 bool isRigidRow(const sap::NodeContactIsland& island, std::size_t r) {
   return (r < island.row_rigid.size() && island.row_rigid[r] >= 0) ||
          (r < island.row_joint.size() && island.row_joint[r] >= 0);
-}
-
-// The lagged model bounds each row's friction by mu times its last normal impulse. Where that
-// impulse is far from the present one the bound is wrong for a step: a contact new to the solve
-// has none (a box landing on a slope slides freely: +12 % of Coulomb's distance on the soft
-// incline), and after an impact the bound is the impact's (a box landing while it slides is
-// braked by mu times its impact for one more step). Where a partner's rows together carried a
-// normal impulse outside [1/1.1, 1.1] times the one the solve gave them, each row's bound becomes
-// the impulse just found, in the island's rows and in the problem (whose other data do not
-// depend on it), and the island is solved again: a fixed point of mu gamma_n, reached for the
-// partners that need it. So is a partner whose new rows carried more than kNewRowsShare of its
-// normal impulse. Returns whether any bound changed.
-bool matchFrictionBounds(sap::NodeContactIsland& island, sap::SapProblem& problem,
-                         const std::vector<int>& row_partner, const sap::SapReport& report) {
-  if (row_partner.empty()) return false;
-  const auto groups =
-      static_cast<std::size_t>(*std::max_element(row_partner.begin(), row_partner.end()) + 1);
-  std::vector<double> lagged(groups, 0.0), solved(groups, 0.0), unbounded(groups, 0.0);
-  for (std::size_t r = 0; r < island.rows.size(); ++r) {
-    const auto k = static_cast<std::size_t>(row_partner[r]);
-    const double gamma_n = std::max(0.0, report.impulses[r].z());
-    lagged[k] += island.rows[r].lagged_normal_impulse;
-    solved[k] += gamma_n;
-    if (island.rows[r].lagged_normal_impulse == 0) unbounded[k] += gamma_n;
-  }
-  bool changed = false;
-  for (std::size_t r = 0; r < island.rows.size(); ++r) {
-    const auto k = static_cast<std::size_t>(row_partner[r]);
-    const bool mismatched = lagged[k] * kLaggedMismatch < solved[k] ||
-                            lagged[k] > kLaggedMismatch * solved[k] ||
-                            unbounded[k] > kNewRowsShare * solved[k];
-    if (!mismatched || island.rows[r].mu == 0 || island.rows[r].kind != sap::RowKind::kContact)
-      continue;
-    const double gamma_n = std::max(0.0, report.impulses[r].z());
-    if (gamma_n != island.rows[r].lagged_normal_impulse) {
-      island.rows[r].lagged_normal_impulse = gamma_n;
-      problem.setLaggedNormalImpulse(static_cast<int>(r), gamma_n);  // >= 0 and finite
-      changed = true;
-    }
-  }
-  return changed;
 }
 
 }  // namespace
@@ -180,9 +126,7 @@ double RigidContactSolver::lookahead(double dt) const {
   return dt * (1 + sap::RowDefaults{}.dissipation_steps);
 }
 
-LinearSolveReport RigidContactSolver::solveConvex(const SystemOperator& op,
-                                                  const NodeConstraints& constraints,
-                                                  const Eigen::VectorXd& b, Eigen::VectorXd& v) {
+sap::ConvexRows RigidContactSolver::convexRows() {
   const sap::RowDefaults defaults;
   // Last step's normal impulses: the friction bounds of the lagged model.
   std::vector<sap::LaggedImpulse> lagged_nodes;
@@ -191,68 +135,67 @@ LinearSolveReport RigidContactSolver::solveConvex(const SystemOperator& op,
     if (gamma_n > 0)
       lagged_nodes.push_back({previous_active_[k].first, previous_active_[k].second, gamma_n});
   }
-  const sap::RigidContactGroup& group = rigid_group_;
-  sap::NodeContactIsland island =
-      sap::buildNodeContactIsland(contacts_, partners_, 0, lagged_nodes, defaults, dt_);
-  const std::vector<FaceContact> faces = sap::islandFaceContacts(*this);
+  sap::ConvexRows rows;
+  rows.island = sap::buildNodeContactIsland(contacts_, partners_, 0, lagged_nodes, defaults, dt_);
+  rows.faces = sap::islandFaceContacts(*this);
   if (feature_match_radius_ < 0) feature_match_radius_ = featureMatchRadius(model_->mesh());
-  sap::addFaceContactRows(island, faces, partners_, 0, lagged_features_, feature_match_radius_,
-                          defaults, dt_);
+  sap::addFaceContactRows(rows.island, rows.faces, partners_, 0, lagged_features_,
+                          feature_match_radius_, defaults, dt_);
+  const sap::RigidContactGroup& group = rigid_group_;
   std::vector<int> group_body(group.bodies.size());
   for (std::size_t g = 0; g < group.bodies.size(); ++g)
-    group_body[g] = island.partner_body[static_cast<std::size_t>(partnerIndex(group.bodies[g]))];
-  sap::addRigidContactRows(island, group, group_body, defaults, dt_);
-  sap::addRigidJointRows(island, group, group_body);
-  const sap::FemIslandBody fem(op, constraints, b);
-  const std::vector<int> row_partner = rowGroups(island, contacts_, faces, partners_.size());
-  Result<sap::SapProblem> created =
-      sap::SapProblem::create(sap::islandBodies(fem, island), island.rows, dt_);
-  if (!created) return brokenDown({}, "the contact rows do not form a valid problem");
-  Eigen::VectorXd x(created.value().dofs());
-  x.head(v.size()) = v;
-  // Warm start: each body's velocity at the step's start, as the FEM body's (the last step's
-  // answer). Bullet's velocity carries the step's forces, gravity included, which the contacts
-  // under a resting body cancel: started there, Newton's first directions went through the
-  // contacts and were cut to a few percent by the line search (bullet_boxes: 23 Newton
-  // iterations a step at rest, 12 from the step's start).
+    group_body[g] =
+        rows.island.partner_body[static_cast<std::size_t>(partnerIndex(group.bodies[g]))];
+  sap::addRigidContactRows(rows.island, group, group_body, defaults, dt_);
+  sap::addRigidJointRows(rows.island, group, group_body);
+  rows.row_group = rowGroups(rows.island, contacts_, rows.faces, partners_.size());
+  rows.body_objects.assign(rows.island.rigid_bodies.size(), nullptr);
+  rows.start_twists.assign(rows.island.rigid_bodies.size(), Vector6d::Zero());
   for (std::size_t k = 0; k < partners_.size(); ++k) {
-    const int body = island.partner_body[k];
-    if (body >= 0)
-      x.segment<6>(created.value().bodyOffset(body)) = stepStartVelocity(partners_[k], dt_);
+    const int body = rows.island.partner_body[k];
+    if (body < 1) continue;
+    rows.body_objects[static_cast<std::size_t>(body - 1)] = partners_[k].object;
+    // Warm start: each body's velocity at the step's start, as the FEM body's (the last step's
+    // answer). Bullet's velocity carries the step's forces, gravity included, which the contacts
+    // under a resting body cancel: started there, Newton's first directions went through the
+    // contacts and were cut to a few percent by the line search (bullet_boxes: 23 Newton
+    // iterations a step at rest, 12 from the step's start).
+    rows.start_twists[static_cast<std::size_t>(body - 1)] = stepStartVelocity(partners_[k], dt_);
   }
-  // One solver for the rounds: its workspace is sized once.
-  sap::SapSolver solver;
-  sap::SapReport report = solver.solve(created.value(), x);
-  // Every round's iterations count: the statistics say what the step cost.
-  int newton = report.newton_iterations;
-  int cg = report.cg_iterations;
-  for (int round = 0; round < kMaxFrictionBoundRounds && report.converged &&
-                      matchFrictionBounds(island, created.value(), row_partner, report);
-       ++round) {
-    report = solver.solve(created.value(), x);  // from the last solution
-    newton += report.newton_iterations;
-    cg += report.cg_iterations;
+  for (std::size_t r = 0; r < rows.island.rows.size(); ++r) {
+    if (r < rows.island.row_rigid.size() && rows.island.row_rigid[r] >= 0) {
+      rows.row_key.push_back(
+          group.points[static_cast<std::size_t>(rows.island.row_rigid[r])].point);
+      rows.row_key_index.push_back(0);
+    } else if (r < rows.island.row_joint.size() && rows.island.row_joint[r] >= 0) {
+      const auto j = static_cast<std::size_t>(rows.island.row_joint[r]);
+      rows.row_key.push_back(group.joint_rows[j].joint);
+      rows.row_key_index.push_back(static_cast<int>(j));
+    } else {
+      rows.row_key.push_back(nullptr);  // this body's own
+      rows.row_key_index.push_back(0);
+    }
   }
-  const sap::SapProblem& problem = created.value();
-  v = x.head(v.size());
+  return rows;
+}
 
+void RigidContactSolver::takeConvexSolution(const sap::ConvexRows& rows,
+                                            const sap::SapReport& report,
+                                            const std::vector<sap::SolvedBody>& bodies) {
+  const sap::NodeContactIsland& island = rows.island;
+  const std::vector<FaceContact>& faces = rows.faces;
+  const sap::RigidContactGroup& group = rigid_group_;
   // The partners: every one's impulse (what finish() gives supported bodies and multibody links)
-  // is the wrench of its rows. A dynamic one's twist is its momentum plus the wrench of every row
-  // on it (the island's J^T gamma), divided by its mass: the island's twist to the solve's
-  // tolerance, and its momentum balance with the impulses the contacts report exact (the
-  // optimality criterion alone leaves a residual of 1e-6 of the momenta).
+  // is the wrench of its rows; a dynamic one's twist is the island's (sap::SolvedBody).
   std::vector<Vector6d> impulses = sap::partnerImpulses(island, contacts_, partners_, report);
   sap::addFacePartnerImpulses(island, faces, report, impulses);
-  Eigen::VectorXd row_impulses = Eigen::VectorXd::Zero(problem.dofs());
-  for (int i = 0; i < problem.rowCount(); ++i)
-    problem.addRowTranspose(i, report.impulses[static_cast<std::size_t>(i)], row_impulses);
   for (std::size_t k = 0; k < partners_.size(); ++k) {
     partners_[k].impulse = impulses[k];
     const int body = island.partner_body[k];
-    if (body < 0) continue;
-    const sap::IslandBody& rigid = *island.rigid_bodies[static_cast<std::size_t>(body - 1)];
-    const Vector6d momentum = rigid.momentum() + row_impulses.segment<6>(problem.bodyOffset(body));
-    partners_[k].velocity = Matrix6d(rigid.diagonalBlock(0)).llt().solve(momentum);
+    if (body < 1) continue;
+    const sap::SolvedBody& solved = bodies[static_cast<std::size_t>(body - 1)];
+    partners_[k].velocity = solved.twist;
+    partners_[k].applied_by_another_body = !solved.applies;
   }
   // The rows' states and impulses, where detection's memory, the statistics and the checkpoints
   // read them.
@@ -295,11 +238,32 @@ LinearSolveReport RigidContactSolver::solveConvex(const SystemOperator& op,
               : report.states[r] == sap::ContactState::kStick ? FaceContact::State::kStick
                                                               : FaceContact::State::kSlide;
   }
-  stats_.active_set_iterations = newton;
+  stats_.active_set_iterations = report.newton_iterations;
   stats_.active_set_converged = report.converged;
+}
 
+LinearSolveReport RigidContactSolver::solveConvex(const SystemOperator& op,
+                                                  const NodeConstraints& constraints,
+                                                  const Eigen::VectorXd& b, Eigen::VectorXd& v) {
+  sap::ConvexRows rows = convexRows();
+  const sap::FemIslandBody fem(op, constraints, b);
+  Result<sap::SapProblem> created =
+      sap::SapProblem::create(sap::islandBodies(fem, rows.island), rows.island.rows, dt_);
+  if (!created) return brokenDown({}, "the contact rows do not form a valid problem");
+  sap::SapProblem& problem = created.value();
+  Eigen::VectorXd x(problem.dofs());
+  x.head(v.size()) = v;
+  for (std::size_t k = 0; k < rows.start_twists.size(); ++k)
+    x.segment<6>(problem.bodyOffset(static_cast<int>(k) + 1)) = rows.start_twists[k];
+  const sap::SapReport report = sap::solveWithMatchedFrictionBounds(problem, rows.row_group, x);
+  v = x.head(v.size());
+  const std::vector<Vector6d> twists = sap::solvedTwists(problem, report, 1);
+  std::vector<sap::SolvedBody> bodies(twists.size());
+  for (std::size_t k = 0; k < bodies.size(); ++k)
+    bodies[k].twist = twists[k];
+  takeConvexSolution(rows, report, bodies);
   LinearSolveReport out;
-  out.iterations = cg;
+  out.iterations = report.cg_iterations;
   out.converged = true;  // the linear solves inside Newton; the contact solve's own verdict is
                          // stats().active_set_converged
   return out;

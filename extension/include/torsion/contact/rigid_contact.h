@@ -62,6 +62,9 @@
 
 namespace torsion::sap {
 class JointLedger;  // solve/joint_ledger.h
+struct ConvexRows;  // solve/convex_rows.h
+struct SolvedBody;
+struct SapReport;  // solve/sap_solver.h
 }  // namespace torsion::sap
 
 namespace torsion {
@@ -245,6 +248,15 @@ class RigidContactSolver {
   /// After the step: velocities and pose corrections onto dynamic rigid bodies, impulses onto
   /// multibodies.
   void finish();
+
+  /// The convex solve's rows of this step (contact/solve/convex_rows.h), for the body's own solve
+  /// or an island of several FEM bodies (FemContactIslands).
+  sap::ConvexRows convexRows();
+  /// The island's answer for those rows (`report` restricted to them, in their order; `bodies`:
+  /// the rigid island bodies of rows.island), where finish(), detection's memory, the statistics
+  /// and the checkpoints read it.
+  void takeConvexSolution(const sap::ConvexRows& rows, const sap::SapReport& report,
+                          const std::vector<sap::SolvedBody>& bodies);
 
   // ---- in an island of touching FEM bodies (contact/island_contact.h) ----
   // A body whose rigid partners are all prescribed (static, kinematic, or supported by Bullet's

@@ -51,6 +51,9 @@ struct RigidPartner {
   /// surface, and a node or face contact it slips over starts sliding
   /// (rigid_contact_active_set.cpp, face_contacts.cpp).
   bool sliding = false;
+  /// A dynamic body that another FEM body of the same convex island also touches, and whose
+  /// solved velocity that body applies (contact/solve/convex_rows.h): finish() leaves it alone.
+  bool applied_by_another_body = false;
 };
 
 /// M V: the partner's momentum (linear, angular about com) at velocity V (dynamic partners). A

@@ -158,6 +158,8 @@ class SapProblem {
   /// problem is the one create() makes from the changed row (a re-solve with matched friction
   /// bounds, rigid_contact_convex.cpp). Returns false, changing nothing, on an invalid impulse.
   bool setLaggedNormalImpulse(int i, double impulse);
+  const IslandBody& body(int b) const { return *bodies_[static_cast<size_t>(b)]; }
+  int bodyCount() const { return static_cast<int>(bodies_.size()); }
   /// The first island dof of body `body`.
   int bodyOffset(int body) const { return body_offsets_[static_cast<size_t>(body)]; }
   const Eigen::VectorXd& momentum() const { return momentum_; }
