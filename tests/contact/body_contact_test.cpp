@@ -351,5 +351,63 @@ TEST(BodyContact, ARidgeDroppedAcrossAnotherRidgeIsStoppedByItsEdgeWhereNoNodeMe
   EXPECT_GT(with.top_ridge_z, ridge - 1e-3);
 }
 
+// Two soft blocks side by side, pressed against each other, and a 2 kg rigid box resting across
+// both: one island of two FEM bodies with one dynamic rigid body that both touch. The box is one
+// body of the island (solved once with both blocks' contacts, its velocity applied once): it
+// settles, and the blocks' contacts carry its weight between them, split by symmetry.
+TEST(BodyContact, ARigidBoxAcrossTwoTouchingSoftBlocksIsOneBodyOfTheirIsland) {
+  WorldSettings settings;
+  settings.solver.time_step = 0.005;
+  FemWorld world(settings);
+  FemBody* left =
+      world
+          .addBody("left", makeBoxTetMesh({-0.2, -0.1, 0}, {0, 0.1, 0.1}, 4, 4, 2).value(),
+                   soft(2e5))
+          .value();
+  FemBody* right =
+      world
+          .addBody("right", makeBoxTetMesh({0, -0.1, 0}, {0.2, 0.1, 0.1}, 4, 4, 2).value(),
+                   soft(2e5))
+          .value();
+  for (FemBody* block : {left, right})
+    block->carryNodes(
+        "base", nodesWhere(*block, 1e-9), [](double) { return Frame{}; }, 0.0);
+  btTransform start;
+  start.setIdentity();
+  start.setOrigin(btVector3(0, 0, btScalar(0.1 + 0.025 + 1e-4)));
+  btRigidBody* box = world.addRigidBody(
+      std::make_unique<btBoxShape>(btVector3(btScalar(0.15), btScalar(0.05), btScalar(0.025))), 2.0,
+      start);
+  double fastest = 0, drift = 0;
+  int unconverged = 0, islands = 0;
+  const int steps = 400;  // 2 s
+  for (int k = 0; k < steps; ++k) {
+    const WorldStepReport r = world.step();
+    ASSERT_TRUE(r.ok) << r.message;
+    const FemContactStats& s = world.femSolver().femContact()->stats();
+    if (!s.converged) ++unconverged;
+    islands = std::max(islands, s.islands);
+    if (k * settings.solver.time_step >= 1.0) {
+      fastest = std::max(fastest, static_cast<double>(box->getLinearVelocity().length()));
+      drift += static_cast<double>(box->getLinearVelocity().x()) / (steps / 2);
+    }
+  }
+  const double g = 9.81, dt = settings.solver.time_step;
+  // The box's weight, as the two blocks' rigid contacts carry it (their normal impulses over dt:
+  // the contacts under a flat box are vertical).
+  const double on_left = left->contacts().stats().normal_impulse;
+  const double on_right = right->contacts().stats().normal_impulse;
+  std::printf(
+      "[figures] box across two soft blocks: islands %d, unconverged steps %d, fastest after 1 s "
+      "%.2e m/s, drift %.2e m/s, box weight %.4f N carried %.4f (left) + %.4f (right) N\n",
+      islands, unconverged, fastest, drift, 2 * g, on_left / dt, on_right / dt);
+  EXPECT_EQ(islands, 1) << "the blocks touch: one island";
+  EXPECT_EQ(unconverged, 0);
+  EXPECT_LT(fastest, 1e-3) << "it rests";
+  EXPECT_LT(std::abs(drift), 1e-4);
+  EXPECT_NEAR((on_left + on_right) / dt, 2 * g, 0.01 * 2 * g);
+  EXPECT_NEAR(on_left, on_right, 0.05 * (on_left + on_right)) << "split by symmetry";
+}
+
 }  // namespace
 }  // namespace torsion

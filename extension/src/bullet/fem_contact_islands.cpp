@@ -120,6 +120,11 @@ void FemContactIslands::advance(const std::vector<FemBody*>& group, const StepCo
     return;
   }
   setUpIsland(group);
+  if (convexIsland(group)) {
+    const bool solved = advanceConvex(group, ctx);
+    addStats(group, solved);
+    return;
+  }
   // Every body up to its solve; one that stops there (non-finite forces) leaves the island, and
   // its pairs sit the step out.
   bool any = false;
@@ -135,6 +140,13 @@ void FemContactIslands::advance(const std::vector<FemBody*>& group, const StepCo
     if (slots_[k].present) group[k]->finish(*slots_[k].v, slots_[k].report);
   }
   addStats(group, any);
+}
+
+bool FemContactIslands::convexIsland(const std::vector<FemBody*>& group) {
+  return std::all_of(group.begin(), group.end(), [](const FemBody* body) {
+    return body->contacts().settings().friction_solve == ContactSettings::FrictionSolve::kConvex &&
+           body->selfContact() == nullptr && !body->model().material().hyperelastic();
+  });
 }
 
 void FemContactIslands::setUpIsland(const std::vector<FemBody*>& group) {

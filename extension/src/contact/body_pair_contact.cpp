@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include "torsion/contact/surface_candidates.h"
 #include "torsion/format_number.h"
@@ -36,6 +37,31 @@ void nodeNormals(const TetMesh& mesh, const Eigen::VectorXd& x, Eigen::VectorXd&
     const double length = normals.segment<3>(3 * i).norm();
     if (length > 0) normals.segment<3>(3 * i) /= length;
   }
+}
+
+// Whether node x, whose surface does not face the triangle (its normal against the triangle's,
+// n_p . n above -kFacing), lies at the triangle's rim: its projection within kRimBand of the
+// triangle's perimeter. Such a node sits in the plane the two bodies touch along, at the edge of
+// the other body's side face (a slab's top node just ahead of a sliding block's front face): a
+// contact there holds the block against its own contact plane, a wall in its path (measured: a
+// soft block sliding down a soft incline stopped dead at the first node line, 0.15 m/s to 0 within
+// two steps). A node meeting a face head-on, or crossing into it on its path, projects inside.
+constexpr double kRimBand = 0.02;  // of the triangle's shortest altitude
+bool grazesRim(const Eigen::Vector3d& x, const std::array<Eigen::Vector3d, 3>& t,
+               const Eigen::Vector3d& node_normal, const Eigen::Vector3d& normal) {
+  if (node_normal.dot(normal) <= -kFacing) return false;
+  const Eigen::Vector3d w = projectionWeights(x, t[0], t[1], t[2]);
+  if (!w.allFinite()) return false;
+  const double twice_area = (t[1] - t[0]).cross(t[2] - t[0]).norm();
+  double nearest = std::numeric_limits<double>::infinity(), lowest = nearest;
+  for (int i = 0; i < 3; ++i) {
+    const double edge =
+        (t[static_cast<size_t>((i + 2) % 3)] - t[static_cast<size_t>((i + 1) % 3)]).norm();
+    const double altitude = twice_area / edge;
+    nearest = std::min(nearest, w[i] * altitude);
+    lowest = std::min(lowest, altitude);
+  }
+  return nearest <= kRimBand * lowest;
 }
 
 double meanSurfaceEdge(const TetMesh& mesh) {
@@ -184,6 +210,8 @@ void BodyPairContact::addCandidates(const FemModel& nodes_model, int node_offset
           nodeTriangleCandidate({xp, ep}, t0, {at(et, tri[0]), at(et, tri[1]), at(et, tri[2])},
                                 rules, set_.wasActive(pair_node, pair_triangle), not_facing);
       if (!hit) continue;
+      if (grazesRim(xp, t0, node_normal, hit->normal) && !set_.wasActive(pair_node, pair_triangle))
+        continue;
       const Eigen::Vector3d& w = hit->weights;
       // The impulse's triangle point: the node's projection at the step's start, unclamped while
       // within the slack. Node and point then differ only along the normal, so the pair of
@@ -208,6 +236,30 @@ void BodyPairContact::addCandidates(const FemModel& nodes_model, int node_offset
       set_.add(c);
     }
   }
+}
+
+bool BodyPairContact::slidesAlongFlatFaces(const SurfaceContact& pair, const std::array<int, 2>& e,
+                                           const std::array<int, 2>& f, const Eigen::VectorXd& xa,
+                                           const Eigen::VectorXd& ea, const Eigen::VectorXd& xb,
+                                           const Eigen::VectorXd& eb) const {
+  const std::vector<Triangle>& triangles_a = tree_a_.triangles();
+  const std::vector<Triangle>& triangles_b = tree_b_.triangles();
+  if (edges_a_.foldCosine(pair.edge, triangles_a, xa) <= kFlatFold ||
+      edges_b_.foldCosine(pair.triangle, triangles_b, xb) <= kFlatFold)
+    return false;
+  const Eigen::Vector3d na = edges_a_.outwardNormal(pair.edge, triangles_a, xa);
+  const Eigen::Vector3d nb = edges_b_.outwardNormal(pair.triangle, triangles_b, xb);
+  if (na.dot(nb) <= -kFacing) return false;  // faces meeting head-on
+  // The step's relative motion of the two edges' midpoints, and whether it runs along a face.
+  auto moved = [](const Eigen::VectorXd& start, const Eigen::VectorXd& end, int node) {
+    return Eigen::Vector3d(end.segment<3>(3 * node) - start.segment<3>(3 * node));
+  };
+  const Eigen::Vector3d motion =
+      0.5 * (moved(xb, eb, f[0]) + moved(xb, eb, f[1]) - moved(xa, ea, e[0]) - moved(xa, ea, e[1]));
+  const double length = motion.norm();
+  if (!(length > 0)) return false;
+  return std::abs(motion.dot(na)) <= kFacing * length ||
+         std::abs(motion.dot(nb)) <= kFacing * length;
 }
 
 void BodyPairContact::addEdgeCandidates(const Eigen::VectorXd& xa, const Eigen::VectorXd& ea,
@@ -271,6 +323,7 @@ void BodyPairContact::addEdgeCandidates(const Eigen::VectorXd& xa, const Eigen::
           edgeEdgeCandidate(edge_e, {{{at(xb, f[0]), at(xb, f[1])}, {at(eb, f[0]), at(eb, f[1])}}},
                             rules, held, outward, resting_on_flat);
       if (!hit) continue;
+      if (held() == nullptr && slidesAlongFlatFaces(contact, e, f, xa, ea, xb, eb)) continue;
       SurfaceContact c = contact;
       c.nodes = {e[0], e[1], node_count_a_ + f[0], node_count_a_ + f[1]};
       c.beta = {1.0 - hit->u, hit->u, -(1.0 - hit->v), -hit->v};

@@ -26,6 +26,7 @@
 #include "torsion/bullet/step_context.h"
 #include "torsion/contact/body_pair_contact.h"
 #include "torsion/contact/island_contact.h"
+#include "torsion/contact/solve/sap_problem.h"
 
 namespace torsion {
 
@@ -84,6 +85,16 @@ class FemContactIslands {
   void setUpIsland(const std::vector<FemBody*>& group);
   // Body k's prepared system into its slot, with its own contact solve where it keeps one.
   void enter(size_t k, FemBody* body);
+  // Whether the island is stepped as one convex problem (fem_convex_island.cpp): every body's
+  // contacts use the convex solve, none has self-contact or a hyperelastic law.
+  static bool convexIsland(const std::vector<FemBody*>& group);
+  // Steps the island as one convex problem; returns whether any body got to its solve.
+  bool advanceConvex(const std::vector<FemBody*>& group, const StepContext& ctx);
+  // The pairs' gaps onto their true end surface at the island's velocities x; returns how many
+  // rows of `problem` changed their gap (fem_convex_island.cpp).
+  int correctPairGaps(sap::SapProblem& problem, const Eigen::VectorXd& x,
+                      const std::vector<int>& island_body, const std::vector<int>& pair_first,
+                      double dt);
   // The island's statistics into stats_; a warning on its bodies when `solved` did not converge.
   void addStats(const std::vector<FemBody*>& group, bool solved);
 

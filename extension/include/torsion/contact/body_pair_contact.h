@@ -14,6 +14,7 @@
 
 #include <Eigen/Core>
 #include <Eigen/Geometry>
+#include <array>
 #include <memory>
 #include <vector>
 
@@ -102,6 +103,18 @@ class BodyPairContact {
   // a's surface edges against b's (b's tree refitted to b's motion): the crossings of two edges
   // that no node meets, as in self-contact; keyed (a's edge, b's edge).
   CandidateRules candidateRules(double margin) const;
+  // Whether edge pair `pair` (a's edge e against b's edge f, positions x and predicted e) joins two
+  // flat parts of surfaces that do not face each other (outward normals n_a . n_b above -0.25)
+  // while the bodies slide along one of them (the step's relative motion within 75.5 deg of its
+  // plane): a side face moving over the face it stands on, whose corner the nodes and the bodies'
+  // sharp edges hold. As a new pair it is a wall: a block's side-face diagonal, rising from its
+  // bottom node, met a slab edge lying in their contact plane just ahead of it and threw the
+  // sliding block back (frictionless at 20 deg: 47 % of Coulomb's distance). Faces meeting
+  // head-on, or approaching across both faces (two cubes thrown together), still pair.
+  bool slidesAlongFlatFaces(const SurfaceContact& pair, const std::array<int, 2>& e,
+                            const std::array<int, 2>& f, const Eigen::VectorXd& xa,
+                            const Eigen::VectorXd& ea, const Eigen::VectorXd& xb,
+                            const Eigen::VectorXd& eb) const;
   void addEdgeCandidates(const Eigen::VectorXd& xa, const Eigen::VectorXd& ea,
                          const Eigen::VectorXd& xb, const Eigen::VectorXd& eb, double margin);
 

@@ -134,6 +134,7 @@ Result<SapProblem> SapProblem::create(std::vector<const IslandBody*> bodies,
     if (!status)
       return Error{"SAP problem: row " + std::to_string(i) + ": " + status.error().message};
   }
+  p.dt_ = dt;
   for (const ContactRow& row : p.rows_)
     p.models_.push_back(p.makeModel(row, dt, parameters));
   return Result<SapProblem>(std::move(p));
@@ -246,6 +247,14 @@ bool SapProblem::setLaggedNormalImpulse(int i, double impulse) {
   const auto k = static_cast<size_t>(i);
   rows_[k].lagged_normal_impulse = impulse;
   models_[k].radius = rows_[k].mu * impulse;  // as makeModel
+  return true;
+}
+
+bool SapProblem::setGap(int i, double gap) {
+  const auto k = static_cast<size_t>(i);
+  if (!std::isfinite(gap) || rows_[k].kind == RowKind::kJoint) return false;
+  rows_[k].gap = gap;
+  models_[k].v_hat = -gap / (dt_ + rows_[k].dissipation_time);  // as makeModel
   return true;
 }
 

@@ -160,6 +160,11 @@ class SapProblem {
   bool setLaggedNormalImpulse(int i, double impulse);
   const IslandBody& body(int b) const { return *bodies_[static_cast<size_t>(b)]; }
   int bodyCount() const { return static_cast<int>(bodies_.size()); }
+  /// Sets row i's gap phi0 (m, finite; a contact or anchor row) and with it its v_hat, the rest of
+  /// its model unchanged: a re-solve on a gap measured again (a FEM pair's true end surface,
+  /// BodyPairContact::correctGaps). Returns false, changing nothing, on a joint row or a gap that
+  /// is not finite.
+  bool setGap(int i, double gap);
   /// The first island dof of body `body`.
   int bodyOffset(int body) const { return body_offsets_[static_cast<size_t>(body)]; }
   const Eigen::VectorXd& momentum() const { return momentum_; }
@@ -219,6 +224,7 @@ class SapProblem {
   // Per block: whether a row acting on it enters preconditionerBlocks (scratch, kept zero).
   mutable std::vector<char> touched_;
   int dofs_ = 0;
+  double dt_ = 0;
   Eigen::VectorXd momentum_;
   Eigen::VectorXd inverse_sqrt_diagonal_;
   // Per-body scratch of multiplyA (one solve thread per problem).
