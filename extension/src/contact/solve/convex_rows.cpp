@@ -86,7 +86,7 @@ std::vector<Vector6d> solvedTwists(const SapProblem& problem, const SapReport& r
     const int offset = problem.bodyOffset(b);
     const Vector6d momentum =
         problem.momentum().segment<6>(offset) + row_impulses.segment<6>(offset);
-    twists.push_back(Matrix6d(problem.body(b).diagonalBlock(0)).llt().solve(momentum));
+    twists.emplace_back(Matrix6d(problem.body(b).diagonalBlock(0)).llt().solve(momentum));
   }
   return twists;
 }
