@@ -5,7 +5,9 @@
 
 #include <cmath>
 #include <cstdio>
+#include <utility>
 
+#include "../contact/contact_fixtures.h"
 #include "multibody_world.h"
 #include "torsion/mesh/box_mesh.h"
 
@@ -34,20 +36,20 @@ struct HingedPendulum {
   std::unique_ptr<btHingeConstraint> hinge;
   std::unique_ptr<btFixedConstraint> weld;
 
-  explicit HingedPendulum(bool fem_bar, double youngs_modulus = 1e6, bool hinged = true) {
+  explicit HingedPendulum(bool fem_bar) {
     bob = user.addRigid(std::make_unique<btBoxShape>(btVector3(0.05, 0.05, 0.05)), kBobMass,
                         btVector3(0, 0, -kBobDepth));
     bob->setDamping(0, 0);
     hinge =
         std::make_unique<btHingeConstraint>(*bob, btVector3(0, 0, kBobDepth), btVector3(0, 1, 0));
-    if (hinged) user.world.addConstraint(hinge.get());
+    user.world.addConstraint(hinge.get());
     const Eigen::Vector3d spin(0, kSpin, 0);
     bob->setAngularVelocity(btVector3(0, kSpin, 0));
     bob->setLinearVelocity(toBt(Eigen::Vector3d(spin.cross(Eigen::Vector3d(0, 0, -kBobDepth)))));
     const Eigen::Vector3d bar_centre(0, 0, 0.5 * (kBarTop + kBarBottom));
     if (fem_bar) {
       Material material;
-      material.youngs_modulus = youngs_modulus;
+      material.youngs_modulus = 1e6;
       material.poisson_ratio = 0.3;
       bar = user.fem
                 .addBody(
@@ -75,7 +77,7 @@ struct HingedPendulum {
   }
   ~HingedPendulum() {
     if (weld) user.world.removeConstraint(weld.get());
-    if (hinge->isEnabled()) user.world.removeConstraint(hinge.get());
+    user.world.removeConstraint(hinge.get());
   }
 
   static double rigidEnergy(const btRigidBody& body) {
@@ -131,6 +133,19 @@ Swing swing(HingedPendulum& p, double dt, double seconds) {
   return s;
 }
 
+// The rigid pendulum in Bullet alone and the FEM one, each swung for 10 s at step `dt`.
+std::pair<Swing, Swing> swingBoth(double dt) {
+  HingedPendulum rigid(false);
+  const Swing reference = swing(rigid, dt, 10);
+  HingedPendulum soft(true);
+  const Swing fem = swing(soft, dt, 10);
+  std::printf(
+      "dt %.4f s: Bullet alone: energy peak %+.2f %%, pivot %.3f mm; FEM bar: %+.2f %%, "
+      "%.3f mm\n",
+      dt, 100 * reference.gain, 1e3 * reference.stretch, 100 * fem.gain, 1e3 * fem.stretch);
+  return {reference, fem};
+}
+
 // The pendulum swings for 10 s. Its energy is not conserved exactly by either solver: Bullet's
 // symplectic Euler and its joint's error correction make it oscillate within a swing (peaks of
 // +0.8 % at 1/240 s, +1.2 % at 1/60 s for the rigid bar) while damping makes it decay; the peak
@@ -138,13 +153,7 @@ Swing swing(HingedPendulum& p, double dt, double seconds) {
 // solved before the FEM step with the bob alone, the bar's pull came a step late: +7.5 % and a
 // pivot stretched 4.6 mm at 1/240 s; at 1/60 s it blew up within 10 steps.
 TEST(JointCoupling, AFemBarUnderAHingedBobGainsNoMoreEnergyThanBulletsRigidPendulum) {
-  constexpr double kStep = 1 / 240.;
-  HingedPendulum rigid(false);
-  const Swing reference = swing(rigid, kStep, 10);
-  HingedPendulum soft(true);
-  const Swing fem = swing(soft, kStep, 10);
-  std::printf("Bullet alone: energy peak %+.2f %%, pivot %.3f mm; FEM bar: %+.2f %%, %.3f mm\n",
-              100 * reference.gain, 1e3 * reference.stretch, 100 * fem.gain, 1e3 * fem.stretch);
+  const auto [reference, fem] = swingBoth(1 / 240.);
   EXPECT_LE(fem.gain, reference.gain);
   EXPECT_LT(fem.stretch, 1e-3) << "the hinge's pivot holds";
   // The swing's energy lifts the pendulum by 37 deg: its bob 0.18 m out.
@@ -153,13 +162,7 @@ TEST(JointCoupling, AFemBarUnderAHingedBobGainsNoMoreEnergyThanBulletsRigidPendu
 
 // At Bullet's default step, 1/60 s: stable, and the pivot no looser than Bullet's own.
 TEST(JointCoupling, AtBulletsDefaultStepTheHingedPendulumHoldsItsPivotAsBulletAlone) {
-  constexpr double kStep = 1 / 60.;
-  HingedPendulum rigid(false);
-  const Swing reference = swing(rigid, kStep, 10);
-  HingedPendulum soft(true);
-  const Swing fem = swing(soft, kStep, 10);
-  std::printf("Bullet alone: energy peak %+.2f %%, pivot %.3f mm; FEM bar: %+.2f %%, %.3f mm\n",
-              100 * reference.gain, 1e3 * reference.stretch, 100 * fem.gain, 1e3 * fem.stretch);
+  const auto [reference, fem] = swingBoth(1 / 60.);
   EXPECT_LT(fem.stretch, 1.1 * reference.stretch);
   EXPECT_LT(fem.gain, 0.02) << "energy oscillates within a swing by about Bullet alone's";
 }
@@ -180,11 +183,7 @@ TEST(JointCoupling, AMotorDrivenPusherHoldsItsTargetSpeedAgainstFriction) {
           .addBody("slab", makeBoxTetMesh({-0.5, -0.2, 0}, {0.5, 0.2, 0.1}, 20, 8, 2).value(),
                    material)
           .value();
-  std::vector<int> base;
-  for (int i = 0; i < slab->model().nodeCount(); ++i)
-    if (slab->state().position(i).z() < 1e-9) base.push_back(i);
-  slab->carryNodes(
-      "base", base, [](double) { return Frame{}; }, 0.0);
+  test::holdBase(*slab);
   btRigidBody* box = user.addRigid(std::make_unique<btBoxShape>(btVector3(0.1, 0.1, 0.05)), 1.0,
                                    btVector3(-0.2, 0, 0.1 + 0.05 + 1e-4));
   box->setFriction(kMu);

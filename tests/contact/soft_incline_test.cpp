@@ -9,6 +9,7 @@
 #include <cstdlib>
 #include <vector>
 
+#include "contact_fixtures.h"
 #include "torsion/bullet/fem_body.h"
 #include "torsion/bullet/fem_world.h"
 #include "torsion/mesh/box_mesh.h"
@@ -72,11 +73,7 @@ SlideResult slide(double degrees, double mu = kFriction, double time = 0.5,
                                    .value(),
                                material)
                       .value();
-  std::vector<int> base;
-  for (int i = 0; i < slab->model().nodeCount(); ++i)
-    if (slab->state().position(i).z() < 1e-9) base.push_back(i);
-  slab->carryNodes(
-      "base", base, [](double) { return Frame{}; }, 0.0);
+  test::holdBase(*slab);
   FemBody* block = world
                        .addBody("block",
                                 makeBoxTetMesh({0.17 - half_length, -0.05, 0.1002},

@@ -168,7 +168,7 @@ bool FemContactIslands::advanceConvex(const std::vector<FemBody*>& group, const 
     island_stats_.gap_tolerance =
         std::max(island_stats_.gap_tolerance, pair.contact->gapTolerance());
   }
-  Result<sap::SapProblem> created = sap::SapProblem::create(m.bodies, m.rows, ctx.dt);
+  Result<sap::SapProblem> created = sap::SapProblem::create(m.bodies, std::move(m.rows), ctx.dt);
   if (!created) {
     // Cannot happen with rows built from the bodies' own data; reported, never skipped silently.
     for (std::size_t k = 0; k < group.size(); ++k)
@@ -200,8 +200,6 @@ bool FemContactIslands::advanceConvex(const std::vector<FemBody*>& group, const 
   }
   report.newton_iterations = newton;
   report.cg_iterations = cg;
-  for (int r = 0; r < problem.rowCount(); ++r)
-    m.rows[static_cast<std::size_t>(r)].gap = problem.row(r).gap;  // the corrected ones
   const std::vector<Vector6d> twists = sap::solvedTwists(problem, report, fem_count);
 
   // Every share takes its answer; the pairs keep their impulses for the next step's bounds.
@@ -220,7 +218,7 @@ bool FemContactIslands::advanceConvex(const std::vector<FemBody*>& group, const 
   for (std::size_t p = 0; p < island_pairs_.size(); ++p) {
     if (pair_first[p] < 0) continue;
     SurfaceContactSet& set = island_pairs_[p].contact->set();
-    sap::takeSurfaceContactImpulses(set, m.rows, pair_first[p], report, ctx.dt);
+    sap::takeSurfaceContactImpulses(set, problem, pair_first[p], report, ctx.dt);
     for (const SurfaceContact& c : set.contacts()) {
       island_stats_.max_end_penetration = std::max(island_stats_.max_end_penetration, -c.end_gap);
       if (c.state == SurfaceContact::State::kInactive) continue;

@@ -32,13 +32,13 @@ namespace torsion {
 
 /// The last substep's contact between FEM bodies, summed over its islands.
 struct FemContactStats {
-  int touching_pairs = 0;          ///< pairs whose boxes overlap
-  int islands = 0;                 ///< islands of two or more bodies
-  int candidates = 0;              ///< node-triangle pairs
-  int active = 0;                  ///< pushing at the end of the step
-  int sticking = 0;                ///< of which sticking
-  int iterations = 0;  ///< the most of any island: Newton iterations (convex) or Uzawa updates
-  bool converged = true;           ///< every island
+  int touching_pairs = 0;  ///< pairs whose boxes overlap
+  int islands = 0;         ///< islands of two or more bodies
+  int candidates = 0;      ///< node-triangle pairs
+  int active = 0;          ///< pushing at the end of the step
+  int sticking = 0;        ///< of which sticking
+  int iterations = 0;      ///< the most of any island: Newton iterations (convex) or Uzawa updates
+  bool converged = true;   ///< every island
   double normal_impulse = 0;       ///< N s, sum over active contacts
   double max_end_penetration = 0;  ///< m, deepest linearised end gap
 };

@@ -29,17 +29,18 @@ int addSurfaceContactRows(std::vector<ContactRow>& rows, const SurfaceContactSet
   return first;
 }
 
-void takeSurfaceContactImpulses(SurfaceContactSet& set, const std::vector<ContactRow>& rows,
-                                int first_row, const SapReport& report, double dt) {
-  std::size_t r = static_cast<std::size_t>(first_row);
+void takeSurfaceContactImpulses(SurfaceContactSet& set, const SapProblem& problem, int first_row,
+                                const SapReport& report, double dt) {
+  int i = first_row;
   for (SurfaceContact& c : set.contacts()) {
+    const auto r = static_cast<std::size_t>(i);
+    const ContactRow& row = problem.row(i++);
     const Eigen::Vector3d& gamma = report.impulses[r];
-    c.multiplier = rows[r].frame.transpose() * gamma;
+    c.multiplier = row.frame.transpose() * gamma;
     c.state = !(gamma.z() > 0)                           ? SurfaceContact::State::kInactive
               : report.states[r] == ContactState::kStick ? SurfaceContact::State::kStick
                                                          : SurfaceContact::State::kSlide;
-    c.end_gap = rows[r].gap + dt * report.contact_velocities[r].z();
-    ++r;
+    c.end_gap = row.gap + dt * report.contact_velocities[r].z();
   }
 }
 

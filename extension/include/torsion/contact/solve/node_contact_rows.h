@@ -79,8 +79,7 @@ struct NodeContactIsland {
 
 /// Builds the rows for `contacts` (active or not: every detected node contact, except held nodes
 /// against prescribed partners, whose rows have no unknown to act on; an anchor's row is
-/// bilateral) of FEM island
-/// body `fem_body` against `partners`, with lagged normal
+/// RowKind::kAnchor) of FEM island body `fem_body` against `partners`, with lagged normal
 /// impulses from `lagged` (0 for a contact not in it) and parameters `defaults` at step dt.
 NodeContactIsland buildNodeContactIsland(const std::vector<NodeContact>& contacts,
                                          const std::vector<RigidPartner>& partners, int fem_body,
