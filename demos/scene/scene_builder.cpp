@@ -90,7 +90,6 @@ Result<std::unique_ptr<BuiltScene>> buildScene(SceneSpec spec, int threads_overr
       if (Status on = added.value()->enableSelfContact(*body.self_contact); !on)
         return Error{entry + ": " + on.error().message};
     }
-    added.value()->contacts().settings().friction_solve = body.friction_solve;
   }
 
   for (size_t s = 0; s < spec.node_sets.size(); ++s) {

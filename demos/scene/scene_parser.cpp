@@ -367,15 +367,6 @@ BodySpec readBody(const JsonObject& b, const SceneSpec& scene, const std::string
     if (Status valid = self.validate(); !valid) b.fail("self_contact", valid.error().message);
     body.self_contact = self;
   }
-  const std::string friction_solve =
-      b.string("friction_solve", frictionSolveName(body.friction_solve));
-  if (const auto solve = frictionSolveFromName(friction_solve)) {
-    body.friction_solve = *solve;
-  } else {
-    b.fail("friction_solve",
-           "'" + friction_solve +
-               "' is not a friction solve (auto, active_set, contact_space or convex)");
-  }
   b.finish();
   return body;
 }

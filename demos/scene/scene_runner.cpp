@@ -100,15 +100,13 @@ struct ContactTotals {
   int active_max = 0;
   double normal_impulse = 0;   // N s
   double max_penetration = 0;  // m, measured at the start of a step
-  int active_set_iterations_max = 0;
+  int newton_iterations_max = 0;
   int unconverged_steps = 0;
 
   void add(const FemWorld& world) {
     int active = 0;
     int rigid_rows = 0;
     bool converged = true;
-    bool fell_back = false;
-    bool in_contact_space = false;
     for (const auto& body : world.bodies()) {
       if (const SelfContactSolver* self = body->selfContact()) {
         const SelfContactStats& s = self->stats();
@@ -122,17 +120,9 @@ struct ContactTotals {
       active += s.active;
       normal_impulse += s.normal_impulse;
       max_penetration = std::max(max_penetration, s.max_penetration);
-      active_set_iterations_max = std::max(active_set_iterations_max, s.active_set_iterations);
-      converged = converged && s.active_set_converged;
+      newton_iterations_max = std::max(newton_iterations_max, s.newton_iterations);
+      converged = converged && s.converged;
       rigid_rows += s.rigid_rows;
-      if (body->contacts().settings().friction_solve == ContactSettings::FrictionSolve::kConvex)
-        has_convex = true;
-      if (body->contacts().settings().friction_solve !=
-          ContactSettings::FrictionSolve::kActiveSet) {
-        has_contact_space = true;
-        in_contact_space = in_contact_space || s.in_contact_space;
-        fell_back = fell_back || s.coulomb_fell_back;
-      }
     }
     if (const FemContactIslands* islands = world.femSolver().femContact()) {
       const FemContactStats& s = islands->stats();
@@ -151,18 +141,9 @@ struct ContactTotals {
     active_max = std::max(active_max, active);
     rigid_rows_max = std::max(rigid_rows_max, rigid_rows);
     if (!converged) ++unconverged_steps;
-    if (fell_back) ++fallback_steps;
-    if (in_contact_space) ++contact_space_steps;
   }
-  // Bodies whose "friction_solve" may take contact space ("auto", "contact_space"): steps that
-  // took it, and steps whose Coulomb problem did not converge and were solved by the active set
-  // instead.
-  bool has_contact_space = false;
-  int contact_space_steps = 0;
-  // Bodies on "convex": the most contacts between rigid bodies their islands solved in a step.
-  bool has_convex = false;
+  // The most contacts between rigid bodies the FEM bodies' islands solved in a step.
   int rigid_rows_max = 0;
-  int fallback_steps = 0;
   // Self-contact (bodies with "self_contact"): summed over bodies, steps counted per body.
   bool has_self_contact = false;
   int self_active_max = 0;
@@ -182,13 +163,9 @@ struct ContactTotals {
                         {"active_max", active_max},
                         {"normal_impulse_total_Ns", normal_impulse},
                         {"max_penetration_m", max_penetration},
-                        {"active_set_iterations_max", active_set_iterations_max},
-                        {"active_set_unconverged_steps", unconverged_steps}};
-    if (has_contact_space) {
-      j["contact_space_steps"] = contact_space_steps;
-      j["contact_space_fallback_steps"] = fallback_steps;
-    }
-    if (has_convex) j["rigid_rows_max"] = rigid_rows_max;
+                        {"newton_iterations_max", newton_iterations_max},
+                        {"unconverged_steps", unconverged_steps},
+                        {"rigid_rows_max", rigid_rows_max}};
     if (has_self_contact) {
       j["self_contact"] = {{"active_max", self_active_max},
                            {"iterations_max", self_iterations_max},

@@ -37,10 +37,6 @@ struct BodySpec {
   /// "self_contact": {"friction", "gap_tolerance", "thickness_factor"}: on when present
   /// (docs/contact.md).
   std::optional<SelfContactSettings> self_contact;
-  /// "friction_solve": "convex" (default) | "auto" | "contact_space" | "active_set": how the
-  /// body's contacts with rigid bodies are solved (ContactSettings::friction_solve,
-  /// docs/contact-solve.md).
-  ContactSettings::FrictionSolve friction_solve = ContactSettings{}.friction_solve;
 };
 
 /// Which nodes of a body a set takes (rest positions, after the body's pose).

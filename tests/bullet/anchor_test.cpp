@@ -92,12 +92,11 @@ FemBody* addHangingBlock(FemSoftBodySolver& fem) {
       .value();
 }
 
-void pullALightFreeBodyWithASoftBar(ContactSettings::FrictionSolve friction_solve) {
+void pullALightFreeBodyWithASoftBar() {
   MultibodyWorld user(btVector3(0, 0, 0));  // no external force
   solveTightly(user.fem);
   FemBody* bar = addBar(user.fem);  // 1 kg
-  bar->contacts().settings().friction_solve = friction_solve;
-  const double mass = 0.01;  // a hundred times lighter than the bar
+  const double mass = 0.01;         // a hundred times lighter than the bar
   btRigidBody* box = user.addRigid(std::make_unique<btBoxShape>(btVector3(0.025, 0.025, 0.025)),
                                    mass, btVector3(0.425, 0, 0));
   const std::vector<int> end =
@@ -124,22 +123,15 @@ void pullALightFreeBodyWithASoftBar(ContactSettings::FrictionSolve friction_solv
 }
 
 TEST(Anchors, ALightFreeBodyPulledByASoftBarConservesMomentumAndStaysStable) {
-  pullALightFreeBodyWithASoftBar(ContactSettings::FrictionSolve::kActiveSet);
-}
-
-// The anchors as bilateral rows of the convex solve (docs/contact-solve.md), the box one of the
-// island's bodies.
-TEST(Anchors, ALightFreeBodyPulledByASoftBarConservesMomentumInTheConvexSolve) {
-  pullALightFreeBodyWithASoftBar(ContactSettings::FrictionSolve::kConvex);
+  pullALightFreeBodyWithASoftBar();
 }
 
 // Bullet's pivot is solved before the FEM step, with the bob alone: the block's pull reaches it a
 // step late, so the bob must not be much lighter than what hangs from it (a multibody's joints
 // are inside the solve: the next test's bob is twenty times lighter).
-void swingOnARigidPendulum(ContactSettings::FrictionSolve friction_solve) {
+void swingOnARigidPendulum() {
   MultibodyWorld user(btVector3(0, 0, 0));
   FemBody* block = addHangingBlock(user.fem);  // 1 kg
-  block->contacts().settings().friction_solve = friction_solve;
   const double mass = 1.0;
   btRigidBody* bob = user.addRigid(std::make_unique<btBoxShape>(btVector3(0.05, 0.05, 0.025)), mass,
                                    btVector3(0, 0, -0.475));
@@ -177,17 +169,12 @@ void swingOnARigidPendulum(ContactSettings::FrictionSolve friction_solve) {
 }
 
 TEST(Anchors, ASoftBlockOnARigidPendulumSwingsWithoutGainingEnergy) {
-  swingOnARigidPendulum(ContactSettings::FrictionSolve::kActiveSet);
+  swingOnARigidPendulum();
 }
 
-TEST(Anchors, ASoftBlockOnARigidPendulumSwingsWithoutGainingEnergyInTheConvexSolve) {
-  swingOnARigidPendulum(ContactSettings::FrictionSolve::kConvex);
-}
-
-void swingOnALightMultibodyPendulum(ContactSettings::FrictionSolve friction_solve) {
+void swingOnALightMultibodyPendulum() {
   MultibodyWorld user(btVector3(0, 0, 0));
   FemBody* block = addHangingBlock(user.fem);  // 1 kg
-  block->contacts().settings().friction_solve = friction_solve;
   // A revolute joint about y at the origin; the bob, twenty times lighter than the block, 0.475 m
   // below it.
   const double mass = 0.05;
@@ -229,17 +216,10 @@ void swingOnALightMultibodyPendulum(ContactSettings::FrictionSolve friction_solv
 }
 
 TEST(Anchors, ASoftBlockOnALightMultibodyPendulumSwingsWithoutGainingEnergy) {
-  swingOnALightMultibodyPendulum(ContactSettings::FrictionSolve::kActiveSet);
+  swingOnALightMultibodyPendulum();
 }
 
-// The anchors as bilateral rows of the contact-space solve, the link's response through its
-// effective mass. (Before the solve kept its node impulses for the link, this blew up within 20
-// steps: the link received the residual check's A v instead.)
-TEST(Anchors, ASoftBlockOnALightMultibodyPendulumSwingsWithoutGainingEnergyInContactSpace) {
-  swingOnALightMultibodyPendulum(ContactSettings::FrictionSolve::kContactSpace);
-}
-
-void followAKinematicBody(ContactSettings::FrictionSolve friction_solve) {
+void followAKinematicBody() {
   MultibodyWorld user(btVector3(0, 0, -9.81));
   Material material;
   material.youngs_modulus = 1e5;
@@ -248,7 +228,6 @@ void followAKinematicBody(ContactSettings::FrictionSolve friction_solve) {
           .addBody("block", makeBoxTetMesh({-0.05, -0.05, -0.1}, {0.05, 0.05, 0}, 3, 3, 3).value(),
                    material)
           .value();
-  block->contacts().settings().friction_solve = friction_solve;
   btRigidBody* plate = user.addRigid(std::make_unique<btBoxShape>(btVector3(0.08, 0.08, 0.01)), 0,
                                      btVector3(0, 0, 0.01));
   plate->setCollisionFlags(plate->getCollisionFlags() | btCollisionObject::CF_KINEMATIC_OBJECT);
@@ -279,11 +258,7 @@ void followAKinematicBody(ContactSettings::FrictionSolve friction_solve) {
 }
 
 TEST(Anchors, NodesAnchoredToAKinematicBodyFollowItExactly) {
-  followAKinematicBody(ContactSettings::FrictionSolve::kActiveSet);
-}
-
-TEST(Anchors, NodesAnchoredToAKinematicBodyFollowItExactlyInTheConvexSolve) {
-  followAKinematicBody(ContactSettings::FrictionSolve::kConvex);
+  followAKinematicBody();
 }
 
 TEST(Anchors, ASoftBarAnchoredToAFreeMultibodyConservesMomentum) {

@@ -25,9 +25,7 @@ namespace {
 // hand after the world was built and turned about z.
 class BlockRig {
  public:
-  explicit BlockRig(
-      ContactSettings::FrictionSolve friction_solve = ContactSettings{}.friction_solve)
-      : world_(test::checkpointWorldSettings()) {
+  BlockRig() : world_(test::checkpointWorldSettings()) {
     Material material;
     material.youngs_modulus = 2e4;
     body_ =
@@ -35,7 +33,6 @@ class BlockRig {
             .addBody("block", makeBoxTetMesh({-0.2, -0.2, 0.02}, {0.2, 0.2, 0.42}, 2, 2, 2).value(),
                      material)
             .value();
-    body_->contacts().settings().friction_solve = friction_solve;
     btTransform slab;
     slab.setIdentity();
     slab.setOrigin(btVector3(0, 0, btScalar(-0.5)));
@@ -72,10 +69,10 @@ std::uint64_t payloadHash(const std::string& bytes) {
 }
 
 // Saved after 40 steps, the world goes on 20; a world built the same way and read from the bytes
-// must take the same 20 steps to the bit (the contacts' warm starts included: states for the
-// active set, impulses for the contact-space solve).
-void expectBytesContinueBitForBit(ContactSettings::FrictionSolve friction_solve) {
-  BlockRig rig(friction_solve);
+// must take the same 20 steps to the bit (the contacts' warm starts included: their impulses,
+// the next step's friction bounds).
+TEST(CheckpointIo, BytesReadIntoANewWorldContinueBitForBitWithContactsAndAGrab) {
+  BlockRig rig;
   for (int k = 0; k < 40; ++k)
     rig.step();
   ASSERT_FALSE(rig.body_->contacts().contacts().empty()) << "the block must rest on the slab";
@@ -84,7 +81,7 @@ void expectBytesContinueBitForBit(ContactSettings::FrictionSolve friction_solve)
   for (int k = 0; k < 20; ++k)
     rig.step();
 
-  BlockRig fresh(friction_solve);  // built the same way, never stepped, nothing grabbed
+  BlockRig fresh;  // built the same way, never stepped, nothing grabbed
   ASSERT_TRUE(fresh.load(bytes).ok());
   EXPECT_TRUE(fresh.hand_->grabbed());
   for (int k = 0; k < 20; ++k)
@@ -94,18 +91,6 @@ void expectBytesContinueBitForBit(ContactSettings::FrictionSolve friction_solve)
             0.0);
   EXPECT_EQ(fresh.hand_->wrench().torque, rig.hand_->wrench().torque);
   EXPECT_GT(rig.hand_->wrench().torque.norm(), 1e-4) << "the block must be twisted";
-}
-
-TEST(CheckpointIo, BytesReadIntoANewWorldContinueBitForBitWithContactsAndAGrab) {
-  expectBytesContinueBitForBit(ContactSettings::FrictionSolve::kActiveSet);
-}
-
-TEST(CheckpointIo, BytesCarryTheContactSpaceSolvesImpulsesAndContinueBitForBit) {
-  expectBytesContinueBitForBit(ContactSettings::FrictionSolve::kContactSpace);
-}
-
-TEST(CheckpointIo, BytesCarryTheConvexSolvesNodeImpulsesAndContinueBitForBit) {
-  expectBytesContinueBitForBit(ContactSettings::FrictionSolve::kConvex);
 }
 
 // A dynamic box resting on a soft slab, solved by the convex solve: its face rows (the box's
@@ -121,7 +106,6 @@ TEST(CheckpointIo, BytesCarryTheConvexSolvesFaceRowsAndContinueBitForBit) {
                  .addBody("slab", makeBoxTetMesh({-0.3, -0.3, 0}, {0.3, 0.3, 0.1}, 5, 5, 2).value(),
                           material)
                  .value();
-      slab->contacts().settings().friction_solve = ContactSettings::FrictionSolve::kConvex;
       test::holdBase(*slab);
       btTransform pose;
       pose.setIdentity();

@@ -665,7 +665,7 @@ import json, sys
 c = json.load(open(sys.argv[1]))["contacts"]
 assert c["active_max"] >= 32 and c["normal_impulse_total_Ns"] > 0, c
 # The convex solve's near-rigid contacts: 0.20 mm under a 6 cm press (contact_physics_test.cpp).
-assert c["max_penetration_m"] < 3e-4 and c["active_set_unconverged_steps"] == 0, c
+assert c["max_penetration_m"] < 3e-4 and c["unconverged_steps"] == 0, c
 PY
     ;;
 

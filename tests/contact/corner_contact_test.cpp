@@ -41,7 +41,6 @@ CornerRun runCorner(ElementKind element, double youngs_modulus) {
   if (!added.ok()) return {};
   FemBody* block = added.value();
   block->contacts().settings().friction = 1.0;
-  block->contacts().settings().friction_solve = ContactSettings::FrictionSolve::kConvex;
   CornerRun run;
   const int steps = 200;
   for (int k = 0; k < steps; ++k) {
@@ -51,7 +50,7 @@ CornerRun runCorner(ElementKind element, double youngs_modulus) {
       run.ok = false;
       return run;
     }
-    if (!block->contacts().stats().active_set_converged) ++run.unconverged_steps;
+    if (!block->contacts().stats().converged) ++run.unconverged_steps;
     for (int i = 0; k >= 20 && i < block->model().nodeCount(); ++i) {
       const Eigen::Vector3d x = block->state().position(i);
       run.deepest_in_ground = std::max(run.deepest_in_ground, -x.z());

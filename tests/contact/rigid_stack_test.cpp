@@ -55,7 +55,6 @@ FemBody* addSoftSlab(FemWorld& world) {
                          softMaterial(5e4, 1000));
   if (slab == nullptr) return nullptr;
   slab->contacts().settings().friction = 1.0;
-  slab->contacts().settings().friction_solve = ContactSettings::FrictionSolve::kConvex;
   holdBase(*slab);
   return slab;
 }
@@ -74,7 +73,7 @@ BoxRun measure(FemWorld& world, const FemBody* slab, const std::vector<btRigidBo
       run.ok = false;
       return run;
     }
-    if (slab != nullptr && !slab->contacts().stats().active_set_converged) ++run.unconverged_steps;
+    if (slab != nullptr && !slab->contacts().stats().converged) ++run.unconverged_steps;
     for (std::size_t b = 1; stacked && b < boxes.size(); ++b) {
       const double o = overlap(*boxes[b - 1], *boxes[b]);
       run.deepest_overlap = std::max(run.deepest_overlap, o);

@@ -99,8 +99,8 @@ TEST(SelfContact, ABlockThrownAtAnotherAt15MetresPerSecondHandsItsMomentumOverEx
       max_active, unconverged, crossing_steps, worst_linear, before.linear.norm(), worst_angular,
       before.angular.norm(), struck.x());
   EXPECT_GT(max_active, 0);
-  // Not asserted (docs/contact.md, "Self-contact", open points): at the blocks' rims a few steps
-  // end with crossing surface triangles and some contact solves stop unconverged (reported).
+  // Not asserted (docs/contact.md, "Limits"): at the blocks' rims a few steps may end with
+  // crossing surface triangles and a contact solve may stop unconverged (reported).
   EXPECT_LT(worst_linear, 0.01 * before.linear.norm());
   EXPECT_LT(worst_angular, 0.02 * before.angular.norm());
   EXPECT_LT(struck.x(), -0.3 * before.linear.norm());  // moving the way it was struck
@@ -162,45 +162,6 @@ TEST(SelfContact, TheImpactEndsTheSameToTheLastBitOnOneAndOnTwoThreads) {
   }
   EXPECT_GT(active, 0);  // the blocks met: the search found and held contacts
   EXPECT_EQ((result[0] - result[1]).cwiseAbs().maxCoeff(), 0.0);
-}
-
-TEST(SelfContact, RoughFirstSolvesEndEveryStepOnAnAccurateOneAndTheImpactComesOutTheSame) {
-  // The contact loop may start on CG solves 100 times less accurate (rough_tolerance_factor):
-  // every step must still end on a solve within the solver's tolerance, and the impact must come
-  // out as with accurate solves only, to within what that tolerance allows.
-  int second = 0;
-  const TetMesh mesh = twoBlocks(0.02, 0.03, 3, second);
-  Eigen::Vector3d struck[2];
-  double thrown = 0;
-  int rough_rounds_steps = 0;
-  for (int run = 0; run < 2; ++run) {
-    WorldSettings settings;
-    settings.gravity.setZero();
-    settings.solver.time_step = 5e-4;
-    FemWorld world(settings);
-    FemBody* body = world.addBody("blocks", mesh, Material{}).value();
-    SelfContactSettings contact;
-    contact.rough_tolerance_factor = run == 0 ? 1.0 : 100.0;
-    ASSERT_TRUE(body->enableSelfContact(contact).ok());
-    FemBodyCheckpoint start = body->checkpoint();
-    for (int i = second; i < mesh.nodeCount(); ++i)
-      start.state.velocities.segment<3>(3 * i) = Eigen::Vector3d(-15, 0, 0);
-    body->restore(start);
-    thrown = momenta(*body).linear.norm();
-    for (int k = 0; k < 120; ++k) {
-      ASSERT_TRUE(world.step().ok);
-      const LinearSolveReport& solve = body->lastReport().solve;
-      EXPECT_LE(solve.relative_residual, settings.solver.tolerance)
-          << "run " << run << ", step " << k;
-      if (run == 1 && body->selfContact()->stats().iterations > 1) ++rough_rounds_steps;
-    }
-    struck[run] = Eigen::Vector3d::Zero();
-    for (int i = 0; i < second; ++i)
-      struck[run] += body->model().nodeMasses()[static_cast<size_t>(i)] * body->state().velocity(i);
-  }
-  EXPECT_GT(rough_rounds_steps, 0);  // the loop ran more than one solve: rough ones first
-  EXPECT_LT(struck[0].x(), -0.3 * thrown);
-  EXPECT_LT((struck[1] - struck[0]).norm(), 0.02 * thrown);
 }
 
 }  // namespace

@@ -91,7 +91,7 @@ TEST(SoftStack, AStackOfSoftBodiesOnRigidGroundCarriesItsWeightWithEveryStepConv
     bool converged = s.converged;
     double impulse = 0;
     for (const auto& body : world.bodies()) {
-      converged = converged && body->contacts().stats().active_set_converged;
+      converged = converged && body->contacts().stats().converged;
       impulse += body->contacts().stats().normal_impulse;
     }
     if (!converged) ++unconverged;

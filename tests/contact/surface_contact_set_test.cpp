@@ -1,6 +1,6 @@
-// SurfaceContactSet's convergence test (surface_contact_set.h): judged within the gap tolerance,
-// a contact released after a pull too small to move it by the tolerance leaves the set converged;
-// a larger pull, or the default test (any change of state), does not.
+// SurfaceContactSet's memory from one step to the next (surface_contact_set.h): a contact that
+// pushed at the end of a step starts the next with its impulse, projected onto its new friction
+// cone; one that did not push, or is found again under another key, starts inactive.
 #include "torsion/contact/surface_contact_set.h"
 
 #include <gtest/gtest.h>
@@ -8,45 +8,50 @@
 namespace torsion {
 namespace {
 
-constexpr double kDt = 1e-3;            // s
-constexpr double kGapTolerance = 1e-4;  // m
-constexpr double kActivation = 1e-5;    // m
-constexpr double kPenaltyFactor = 8;    // rho = 8 x the contact's effective mass (0.75 kg): 6 kg
-
-// One node above the middle of a triangle, four nodes of 1 kg, no friction: activated by a
-// first solve that ends 50 um deep, then released by a second whose node moves away at `away`
-// (m/s); returns whether that update counts as converged.
-bool convergedAfterRelease(bool within_tolerance, double away) {
-  SurfaceContactSet set;
-  set.setConvergedWithinTolerance(within_tolerance);
+SurfaceContact nodeOverTriangle(int node, int triangle, double friction) {
   SurfaceContact c;
-  c.nodes = {0, 1, 2, 3};
+  c.nodes = {node, 1, 2, 3};
   c.beta = {1.0, -1.0 / 3, -1.0 / 3, -1.0 / 3};
+  c.triangle = triangle;
   c.normal = Eigen::Vector3d::UnitZ();
-  c.gap = 0;
-  c.friction = 0;
-  set.add(c);
-  set.setPenalties(std::vector<Eigen::Matrix3d>(4, Eigen::Matrix3d::Identity()), kPenaltyFactor);
-  Eigen::VectorXd v = Eigen::VectorXd::Zero(12);
-  v[2] = -0.05;  // 50 um deep at the end of the step: active, lambda_n = 6 kg x 0.05 m/s
-  set.update(v, kDt, kActivation, kGapTolerance);
-  EXPECT_EQ(set.contacts()[0].state, SurfaceContact::State::kSlide);
-  v[2] = away;  // the solve pulled with 6 kg x (away - 0.05 m/s): released
-  const bool converged = set.update(v, kDt, kActivation, kGapTolerance);
-  EXPECT_EQ(set.contacts()[0].state, SurfaceContact::State::kInactive);
-  return converged;
+  c.friction = friction;
+  return c;
 }
 
-TEST(SurfaceContactSet, AReleaseAfterAPullThatMovesTheNodeLessThanTheToleranceIsConverged) {
-  // Pull 6 kg x 2 mm/s = 0.012 N s; over 0.75 kg for 1 ms: 16 um, within 100 um.
-  EXPECT_TRUE(convergedAfterRelease(true, 0.052));
-  EXPECT_FALSE(convergedAfterRelease(false, 0.052));
+TEST(SurfaceContactSet, APushingContactStartsTheNextStepWithItsImpulseInsideItsNewCone) {
+  SurfaceContactSet set;
+  set.beginStep();
+  set.add(nodeOverTriangle(0, 7, 0.5));
+  set.add(nodeOverTriangle(4, 7, 0.5));
+  // The solve's answer: node 0 pushed 2 N s with 0.4 N s of friction, node 4 let go.
+  set.contacts()[0].multiplier = Eigen::Vector3d(0.4, 0, 2);
+  set.contacts()[0].state = SurfaceContact::State::kStick;
+  const SurfaceContactSet::WarmStarts warm = set.warmStarts();
+  ASSERT_EQ(warm.size(), 1u);
+
+  set.beginStep();
+  EXPECT_TRUE(set.wasActive(0, 7));
+  EXPECT_FALSE(set.wasActive(4, 7));
+  EXPECT_FALSE(set.wasActive(0, 8));
+  // Found again with a lower friction coefficient: the 0.4 N s of friction exceed 0.1 x 2 N s,
+  // so it starts sliding at the cone's edge; the normal impulse is kept.
+  set.add(nodeOverTriangle(0, 7, 0.1));
+  set.add(nodeOverTriangle(4, 7, 0.5));
+  const SurfaceContact& kept = set.contacts()[0];
+  EXPECT_EQ(kept.state, SurfaceContact::State::kSlide);
+  EXPECT_DOUBLE_EQ(kept.multiplier.z(), 2.0);
+  EXPECT_NEAR(kept.multiplier.x(), 0.2, 1e-15);
+  EXPECT_EQ(set.contacts()[1].state, SurfaceContact::State::kInactive);
+  EXPECT_EQ(set.contacts()[1].multiplier, Eigen::Vector3d::Zero());
 }
 
-TEST(SurfaceContactSet, AReleaseAfterAPullThatMovesTheNodeBeyondTheToleranceIsNotConverged) {
-  // Pull 6 kg x 0.15 m/s = 0.9 N s; over 0.75 kg for 1 ms: 1.2 mm.
-  EXPECT_FALSE(convergedAfterRelease(true, 0.2));
-  EXPECT_FALSE(convergedAfterRelease(false, 0.2));
+TEST(SurfaceContactSet, RestoredWarmStartsSurviveTheNextBeginStep) {
+  SurfaceContactSet set;
+  set.setWarmStarts({{(std::uint64_t{3} << 32) | 9, Eigen::Vector3d(0, 0, 1)}});
+  set.beginStep();
+  EXPECT_TRUE(set.wasActive(3, 9));
+  set.add(nodeOverTriangle(3, 9, 0.3));
+  EXPECT_EQ(set.contacts()[0].state, SurfaceContact::State::kStick);
 }
 
 }  // namespace

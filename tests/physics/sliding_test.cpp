@@ -38,8 +38,6 @@ struct Slope {
   /// The box settles on the slab under the slope's normal gravity before the pull along the slope
   /// starts (t = 0 at rest, as Coulomb's distance assumes); else it is dropped onto the slope.
   bool settle = true;
-  /// How the slab's contact solve decides stick and slide (ContactSettings::friction_solve).
-  ContactSettings::FrictionSolve friction_solve = ContactSettings{}.friction_solve;
 };
 
 double coulombDistance(const Slope& s, double t) {
@@ -85,7 +83,6 @@ double slideDistance(const Slope& s, double seconds) {
     return std::nan("");
   }
   FemBody* slab = added.value();
-  slab->contacts().settings().friction_solve = s.friction_solve;
   std::vector<int> base;
   for (int i = 0; i < slab->model().nodeCount(); ++i) {
     if (slab->state().position(i).z() < 1e-9) base.push_back(i);
@@ -203,7 +200,7 @@ TEST(Sliding, BoxWithFrictionSlidesAsCoulombSaysOnAStiffSlab) {
 
 // The stick/slip threshold tan(a) = mu (16.7 deg for mu = 0.3), on a stiff slab: 1 deg below the
 // box stays (creep within 2 mm in 1 s), 1 deg above it slides as Coulomb says (8.9 cm in 1 s).
-// One slab of the threshold tests, its bounds, and the friction solve it runs with.
+// One slab of the threshold tests and its bounds.
 struct ThresholdCase {
   double youngs_modulus;
   int cells;
@@ -213,21 +210,18 @@ struct ThresholdCase {
 };
 
 // The box settled, then pulled 1 deg below and 1 deg above the friction angle on each slab.
-void expectThresholds(const std::vector<ThresholdCase>& cases,
-                      ContactSettings::FrictionSolve friction_solve, const char* label) {
+void expectThresholds(const std::vector<ThresholdCase>& cases) {
   for (const ThresholdCase& c : cases) {
     Slope s;
     s.youngs_modulus = c.youngs_modulus;
     s.cells_along = c.cells;
     s.element = c.element;
-    s.friction_solve = friction_solve;
     const Threshold t = oneDegreeEitherSide(s);
     const char* element = c.element == ElementKind::kTet10 ? "tet10" : "tet4";
-    std::cout << "[figures] sliding threshold" << label << " (settled, mu 0.3), E "
-              << c.youngs_modulus << ", " << element << ": " << t.friction_angle - 1
-              << " deg moved " << t.below << " m; " << t.friction_angle + 1 << " deg moved "
-              << t.above << " m (Coulomb " << t.coulomb << " m, " << 100 * (t.above / t.coulomb - 1)
-              << " %)\n";
+    std::cout << "[figures] sliding threshold (settled, mu 0.3), E " << c.youngs_modulus << ", "
+              << element << ": " << t.friction_angle - 1 << " deg moved " << t.below << " m; "
+              << t.friction_angle + 1 << " deg moved " << t.above << " m (Coulomb " << t.coulomb
+              << " m, " << 100 * (t.above / t.coulomb - 1) << " %)\n";
     EXPECT_LT(std::abs(t.below), c.held_bound) << c.youngs_modulus << " Pa, " << element;
     EXPECT_NEAR(t.above, t.coulomb, c.above_tolerance * t.coulomb)
         << c.youngs_modulus << " Pa, " << element;
@@ -247,47 +241,13 @@ TEST(Sliding, StiffSlabHoldsTheBoxBelowTheFrictionAngleAndLetsItSlideAbove) {
   EXPECT_NEAR(t.above, t.coulomb, 0.15 * t.coulomb);
 }
 
-// The stick/slip threshold tan(a) = mu (16.7 deg for mu = 0.3) on soft and stiff, tet4 and tet10
-// slabs, the box settled first and then pulled along the slope, with the "auto" friction solve
-// (Coulomb's law solved in contact space while the dynamic box touches the slab,
-// docs/contact.md). 1 deg below it the box should stay:
-// the slab's elastic shear under the pull (88 Pa over the box's 0.06 m2 in a 0.1 m layer) moves it
-// 0.23 mm on the soft slab (shear modulus 3.8e4 Pa) and 0.23 um on the stiff one. 1 deg above it
-// slides as Coulomb says (8.9 cm in 1 s), a distance that magnifies a friction error by
-// mu cos a / (sin a - mu cos a) = 15.7. Measured: below 0.28 mm, 1.3 um, 2.2 mm, 2.8 um; above
-// +3.8 %, +1.0 %, +4.3 %, +1.0 % (soft tet4, stiff tet4, soft tet10, stiff tet10). The soft tet10
-// slab's 2.2 mm is a creep while most contacts under the box's edges slide (docs/contact.md); it is
-// bounded at 2.5 mm, under 3 % of the 1 deg-above slide's distance; the stiff slabs at 10 um.
-TEST(Sliding, BoxHoldsOneDegreeBelowTheFrictionAngleAndSlidesOneDegreeAboveOnEverySlab) {
-  // The older solve, on the tet4 slabs only (its tet10 figures: docs/validation.md).
-  expectThresholds(
-      {{1e5, 20, ElementKind::kTet4, 1e-3, 0.05}, {1e8, 20, ElementKind::kTet4, 1e-5, 0.05}},
-      ContactSettings::FrictionSolve::kAuto, "");
-}
-
-// The same threshold with the active set (ContactSettings::kActiveSet, the default before "auto",
-// kept as an option): states switched between CG solves by rules. Every anti-cycling budget lets
-// some step end outside Coulomb's law, and on the soft slabs that shows: the box creeps 3.0 mm
-// (tet4) and 3.3 mm (tet10) in 1 s below the threshold and slides 8.9 % and 9.6 % too far above it
-// (stiff slabs: 2 and 6 um, +2.0 % and +3.1 %). These bounds hold what the active set reaches,
-// not the physical bound (docs/contact.md, "Open: the soft slabs at the threshold").
-TEST(Sliding, TheActiveSetOptionHoldsTheStiffThresholdAndNearlyTheSoftOne) {
-  // The older solve, on the tet4 slabs only (its tet10 figures: docs/validation.md).
-  expectThresholds(
-      {{1e5, 20, ElementKind::kTet4, 5e-3, 0.12}, {1e8, 20, ElementKind::kTet4, 1e-4, 0.05}},
-      ContactSettings::FrictionSolve::kActiveSet, ", active set");
-}
-
 // Coulomb's distance whatever the slab: soft (E = 1e5 Pa) and stiff (1e8), node rows 0.2 m (the
 // box's length), 0.1 m and 0.05 m apart, tet4 and tet10, two slopes by two coefficients
 // (docs/validation.md, "Sliding over an FEM slab"). Before the sliding-body rules
 // (docs/contact.md, "Sliding over nodes") the soft slab gave -64 % at 20 deg with mu = 0.3; before
 // the friction's slip resistance node rows as long as the box gave +6.4 % (soft) and +5.0 %
 // (stiff) at 20 deg with mu = 0.3, and the box on the stiff coarse tet10 slab at 25 deg with
-// mu = 0.2 stopped dead at a node row at 2 m/s (-15 %). With the default contact-space solve before
-// its contact compliance (ContactSettings::coulomb_compliance) the coarse stiff slab at 25 deg with
-// mu = 0.2 gave -28 %: a third of the steps stopped unconverged at 1e-6 to 1e-5 m/s, and one that
-// fell back to the active set took 0.58 m/s off the box.
+// mu = 0.2 stopped dead at a node row at 2 m/s (-15 %).
 TEST(Sliding, BoxWithFrictionSlidesAsCoulombSaysOverSoftStiffCoarseFineTet4AndTet10Slabs) {
   struct Case {
     double degrees, mu, youngs_modulus;
@@ -320,9 +280,8 @@ TEST(Sliding, BoxWithFrictionSlidesAsCoulombSaysOverSoftStiffCoarseFineTet4AndTe
 // Rubber-like slabs, the materials people twist: nu = 0.49 and 0.499 on tet4 with the nodal
 // average of the volumetric strain (per element, tet4 locks: the slab would be far stiffer than
 // the material says, docs/validation.md), and nu = 0.49 on tet10 per element. The slab's contact
-// solve factorises its matrix with the large volumetric stiffness lambda (49 to 499 times mu)
-// and condenses it onto the contacts: the box must still feel only the normal force and Coulomb's
-// friction.
+// solve works on its matrix with the large volumetric stiffness lambda (49 to 499 times mu),
+// and the box must still feel only the normal force and Coulomb's friction.
 TEST(Sliding, BoxWithFrictionSlidesAsCoulombSaysOverNearlyIncompressibleSlabs) {
   struct Case {
     double poisson_ratio;
@@ -344,17 +303,17 @@ TEST(Sliding, BoxWithFrictionSlidesAsCoulombSaysOverNearlyIncompressibleSlabs) {
   }
 }
 
-// The stick/slip threshold in the convex solve, 1 deg either side of tan(a) = mu = 0.3. Below, the
-// box stays: the soft slabs' elastic shear under the pull is 0.23 mm (see above; measured 0.11 and
-// 0.16 mm, tet4 and tet10), the stiff ones' 0.23 um (measured 1.9 and 1.2 um). Above, Coulomb's
-// distance (8.9 cm) magnifies a friction error 15.7 times, and the integrator adds its +1 %:
-// measured +4.0 % and +5.3 % on the soft slabs, +1.7 % and +1.9 % on the stiff ones.
-TEST(Sliding, TheConvexSolveHoldsTheBoxBelowTheFrictionAngleAndSlidesAbove) {
+// The stick/slip threshold, 1 deg either side of tan(a) = mu = 0.3 (16.7 deg), the box settled
+// first and then pulled along the slope. Below, the box stays: the soft slabs' elastic shear under
+// the pull (88 Pa over the box's 0.06 m2 in a 0.1 m layer, shear modulus 3.8e4 Pa) is 0.23 mm
+// (measured 0.11 and 0.16 mm, tet4 and tet10), the stiff ones' 0.23 um (measured 1.9 and 1.2 um).
+// Above, Coulomb's distance (8.9 cm) magnifies a friction error 15.7 times, and the integrator adds
+// its +1 %: measured +4.0 % and +5.3 % on the soft slabs, +1.7 % and +1.9 % on the stiff ones.
+TEST(Sliding, BoxHoldsOneDegreeBelowTheFrictionAngleAndSlidesOneDegreeAboveOnEverySlab) {
   expectThresholds({{1e5, 20, ElementKind::kTet4, 3e-4, 0.06},
                     {1e8, 20, ElementKind::kTet4, 1e-5, 0.03},
                     {1e5, 10, ElementKind::kTet10, 3e-4, 0.06},
-                    {1e8, 10, ElementKind::kTet10, 1e-5, 0.03}},
-                   ContactSettings::FrictionSolve::kConvex, ", convex");
+                    {1e8, 10, ElementKind::kTet10, 1e-5, 0.03}});
 }
 
 }  // namespace

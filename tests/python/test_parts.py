@@ -83,7 +83,7 @@ def test_a_frame_prints_its_origin_and_rotation():
     assert "1.0" in text and "quaternion=(0.0" in text
 
 
-def box_on_a_tilted_slab(degrees, friction_solve):
+def box_on_a_tilted_slab(degrees):
     """A 1 kg box on a soft slab (1 x 1 x 0.2 m, base held) under gravity tilted by `degrees`
     about y; mu = 0.5 (the body's 1.0 times the box's 0.5). Returns the box's x after 0.5 s."""
     a = np.radians(degrees)
@@ -93,8 +93,6 @@ def box_on_a_tilted_slab(degrees, friction_solve):
     nodes = nodes * [1.0, 1.0, 0.2]
     slab = world.add_body("slab", nodes=nodes, tets=tets,
                           material=torsion.Material(E=1e6, nu=0.3, rho=200, stiffness_damping=0.01))
-    slab.friction_solve = friction_solve
-    assert slab.friction_solve == friction_solve
     world.add_node_set("base", slab, plane=((0, 0, 0), (0, 0, 1)))
     box = world.add_rigid_body("box", "box", half_extents=(0.15, 0.15, 0.05), mass=1.0,
                                frame=torsion.Frame(position=(0.35, 0.5, 0.2 + 0.05 + 1e-4)),
@@ -104,25 +102,11 @@ def box_on_a_tilted_slab(degrees, friction_solve):
     return box.position[0] - x0
 
 
-@pytest.mark.parametrize("friction_solve", ["auto", "active_set", "contact_space", "convex"])
-def test_a_box_on_a_soft_slab_holds_below_the_friction_angle_and_slides_as_coulomb_above(
-        friction_solve):
+def test_a_box_on_a_soft_slab_holds_below_the_friction_angle_and_slides_as_coulomb_above():
     # atan(0.5) = 26.6 deg. 20 deg below: held (the landing's slip and the slab's shear only).
-    assert abs(box_on_a_tilted_slab(20, friction_solve)) < 2e-3
+    assert abs(box_on_a_tilted_slab(20)) < 2e-3
     # 35 deg: Coulomb's 0.5 g (sin a - mu cos a) t^2 = 0.201 m in 0.5 s; dropped 0.1 mm onto the
     # slope, the box first falls freely along it for 5 ms (+4 %), hence 10 %.
     a = np.radians(35)
     coulomb = 0.5 * 9.81 * (np.sin(a) - 0.5 * np.cos(a)) * 0.5 ** 2
-    assert box_on_a_tilted_slab(35, friction_solve) == pytest.approx(coulomb, rel=0.1)
-
-
-def test_friction_solve_names_what_it_accepts():
-    world = torsion.World()
-    nodes, tets = cube_mesh(1)
-    body = world.add_body("cube", nodes=nodes, tets=tets)
-    assert body.friction_solve == "convex"
-    for name in ("active_set", "contact_space", "auto", "convex"):
-        body.friction_solve = name
-        assert body.friction_solve == name
-    with pytest.raises(ValueError, match="auto.*active_set.*contact_space.*convex.*exact"):
-        body.friction_solve = "exact"
+    assert box_on_a_tilted_slab(35) == pytest.approx(coulomb, rel=0.1)

@@ -180,7 +180,7 @@ TEST(RigidScene, KinematicPlateFollowsItsScriptAndRunWritesOutputs) {
   EXPECT_GT(summary["contacts"]["active_max"].get<int>(), 16);  // ground and plate
   EXPECT_GT(summary["contacts"]["normal_impulse_total_Ns"].get<double>(), 0);
   EXPECT_LT(summary["contacts"]["max_penetration_m"].get<double>(), 1e-4);
-  EXPECT_EQ(summary["contacts"]["active_set_unconverged_steps"].get<int>(), 0);
+  EXPECT_EQ(summary["contacts"]["unconverged_steps"].get<int>(), 0);
   std::filesystem::remove_all(out);
 }
 

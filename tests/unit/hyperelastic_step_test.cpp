@@ -7,6 +7,7 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/Geometry>
+#include <numeric>
 
 #include "torsion/bullet/fem_world.h"
 #include "torsion/bullet/hand.h"
@@ -259,6 +260,22 @@ TEST(HyperelasticStep, ContactEndsTheStepAsAFailureNamingTheLaw) {
   EXPECT_FALSE(r.ok);
   EXPECT_NE(r.message.find("corotated bodies only"), std::string::npos) << r.message;
   EXPECT_NE(r.message.find("mooney_rivlin"), std::string::npos) << r.message;
+
+  // Dropped onto a corotated FEM block held in place: the same refusal once they touch.
+  FemWorld pair{WorldSettings{}};
+  pair.addBody("bar", mesh, rubber(MaterialLaw::kStableNeoHookean), above).value();
+  Frame below;
+  below.origin = Eigen::Vector3d(0, 0, -0.4);
+  FemBody* block = pair.addBody("block", mesh, Material{}, below).value();
+  std::vector<int> all(static_cast<size_t>(mesh.nodeCount()));
+  std::iota(all.begin(), all.end(), 0);
+  block->carryNodes(
+      "all", all, [](double) { return Frame{}; }, 0);
+  WorldStepReport touched;
+  for (int k = 0; k < 100 && touched.ok; ++k)
+    touched = pair.step();
+  EXPECT_FALSE(touched.ok);
+  EXPECT_NE(touched.message.find("corotated bodies only"), std::string::npos) << touched.message;
 }
 
 // A hand plane (bullet/hand.h) twists a hyperelastic bar as it twists a corotated one: the same

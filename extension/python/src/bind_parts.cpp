@@ -189,28 +189,6 @@ void bindParts(py::module_& m) {
             return vectorArray(out.data(), static_cast<py::ssize_t>(out.size()));
           },
           "Per tet, dimensionless: equivalent strain sqrt(2/3 dev(eps):dev(eps)).")
-      .def_property(
-          "friction_solve",
-          [](const B& b) {
-            return frictionSolveName(b.body->contacts().settings().friction_solve);
-          },
-          [](const B& b, const std::string& how) {
-            const auto solve = frictionSolveFromName(how);
-            if (!solve)
-              throw py::value_error(
-                  "friction_solve: expected \"auto\", \"active_set\", \"contact_space\" or "
-                  "\"convex\", got "
-                  "\"" +
-                  how + "\"");
-            WorldGuard guard(*b.world, WorldGuard::kWrite);
-            b.body->contacts().settings().friction_solve = *solve;
-          },
-          "How the body's contacts with rigid bodies are solved: \"convex\" (default: the body, "
-          "the rigid bodies it touches and their contacts as one convex problem, "
-          "docs/contact-solve.md), or the older \"auto\" (contact space in the steps where a "
-          "dynamic rigid body touches the body, the active set otherwise), \"contact_space\" "
-          "(Coulomb's law solved for all contacts at once) or \"active_set\" (states switched "
-          "between linear solves by rules).")
       .def_property_readonly(
           "kinetic_energy", [](const B& b) { return b.body->lastReport().kinetic_energy; },
           "J, at the end of the last step")

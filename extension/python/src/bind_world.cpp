@@ -122,7 +122,7 @@ scene::RigidBodySpec::Shape toShape(const std::string& name) {
 }
 
 // A World's pickled form: what rebuilds it from its scene and puts it where it was,
-// (scene, threads, gravity, dt, [(body, friction_solve)], state bytes). Only a world its scene
+// (scene, threads, gravity, dt, state bytes). Only a world its scene
 // describes pickles: one Python added parts to, drives devices in, or set kinematic targets in
 // is refused with what stands in the way.
 py::tuple worldDescription(PyWorld& w) {
@@ -148,18 +148,14 @@ py::tuple worldDescription(PyWorld& w) {
   std::string scene = w.sceneSource();
   if (scene.find('/') != std::string::npos || std::filesystem::exists(scene))
     scene = std::filesystem::absolute(w.scene().spec.file).lexically_normal().string();
-  py::list friction;
-  for (const auto& body : w.world().bodies())
-    friction.append(py::make_tuple(body->name(),
-                                   frictionSolveName(body->contacts().settings().friction_solve)));
   const WorldSettings& settings = w.world().settings();
   const Eigen::Vector3d& g = settings.gravity;
   return py::make_tuple(scene, w.sceneThreads(), py::make_tuple(g.x(), g.y(), g.z()),
-                        settings.solver.time_step, friction, py::bytes(w.serialize(state.value())));
+                        settings.solver.time_step, py::bytes(w.serialize(state.value())));
 }
 
 std::unique_ptr<PyWorld> worldFromDescription(const py::tuple& t) {
-  if (t.size() != 6) throw py::value_error("torsion.World: bad pickle (6 fields expected)");
+  if (t.size() != 5) throw py::value_error("torsion.World: bad pickle (5 fields expected)");
   FailureKind kind;
   Result<std::unique_ptr<PyWorld>> built =
       PyWorld::fromScene(t[0].cast<std::string>(), t[1].cast<int>(), {}, &kind);
@@ -168,17 +164,9 @@ std::unique_ptr<PyWorld> worldFromDescription(const py::tuple& t) {
   if (Status s = w.setGravity(toVector3(t[2], "gravity")); !s)
     throw py::value_error(s.error().message);
   if (Status s = w.setTimeStep(t[3].cast<double>()); !s) throw py::value_error(s.error().message);
-  for (auto item : t[4].cast<py::list>()) {
-    auto pair = item.cast<py::tuple>();
-    FemBody* body = w.world().body(pair[0].cast<std::string>());
-    const auto solve = frictionSolveFromName(pair[1].cast<std::string>());
-    if (body == nullptr || !solve)
-      throw py::value_error("torsion.World: the pickle names another scene's bodies");
-    body->contacts().settings().friction_solve = *solve;
-  }
   PyWorldState state;
   state.in_memory = false;
-  state.bytes = t[5].cast<std::string>();
+  state.bytes = t[4].cast<std::string>();
   if (Status s = w.restoreState(state); !s) throw py::value_error(s.error().message);
   return std::move(built).value();
 }

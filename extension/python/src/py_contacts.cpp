@@ -40,13 +40,14 @@ void addFemRigidContacts(PyWorld& world, const FemBody& body, ContactList& list)
                ? partnerName(world, partners[static_cast<size_t>(index)].object)
                : std::string();
   };
+  // Every contact that gave an impulse: one that let go this step may still carry friction (its
+  // bound lags by a step, docs/contact-solve.md, "Limits").
   for (const NodeContact& c : solver.contacts()) {
-    if (c.state == NodeContact::State::kInactive || c.anchored) continue;
+    if (c.anchored || c.impulse.isZero(0)) continue;
     add(list, body.name(), partner(c.partner), body.state().position(c.node), c.normal, c.impulse);
   }
   for (const FaceContact& f : solver.solvedFaceContacts()) {
-    // A determined face sits out: the contacts of its nodes carry its impulse.
-    if (f.state == FaceContact::State::kInactive || f.determined) continue;
+    if (f.impulse.isZero(0)) continue;
     Eigen::Vector3d point = Eigen::Vector3d::Zero();
     for (size_t k = 0; k < 3; ++k)
       point += f.weights[static_cast<Eigen::Index>(k)] * body.state().position(f.nodes[k]);

@@ -3,11 +3,11 @@
 // bodies, a point, the normal, the impulse. Python-free; World.contacts() (bind_world.cpp) makes
 // numpy arrays of it. Two kinds are listed, each where the library keeps it after a step:
 //   - an FEM body's nodes and surface faces against rigid bodies (RigidContactSolver::contacts()
-//     and faceContacts(): the active ones; anchors are not contacts);
+//     and solvedFaceContacts(): those that gave an impulse; anchors are not contacts);
 //   - rigid bodies against each other (Bullet's persistent manifolds: points that touch or that
 //     carried an impulse).
-// Contact between FEM bodies and self-contact are not listed: their impulses live inside the
-// pair solve (contact/surface_contact_set.h) as multipliers and penalties.
+// Contact between FEM bodies and self-contact are not listed: their impulses live in their
+// surface contact sets (contact/surface_contact_set.h) as multipliers.
 
 #include <string>
 #include <vector>

@@ -104,7 +104,6 @@ class Body:
     external_forces: npt.NDArray[np.float64]  # (n, 3) N, copy
     kinetic_energy: float  # J, end of the last step
     solver_iterations: int  # CG iterations of the last step
-    friction_solve: str  # "auto" (default), "contact_space", "active_set" or "convex"
     def set_material(self, material: Material) -> None: ...
     def set_external_forces(self, forces: ArrayLike) -> None: ...  # (n, 3) N, kept every step
     def set_velocity(self, velocity: ArrayLike) -> None: ...  # (3,) m/s, every node
@@ -174,12 +173,11 @@ class World:
     def from_scene(scene: str, threads: int = -1, *,
                    devices: Union[dict[str, str], Sequence[str], None] = None,
                    haptics: str = "", allow_remote_devices: bool = False) -> World: ...
-    # A world from a scene pickles as (scene, threads, gravity, dt, [(body, friction_solve)],
-    # state bytes); TypeError for one built or extended in code, with devices or kinematic targets
-    def __getstate__(self) -> tuple[str, int, tuple[float, float, float], float,
-                                    list[tuple[str, str]], bytes]: ...
+    # A world from a scene pickles as (scene, threads, gravity, dt, state bytes); TypeError for
+    # one built or extended in code, with devices or kinematic targets
+    def __getstate__(self) -> tuple[str, int, tuple[float, float, float], float, bytes]: ...
     def __setstate__(self, state: tuple[str, int, tuple[float, float, float], float,
-                                        list[tuple[str, str]], bytes]) -> None: ...
+                                        bytes]) -> None: ...
     def step(self, n: int = 1) -> None: ...  # releases the GIL; Ctrl-C stops it between steps
     time: float  # s
     step_count: int

@@ -24,7 +24,10 @@ constexpr char kMagic[8] = {'T', 'R', 'S', 'N', 'C', 'K', 'P', 'T'};
 // 4: the node contacts' normals (the plane a contact keeps while its node stays over it).
 // 5: the payload's hash is the standard FNV-1a (torsion/fnv1a.h); 4 used an offset basis one
 //    digit short of it.
-constexpr std::uint32_t kVersion = 6;
+// 6: the convex solve's face features.
+// 7: no augmented-Lagrangian memory: self-contact settings without its penalty and iteration
+//    cap, no face contact multipliers (the face rows' features carry the convex solve's).
+constexpr std::uint32_t kVersion = 7;
 constexpr size_t kHeaderSize = sizeof(kMagic) + 4 + 8 + 8;
 
 class Writer {
@@ -348,15 +351,6 @@ void writeBody(Writer& w, FemWorld& world, const FemBody& body, const FemBodyChe
     w.vec3(n.impulse);
     w.vec3(n.normal);
   }
-  w.u32(carried.faces.size());
-  for (const CarriedContacts::Face& f : carried.faces) {
-    for (int node : f.key)
-      w.i32(node);
-    w.i32(collisionObjectIndex(world, f.object));
-    w.u8(static_cast<int>(f.state));
-    w.vec3(f.multiplier);
-    w.i32(f.stalls);
-  }
   w.u32(carried.features.size());
   for (const CarriedContacts::Feature& f : carried.features) {
     w.i32(collisionObjectIndex(world, f.object));
@@ -366,9 +360,8 @@ void writeBody(Writer& w, FemWorld& world, const FemBody& body, const FemBodyChe
 
   w.u8(c.self_contact);
   const SelfContactSettings& s = c.self_contact_settings;
-  for (double v : {s.friction, s.gap_tolerance, s.margin, s.max_depth, s.penalty_factor})
+  for (double v : {s.friction, s.gap_tolerance, s.margin, s.max_depth})
     w.f64(v);
-  w.i32(s.max_iterations);
   w.u32(c.self_contact_warm_starts.size());
   for (const auto& [key, lambda] : c.self_contact_warm_starts) {
     w.raw(key);
@@ -506,15 +499,6 @@ Result<FemBodyCheckpoint> readBody(Reader& r, FemWorld& world, FemBody& body,
     n.normal = r.vec3();
     if (n.node < 0 || n.node >= model.nodeCount()) r.fail();
   }
-  carried.faces.resize(r.count(45));
-  for (CarriedContacts::Face& f : carried.faces) {
-    for (int& node : f.key)
-      node = r.i32();
-    f.object = objectAt(r.i32());
-    f.state = r.enumeration(FaceContact::State::kStick);
-    f.multiplier = r.vec3();
-    f.stalls = r.i32();
-  }
   carried.features.resize(r.count(36));
   for (CarriedContacts::Feature& f : carried.features) {
     f.object = objectAt(r.i32());
@@ -529,15 +513,13 @@ Result<FemBodyCheckpoint> readBody(Reader& r, FemWorld& world, FemBody& body,
 
   c.self_contact = r.u8() != 0;
   SelfContactSettings& s = c.self_contact_settings;
-  // What the format does not store (thickness_factor, rough_tolerance_factor, search_skin: they
+  // What the format does not store (thickness_factor, search_skin: they
   // do not change between saving and restoring a run) stays the body's own.
   s = now.self_contact_settings;
   s.friction = r.f64();
   s.gap_tolerance = r.f64();
   s.margin = r.f64();
   s.max_depth = r.f64();
-  s.penalty_factor = r.f64();
-  s.max_iterations = r.i32();
   c.self_contact_warm_starts.resize(r.count(32));
   for (auto& [key, lambda] : c.self_contact_warm_starts) {
     key = r.raw<std::uint64_t>();

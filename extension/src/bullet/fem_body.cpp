@@ -167,16 +167,7 @@ void FemBody::predict(double dt, bool for_contact) {
   contacts_->beginStep(dt);
 }
 
-const StepReport& FemBody::advance(const StepContext& ctx) {
-  if (!prepare(ctx)) return last_report_;
-  const PreparedSystem p = stepper_.prepared();
-  const LinearSolveReport solve =
-      hasContactSolve() ? solveContacts(*p.op, *p.constraints, *p.b, *p.settings, *p.v)
-                        : stepper_.solve();
-  return finish(*p.v, solve);
-}
-
-bool FemBody::prepare(const StepContext& ctx, const AddedOperatorTerm* island_term) {
+bool FemBody::prepare(const StepContext& ctx, bool touches_fem_bodies) {
   const double dt = ctx.dt;
   constraints_.reset(model_->nodeCount());
   for (const auto& group : groups_)
@@ -186,11 +177,11 @@ bool FemBody::prepare(const StepContext& ctx, const AddedOperatorTerm* island_te
     step_forces_.segment<3>(3 * i) += model_->nodeMasses()[static_cast<size_t>(i)] * ctx.gravity;
   // Contacts with rigid bodies: unilateral constraints in the same projected solve.
   rigid_contact_ = contacts_->detect(state_, constraints_, dt, ctx.joints);
-  // Self-contact: an augmented Lagrangian added to the system, around the same solve.
-  // Its solve runs whenever it is on, candidates or not: it looks again along the solved motion.
+  // Self-contact: rows of the body's island; it looks again along the solved motion, candidates
+  // or not.
   const bool self = self_contact_ != nullptr;
   if (self) self_contact_->detect(state_, constraints_, dt);
-  if (model_->material().hyperelastic() && (rigid_contact_ || self || island_term != nullptr)) {
+  if (model_->material().hyperelastic() && (rigid_contact_ || self || touches_fem_bodies)) {
     // The Newton step has no contact solve yet: refused, never stepped without its contacts.
     last_report_ = StepReport{};
     last_report_.health = StepHealth::kSolverFailed;
@@ -200,35 +191,14 @@ bool FemBody::prepare(const StepContext& ctx, const AddedOperatorTerm* island_te
                            toString(model_->material().law) + " (docs/materials.md)";
     return false;
   }
-  added_terms_.set(self ? &self_contact_->term() : nullptr, island_term);
-  if (self || island_term != nullptr) stepper_.setAddedOperatorTerm(&added_terms_);
   last_report_ = stepper_.prepare(state_, constraints_, step_forces_, dt);
-  if (!isFatal(last_report_.health)) return true;
-  stepper_.setAddedOperatorTerm(nullptr);  // the terms are this step's only
-  return false;
-}
-
-LinearSolveReport FemBody::solveContacts(const SystemOperator& op,
-                                         const NodeConstraints& constraints,
-                                         const Eigen::VectorXd& b, const SolverSettings& settings,
-                                         Eigen::VectorXd& v) {
-  if (self_contact_ == nullptr) return contacts_->solve(op, constraints, b, settings, v);
-  // Self-contact's loop runs the rigid-contact solve once on its augmented system when there are
-  // rigid contacts, its own CG rounds otherwise.
-  SelfContactSolver::InnerSolve rigid_solve;
-  if (rigid_contact_) {
-    rigid_solve = [this](const SystemOperator& o, const NodeConstraints& c,
-                         const Eigen::VectorXd& rhs, const SolverSettings& s,
-                         Eigen::VectorXd& x) { return contacts_->solve(o, c, rhs, s, x); };
-  }
-  return self_contact_->solve(op, constraints, b, settings, v, rigid_solve);
+  return !isFatal(last_report_.health);
 }
 
 const StepReport& FemBody::finish(const Eigen::Ref<const Eigen::VectorXd>& velocities,
                                   const LinearSolveReport& solve) {
   last_report_.solve = solve;
   stepper_.finish(state_, velocities, last_report_);
-  stepper_.setAddedOperatorTerm(nullptr);
   if (self_contact_ && !self_contact_->stats().converged && !isFatal(last_report_.health)) {
     // Reported per step, never accepted silently (a warning: the step is usable).
     const SelfContactStats& s = self_contact_->stats();
@@ -236,7 +206,7 @@ const StepReport& FemBody::finish(const Eigen::Ref<const Eigen::VectorXd>& veloc
       last_report_.health = StepHealth::kContactNotConverged;
     last_report_.message += (last_report_.message.empty() ? "" : "; ") +
                             std::string("self-contact did not converge in ") +
-                            std::to_string(s.iterations) + " updates (end penetration " +
+                            std::to_string(s.iterations) + " Newton iterations (end penetration " +
                             std::to_string(s.max_end_penetration) + " m, tolerance " +
                             std::to_string(self_contact_->gapTolerance()) + " m)";
   }

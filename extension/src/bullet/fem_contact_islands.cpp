@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <numeric>
-#include <sstream>
 
 namespace torsion {
 
@@ -115,106 +114,26 @@ std::vector<std::vector<FemBody*>> FemContactIslands::plan(const std::vector<Fem
 }
 
 void FemContactIslands::advance(const std::vector<FemBody*>& group, const StepContext& ctx) {
-  if (group.size() == 1) {
-    group.front()->advance(ctx);
-    return;
-  }
-  setUpIsland(group);
-  if (convexIsland(group)) {
-    const bool solved = advanceConvex(group, ctx);
-    addStats(group, solved);
-    return;
-  }
-  // Every body up to its solve; one that stops there (non-finite forces) leaves the island, and
-  // its pairs sit the step out.
-  bool any = false;
-  for (size_t k = 0; k < group.size(); ++k) {
-    if (!group[k]->prepare(ctx, &terms_[k])) continue;
-    enter(k, group[k]);
-    any = true;
-  }
-  island_stats_ = any ? solver_.solve(slots_, island_pairs_, ctx.dt) : IslandContactStats{};
-  // Last body first: a dynamic rigid body touching several bodies of the island takes their
-  // corrections (RigidContactSolver::finish) in this fixed order, the first body's last.
-  for (size_t k = group.size(); k-- > 0;) {
-    if (slots_[k].present) group[k]->finish(*slots_[k].v, slots_[k].report);
-  }
-  addStats(group, any);
-}
-
-bool FemContactIslands::convexIsland(const std::vector<FemBody*>& group) {
-  return std::all_of(group.begin(), group.end(), [](const FemBody* body) {
-    return body->contacts().settings().friction_solve == ContactSettings::FrictionSolve::kConvex &&
-           body->selfContact() == nullptr && !body->model().material().hyperelastic();
-  });
-}
-
-void FemContactIslands::setUpIsland(const std::vector<FemBody*>& group) {
-  const size_t n = group.size();
-  slots_.assign(n, IslandContactSolve::Body{});
-  terms_.assign(n, PairContactTerm{});
-  island_pairs_.clear();
   auto slot = [&](const FemBody* body) {
     return static_cast<int>(std::find(group.begin(), group.end(), body) - group.begin());
   };
+  std::vector<IslandPair> pairs;
   for (const auto& [key, contact] : live_) {
     const int first = slot(key.first), second = slot(key.second);
-    if (first == static_cast<int>(n) || second == static_cast<int>(n)) continue;
-    island_pairs_.push_back({contact, first, second});
-    const int na = contact->nodeCountA();
-    terms_[static_cast<size_t>(first)].addSide({&contact->set(), 0, na});
-    terms_[static_cast<size_t>(second)].addSide(
-        {&contact->set(), na, key.second->model().nodeCount()});
+    if (first == static_cast<int>(group.size()) || second == static_cast<int>(group.size()))
+      continue;
+    pairs.push_back({contact, first, second});
   }
-}
-
-void FemContactIslands::enter(size_t k, FemBody* body) {
-  const PreparedSystem system = body->preparedSystem();
-  IslandContactSolve::Body& s = slots_[k];
-  s.op = system.op;
-  s.constraints = system.constraints;
-  s.b = system.b;
-  s.settings = system.settings;
-  s.v = system.v;
-  // Node contacts with prescribed rigid partners (the ground) join the island's joint solve; a
-  // body with self-contact or a dynamic rigid partner keeps its own solve.
-  s.rigid = nullptr;
-  s.solve = nullptr;
-  if (body->hasContactSolve()) {
-    if (body->selfContact() == nullptr && body->contacts().joinsIsland()) {
-      s.rigid = &body->contacts();
-    } else {
-      s.solve = [body](const SystemOperator& op, const NodeConstraints& constraints,
-                       const Eigen::VectorXd& b, const SolverSettings& settings,
-                       Eigen::VectorXd& v) {
-        return body->solveContacts(op, constraints, b, settings, v);
-      };
-    }
-  }
-  s.term = &terms_[k];
-  s.present = true;
-}
-
-void FemContactIslands::addStats(const std::vector<FemBody*>& group, bool solved) {
+  const IslandPairStats island = stepIsland(group, pairs, ctx);
+  if (pairs.empty()) return;
   ++stats_.islands;
-  stats_.candidates += island_stats_.candidates;
-  stats_.active += island_stats_.active;
-  stats_.sticking += island_stats_.sticking;
-  stats_.iterations = std::max(stats_.iterations, island_stats_.iterations);
-  stats_.normal_impulse += island_stats_.normal_impulse;
-  stats_.max_end_penetration =
-      std::max(stats_.max_end_penetration, island_stats_.max_end_penetration);
-  if (!solved || island_stats_.converged) return;
-  // Reported per step, never accepted silently (a warning: the step is usable).
-  stats_.converged = false;
-  std::ostringstream s;
-  s << "contact between FEM bodies did not converge in " << island_stats_.iterations
-    << " updates (end penetration " << island_stats_.max_end_penetration << " m, tolerance "
-    << island_stats_.gap_tolerance << " m)";
-  for (size_t k = 0; k < group.size(); ++k) {
-    if (slots_[k].present && !isFatal(group[k]->lastReport().health))
-      group[k]->noteContactNotConverged(s.str());
-  }
+  stats_.candidates += island.candidates;
+  stats_.active += island.active;
+  stats_.sticking += island.sticking;
+  stats_.iterations = std::max(stats_.iterations, island.iterations);
+  stats_.normal_impulse += island.normal_impulse;
+  stats_.max_end_penetration = std::max(stats_.max_end_penetration, island.max_end_penetration);
+  stats_.converged = stats_.converged && island.converged;
 }
 
 }  // namespace torsion

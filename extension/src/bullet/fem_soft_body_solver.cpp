@@ -292,7 +292,7 @@ void FemSoftBodySolver::solveConstraints(btScalar solver_dt) {
     if (fem_contact_) {
       fem_contact_->advance(group, ctx);
     } else {
-      group.front()->advance(ctx);
+      stepIsland(group, {}, ctx);
     }
     for (FemBody* body : group) {
       const StepReport& report = body->lastReport();

@@ -1,6 +1,6 @@
 // The warm starts of RigidContactSolver in a form that names the rigid objects alone, for
-// checkpoints that leave memory. Mirrors what detect() and FaceContactSet::beginStep() read from
-// the last step: active, non-held node contacts with their partner's object, and face contacts.
+// checkpoints that leave memory. Mirrors what detect() and the island's rows read from the last
+// step: active, non-held node contacts with their partner's object, and the face rows' features.
 
 #include "torsion/contact/rigid_contact.h"
 
@@ -12,11 +12,6 @@ CarriedContacts RigidContactSolver::carriedContacts() const {
     if (c.state == NodeContact::State::kInactive || c.held) continue;
     carried.nodes.push_back(
         {c.node, partners_[static_cast<size_t>(c.partner)].object, c.state, c.impulse, c.normal});
-  }
-  for (const FaceContact& c : faces_.contacts()) {
-    if (c.state == FaceContact::State::kInactive) continue;
-    carried.faces.push_back(
-        {c.key, partners_[static_cast<size_t>(c.partner)].object, c.state, c.multiplier, c.stalls});
   }
   carried.features = lagged_features_;
   return carried;
@@ -46,17 +41,6 @@ void RigidContactSolver::restoreCarriedContacts(const CarriedContacts& carried) 
     c.impulse = n.impulse;
     contacts_.push_back(c);
   }
-  std::vector<FaceContact> faces;
-  for (const CarriedContacts::Face& f : carried.faces) {
-    FaceContact c;
-    c.key = f.key;
-    c.partner = partner(f.object);
-    c.state = f.state;
-    c.multiplier = f.multiplier;
-    c.stalls = f.stalls;
-    faces.push_back(c);
-  }
-  faces_.restoreContacts(std::move(faces));
   lagged_features_ = carried.features;
 }
 

@@ -16,33 +16,11 @@ namespace {
 // A weight below this puts the contact point on the opposite edge (or corner): the contact is the
 // edge's (or the node's), whichever triangle found it.
 constexpr double kEdgeWeight = 1e-6;
-constexpr int kMaxStalls = 3;
 // A face point must come this fraction of the detection reach nearer the shape than its nodes'
 // interpolated distances to be a contact of its own (round-off on flat-on-flat is far below).
 constexpr double kDuplicateMargin = 1e-3;
-constexpr int kMaxSwitches = 1;
-constexpr int kMaxFaceFrictionRefinements = 8;
-// m/s: a sliding face carried past the body faster than this by its friction sticks at once.
-constexpr double kCarriedPastSpeed = 0.01;
 // m: round-off between the nearest pair's and a supporting plane's predicted end gaps.
 constexpr double kPlaneChoiceMargin = 1e-9;
-
-// Whether the contact takes part in this solve.
-bool participates(const FaceContact& c) {
-  return c.state != FaceContact::State::kInactive && !c.determined;
-}
-
-Eigen::Matrix3d projector(const FaceContact& c) {
-  return c.state == FaceContact::State::kStick ? Eigen::Matrix3d::Identity()
-                                               : Eigen::Matrix3d(c.normal * c.normal.transpose());
-}
-
-// kg: the contact's impulse per unit relative velocity in the solve. A stuck face's penalty acts
-// in all three directions, a sliding face's along the normal only, plus its friction's resistance
-// to a slip across the friction's direction (FaceContact::slip_resistance).
-Eigen::Matrix3d stiffness(const FaceContact& c) {
-  return c.penalty * projector(c) + c.slip_resistance;
-}
 
 // Whether the triangle is better held against the rigid shape's supporting plane that faces it
 // (normal minus the triangle's) than along the nearest pair (f), by the end gaps the predicted
@@ -100,15 +78,7 @@ FaceContactSet::FaceContactSet(const TetMesh& mesh) : triangles_(mesh.surfaceTri
   triangle_stamp_.assign(triangles_.size(), 0);
 }
 
-void FaceContactSet::beginStep(const std::vector<RigidPartner>& partners) {
-  previous_.clear();
-  for (const FaceContact& c : contacts_) {
-    if (c.state == FaceContact::State::kInactive) continue;
-    // A stalled contact's multiplier grew against constraints that left it no room: carried
-    // over, it would grow again each step without bound.
-    const Eigen::Vector3d carried = c.stalls > kMaxStalls ? Eigen::Vector3d::Zero() : c.multiplier;
-    previous_[{c.key, partners[static_cast<size_t>(c.partner)].object}] = {c.state, carried};
-  }
+void FaceContactSet::beginStep() {
   contacts_.clear();
   features_.clear();
   index_.clear();
@@ -196,293 +166,14 @@ void FaceContactSet::detect(const FemState& state, const NodeConstraints& held,
       if (found != index_.end()) {
         // An edge seen from its two triangles: keep the nearer reading.
         FaceContact& existing = contacts_[static_cast<size_t>(found->second)];
-        if (fc.gap < existing.gap) {
-          fc.state = existing.state;
-          fc.multiplier = existing.multiplier;
-          existing = fc;
-        }
+        if (fc.gap < existing.gap) existing = fc;
         continue;
-      }
-      const auto remembered = previous_.find({fc.key, p.object});
-      if (remembered != previous_.end()) {
-        fc.state = fc.friction > 0 ? remembered->second.state : FaceContact::State::kSlide;
-        fc.multiplier = remembered->second.multiplier;
       }
       index_[{fc.key, partner}] = static_cast<int>(contacts_.size());
       contacts_.push_back(fc);
     }
   }
   if (features) features->appendTo(features_);
-}
-
-std::vector<FaceContact::State> FaceContactSet::states() const {
-  std::vector<FaceContact::State> states;
-  states.reserve(contacts_.size());
-  for (const FaceContact& c : contacts_)
-    states.push_back(c.state);
-  return states;
-}
-
-void FaceContactSet::restoreStates(const std::vector<FaceContact::State>& states) {
-  for (size_t c = 0; c < contacts_.size() && c < states.size(); ++c)
-    contacts_[c].state = states[c];
-}
-
-void FaceContactSet::setPenalties(const std::vector<Eigen::Matrix3d>& diagonal_blocks,
-                                  double scale) {
-  for (FaceContact& c : contacts_) {
-    double compliance = 0;  // 1 / kg: the face point's velocity change per unit impulse along n
-    for (size_t j = 0; j < 3; ++j) {
-      const double w = c.weights[static_cast<Eigen::Index>(j)];
-      if (w <= 0) continue;
-      compliance +=
-          w * w *
-          c.normal.dot(diagonal_blocks[static_cast<size_t>(c.nodes[j])].ldlt().solve(c.normal));
-    }
-    c.penalty = compliance > 0 ? scale / compliance : 0;
-  }
-}
-
-Eigen::Vector3d FaceContactSet::relativeVelocity(const FaceContact& c, const Eigen::VectorXd& v,
-                                                 const Eigen::Vector3d& rigid) const {
-  Eigen::Vector3d u = -rigid;
-  for (size_t j = 0; j < 3; ++j)
-    u += c.weights[static_cast<Eigen::Index>(j)] * v.segment<3>(3 * c.nodes[j]);
-  return u;
-}
-
-void FaceContactSet::addProduct(const Eigen::VectorXd& v, const Eigen::VectorXd& q,
-                                const std::vector<RigidPartner>& partners, int rigid_offset,
-                                Eigen::VectorXd& node_out, Eigen::VectorXd& rigid_out) const {
-  for (const FaceContact& c : contacts_) {
-    if (!participates(c)) continue;
-    const RigidPartner& k = partners[static_cast<size_t>(c.partner)];
-    const Eigen::Vector3d rigid =
-        k.dynamic ? pointVelocity(q.segment<6>(k.unknown), c.lever) : Eigen::Vector3d::Zero();
-    const Eigen::Vector3d y = stiffness(c) * relativeVelocity(c, v, rigid);
-    for (size_t j = 0; j < 3; ++j)
-      node_out.segment<3>(3 * c.nodes[j]) += c.weights[static_cast<Eigen::Index>(j)] * y;
-    if (k.dynamic) rigid_out.segment<6>(k.unknown - rigid_offset) -= pointWrench(y, c.lever);
-  }
-}
-
-void FaceContactSet::addRightHandSide(const Eigen::VectorXd& prescribed,
-                                      const std::vector<RigidPartner>& partners, double dt,
-                                      int rigid_offset, Eigen::VectorXd& node_rhs,
-                                      Eigen::VectorXd& rigid_rhs) const {
-  for (const FaceContact& c : contacts_) {
-    if (!participates(c)) continue;
-    const RigidPartner& k = partners[static_cast<size_t>(c.partner)];
-    const Eigen::Vector3d rigid =
-        k.dynamic ? Eigen::Vector3d::Zero() : pointVelocity(k.entry_velocity, c.lever);
-    const Eigen::Vector3d h0 = relativeVelocity(c, prescribed, rigid) + c.normal * (c.gap / dt);
-    const Eigen::Vector3d y = c.multiplier - stiffness(c) * h0;
-    for (size_t j = 0; j < 3; ++j)
-      node_rhs.segment<3>(3 * c.nodes[j]) += c.weights[static_cast<Eigen::Index>(j)] * y;
-    if (k.dynamic) rigid_rhs.segment<6>(k.unknown - rigid_offset) -= pointWrench(y, c.lever);
-  }
-}
-
-void FaceContactSet::addPreconditioner(std::vector<Eigen::Matrix3d>& node_blocks,
-                                       std::vector<Eigen::Matrix<double, 6, 6>>& rigid_blocks,
-                                       const std::vector<RigidPartner>& partners) const {
-  for (const FaceContact& c : contacts_) {
-    if (!participates(c)) continue;
-    const Eigen::Matrix3d P = stiffness(c);
-    for (size_t j = 0; j < 3; ++j) {
-      const double w = c.weights[static_cast<Eigen::Index>(j)];
-      node_blocks[static_cast<size_t>(c.nodes[j])] += w * w * P;
-    }
-    if (partners[static_cast<size_t>(c.partner)].dynamic) {
-      const Eigen::Matrix<double, 3, 6> J = pointJacobian(c.lever);
-      rigid_blocks[static_cast<size_t>(c.partner)] += J.transpose() * P * J;
-    }
-  }
-}
-
-double FaceContactSet::endGap(const FaceContact& c, const Eigen::VectorXd& v,
-                              const std::vector<RigidPartner>& partners, double dt) const {
-  const Eigen::Vector3d rigid =
-      pointVelocity(partners[static_cast<size_t>(c.partner)].velocity, c.lever);
-  return c.gap + dt * c.normal.dot(relativeVelocity(c, v, rigid));
-}
-
-void FaceContactSet::takeImpulses(const Eigen::VectorXd& v,
-                                  const std::vector<RigidPartner>& partners, double dt,
-                                  Eigen::VectorXd& node_impulse) {
-  for (FaceContact& c : contacts_) {
-    if (!participates(c)) {
-      c.impulse.setZero();
-      continue;
-    }
-    const Eigen::Vector3d rigid =
-        pointVelocity(partners[static_cast<size_t>(c.partner)].velocity, c.lever);
-    const Eigen::Vector3d h = relativeVelocity(c, v, rigid) + c.normal * (c.gap / dt);
-    c.impulse = c.multiplier - stiffness(c) * h;
-    for (size_t j = 0; j < 3; ++j)
-      node_impulse.segment<3>(3 * c.nodes[j]) -=
-          c.weights[static_cast<Eigen::Index>(j)] * c.impulse;
-  }
-}
-
-bool FaceContactSet::update(const Eigen::VectorXd& v, const std::vector<RigidPartner>& partners,
-                            double dt, double activation_tolerance, double gap_tolerance) {
-  bool again = false;
-  for (FaceContact& c : contacts_) {
-    const Eigen::Vector3d rigid =
-        pointVelocity(partners[static_cast<size_t>(c.partner)].velocity, c.lever);
-    const Eigen::Vector3d h = relativeVelocity(c, v, rigid) + c.normal * (c.gap / dt);
-    const double end_gap = dt * c.normal.dot(h);
-    if (c.determined) continue;
-    if (c.state == FaceContact::State::kInactive) {
-      // Within the stated tolerance a face stays out: activating an edge contact for a
-      // micrometre, releasing it the next solve, and the nodes' friction following each time,
-      // was most of the active-set iterations of rigid_mix.
-      if (end_gap < -std::max(activation_tolerance, gap_tolerance)) {
-        // A face that a body sliding over the surface (RigidPartner::sliding) slips over by more
-        // than the gap tolerance this step starts sliding, as node contacts do
-        // (rigid_contact_active_set.cpp); its friction follows from the next update. Started
-        // stuck, its penalty glued a box sliding over a soft slab to each new triangle for a
-        // solve, the face then pulled, was released and added again, and the loop cycled to its
-        // cap on those two sets, ending the step on a glued solve (docs/contact.md, "Sliding over
-        // nodes"). Other faces start stuck: a landing or resting body's (Poisson's slips).
-        // The slip with this solve's velocities or the body's before the step (as for nodes).
-        const RigidPartner& k = partners[static_cast<size_t>(c.partner)];
-        const Eigen::Vector3d entry_h =
-            relativeVelocity(c, v, pointVelocity(k.entry_velocity, c.lever));
-        const double slip = std::max((h - c.normal * c.normal.dot(h)).norm(),
-                                     (entry_h - c.normal * c.normal.dot(entry_h)).norm());
-        const bool slipping =
-            k.sliding && dt * slip > std::max(activation_tolerance, gap_tolerance);
-        c.state =
-            c.friction > 0 && !slipping ? FaceContact::State::kStick : FaceContact::State::kSlide;
-        c.multiplier.setZero();
-        again = true;
-      }
-      continue;
-    }
-    // A violation that does not shrink is a constraint the others leave no room for (a rigid
-    // body squeezed between held faces, or nodes held by another body): after kMaxStalls
-    // updates its multiplier stops growing for the rest of the step, and its rigid partner
-    // takes the violation instead of an unbounded impulse.
-    const double violation = std::abs(end_gap);
-    if (c.last_violation > 0 && violation > gap_tolerance && violation > 0.95 * c.last_violation)
-      ++c.stalls;
-    c.last_violation = violation;
-    if (c.stalls > kMaxStalls) continue;
-    // Uzawa: the multiplier moves by -rho h, then onto Coulomb's cone.
-    const Eigen::Vector3d trial = c.multiplier - c.penalty * h;
-    const double lambda = c.normal.dot(trial);
-    if (lambda <= 0) {
-      ++c.releases;
-      c.state = FaceContact::State::kInactive;
-      c.multiplier.setZero();
-      again = true;
-      continue;
-    }
-    const Eigen::Vector3d tangential = trial - c.normal * lambda;
-    const double bound =
-        partners[static_cast<size_t>(c.partner)].friction_share * c.friction * lambda;
-    const FaceContact::State before = c.state;
-    const Eigen::Vector3d applied = c.multiplier - c.normal * c.normal.dot(c.multiplier);
-    const double applied_friction = applied.norm();
-    const Eigen::Vector3d slip = h - c.normal * c.normal.dot(h);
-    const bool overshot = before == FaceContact::State::kSlide && c.friction > 0 &&
-                          applied_friction > 0 && slip.dot(applied) > 0;
-    const bool carried_past = slip.norm() > kCarriedPastSpeed;
-    if (overshot && ((carried_past && c.switches < kMaxSwitches) ||
-                     (c.switches >= kMaxSwitches && tangential.norm() > bound))) {
-      // The slip turned along the friction the solve applied: that friction was more than enough
-      // to stop it within the step (a light face under a heavy sliding body: the friction carries
-      // its nodes past the body). Projected onto the cone along the new slip, the friction would
-      // flip back and forth with each solve, and the step could end on either sign (a box
-      // sliding over a soft slab was pushed downhill, 1 deg below the friction angle it crept
-      // 3 cm in 1 s). Instead, when the face was carried past the body faster than
-      // kCarriedPastSpeed, it sticks, from the applied friction within this solve's cone (for
-      // every overshoot, a box dropped onto a slope below the friction angle crept 7 mm in 1 s);
-      // past the switch budget, where Uzawa's trial would leave the cone on the other side, it
-      // keeps its friction (direction and magnitude), brought within this solve's cone: a fixed
-      // friction bounded by mu lambda. (Uzawa's update along the direction, less rho times the
-      // slip along it, took the friction to zero, and the next solve back onto the cone: the same
-      // cycle.) A trial within the cone is taken as before (below).
-      const Eigen::Vector3d d = applied / applied_friction;
-      const double magnitude = std::min(applied_friction, bound);
-      c.multiplier = c.normal * lambda + magnitude * d;
-      if (c.switches < kMaxSwitches) {
-        c.state = FaceContact::State::kStick;
-        ++c.switches;
-      } else if (applied_friction - magnitude > 1e-2 * bound &&
-                 c.friction_refinements++ < kMaxFaceFrictionRefinements) {
-        again = true;
-      }
-      if (c.state != before || violation > gap_tolerance) again = true;
-      continue;
-    }
-    if (c.friction > 0 && tangential.norm() <= bound) {
-      // Within the cone: sticks, or, after kMaxSwitches slide-to-stick switches this step (they
-      // can cycle: neighbouring contacts' tangential impulses are coupled through the body),
-      // keeps sliding with the trial's friction, which is within mu lambda (Uzawa on the
-      // tangential multiplier alone).
-      if (before != FaceContact::State::kSlide || c.switches < kMaxSwitches)
-        c.state = FaceContact::State::kStick;
-      c.multiplier = trial;
-    } else {
-      c.state = FaceContact::State::kSlide;
-      c.multiplier = c.normal * lambda;
-      if (c.friction > 0) c.multiplier += bound * tangential.normalized();
-    }
-    // Another solve while the end gap is off, or for a stick/slide switch. Stick to slide always
-    // solves again: a stuck face's impulse in the solve just done (Lambda - rho h, the trial) is
-    // beyond the cone, and a step must not end on it (a sliding box's edge glued to each new
-    // triangle it reached). The way back is bounded above (kMaxSwitches). The stick's slip is
-    // not a criterion: its penalty keeps it at the scale of the gap tolerance.
-    if (c.state != before) {
-      if (c.state == FaceContact::State::kStick) ++c.switches;
-      again = true;
-    }
-    if (violation > gap_tolerance) again = true;
-    // A sliding face's friction was set from the multiplier of the solve before; its normal
-    // impulse in this solve (Lambda - rho h) can differ by rho times an end gap still within the
-    // gap tolerance, a large part of a light body's weight on a soft slab. Until they agree
-    // within 1 % (or kMaxFaceFrictionRefinements solves) the loop goes on, as for node friction.
-    if (c.state == FaceContact::State::kSlide && before == FaceContact::State::kSlide &&
-        c.friction > 0 && std::abs(bound - applied_friction) > 1e-2 * bound &&
-        c.friction_refinements++ < kMaxFaceFrictionRefinements)
-      again = true;
-  }
-  setSlipResistance(v, partners);
-  return again;
-}
-
-void FaceContactSet::setSlipResistance(const Eigen::VectorXd& v,
-                                       const std::vector<RigidPartner>& partners) {
-  // Coulomb's sliding friction is -mu lambda s / |s| of the slip s the solve ends with, but each
-  // solve applies a friction fixed beforehand (the last update's), along the slip of the solve
-  // before. On a soft slab a sliding box's edge moves the light nodes under it sideways as it
-  // indents them, so each face's slip, and with it the next solve's friction, turned by up to
-  // 45 deg from step to step: the frictions' sum along the slope fell to 0.28 of the normal
-  // impulse (mu = 0.3), and a box 1 deg below the friction angle kept sliding. The friction's
-  // linearisation in the slip, d f / d s = -(|f| / |s|)(P_t - d d^T) (d the slip's direction),
-  // goes into the next solve: a slip across the friction meets the friction it would turn, and
-  // the friction's direction follows the slip inside the solve. It is bounded by the penalty of a
-  // stuck face (a slip slower than |f| / rho would have the face stick).
-  for (FaceContact& c : contacts_) {
-    c.slip_resistance.setZero();
-    if (c.determined || c.state != FaceContact::State::kSlide || c.friction <= 0) continue;
-    const Eigen::Vector3d friction = c.multiplier - c.normal * c.normal.dot(c.multiplier);
-    const double magnitude = friction.norm();
-    if (magnitude <= 0) continue;
-    const Eigen::Vector3d rigid =
-        pointVelocity(partners[static_cast<size_t>(c.partner)].velocity, c.lever);
-    const Eigen::Vector3d h = relativeVelocity(c, v, rigid);
-    const Eigen::Vector3d slip = h - c.normal * c.normal.dot(h);
-    const double speed = slip.norm();
-    if (speed <= 0) continue;
-    const double resistance = speed * c.penalty > magnitude ? magnitude / speed : c.penalty;
-    const Eigen::Vector3d d = slip / speed;
-    c.slip_resistance = resistance * (Eigen::Matrix3d::Identity() -
-                                      c.normal * c.normal.transpose() - d * d.transpose());
-  }
 }
 
 }  // namespace torsion

@@ -1,8 +1,7 @@
-// The convex contact solve of one FEM body and its rigid partners (ContactSettings::FrictionSolve
-// ::kConvex, docs/contact-solve.md): this step's detection as one SAP island, solved once; the
-// answer written back where detection, the rigid partners' finish() and the checkpoints read it.
+// The FEM body's share of its contact island (docs/contact-solve.md, bullet/island_step.h): this
+// step's detection as SAP rows; the answer written back where detection, the rigid partners'
+// finish() and the checkpoints read it.
 
-#include <Eigen/Cholesky>
 #include <algorithm>
 #include <cmath>
 #include <cstddef>
@@ -12,7 +11,6 @@
 #include "torsion/contact/rigid_contact.h"
 #include "torsion/contact/solve/convex_rows.h"
 #include "torsion/contact/solve/face_contact_rows.h"
-#include "torsion/contact/solve/fem_island_body.h"
 #include "torsion/contact/solve/node_contact_rows.h"
 #include "torsion/contact/solve/rigid_contact_rows.h"
 #include "torsion/contact/solve/rigid_joint_rows.h"
@@ -78,7 +76,6 @@ bool isRigidRow(const sap::NodeContactIsland& island, std::size_t r) {
 }  // namespace
 
 bool RigidContactSolver::islandTakesRigidContacts(btRigidBody& body) const {
-  if (settings_.friction_solve != ContactSettings::FrictionSolve::kConvex) return false;
   btDispatcher* dispatcher = soft_body_->getWorldInfo()->m_dispatcher;
   if (dispatcher == nullptr) return false;
   return sap::gatherRigidContactGroup(
@@ -91,7 +88,6 @@ bool RigidContactSolver::islandTakesRigidContacts(btRigidBody& body) const {
 void RigidContactSolver::takeRigidContacts() {
   rigid_group_ = {};
   rigid_impulses_.clear();
-  if (settings_.friction_solve != ContactSettings::FrictionSolve::kConvex) return;
   btDispatcher* dispatcher = soft_body_->getWorldInfo()->m_dispatcher;
   std::vector<btRigidBody*> seeds;
   for (const RigidPartner& k : partners_) {
@@ -122,7 +118,6 @@ void RigidContactSolver::takeRigidContacts() {
 }
 
 double RigidContactSolver::lookahead(double dt) const {
-  if (settings_.friction_solve != ContactSettings::FrictionSolve::kConvex) return dt;
   return dt * (1 + sap::RowDefaults{}.dissipation_steps);
 }
 
@@ -233,40 +228,12 @@ void RigidContactSolver::takeConvexSolution(const sap::ConvexRows& rows,
     FaceContact& f = solved_faces_[static_cast<std::size_t>(island.row_face[r])];
     const Eigen::Vector3d& gamma = report.impulses[r];
     f.impulse = island.rows[r].frame.transpose() * gamma;  // on the face
-    f.determined = false;
     f.state = !(gamma.z() > 0)                                ? FaceContact::State::kInactive
               : report.states[r] == sap::ContactState::kStick ? FaceContact::State::kStick
                                                               : FaceContact::State::kSlide;
   }
-  stats_.active_set_iterations = report.newton_iterations;
-  stats_.active_set_converged = report.converged;
-}
-
-LinearSolveReport RigidContactSolver::solveConvex(const SystemOperator& op,
-                                                  const NodeConstraints& constraints,
-                                                  const Eigen::VectorXd& b, Eigen::VectorXd& v) {
-  sap::ConvexRows rows = convexRows();
-  const sap::FemIslandBody fem(op, constraints, b);
-  Result<sap::SapProblem> created =
-      sap::SapProblem::create(sap::islandBodies(fem, rows.island), rows.island.rows, dt_);
-  if (!created) return brokenDown({}, "the contact rows do not form a valid problem");
-  sap::SapProblem& problem = created.value();
-  Eigen::VectorXd x(problem.dofs());
-  x.head(v.size()) = v;
-  for (std::size_t k = 0; k < rows.start_twists.size(); ++k)
-    x.segment<6>(problem.bodyOffset(static_cast<int>(k) + 1)) = rows.start_twists[k];
-  const sap::SapReport report = sap::solveWithMatchedFrictionBounds(problem, rows.row_group, x);
-  v = x.head(v.size());
-  const std::vector<Vector6d> twists = sap::solvedTwists(problem, report, 1);
-  std::vector<sap::SolvedBody> bodies(twists.size());
-  for (std::size_t k = 0; k < bodies.size(); ++k)
-    bodies[k].twist = twists[k];
-  takeConvexSolution(rows, report, bodies);
-  LinearSolveReport out;
-  out.iterations = report.cg_iterations;
-  out.converged = true;  // the linear solves inside Newton; the contact solve's own verdict is
-                         // stats().active_set_converged
-  return out;
+  stats_.newton_iterations = report.newton_iterations;
+  stats_.converged = report.converged;
 }
 
 }  // namespace torsion

@@ -21,7 +21,10 @@ namespace {
 
 // m: a supporting plane replaces the nearest feature's only if it leaves a larger predicted end
 // gap by more than round-off (at rest the two agree).
-constexpr double kPlaneChoiceMargin = 1e-9;
+constexpr double kDetectionPlaneMargin = 1e-9;
+// m: how far beyond a face's edge a node's foot may fall and still be over the face (the stated
+// penetration tolerance of a rigid feature between nodes).
+constexpr double kOverFaceTolerance = 1e-5;
 
 // Collects the soft body's nodes whose tree leaves overlap a volume.
 struct NodeCollector : btDbvt::ICollide {
@@ -165,18 +168,15 @@ void RigidContactSolver::chooseSupportPlane(const btCollisionShape& shape,
   const NodeContact nearest = c;
   const Eigen::Vector3d relative = state.velocity(node) - pointVelocity(k.entry_velocity, c.lever);
   bool taken = takeFacingPlane(shape, transform, x, into_surface, relative, dt, nearest, c);
-  if (settings_.friction_solve == ContactSettings::FrictionSolve::kConvex) {
-    const std::vector<Triangle>& triangles = model_->mesh().surfaceTriangles();
-    const auto [first, last] = faces_.trianglesOf(node);
-    for (const int* t = first; t != last; ++t) {
-      const Triangle& tri = triangles[static_cast<size_t>(*t)];
-      const Eigen::Vector3d a = state.position(tri[0]);
-      const Eigen::Vector3d normal = (state.position(tri[1]) - a).cross(state.position(tri[2]) - a);
-      if (normal.squaredNorm() == 0) continue;
-      taken =
-          takeFacingPlane(shape, transform, x, -normal.normalized(), relative, dt, nearest, c) ||
-          taken;
-    }
+  const std::vector<Triangle>& triangles = model_->mesh().surfaceTriangles();
+  const auto [first, last] = faces_.trianglesOf(node);
+  for (const int* t = first; t != last; ++t) {
+    const Triangle& tri = triangles[static_cast<size_t>(*t)];
+    const Eigen::Vector3d a = state.position(tri[0]);
+    const Eigen::Vector3d normal = (state.position(tri[1]) - a).cross(state.position(tri[2]) - a);
+    if (normal.squaredNorm() == 0) continue;
+    taken = takeFacingPlane(shape, transform, x, -normal.normalized(), relative, dt, nearest, c) ||
+            taken;
   }
   if (taken) c.swept = true;
 }
@@ -194,9 +194,9 @@ bool RigidContactSolver::takeFacingPlane(const btCollisionShape& shape,
   slip -= plane->normal * plane->normal.dot(slip);
   const double end_nearest = nearest.gap + dt * nearest.normal.dot(slip);
   const double end_plane = plane->distance;
-  if (end_plane <= end_nearest + kPlaneChoiceMargin) return false;
+  if (end_plane <= end_nearest + kDetectionPlaneMargin) return false;
   // A plane already taken instead of the nearest: the one of larger end gap.
-  if (c.normal != nearest.normal && end_plane <= c.gap + kPlaneChoiceMargin) return false;
+  if (c.normal != nearest.normal && end_plane <= c.gap + kDetectionPlaneMargin) return false;
   // Where the node would touch the plane: its foot on the plane, moved onto the shape.
   const Eigen::Vector3d foot = x - plane->distance * plane->normal;
   const std::optional<SurfacePoint> onto = signedDistance(shape, transform, foot, 0);
@@ -221,11 +221,7 @@ void RigidContactSolver::keepPreviousPlane(const btCollisionShape& shape,
   // block. Only towards the face that faces the surface: a node ahead of a box sliding over a slab
   // must not keep the front face it saw as the nearest (chooseSupportPlane), or the box meets it
   // as a wall; nor is a plane the sweep chose (c.swept) replaced.
-  // The active set's rules were settled on planes chosen afresh, and keeping the plane costs them
-  // accuracy at the stick/slip threshold (the stiff tet10 slab 1 deg above the friction angle:
-  // -22.6 % instead of +3.1 %), while face contacts already catch what such a corner node lets go
-  // of there: a body solved by the active set alone keeps choosing afresh.
-  if (c.swept || settings_.friction_solve == ContactSettings::FrictionSolve::kActiveSet) return;
+  if (c.swept) return;
   const int k = previous_of_node_.empty() ? -1 : previous_of_node_[static_cast<size_t>(c.node)];
   if (k < 0 || previous_active_[static_cast<size_t>(k)].second != &object) return;
   const Eigen::Vector3d& kept = previous_normal_[static_cast<size_t>(k)];
@@ -238,53 +234,35 @@ void RigidContactSolver::keepPreviousPlane(const btCollisionShape& shape,
   // tenths of a micron as the block under a box bulges).
   const Eigen::Vector3d foot = x - plane->distance * plane->normal;
   const std::optional<SurfacePoint> onto = signedDistance(shape, transform, foot, 0);
-  if (!onto || std::abs(onto->distance) > settings_.face_gap_tolerance) return;
+  if (!onto || std::abs(onto->distance) > kOverFaceTolerance) return;
   c.normal = plane->normal;
   c.gap = plane->distance;
   c.lever = foot - partners_[static_cast<size_t>(c.partner)].com;
 }
 
 void RigidContactSolver::rememberActiveContacts() {
-  // Last step's active contacts start this step active (warm active set).
+  // Last step's active contacts: their impulses are this step's friction bounds, their normals
+  // the planes they keep (keepPreviousPlane).
   previous_active_.clear();
-  previous_state_.clear();
   previous_impulse_.clear();
   previous_normal_.clear();
-  std::vector<char> slid(partners_.size(), 0), stuck(partners_.size(), 0);
   for (const NodeContact& c : contacts_) {
     if (c.state != NodeContact::State::kInactive && !c.held) {
       previous_active_.emplace_back(c.node, partners_[static_cast<size_t>(c.partner)].object);
-      previous_state_.push_back(c.state);
       previous_impulse_.push_back(c.impulse);
       previous_normal_.push_back(c.normal);
-      (c.state == NodeContact::State::kSlide ? slid : stuck)[static_cast<size_t>(c.partner)] = 1;
     }
   }
   previous_of_node_.assign(static_cast<size_t>(model_->nodeCount()), -1);
   for (size_t k = 0; k < previous_active_.size(); ++k)
     previous_of_node_[static_cast<size_t>(previous_active_[k].first)] = static_cast<int>(k);
-  for (const FaceContact& f : faces_.contacts()) {
-    // A face that sat the last solve out (its nodes decided) kept the state it started with.
-    if (f.state == FaceContact::State::kInactive || f.determined) continue;
-    (f.state == FaceContact::State::kSlide ? slid : stuck)[static_cast<size_t>(f.partner)] = 1;
-  }
-  // A body whose contacts (node and face) all ended the last step sliding may be sliding over the
-  // surface (RigidContactSolver::detect decides by its speed). Taken from the end of the last step,
-  // not from the contacts that survive into this one: a box sliding at 2 m/s leaves its contacts of
-  // the last step behind, and counting the survivors took it for not sliding, so its new
-  // contacts started stuck and took 1.3 m/s off it in one step. Face contacts count as nodes do:
-  // under a box on a soft slab whole steps pass with face contacts alone.
-  previous_sliding_.clear();
-  for (size_t k = 0; k < partners_.size(); ++k) {
-    if (slid[k] && !stuck[k]) previous_sliding_.push_back(partners_[k].object);
-  }
 }
 
 void RigidContactSolver::forgetLastStep(double dt) {
   for (const NodeContact& c : contacts_) {
     if (c.node >= 0 && !c.held) node_contact_[static_cast<size_t>(c.node)] = -1;
   }
-  faces_.beginStep(partners_);
+  faces_.beginStep();
   contacts_.clear();
   partners_.clear();
   solved_faces_.clear();
@@ -293,7 +271,6 @@ void RigidContactSolver::forgetLastStep(double dt) {
   joint_impulses_.clear();
   stats_ = ContactStepStats{};
   dt_ = dt;
-  dynamic_count_ = 0;
 }
 
 void RigidContactSolver::findContacts(const FemState& state, const NodeConstraints& constraints,
@@ -390,20 +367,6 @@ void RigidContactSolver::dropUntouchedPartners() {
   for (size_t k = 0; k < partners_.size(); ++k) {
     if (!touched[k]) partners_[k].dynamic = partners_[k].supported = false;
   }
-}
-
-void RigidContactSolver::warmStartActiveSet() {
-  for (NodeContact& c : contacts_) {
-    if (c.held || c.anchored) continue;
-    const int k = previous_of_node_[static_cast<size_t>(c.node)];
-    if (k >= 0 && previous_active_[static_cast<size_t>(k)].second ==
-                      partners_[static_cast<size_t>(c.partner)].object)
-      c.state =
-          c.friction > 0 ? previous_state_[static_cast<size_t>(k)] : NodeContact::State::kSlide;
-  }
-  for (RigidPartner& k : partners_)
-    k.sliding = std::find(previous_sliding_.begin(), previous_sliding_.end(), k.object) !=
-                previous_sliding_.end();
 }
 
 void RigidContactSolver::recordDetectionStats() {

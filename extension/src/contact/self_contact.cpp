@@ -5,6 +5,7 @@
 #include <cmath>
 #include <limits>
 
+#include "torsion/contact/solve/node_contact_rows.h"
 #include "torsion/contact/surface_candidates.h"
 #include "torsion/format_number.h"
 
@@ -12,13 +13,8 @@ namespace torsion {
 
 namespace {
 
-// Searches along the solved motion per step (each may add candidates and solves).
+// Searches along the solved motion per step (each may add candidates and a solve).
 constexpr int kMaxRedetections = 3;
-// Accurate rounds a search along the solved motion that found new pairs leaves at least, past
-// max_iterations if need be (at most kMaxRedetections times this per step).
-constexpr int kRoundsAfterRedetection = 5;
-// Passes of correctGaps per step (each reopens the loop on the shifted gaps).
-constexpr int kMaxSelfGapCorrections = 3;
 // Surface nodes (edges) per block of the parallel search: blocks are fixed, whatever the thread
 // count, and their finds are added in block order.
 constexpr int kSearchBlock = 64;
@@ -38,17 +34,8 @@ Status SelfContactSettings::validate() const {
     return Error{"self_contact: margin = " + formatNumber(margin) + ": must be in [0, 1]"};
   if (!(std::isfinite(max_depth) && max_depth > 0 && max_depth <= 0.5))
     return Error{"self_contact: max_depth = " + formatNumber(max_depth) + ": must be in (0, 0.5]"};
-  if (!(std::isfinite(penalty_factor) && penalty_factor > 0))
-    return Error{"self_contact: penalty_factor = " + formatNumber(penalty_factor) +
-                 ": must be > 0"};
-  if (!(std::isfinite(rough_tolerance_factor) && rough_tolerance_factor >= 1))
-    return Error{"self_contact: rough_tolerance_factor = " + formatNumber(rough_tolerance_factor) +
-                 ": must be >= 1"};
   if (!(std::isfinite(search_skin) && search_skin >= 0))
     return Error{"self_contact: search_skin = " + formatNumber(search_skin) + ": must be >= 0"};
-  if (max_iterations < 1)
-    return Error{"self_contact: max_iterations = " + std::to_string(max_iterations) +
-                 ": must be >= 1"};
   return Ok{};
 }
 
@@ -68,11 +55,6 @@ SelfContactSolver::SelfContactSolver(std::shared_ptr<const FemModel> model,
       parallel_(parallel != nullptr ? parallel : own_parallel_.get()),
       surface_edges_(model_->mesh().surfaceTriangles()),
       pairs_(model_->mesh().surfaceTriangles(), surface_edges_, model_->mesh().surfaceNodes()) {
-  // Converged once the solved motion is within the gap tolerance of a physical one (every
-  // impulse in Coulomb's cone), not once every state has stopped changing: in the plectoneme's
-  // coils a few contacts switching stick and slide, or a sliding friction impulse still moving
-  // with no visible effect, kept most contact steps going to max_iterations.
-  set_.setConvergedWithinTolerance(true);
   const TetMesh& mesh = model_->mesh();
   const std::vector<Triangle>& triangles = mesh.surfaceTriangles();
   node_triangles_.assign(static_cast<size_t>(mesh.nodeCount()), {});
@@ -93,6 +75,7 @@ SelfContactSolver::SelfContactSolver(std::shared_ptr<const FemModel> model,
 bool SelfContactSolver::detect(const FemState& state, const NodeConstraints& constraints,
                                double dt) {
   dt_ = dt;
+  redetections_ = 0;
   stats_ = SelfContactStats{};
   set_.beginStep();
   for (int p : touched_nodes_)
@@ -101,7 +84,9 @@ bool SelfContactSolver::detect(const FemState& state, const NodeConstraints& con
   touched_nodes_.clear();
   start_ = &state.positions;
   constraints_ = &constraints;
-  end_ = state.positions + dt * state.velocities;  // the predicted motion, before contacts
+  // The predicted motion, before contacts, over the rows' reach: a row engages where its gap
+  // closes within dt + tau_d (sap::RowDefaults).
+  end_ = state.positions + dt * (1 + sap::RowDefaults{}.dissipation_steps) * state.velocities;
   addCandidates(state.positions, end_);
   stats_.candidates = static_cast<int>(set_.contacts().size());
   return !set_.empty();
@@ -290,7 +275,9 @@ int SelfContactSolver::correctGaps(const Eigen::VectorXd& v) {
       if (n.dot(c.normal) < 0) n = -n;  // the side the contact keeps its edges on
       true_gap = n.dot((p + u * (q - p)) - (r + s * (t - r)));
     }
-    const double linear_gap = c.end_gap + c.target_gap;
+    double linear_gap = c.gap;
+    for (size_t k = 0; k < c.nodes.size(); ++k)
+      linear_gap += dt_ * c.beta[k] * c.normal.dot(v.segment<3>(3 * c.nodes[k]));
     if (true_gap >= c.target_gap - gap_tolerance_ || true_gap >= linear_gap) continue;
     c.gap += true_gap - linear_gap;
     ++shifted;
@@ -306,149 +293,21 @@ CandidateRules SelfContactSolver::rules() const {
   return rules;
 }
 
-LinearSolveReport SelfContactSolver::solve(const SystemOperator& op,
-                                           const NodeConstraints& constraints,
-                                           const Eigen::VectorXd& b, const SolverSettings& settings,
-                                           Eigen::VectorXd& v, const InnerSolve& inner) {
-  // Penalties from the system without the term (the operator includes it otherwise); its
-  // diagonal blocks are only taken once there are candidates.
-  penalties_ready_ = false;
-  const auto set_penalties = [&] {
-    if (!penalties_ready_) {
-      set_.setSuspended(true);
-      op.diagonalBlocks(blocks_);
-      set_.setSuspended(false);
-      penalties_ready_ = true;
-    }
-    set_.setPenalties(blocks_, settings_.penalty_factor);
-  };
-  if (!set_.empty()) set_penalties();
-  // Activation below a tenth of the tolerance: a contact hovering at zero gap does not flip.
-  const double activation = 0.1 * gap_tolerance_;
+int SelfContactSolver::searchAlong(const Eigen::VectorXd& v) {
+  const double margin = settings_.margin * mean_edge_;
+  const double moved = (dt_ * v - (end_ - *start_)).lpNorm<Eigen::Infinity>();
+  if (!(moved > 0.5 * margin / std::sqrt(3.0)) || redetections_ >= kMaxRedetections) return 0;
+  ++redetections_;
+  end_ = *start_ + dt_ * v;
+  return addCandidates(*start_, end_);
+}
 
-  LinearSolveReport total;
-  stats_.converged = false;
-  int rounds = inner ? 1 : settings_.max_iterations;
-  int redetections = 0;
-  int corrections = 0;                                          // correctGaps passes
-  double best_error = std::numeric_limits<double>::infinity();  // no accurate round yet
-  int worse = 0;
-  // Rough rounds first: while the active set and the multipliers are still far from settled,
-  // each CG solve stops at rough_tolerance_factor times the tolerance (its motion only steers
-  // the next Uzawa update). Once a rough round settles, or three rough rounds in a row did
-  // worse, or a quarter of the rounds has passed, the rounds are accurate for the rest of the
-  // step: the step only ends on an accurate solve, judged by the same criteria as before. A
-  // round with no contact pushing is accurate (a step with candidates but no contact solves as
-  // it did without the rough rounds, to the bit).
-  SolverSettings rough = settings;
-  rough.tolerance = settings_.rough_tolerance_factor * settings.tolerance;
-  bool rough_over = inner || !(settings_.rough_tolerance_factor > 1);
-  double rough_best = -1;  // the smallest gap error of the rough rounds (-1: none yet)
-  const auto any_pushing = [this] {
-    for (const SurfaceContact& c : set_.contacts())
-      if (!c.determined && c.state != SurfaceContact::State::kInactive) return true;
-    return false;
-  };
-  for (int round = 0; round < rounds; ++round) {
-    // Where the rough rounds cycle, the accurate ones still have three quarters to settle in.
-    if (round == rounds - 1 || 4 * round >= rounds) rough_over = true;
-    const bool accurate = rough_over || !any_pushing();
-    b_aug_ = b;
-    set_.addRightHandSide(dt_, b_aug_);
-    const SolverSettings& round_settings = accurate ? settings : rough;
-    const LinearSolveReport r = inner ? inner(op, constraints, b_aug_, settings, v)
-                                      : cg_.solve(op, constraints, b_aug_, round_settings, v);
-    total.iterations += r.iterations;
-    total.relative_residual = r.relative_residual;
-    total.converged = r.converged;
-    total.breakdown = r.breakdown;
-    total.breakdown_reason = r.breakdown_reason;
-    ++stats_.iterations;
-    if (r.breakdown) break;
-    const bool settled = set_.update(v, dt_, activation, gap_tolerance_);
-    if (!accurate) {
-      // Rough: no best kept, nothing judged; worse rounds end the rough phase instead.
-      const double error = set_.maxGapError();
-      const bool first_rough = rough_best < 0;
-      if (settled ||
-          (!first_rough && error >= rough_best && error > gap_tolerance_ && ++worse >= 3)) {
-        rough_over = true;
-      } else if (first_rough || error < rough_best) {
-        worse = 0;
-      }
-      rough_best = first_rough ? error : std::min(rough_best, error);
-      if (rough_over) {
-        // The accurate rounds start their own safeguard: the first is the best so far.
-        worse = 0;
-        best_error = std::numeric_limits<double>::infinity();
-      }
-      continue;
-    }
-    // Safeguard: where constraints contradict each other (crossed before, a crease) Uzawa can
-    // diverge. The best solve so far is kept; three worse ones in a row, beyond the tolerance,
-    // end the step with it (reported as not converged).
-    // An update whose gaps are all within the tolerance is never "worse": it is kept and the
-    // loop goes on to settle states and friction (stopping there left most of the plectoneme's
-    // contact steps unconverged with their gaps already within the tolerance).
-    const double error = set_.maxGapError();
-    if (round == 0 || error < best_error || error <= gap_tolerance_) {
-      best_error = error;
-      best_v_ = v;
-      best_contacts_ = set_.contacts();
-      worse = 0;
-    } else if (++worse >= 3) {
-      v = best_v_;
-      set_.contacts() = best_contacts_;
-      break;
-    }
-    // Look again along the solved motion, which can differ from the predicted one the candidates
-    // were found along (a kink snapping through, a loop closing), after every accurate round, not
-    // only once the loop settles: a loop that ran to max_iterations, or that the safeguard ended,
-    // had its last motion never searched, and on the Greenhill rod a closing loop went 6 mm
-    // through the rod that way (docs/contact.md). Unless every node ends within half the margin
-    // of the end last searched: then any pair the solved path meets was found along that one
-    // (within the margin at its end). New pairs reopen the loop with a few rounds to settle in.
-    const double margin = settings_.margin * mean_edge_;
-    const double moved = (dt_ * v - (end_ - *start_)).lpNorm<Eigen::Infinity>();
-    if (moved > 0.5 * margin / std::sqrt(3.0) && redetections < kMaxRedetections) {
-      end_ = *start_ + dt_ * v;
-      if (addCandidates(*start_, end_) > 0) {
-        ++redetections;
-        set_penalties();
-        set_.update(v, dt_, activation, gap_tolerance_);  // activates the new ones
-        // The safeguard starts over: the best solve so far was judged without the new pairs
-        // (its gap error did not count them), and going back to it would let them cross. On the
-        // Greenhill rod's closing loop the re-search found the pairs of a loop passing through
-        // the rod, three worse rounds followed, and the safeguard's "best", the first solve with
-        // no candidate at all, put the loop 3.4 mm through the rod (docs/contact.md).
-        best_error = std::numeric_limits<double>::infinity();
-        worse = 0;
-        if (!inner) rounds = std::max(rounds, round + 1 + kRoundsAfterRedetection);
-        continue;
-      }
-    }
-    // Settled on the linearised gaps, or at least every linearised gap within the tolerance
-    // (states or friction may not settle, and the safeguard may then end the loop): measure them
-    // on the true end geometry of this motion. A pair whose edges slide across each other, or
-    // whose triangle turns, during the step ends closer than its linearised gap says (on the
-    // Greenhill rod's closed loop edge pairs crossed by up to 0.5 mm with their contacts in
-    // place, at a thickness of 12 um): shifted gaps reopen the loop (docs/contact.md, "Contact
-    // thickness").
-    if ((settled || error <= gap_tolerance_) && corrections < kMaxSelfGapCorrections &&
-        correctGaps(v) > 0) {
-      ++corrections;
-      set_.update(v, dt_, activation, gap_tolerance_);  // activates the shifted ones
-      best_error = std::numeric_limits<double>::infinity();
-      worse = 0;
-      if (!inner) rounds = std::max(rounds, round + 1 + kRoundsAfterRedetection);
-      continue;
-    }
-    if (!settled) continue;
-    stats_.converged = true;
-    break;
-  }
+void SelfContactSolver::finishStep(int iterations, bool converged) {
+  stats_.iterations = iterations;
+  stats_.converged = converged;
   stats_.candidates = static_cast<int>(set_.contacts().size());
-
+  stats_.active = stats_.sticking = 0;
+  stats_.normal_impulse = 0;
   for (const SurfaceContact& c : set_.contacts()) {
     if (c.determined || c.state == SurfaceContact::State::kInactive) continue;
     ++stats_.active;
@@ -456,7 +315,6 @@ LinearSolveReport SelfContactSolver::solve(const SystemOperator& op,
     stats_.normal_impulse += c.normal.dot(c.multiplier);
   }
   stats_.max_end_penetration = set_.maxEndPenetration();
-  return total;
 }
 
 }  // namespace torsion

@@ -396,13 +396,12 @@ void SystemOperator::gather(const std::vector<Eigen::Vector3d>& element_values, 
 
 void SystemOperator::multiply(const Eigen::VectorXd& y, Eigen::VectorXd& out) const {
   apply(y, out, mass_coefficient_, stiffness_coefficient_);
-  if (added_term_ != nullptr) added_term_->addProduct(y, out);
 }
 
 void SystemOperator::multiplyFromNodes(const Eigen::VectorXd& y, const std::vector<int>& nodes,
                                        Eigen::VectorXd& out) const {
-  if (model_->nodalPressure() || added_term_ != nullptr) {
-    multiply(y, out);  // both couple rows beyond the block pattern
+  if (model_->nodalPressure()) {
+    multiply(y, out);  // it couples rows beyond the block pattern
     return;
   }
   assemble();
@@ -457,7 +456,6 @@ void SystemOperator::diagonalBlocks(std::vector<Eigen::Matrix3d>& blocks) const 
                 stiffness_coefficient_ * block_values_[static_cast<size_t>(diagonal_slots_[n])];
   }
   if (model_->nodalPressure()) addNodalPressureDiagonal(blocks);
-  if (added_term_ != nullptr) added_term_->addDiagonalBlocks(blocks);
 }
 
 void SystemOperator::buildPatches() {

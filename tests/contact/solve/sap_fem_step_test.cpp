@@ -1,8 +1,8 @@
 // The SAP solve on the real pipeline (docs/contact-solve.md, "From detection to rows"): Bullet's
 // collision detection, FemBody::prepare (RigidContactSolver::detect), the node contacts as SAP
-// rows (node_contact_rows.h), the SAP solve in place of FemBody::solveContacts, FemBody::finish,
-// the dynamic partners' new twists written to Bullet. Each scene also runs with today's solver
-// (FemBody::advance) and the figures are printed side by side.
+// rows (node_contact_rows.h), the SAP solve of this prototype, FemBody::finish, the dynamic
+// partners' new twists written to Bullet. Each scene also runs through the product's island step
+// (bullet/island_step.h) and the figures are printed side by side.
 
 #include <BulletSoftBody/btSoftBodyRigidBodyCollisionConfiguration.h>
 #include <BulletSoftBody/btSoftRigidDynamicsWorld.h>
@@ -18,6 +18,7 @@
 
 #include "torsion/bt_conversions.h"
 #include "torsion/bullet/fem_soft_body_solver.h"
+#include "torsion/bullet/island_step.h"
 #include "torsion/contact/solve/face_contact_rows.h"
 #include "torsion/contact/solve/fem_island_body.h"
 #include "torsion/contact/solve/node_contact_rows.h"
@@ -31,7 +32,8 @@ namespace {
 constexpr double kDt = 0.01;
 constexpr double kG = 9.81;
 
-/// The FEM step with the SAP contact solve (or today's, FemBody::advance), on every FEM body.
+/// The FEM step with this prototype's SAP contact solve (or the product's, stepIsland), on every
+/// FEM body.
 class SapStepSolver final : public FemSoftBodySolver {
  public:
   explicit SapStepSolver(bool sap) : FemSoftBodySolver(settings()), sap_(sap) {}
@@ -44,7 +46,7 @@ class SapStepSolver final : public FemSoftBodySolver {
     time_ += ctx.dt;
     for (const auto& body : bodies()) {
       if (!sap_) {
-        body->advance(ctx);
+        stepIsland({body.get()}, {}, ctx);
       } else {
         sapStep(*body, ctx);
       }
@@ -77,7 +79,7 @@ class SapStepSolver final : public FemSoftBodySolver {
     if (!body.prepare(ctx)) return;
     const PreparedSystem p = body.preparedSystem();
     normal_impulse = 0;
-    if (!body.hasContactSolve()) {
+    if (!body.touchesRigid()) {
       body.finish(*p.v, body.stepper().solve());
       lagged_.clear();
       lagged_faces_.clear();
@@ -112,7 +114,7 @@ class SapStepSolver final : public FemSoftBodySolver {
     writeRigid(island, contacts.partners(), problem, v, ctx.dt);
     if (carry)
       body.contacts().restoreCarriedContacts(
-          carriedContacts(island, contacts.contacts(), faces, contacts.partners(), report));
+          carriedContacts(island, contacts.contacts(), contacts.partners(), report));
   }
 
   void record(const SapReport& report) {
@@ -169,14 +171,12 @@ class SapStepSolver final : public FemSoftBodySolver {
   std::vector<LaggedFaceImpulse> lagged_faces_;
 };
 
-/// Today's solver (FemBody::advance); SAP with node rows alone; SAP with node and face rows;
-/// FemBody::advance with the convex solve (ContactSettings::FrictionSolve::kConvex).
-enum class Mode { kToday, kNodeRows, kSap, kConvex };
+/// This prototype's SAP with node rows alone, or with node and face rows; the product's island step
+/// (stepIsland).
+enum class Mode { kNodeRows, kSap, kConvex };
 
 const char* label(Mode mode) {
   switch (mode) {
-    case Mode::kToday:
-      return "today     ";
     case Mode::kNodeRows:
       return "SAP nodes ";
     case Mode::kSap:
@@ -189,9 +189,8 @@ const char* label(Mode mode) {
 
 /// A user world (tests/bullet/user_world.h) stepped by SapStepSolver.
 struct World {
-  explicit World(Mode mode) : fem(mode != Mode::kToday && mode != Mode::kConvex), mode_(mode) {
+  explicit World(Mode mode) : fem(mode != Mode::kConvex) {
     fem.face_rows = mode == Mode::kSap;
-    fem.carry = mode != Mode::kToday;
     world.setGravity(btVector3(0, 0, btScalar(-kG)));
     world.getWorldInfo().m_gravity = world.getGravity();
     world.getWorldInfo().m_sparsesdf.Initialize();
@@ -224,8 +223,6 @@ struct World {
     m.stiffness_damping = 0.01;
     FemBody* body = fem.addBody("slab", makeBoxTetMesh(lo, hi, nx, ny, nz).value(), m).value();
     body->contacts().settings().friction = 1.0;
-    if (mode_ == Mode::kConvex)
-      body->contacts().settings().friction_solve = ContactSettings::FrictionSolve::kConvex;
     if (!fix_base) return body;
     std::vector<int> base;
     for (int i = 0; i < body->model().nodeCount(); ++i)
@@ -238,12 +235,12 @@ struct World {
     world.stepSimulation(btScalar(kDt), 1, btScalar(kDt));
     for (const auto& body : fem.bodies()) {
       const ContactStepStats& s = body->contacts().stats();
-      if (!s.active_set_converged) ++unconverged_steps;
-      max_iterations = std::max(max_iterations, s.active_set_iterations);
+      if (!s.converged) ++unconverged_steps;
+      max_iterations = std::max(max_iterations, s.newton_iterations);
     }
   }
-  /// Steps whose contact solve did not converge, and the most iterations (active-set solves, or
-  /// the convex solve's Newton iterations) in one, from the bodies' stats (FemBody::advance).
+  /// Steps whose contact solve did not converge, and the most Newton iterations in one, from the
+  /// bodies' stats (stepIsland).
   int unconverged_steps = 0;
   int max_iterations = 0;
 
@@ -255,7 +252,6 @@ struct World {
   btSoftRigidDynamicsWorld world{&dispatcher, &broadphase, &solver, &config, &fem};
   std::vector<std::unique_ptr<btCollisionShape>> shapes;
   std::vector<std::unique_ptr<btRigidBody>> rigids;
-  Mode mode_;
 };
 
 double fastestNode(const FemBody& body) {
@@ -278,7 +274,7 @@ struct BlockRun {
 };
 
 BlockRun runBlock(bool sap) {
-  World w(sap ? Mode::kSap : Mode::kToday);
+  World w(sap ? Mode::kSap : Mode::kConvex);
   w.addRigid(std::make_unique<btStaticPlaneShape>(btVector3(0, 0, 1), 0), 0, btVector3(0, 0, 0),
              0.5);
   FemBody* block = w.addSlab({-0.1, -0.1, 0.001}, {0.1, 0.1, 0.201}, 4, 4, 4, 1e5, false);
@@ -291,7 +287,7 @@ BlockRun runBlock(bool sap) {
   run.impulse_error = std::abs(
       (sap ? w.fem.normal_impulse : block->contacts().stats().normal_impulse) / weight - 1);
   std::printf("[block %s] normal impulse / (m g dt) - 1 = %.2e; fastest node, last 1 s: %.2e m/s",
-              sap ? "SAP  " : "today", run.impulse_error, run.settled_speed);
+              sap ? "SAP   " : "island", run.impulse_error, run.settled_speed);
   if (sap) std::printf("; max Newton %d, max CG %d", w.fem.max_newton, w.fem.max_cg);
   std::printf("\n");
   if (sap) {
@@ -301,11 +297,11 @@ BlockRun runBlock(bool sap) {
 }
 
 TEST(SapFemStep, SoftBlockRestsOnGroundWithItsWeight) {
-  const BlockRun today = runBlock(false);
-  const BlockRun run = runBlock(true);
-  (void)today;
-  EXPECT_LT(run.impulse_error, 0.01);
-  EXPECT_LT(run.settled_speed, 1e-3);
+  for (bool sap : {false, true}) {
+    const BlockRun run = runBlock(sap);
+    EXPECT_LT(run.impulse_error, 0.01) << (sap ? "prototype" : "island step");
+    EXPECT_LT(run.settled_speed, 1e-3) << (sap ? "prototype" : "island step");
+  }
 }
 
 struct BoxRun {
@@ -365,7 +361,6 @@ TEST(SapFemStep, RigidBoxRestsOnSoftSlab) {
   // solve.
   if (sizeof(btScalar) != sizeof(double)) GTEST_SKIP() << "double Bullet only (see the comment)";
   for (int cells : {6, 7}) {
-    runRestingBox(Mode::kToday, cells);
     runRestingBox(Mode::kNodeRows, cells);
     for (Mode mode : {Mode::kSap, Mode::kConvex}) {
       const BoxRun run = runRestingBox(mode, cells);
@@ -422,11 +417,9 @@ TEST(SapFemStep, SlidingBoxDeceleratesAsCoulombSays) {
   // sensitivity of the prototype to resolve before SAP replaces the step's contact solve, not a
   // tolerance to widen.
   if (sizeof(btScalar) != sizeof(double)) GTEST_SKIP() << "double Bullet only (see the comment)";
-  const double today = runSlidingBox(Mode::kToday, 0.3);
   const double nodes = runSlidingBox(Mode::kNodeRows, 0.3);
   const double faces = runSlidingBox(Mode::kSap, 0.3);
   const double convex = runSlidingBox(Mode::kConvex, 0.3);
-  (void)today;
   EXPECT_LT(std::abs(nodes), 0.03);
   EXPECT_LT(std::abs(faces), 0.03);
   EXPECT_LT(std::abs(convex), 0.03);

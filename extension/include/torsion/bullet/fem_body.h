@@ -17,7 +17,6 @@
 #include "torsion/fem/fem_model.h"
 #include "torsion/result.h"
 #include "torsion/solve/implicit_stepper.h"
-#include "torsion/solve/summed_operator_term.h"
 
 namespace torsion {
 
@@ -107,29 +106,20 @@ class FemBody {
   void predict(double dt, bool for_contact = true);
   /// Bullet's end of the step: node normals and bounds.
   void refreshSurface();
-  /// The FEM step from ctx.time to ctx.endTime(): prepare(), the body's own solve (its contact
-  /// solve, or the stepper's CG / CHOLMOD without contacts), finish(). A hyperelastic body
-  /// (Material::law) that touches anything (rigid contacts or anchors, self-contact, another FEM
-  /// body) fails its step (StepHealth::kSolverFailed): its Newton step has no contact solve.
-  const StepReport& advance(const StepContext& ctx);
-
-  // ---- the same step in stages (FemContactIslands solves several bodies' systems together) ----
+  // ---- the step in stages, driven by the body's contact island (bullet/island_step.h) ----
   /// Up to the linear solve: the node groups' prescriptions, this step's forces (external + m_i g),
-  /// contact detection (rigid, self), the stepper's prepare(). `island_term` (not owned; nullptr
-  /// outside an island) is added to the system, with self-contact's term, until finish(). False
-  /// when the step ended there (non-finite forces: lastReport() says why; the state untouched;
-  /// no finish()).
-  bool prepare(const StepContext& ctx, const AddedOperatorTerm* island_term = nullptr);
+  /// contact detection (rigid, self), the stepper's prepare(). `touches_fem_bodies`: the body is
+  /// in an island with other FEM bodies. False when the step ended there (non-finite forces, or a
+  /// hyperelastic body (Material::law) that touches anything: its Newton step has no contact
+  /// solve; lastReport() says why; the state untouched; no finish()).
+  bool prepare(const StepContext& ctx, bool touches_fem_bodies = false);
   /// The prepared step's system: operator, constraints (the groups' and anchors'), b, warm start.
   PreparedSystem preparedSystem() { return stepper_.prepared(); }
-  /// Whether this step has a contact solve of its own (rigid contacts found, or self-contact on).
-  bool hasContactSolve() const { return rigid_contact_ || self_contact_ != nullptr; }
-  /// This step's contact solve (hasContactSolve()) of A v = b: self-contact's loop around the
-  /// rigid-contact solve, or either alone. v: the warm start on entry, v' on return. Islands call
-  /// it with their own right-hand sides (contact/island_contact.h).
-  LinearSolveReport solveContacts(const SystemOperator& op, const NodeConstraints& constraints,
-                                  const Eigen::VectorXd& b, const SolverSettings& settings,
-                                  Eigen::VectorXd& v);
+  /// Whether this step found rigid objects near the body (its contact rows, anchors included).
+  bool touchesRigid() const { return rigid_contact_; }
+  /// The prepared step's solve without contact (the stepper's CG, CHOLMOD or Newton): v' into
+  /// preparedSystem().v.
+  LinearSolveReport solveAlone() { return stepper_.solve(); }
   /// After the solve: the stepper's finish() with v' = `velocities` (3n) and `solve` (the solve's
   /// report), the self-contact warning, impulses onto rigid bodies, the btSoftBody written back.
   const StepReport& finish(const Eigen::Ref<const Eigen::VectorXd>& velocities,
@@ -155,8 +145,8 @@ class FemBody {
   void disableSelfContact();
   /// The self-contact solver (its last step's contacts and statistics), or nullptr when off.
   const SelfContactSolver* selfContact() const { return self_contact_.get(); }
+  SelfContactSolver* selfContact() { return self_contact_.get(); }
 
-  // ---- contact between FEM bodies (FemSoftBodySolver's islands, docs/contact.md) ----
   /// Marks the last step's report as not converged in contact (a warning, unless the step was
   /// already worse) and appends `what` to its message.
   void noteContactNotConverged(const std::string& what);
@@ -176,8 +166,7 @@ class FemBody {
   std::unique_ptr<btSoftBody> soft_body_;
   std::unique_ptr<RigidContactSolver> contacts_;
   std::unique_ptr<SelfContactSolver> self_contact_;
-  bool rigid_contact_ = false;      // this step found nodes near rigid bodies (prepare)
-  SummedOperatorTerm added_terms_;  // self-contact and island terms together
+  bool rigid_contact_ = false;  // this step found nodes near rigid bodies (prepare)
   StepReport last_report_;
 };
 

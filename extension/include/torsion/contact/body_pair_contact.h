@@ -10,7 +10,7 @@
 // triangle point's barycentric weights w, beta = (1, -w_a, -w_b, -w_c), relative velocity
 // u = sum_k beta_k v_k, linearised end-of-step gap g + dt n.u >= 0. Since sum_k beta_k = 0, an
 // impulse lambda on the node and -w_j lambda on the triangle's corners exchanges momentum exactly.
-// The island solve (island_contact.h) resolves them.
+// The contact island (bullet/island_step.h) solves them as rows.
 
 #include <Eigen/Core>
 #include <Eigen/Geometry>
@@ -42,11 +42,6 @@ struct BodyContactSettings {
   /// A node this fraction of the triangle's shortest edge behind it is deep inside the other body
   /// (on its far side), not through its surface: no candidate.
   double max_depth = 0.25;
-  /// rho in units of the contact's effective mass (surface_contact_set.h), for the island's
-  /// joint solve; its Gauss-Seidel path uses a hundredth of it (island_contact.h).
-  double penalty_factor = 20;
-  /// Uzawa updates per step (each one linear solve of every body of the island).
-  int max_iterations = 60;
   /// Edge-against-edge candidates besides node-against-triangle ones: two edges crossing where
   /// no node meets a face (an edge across an edge). On by default: with them the exact checker
   /// finds fewer crossings in the contact scenes (soft_stack: 360 crossing triangle pairs over

@@ -10,7 +10,7 @@
 // own multibody contacts use), with the pose corrected by dt dqdot.
 //
 // Approximations: J M^-1 J^T is singular in the directions a link cannot move (a fixed base, a
-// joint's locked axes); there the link yields within the solve as a body 1000 times its own mass
+// joint's locked axes); there the link yields within the solve as a body 1e6 times its own mass
 // and inertia would (the impulse the multibody then receives moves it only where it can move);
 // J and M^-1 are taken at Bullet's configuration of the step (J after its integration, M^-1 as
 // cached by its forward dynamics); two links of one multibody touched in the same step are

@@ -41,16 +41,6 @@ struct RigidPartner {
   /// step, which the convex island solves afresh as rows (contact/solve/rigid_contact_rows.h):
   /// the body's momentum before contact is M entry_velocity less it. Zero otherwise.
   Vector6d bullet_contact_impulse = Vector6d::Zero();
-  int unknown = -1;  ///< offset of its 6 unknowns in the CG vector
-  /// The net normal impulse of this body's contacts over the sum of their pushes, in the last
-  /// solve (1 without pulls): Coulomb's bounds of the pushing contacts are scaled by it, so that
-  /// their friction together is mu times the net normal impulse (docs/contact.md, "Sliding over
-  /// nodes").
-  double friction_share = 1;
-  /// All its contacts (node and face) ended the last step sliding: the body slides over the
-  /// surface, and a node or face contact it slips over starts sliding
-  /// (rigid_contact_active_set.cpp, face_contacts.cpp).
-  bool sliding = false;
   /// A dynamic body that another FEM body of the same convex island also touches, and whose
   /// solved velocity that body applies (contact/solve/convex_rows.h): finish() leaves it alone.
   bool applied_by_another_body = false;

@@ -1,11 +1,12 @@
 #pragma once
-// Self-contact of one FEM body: its surface nodes against its own surface triangles, with
-// Coulomb friction, inside the body's implicit step (docs/contact.md, "Self-contact"). Touched
-// only by the simulation thread.
+// Self-contact of one FEM body: its surface nodes against its own surface triangles (and its
+// surface edges across each other), with Coulomb friction, inside the body's implicit step
+// (docs/contact.md, "Self-contact"). Touched only by the simulation thread.
 //
-// Per step:
+// Per step (the island's stages, bullet/island_step.h):
 //   detect (before the solve)  the surface triangle tree (surface_tree.h) is refitted to the
-//                              triangles swept over the predicted motion x + s dt v, s in [0, 1];
+//                              triangles swept over the predicted motion x + s (dt + tau_d) v,
+//                              s in [0, 1] (the rows' reach, tau_d their dissipation time);
 //                              every surface node queries it with its own swept box. A pair
 //                              (node, triangle) is a candidate unless the triangle is in the
 //                              node's one-ring (has the node as a corner), when the node lies in
@@ -13,18 +14,17 @@
 //                              projection falls inside the triangle at the moment of the
 //                              predicted motion where it crosses the triangle's plane (or now, if
 //                              it is within the margin): a continuous test on the predicted path.
-//   solve (the step's solve)   the candidates' augmented Lagrangian (surface_contact_set.h) is
-//                              added to the body's system operator; Uzawa updates alternate with
-//                              warm-started CG solves until every end-of-step gap is within
-//                              gap_tolerance (or max_iterations: reported, not accepted
-//                              silently). With rigid contacts in the same step, the rigid
-//                              contact solve runs once on the augmented system and the
-//                              multipliers are updated once (the gap then converges over steps).
+//   the solve                  the candidates are rows of the body's contact island
+//                              (surface_contact_rows.h), solved with everything else it touches.
+//                              After each solve the island asks for the true end gaps of the
+//                              solved motion (correctGaps) and for a search along that motion
+//                              (searchAlong): new candidates become new rows.
+//   after the solve            takeSolution(): the rows' impulses as multipliers (the next step's
+//                              lagged friction bounds) and the statistics.
 
 #include <Eigen/Core>
 #include <array>
 #include <cstdint>
-#include <functional>
 #include <memory>
 #include <optional>
 #include <set>
@@ -38,9 +38,6 @@
 #include "torsion/solve/fem_state.h"
 #include "torsion/solve/node_constraints.h"
 #include "torsion/solve/parallel.h"
-#include "torsion/solve/projected_cg.h"
-#include "torsion/solve/solver_settings.h"
-#include "torsion/solve/system_operator.h"
 
 namespace torsion {
 
@@ -60,19 +57,6 @@ struct SelfContactSettings {
   /// A node this fraction of the triangle's shortest edge behind it is on the far side of the
   /// body, not through the surface: no candidate (see docs/contact.md for why 0.25).
   double max_depth = 0.25;
-  /// rho in units of the contact's effective mass (surface_contact_set.h). Stiffer converges the
-  /// normal gap in fewer updates but each CG solve takes longer and friction settles worse: on
-  /// six steps of the plectoneme's contact phase 8 took half the CPU time of 20 (60: a quarter
-  /// more than 20); 2 left steps unconverged (docs/contact.md).
-  double penalty_factor = 8;
-  /// Uzawa updates (each one warm-started CG solve) per step.
-  int max_iterations = 40;
-  /// The CG tolerance of the rough rounds, in units of the solver's: the Uzawa updates start on
-  /// solves this much less accurate, and the step goes on with accurate ones once they settle,
-  /// once three rough rounds in a row did worse, or after a quarter of max_iterations (it ends
-  /// on an accurate solve, judged as before). 1: every solve accurate. On the plectoneme's
-  /// contact phase 100 took 31 % less CPU than 1, and 30 only 13 % less (docs/performance.md).
-  double rough_tolerance_factor = 100;
   /// The candidate search keeps its pairs across steps while every surface node stays within
   /// this fraction of the mean surface edge of where it was when they were found
   /// (surface_pair_cache.h): the same candidates as a fresh search, most steps without a tree
@@ -86,7 +70,7 @@ struct SelfContactStats {
   int candidates = 0;  ///< (node, triangle) pairs this step
   int active = 0;      ///< pushing at the end of the step
   int sticking = 0;    ///< of which sticking
-  int iterations = 0;  ///< Uzawa updates (CG solves) this step
+  int iterations = 0;  ///< Newton iterations of the island's solves this step
   int searches = 0;    ///< tree searches this step: 1, plus the re-searches along the solved motion
   int search_builds = 0;      ///< of which walked the tree (the others reused the kept pairs)
   double search_seconds = 0;  ///< s, wall time of those searches (refit, queries, candidates)
@@ -114,18 +98,24 @@ class SelfContactSolver {
   /// Before the solve: candidates from the state at the start of the step and its predicted
   /// motion. Returns whether there are any.
   bool detect(const FemState& state, const NodeConstraints& constraints, double dt);
-  /// The augmented Lagrangian term to add to the body's system operator for this step.
-  const AddedOperatorTerm& term() const { return set_; }
-  /// The step's linear solve, on the stepper's prepared system with term() added
-  /// (ImplicitStepper::prepared(); FemBody::solveContacts). `inner`, when given, is the solve that
-  /// would run without self-contact (the rigid contact solve): it runs once on the augmented
-  /// system. Without it, CG solves alternate with Uzawa updates until converged.
-  using InnerSolve = std::function<LinearSolveReport(const SystemOperator&, const NodeConstraints&,
-                                                     const Eigen::VectorXd&, const SolverSettings&,
-                                                     Eigen::VectorXd&)>;
-  LinearSolveReport solve(const SystemOperator& op, const NodeConstraints& constraints,
-                          const Eigen::VectorXd& b, const SolverSettings& settings,
-                          Eigen::VectorXd& v, const InnerSolve& inner);
+  /// After a solve with velocities v (3n): looks again along the solved motion x + s dt v, which
+  /// can differ from the predicted one the candidates were found along (a kink snapping through,
+  /// a loop closing), unless every node ends within half the margin of the end last searched
+  /// (then any pair the solved path meets was found along that one). At most three searches
+  /// per step. Returns how many candidates it added (at the end of set().contacts()).
+  int searchAlong(const Eigen::VectorXd& v);
+  /// After a solve with velocities v: moves the linearised gaps onto the true end-of-step
+  /// geometry of the motion x + dt v: each contact whose true end gap (node against the end
+  /// triangle's plane; edge against edge along the end edges' common normal, where their closest
+  /// points lie inside both) is below its target by more than the tolerance, and below its
+  /// linearised one, takes the difference into its gap (a secant step of the gap function).
+  /// Returns how many moved.
+  int correctGaps(const Eigen::VectorXd& v);
+  /// The step's candidates (rows of the island), their multipliers and states.
+  SurfaceContactSet& set() { return set_; }
+  /// After the island's last solve (takeSurfaceContactImpulses done): the statistics, with its
+  /// Newton iterations and whether it converged.
+  void finishStep(int iterations, bool converged);
 
   const SelfContactStats& stats() const { return stats_; }
   const std::vector<SurfaceContact>& contacts() const { return set_.contacts(); }
@@ -144,12 +134,6 @@ class SelfContactSolver {
   // have yet, then the edge pairs; returns how many. The tree queries run in fixed blocks of
   // nodes (edges) on the threads, and the blocks' finds are added in block order.
   int addCandidates(const Eigen::VectorXd& x, const Eigen::VectorXd& end);
-  // Moves the linearised gaps onto the true end-of-step geometry of the solved motion x + dt v:
-  // each contact whose true end gap (node against the end triangle's plane; edge against edge
-  // along the end edges' common normal, where their closest points lie inside both) is below
-  // its target by more than the tolerance, and below its linearised one, takes the difference
-  // into its gap (a secant step of the gap function). Returns how many moved.
-  int correctGaps(const Eigen::VectorXd& v);
   // The contact of node p with triangle t along the motion, if they are a candidate (reads only).
   std::optional<SurfaceContact> nodeCandidate(int p, int t, const Eigen::VectorXd& x,
                                               const Eigen::VectorXd& end) const;
@@ -181,11 +165,8 @@ class SelfContactSolver {
   SurfaceContactSet set_;
   SelfContactStats stats_;
   double dt_ = 0;
-  ProjectedCg cg_;
-  std::vector<Eigen::Matrix3d> blocks_;
-  Eigen::VectorXd end_, b_aug_, best_v_;
-  std::vector<SurfaceContact> best_contacts_;
-  bool penalties_ready_ = false;  // blocks_ hold this step's diagonal blocks
+  Eigen::VectorXd end_;   // the end of the motion last searched along
+  int redetections_ = 0;  // searches along the solved motion this step
 };
 
 }  // namespace torsion

@@ -1,7 +1,8 @@
 #pragma once
-// Node-against-triangle (and edge-against-edge) contacts between FEM surfaces (one body against
-// itself: self_contact.h), solved inside the implicit step's linear solves by an augmented
-// Lagrangian (docs/contact.md, "Self-contact"). Touched only by the simulation thread.
+// Node-against-triangle (and edge-against-edge) contacts between FEM surfaces: one body against
+// itself (self_contact.h) or two touching bodies (body_pair_contact.h). The set holds a step's
+// candidates and their multipliers; the contact island solves them as rows
+// (contact/solve/surface_contact_rows.h). Touched only by the simulation thread.
 //
 // A contact c joins a surface node p and a surface triangle (a, b, c) it must not pass through.
 // With the triangle point's barycentric weights w, the relative velocity is
@@ -11,28 +12,17 @@
 // separation so that surfaces it holds never touch, docs/contact.md, "Contact thickness"). The
 // impulse lambda (N s) acts on p and -w_j lambda on the triangle's corners, so the pair exchanges
 // momentum exactly (sum beta_k = 0) and, the lever being the same point, angular momentum up to the
-// linearisation.
+// linearisation. An edge crossing an edge is the same with beta = (1 - s, s, -(1 - t), -t).
 //
-// Augmented Lagrangian (Alart & Curnier 1991; Uzawa's update) for the normal impulse, with
-// Coulomb's friction implicit in the tangential direction. Each linear solve takes the impulse as
-//   sticking: lambda = Lambda - rho h,                         h = u + n (gap - d) / dt,
-//   sliding:  lambda = n (n.Lambda - rho n.h) - k_t (I - n n^T) u,
-// which adds rho beta_k beta_l I (sticking) or beta_k beta_l (rho n n^T + k_t (I - n n^T))
-// (sliding) to the system (this class is the AddedOperatorTerm) and beta_k (Lambda - rho n (gap -
-// d) / dt) to its right-hand side (only Lambda's normal part when sliding). After each solve
-// update() projects on Coulomb's cone: lambda_n = max(0, n.Lambda - rho n.h); a sticking contact
-// keeps Lambda - rho h while its tangential part stays within mu lambda_n; a sliding one gets k_t =
-// mu lambda_n / |u_t| (at most rho: below the slip speed mu lambda_n / rho it sticks again), so its
-// friction impulse -k_t u_t is Coulomb's, opposes the slip of the same solve and can never reverse
-// it (a fixed point of lagged stiffnesses: Kacanov's iteration, not an explicit force). rho is
-// `penalty_factor` times the contact's effective mass from the system's 3x3 diagonal blocks.
+// Each step starts from the last one's multipliers, keyed by node (or edge) and triangle (or
+// edge): a contact that pushed at the end of the last step starts with that impulse, projected
+// onto its new friction cone (the lagged friction bound of the next solve).
 
 #include <Eigen/Core>
 #include <array>
 #include <cstdint>
+#include <utility>
 #include <vector>
-
-#include "torsion/solve/added_operator_term.h"
 
 namespace torsion {
 
@@ -49,21 +39,15 @@ struct SurfaceContact {
   /// 0), so momentum is exchanged exactly whatever it is.
   double target_gap = 0;
   double friction = 0;                                   ///< Coulomb coefficient mu
-  double penalty = 0;                                    ///< rho, kg
   Eigen::Vector3d multiplier = Eigen::Vector3d::Zero();  ///< Lambda, N s on p
   State state = State::kInactive;
-  bool determined = false;  ///< all four nodes fully prescribed: sits the solves out
-  int releases = 0;         ///< releases this step (anti-cycling: one)
-  int switches = 0;         ///< stick/slide switches this step (anti-cycling: then it stays)
-  /// kg, sliding: k_t, the friction impulse being -k_t u_t (the tangential relative velocity);
-  /// at most the penalty. Negative: the penalty (a warm-started contact's first solve).
-  double tangential_stiffness = 0;
+  bool determined = false;  ///< all four nodes fully prescribed: nothing to solve
   /// m, the linearised end-of-step gap after the last solve, less target_gap (< 0: inside the
   /// contact's thickness).
   double end_gap = 0;
 };
 
-class SurfaceContactSet final : public AddedOperatorTerm {
+class SurfaceContactSet {
  public:
   /// Forgets the last step's candidates; their multipliers stay as warm starts (keyed by node and
   /// triangle) for add().
@@ -80,20 +64,6 @@ class SurfaceContactSet final : public AddedOperatorTerm {
   const std::vector<SurfaceContact>& contacts() const { return contacts_; }
   bool empty() const { return contacts_.empty(); }
 
-  /// A sliding contact that keeps sliding takes this fraction of the k_t its slip asks for and
-  /// keeps the rest of its last one (1, the default: all of it). Below 1 damps the two-cycle
-  /// Kacanov's iteration can fall into when k_t and the slip's speed trade places from one
-  /// update to the next (measured between FEM bodies: body_pair_contact.h uses 0.5).
-  void setFrictionRelaxation(double fraction) { friction_relaxation_ = fraction; }
-  /// rho of every contact from the system's diagonal blocks (without this term).
-  void setPenalties(const std::vector<Eigen::Matrix3d>& diagonal_blocks, double penalty_factor);
-  /// The contact's block of the operator: rho I sticking, rho n n^T + k_t (I - n n^T) sliding
-  /// (its impulse on the relative velocity u is -block u beyond the right-hand side's).
-  static Eigen::Matrix3d operatorBlock(const SurfaceContact& c);
-  /// N s: what the contact puts on the right-hand side (times beta_k on its nodes): Lambda
-  /// (sliding: its normal part; the friction is in the operator) less rho n (gap - target_gap) /
-  /// dt.
-  static Eigen::Vector3d rightHandSideImpulse(const SurfaceContact& c, double dt);
   /// Marks contacts whose nodes the solve cannot move (is_fixed(node) for all four).
   template <typename IsFixed>
   void markDetermined(IsFixed is_fixed) {
@@ -103,38 +73,9 @@ class SurfaceContactSet final : public AddedOperatorTerm {
         c.determined = c.determined && is_fixed(node);
     }
   }
-  /// b += sum over active contacts of beta_k (Lambda - rho n (gap - target_gap) / dt).
-  void addRightHandSide(double dt, Eigen::VectorXd& b) const;
-  /// Uzawa's projection after a solve with velocities v (3n). Activates contacts whose end gap is
-  /// below target_gap - activation_tolerance. Gaps below are judged against target_gap. Returns
-  /// whether the set has converged: no contact changed state, every end gap within gap_tolerance
-  /// (no penetration beyond it, no active contact pushing across a gap beyond it), no sticking
-  /// contact slipping more than gap_tolerance and every sliding contact's friction impulse within 2
-  /// % of mu lambda_n of the last solve's.
-  bool update(const Eigen::VectorXd& v, double dt, double activation_tolerance,
-              double gap_tolerance);
-  /// Whether update() judges convergence by what the last solve's motion is off by, rather than
-  /// by the states settling: the solve's impulse minus the one Uzawa's projection gives (a pull
-  /// that releases a contact, friction beyond Coulomb's cone that makes it slide, a sliding
-  /// friction impulse that changes), over the contact's effective mass (its penalty over
-  /// penalty_factor), times dt, must be at most gap_tolerance: the same geometric accuracy as
-  /// the end gaps and a sticking contact's slip. A state change alone (an activation within the
-  /// tolerance, a switch with a negligible impulse) then no longer keeps the loop going, nor
-  /// does a sliding impulse still moving by more than 2 % of mu lambda_n with no effect on the
-  /// motion. Off by default (the changes of state count).
-  void setConvergedWithinTolerance(bool on) { within_tolerance_ = on; }
   /// m, the deepest linearised end-of-step penetration of any candidate (>= 0): below zero gap,
   /// not below its target_gap.
   double maxEndPenetration() const;
-  /// m, the largest gap error after the last update: any candidate's end gap below its target,
-  /// or an active contact's end gap away from its target.
-  double maxGapError() const;
-
-  // AddedOperatorTerm: beta_k beta_l (rho I or rho n n^T + k_t (I - n n^T)) of the active contacts.
-  void addProduct(const Eigen::VectorXd& y, Eigen::VectorXd& out) const override;
-  void addDiagonalBlocks(std::vector<Eigen::Matrix3d>& blocks) const override;
-  /// While suspended the term adds nothing (the penalties are taken from A alone).
-  void setSuspended(bool suspended) { suspended_ = suspended; }
 
   /// Warm starts the next step starts from: (key, Lambda) of the active contacts, sorted by key.
   using WarmStarts = std::vector<std::pair<std::uint64_t, Eigen::Vector3d>>;
@@ -155,21 +96,10 @@ class SurfaceContactSet final : public AddedOperatorTerm {
            static_cast<std::uint32_t>(triangle);
   }
   const Eigen::Vector3d* warmStartOf(std::uint64_t k) const;
-  bool participates(const SurfaceContact& c) const {
-    return !suspended_ && !c.determined && c.state != SurfaceContact::State::kInactive;
-  }
-  Eigen::Vector3d relativeVelocity(const SurfaceContact& c, const Eigen::VectorXd& v) const;
-  // Whether `impulse` (N s) on c moves it by more than gap_tolerance over the step.
-  bool beyondTolerance(const SurfaceContact& c, double impulse, double dt,
-                       double gap_tolerance) const;
 
   std::vector<SurfaceContact> contacts_;
-  WarmStarts warm_;  // the last step's, looked up by add()
-  bool suspended_ = false;
-  double friction_relaxation_ = 1;
-  bool within_tolerance_ = false;
-  double penalty_factor_ = 1;  // the last setPenalties' (rho over the effective mass)
-  bool restored_ = false;      // warm_ was set by setWarmStarts: beginStep keeps it
+  WarmStarts warm_;        // the last step's, looked up by add()
+  bool restored_ = false;  // warm_ was set by setWarmStarts: beginStep keeps it
 };
 
 }  // namespace torsion

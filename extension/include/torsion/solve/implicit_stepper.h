@@ -105,7 +105,7 @@ struct StepReport {
 /// The linear system of a prepared step (ImplicitStepper::prepare), what any solve of it needs:
 /// A v' = b, the prescribed components of v' imposed. Valid until the stepper's next prepare().
 struct PreparedSystem {
-  /// A = M (1 + dt alpha) + (dt^2 + dt beta) K, plus the added term (setAddedOperatorTerm).
+  /// A = M (1 + dt alpha) + (dt^2 + dt beta) K.
   const SystemOperator* op = nullptr;
   const NodeConstraints* constraints = nullptr;  ///< the ones given to prepare() (the caller's)
   const Eigen::VectorXd* b = nullptr;            ///< M v + dt (f(x) + f_ext), 3n
@@ -164,9 +164,6 @@ class ImplicitStepper {
   const Eigen::VectorXd& elasticForces() const { return elastic_forces_; }
 
   const SolverSettings& settings() const { return settings_; }
-  /// Adds `term` (not owned; nullptr removes it) to the system of the following steps' solves
-  /// (SystemOperator::setAddedTerm): self-contact's augmented Lagrangian.
-  void setAddedOperatorTerm(const AddedOperatorTerm* term) { system_.setAddedTerm(term); }
   /// Takes effect at the next step (linear solver, tolerance...); the caller validates.
   void setSettings(const SolverSettings& settings) { settings_ = settings; }
   /// Live material edit between steps (FemBody::setMaterial): `model` has the same mesh. The

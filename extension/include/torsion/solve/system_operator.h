@@ -29,7 +29,6 @@
 
 #include "torsion/fem/fem_model.h"
 #include "torsion/fem/volume_barrier.h"
-#include "torsion/solve/added_operator_term.h"
 #include "torsion/solve/parallel.h"
 
 namespace torsion {
@@ -97,12 +96,7 @@ class SystemOperator {
   /// The system coefficients: A = mass_coefficient M + stiffness_coefficient K.
   void setCoefficients(double mass_coefficient, double stiffness_coefficient);
 
-  /// Adds `term` (not owned; nullptr removes it) to A in multiply() and diagonalBlocks() until
-  /// removed: contact penalties of an augmented Lagrangian (added_operator_term.h).
-  void setAddedTerm(const AddedOperatorTerm* term) { added_term_ = term; }
-  const AddedOperatorTerm* addedTerm() const { return added_term_; }
-
-  /// out = A y (plus the added term, if any).
+  /// out = A y.
   void multiply(const Eigen::VectorXd& y, Eigen::VectorXd& out) const;
   /// out = A y for a y that is zero outside `nodes`: only the block rows coupled to those nodes
   /// are multiplied, the others are zero; bit for bit what multiply() gives (with nodal pressure
@@ -190,7 +184,6 @@ class SystemOperator {
   std::shared_ptr<const FemModel> model_;
   const Parallel& parallel_;
   std::vector<Eigen::Matrix3d> rotations_;
-  const AddedOperatorTerm* added_term_ = nullptr;
   std::vector<SlotBlock> stiffness_additions_;
   const std::vector<TetStiffness>* element_stiffnesses_ = nullptr;
   const std::vector<Eigen::Matrix3d>* lagged_blocks_ = nullptr;

@@ -103,7 +103,6 @@ std::vector<LaggedFaceImpulse> laggedFaceImpulses(const NodeContactIsland& islan
 
 CarriedContacts carriedContacts(const NodeContactIsland& island,
                                 const std::vector<NodeContact>& contacts,
-                                const std::vector<FaceContact>& faces,
                                 const std::vector<RigidPartner>& partners,
                                 const SapReport& report) {
   CarriedContacts carried;
@@ -118,11 +117,6 @@ CarriedContacts carriedContacts(const NodeContactIsland& island,
       carried.nodes.push_back({c.node, partners[static_cast<std::size_t>(c.partner)].object,
                                stick ? NodeContact::State::kStick : NodeContact::State::kSlide,
                                impulse, c.normal});
-    } else if (r < island.row_face.size() && island.row_face[r] >= 0) {
-      const FaceContact& c = faces[static_cast<std::size_t>(island.row_face[r])];
-      carried.faces.push_back({c.key, partners[static_cast<std::size_t>(c.partner)].object,
-                               stick ? FaceContact::State::kStick : FaceContact::State::kSlide,
-                               impulse, 0});
     }
   }
   return carried;

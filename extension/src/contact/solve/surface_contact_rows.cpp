@@ -29,12 +29,13 @@ int addSurfaceContactRows(std::vector<ContactRow>& rows, const SurfaceContactSet
   return first;
 }
 
-void takeSurfaceContactImpulses(SurfaceContactSet& set, const SapProblem& problem, int first_row,
-                                const SapReport& report, double dt) {
-  int i = first_row;
+void takeSurfaceContactImpulses(SurfaceContactSet& set, const SapProblem& problem,
+                                const std::vector<int>& rows, const SapReport& report, double dt) {
+  std::size_t k = 0;
   for (SurfaceContact& c : set.contacts()) {
+    const int i = rows[k++];
     const auto r = static_cast<std::size_t>(i);
-    const ContactRow& row = problem.row(i++);
+    const ContactRow& row = problem.row(i);
     const Eigen::Vector3d& gamma = report.impulses[r];
     c.multiplier = row.frame.transpose() * gamma;
     c.state = !(gamma.z() > 0)                           ? SurfaceContact::State::kInactive

@@ -63,15 +63,14 @@ std::vector<LaggedFaceImpulse> laggedFaceImpulses(const NodeContactIsland& islan
                                                   const SapReport& report);
 
 /// What the island's solve leaves detection for the next step (RigidContactSolver::
-/// restoreCarriedContacts): the rows with gamma_n > 0 as the active contacts today's solver would
-/// carry, node rows with their normal (detect() keeps a node's plane while the node stays over that
-/// face: RigidContactSolver::keepPreviousPlane), state stick when |gamma_t| is inside the friction
-/// disk, and impulse (world, N s, on the node or face). Without it every contact is new to
-/// detection, and a node under a box's edge is linearised afresh each step on whichever of the two
-/// faces meeting there is nearer: often the side face.
+/// restoreCarriedContacts): the node rows with gamma_n > 0 as active contacts, with their normal
+/// (detect() keeps a node's plane while the node stays over that face:
+/// RigidContactSolver::keepPreviousPlane), state stick when |gamma_t| is inside the friction disk,
+/// and impulse (world, N s, on the node). Without it every contact is new to detection, and a node
+/// under a box's edge is linearised afresh each step on whichever of the two faces meeting there
+/// is nearer: often the side face.
 CarriedContacts carriedContacts(const NodeContactIsland& island,
                                 const std::vector<NodeContact>& contacts,
-                                const std::vector<FaceContact>& faces,
                                 const std::vector<RigidPartner>& partners, const SapReport& report);
 
 }  // namespace torsion::sap

@@ -35,10 +35,10 @@ int addSurfaceContactRows(std::vector<ContactRow>& rows, const SurfaceContactSet
                           int node_count_a, int body_a, int body_b, const RowDefaults& defaults,
                           double dt);
 
-/// The solve's answer onto the candidates of `set` (rows first_row.. of `problem` and `report`,
-/// in the order addSurfaceContactRows made them, their gaps as last set): impulse on the node
-/// (world) as the multiplier, the state, and the end gap less the thickness.
-void takeSurfaceContactImpulses(SurfaceContactSet& set, const SapProblem& problem, int first_row,
-                                const SapReport& report, double dt);
+/// The solve's answer onto the candidates of `set` (candidate c is row rows[c] of `problem` and
+/// `report`, as addSurfaceContactRows made it, its gap as last set): impulse on the node (world)
+/// as the multiplier, the state, and the end gap less the thickness.
+void takeSurfaceContactImpulses(SurfaceContactSet& set, const SapProblem& problem,
+                                const std::vector<int>& rows, const SapReport& report, double dt);
 
 }  // namespace torsion::sap
