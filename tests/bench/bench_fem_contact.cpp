@@ -22,7 +22,7 @@
 // Bullet's soft body margin (default 0.01 m); --bullet-substeps: Bullet steps per scene step;
 // --bullet-ground-box: Bullet's ground a big box, as in its demos, instead of the scene's plane;
 // --only: just these runs (torsion, torsion_no_fem_contact, bullet), e.g. one per callgrind run;
-// --per-step: each step's CPU ms, detection ms (and Torsion's Uzawa updates, converged) too.
+// --per-step: each step's CPU ms, detection ms (and Torsion's Newton iterations, converged) too.
 
 #include <time.h>
 
@@ -62,9 +62,9 @@ struct Run {
   bench::EndState end;         // for bench_demo_checks (exploded, sank)
   bench::ContactEnd contact;   // for bench_contact_checks
   int fem_candidates_max = 0;  // Torsion: node-triangle candidates, most in a step
-  int fem_iterations_max = 0;  // Torsion: Uzawa updates, most in a step
+  int fem_iterations_max = 0;  // Torsion: the island's Newton iterations, most in a step
   int fem_unconverged = 0;     // Torsion: steps whose FEM pair contact did not converge
-  // Torsion, per step: Uzawa updates and whether FEM pair contact converged (--per-step).
+  // Torsion, per step: Newton iterations and whether FEM pair contact converged (--per-step).
   std::vector<int> fem_iterations;
   std::vector<bool> fem_converged;
 };
@@ -260,7 +260,7 @@ nlohmann::json row(const scene::SceneSpec& spec, const std::vector<TetMesh>& res
     j["fem_unconverged_steps"] = run.fem_unconverged;
   }
   if (per_step) {
-    // [CPU ms, detection CPU ms, Uzawa updates, converged] per step (updates and converged for
+    // [CPU ms, detection CPU ms, Newton iterations, converged] per step (iterations and converged for
     // Torsion with FEM contact only).
     nlohmann::json steps = nlohmann::json::array();
     for (size_t k = 0; k < run.cpu_ms.size(); ++k) {

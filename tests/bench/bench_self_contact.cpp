@@ -1,8 +1,8 @@
 // Self-contact over a whole scene (docs/performance.md, "Self-contact on the plectoneme rod";
 // docs/contact.md, "Self-contact"): steps/s, and per body with self-contact the steps whose
 // contact solve stopped unconverged, the most active contacts, the deepest linearised end-of-step
-// penetration, the tree searches, how many unconverged steps used every Uzawa update (the others
-// were stopped by the safeguard), and every `--check-every` steps whether any two surface
+// penetration, the tree searches, the island's Newton iterations, and every `--check-every` steps
+// whether any two surface
 // triangles intersect (analysis/surface_intersections.h, exact). One JSON line on stdout.
 //
 //   bench_self_contact SCENE [--steps N] [--threads T] [--check-every K]
@@ -86,7 +86,6 @@ int main(int argc, char** argv) {
     return 1;
   }
   const double gap_tolerance = body->selfContact()->gapTolerance();
-  const int max_iterations = body->selfContact()->settings().max_iterations;
   std::vector<Hand*> hands;
   for (SceneHand& h : scene.hands)
     hands.push_back(h.hand.get());
@@ -131,10 +130,10 @@ int main(int argc, char** argv) {
                     body->model().mesh().restPositions()[static_cast<size_t>(t[(a + 1) % 3])])
                        .norm();
   mean_edge /= 3.0 * static_cast<double>(std::max<size_t>(surface.size(), 1));
-  int unconverged = 0, at_cap = 0, max_active = 0, searches = 0, search_builds = 0,
-      crossing_checks = 0, crossing_first = -1, exact_crossing_checks = 0;
+  int unconverged = 0, max_active = 0, searches = 0, search_builds = 0, crossing_checks = 0,
+      crossing_first = -1, exact_crossing_checks = 0;
   CrossingKinds kinds;  // the exact checker's pairs at the checks, summed (crossing_kinds.h)
-  long updates = 0;
+  long newton = 0;
   double worst_end = 0, stepping = 0, searching = 0;
   const std::clock_t cpu0 = std::clock();
   for (int k = 1; k <= steps; ++k) {
@@ -156,9 +155,7 @@ int main(int argc, char** argv) {
     if (body->selfContact() != nullptr) {
       const SelfContactStats& s = body->selfContact()->stats();
       unconverged += s.converged ? 0 : 1;
-      updates += s.iterations;
-      // Unconverged with every update used, rather than stopped early by the safeguard.
-      if (!s.converged && s.iterations >= max_iterations) ++at_cap;
+      newton += s.iterations;
       max_active = std::max(max_active, s.active);
       worst_end = std::max(worst_end, s.max_end_penetration);
       searches += s.searches;
@@ -166,10 +163,10 @@ int main(int argc, char** argv) {
       searching += s.search_seconds;
       if (per_step)
         std::fprintf(stderr,
-                     "step %d: candidates %d, active %d, updates %d, searches %d, %s, end "
+                     "step %d: candidates %d, active %d, Newton %d, CG %d, searches %d, %s, end "
                      "penetration %.3g m\n",
-                     k, s.candidates, s.active, s.iterations, s.searches,
-                     s.converged ? "converged" : "UNCONVERGED", s.max_end_penetration);
+                     k, s.candidates, s.active, s.iterations, body->lastReport().solve.iterations,
+                     s.searches, s.converged ? "converged" : "UNCONVERGED", s.max_end_penetration);
     }
     if (check_every > 0 && k % check_every == 0) {
       const std::vector<Triangle>& triangles = surface;
@@ -218,8 +215,8 @@ int main(int argc, char** argv) {
   std::printf(
       "{\"scene\": \"%s\", \"steps\": %d, \"threads\": %d, \"steps_per_s\": %.2f, "
       "\"cpu_s_per_step\": %.4g, \"search_ms_per_step\": %.3g, \"self_contact\": %s, "
-      "\"uzawa_updates\": %ld, "
-      "\"unconverged\": %d, \"unconverged_at_max_iterations\": %d, \"max_active\": %d, "
+      "\"newton_iterations\": %ld, "
+      "\"unconverged\": %d, \"max_active\": %d, "
       "\"worst_end_penetration_m\": %.3g, "
       "\"gap_tolerance_m\": %.3g, \"searches\": %d, \"search_builds\": %d, "
       "\"crossing_checks\": %d, "
@@ -229,10 +226,9 @@ int main(int argc, char** argv) {
       "\"crossing_pairs_edge_edge_with_candidate\": %d, "
       "\"crossing_pairs_within_gap_tolerance\": %d, \"deepest_crossing_m\": %.3g}\n",
       scene.spec.name.c_str(), steps, threads, steps / stepping, cpu / steps,
-      1e3 * searching / steps, self_contact ? "true" : "false", updates, unconverged, at_cap,
-      max_active, worst_end, gap_tolerance, searches, search_builds, crossing_checks,
-      crossing_first, exact_crossing_checks, kinds.node_in_face, kinds.node_in_face_deep,
-      kinds.edge_edge, kinds.with_candidate, kinds.edge_edge_with_candidate, kinds.within_tolerance,
-      kinds.deepest);
+      1e3 * searching / steps, self_contact ? "true" : "false", newton, unconverged, max_active,
+      worst_end, gap_tolerance, searches, search_builds, crossing_checks, crossing_first,
+      exact_crossing_checks, kinds.node_in_face, kinds.node_in_face_deep, kinds.edge_edge,
+      kinds.with_candidate, kinds.edge_edge_with_candidate, kinds.within_tolerance, kinds.deepest);
   return 0;
 }
