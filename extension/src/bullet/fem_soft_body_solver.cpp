@@ -328,7 +328,7 @@ void FemSoftBodySolver::updateSoftBodies() {
 }
 
 void FemSoftBodySolver::processCollision(btSoftBody* soft, const btCollisionObjectWrapper* other) {
-  // A broadphase pair: our narrow phase runs in FemBody::advance, at the rigid body's pose after
+  // A broadphase pair: our narrow phase runs in FemBody::prepare, at the rigid body's pose after
   // Bullet's rigid integration (docs/contact.md). Bullet's soft bodies collide as Bullet does.
   if (FemBody* body = femBodyOf(soft)) {
     body->contacts().addCandidate(other->getCollisionObject());

@@ -6,7 +6,6 @@
 #include <cstddef>
 #include <map>
 #include <memory>
-#include <optional>
 #include <sstream>
 #include <string>
 #include <utility>
@@ -74,8 +73,6 @@ class Island {
   // The surface rows' gaps moved onto the solved motion's end surface, self-contact's search
   // along it; returns whether anything moved (`added`: new candidates, now rows).
   bool correctSurfaces(sap::SapProblem& problem, bool& added);
-  // The bodies' own solves (each once a step), and whether they answer the island (below).
-  std::optional<sap::SapReport> freeMotion(const sap::SapProblem& problem);
   void takeAnswers(const sap::SapProblem& problem, const sap::SapReport& report,
                    IslandPairStats& stats);
   void reportFailure(const std::string& message);
@@ -89,8 +86,6 @@ class Island {
   const StepContext& ctx_;
   std::vector<int> island_body_;  // per group body: its island body, or -1 (left the island)
   std::vector<PreparedSystem> systems_;
-  std::vector<LinearSolveReport> alone_;  // per group body: its own solve, if it ran
-  bool solved_alone_ = false;             // every present body's own solve ran
   int fem_count_ = 0;
   // The island's bodies: FEM bodies first (in the group's order), then each dynamic rigid body
   // once, in the order the shares first name them; their first dofs.
@@ -115,7 +110,6 @@ class Island {
 bool Island::prepare() {
   island_body_.assign(group_.size(), -1);
   systems_.resize(group_.size());
-  alone_.resize(group_.size());
   for (std::size_t k = 0; k < group_.size(); ++k) {
     // A body that stops here leaves the island, and its pairs sit the step out.
     if (!group_[k]->prepare(ctx_, group_.size() > 1)) continue;
@@ -130,45 +124,11 @@ bool Island::solvesAlone() {
   FemBody& body = *group_[0];
   SelfContactSolver* self = body.selfContact();
   if (self != nullptr && !self->set().empty()) return false;
-  alone_[0] = body.solveAlone();
-  solved_alone_ = true;
+  const LinearSolveReport solve = body.solveAlone();
   if (self != nullptr && self->searchAlong(*systems_[0].v) > 0) return false;
   if (self != nullptr) self->finishStep(0, true);
-  body.finish(*systems_[0].v, alone_[0]);
+  body.finish(*systems_[0].v, solve);
   return true;
-}
-
-std::optional<sap::SapReport> Island::freeMotion(const sap::SapProblem& problem) {
-  // With no dynamic rigid body in the island, the bodies' own solves of A v = b are the island's
-  // problem without its rows; where that motion leaves every row separated, each row's cost and
-  // gradient vanish there and it is the minimiser of the whole convex problem, to the bodies'
-  // own solver tolerance. Most steps of a body near itself or another (candidates within the
-  // search margin, none pushing) end here. Otherwise the solve starts from the stepper's warm
-  // start, not from this motion: that one follows the last step's contacts, the free motion
-  // goes through them (from it the plectoneme's coiled steps took five times the Newton
-  // iterations).
-  if (bodies_.size() != static_cast<std::size_t>(fem_count_)) return std::nullopt;
-  const Eigen::VectorXd warm = x_;
-  for (std::size_t k = 0; k < group_.size(); ++k) {
-    if (island_body_[k] < 0) continue;
-    if (!solved_alone_) alone_[k] = group_[k]->solveAlone();
-    velocitiesOf(island_body_[k]) = *systems_[k].v;
-  }
-  solved_alone_ = true;
-  sap::SapEvaluation e;
-  problem.evaluate(x_, e);
-  for (const sap::RowResponse& row : e.rows) {
-    if (row.state != sap::ContactState::kSeparated) {
-      x_ = warm;
-      return std::nullopt;
-    }
-  }
-  sap::SapReport report;
-  report.converged = true;
-  report.impulses.assign(e.rows.size(), Eigen::Vector3d::Zero());
-  report.contact_velocities = e.contact_velocity;
-  report.states.assign(e.rows.size(), sap::ContactState::kSeparated);
-  return report;
 }
 
 void Island::mergeShare(std::size_t k) {
@@ -345,10 +305,7 @@ IslandPairStats Island::solveAndFinish() {
     stats.converged = false;
     return stats;
   }
-  std::optional<sap::SapReport> free = freeMotion(created.value());
-  bool solved = !free;  // the island's solve ran (else the bodies' own solves answer it)
-  sap::SapReport report =
-      free ? *free : sap::solveWithMatchedFrictionBounds(created.value(), row_group_, x_);
+  sap::SapReport report = sap::solveWithMatchedFrictionBounds(created.value(), row_group_, x_);
   int newton = report.newton_iterations, cg = report.cg_iterations;
   // The rows are linearised at the step's start: at 15 m/s a node ended 9.6 mm inside the other
   // cube without the gaps moved onto the end surface (bullet_collide_soft), and a closing loop of
@@ -372,7 +329,6 @@ IslandPairStats Island::solveAndFinish() {
       }
     }
     report = sap::solveWithMatchedFrictionBounds(created.value(), row_group_, x_);
-    solved = true;
     newton += report.newton_iterations;
     cg += report.cg_iterations;
   }
@@ -387,7 +343,7 @@ IslandPairStats Island::solveAndFinish() {
   // Last body first: a dynamic rigid body shared by several bodies takes its twist from the
   // share that owns it, whatever the order.
   for (std::size_t k = group_.size(); k-- > 0;)
-    if (island_body_[k] >= 0) group_[k]->finish(*systems_[k].v, solved ? solve : alone_[k]);
+    if (island_body_[k] >= 0) group_[k]->finish(*systems_[k].v, solve);
   if (!report.converged) {
     // Reported per step, never accepted silently (a warning: the step is usable).
     std::ostringstream s;

@@ -425,7 +425,7 @@ TEST(SapFemStep, SlidingBoxDeceleratesAsCoulombSays) {
   EXPECT_LT(std::abs(convex), 0.03);
 }
 
-// The same box on slabs 2x and 3x finer, through FemBody::advance with the convex solve: more
+// The same box on slabs 2x and 3x finer, through the island step (stepIsland): more
 // nodes and edges come and go under the box each step. Detection predicts a node's motion over
 // the solve's look-ahead, dt + tau_d (RigidContactSolver::lookahead): over dt alone, the nodes
 // just ahead of the box's front edge met it as a wall in a few steps (+11 % and +13 %).
