@@ -44,6 +44,8 @@ double monotonicSeconds() {
 namespace {
 
 // The peer; main() below only turns an escaping exception (out of memory) into an error line.
+// Its options, its session and its loop read in order as one program.
+// NOLINTNEXTLINE(readability-function-size)
 int runPeer(int argc, char** argv) {
   using namespace torsion::device;
   std::string trajectory_path, log_path, host = "127.0.0.1";

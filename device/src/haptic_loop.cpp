@@ -67,6 +67,9 @@ HapticLoop::~HapticLoop() {
   stop();
 }
 
+// The 1 kHz tick's stages in order, kept in one body so that the loop's timing reads top to
+// bottom.
+// NOLINTNEXTLINE(readability-function-size)
 void HapticLoop::tick(double now, double deadline) {
   ++tick_;
   const double dt = have_previous_ ? now - previous_time_ : 1.0 / settings_.rate_hz;

@@ -392,6 +392,8 @@ std::string anotherWorld(const std::string& why) {
 // Reads one body's checkpoint onto `body` of the world being restored (its current checkpoint
 // `now` gives what is code rather than data: the motions of its groups, its contact solver's
 // settings and anchors).
+// The format's body section, read field by field in the order writeBody writes it.
+// NOLINTNEXTLINE(readability-function-size)
 Result<FemBodyCheckpoint> readBody(Reader& r, FemWorld& world, FemBody& body,
                                    const std::vector<Hand*>& hands,
                                    const std::vector<HandCheckpoint>& hand_checkpoints) {
@@ -655,6 +657,8 @@ void checkRigidPose(const btMatrix3x3& basis, const btVector3 (&v)[3], Reader& r
     r.refuse("a rigid body's pose or velocity (not finite, or a basis that is not a rotation)");
 }
 
+// The format's sections in their order, each refused naming the value it holds.
+// NOLINTNEXTLINE(readability-function-size,readability-function-cognitive-complexity)
 Result<StoredCheckpoint> readCheckpoint(std::string_view bytes, FemWorld& world,
                                         const std::vector<Hand*>& hands) {
   Result<std::string_view> payload = payloadOf(bytes);

@@ -130,50 +130,67 @@ void FaceContactSet::detect(const FemState& state, const NodeConstraints& held,
       // box squeezed under a deformable faster each step through that explicit coupling (its
       // rotation is resolved against the ground by Bullet only the step after).
       if (p.supported) continue;
-      const std::optional<FacePoint> f = shapeToTriangle(shape, transform, a, b, c, reach);
-      if (!f || f->distance > reach) continue;
-      // At a corner: the node's own contact measures the same distance.
-      if (f->barycentric.maxCoeff() > 1 - kEdgeWeight) continue;
-      // A face point no nearer the shape than its nodes' own distances, interpolated, is held by
-      // the node contacts (a flat rigid face on a flat soft face): a face contact there would only
-      // duplicate them, and duplicates slow the active set. What is left are rigid features that
-      // come nearer between the nodes than at them: corners, edges, curved shapes.
-      double interpolated = 0;
-      for (size_t j = 0; j < 3; ++j) {
-        const std::optional<SurfacePoint> d =
-            signedDistance(shape, transform, state.position(tri[j]), reach);
-        interpolated += f->barycentric[static_cast<Eigen::Index>(j)] *
-                        (d ? d->distance : std::numeric_limits<double>::infinity());
-      }
-      if (f->distance >= interpolated - kDuplicateMargin * reach) continue;
-      if (supportPlaneLeavesMore(shape, transform, state, tri, *f, p, dt)) continue;
-      FaceContact fc;
-      fc.nodes = {tri[0], tri[1], tri[2]};
-      fc.weights = f->barycentric;
-      // Sorted nodes of non-zero weight, -1 padded (no per-triangle allocation: a hot loop).
-      fc.key = {-1, -1, -1};
-      size_t used = 0;
-      for (size_t j = 0; j < 3; ++j) {
-        if (fc.weights[static_cast<Eigen::Index>(j)] > kEdgeWeight) fc.key[used++] = tri[j];
-      }
-      std::sort(fc.key.begin(), fc.key.begin() + static_cast<std::ptrdiff_t>(used));
-      fc.partner = partner;
-      fc.normal = f->normal;
-      fc.gap = f->distance;
-      fc.lever = f->shape_point - p.com;
-      fc.friction = friction;
-      const auto found = index_.find({fc.key, partner});
-      if (found != index_.end()) {
-        // An edge seen from its two triangles: keep the nearer reading.
-        FaceContact& existing = contacts_[static_cast<size_t>(found->second)];
-        if (fc.gap < existing.gap) existing = fc;
-        continue;
-      }
-      index_[{fc.key, partner}] = static_cast<int>(contacts_.size());
-      contacts_.push_back(fc);
+      std::optional<FaceContact> fc =
+          faceContact(state, tri, shape, transform, reach, dt, partner, p, friction);
+      if (fc) add(*fc);
     }
   }
   if (features) features->appendTo(features_);
+}
+
+std::optional<FaceContact> FaceContactSet::faceContact(const FemState& state, const Triangle& tri,
+                                                       const btCollisionShape& shape,
+                                                       const btTransform& transform, double reach,
+                                                       double dt, int partner,
+                                                       const RigidPartner& p,
+                                                       double friction) const {
+  const Eigen::Vector3d a = state.position(tri[0]), b = state.position(tri[1]),
+                        c = state.position(tri[2]);
+  const std::optional<FacePoint> f = shapeToTriangle(shape, transform, a, b, c, reach);
+  if (!f || f->distance > reach) return std::nullopt;
+  // At a corner: the node's own contact measures the same distance.
+  if (f->barycentric.maxCoeff() > 1 - kEdgeWeight) return std::nullopt;
+  // A face point no nearer the shape than its nodes' own distances, interpolated, is held by
+  // the node contacts (a flat rigid face on a flat soft face): a face contact there would only
+  // duplicate them. What is left are rigid features that come nearer between the nodes than at
+  // them: corners, edges, curved shapes.
+  double interpolated = 0;
+  for (size_t j = 0; j < 3; ++j) {
+    const std::optional<SurfacePoint> d =
+        signedDistance(shape, transform, state.position(tri[j]), reach);
+    interpolated += f->barycentric[static_cast<Eigen::Index>(j)] *
+                    (d ? d->distance : std::numeric_limits<double>::infinity());
+  }
+  if (f->distance >= interpolated - kDuplicateMargin * reach) return std::nullopt;
+  if (supportPlaneLeavesMore(shape, transform, state, tri, *f, p, dt)) return std::nullopt;
+  FaceContact fc;
+  fc.nodes = {tri[0], tri[1], tri[2]};
+  fc.weights = f->barycentric;
+  // Sorted nodes of non-zero weight, -1 padded (no per-triangle allocation: a hot loop).
+  fc.key = {-1, -1, -1};
+  size_t used = 0;
+  for (size_t j = 0; j < 3; ++j) {
+    if (fc.weights[static_cast<Eigen::Index>(j)] > kEdgeWeight) fc.key[used++] = tri[j];
+  }
+  std::sort(fc.key.begin(), fc.key.begin() + static_cast<std::ptrdiff_t>(used));
+  fc.partner = partner;
+  fc.normal = f->normal;
+  fc.gap = f->distance;
+  fc.lever = f->shape_point - p.com;
+  fc.friction = friction;
+  return fc;
+}
+
+void FaceContactSet::add(const FaceContact& fc) {
+  const auto found = index_.find({fc.key, fc.partner});
+  if (found != index_.end()) {
+    // An edge seen from its two triangles: keep the nearer reading.
+    FaceContact& existing = contacts_[static_cast<size_t>(found->second)];
+    if (fc.gap < existing.gap) existing = fc;
+    return;
+  }
+  index_[{fc.key, fc.partner}] = static_cast<int>(contacts_.size());
+  contacts_.push_back(fc);
 }
 
 }  // namespace torsion

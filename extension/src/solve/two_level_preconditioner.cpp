@@ -24,6 +24,8 @@ struct Parents {
 TwoLevelPreconditioner::TwoLevelPreconditioner() : factor_(std::make_unique<SparseCholesky>()) {}
 TwoLevelPreconditioner::~TwoLevelPreconditioner() = default;
 
+// One pass over the coarse pattern's three index sets, kept together.
+// NOLINTNEXTLINE(readability-function-size)
 void TwoLevelPreconditioner::buildPattern(const SystemOperator& op) {
   const FemModel& model = op.model();
   fine_nodes_ = model.nodeCount();

@@ -14,6 +14,7 @@
 #include <Eigen/Core>
 #include <array>
 #include <map>
+#include <optional>
 #include <utility>
 #include <vector>
 
@@ -79,6 +80,16 @@ class FaceContactSet {
   }
 
  private:
+  // The face contact of triangle `tri` (its corners at `state`) with the shape, if it is one
+  // (within reach, not at a corner, nearer than its nodes, not better held by its nodes against
+  // the supporting plane).
+  std::optional<FaceContact> faceContact(const FemState& state, const Triangle& tri,
+                                         const btCollisionShape& shape,
+                                         const btTransform& transform, double reach, double dt,
+                                         int partner, const RigidPartner& p, double friction) const;
+  // Adds `fc`, or keeps the nearer reading of an edge two triangles found.
+  void add(const FaceContact& fc);
+
   std::vector<Triangle> triangles_;
   std::vector<int> node_triangle_start_, node_triangles_;  // CSR: surface triangles by node
   std::vector<int> triangle_stamp_;                        // per triangle: last detect seen
