@@ -260,8 +260,8 @@ nlohmann::json row(const scene::SceneSpec& spec, const std::vector<TetMesh>& res
     j["fem_unconverged_steps"] = run.fem_unconverged;
   }
   if (per_step) {
-    // [CPU ms, detection CPU ms, Newton iterations, converged] per step (iterations and converged for
-    // Torsion with FEM contact only).
+    // [CPU ms, detection CPU ms, Newton iterations, converged] per step (iterations and converged
+    // for Torsion with FEM contact only).
     nlohmann::json steps = nlohmann::json::array();
     for (size_t k = 0; k < run.cpu_ms.size(); ++k) {
       nlohmann::json step = {run.cpu_ms[k],

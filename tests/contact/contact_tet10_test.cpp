@@ -179,8 +179,8 @@ TEST(ContactTet10, BoxRestsOnSlabWithConvergedSag) {
             << run.worst_penetration << " m, contacts " << run.contacts << " ("
             << run.corner_contacts << " at corners) of " << same_mesh.patch_nodes
             << " nodes under the box, largest gap under the box " << run.largest_gap_under_box
-            << " m, Newton iterations max " << run.most_newton_iterations
-            << ", unconverged steps " << run.unconverged_steps << "\n";
+            << " m, Newton iterations max " << run.most_newton_iterations << ", unconverged steps "
+            << run.unconverged_steps << "\n";
   // At rest above the slab, centred: 1 mm/s and 1 mm against a 2 cm drop settled for 4 s.
   EXPECT_LT(run.box_speed, 1e-3);
   EXPECT_LT(run.off_centre, 1e-3);

@@ -34,9 +34,8 @@ struct RestingBoxRun {
 /// `p` gives the slab, the box's footprint (half-width c) and weight; the box is 0.1 m high and
 /// starts 2 cm above the slab. The slab's node rows are at +-`row` (punchSlabMesh). Steps of
 /// 0.01 s for `seconds`.
-inline RestingBoxRun runRestingBox(
-    const PunchProblem& p, int cells_across, int cells_thick, ElementKind element, double seconds,
-    double row) {
+inline RestingBoxRun runRestingBox(const PunchProblem& p, int cells_across, int cells_thick,
+                                   ElementKind element, double seconds, double row) {
   const double box_half_height = 0.05, box_mass = p.load / p.gravity;
   FemWorld world(contactSettings(0.01));
   Result<FemBody*> added = world.addBody("slab", punchSlabMesh(p, cells_across, cells_thick, row),
