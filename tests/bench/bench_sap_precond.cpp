@@ -5,10 +5,13 @@
 //   plain_cg       A v = b by the body's CG (block-Jacobi, tolerance 1e-4), no contact
 //   plain_cholmod  A v = b by CHOLMOD (assemble, factorise, solve), no contact
 //   sap_*          the island's SAP solve (tolerance 1e-6) with the CG preconditioned by
-//     jacobi          block-Jacobi on H's diagonal blocks (the contact terms included)
+//     coupled         block-Jacobi on A with the contact terms whole (coupled_preconditioner.h)
+//     coupled_1e-4    the same at the tolerance of the body's CG, 1e-4: how the island step
+//                     solves an island of CG bodies (island_step.cpp), equal accuracy with
+//                     plain_cg
 //     factor          the step's CHOLMOD factor for the slab (factorisation included) with the
 //                     capacitance correction (sap_solver.h), which above max_correction_rows = 32
-//                     rows falls back to block-Jacobi (the factorisation still paid)
+//                     rows gives way to coupled (the factorisation still paid)
 //     factor_all      the same with the correction at any number of rows
 // Counters: Newton and CG iterations per solve (plain: CG iterations), rows, nodes, tets.
 // Run: build/tests/bench/bench_sap_precond --benchmark_counters_tabular=true
@@ -26,7 +29,14 @@ namespace {
 using torsion::sap::test::SlabScene;
 using torsion::sap::test::SlabSpec;
 
-enum Method { kPlainCg, kPlainCholmod, kSapJacobi, kSapFactor, kSapFactorAll };
+enum Method {
+  kPlainCg,
+  kPlainCholmod,
+  kSapCoupled,
+  kSapCoupledBodyTolerance,
+  kSapFactor,
+  kSapFactorAll
+};
 
 SlabSpec slabSpec(int log10_e, bool ground, int dt_ms) {
   SlabSpec spec;
@@ -64,6 +74,7 @@ void sapStep(benchmark::State& state, SlabScene& scene, Method method) {
   torsion::sap::SapSolverSettings settings;
   settings.max_cg_iterations = 100000;
   if (method == kSapFactorAll) settings.max_correction_rows = 1 << 30;
+  if (method == kSapCoupledBodyTolerance) settings.relative_tolerance = 1e-4;
   torsion::sap::SapSolver solver(settings);
   torsion::CholmodSolver factor;
   const torsion::sap::RigidBody box = scene.boxBody();
@@ -102,8 +113,8 @@ void BM_SlabStep(benchmark::State& state) {
   state.counters["rows"] = static_cast<double>(scene.rows().size());
   state.counters["nodes"] = scene.nodeCount();
   state.counters["tets"] = scene.tetCount();
-  static const char* const kNames[] = {"plain_cg", "plain_cholmod", "sap_jacobi", "sap_factor",
-                                       "sap_factor_all"};
+  static const char* const kNames[] = {"plain_cg",         "plain_cholmod", "sap_coupled",
+                                       "sap_coupled_1e-4", "sap_factor",    "sap_factor_all"};
   state.SetLabel(std::string(kNames[method]) + (ground ? " ground" : " box") + " E=1e" +
                  std::to_string(log10_e) + " dt=" + std::to_string(dt_ms) + "ms");
 }

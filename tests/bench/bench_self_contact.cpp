@@ -167,6 +167,8 @@ int main(int argc, char** argv) {
                      "penetration %.3g m\n",
                      k, s.candidates, s.active, s.iterations, body->lastReport().solve.iterations,
                      s.searches, s.converged ? "converged" : "UNCONVERGED", s.max_end_penetration);
+    } else if (per_step) {
+      std::fprintf(stderr, "step %d: CG %d\n", k, body->lastReport().solve.iterations);
     }
     if (check_every > 0 && k % check_every == 0) {
       const std::vector<Triangle>& triangles = surface;

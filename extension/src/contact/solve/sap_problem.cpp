@@ -159,7 +159,6 @@ void SapProblem::collectBlocks() {
     }
   }
   block_starts_.push_back(static_cast<int>(blocks_.size()));
-  touched_.assign(blocks_.size(), 0);
   body_in_.resize(bodies_.size());
   body_out_.resize(bodies_.size());
 }
@@ -354,37 +353,14 @@ void SapProblem::multiplyHessian(const SapEvaluation& e, const Eigen::VectorXd& 
   filter(out);
 }
 
-void SapProblem::preconditionerBlocks(const SapEvaluation* e, std::vector<DiagonalBlock>& inverse,
-                                      bool use_bodies) const {
+void SapProblem::preconditionerBlocks(std::vector<DiagonalBlock>& inverse) const {
   // Blocks of a body with its own preconditioner are not used (applyPreconditioner): left as A's.
-  // A block no row acts on is A's block inverted on its free dofs, made once (free_inverses_);
-  // only the blocks rows act on are summed and inverted again, the same sums in the same order.
-  for (int i = 0; i < rowCount() && e != nullptr; ++i) {
-    if (e->rows[static_cast<size_t>(i)].state == ContactState::kSeparated) continue;
-    for (const ContactTerm& term : row(i).terms)
-      touched_[static_cast<size_t>(termBlock(term))] = 1;
-  }
   inverse.resize(blocks_.size());
   for (size_t b = 0; b < bodies_.size(); ++b) {
-    const bool own = use_bodies && bodies_[b]->hasPreconditioner();
+    const bool own = bodies_[b]->hasPreconditioner();
     for (int k = block_starts_[b]; k < block_starts_[b + 1]; ++k) {
       const auto j = static_cast<size_t>(k);
-      inverse[j] = own || touched_[j] != 0 ? blocks_[j] : free_inverses_[j];
-    }
-  }
-  for (int i = 0; i < rowCount() && e != nullptr; ++i) {
-    const RowResponse& r = e->rows[static_cast<size_t>(i)];
-    if (r.state == ContactState::kSeparated) continue;
-    for (const ContactTerm& term : row(i).terms)
-      inverse[static_cast<size_t>(termBlock(term))] += term.block.transpose() * r.g * term.block;
-  }
-  for (size_t b = 0; b < bodies_.size(); ++b) {
-    const bool own = use_bodies && bodies_[b]->hasPreconditioner();
-    for (int k = block_starts_[b]; k < block_starts_[b + 1]; ++k) {
-      const auto j = static_cast<size_t>(k);
-      if (touched_[j] == 0) continue;
-      touched_[j] = 0;
-      if (!own) inverse[j] = inverseOnFreeDofs(inverse[j], projectors_[j]);
+      inverse[j] = own ? blocks_[j] : free_inverses_[j];
     }
   }
 }
@@ -395,12 +371,11 @@ bool SapProblem::hasBodyPreconditioner() const {
 }
 
 void SapProblem::applyPreconditioner(const std::vector<DiagonalBlock>& inverse,
-                                     const Eigen::VectorXd& r, Eigen::VectorXd& out,
-                                     bool use_bodies) const {
+                                     const Eigen::VectorXd& r, Eigen::VectorXd& out) const {
   out.resize(dofs_);
   for (size_t b = 0; b < bodies_.size(); ++b) {
     const IslandBody& body = *bodies_[b];
-    if (use_bodies && body.hasPreconditioner()) {
+    if (body.hasPreconditioner()) {
       body_in_[b] = r.segment(body_offsets_[b], body.dofs());
       body.applyPreconditioner(body_in_[b], body_out_[b]);
       out.segment(body_offsets_[b], body.dofs()) = body_out_[b];

@@ -27,6 +27,7 @@ SapReport SapSolver::solve(const SapProblem& problem, Eigen::VectorXd& v) {
   correction_ =
       problem.hasBodyPreconditioner() && problem.rowCount() <= settings_.max_correction_rows;
   if (correction_) prepareCorrection(problem);
+  coupled_.forget();
   Eigen::VectorXd dv;
   double first_residual = 0;
   for (;;) {
@@ -73,13 +74,13 @@ SapReport SapSolver::solve(const SapProblem& problem, Eigen::VectorXd& v) {
 
 void SapSolver::prepareCorrection(const SapProblem& problem) {
   // P0: the bodies' own preconditioners and the inverse of A's blocks (no contact terms).
-  problem.preconditionerBlocks(nullptr, preconditioner_, true);
+  problem.preconditionerBlocks(preconditioner_);
   const int columns = 3 * problem.rowCount();
   correction_y_.resize(problem.dofs(), columns);
   for (int c = 0; c < columns; ++c) {
     residual_.setZero(problem.dofs());
     problem.addRowTranspose(c / 3, Eigen::Vector3d::Unit(c % 3), residual_);
-    problem.applyPreconditioner(preconditioner_, residual_, z_, true);
+    problem.applyPreconditioner(preconditioner_, residual_, z_);
     correction_y_.col(c) = z_;
   }
   correction_w_.resize(columns, columns);
@@ -92,7 +93,7 @@ void SapSolver::prepareCorrection(const SapProblem& problem) {
 
 void SapSolver::preparePreconditioner(const SapProblem& problem) {
   if (!correction_) {
-    problem.preconditionerBlocks(&evaluation_, preconditioner_, false);
+    coupled_.prepare(problem, evaluation_);
     return;
   }
   // I + G W, G = blockdiag(G_i) (zero for a separated row).
@@ -107,8 +108,12 @@ void SapSolver::preparePreconditioner(const SapProblem& problem) {
 
 void SapSolver::precondition(const SapProblem& problem, const Eigen::VectorXd& r,
                              Eigen::VectorXd& z) {
-  problem.applyPreconditioner(preconditioner_, r, z, correction_);
-  if (!correction_ || problem.rowCount() == 0) return;
+  if (!correction_) {
+    coupled_.apply(problem, r, z);
+    return;
+  }
+  problem.applyPreconditioner(preconditioner_, r, z);
+  if (problem.rowCount() == 0) return;
   // z = P0 r - Y (I + G W)^-1 G J P0 r.
   row_values_.resize(3 * problem.rowCount());
   for (int i = 0; i < problem.rowCount(); ++i)

@@ -56,7 +56,7 @@ struct SolvedBody {
 /// and the island is solved again (at most twice): a fixed point of mu gamma_n for the groups
 /// that need it.
 SapReport solveWithMatchedFrictionBounds(SapProblem& problem, const std::vector<int>& row_group,
-                                         Eigen::VectorXd& x);
+                                         Eigen::VectorXd& x, const SapSolverSettings& settings);
 
 /// The twists of rigid island bodies first_body.. (6 dofs each) after the solve: each one's
 /// momentum plus the wrench of every row on it (J^T gamma), through its mass: its momentum

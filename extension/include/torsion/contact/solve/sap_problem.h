@@ -186,20 +186,25 @@ class SapProblem {
   /// out = S H x at the evaluation's G blocks, x = S x.
   void multiplyHessian(const SapEvaluation& e, const Eigen::VectorXd& x,
                        Eigen::VectorXd& out) const;
-  /// The preconditioner of S H S, body by body: a body with its own (IslandBody::
-  /// hasPreconditioner) applies it, P_b ~ A_b^-1 (the contact terms on it left to CG: with the
-  /// exact A_b^-1 they are a perturbation of rank at most 3 per row); every other body's block k
-  /// gets block-Jacobi, S_k (S_k H_kk S_k + I - S_k)^{-1} S_k, H_kk = A_kk + the G terms acting on
-  /// block k. `inverse`: those blocks. `e` null: A's blocks alone, without the contact terms.
-  /// `use_bodies` false: block-Jacobi for every body, its own preconditioner or not.
-  void preconditionerBlocks(const SapEvaluation* e, std::vector<DiagonalBlock>& inverse,
-                            bool use_bodies) const;
-  /// Whether a body brings its own preconditioner (then sap_solver.h adds the contacts by the
-  /// capacitance correction).
-  bool hasBodyPreconditioner() const;
-  /// out = the preconditioner applied to r (`use_bodies` as preconditionerBlocks was given).
+  /// P0, the capacitance correction's base (sap_solver.h): a body with its own preconditioner
+  /// (IslandBody::hasPreconditioner) applies it, P_b ~ A_b^-1; every other body's block k is
+  /// block-Jacobi's, S_k (S_k A_kk S_k + I - S_k)^{-1} S_k. `inverse`: those blocks.
+  void preconditionerBlocks(std::vector<DiagonalBlock>& inverse) const;
+  /// out = P0 r.
   void applyPreconditioner(const std::vector<DiagonalBlock>& inverse, const Eigen::VectorXd& r,
-                           Eigen::VectorXd& out, bool use_bodies) const;
+                           Eigen::VectorXd& out) const;
+  /// A's diagonal blocks, island-wide (body after body, node or twist after the next): their
+  /// count, first island dof, the block itself, S on it, and S (S A_jj S + I - S)^-1 S.
+  int blockCount() const { return static_cast<int>(blocks_.size()); }
+  int blockOffset(int j) const { return block_offsets_[static_cast<size_t>(j)]; }
+  const DiagonalBlock& blockOfA(int j) const { return blocks_[static_cast<size_t>(j)]; }
+  const DiagonalBlock& blockProjector(int j) const { return projectors_[static_cast<size_t>(j)]; }
+  const DiagonalBlock& freeInverse(int j) const { return free_inverses_[static_cast<size_t>(j)]; }
+  /// The island block a term acts on.
+  int termBlock(const ContactTerm& term) const;
+  /// Whether a body brings its own preconditioner (then sap_solver.h may use the capacitance
+  /// correction).
+  bool hasBodyPreconditioner() const;
 
  private:
   SapProblem() = default;
@@ -209,7 +214,6 @@ class SapProblem {
   RowModel makeModel(const ContactRow& row, double dt, const SapParameters& parameters) const;
   // The island dof of a term's first column.
   int termOffset(const ContactTerm& term) const { return bodyOffset(term.body) + term.first_dof; }
-  int termBlock(const ContactTerm& term) const;
 
   std::vector<const IslandBody*> bodies_;
   std::vector<ContactRow> rows_;
@@ -221,8 +225,6 @@ class SapProblem {
   std::vector<DiagonalBlock> projectors_;  // S per block
   // S (S A_kk S + I - S)^-1 S per block, made once: block-Jacobi's block wherever no row acts.
   std::vector<DiagonalBlock> free_inverses_;
-  // Per block: whether a row acting on it enters preconditionerBlocks (scratch, kept zero).
-  mutable std::vector<char> touched_;
   int dofs_ = 0;
   double dt_ = 0;
   Eigen::VectorXd momentum_;

@@ -13,9 +13,10 @@
 //      on ell'(alpha) with bisection (the Hessian is only piecewise continuous). ell' is
 //      monotone, so the bracket always holds the minimiser, and the cost never increases.
 //
-// The preconditioner: block-Jacobi on H's diagonal blocks, unless a body brings its own
-// approximate inverse P_b of A_b (IslandBody::hasPreconditioner: a FEM body's step factor) and the
-// island has at most max_correction_rows rows. Then,
+// The preconditioner: block-Jacobi on A with the contact terms J^T G J kept whole
+// (coupled_preconditioner.h: the blocks active rows act on factorised together), unless a body
+// brings its own approximate inverse P_b of A_b (IslandBody::hasPreconditioner: a FEM body's step
+// factor) and the island has at most max_correction_rows rows. Then,
 // with P0 = blockdiag(P_b, the inverse of A's blocks for the other bodies), the contacts are
 // folded in exactly by Woodbury's identity (the capacitance correction):
 //
@@ -23,10 +24,10 @@
 //
 // Y and W made once per solve (3 applications of P0 per row: W is the Delassus operator when
 // P0 = A^-1), I + G W (dense, 3 rows square) factorised per Newton iteration. With every P0 exact
-// (a body's Cholesky factor, a rigid body's mass) P = H^-1: one CG iteration per direction. P0
-// alone, without the correction, leaves CG the rank-3-per-row perturbation A^-1 J^T G J, whose
-// stiff, spread eigenvalues (G ~ 1/R up to 1e3 times A's blocks) cost up to rank + 1 iterations
-// per direction and more with rounding: measured, it loses (docs/contact-solve.md, "Cost").
+// (a body's Cholesky factor, a rigid body's mass) P = H^-1: one CG iteration per direction.
+// Both fold the contacts in whole: with only their diagonal blocks, the stiff, spread eigenvalues
+// of J^T G J (G ~ 1/R up to 1e3 times A's blocks) cost up to rank + 1 CG iterations per
+// direction (docs/contact-solve.md, "Cost").
 //
 // The cost is strictly convex and C1 with a piecewise-smooth gradient: Newton with exact line
 // search converges from any start. It stops on the paper's optimality criterion,
@@ -45,21 +46,24 @@
 #include <string>
 #include <vector>
 
+#include "torsion/contact/solve/coupled_preconditioner.h"
 #include "torsion/contact/solve/sap_problem.h"
 
 namespace torsion::sap {
 
 struct SapSolverSettings {
-  double relative_tolerance = 1e-6;   ///< eps_rel (the paper's default)
+  /// eps_rel (the paper's default; an island of CG bodies alone uses theirs: island_step.cpp)
+  double relative_tolerance = 1e-6;
   double absolute_tolerance = 1e-14;  ///< eps_abs, sqrt(kg) m/s
   int max_newton_iterations = 100;
   int max_cg_iterations = 1000;  ///< per Newton direction
   double max_forcing = 0.1;      ///< the CG's relative tolerance is at most this
   int max_line_search_iterations = 100;
   /// The capacitance correction (below) costs 3 applications of the body preconditioners per
-  /// row; above this many rows the island falls back to block-Jacobi with the contact blocks for
-  /// every body. 32: on a 1445-node slab one CHOLMOD solve costs about 1/60 of its factorisation,
-  /// so 32 rows add at most about 1.6 factorisations (docs/contact-solve.md, "Cost").
+  /// row; above this many rows the island is preconditioned by block-Jacobi with the contacts
+  /// (coupled_preconditioner.h) for every body. 32: on a 1445-node slab one CHOLMOD solve costs
+  /// about 1/60 of its factorisation, so 32 rows add at most about 1.6 factorisations
+  /// (docs/contact-solve.md, "Cost").
   int max_correction_rows = 32;
 };
 
@@ -111,7 +115,8 @@ class SapSolver {
   SapSolverSettings settings_;
   // Workspace, kept between solves.
   SapEvaluation evaluation_;
-  std::vector<DiagonalBlock> preconditioner_;
+  std::vector<DiagonalBlock> preconditioner_;  // P0's blocks (the capacitance correction)
+  CoupledPreconditioner coupled_;              // otherwise
   // The capacitance correction: P0 J^T, J P0 J^T, the LU of I + G W, scratch.
   Eigen::MatrixXd correction_y_, correction_w_, capacitance_matrix_;
   Eigen::PartialPivLU<Eigen::MatrixXd> capacitance_;
