@@ -167,6 +167,31 @@ void bindParts(py::module_& m) {
           },
           py::arg("velocity"), "Every node's velocity, m/s.")
       .def(
+          "anchor",
+          [](const B& b, py::object nodes, const RigidHandle& rigid) {
+            IndexArray a = toIndexArray(nodes, "nodes");
+            if (a.shape.size() != 1) throw py::value_error("nodes: expected a 1-D int array");
+            if (rigid.world != b.world)
+              throw py::value_error("rigid_body: '" + rigid.name + "' is another world's");
+            WorldGuard guard(*b.world, WorldGuard::kWrite);
+            Result<int> anchor = b.body->anchorNodes(std::move(a.values), rigid.body);
+            if (!anchor) throw py::value_error(anchor.error().message);
+            return anchor.value();
+          },
+          py::arg("nodes"), py::arg("rigid_body"),
+          "Ties the nodes to the rigid body at their current offsets from it (PyBullet's "
+          "createSoftBodyAnchor): they move with it and the body pulls on it, both ways, in the "
+          "contact solve. Returns the anchor's id for remove_anchor. ValueError, nothing changed: "
+          "no nodes, a node out of range, anchored already or listed twice.")
+      .def(
+          "remove_anchor",
+          [](const B& b, int anchor) {
+            WorldGuard guard(*b.world, WorldGuard::kWrite);
+            if (Status s = b.body->removeAnchor(anchor); !s)
+              throw py::value_error(s.error().message);
+          },
+          py::arg("anchor"), "Frees an anchor's nodes from the next step on.")
+      .def(
           "von_mises_stress",
           [](const B& b) {
             WorldGuard guard(*b.world);
