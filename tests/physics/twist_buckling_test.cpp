@@ -363,7 +363,7 @@ TEST(TwistBuckling, Tet10CriticalTwistMatchesGreenhillWithinFivePercent) {
 // the end in over half the length: the helix coils and its loop closes onto the rod, which the
 // open helix of the test above never does. No levels (the straight phase is the test above's);
 // the ramp at 2 rad/s. Self-contact holds the loop. The exact check after every step still finds
-// surface triangles crossing in some steps (57 of 684, docs/validation.md, "Twist buckling
+// surface triangles crossing in some steps (40 of 684, docs/validation.md, "Twist buckling
 // against Greenhill"): shallow edge pairs sliding across each other within a step, never more
 // than 0.15 mm deep. Before the contact thickness, the search along the solved motion and the gap
 // correction (docs/contact.md, "Contact thickness"), the closing loop passed 3.4 to 6.2 mm through
