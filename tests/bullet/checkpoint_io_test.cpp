@@ -155,6 +155,54 @@ TEST(CheckpointIo, TruncatedForeignOrAlteredBytesAreRefusedWithTheirReason) {
   EXPECT_TRUE(rig.load(bytes).ok());
 }
 
+// A checkpoint in memory keeps the contact solvers' memory as the bytes a file stores
+// (FemBodyCheckpoint::contacts). Those bytes cut short, or naming a rigid object the world does not
+// have, are refused naming the body and the part being read, in memory as from a file, and the
+// world is left as it was.
+TEST(CheckpointIo, ContactBytesCutShortOrNamingNoObjectAreRefusedNamingThem) {
+  BlockRig rig;
+  for (int k = 0; k < 40; ++k)
+    rig.step();
+  ASSERT_FALSE(rig.body_->contacts().carriedContacts().nodes.empty())
+      << "the block must rest on the slab";
+  const double time = rig.world_.time();
+  const WorldCheckpoint saved = rig.world_.checkpoint();
+  const std::string& contacts = saved.fem.bodies.front().second.contacts;
+  EXPECT_NE(rig.save().find(contacts), std::string::npos) << "a file holds the same bytes";
+
+  const auto refusals = [&](const std::string& altered) {
+    WorldCheckpoint c = saved;
+    c.fem.bodies.front().second.contacts = altered;
+    const Status restored = rig.world_.restore(c);
+    EXPECT_EQ(rig.world_.time(), time) << "a refused checkpoint changes nothing";
+    std::vector<HandCheckpoint> hands{rig.hand_->checkpoint()};
+    const std::string bytes = writeCheckpoint(rig.world_, c, {rig.hand_.get()}, hands, "");
+    Result<StoredCheckpoint> read = readCheckpoint(bytes, rig.world_, {rig.hand_.get()});
+    return std::pair<std::string, std::string>{
+        restored.ok() ? "(restored)" : restored.error().message,
+        read.ok() ? "(read)" : read.error().message};
+  };
+  const auto [cut_in_memory, cut_in_file] = refusals(contacts.substr(0, contacts.size() - 1));
+  EXPECT_EQ(cut_in_memory,
+            "restore: the checkpoint is truncated or corrupted (reading body 'block': its rigid "
+            "contacts)");
+  EXPECT_EQ(cut_in_file,
+            "the checkpoint is truncated or corrupted (reading body 'block': its rigid contacts)");
+
+  // After the friction (f64), the count of node contacts (u32) and the first one's node (i32):
+  // its rigid object's index among the world's collision objects (the block and the slab).
+  std::string elsewhere = contacts;
+  const std::int32_t absent = 7;
+  elsewhere.replace(16, 4, reinterpret_cast<const char*>(&absent), 4);
+  const auto [absent_in_memory, absent_in_file] = refusals(elsewhere);
+  const std::string why =
+      "the checkpoint holds an invalid value: rigid object 7 (the world has 2 collision objects) "
+      "(reading body 'block': its rigid contacts)";
+  EXPECT_EQ(absent_in_memory, "restore: " + why);
+  EXPECT_EQ(absent_in_file, why);
+  ASSERT_TRUE(rig.world_.restore(saved).ok()) << "the bytes as saved still restore";
+}
+
 // The published FNV-1a 64 test vectors (the IETF draft's), so that anyone can check a
 // checkpoint's hash with a standard implementation; the header carries exactly that hash of the
 // payload.

@@ -107,6 +107,8 @@ class Body:
     def set_material(self, material: Material) -> None: ...
     def set_external_forces(self, forces: ArrayLike) -> None: ...  # (n, 3) N, kept every step
     def set_velocity(self, velocity: ArrayLike) -> None: ...  # (3,) m/s, every node
+    def anchor(self, nodes: ArrayLike, rigid_body: RigidBody) -> int: ...  # an id
+    def remove_anchor(self, anchor: int) -> None: ...
     def von_mises_stress(self) -> npt.NDArray[np.float64]: ...  # per tet, Pa
     def von_mises_strain(self) -> npt.NDArray[np.float64]: ...  # per tet, dimensionless
 

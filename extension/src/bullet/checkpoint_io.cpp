@@ -6,17 +6,13 @@
 #include <cstring>
 #include <deque>
 #include <mutex>
-#include <type_traits>
 
+#include "torsion/checkpoint_stream.h"
 #include "torsion/fnv1a.h"
 #include "torsion/format_number.h"
 
 namespace torsion {
 namespace {
-
-#if defined(__BYTE_ORDER__)
-static_assert(__BYTE_ORDER__ == __ORDER_LITTLE_ENDIAN__, "checkpoint bytes are little-endian");
-#endif
 
 constexpr char kMagic[8] = {'T', 'R', 'S', 'N', 'C', 'K', 'P', 'T'};
 // 2: the pair multipliers of contact between FEM bodies.
@@ -27,147 +23,10 @@ constexpr char kMagic[8] = {'T', 'R', 'S', 'N', 'C', 'K', 'P', 'T'};
 // 6: the convex solve's face features.
 // 7: no augmented-Lagrangian memory: self-contact settings without its penalty and iteration
 //    cap, no face contact multipliers (the face rows' features carry the convex solve's).
-constexpr std::uint32_t kVersion = 7;
+// 8: contact memory as the bytes of the solvers' own save() (checkpoint_stream.h), with the
+//    contact friction; pair multipliers likewise.
+constexpr std::uint32_t kVersion = 8;
 constexpr size_t kHeaderSize = sizeof(kMagic) + 4 + 8 + 8;
-
-class Writer {
- public:
-  template <typename T>
-  void raw(T value) {
-    static_assert(std::is_arithmetic_v<T>);
-    char bytes[sizeof(T)];
-    std::memcpy(bytes, &value, sizeof(T));
-    out_.append(bytes, sizeof(T));
-  }
-  void u8(int v) { raw(static_cast<std::uint8_t>(v)); }
-  void u32(size_t v) { raw(static_cast<std::uint32_t>(v)); }
-  void i32(int v) { raw(static_cast<std::int32_t>(v)); }
-  void i64(std::int64_t v) { raw(v); }
-  void f64(double v) { raw(v); }
-  void str(std::string_view s) {
-    u32(s.size());
-    out_.append(s.data(), s.size());
-  }
-  void vec3(const Eigen::Vector3d& v) {
-    for (int k = 0; k < 3; ++k)
-      f64(v[k]);
-  }
-  void vector(const Eigen::VectorXd& v) {
-    u32(static_cast<size_t>(v.size()));
-    for (Eigen::Index k = 0; k < v.size(); ++k)
-      f64(v[k]);
-  }
-  void ints(const std::vector<int>& v) {
-    u32(v.size());
-    for (int x : v)
-      i32(x);
-  }
-  void frame(const Frame& f) {
-    vec3(f.origin);
-    for (double c : {f.rotation.x(), f.rotation.y(), f.rotation.z(), f.rotation.w()})
-      f64(c);
-  }
-  std::string& bytes() { return out_; }
-
- private:
-  std::string out_;
-};
-
-// Every read checks the bytes left; the first failure sticks and later reads return zeros, so a
-// reader can parse on and check ok() at the points where a wrong value would do harm.
-class Reader {
- public:
-  explicit Reader(std::string_view bytes) : in_(bytes) {}
-  bool ok() const { return ok_; }
-  /// Bytes that pass the hash can still carry values no save writes (crafted, or a writer's bug):
-  /// the first such value's description, empty while every value checked was valid.
-  const std::string& invalid() const { return invalid_; }
-  void refuse(const std::string& why) {
-    if (invalid_.empty()) invalid_ = why;
-    ok_ = false;
-  }
-  template <typename T>
-  T raw() {
-    T value{};
-    if (!take(sizeof(T))) return value;
-    std::memcpy(&value, in_.data() + at_ - sizeof(T), sizeof(T));
-    return value;
-  }
-  int u8() { return raw<std::uint8_t>(); }
-  size_t u32() { return raw<std::uint32_t>(); }
-  int i32() { return raw<std::int32_t>(); }
-  std::int64_t i64() { return raw<std::int64_t>(); }
-  double f64() { return raw<double>(); }
-  /// A count of items of at least `item_size` bytes each: no more than the bytes left hold.
-  size_t count(size_t item_size) {
-    const size_t n = u32();
-    if (n * item_size > in_.size() - at_) ok_ = false;
-    return ok_ ? n : 0;
-  }
-  std::string str() {
-    const size_t n = count(1);
-    if (!take(n)) return {};
-    return std::string(in_.substr(at_ - n, n));
-  }
-  Eigen::Vector3d vec3() {
-    Eigen::Vector3d v;
-    for (int k = 0; k < 3; ++k)
-      v[k] = f64();
-    return v;
-  }
-  Eigen::VectorXd vector() {
-    Eigen::VectorXd v(static_cast<Eigen::Index>(count(8)));
-    for (Eigen::Index k = 0; k < v.size(); ++k)
-      v[k] = f64();
-    return v;
-  }
-  std::vector<int> ints() {
-    std::vector<int> v(count(4));
-    for (int& x : v)
-      x = i32();
-    return v;
-  }
-  /// A frame as Frame holds one: a finite origin and a unit quaternion (saved from a unit one, so
-  /// its norm is 1 to rounding).
-  Frame frame() {
-    Frame f;
-    f.origin = vec3();
-    const double x = f64(), y = f64(), z = f64(), w = f64();
-    f.rotation = Eigen::Quaterniond(w, x, y, z);
-    if (ok_ && !(f.origin.allFinite() && std::abs(f.rotation.norm() - 1) <= 1e-9))
-      refuse("a frame with a non-finite origin or a rotation that is not a unit quaternion");
-    return f;
-  }
-  /// An enum stored as u8, at most `last`.
-  template <typename E>
-  E enumeration(E last) {
-    const int v = u8();
-    if (v > static_cast<int>(last)) ok_ = false;
-    return static_cast<E>(ok_ ? v : 0);
-  }
-  void fail() { ok_ = false; }
-  bool atEnd() const { return at_ == in_.size(); }
-
- private:
-  bool take(size_t n) {
-    if (!ok_ || n > in_.size() - at_) {
-      ok_ = false;
-      return false;
-    }
-    at_ += n;
-    return true;
-  }
-  std::string_view in_;
-  std::string invalid_;
-  size_t at_ = 0;
-  bool ok_ = true;
-};
-
-// Why a payload that passed its hash could not be read: cut short, or a value no save writes.
-Error unreadable(const Reader& r) {
-  if (!r.invalid().empty()) return Error{"the checkpoint holds an invalid value: " + r.invalid()};
-  return Error{"the checkpoint is truncated or corrupted"};
-}
 
 // The bytes of a mesh's rest positions and elements: a body restored onto another mesh would
 // index the wrong nodes.
@@ -191,24 +50,37 @@ const char* internReason(const std::string& reason) {
   return reasons.emplace_back(reason).c_str();
 }
 
-int collisionObjectIndex(FemWorld& world, const btCollisionObject* object) {
-  return world.bulletWorld().getCollisionObjectArray().findLinearSearch(
-      const_cast<btCollisionObject*>(object));
-}
-
 // How a node group moves, which is code, not data: a group of the world with the same index and
 // name (node sets and scripted ends, made when the world is built), a hand's pursuit, or nothing
 // (a released group holds no node).
 enum class GroupMotion { kWorldGroup, kHand, kNone };
 
-void writeMaterial(Writer& w, const Material& m) {
+void writeFrame(CheckpointWriter& w, const Frame& f) {
+  w.vec3(f.origin);
+  for (double c : {f.rotation.x(), f.rotation.y(), f.rotation.z(), f.rotation.w()})
+    w.f64(c);
+}
+
+// A frame as Frame holds one: a finite origin and a unit quaternion (saved from a unit one, so
+// its norm is 1 to rounding).
+Frame readFrame(CheckpointReader& r) {
+  Frame f;
+  f.origin = r.vec3();
+  const double x = r.f64(), y = r.f64(), z = r.f64(), w = r.f64();
+  f.rotation = Eigen::Quaterniond(w, x, y, z);
+  if (r.ok() && !(f.origin.allFinite() && std::abs(f.rotation.norm() - 1) <= 1e-9))
+    r.refuse("a frame with a non-finite origin or a rotation that is not a unit quaternion");
+  return f;
+}
+
+void writeMaterial(CheckpointWriter& w, const Material& m) {
   for (double v :
        {m.youngs_modulus, m.poisson_ratio, m.density, m.mass_damping, m.stiffness_damping})
     w.f64(v);
   w.u8(static_cast<int>(m.volumetric_strain));
 }
 
-Material readMaterial(Reader& r) {
+Material readMaterial(CheckpointReader& r) {
   Material m;
   m.youngs_modulus = r.f64();
   m.poisson_ratio = r.f64();
@@ -225,7 +97,7 @@ bool sameMaterial(const Material& a, const Material& b) {
          a.stiffness_damping == b.stiffness_damping && a.volumetric_strain == b.volumetric_strain;
 }
 
-void writeReport(Writer& w, const StepReport& s) {
+void writeReport(CheckpointWriter& w, const StepReport& s) {
   w.i32(s.solve.iterations);
   w.f64(s.solve.relative_residual);
   w.u8(s.solve.converged);
@@ -239,7 +111,7 @@ void writeReport(Writer& w, const StepReport& s) {
   w.str(s.message);
 }
 
-StepReport readReport(Reader& r) {
+StepReport readReport(CheckpointReader& r) {
   StepReport s;
   s.solve.iterations = r.i32();
   s.solve.relative_residual = r.f64();
@@ -256,11 +128,11 @@ StepReport readReport(Reader& r) {
   return s;
 }
 
-void writeHand(Writer& w, const Hand& hand, const HandCheckpoint& c) {
+void writeHand(CheckpointWriter& w, const Hand& hand, const HandCheckpoint& c) {
   w.str(hand.name());
   w.str(hand.body().name());
-  w.frame(c.values.goal);
-  w.frame(c.values.patch);
+  writeFrame(w, c.values.goal);
+  writeFrame(w, c.values.patch);
   for (double v : {c.values.time, c.values.max_speed, c.values.reach, c.speed_limit})
     w.f64(v);
   const HandSelection& s = c.selection;
@@ -275,10 +147,10 @@ void writeHand(Writer& w, const Hand& hand, const HandCheckpoint& c) {
   w.i32(c.group);
 }
 
-HandCheckpoint readHand(Reader& r) {
+HandCheckpoint readHand(CheckpointReader& r) {
   HandCheckpoint c;
-  c.values.goal = r.frame();
-  c.values.patch = r.frame();
+  c.values.goal = readFrame(r);
+  c.values.patch = readFrame(r);
   c.values.time = r.f64();
   c.values.max_speed = r.f64();
   c.values.reach = r.f64();
@@ -297,7 +169,7 @@ HandCheckpoint readHand(Reader& r) {
   return c;
 }
 
-void writeBody(Writer& w, FemWorld& world, const FemBody& body, const FemBodyCheckpoint& c,
+void writeBody(CheckpointWriter& w, const FemBody& body, const FemBodyCheckpoint& c,
                const std::vector<Hand*>& hands,
                const std::vector<HandCheckpoint>& hand_checkpoints) {
   const FemModel& model = *c.model;
@@ -342,31 +214,11 @@ void writeBody(Writer& w, FemWorld& world, const FemBody& body, const FemBodyChe
     w.u32(owner);
   }
 
-  const CarriedContacts carried = c.contacts->carriedContacts();
-  w.u32(carried.nodes.size());
-  for (const CarriedContacts::Node& n : carried.nodes) {
-    w.i32(n.node);
-    w.i32(collisionObjectIndex(world, n.object));
-    w.u8(static_cast<int>(n.state));
-    w.vec3(n.impulse);
-    w.vec3(n.normal);
-  }
-  w.u32(carried.features.size());
-  for (const CarriedContacts::Feature& f : carried.features) {
-    w.i32(collisionObjectIndex(world, f.object));
-    w.vec3(f.lever);
-    w.f64(f.normal_impulse);
-  }
-
+  w.str(c.contacts);
   w.u8(c.self_contact);
   const SelfContactSettings& s = c.self_contact_settings;
   for (double v : {s.friction, s.gap_tolerance, s.margin, s.max_depth})
     w.f64(v);
-  w.u32(c.self_contact_warm_starts.size());
-  for (const auto& [key, lambda] : c.self_contact_warm_starts) {
-    w.raw(key);
-    w.vec3(lambda);
-  }
   writeReport(w, c.last_report);
 }
 
@@ -389,12 +241,48 @@ std::string anotherWorld(const std::string& why) {
   return "the checkpoint was saved from another world: " + why;
 }
 
+// The node groups of `body`'s section into `c` (c.model set): their motions are code, not data,
+// taken from the group of the world at the same index or the hand that holds it.
+Status readGroups(CheckpointReader& r, FemBody& body, const std::vector<Hand*>& hands,
+                  const std::vector<HandCheckpoint>& hand_checkpoints, FemBodyCheckpoint& c) {
+  const int node_count = c.model->nodeCount();
+  const size_t group_count = r.count(4);
+  for (size_t g = 0; g < group_count && r.ok(); ++g) {
+    std::string name = r.str();
+    std::vector<int> group_nodes = r.ints();
+    std::vector<Eigen::Vector3d> local(r.count(24));
+    for (Eigen::Vector3d& p : local)
+      p = r.vec3();
+    const auto motion = r.enumeration(GroupMotion::kNone);
+    const size_t owner = r.u32();
+    if (!r.ok()) break;
+    for (int node : group_nodes) {
+      if (node < 0 || node >= node_count || local.size() != group_nodes.size())
+        return Error{"the checkpoint is corrupted: node group '" + name + "' is out of range"};
+    }
+    FrameMotion follow = [](double) { return Frame{}; };
+    if (motion == GroupMotion::kWorldGroup) {
+      if (g >= body.groups().size() || body.groups()[g]->name() != name) {
+        return Error{anotherWorld("body '" + body.name() + "' has no node group '" + name +
+                                  "' at index " + std::to_string(g))};
+      }
+      follow = body.groups()[g]->motion();
+    } else if (motion == GroupMotion::kHand) {
+      if (owner >= hands.size() || &hands[owner]->body() != &body)
+        return Error{anotherWorld("node group '" + name + "' belongs to no hand of this world")};
+      follow = followPursuit(hand_checkpoints[owner].pursuit);
+    }
+    c.groups.emplace_back(std::move(name), std::move(group_nodes), std::move(local),
+                          std::move(follow));
+  }
+  return r.status();
+}
+
 // Reads one body's checkpoint onto `body` of the world being restored (its current checkpoint
-// `now` gives what is code rather than data: the motions of its groups, its contact solver's
-// settings and anchors).
+// `now` gives what the format does not store: the constants of its material and self-contact
+// that no live edit changes).
 // The format's body section, read field by field in the order writeBody writes it.
-// NOLINTNEXTLINE(readability-function-size)
-Result<FemBodyCheckpoint> readBody(Reader& r, FemWorld& world, FemBody& body,
+Result<FemBodyCheckpoint> readBody(CheckpointReader& r, FemBody& body,
                                    const std::vector<Hand*>& hands,
                                    const std::vector<HandCheckpoint>& hand_checkpoints) {
   FemBodyCheckpoint now = body.checkpoint();
@@ -410,7 +298,7 @@ Result<FemBodyCheckpoint> readBody(Reader& r, FemWorld& world, FemBody& body,
   // Nor the constitutive law (no live edit changes it).
   material.law = model.material().law;
   material.mooney_rivlin_c2_fraction = model.material().mooney_rivlin_c2_fraction;
-  if (!r.ok()) return unreadable(r);
+  if (!r.ok()) return r.error();
   if (nodes != static_cast<size_t>(model.nodeCount()) ||
       elements != static_cast<size_t>(model.elementCount()) || kind != model.elementKind() ||
       hash != meshHash(model)) {
@@ -450,69 +338,13 @@ Result<FemBodyCheckpoint> readBody(Reader& r, FemWorld& world, FemBody& body,
       c.state.element_rotations.size() != now.state.element_rotations.size() ||
       !dofsOrEmpty(c.stepper.previous_velocities) || !dofsOrEmpty(c.stepper.velocity_next) ||
       !dofsOrEmpty(c.stepper.elastic_forces) || !dofsOrEmpty(c.stepper.internal_forces)) {
-    return unreadable(r);
+    return r.error();
   }
 
-  const size_t group_count = r.count(4);
-  for (size_t g = 0; g < group_count && r.ok(); ++g) {
-    std::string name = r.str();
-    std::vector<int> group_nodes = r.ints();
-    std::vector<Eigen::Vector3d> local(r.count(24));
-    for (Eigen::Vector3d& p : local)
-      p = r.vec3();
-    const auto motion = r.enumeration(GroupMotion::kNone);
-    const size_t owner = r.u32();
-    if (!r.ok()) break;
-    for (int node : group_nodes) {
-      if (node < 0 || node >= model.nodeCount() || local.size() != group_nodes.size())
-        return Error{"the checkpoint is corrupted: node group '" + name + "' is out of range"};
-    }
-    FrameMotion follow = [](double) { return Frame{}; };
-    if (motion == GroupMotion::kWorldGroup) {
-      if (g >= body.groups().size() || body.groups()[g]->name() != name) {
-        return Error{anotherWorld("body '" + body.name() + "' has no node group '" + name +
-                                  "' at index " + std::to_string(g))};
-      }
-      follow = body.groups()[g]->motion();
-    } else if (motion == GroupMotion::kHand) {
-      if (owner >= hands.size() || &hands[owner]->body() != &body)
-        return Error{anotherWorld("node group '" + name + "' belongs to no hand of this world")};
-      follow = followPursuit(hand_checkpoints[owner].pursuit);
-    }
-    c.groups.emplace_back(std::move(name), std::move(group_nodes), std::move(local),
-                          std::move(follow));
-  }
+  if (Status groups = readGroups(r, body, hands, hand_checkpoints, c); !groups)
+    return groups.error();
 
-  auto objectAt = [&](int index) -> const btCollisionObject* {
-    const btCollisionObjectArray& objects = world.bulletWorld().getCollisionObjectArray();
-    if (index < 0 || index >= objects.size()) {
-      r.fail();
-      return nullptr;
-    }
-    return objects[index];
-  };
-  CarriedContacts carried;
-  carried.nodes.resize(r.count(57));
-  for (CarriedContacts::Node& n : carried.nodes) {
-    n.node = r.i32();
-    n.object = objectAt(r.i32());
-    n.state = r.enumeration(NodeContact::State::kStick);
-    n.impulse = r.vec3();
-    n.normal = r.vec3();
-    if (n.node < 0 || n.node >= model.nodeCount()) r.fail();
-  }
-  carried.features.resize(r.count(36));
-  for (CarriedContacts::Feature& f : carried.features) {
-    f.object = objectAt(r.i32());
-    f.lever = r.vec3();
-    f.normal_impulse = r.f64();
-    if (!std::isfinite(f.normal_impulse) || !f.lever.allFinite()) r.fail();
-  }
-  auto contacts = std::make_shared<RigidContactSolver>(*now.contacts);
-  contacts->replaceModel(c.model);
-  contacts->restoreCarriedContacts(carried);
-  c.contacts = std::move(contacts);
-
+  c.contacts = r.str();
   c.self_contact = r.u8() != 0;
   SelfContactSettings& s = c.self_contact_settings;
   // What the format does not store (thickness_factor, search_skin: they
@@ -522,13 +354,9 @@ Result<FemBodyCheckpoint> readBody(Reader& r, FemWorld& world, FemBody& body,
   s.gap_tolerance = r.f64();
   s.margin = r.f64();
   s.max_depth = r.f64();
-  c.self_contact_warm_starts.resize(r.count(32));
-  for (auto& [key, lambda] : c.self_contact_warm_starts) {
-    key = r.raw<std::uint64_t>();
-    lambda = r.vec3();
-  }
   c.last_report = readReport(r);
-  if (!r.ok()) return unreadable(r);
+  if (!r.ok()) return r.error();
+  if (Status contacts = body.checkRestore(c); !contacts) return contacts.error();
   return c;
 }
 
@@ -536,7 +364,7 @@ Result<FemBodyCheckpoint> readBody(Reader& r, FemWorld& world, FemBody& body,
 Result<std::string_view> payloadOf(std::string_view bytes) {
   if (bytes.size() < sizeof(kMagic) || std::memcmp(bytes.data(), kMagic, sizeof(kMagic)) != 0)
     return Error{"not a torsion checkpoint (its first bytes are not \"TRSNCKPT\")"};
-  Reader header(bytes.substr(sizeof(kMagic)));
+  CheckpointReader header(bytes.substr(sizeof(kMagic)));
   const size_t version = header.u32();
   const auto length = header.raw<std::uint64_t>();
   const auto hash = header.raw<std::uint64_t>();
@@ -557,11 +385,13 @@ Result<std::string_view> payloadOf(std::string_view bytes) {
 
 }  // namespace
 
-std::string writeCheckpoint(FemWorld& world, const WorldCheckpoint& checkpoint,
+// The checkpoint names the world's rigid objects by index already (FemBodyCheckpoint::contacts):
+// `world` is not read.
+std::string writeCheckpoint(FemWorld& /*world*/, const WorldCheckpoint& checkpoint,
                             const std::vector<Hand*>& hands,
                             const std::vector<HandCheckpoint>& hand_checkpoints,
                             std::string_view extra) {
-  Writer w;
+  CheckpointWriter w;
   const FemCheckpoint& fem = checkpoint.fem;
   w.f64(fem.time);
   w.i64(fem.steps);
@@ -576,17 +406,13 @@ std::string writeCheckpoint(FemWorld& world, const WorldCheckpoint& checkpoint,
 
   w.u32(fem.bodies.size());
   for (const auto& [body, saved] : fem.bodies)
-    writeBody(w, world, *body, saved, hands, hand_checkpoints);
+    writeBody(w, *body, saved, hands, hand_checkpoints);
 
   w.u32(fem.fem_pairs.size());
   for (const FemPairCheckpoint& pair : fem.fem_pairs) {
     w.str(pair.a->name());
     w.str(pair.b->name());
-    w.u32(pair.warm_starts.size());
-    for (const auto& [key, lambda] : pair.warm_starts) {
-      w.raw(key);
-      w.vec3(lambda);
-    }
+    w.str(pair.multipliers);
   }
 
   w.u32(checkpoint.rigid.size());
@@ -602,7 +428,7 @@ std::string writeCheckpoint(FemWorld& world, const WorldCheckpoint& checkpoint,
   }
   w.str(extra);
 
-  Writer out;
+  CheckpointWriter out;
   out.bytes().append(kMagic, sizeof(kMagic));
   out.raw(kVersion);
   out.raw(static_cast<std::uint64_t>(w.bytes().size()));
@@ -614,16 +440,18 @@ std::string writeCheckpoint(FemWorld& world, const WorldCheckpoint& checkpoint,
 Result<double> checkpointTime(std::string_view bytes) {
   Result<std::string_view> payload = payloadOf(bytes);
   if (!payload) return payload.error();
-  Reader r(payload.value());
+  CheckpointReader r(payload.value());
   const double time = r.f64();
   if (!r.ok()) return Error{"the checkpoint is truncated: it holds no clock"};
   return time;
 }
 
+namespace {
+
 // The clock as a run leaves it: a finite time and last step, counts that are not negative, and a
 // failure (if any) at most one step past the clock (a substep that failed in collision detection
 // is not counted).
-void checkClock(const FemCheckpoint& fem, Reader& r) {
+void checkClock(const FemCheckpoint& fem, CheckpointReader& r) {
   if (!r.ok()) return;
   if (!(std::isfinite(fem.time) && fem.time >= 0 && std::isfinite(fem.last_dt) &&
         fem.last_dt >= 0 && fem.steps >= 0))
@@ -637,7 +465,7 @@ void checkClock(const FemCheckpoint& fem, Reader& r) {
 
 // A rigid body's pose as Bullet keeps one: finite, its basis a rotation (to float Bullet's
 // rounding when saved from a float world).
-void checkRigidPose(const btMatrix3x3& basis, const btVector3 (&v)[3], Reader& r) {
+void checkRigidPose(const btMatrix3x3& basis, const btVector3 (&v)[3], CheckpointReader& r) {
   if (!r.ok()) return;
   bool finite = true;
   for (int row = 0; row < 3; ++row) {
@@ -657,45 +485,35 @@ void checkRigidPose(const btMatrix3x3& basis, const btVector3 (&v)[3], Reader& r
     r.refuse("a rigid body's pose or velocity (not finite, or a basis that is not a rotation)");
 }
 
-// The format's sections in their order, each refused naming the value it holds.
-// NOLINTNEXTLINE(readability-function-size,readability-function-cognitive-complexity)
-Result<StoredCheckpoint> readCheckpoint(std::string_view bytes, FemWorld& world,
-                                        const std::vector<Hand*>& hands) {
-  Result<std::string_view> payload = payloadOf(bytes);
-  if (!payload) return payload.error();
-  Reader r(payload.value());
-  StoredCheckpoint stored;
-  FemCheckpoint& fem = stored.world.fem;
-  fem.time = r.f64();
-  fem.steps = r.i64();
-  fem.last_dt = r.f64();
-  fem.status.ok = r.u8() != 0;
-  fem.status.failed_step = r.i64();
-  fem.status.message = r.str();
-  checkClock(fem, r);
-
-  const size_t hand_count = r.count(8);
-  if (!r.ok()) return unreadable(r);
-  if (hand_count != hands.size()) {
-    std::vector<std::string> here;
-    here.reserve(hands.size());
-    for (const Hand* hand : hands)
-      here.push_back("'" + hand->name() + "' on body '" + hand->body().name() + "'");
-    // A hand's record starts with its name and body's: the first can be read (the others lie
-    // behind its data).
-    std::string first;
-    if (hand_count > 0) {
-      Reader peek = r;
-      const std::string name = peek.str(), body = peek.str();
-      if (peek.ok()) first = " (the first '" + name + "' on body '" + body + "')";
-    }
-    return Error{anotherWorld("it has " +
-                              (hand_count == 0 ? "no hand" : counted(hand_count, "hand")) + first +
-                              ", this world " + counted(hands.size(), "hand") + listed(here))};
+// Refuses the bytes while the hands of the checkpoint are not those of this world, naming both.
+Status checkHandCount(CheckpointReader& r, size_t hand_count, const std::vector<Hand*>& hands) {
+  if (hand_count == hands.size()) return Ok{};
+  std::vector<std::string> here;
+  here.reserve(hands.size());
+  for (const Hand* hand : hands)
+    here.push_back("'" + hand->name() + "' on body '" + hand->body().name() + "'");
+  // A hand's record starts with its name and body's: the first can be read (the others lie
+  // behind its data).
+  std::string first;
+  if (hand_count > 0) {
+    CheckpointReader peek = r;
+    const std::string name = peek.str(), body = peek.str();
+    if (peek.ok()) first = " (the first '" + name + "' on body '" + body + "')";
   }
+  return Error{anotherWorld("it has " +
+                            (hand_count == 0 ? "no hand" : counted(hand_count, "hand")) + first +
+                            ", this world " + counted(hands.size(), "hand") + listed(here))};
+}
+
+Status readHands(CheckpointReader& r, const std::vector<Hand*>& hands, StoredCheckpoint& stored) {
+  r.section("the hands");
+  const size_t hand_count = r.count(8);
+  if (!r.ok()) return r.error();
+  if (Status same = checkHandCount(r, hand_count, hands); !same) return same;
   for (size_t h = 0; h < hand_count; ++h) {
+    r.section("hand " + std::to_string(h));
     const std::string name = r.str(), body = r.str();
-    if (!r.ok()) return unreadable(r);
+    if (!r.ok()) return r.error();
     if (name != hands[h]->name() || body != hands[h]->body().name()) {
       std::string difference = "its hand " + std::to_string(h) + " is '";
       difference += name;
@@ -708,6 +526,7 @@ Result<StoredCheckpoint> readCheckpoint(std::string_view bytes, FemWorld& world,
       difference += "'";
       return Error{anotherWorld(difference)};
     }
+    r.section("hand '" + name + "'");
     stored.hands.push_back(readHand(r));
     const HandSelection& s = stored.hands.back().selection;
     const TetMesh& mesh = hands[h]->body().model().mesh();
@@ -717,11 +536,39 @@ Result<StoredCheckpoint> readCheckpoint(std::string_view bytes, FemWorld& world,
         std::all_of(s.triangles.begin(), s.triangles.end(), [&](int t) {
           return t >= 0 && static_cast<size_t>(t) < mesh.surfaceTriangles().size();
         });
-    if (!r.ok() || !in_range) return unreadable(r);
+    if (!in_range) r.fail();
+    if (!r.ok()) return r.error();
   }
+  return Ok{};
+}
 
+// After the bodies: refuses a world with bodies the checkpoint lacks, naming them.
+Status checkEveryBodyRead(CheckpointReader& r, size_t body_count, const FemWorld& world,
+                          const FemCheckpoint& fem) {
+  if (body_count == world.bodies().size()) return Ok{};
+  std::vector<std::string> unsaved, saved;
+  for (const auto& body : world.bodies()) {
+    const bool in_checkpoint =
+        std::any_of(fem.bodies.begin(), fem.bodies.end(),
+                    [&body](const auto& entry) { return entry.first == body.get(); });
+    (in_checkpoint ? saved : unsaved).push_back("'" + body->name() + "'");
+  }
+  if (unsaved.empty()) {  // a body saved twice
+    r.fail();
+    return r.error();
+  }
+  if (body_count == 0)
+    return Error{anotherWorld("it has no FEM body, this world " + listed(unsaved).substr(2))};
+  return Error{anotherWorld("it has " + counted(body_count, "FEM body", "FEM bodies") +
+                            listed(saved) + "; this world also has " + listed(unsaved).substr(2))};
+}
+
+Status readBodies(CheckpointReader& r, FemWorld& world, const std::vector<Hand*>& hands,
+                  StoredCheckpoint& stored) {
+  FemCheckpoint& fem = stored.world.fem;
+  r.section("the FEM bodies");
   const size_t body_count = r.count(8);
-  if (!r.ok()) return unreadable(r);
+  if (!r.ok()) return r.error();
   std::vector<std::string> names_here;
   names_here.reserve(world.bodies().size());
   for (const auto& body : world.bodies())
@@ -729,72 +576,66 @@ Result<StoredCheckpoint> readCheckpoint(std::string_view bytes, FemWorld& world,
   // Matched by name, each read onto its body here (a record cannot be skipped unread): a saved
   // body missing here is named when it comes, bodies here that were not saved at the end.
   for (size_t b = 0; b < body_count; ++b) {
+    r.section("FEM body " + std::to_string(b));
     const std::string name = r.str();
-    if (!r.ok()) return unreadable(r);
+    if (!r.ok()) return r.error();
     FemBody* body = world.body(name);
     if (body == nullptr) {
       return Error{anotherWorld("its body '" + name + "' is not in this world (" +
                                 counted(world.bodies().size(), "FEM body", "FEM bodies") +
                                 listed(names_here) + ")")};
     }
-    Result<FemBodyCheckpoint> saved = readBody(r, world, *body, hands, stored.hands);
+    r.section("body '" + name + "'");
+    Result<FemBodyCheckpoint> saved = readBody(r, *body, hands, stored.hands);
     if (!saved) return saved.error();
     fem.bodies.emplace_back(body, std::move(saved).value());
   }
-  if (body_count != world.bodies().size()) {
-    std::vector<std::string> unsaved, saved;
-    for (const auto& body : world.bodies()) {
-      const bool in_checkpoint =
-          std::any_of(fem.bodies.begin(), fem.bodies.end(),
-                      [&body](const auto& entry) { return entry.first == body.get(); });
-      (in_checkpoint ? saved : unsaved).push_back("'" + body->name() + "'");
+  if (Status all = checkEveryBodyRead(r, body_count, world, fem); !all) return all;
+  // A hand's group indexes its body's groups (its wrench reads it).
+  for (size_t h = 0; h < hands.size(); ++h) {
+    const int group = stored.hands[h].group;
+    for (const auto& [body, saved] : fem.bodies) {
+      if (body == &hands[h]->body() &&
+          (group < -1 || group >= static_cast<int>(saved.groups.size()))) {
+        r.section("hand '" + hands[h]->name() + "'");
+        r.fail();
+      }
     }
-    if (unsaved.empty()) return unreadable(r);  // a body saved twice
-    if (body_count == 0)
-      return Error{anotherWorld("it has no FEM body, this world " + listed(unsaved).substr(2))};
-    return Error{anotherWorld("it has " + counted(body_count, "FEM body", "FEM bodies") +
-                              listed(saved) + "; this world also has " +
-                              listed(unsaved).substr(2))};
   }
+  return r.status();
+}
 
+Status readPairs(CheckpointReader& r, FemWorld& world, FemCheckpoint& fem) {
+  r.section("the FEM pairs");
   const size_t pair_count = r.count(16);
-  if (!r.ok()) return unreadable(r);
+  if (!r.ok()) return r.error();
   for (size_t p = 0; p < pair_count; ++p) {
+    r.section("FEM pair " + std::to_string(p));
     FemPairCheckpoint pair;
     const std::string a = r.str(), b = r.str();
-    if (!r.ok()) return unreadable(r);
+    if (!r.ok()) return r.error();
     pair.a = world.body(a);
     pair.b = world.body(b);
     if (pair.a == nullptr || pair.b == nullptr)
       return Error{anotherWorld("this world has no body '" + (pair.a == nullptr ? a : b) + "'")};
-    pair.warm_starts.resize(r.count(32));
-    for (auto& [key, lambda] : pair.warm_starts) {
-      key = r.raw<std::uint64_t>();
-      lambda = r.vec3();
-    }
-    if (!r.ok()) return unreadable(r);
+    pair.multipliers = r.str();
+    if (!r.ok()) return r.error();
     fem.fem_pairs.push_back(std::move(pair));
   }
+  return FemContactIslands::checkRestore(fem.fem_pairs);
+}
 
-  // A hand's group indexes its body's groups (its wrench reads it).
-  for (size_t h = 0; h < hand_count; ++h) {
-    const int group = stored.hands[h].group;
-    for (const auto& [body, saved] : fem.bodies) {
-      if (body == &hands[h]->body() &&
-          (group < -1 || group >= static_cast<int>(saved.groups.size())))
-        return unreadable(r);
-    }
-  }
-
+Status readRigidBodies(CheckpointReader& r, const FemWorld& world, WorldCheckpoint& saved) {
+  r.section("the rigid bodies");
   const size_t rigid_count = r.count(18 * 8);
-  if (!r.ok()) return unreadable(r);
+  if (!r.ok()) return r.error();
   if (rigid_count != world.rigidBodies().size()) {
     return Error{anotherWorld("it has " + std::to_string(rigid_count) +
                               " rigid bodies, this world " +
                               std::to_string(world.rigidBodies().size()))};
   }
-  stored.world.rigid.resize(rigid_count);
-  for (WorldCheckpoint::RigidState& rigid : stored.world.rigid) {
+  saved.rigid.resize(rigid_count);
+  for (WorldCheckpoint::RigidState& rigid : saved.rigid) {
     btMatrix3x3 basis;
     for (int row = 0; row < 3; ++row) {
       for (int col = 0; col < 3; ++col)
@@ -810,8 +651,36 @@ Result<StoredCheckpoint> readCheckpoint(std::string_view bytes, FemWorld& world,
     rigid.linear_velocity = v[1];
     rigid.angular_velocity = v[2];
   }
+  return r.status();
+}
+
+}  // namespace
+
+// The format's sections in their order, each refused naming the value it holds.
+Result<StoredCheckpoint> readCheckpoint(std::string_view bytes, FemWorld& world,
+                                        const std::vector<Hand*>& hands) {
+  Result<std::string_view> payload = payloadOf(bytes);
+  if (!payload) return payload.error();
+  CheckpointReader r(payload.value());
+  StoredCheckpoint stored;
+  FemCheckpoint& fem = stored.world.fem;
+  r.section("the clock");
+  fem.time = r.f64();
+  fem.steps = r.i64();
+  fem.last_dt = r.f64();
+  fem.status.ok = r.u8() != 0;
+  fem.status.failed_step = r.i64();
+  fem.status.message = r.str();
+  checkClock(fem, r);
+  if (!r.ok()) return r.error();
+  if (Status read = readHands(r, hands, stored); !read) return read.error();
+  if (Status read = readBodies(r, world, hands, stored); !read) return read.error();
+  if (Status read = readPairs(r, world, fem); !read) return read.error();
+  if (Status read = readRigidBodies(r, world, stored.world); !read) return read.error();
+  r.section("the caller's extra bytes");
   stored.extra = r.str();
-  if (!r.ok() || !r.atEnd()) return unreadable(r);
+  if (r.ok() && !r.atEnd()) r.fail();
+  if (!r.ok()) return r.error();
   return stored;
 }
 

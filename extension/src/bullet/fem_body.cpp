@@ -1,18 +1,21 @@
 #include "torsion/bullet/fem_body.h"
 
+#include <cassert>
+
 #include "torsion/bt_conversions.h"
 namespace torsion {
 
 FemBody::FemBody(std::string name, std::shared_ptr<const FemModel> model,
                  const SolverSettings& settings, const Parallel& parallel,
-                 btSoftBodyWorldInfo& world_info)
+                 btSoftBodyWorldInfo& world_info, const btCollisionObjectArray& world_objects)
     : name_(std::move(name)),
       model_(std::move(model)),
       state_(FemState::atRest(*model_)),
       parallel_(parallel),
       stepper_(model_, settings, parallel),
       constraints_(model_->nodeCount()),
-      external_forces_(Eigen::VectorXd::Zero(3 * model_->nodeCount())) {
+      external_forces_(Eigen::VectorXd::Zero(3 * model_->nodeCount())),
+      world_objects_(world_objects) {
   const int n = model_->nodeCount();
   std::vector<btVector3> x(static_cast<size_t>(n));
   std::vector<btScalar> m(static_cast<size_t>(n));
@@ -241,20 +244,42 @@ FemBodyCheckpoint FemBody::checkpoint() {
   c.groups.reserve(groups_.size());
   for (const auto& group : groups_)
     c.groups.push_back(*group);
-  c.contacts = std::make_shared<const RigidContactSolver>(*contacts_);
+  CheckpointWriter contacts;
+  contacts_->save(contacts);
   if (self_contact_) {
     c.self_contact = true;
     c.self_contact_settings = self_contact_->settings();
-    c.self_contact_warm_starts = self_contact_->warmStarts();
+    self_contact_->set().save(contacts);
   }
+  c.contacts = std::move(contacts.bytes());
   c.last_report = last_report_;
   return c;
+}
+
+Status FemBody::readContacts(const FemBodyCheckpoint& c, RigidContactSolver& rigid,
+                             SurfaceContactSet* self) const {
+  CheckpointReader in(c.contacts, &world_objects_);
+  in.section("body '" + name_ + "': its rigid contacts");
+  if (Status read = rigid.restore(in); !read) return read;
+  if (c.self_contact) {
+    in.section("body '" + name_ + "': its self-contact multipliers");
+    if (Status read = self->restore(in); !read) return read;
+  }
+  if (!in.atEnd()) in.refuse("contact bytes that no part of the body reads");
+  return in.status();
+}
+
+Status FemBody::checkRestore(const FemBodyCheckpoint& c) const {
+  RigidContactSolver rigid(c.model, nullptr);
+  SurfaceContactSet self;
+  return readContacts(c, rigid, &self);
 }
 
 void FemBody::restore(const FemBodyCheckpoint& c) {
   if (c.model != model_) {
     model_ = c.model;
     stepper_.replaceModel(model_);
+    contacts_->replaceModel(model_);
     for (int i = 0; i < model_->nodeCount(); ++i)
       soft_body_->m_nodes[i].m_im = toBtScalar(1 / model_->nodeMasses()[static_cast<size_t>(i)]);
   }
@@ -264,12 +289,14 @@ void FemBody::restore(const FemBodyCheckpoint& c) {
   groups_.clear();
   for (const CarriedNodes& group : c.groups)
     groups_.push_back(std::make_unique<CarriedNodes>(group));
-  *contacts_ = *c.contacts;
   self_contact_.reset();
-  if (c.self_contact) {
+  if (c.self_contact)
     self_contact_ = std::make_unique<SelfContactSolver>(model_, c.self_contact_settings, parallel_);
-    self_contact_->restoreWarmStarts(c.self_contact_warm_starts);
-  }
+  // Bytes that would not pass checkRestore (edited by hand) leave the part that does not read as
+  // it was (a new self-contact cold); nothing reads past their end.
+  const Status read = readContacts(c, *contacts_, self_contact_ ? &self_contact_->set() : nullptr);
+  assert(read.ok());
+  (void)read;
   last_report_ = c.last_report;
   writeBack();
 }

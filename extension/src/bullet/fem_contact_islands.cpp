@@ -1,6 +1,7 @@
 #include "torsion/bullet/fem_contact_islands.h"
 
 #include <algorithm>
+#include <cassert>
 #include <numeric>
 
 namespace torsion {
@@ -31,11 +32,36 @@ void FemContactIslands::forget(const FemBody* body) {
       touching_.end());
 }
 
+namespace {
+
+// Reads the multipliers' bytes of `saved` onto `set` (restore and checkRestore alike).
+Status readMultipliers(const FemPairCheckpoint& saved, SurfaceContactSet& set) {
+  CheckpointReader in(saved.multipliers);
+  in.section("the multipliers of bodies '" + saved.a->name() + "' and '" + saved.b->name() +
+             "' touching");
+  if (Status read = set.restore(in); !read) return read;
+  if (!in.atEnd()) in.refuse("bytes after the multipliers");
+  return in.status();
+}
+
+}  // namespace
+
 std::vector<FemPairCheckpoint> FemContactIslands::checkpoint() const {
   std::vector<FemPairCheckpoint> saved;
-  for (const auto& [key, contact] : pairs_)
-    saved.push_back({key.first, key.second, contact->set().warmStarts()});
+  for (const auto& [key, contact] : pairs_) {
+    CheckpointWriter multipliers;
+    contact->set().save(multipliers);
+    saved.push_back({key.first, key.second, std::move(multipliers.bytes())});
+  }
   return saved;
+}
+
+Status FemContactIslands::checkRestore(const std::vector<FemPairCheckpoint>& pairs) {
+  for (const FemPairCheckpoint& saved : pairs) {
+    SurfaceContactSet scratch;
+    if (Status read = readMultipliers(saved, scratch); !read) return read;
+  }
+  return Ok{};
 }
 
 void FemContactIslands::restore(const std::vector<FemPairCheckpoint>& pairs) {
@@ -47,7 +73,10 @@ void FemContactIslands::restore(const std::vector<FemPairCheckpoint>& pairs) {
   for (const FemPairCheckpoint& saved : pairs) {
     auto contact = std::make_unique<BodyPairContact>(saved.a->modelPointer(),
                                                      saved.b->modelPointer(), settings_);
-    contact->set().setWarmStarts(saved.warm_starts);
+    // Checked before (checkRestore): bytes edited by hand leave the pair cold.
+    const Status read = readMultipliers(saved, contact->set());
+    assert(read.ok());
+    (void)read;
     pairs_.emplace(Key{saved.a, saved.b}, std::move(contact));
   }
 }

@@ -127,8 +127,8 @@ Result<FemBody*> FemSoftBodySolver::addBody(const std::string& name, const TetMe
   auto placed_mesh = std::make_shared<const TetMesh>(std::move(placed), mesh.tets());
   Result<std::shared_ptr<const FemModel>> model = FemModel::create(placed_mesh, material, element);
   if (!model) return Error{"body '" + name + "': " + model.error().message};
-  auto body =
-      std::make_unique<FemBody>(name, std::move(model).value(), settings_, parallel_, *world_info_);
+  auto body = std::make_unique<FemBody>(name, std::move(model).value(), settings_, parallel_,
+                                        *world_info_, world_->getCollisionObjectArray());
   add_to_world_(body->softBody());
   bodies_.push_back(std::move(body));
   return bodies_.back().get();
@@ -178,6 +178,15 @@ Status FemSoftBodySolver::restore(const FemCheckpoint& c) {
           "restore: a body of the checkpoint is not in this world (removed since, or the "
           "checkpoint is another world's; readCheckpoint reads its bytes for this world, naming "
           "what differs)"};
+  }
+  // The contact bytes are read before anything changes (a checkpoint's bytes edited by hand).
+  for (const auto& [body, saved] : c.bodies) {
+    if (Status read = body->checkRestore(saved); !read)
+      return Error{"restore: " + read.error().message};
+  }
+  if (fem_contact_) {
+    if (Status read = FemContactIslands::checkRestore(c.fem_pairs); !read)
+      return Error{"restore: " + read.error().message};
   }
   for (const auto& [body, saved] : c.bodies)
     const_cast<FemBody*>(body)->restore(saved);

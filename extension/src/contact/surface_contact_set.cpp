@@ -15,6 +15,32 @@ SurfaceContactSet::WarmStarts SurfaceContactSet::warmStarts() const {
   return warm;
 }
 
+void SurfaceContactSet::save(CheckpointWriter& out) const {
+  // After setWarmStarts and before a step, warm_ is what the next step takes (contacts_ is empty).
+  const WarmStarts warm = restored_ ? warm_ : warmStarts();
+  out.u32(warm.size());
+  for (const auto& [k, lambda] : warm) {
+    out.raw(k);
+    out.vec3(lambda);
+  }
+}
+
+Status SurfaceContactSet::restore(CheckpointReader& in) {
+  WarmStarts warm(in.count(8 + 3 * 8));
+  for (auto& [k, lambda] : warm) {
+    k = in.raw<std::uint64_t>();
+    lambda = in.vec3();
+  }
+  // warmStartOf searches them by key.
+  for (size_t i = 0; i < warm.size() && in.ok(); ++i) {
+    if (!warm[i].second.allFinite() || (i > 0 && warm[i - 1].first > warm[i].first))
+      in.refuse("contact multipliers out of key order or not finite");
+  }
+  if (!in.ok()) return in.error();
+  setWarmStarts(std::move(warm));
+  return Ok{};
+}
+
 void SurfaceContactSet::beginStep() {
   // The multipliers the last step ended with become this step's warm starts.
   if (!restored_) warm_ = warmStarts();

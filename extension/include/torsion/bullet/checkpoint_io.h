@@ -8,9 +8,11 @@
 // Numbers are little-endian; btScalar values are stored as double. What leaves memory: FEM bodies
 // (state, warm starts, node groups, material, rigid-contact and self-contact warm starts, last
 // step's report), the multipliers of FEM bodies touching each other (their pairs by the bodies'
-// names), the clock and health, the rigid bodies' poses and velocities, the hands. Not in
-// it, as in a checkpoint in memory: Bullet's manifolds between rigid bodies, and the statistics
-// of the last contact step.
+// names), the clock and health, the rigid bodies' poses and velocities, the hands. The contact
+// memory is already bytes in memory (FemBodyCheckpoint::contacts, FemPairCheckpoint::multipliers,
+// written by the solvers' own save(): torsion/checkpoint_stream.h), stored here as they are. Not
+// in it, as in a checkpoint in memory: Bullet's manifolds between rigid bodies, and the
+// statistics of the last contact step.
 
 #include <string>
 #include <string_view>
@@ -38,8 +40,9 @@ std::string writeCheckpoint(FemWorld& world, const WorldCheckpoint& checkpoint,
 
 /// Reads `bytes` for `world` and its `hands` (the same hands, in the order they were written).
 /// Changes nothing. Errors: not a checkpoint ("not a torsion checkpoint"), another version,
-/// truncated or corrupted bytes, or a world that differs from the one saved ("... saved from
-/// another world: ...": other bodies, meshes, hands, node sets or rigid bodies).
+/// truncated or corrupted bytes (naming the part being read: "... (reading body 'cube': its
+/// rigid contacts)"), or a world that differs from the one saved ("... saved from another world:
+/// ...": other bodies, meshes, hands, node sets or rigid bodies).
 Result<StoredCheckpoint> readCheckpoint(std::string_view bytes, FemWorld& world,
                                         const std::vector<Hand*>& hands);
 

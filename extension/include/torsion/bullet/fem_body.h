@@ -27,17 +27,21 @@ struct FemBodyCheckpoint {
   Eigen::VectorXd external_forces;
   ImplicitStepper::Memory stepper;
   std::vector<CarriedNodes> groups;  ///< node groups then (hands: see Hand::checkpoint)
-  std::shared_ptr<const RigidContactSolver> contacts;  ///< warm starts of the contact solve
-  bool self_contact = false;                           ///< self-contact was on
+  /// The contact solvers' memory as bytes (checkpoint_stream.h): RigidContactSolver::save, then,
+  /// with self-contact on, its multipliers (SurfaceContactSet::save). A file holds these bytes.
+  std::string contacts;
+  bool self_contact = false;  ///< self-contact was on
   SelfContactSettings self_contact_settings;
-  SurfaceContactSet::WarmStarts self_contact_warm_starts;  ///< its multipliers
   StepReport last_report;
 };
 
 class FemBody {
  public:
+  /// `world_objects`: the collision objects of the world the body is in (checkpoints name rigid
+  /// objects by their index there).
   FemBody(std::string name, std::shared_ptr<const FemModel> model, const SolverSettings& settings,
-          const Parallel& parallel, btSoftBodyWorldInfo& world_info);
+          const Parallel& parallel, btSoftBodyWorldInfo& world_info,
+          const btCollisionObjectArray& world_objects);
   ~FemBody();
   FemBody(const FemBody&) = delete;
   FemBody& operator=(const FemBody&) = delete;
@@ -131,8 +135,12 @@ class FemBody {
   /// contact multipliers), to go back to with restore(): the continuation is then bit for bit
   /// the one that followed checkpoint(), given the same world around it.
   FemBodyCheckpoint checkpoint();
-  /// Back to `checkpoint` (taken from this body). The btSoftBody mirror follows at once.
+  /// Back to `checkpoint` (taken from this body, or read by readCheckpoint: its contact bytes
+  /// pass checkRestore). The btSoftBody mirror follows at once.
   void restore(const FemBodyCheckpoint& checkpoint);
+  /// Whether the contact bytes of `checkpoint` read for this body, read as restore() reads them
+  /// (onto scratch solvers: nothing changes). Errors name the body and the part that does not.
+  Status checkRestore(const FemBodyCheckpoint& checkpoint) const;
   /// Contact with rigid bodies (docs/contact.md): candidates, settings, last step's contacts.
   RigidContactSolver& contacts() { return *contacts_; }
   const RigidContactSolver& contacts() const { return *contacts_; }
@@ -153,6 +161,10 @@ class FemBody {
 
  private:
   void writeBack();
+  /// Reads the contact bytes of `checkpoint` onto `rigid` and, with self-contact on in it, onto
+  /// `self` (restore() and checkRestore() alike).
+  Status readContacts(const FemBodyCheckpoint& checkpoint, RigidContactSolver& rigid,
+                      SurfaceContactSet* self) const;
 
   std::string name_;
   std::shared_ptr<const FemModel> model_;
@@ -164,6 +176,7 @@ class FemBody {
   Eigen::VectorXd step_forces_;      // N, 3n, this step's: external_forces_ + m_i g
   std::vector<std::unique_ptr<CarriedNodes>> groups_;
   std::unique_ptr<btSoftBody> soft_body_;
+  const btCollisionObjectArray& world_objects_;
   std::unique_ptr<RigidContactSolver> contacts_;
   std::unique_ptr<SelfContactSolver> self_contact_;
   bool rigid_contact_ = false;  // this step found nodes near rigid bodies (prepare)

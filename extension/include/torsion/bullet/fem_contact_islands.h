@@ -14,6 +14,7 @@
 #include <cstdint>
 #include <map>
 #include <memory>
+#include <string>
 #include <utility>
 #include <vector>
 
@@ -41,7 +42,9 @@ struct FemContactStats {
 struct FemPairCheckpoint {
   const FemBody* a = nullptr;  ///< the pair's first body (the earlier in the solver's order)
   const FemBody* b = nullptr;
-  SurfaceContactSet::WarmStarts warm_starts;
+  /// Its multipliers as bytes (SurfaceContactSet::save of BodyPairContact::set): a file holds
+  /// these bytes.
+  std::string multipliers;
 };
 
 class FemContactIslands {
@@ -67,9 +70,13 @@ class FemContactIslands {
   const FemContactStats& stats() const { return stats_; }
   /// Every pair's multipliers now, in key order: what the next step takes over from the last.
   std::vector<FemPairCheckpoint> checkpoint() const;
-  /// Back to `pairs` (from checkpoint()): the pairs now kept are dropped, those saved come back
-  /// with their multipliers, so the next step is bit for bit the one that followed the save.
+  /// Back to `pairs` (from checkpoint(), or read by readCheckpoint: they pass checkRestore): the
+  /// pairs now kept are dropped, those saved come back with their multipliers, so the next step
+  /// is bit for bit the one that followed the save.
   void restore(const std::vector<FemPairCheckpoint>& pairs);
+  /// Whether the multipliers' bytes of `pairs` read, read as restore() reads them (onto scratch
+  /// sets: nothing changes). Errors name the pair.
+  static Status checkRestore(const std::vector<FemPairCheckpoint>& pairs);
   /// The pair contact of two bodies (either order), or nullptr when they are not touching.
   const BodyPairContact* pair(const FemBody* a, const FemBody* b) const;
 

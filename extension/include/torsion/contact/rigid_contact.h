@@ -34,6 +34,7 @@
 #include <memory>
 #include <vector>
 
+#include "torsion/checkpoint_stream.h"
 #include "torsion/contact/face_contacts.h"
 #include "torsion/contact/multibody_partner.h"
 #include "torsion/contact/node_anchors.h"
@@ -106,8 +107,8 @@ struct ContactStepStats {
 
 /// What a RigidContactSolver's next step takes over from its last (its warm starts), with the
 /// rigid objects by pointer: the active node contacts (state, impulse, plane) and the face rows'
-/// features (normal impulse). Checkpoints that leave memory (bullet/checkpoint_io.h) store this
-/// instead of the whole solver; it must list everything detect() reads from the last step.
+/// features (normal impulse). Checkpoints store this (RigidContactSolver::save) instead of the
+/// whole solver; it must list everything detect() reads from the last step.
 struct CarriedContacts {
   struct Node {
     int node = -1;
@@ -185,6 +186,13 @@ class RigidContactSolver {
   /// Back to carried contacts: the next step starts as it did after carriedContacts(). The last
   /// step's contacts() then list them alone, without their geometry and impulses.
   void restoreCarriedContacts(const CarriedContacts& carried);
+  /// The checkpoint's bytes of what the next step takes over: the friction setting and
+  /// carriedContacts(), rigid objects by their index in the world (checkpoint_stream.h).
+  void save(CheckpointWriter& out) const;
+  /// Back to bytes of save(): the next step starts as it did after save(). Errors, changing
+  /// nothing: bytes cut short, or values no save writes (a node out of range, an object not in
+  /// the reader's world, a value not finite).
+  Status restore(CheckpointReader& in);
 
  private:
   // detect's stages (rigid_contact_detection.cpp).

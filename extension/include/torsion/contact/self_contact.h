@@ -119,11 +119,10 @@ class SelfContactSolver {
 
   const SelfContactStats& stats() const { return stats_; }
   const std::vector<SurfaceContact>& contacts() const { return set_.contacts(); }
-  /// The multipliers the next step starts from (checkpoints).
-  SurfaceContactSet::WarmStarts warmStarts() const { return set_.warmStarts(); }
-  void restoreWarmStarts(SurfaceContactSet::WarmStarts warm) {
-    set_.setWarmStarts(std::move(warm));
-  }
+  /// Its multipliers, all the solver carries from one step to the next (the pair cache is
+  /// rebuilt when the motion leaves its skin): checkpoints save and restore them
+  /// (SurfaceContactSet::save, FemBody::checkpoint).
+  const SurfaceContactSet& set() const { return set_; }
   /// Live material edit: the same mesh, new masses.
   void replaceModel(std::shared_ptr<const FemModel> model) { model_ = std::move(model); }
 

@@ -24,6 +24,8 @@
 #include <utility>
 #include <vector>
 
+#include "torsion/checkpoint_stream.h"
+
 namespace torsion {
 
 struct SurfaceContact {
@@ -80,12 +82,19 @@ class SurfaceContactSet {
   /// Warm starts the next step starts from: (key, Lambda) of the active contacts, sorted by key.
   using WarmStarts = std::vector<std::pair<std::uint64_t, Eigen::Vector3d>>;
   WarmStarts warmStarts() const;
-  /// Back to warm starts taken by warmStarts() (checkpoints): the next beginStep() uses them.
+  /// Back to warm starts taken by warmStarts(): the next beginStep() uses them.
   void setWarmStarts(WarmStarts warm) {
     contacts_.clear();
     warm_ = std::move(warm);
     restored_ = true;
   }
+  /// The checkpoint's bytes of the warm starts the next beginStep() takes (checkpoint_stream.h):
+  /// the multipliers of the self-contact of a body (SelfContactSolver::set) or of a touching pair
+  /// (BodyPairContact::set).
+  void save(CheckpointWriter& out) const;
+  /// Back to bytes of save() (setWarmStarts). Errors, changing nothing: bytes cut short, keys
+  /// out of order or multipliers not finite.
+  Status restore(CheckpointReader& in);
 
  private:
   static std::uint64_t key(const SurfaceContact& c) {
