@@ -87,3 +87,17 @@ def test_an_anchor_to_another_worlds_body_and_a_double_anchor_are_refused():
     cube.anchor(top, plate)
     with pytest.raises(ValueError, match="anchored already"):
         cube.anchor(top[:1], plate)
+
+
+def test_restoring_a_state_keeps_the_anchors_there_are_now():
+    # Anchors are part of the world around the bodies (docs/python.md, "Anchors"): one made after
+    # a save still holds after the restore, and the nodes follow the plate.
+    world, cube, plate, top = hanging_cube()
+    state = world.save_state()
+    cube.anchor(top, plate)
+    world.restore_state(state)
+    start = cube.positions[top].copy()
+    for k in range(1, 11):
+        plate.set_kinematic_target((0.5 + 0.01 * k, 0.5, 1.1))
+        world.step()
+    assert np.allclose(cube.positions[top] - start, [0.1, 0, 0], atol=1e-3)
