@@ -192,6 +192,37 @@ void bindParts(py::module_& m) {
           },
           py::arg("anchor"), "Frees an anchor's nodes from the next step on.")
       .def(
+          "enable_self_contact",
+          [](const B& b, double friction, double gap_tolerance, double thickness_factor,
+             double margin) {
+            SelfContactSettings settings;
+            settings.friction = friction;
+            settings.gap_tolerance = gap_tolerance;
+            settings.thickness_factor = thickness_factor;
+            settings.margin = margin;
+            WorldGuard guard(*b.world, WorldGuard::kWrite);
+            if (Status s = b.body->enableSelfContact(settings); !s)
+              throw py::value_error(s.error().message);
+          },
+          py::kw_only(), py::arg("friction") = SelfContactSettings{}.friction,
+          py::arg("gap_tolerance") = SelfContactSettings{}.gap_tolerance,
+          py::arg("thickness_factor") = SelfContactSettings{}.thickness_factor,
+          py::arg("margin") = SelfContactSettings{}.margin,
+          "Contact of the body's surface with itself from the next step on (docs/contact.md, "
+          "\"Self-contact\"): friction (Coulomb), gap_tolerance (m; 0: 1e-3 of the mean surface "
+          "edge), thickness_factor (the gap aimed at, in gap tolerances), margin (the candidate "
+          "search's reach, in mean surface edges). ValueError, nothing changed, on a bad value.")
+      .def(
+          "disable_self_contact",
+          [](const B& b) {
+            WorldGuard guard(*b.world, WorldGuard::kWrite);
+            b.body->disableSelfContact();
+          },
+          "No self-contact from the next step on.")
+      .def_property_readonly(
+          "self_contact", [](const B& b) { return b.body->selfContact() != nullptr; },
+          "Whether the body's surface touches itself (enable_self_contact).")
+      .def(
           "von_mises_stress",
           [](const B& b) {
             WorldGuard guard(*b.world);

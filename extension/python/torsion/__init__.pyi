@@ -109,6 +109,10 @@ class Body:
     def set_velocity(self, velocity: ArrayLike) -> None: ...  # (3,) m/s, every node
     def anchor(self, nodes: ArrayLike, rigid_body: RigidBody) -> int: ...  # an id
     def remove_anchor(self, anchor: int) -> None: ...
+    self_contact: bool
+    def enable_self_contact(self, *, friction: float = 0.3, gap_tolerance: float = 0.0,
+                            thickness_factor: float = 2.0, margin: float = 0.25) -> None: ...
+    def disable_self_contact(self) -> None: ...
     def von_mises_stress(self) -> npt.NDArray[np.float64]: ...  # per tet, Pa
     def von_mises_strain(self) -> npt.NDArray[np.float64]: ...  # per tet, dimensionless
 
