@@ -1,9 +1,11 @@
 // Removing an FEM body from a running world: the world forgets its btSoftBody, the body's memory
-// goes with it, and the other bodies step on as before.
+// goes with it, and the other bodies step on as before. Removing a rigid body: the FEM bodies
+// forget it, an anchored one is refused.
 #include <gtest/gtest.h>
 
 #include <memory>
 
+#include "torsion/bullet/fem_world.h"
 #include "torsion/mesh/box_mesh.h"
 #include "user_world.h"
 
@@ -57,6 +59,96 @@ TEST(RemoveBody, TheWorldForgetsTheBodyItsMemoryIsFreedAndTheOthersStepOn) {
 
   // The name is free again.
   EXPECT_TRUE(user.fem.addBody("left", box, Material{}).ok());
+}
+
+// A 20 kg box resting on a soft slab whose bottom is held, after 60 steps of 1/100 s.
+struct BoxOnSlab {
+  FemWorld world{WorldSettings{}};
+  FemBody* slab = nullptr;
+  btRigidBody* box = nullptr;
+
+  BoxOnSlab() {
+    const TetMesh mesh = makeBoxTetMesh({0, 0, 0}, {1, 1, 0.3}, 3, 3, 1).value();
+    Material soft;
+    soft.youngs_modulus = 2e4;
+    soft.density = 100;
+    slab = world.addBody("slab", mesh, soft).value();
+    std::vector<int> bottom;
+    for (int i = 0; i < slab->model().nodeCount(); ++i) {
+      if (slab->state().position(i).z() < 1e-9) bottom.push_back(i);
+    }
+    slab->carryNodes(
+        "bottom", bottom, [](double) { return Frame{}; }, 0);
+    box = world.addRigidBody(std::make_unique<btBoxShape>(btVector3(0.3, 0.3, 0.1)), 20,
+                             btTransform(btQuaternion::getIdentity(), btVector3(0.5, 0.5, 0.4)));
+    for (int k = 0; k < 60; ++k)
+      EXPECT_TRUE(world.step().ok);
+  }
+};
+
+TEST(RemoveRigidBody, TheFemBodiesForgetItAndTheWorldStepsAndCheckpointsOn) {
+  BoxOnSlab rig;
+  const auto names_box = [&rig](const CarriedContacts& carried) {
+    bool named = false;
+    for (const CarriedContacts::Node& n : carried.nodes)
+      named = named || n.object == rig.box;
+    for (const CarriedContacts::Feature& f : carried.features)
+      named = named || f.object == rig.box;
+    return named;
+  };
+  ASSERT_TRUE(names_box(rig.slab->contacts().carriedContacts()));  // it rests on the slab
+  // Mean height of the slab's top face (rest z = 0.3).
+  const auto top_height = [&rig] {
+    double sum = 0;
+    int count = 0;
+    for (int i = 0; i < rig.slab->model().nodeCount(); ++i) {
+      if (rig.slab->model().mesh().restPositions()[static_cast<size_t>(i)].z() > 0.2) {
+        sum += rig.slab->state().position(i).z();
+        ++count;
+      }
+    }
+    return sum / count;
+  };
+  const double pressed_top = top_height();
+
+  ASSERT_TRUE(rig.world.removeRigidBody(rig.box).ok());
+  EXPECT_TRUE(rig.world.rigidBodies().empty());
+  EXPECT_EQ(rig.world.bulletWorld().getNumCollisionObjects(), 1);  // the slab's soft body alone
+  EXPECT_FALSE(names_box(rig.slab->contacts().carriedContacts()));
+  for (const RigidPartner& partner : rig.slab->contacts().partners())
+    EXPECT_NE(partner.object, rig.box);
+  // Removing it again is an error, not a double free.
+  EXPECT_FALSE(rig.world.removeRigidBody(rig.box).ok());
+
+  // Checkpoints of the world without it continue bit for bit; the slab rises, freed.
+  const WorldCheckpoint saved = rig.world.checkpoint();
+  for (int k = 0; k < 30; ++k)
+    ASSERT_TRUE(rig.world.step().ok);
+  const Eigen::VectorXd first = rig.slab->state().positions;
+  ASSERT_TRUE(rig.world.restore(saved).ok());
+  for (int k = 0; k < 30; ++k)
+    ASSERT_TRUE(rig.world.step().ok);
+  EXPECT_EQ(rig.slab->state().positions, first);
+  EXPECT_GT(top_height(), pressed_top + 1e-4);
+}
+
+TEST(RemoveRigidBody, AnAnchoredBodyIsRefusedUntilItsAnchorsAreRemoved) {
+  BoxOnSlab rig;
+  std::vector<int> top;
+  for (int i = 0; i < rig.slab->model().nodeCount(); ++i) {
+    if (rig.slab->state().position(i).z() > 0.2) top.push_back(i);
+  }
+  const int anchor = rig.slab->anchorNodes(top, rig.box).value();
+  const Status refused = rig.world.removeRigidBody(rig.box);
+  ASSERT_FALSE(refused.ok());
+  EXPECT_NE(refused.error().message.find("FEM body 'slab' anchors nodes to it (anchor 0)"),
+            std::string::npos)
+      << refused.error().message;
+  EXPECT_EQ(rig.world.rigidBodies().size(), 1u);
+  EXPECT_TRUE(rig.world.step().ok);
+  ASSERT_TRUE(rig.slab->removeAnchor(anchor).ok());
+  EXPECT_TRUE(rig.world.removeRigidBody(rig.box).ok());
+  EXPECT_TRUE(rig.world.step().ok);
 }
 
 }  // namespace

@@ -174,7 +174,7 @@ void bindParts(py::module_& m) {
             if (rigid.world != b.world)
               throw py::value_error("rigid_body: '" + rigid.name + "' is another world's");
             WorldGuard guard(*b.world, WorldGuard::kWrite);
-            Result<int> anchor = b.body->anchorNodes(std::move(a.values), rigid.body);
+            Result<int> anchor = b.body->anchorNodes(std::move(a.values), &rigid.live());
             if (!anchor) throw py::value_error(anchor.error().message);
             return anchor.value();
           },
@@ -286,7 +286,33 @@ void bindParts(py::module_& m) {
             WorldGuard guard(*s.world, WorldGuard::kWrite);
             s.set().body->releaseGroup(s.set().group);
           },
-          "Frees the nodes from the next step on (the wrench then reads zero).");
+          "Frees the nodes from the next step on (the wrench then reads zero).")
+      .def(
+          "move_to",
+          [](const N& s, py::object frame) {
+            const Frame f = toFrame(frame, ("move_to: node set '" + s.set().name + "'").c_str());
+            WorldGuard guard(*s.world, WorldGuard::kWrite);
+            if (Status moved = s.world->moveNodeSet(s.index, f); !moved)
+              throw py::value_error(moved.error().message);
+          },
+          py::arg("frame"),
+          "Drives the set as MuJoCo drives a mocap body: its frame (which starts at its "
+          "wrench_about point with the world's axes) reaches `frame` (a Frame or a 4x4 matrix) at "
+          "the end of the next step and stays there until the next call; the nodes are carried "
+          "rigidly with it. ValueError, nothing changed: a released set, a set its scene file "
+          "moves, a position beyond 1e6 m.")
+      .def_property_readonly(
+          "frame",
+          [](const N& s) {
+            WorldGuard guard(*s.world);
+            return s.world->nodeSetFrame(s.index);
+          },
+          "Where the set's frame is at the end of the next step: where it started (its "
+          "wrench_about point, the world's axes) while held, the last move_to, or its scene "
+          "file's motion.")
+      .def_property_readonly(
+          "scripted", [](const N& s) { return s.world->nodeSetScripted(s.index); },
+          "True for a set its scene file moves (a motion): move_to refuses it");
 
   using H = HandHandle;
   py::class_<HandHandle>(m, "Hand", "A hand plane acting on one body (docs/hand-plane.md).")
@@ -366,29 +392,31 @@ void bindParts(py::module_& m) {
           "rows/columns [translation, rotation]). Six CG solves.");
 
   using R = RigidHandle;
-  py::class_<RigidHandle>(m, "RigidBody", "A Bullet rigid body of the world.")
+  py::class_<RigidHandle>(m, "RigidBody",
+                          "A Bullet rigid body of the world. Once World.remove_rigid_body took "
+                          "it out, everything but its name raises ValueError.")
       .def_property_readonly("name", [](const R& r) { return r.name; })
       .def_property_readonly(
-          "position", [](const R& r) { return rigidPose(*r.body, false); },
+          "position", [](const R& r) { return rigidPose(r.live(), false); },
           "(3,) centre of mass, m")
       .def_property_readonly(
-          "quaternion", [](const R& r) { return rigidPose(*r.body, true); },
+          "quaternion", [](const R& r) { return rigidPose(r.live(), true); },
           "(4,) orientation (x, y, z, w)")
       .def_property_readonly(
-          "linear_velocity", [](const R& r) { return btArray(r.body->getLinearVelocity()); },
+          "linear_velocity", [](const R& r) { return btArray(r.live().getLinearVelocity()); },
           "(3,) m/s")
       .def_property_readonly(
-          "angular_velocity", [](const R& r) { return btArray(r.body->getAngularVelocity()); },
+          "angular_velocity", [](const R& r) { return btArray(r.live().getAngularVelocity()); },
           "(3,) rad/s")
       .def_property_readonly(
           "mass",
           [](const R& r) {
-            const double inverse = static_cast<double>(r.body->getInvMass());
+            const double inverse = static_cast<double>(r.live().getInvMass());
             return inverse > 0 ? 1 / inverse : 0.0;
           },
           "kg (0: static or kinematic)")
       .def_property_readonly(
-          "kind", [](const R& r) { return rigidKindName(rigidKind(*r.world, *r.body)); },
+          "kind", [](const R& r) { return rigidKindName(rigidKind(*r.world, r.live())); },
           "\"dynamic\" (mass > 0), \"static\" (mass 0) or \"kinematic\" (following its scene "
           "file's script, or the targets of set_kinematic_target)")
       .def(
@@ -396,7 +424,7 @@ void bindParts(py::module_& m) {
           [](const R& r, py::object position, py::object quaternion) {
             const Frame pose = rigidFrame(r, "set_pose", position, quaternion);
             WorldGuard guard(*r.world, WorldGuard::kWrite);
-            if (Status s = setRigidPose(*r.world, r.name, *r.body, pose); !s)
+            if (Status s = setRigidPose(*r.world, r.name, r.live(), pose); !s)
               throw py::value_error(s.error().message);
           },
           py::arg("position"), py::arg("quaternion") = py::make_tuple(0.0, 0.0, 0.0, 1.0),
@@ -414,7 +442,7 @@ void bindParts(py::module_& m) {
             if (!angular.is_none())
               w = toVector3(angular, (who(r, "set_velocity") + ": angular").c_str());
             WorldGuard guard(*r.world, WorldGuard::kWrite);
-            if (Status s = setRigidVelocity(*r.world, r.name, *r.body, v, w); !s)
+            if (Status s = setRigidVelocity(*r.world, r.name, r.live(), v, w); !s)
               throw py::value_error(s.error().message);
           },
           py::arg("linear") = py::none(), py::arg("angular") = py::none(),
@@ -428,7 +456,7 @@ void bindParts(py::module_& m) {
             if (!point.is_none())
               at = toVector3(point, (who(r, "apply_force") + ": point").c_str());
             WorldGuard guard(*r.world, WorldGuard::kWrite);
-            if (Status s = applyRigidLoad(*r.world, "apply_force", r.name, *r.body, f, at,
+            if (Status s = applyRigidLoad(*r.world, "apply_force", r.name, r.live(), f, at,
                                           Eigen::Vector3d::Zero());
                 !s) {
               throw py::value_error(s.error().message);
@@ -444,7 +472,7 @@ void bindParts(py::module_& m) {
             const Eigen::Vector3d t =
                 toVector3(torque, (who(r, "apply_torque") + ": torque").c_str());
             WorldGuard guard(*r.world, WorldGuard::kWrite);
-            if (Status s = applyRigidLoad(*r.world, "apply_torque", r.name, *r.body,
+            if (Status s = applyRigidLoad(*r.world, "apply_torque", r.name, r.live(),
                                           Eigen::Vector3d::Zero(), std::nullopt, t);
                 !s) {
               throw py::value_error(s.error().message);
@@ -456,7 +484,7 @@ void bindParts(py::module_& m) {
           "applied_force",
           [](const R& r) {
             WorldGuard guard(*r.world);
-            const Wrench load = r.world->queuedLoad(*r.body);
+            const Wrench load = r.world->queuedLoad(r.live());
             return vectorArray(load.force.data(), 3);
           },
           "(3,) N: the force queued for the next step (apply_force), a copy")
@@ -464,7 +492,7 @@ void bindParts(py::module_& m) {
           "applied_torque",
           [](const R& r) {
             WorldGuard guard(*r.world);
-            const Wrench load = r.world->queuedLoad(*r.body);
+            const Wrench load = r.world->queuedLoad(r.live());
             return vectorArray(load.torque.data(), 3);
           },
           "(3,) N m about the centre of mass: the torque queued for the next step (apply_torque, "
@@ -474,7 +502,7 @@ void bindParts(py::module_& m) {
           [](const R& r, py::object position, py::object quaternion) {
             const Frame target = rigidFrame(r, "set_kinematic_target", position, quaternion);
             WorldGuard guard(*r.world, WorldGuard::kWrite);
-            if (Status s = setKinematicTarget(*r.world, r.name, *r.body, target); !s)
+            if (Status s = setKinematicTarget(*r.world, r.name, r.live(), target); !s)
               throw py::value_error(s.error().message);
           },
           py::arg("position"), py::arg("quaternion") = py::make_tuple(0.0, 0.0, 0.0, 1.0),

@@ -141,6 +141,13 @@ py::tuple worldDescription(PyWorld& w) {
   if (w.hasKinematicTargets())
     throw py::type_error(cannot +
                          "a rigid body has a kinematic target, which a state does not hold");
+  if (w.rigidRemoved()) throw py::type_error(cannot + "Python removed rigid bodies of its scene");
+  if (w.nodeSetsDriven())
+    throw py::type_error(cannot + "a node set is driven by move_to, which a state does not hold");
+  if (w.femContactChanged())
+    throw py::type_error(cannot +
+                         "Python changed its contact between FEM bodies (enable_fem_contact, "
+                         "disable_fem_contact)");
   Result<PyWorldState> state = w.saveState();
   if (!state) throw py::type_error(cannot + state.error().message);
   // A demo scene's name travels as it is (each machine finds it in its own data folder); a path
@@ -404,18 +411,79 @@ void bindWorld(py::module_& m) {
           [](py::object owner) {
             std::vector<RigidHandle> out;
             for (const scene::SceneRigidBody& r : self(owner).scene().rigid_bodies)
-              out.push_back({owner, &self(owner), r.name, r.body});
+              out.emplace_back(owner, self(owner), r.name, r.body);
             return out;
           })
       .def(
           "rigid_body",
           [](py::object owner, const std::string& name) {
             for (const scene::SceneRigidBody& r : self(owner).scene().rigid_bodies) {
-              if (r.name == name) return RigidHandle{owner, &self(owner), r.name, r.body};
+              if (r.name == name) return RigidHandle(owner, self(owner), r.name, r.body);
             }
             throw py::key_error("no rigid body named '" + name + "'");
           },
           py::arg("name"))
+      .def(
+          "remove_rigid_body",
+          [](py::object owner, py::object body) {
+            PyWorld& w = self(owner);
+            btRigidBody* rigid = nullptr;
+            if (py::isinstance<RigidHandle>(body)) {
+              const RigidHandle& r = body.cast<const RigidHandle&>();
+              if (r.world != &w)
+                throw py::value_error("remove_rigid_body: '" + r.name + "' is another world's");
+              rigid = &r.live();
+            } else {
+              const std::string name = body.cast<std::string>();
+              for (const scene::SceneRigidBody& r : w.scene().rigid_bodies) {
+                if (r.name == name) rigid = r.body;
+              }
+              if (rigid == nullptr) throw py::key_error("no rigid body named '" + name + "'");
+            }
+            WorldGuard guard(w, WorldGuard::kWrite);
+            if (Status s = w.removeRigidBody(*rigid); !s) throw py::value_error(s.error().message);
+          },
+          py::arg("body"),
+          "Takes a rigid body (a RigidBody or its name) out of the world for good, from the next "
+          "step on: FEM bodies it pressed on are free, its handles raise ValueError, contacts() "
+          "is empty until the next step and states saved before no longer restore. ValueError, "
+          "nothing changed: an FEM body anchors nodes to it (remove_anchor first), a handle of a "
+          "body removed already; KeyError: no rigid body of that name.")
+      .def(
+          "enable_fem_contact",
+          [](PyWorld& w, double friction, double gap_tolerance, double thickness_factor,
+             double margin) {
+            BodyContactSettings settings;
+            settings.friction = friction;
+            settings.gap_tolerance = gap_tolerance;
+            settings.thickness_factor = thickness_factor;
+            settings.margin = margin;
+            WorldGuard guard(w, WorldGuard::kWrite);
+            if (Status s = w.setFemContact(settings, true); !s)
+              throw py::value_error(s.error().message);
+          },
+          py::kw_only(), py::arg("friction") = BodyContactSettings{}.friction,
+          py::arg("gap_tolerance") = BodyContactSettings{}.gap_tolerance,
+          py::arg("thickness_factor") = BodyContactSettings{}.thickness_factor,
+          py::arg("margin") = BodyContactSettings{}.margin,
+          "Contact between FEM bodies from the next step on, with these settings (a scene's "
+          "\"fem_contact\"; on by default): friction (Coulomb), gap_tolerance (m; 0: 1e-3 of the "
+          "smaller mean surface edge), thickness_factor (the gap aimed at, in gap tolerances), "
+          "margin (the candidate search's reach, in mean surface edges). ValueError, nothing "
+          "changed, on a bad value.")
+      .def(
+          "disable_fem_contact",
+          [](PyWorld& w, bool refuse_touching) {
+            WorldGuard guard(w, WorldGuard::kWrite);
+            (void)w.setFemContact(std::nullopt, refuse_touching);
+          },
+          py::kw_only(), py::arg("refuse_touching") = false,
+          "No contact between FEM bodies from the next step on: they pass through each other, or, "
+          "with refuse_touching=True, a step in which two touch fails (UnstableError naming "
+          "them), as a scene's \"fem_contact\": {\"enabled\": false} does.")
+      .def_property_readonly(
+          "fem_contact", [](PyWorld& w) { return w.world().femSolver().femContact() != nullptr; },
+          "Whether FEM bodies touch each other (enable_fem_contact, disable_fem_contact)")
       .def(
           "contacts",
           [](PyWorld& w) {
@@ -528,7 +596,7 @@ void bindWorld(py::module_& m) {
             WorldGuard guard(w, WorldGuard::kWrite);
             Result<btRigidBody*> body = w.addRigidBody(spec, false);
             if (!body) throw py::value_error(body.error().message);
-            return RigidHandle{owner, &w, name, body.value()};
+            return RigidHandle(owner, w, name, body.value());
           },
           py::arg("name"), py::arg("shape") = "box", py::kw_only(),
           py::arg("half_extents") = py::make_tuple(0.5, 0.5, 0.5), py::arg("radius") = 0.5,

@@ -5,8 +5,10 @@
 
 #include <pybind11/pybind11.h>
 
+#include <cstdint>
 #include <mutex>
 #include <string>
+#include <utility>
 
 #include "py_world.h"
 
@@ -55,6 +57,21 @@ struct RigidHandle {
   PyWorld* world = nullptr;
   std::string name;
   btRigidBody* body = nullptr;
+  std::uint64_t serial = 0;  ///< PyWorld::rigidSerial of the body when the handle was made
+
+  RigidHandle(py::object owner_, PyWorld& world_, std::string name_, btRigidBody* body_)
+      : owner(std::move(owner_)),
+        world(&world_),
+        name(std::move(name_)),
+        body(body_),
+        serial(world_.rigidSerial(body_)) {}
+  /// The body, while it is in the world: ValueError once remove_rigid_body took it out (its
+  /// address may be another body's by then, so it is never touched).
+  btRigidBody& live() const {
+    if (serial == 0 || world->rigidSerial(body) != serial)
+      throw py::value_error("rigid body '" + name + "' was removed from its world");
+    return *body;
+  }
 };
 
 void bindTypes(py::module_& m);

@@ -1,5 +1,6 @@
 #include "py_world.h"
 
+#include <algorithm>
 #include <atomic>
 #include <cmath>
 #include <cstdio>
@@ -123,6 +124,8 @@ Result<std::unique_ptr<PyWorld>> PyWorld::fromScene(const std::string& name_or_p
   world->scene_threads_ = threads;
   world->devices_overridden_ = !devices.devices.empty() || !devices.haptics.empty();
   world->recordBuiltMaterials();
+  for (const scene::SceneRigidBody& r : world->scene_->rigid_bodies)
+    world->registerRigid(r.body);
   return world;
 }
 
@@ -337,9 +340,124 @@ Result<btRigidBody*> PyWorld::addRigidBody(const scene::RigidBodySpec& spec, boo
   if (Status s = checkRigidSpec(spec, ground); !s) return s.error();
   scene::SceneRigidBody added = scene::addSceneRigidBody(world(), spec);
   btRigidBody* body = added.body;
-  if (!ground) scene_->rigid_bodies.push_back(std::move(added));
+  if (!ground) {
+    scene_->rigid_bodies.push_back(std::move(added));
+    registerRigid(body);
+  }
   parts_added_ = true;
   return body;
+}
+
+Status PyWorld::removeRigidBody(btRigidBody& body) {
+  const auto entry =
+      std::find_if(scene_->rigid_bodies.begin(), scene_->rigid_bodies.end(),
+                   [&body](const scene::SceneRigidBody& r) { return r.body == &body; });
+  if (entry == scene_->rigid_bodies.end())
+    return Error{"remove_rigid_body: not a rigid body of this world"};
+  const std::string who = "remove_rigid_body '" + entry->name + "': ";
+  if (Status removed = world().removeRigidBody(&body); !removed) {
+    const std::string prefix = "remove rigid body: ";
+    std::string why = removed.error().message;
+    if (why.rfind(prefix, 0) == 0) why.erase(0, prefix.size());
+    return Error{who + why};
+  }
+  // The body is gone (a scripted one's motion state may go now); nothing of Python's may point
+  // to it any more.
+  scene_->rigid_bodies.erase(entry);
+  const auto on_body = [&body](const auto& input) { return input.body == &body; };
+  loads_.erase(std::remove_if(loads_.begin(), loads_.end(), on_body), loads_.end());
+  anchor_loads_.erase(std::remove_if(anchor_loads_.begin(), anchor_loads_.end(), on_body),
+                      anchor_loads_.end());
+  targets_.erase(std::remove_if(targets_.begin(), targets_.end(), on_body), targets_.end());
+  rigid_serials_.erase(&body);
+  ++rigid_removals_;
+  anchor_.reset();
+  stepped_ = false;
+  return Ok{};
+}
+
+std::uint64_t PyWorld::rigidSerial(const btRigidBody* body) const {
+  const auto found = rigid_serials_.find(body);
+  return found == rigid_serials_.end() ? 0 : found->second;
+}
+
+bool PyWorld::nodeSetScripted(size_t index) const {
+  const std::string& name = scene_->node_sets[index].name;
+  for (const scene::NodeSetSpec& set : scene_->spec.node_sets) {
+    if (set.name == name) return !set.fixed;
+  }
+  return false;
+}
+
+Status PyWorld::moveNodeSet(size_t index, const Frame& pose) {
+  const scene::NodeSetHandle& set = scene_->node_sets[index];
+  const std::string who = "move_to: node set '" + set.name + "': ";
+  if (nodeSetScripted(index))
+    return Error{who + "it follows its scene file's motion, which sets it at every step"};
+  if (set.body->groups()[static_cast<size_t>(set.group)]->nodes().empty())
+    return Error{who + "it was released and holds no node any more"};
+  if (!(pose.origin.cwiseAbs().maxCoeff() <= scene::kMaxPlacement)) {
+    return Error{who + "position (" + formatNumber(pose.origin.x()) + ", " +
+                 formatNumber(pose.origin.y()) + ", " + formatNumber(pose.origin.z()) +
+                 ") m: each coordinate must be finite and within " +
+                 formatNumber(scene::kMaxPlacement) + " m of the origin"};
+  }
+  if (!(std::abs(pose.rotation.norm() - 1) <= 1e-6))
+    return Error{who + "the quaternion is not a unit quaternion"};
+  // The set's frame started at wrench_about with the world's axes: the displacement that puts it
+  // at `pose` is x -> R (x - a) + O.
+  std::shared_ptr<NodeSetDrive>& drive = drives_[index];
+  if (!drive) drive = std::make_shared<NodeSetDrive>();
+  drive->goal = pose;
+  drive->displacement.rotation = pose.rotation.normalized();
+  drive->displacement.origin = pose.origin - drive->displacement.rotation * set.wrench_about;
+  installDrives();
+  return Ok{};
+}
+
+void PyWorld::installDrives() {
+  for (const auto& [index, drive] : drives_) {
+    const scene::NodeSetHandle& set = scene_->node_sets[index];
+    set.body->setGroupMotion(set.group, [shared = drive](double) { return shared->displacement; });
+  }
+}
+
+Frame PyWorld::nodeSetFrame(size_t index) {
+  const scene::NodeSetHandle& set = scene_->node_sets[index];
+  const CarriedNodes& group = *set.body->groups()[static_cast<size_t>(set.group)];
+  if (const auto driven = drives_.find(index); driven != drives_.end() && !group.nodes().empty())
+    return driven->second->goal;
+  const double end = world().time() + world().settings().solver.time_step;
+  const Frame displacement = group.frameAt(end);
+  Frame pose;
+  pose.rotation = displacement.rotation;
+  pose.origin = displacement.toWorld(set.wrench_about);
+  return pose;
+}
+
+Status PyWorld::setFemContact(const std::optional<BodyContactSettings>& settings,
+                              bool refuse_touching) {
+  FemSoftBodySolver& solver = world().femSolver();
+  if (settings) {
+    if (Status valid = settings->validate(); !valid) return valid;
+    const FemContactIslands* on = solver.femContact();
+    const auto same = [](const BodyContactSettings& a, const BodyContactSettings& b) {
+      return a.friction == b.friction && a.gap_tolerance == b.gap_tolerance &&
+             a.thickness_factor == b.thickness_factor && a.margin == b.margin &&
+             a.max_depth == b.max_depth && a.edge_edge == b.edge_edge;
+    };
+    // The same settings again keep the pairs and their warm starts.
+    if (on == nullptr || !same(on->settings(), *settings)) {
+      if (Status set = solver.setFemContact(settings); !set) return set;
+    }
+    solver.setUnsupportedContact(UnsupportedContact::kError);
+  } else {
+    (void)solver.setFemContact(std::nullopt);
+    solver.setUnsupportedContact(refuse_touching ? UnsupportedContact::kError
+                                                 : UnsupportedContact::kWarn);
+  }
+  fem_contact_changed_ = true;
+  return Ok{};
 }
 
 Status PyWorld::setGravity(const Eigen::Vector3d& gravity) {
@@ -377,6 +495,7 @@ Result<PyWorldState> PyWorld::saveState() {
   state.failure = failure_;
   state.time = state.world.fem.time;
   state.source = id_;
+  state.rigid_removals = rigid_removals_;
   return state;
 }
 
@@ -517,18 +636,22 @@ Status PyWorld::restoreState(const PyWorldState& state) {
         deserialize(state.bytes, world(), hands(), scene_->hands.size(), built_materials_);
     if (!read) return read.error();
     read.value().source = id_;
+    read.value().rigid_removals = rigid_removals_;  // its bytes were read for the world as it is
     return restoreState(read.value());
   }
   std::vector<Hand*> all = hands();
   if (all.size() != state.hands.size() || state.node_set_count != scene_->node_sets.size()) {
     return Error{"restore_state: hands or node sets were added since the state was saved"};
   }
+  if (state.rigid_removals != rigid_removals_)
+    return Error{"restore_state: a rigid body was removed since the state was saved"};
   if (Status restored = world().restore(state.world); !restored) return restored;
   for (size_t h = 0; h < all.size(); ++h)
     all[h]->restore(state.hands[h]);
   for (size_t h = 0; h < scene_->hands.size(); ++h)
     scene_->hands[h].released = state.released[h];
   failure_ = state.failure;
+  installDrives();
   anchor_.reset();
   stepped_ = false;
   return Ok{};

@@ -42,6 +42,9 @@ struct PyWorldState {
   std::vector<bool> released;         ///< per scene hand: let go for good (driveHands)
   size_t node_set_count = 0;
   std::string failure;
+  /// PyWorld::removeRigidBody calls before it was saved: the in-memory part points to the rigid
+  /// bodies there were then.
+  std::uint64_t rigid_removals = 0;
   /// The world that saved it (PyWorld::id()); the in-memory part refers to that world's parts, so
   /// another world reads `bytes` instead.
   std::uint64_t source = 0;
@@ -72,6 +75,11 @@ class PyWorld {
   bool devicesOverridden() const { return devices_overridden_; }
   /// Whether Python set a rigid body's kinematic target (a checkpoint holds poses, not targets).
   bool hasKinematicTargets() const { return !targets_.empty(); }
+  /// Whether Python removed a rigid body (removeRigidBody), drove a node set (moveNodeSet) or
+  /// changed the contact between FEM bodies (setFemContact): what the scene does not describe.
+  bool rigidRemoved() const { return rigid_removals_ > 0; }
+  bool nodeSetsDriven() const { return !drives_.empty(); }
+  bool femContactChanged() const { return fem_contact_changed_; }
   FemWorld& world() { return *scene_->world; }
 
   /// n steps (scripted hands driven, device hands through their haptics, as `torsion run`).
@@ -99,6 +107,31 @@ class PyWorld {
   /// lengths in (0, 1e6] m, mass 0 (static) or in [1e-9, 1e12] kg, all finite (errors name the
   /// add_rigid_body / add_ground argument and its value).
   Result<btRigidBody*> addRigidBody(const scene::RigidBodySpec& spec, bool ground);
+  /// Takes a rigid body (the scene's or one added in code, not the ground) out of the world for
+  /// good (FemWorld::removeRigidBody), with what Python queued for it (loads, kinematic target).
+  /// contacts() is empty until the next step, and states saved before no longer restore. Errors,
+  /// changing nothing, starting "remove_rigid_body 'name': ": an FEM body anchors nodes to it.
+  Status removeRigidBody(btRigidBody& body);
+  /// Nonzero while `body` is one of the world's rigid bodies: a number never given to another
+  /// body of this world (a removed body's address may come back as a new body's, its serial not).
+  std::uint64_t rigidSerial(const btRigidBody* body) const;
+
+  /// Node set `index` (scene().node_sets) driven like a mocap body: its frame reaches `pose` at
+  /// the end of the next step and stays there until the next call. The set's frame starts at its
+  /// wrench_about point with the world's axes; its nodes are carried rigidly with it. Errors,
+  /// changing nothing, starting "move_to: node set 'name': ": a released set, a set its scene file
+  /// moves, a position beyond scene::kMaxPlacement.
+  Status moveNodeSet(size_t index, const Frame& pose);
+  /// Where node set `index`'s frame is at the end of the next step (held: where it started).
+  Frame nodeSetFrame(size_t index);
+  /// Whether node set `index` follows a motion of its scene file.
+  bool nodeSetScripted(size_t index) const;
+
+  /// Contact between FEM bodies from the next step on (FemSoftBodySolver::setFemContact):
+  /// `settings`, or off (nullopt). Off, FEM bodies that touch pass through each other, or with
+  /// `refuse_touching` fail the step as a scene's "enabled": false does. Errors, changing
+  /// nothing: invalid settings.
+  Status setFemContact(const std::optional<BodyContactSettings>& settings, bool refuse_touching);
 
   /// Gravity for the next steps, m/s^2 (FEM and dynamic rigid bodies): finite, magnitude at most
   /// a scene file's bound (scene::checkGravity). Errors change nothing.
@@ -155,6 +188,10 @@ class PyWorld {
   /// Every body's material as built (set_material changes the live one), by body name: a state
   /// restores into a world whose bodies were built as the saved world's were.
   void recordBuiltMaterials();
+  void registerRigid(const btRigidBody* body) { rigid_serials_[body] = next_rigid_serial_++; }
+  /// The driven node sets' groups to their drives (a restored group has the motion it was saved
+  /// with: the drive is the world's, as a kinematic target is).
+  void installDrives();
   std::unique_ptr<scene::BuiltScene> scene_;
   std::uint64_t id_ = 0;
   std::string scene_source_;
@@ -171,6 +208,18 @@ class PyWorld {
   std::vector<RigidLoad> anchor_loads_;    // those the step from anchor_ took: replayed with it
   std::vector<KinematicTarget> targets_;   // set from Python, handed to Bullet before each step
   bool stepped_ = false;                   // stepped(): reset by restoreState
+  std::map<const btRigidBody*, std::uint64_t> rigid_serials_;  // rigidSerial()
+  std::uint64_t next_rigid_serial_ = 1;
+  std::uint64_t rigid_removals_ = 0;
+  // A driven node set's goal (its frame, as move_to gave it) and the displacement that carries
+  // its nodes there (x = R x0 + O from where they were when the set was made), which the motion
+  // of its group reads.
+  struct NodeSetDrive {
+    Frame goal;
+    Frame displacement;
+  };
+  std::map<size_t, std::shared_ptr<NodeSetDrive>> drives_;  // by node set index
+  bool fem_contact_changed_ = false;
   std::mutex busy_;
 };
 

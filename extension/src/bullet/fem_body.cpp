@@ -1,5 +1,6 @@
 #include "torsion/bullet/fem_body.h"
 
+#include <algorithm>
 #include <cassert>
 
 #include "torsion/bt_conversions.h"
@@ -55,6 +56,11 @@ void FemBody::releaseGroup(int group) {
       g->name(), std::vector<int>{}, [](double) { return Frame{}; }, state_, 0.0);
 }
 
+void FemBody::setGroupMotion(int group, FrameMotion motion) {
+  CarriedNodes& g = *groups_[static_cast<size_t>(group)];
+  if (!g.nodes().empty()) g.setMotion(std::move(motion));
+}
+
 Wrench FemBody::groupWrench(int group, const Eigen::Vector3d& point) {
   const CarriedNodes& carried = *groups_[static_cast<size_t>(group)];
   return carried.wrenchOn(stepper_.internalForcesAt(carried.nodes()), state_, point);
@@ -86,6 +92,35 @@ Status FemBody::removeAnchor(int anchor) {
   }
   contacts_->removeAnchor(anchor);
   return Ok{};
+}
+
+std::vector<int> FemBody::anchorsOn(const btCollisionObject* object) const {
+  std::vector<int> ids;
+  const auto& anchors = contacts_->anchors().anchors();
+  for (size_t k = 0; k < anchors.size(); ++k) {
+    if (object != nullptr && anchors[k].object == object) ids.push_back(static_cast<int>(k));
+  }
+  return ids;
+}
+
+void FemBody::forgetObject(const btCollisionObject* object) {
+  // What the next step takes over from the last names objects by pointer: a deleted object's
+  // address could come back as another's. Going through the warm starts, as a checkpoint restore
+  // does, rebuilds the solver's memory without it.
+  CarriedContacts carried = contacts_->carriedContacts();
+  bool named = false;
+  for (const RigidPartner& partner : contacts_->partners())
+    named = named || partner.object == object;
+  const auto is_object = [object](const auto& entry) { return entry.object == object; };
+  const size_t node_count = carried.nodes.size(), feature_count = carried.features.size();
+  carried.nodes.erase(std::remove_if(carried.nodes.begin(), carried.nodes.end(), is_object),
+                      carried.nodes.end());
+  carried.features.erase(
+      std::remove_if(carried.features.begin(), carried.features.end(), is_object),
+      carried.features.end());
+  named = named || carried.nodes.size() != node_count || carried.features.size() != feature_count;
+  if (named) contacts_->restoreCarriedContacts(carried);
+  soft_body_->m_rcontacts.resizeNoInitialize(0);
 }
 
 Status FemBody::setVelocity(const Eigen::Vector3d& velocity) {

@@ -58,6 +58,7 @@ btRigidBody* FemWorld::addRigidBody(std::unique_ptr<btCollisionShape> shape, dou
   world_->addRigidBody(rigid);
   shapes_.push_back(std::move(shape));
   motion_states_.push_back(std::move(motion));
+  owned_.push_back(rigid);
   rigid_bodies_.push_back(rigid);
   return rigid;
 }
@@ -90,6 +91,43 @@ Status FemWorld::restore(const WorldCheckpoint& c) {
     rigid->clearForces();
     if (rigid->getMotionState() != nullptr) rigid->getMotionState()->setWorldTransform(r.pose);
   }
+  return Ok{};
+}
+
+Status FemWorld::removeRigidBody(btRigidBody* body) {
+  const auto listed = std::find(rigid_bodies_.begin(), rigid_bodies_.end(), body);
+  if (body == nullptr || listed == rigid_bodies_.end())
+    return Error{"remove rigid body: not a rigid body of this world"};
+  for (const auto& fem : bodies()) {
+    const std::vector<int> anchors = fem->anchorsOn(body);
+    if (anchors.empty()) continue;
+    std::string ids;
+    for (int id : anchors)
+      ids += (ids.empty() ? "" : ", ") + std::to_string(id);
+    return Error{"remove rigid body: FEM body '" + fem->name() + "' anchors nodes to it (anchor" +
+                 (anchors.size() > 1 ? "s " : " ") + ids + "); remove the anchors first"};
+  }
+  if (body->getNumConstraintRefs() > 0) {
+    return Error{"remove rigid body: " + std::to_string(body->getNumConstraintRefs()) +
+                 " Bullet constraint(s) refer to it; remove them from the world first"};
+  }
+  world_->removeRigidBody(body);
+  for (const auto& fem : bodies())
+    fem->forgetObject(body);
+  rigid_bodies_.erase(listed);
+  const auto tracked = std::find(tracked_.begin(), tracked_.end(), body);
+  if (tracked != tracked_.end()) {
+    tracked_.erase(tracked);
+    return Ok{};
+  }
+  // Its shape and motion state go with it (a scene's script may have replaced the motion state
+  // the body was made with: the one made here is the one freed here).
+  const auto owned = std::find(owned_.begin(), owned_.end(), body);
+  const auto k = owned - owned_.begin();
+  delete body;
+  owned_.erase(owned);
+  shapes_.erase(shapes_.begin() + k);
+  motion_states_.erase(motion_states_.begin() + k);
   return Ok{};
 }
 

@@ -58,6 +58,9 @@ class FemBody {
   int carryNodes(std::string group_name, std::vector<int> nodes, FrameMotion motion, double now);
   /// Frees the group's nodes (its index stays reserved and reports zero wrench).
   void releaseGroup(int group);
+  /// Carries group `group` along `motion` from the next step on (CarriedNodes::setMotion): a held
+  /// or scripted group becomes driven by whoever supplies the frames. A released group stays free.
+  void setGroupMotion(int group, FrameMotion motion);
   const std::vector<std::unique_ptr<CarriedNodes>>& groups() const { return groups_; }
 
   /// The wrench the body exerts on group `group` at the end of the last step, about `point`.
@@ -72,6 +75,13 @@ class FemBody {
   Result<int> anchorNodes(std::vector<int> nodes, btCollisionObject* object);
   /// Frees an anchor's nodes (its id stays reserved). Errors: an unknown or removed anchor.
   Status removeAnchor(int anchor);
+  /// The ids of the anchors that tie nodes to `object` now (empty: none).
+  std::vector<int> anchorsOn(const btCollisionObject* object) const;
+  /// Forgets `object`, which is leaving the world: the contact warm starts with it are dropped
+  /// (the others are kept, as a checkpoint restore keeps them) and Bullet's contact list of the
+  /// btSoftBody is cleared, so nothing the next step or a checkpoint reads points to it. Call it
+  /// before the object is deleted; an object anchored to (anchorsOn) must not leave.
+  void forgetObject(const btCollisionObject* object);
 
   /// Sets every node's velocity (m/s), e.g. an initial velocity before the first step. Errors
   /// (nothing set): a velocity that is not finite.

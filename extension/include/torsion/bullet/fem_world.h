@@ -74,6 +74,14 @@ class FemWorld {
   /// btBulletWorldImporter): it is listed in rigidBodies() (drawing, checkpoints) but neither
   /// removed from the world nor deleted by this FemWorld; its owner must keep it alive as long.
   void trackRigidBody(btRigidBody* body);
+  /// Takes a rigid body of rigidBodies() out of the world for good: out of Bullet's world, out of
+  /// every FEM body's contact memory (FemBody::forgetObject) and out of rigidBodies() (the others
+  /// keep their order); one the world owns is deleted with its shape and motion state, a tracked
+  /// one is left to its owner. Pointers to it are stale afterwards, and checkpoints taken before
+  /// no longer restore (restore() counts the rigid bodies). Errors, changing nothing: not a rigid
+  /// body of this world; an FEM body anchors nodes to it (remove the anchors first); a Bullet
+  /// constraint refers to it (remove it from bulletWorld() first).
+  Status removeRigidBody(btRigidBody* body);
 
   /// One step of settings().solver.time_step (also with no bodies: the clock moves on). Not ok
   /// when a rigid body became non-finite or overflowed (bullet/rigid_health.h) or an FEM step
@@ -126,6 +134,7 @@ class FemWorld {
   std::vector<std::unique_ptr<btMotionState>> motion_states_;
   std::vector<btRigidBody*> rigid_bodies_;  // owned ones deleted after removal from the world
   std::vector<btRigidBody*> tracked_;       // not owned (trackRigidBody)
+  std::vector<btRigidBody*> owned_;  // addRigidBody's, each with shapes_[k], motion_states_[k]
 };
 
 }  // namespace torsion

@@ -6,6 +6,7 @@
 
 #include <Eigen/Core>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "torsion/constraints/frame.h"
@@ -36,6 +37,10 @@ class CarriedNodes {
   const std::vector<Eigen::Vector3d>& localCoordinates() const { return local_; }
   Frame frameAt(double time) const { return motion_(time); }
   const FrameMotion& motion() const { return motion_; }
+  /// Hands the group to another motion from the next prescribe() on (a program that drives a set
+  /// the scene held): the nodes and their p_hat stay, so `motion` is the same kind of frame, the
+  /// map from where the nodes were at construction to where they go.
+  void setMotion(FrameMotion motion) { motion_ = std::move(motion); }
 
   /// Prescribes each node's velocity so it reaches R(t_next) p_hat + O(t_next) after dt.
   void prescribe(double time_next, double dt, const FemState& state,
