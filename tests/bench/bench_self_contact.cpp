@@ -134,6 +134,7 @@ int main(int argc, char** argv) {
       crossing_first = -1, exact_crossing_checks = 0;
   CrossingKinds kinds;  // the exact checker's pairs at the checks, summed (crossing_kinds.h)
   long newton = 0;
+  long cg = 0;  // the body's CG iterations (with contact: the island's, summed over Newton)
   double worst_end = 0, stepping = 0, searching = 0;
   const std::clock_t cpu0 = std::clock();
   for (int k = 1; k <= steps; ++k) {
@@ -152,6 +153,7 @@ int main(int argc, char** argv) {
       std::ofstream(save_file, std::ios::binary)
           << writeCheckpoint(*scene.world, scene.world->checkpoint(), hands, hand_checkpoints, "");
     }
+    cg += body->lastReport().solve.iterations;
     if (body->selfContact() != nullptr) {
       const SelfContactStats& s = body->selfContact()->stats();
       unconverged += s.converged ? 0 : 1;
@@ -217,7 +219,7 @@ int main(int argc, char** argv) {
   std::printf(
       "{\"scene\": \"%s\", \"steps\": %d, \"threads\": %d, \"steps_per_s\": %.2f, "
       "\"cpu_s_per_step\": %.4g, \"search_ms_per_step\": %.3g, \"self_contact\": %s, "
-      "\"newton_iterations\": %ld, "
+      "\"newton_iterations\": %ld, \"cg_per_step\": %.1f, "
       "\"unconverged\": %d, \"max_active\": %d, "
       "\"worst_end_penetration_m\": %.3g, "
       "\"gap_tolerance_m\": %.3g, \"searches\": %d, \"search_builds\": %d, "
@@ -228,9 +230,10 @@ int main(int argc, char** argv) {
       "\"crossing_pairs_edge_edge_with_candidate\": %d, "
       "\"crossing_pairs_within_gap_tolerance\": %d, \"deepest_crossing_m\": %.3g}\n",
       scene.spec.name.c_str(), steps, threads, steps / stepping, cpu / steps,
-      1e3 * searching / steps, self_contact ? "true" : "false", newton, unconverged, max_active,
-      worst_end, gap_tolerance, searches, search_builds, crossing_checks, crossing_first,
-      exact_crossing_checks, kinds.node_in_face, kinds.node_in_face_deep, kinds.edge_edge,
-      kinds.with_candidate, kinds.edge_edge_with_candidate, kinds.within_tolerance, kinds.deepest);
+      1e3 * searching / steps, self_contact ? "true" : "false", newton,
+      static_cast<double>(cg) / steps, unconverged, max_active, worst_end, gap_tolerance, searches,
+      search_builds, crossing_checks, crossing_first, exact_crossing_checks, kinds.node_in_face,
+      kinds.node_in_face_deep, kinds.edge_edge, kinds.with_candidate,
+      kinds.edge_edge_with_candidate, kinds.within_tolerance, kinds.deepest);
   return 0;
 }

@@ -24,6 +24,7 @@ DiagonalBlock FemIslandBody::diagonalBlock(int node) const {
 
 DiagonalBlock FemIslandBody::freeProjector(int node) const {
   // S on one node: the filter applied to the unit vectors (identity, zero, or I - d d^T).
+  if (constraints_.kind(node) == NodeConstraints::Kind::kFree) return DiagonalBlock::Identity(3, 3);
   DiagonalBlock s(3, 3);
   for (int k = 0; k < 3; ++k)
     s.col(k) = constraints_.filterNode(node, Eigen::Vector3d::Unit(k));
