@@ -21,6 +21,9 @@ void addViewCommand(CLI::App& app, CommandAction& chosen) {
       ->check(CLI::NonNegativeNumber);
   cmd->add_option("--frames", options->frames, "Quit after this many frames (tests)")
       ->check(CLI::PositiveNumber);
+  cmd->add_option("--steps-per-frame", options->steps_per_frame,
+                  "Take this many steps a frame instead of following the wall clock (tests)")
+      ->check(CLI::PositiveNumber);
   cmd->add_option("--script", options->script,
                   "Synthetic input, one event a line: '<frame> key NAME [shift]', '<frame> drag "
                   "left|right|middle DX DY [ctrl]', '<frame> scroll DY'");

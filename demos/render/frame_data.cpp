@@ -193,22 +193,24 @@ BodyDrawData bodyDrawData(const FemBody& body, Eigen::AlignedBox3d& bounds) {
   return d;
 }
 
-// One hand: its frame, and a square covering the grabbed patch with a margin (or a tenth of the
-// scene); the nodes it holds are marked on their body.
-HandDrawData handDrawData(const scene::SceneHand& h, double time, FrameData& frame) {
+// One hand: its frame (the patch while it holds, else `free_frame`), and a square covering the
+// grabbed patch with a margin (or a tenth of the scene); the nodes it holds are marked on their
+// body.
+HandDrawData handDrawData(const Hand& hand, const std::string& name, const Frame& free_frame,
+                          FrameData& frame) {
   HandDrawData d;
-  d.name = h.spec.name;
-  d.frame = h.hand->grabbed() ? h.hand->frame() : h.spec.frameAt(time);
-  d.holding = h.hand->grabbed();
+  d.name = name;
+  d.frame = hand.grabbed() ? hand.frame() : free_frame;
+  d.holding = hand.grabbed();
   double reach = 0;
   if (d.holding) {
-    const FemBody& body = h.hand->body();
-    for (int i : h.hand->grabbedNodes())
+    const FemBody& body = hand.body();
+    for (int i : hand.grabbedNodes())
       reach = std::max(reach, (body.state().position(i) - d.frame.origin).norm());
     for (BodyDrawData& b : frame.bodies) {
       if (b.name == body.name()) {
-        b.grabbed_nodes.insert(b.grabbed_nodes.end(), h.hand->grabbedNodes().begin(),
-                               h.hand->grabbedNodes().end());
+        b.grabbed_nodes.insert(b.grabbed_nodes.end(), hand.grabbedNodes().begin(),
+                               hand.grabbedNodes().end());
       }
     }
   }
@@ -219,6 +221,13 @@ HandDrawData handDrawData(const scene::SceneHand& h, double time, FrameData& fra
 }
 
 }  // namespace
+
+void addHand(FrameData& frame, const Hand& hand, const std::string& name, const Frame& free_frame) {
+  frame.hands.push_back(handDrawData(hand, name, free_frame, frame));
+  frame.bounds.extend(frame.hands.back().frame.origin);
+  const Wrench w = hand.wrench();
+  frame.wrenches.push_back({name, w.force, w.torque});
+}
 
 // The frame as its stages: the header, the FEM bodies, the hands and wrenches, the rigid bodies,
 // then the bounds and the stress scale over all of them.
@@ -243,12 +252,8 @@ FrameData captureFrame(scene::BuiltScene& scene, double steps_per_second) {
       stress_max = std::max(
           stress_max, static_cast<double>(frame.bodies.back().stress[static_cast<size_t>(i)]));
   }
-  for (const scene::SceneHand& h : scene.hands) {
-    frame.hands.push_back(handDrawData(h, world.time(), frame));
-    frame.bounds.extend(frame.hands.back().frame.origin);
-    const Wrench w = h.hand->wrench();
-    frame.wrenches.push_back({h.spec.name, w.force, w.torque});
-  }
+  for (const scene::SceneHand& h : scene.hands)
+    addHand(frame, *h.hand, h.spec.name, h.spec.frameAt(world.time()));
   for (scene::NodeSetHandle& s : scene.node_sets) {
     const Wrench w = s.body->groupWrench(s.group, s.wrench_about);
     frame.wrenches.push_back({s.name, w.force, w.torque});

@@ -85,6 +85,11 @@ double niceCeiling(double value);
 /// least the stress of a 1e-6 strain (so a body at rest shows uniform blue, not round-off).
 FrameData captureFrame(scene::BuiltScene& scene, double steps_per_second = 0);
 
+/// Adds a hand the scene does not list (one a program added to the world): drawn at its patch
+/// while it holds, else at `free_frame`, its wrench listed after those already in `frame`.
+/// captureFrame adds the scene's hands this way; call before the bounds are used (frameCamera).
+void addHand(FrameData& frame, const Hand& hand, const std::string& name, const Frame& free_frame);
+
 /// The colour map of the stress: a dark-blue, teal, green, yellow ramp of increasing lightness
 /// (no orange, which marks grabbed nodes). s in [0, 1], clamped.
 Eigen::Vector3d stressColour(double s);

@@ -16,10 +16,12 @@
 #include "camera.h"
 #include "frame_data.h"
 #include "image.h"
+#include "pacing.h"
 #include "renderer.h"
 #include "scene_builder.h"
 #include "scene_haptics.h"
 #include "scene_parser.h"
+#include "viewer_window.h"
 
 namespace torsion::viewer {
 
@@ -123,7 +125,7 @@ Result<std::vector<InputEvent>> readScript(const std::string& path) {
   return events;
 }
 
-class Viewer {
+class Viewer : public InputSink {
  public:
   Viewer(const ViewerOptions& options, scene::SceneSpec spec)
       : options_(options), spec_(std::move(spec)) {}
@@ -146,7 +148,7 @@ class Viewer {
   }
 
   // ---- input ----
-  void onKey(int key, bool shift) {
+  void onKey(int key, bool shift) override {
     const double size = sceneSize();
     const double step = 0.05 * size, angle = 5 * M_PI / 180;
     const Eigen::Vector3d axis =
@@ -218,23 +220,20 @@ class Viewer {
   }
 
   // dx, dy in pixels of a window `height` pixels high.
-  void onDrag(int button, double dx, double dy, bool ctrl, int height) {
-    const double h = std::max(1, height);
+  void onDrag(int button, double dx, double dy, bool ctrl, int height) override {
     if (ctrl && button == GLFW_MOUSE_BUTTON_LEFT) {
       if (!manual_ && !toggleManual()) return;
       const Eigen::Matrix4d v = camera_.view();
       const double visible = 2 * camera_.distance * std::tan(camera_.fov_y / 2);
       manual_frame_.origin +=
-          visible / h *
+          visible / std::max(1, height) *
           (dx * v.block<1, 3>(0, 0).transpose() - dy * v.block<1, 3>(1, 0).transpose());
-    } else if (button == GLFW_MOUSE_BUTTON_LEFT) {
-      camera_.orbit(-dx / h * 3, dy / h * 3);
     } else {
-      camera_.pan(-dx / h, dy / h);
+      dragCamera(camera_, button, dx, dy, height);
     }
   }
 
-  void onScroll(double dy) { camera_.zoom(std::pow(0.9, dy)); }
+  void onScroll(double dy) override { scrollCamera(camera_, dy); }
 
   void apply(const InputEvent& e, int height) {
     switch (e.kind) {
@@ -251,6 +250,31 @@ class Viewer {
   }
 
   // ---- simulation ----
+  /// One frame's steps, `elapsed` s of wall time after the previous frame's: --steps-per-frame
+  /// of them, or as many as keep simulated time on the wall clock (pacing.h); none while paused
+  /// (N: one).
+  void advanceFrame(double elapsed) {
+    if (!unstable_.empty()) return;
+    if (paused_ || options_.steps_per_frame > 0) {
+      lag_ = 0;
+      const int steps = paused_ ? (single_step_ ? 1 : 0) : options_.steps_per_frame;
+      for (int i = 0; i < steps && unstable_.empty(); ++i)
+        advance();
+      return;
+    }
+    PacingInput in;
+    in.dt = scene_->world->settings().solver.time_step;
+    in.elapsed = elapsed;
+    in.step_cost = step_cost_;
+    in.lag = lag_;
+    const PacingDecision d = paceFrame(in);
+    for (int i = 0; i < d.steps && unstable_.empty(); ++i)
+      advance();
+    lag_ = d.lag;
+    // The HUD's factor over the last second or so of frames, so it reads steadily.
+    shown_factor_ += 0.1 * (d.real_time_factor - shown_factor_);
+  }
+
   void advance() {
     if (!unstable_.empty()) return;
     if (paused_ && !single_step_) return;
@@ -266,12 +290,15 @@ class Viewer {
         return;
       }
     }
+    // A threaded haptic loop waits for the step's wall-clock time: outside its measured cost.
+    if (scene_->haptics) scene_->haptics->pace();
     const auto t0 = std::chrono::steady_clock::now();
     // Device hands (if any) step through their haptic loops.
     const WorldStepReport r = scene_->haptics ? scene_->haptics->step() : scene_->world->step();
     const double seconds =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     rate_ = seconds > 0 ? 0.9 * rate_ + 0.1 / seconds : rate_;
+    step_cost_ = step_cost_ > 0 ? 0.8 * step_cost_ + 0.2 * seconds : seconds;
     ++steps_;
     if (!r.ok) unstable_ = r.message;
     recordWrench();
@@ -306,7 +333,13 @@ class Viewer {
                       (manual_        ? "  HAND: MANUAL (G GRAB, U RELEASE)"
                        : deviceHand() ? "  HAND: DEVICE"
                                       : "  HAND: SCRIPT (M MANUAL)"));
-    if (!unstable_.empty()) f.notes.push_back("STOPPED: " + unstable_.substr(0, 60));
+    if (!unstable_.empty()) {
+      f.notes.push_back("STOPPED: " + unstable_.substr(0, 60));
+    } else if (!paused_) {
+      f.notes.push_back(options_.steps_per_frame > 0
+                            ? std::to_string(options_.steps_per_frame) + " STEPS PER FRAME"
+                            : realTimeNote(shown_factor_));
+    }
     f.notes.push_back("KEYS SPACE N R F  T E P D C  M G U ARROWS PGUP PGDN");
     if (manual_ && hand() && !hand()->hand->grabbed()) {
       render::HandDrawData d;
@@ -483,21 +516,13 @@ class Viewer {
   Frame manual_frame_;
   bool manual_ = false, paused_ = false, single_step_ = false, quit_ = false, reframe_ = false;
   double rate_ = 0;
+  double step_cost_ = 0;     // s of wall time per step, smoothed (pacing)
+  double lag_ = 0;           // s of simulated time owed to the wall clock (pacing)
+  double shown_factor_ = 1;  // real-time factor on the HUD, smoothed
   int steps_ = 0;
   std::string unstable_;
   render::WrenchHistory history_;
 };
-
-// GLFW callbacks reach the viewer through the window's user pointer.
-struct WindowState {
-  Viewer* viewer = nullptr;
-  double last_x = 0, last_y = 0;
-  int height = 1;
-};
-
-WindowState* stateOf(GLFWwindow* w) {
-  return static_cast<WindowState*>(glfwGetWindowUserPointer(w));
-}
 
 // The scene file with --device / --haptics applied, and the --script events.
 struct ViewerInput {
@@ -522,119 +547,39 @@ Result<ViewerInput> loadInput(const ViewerOptions& options) {
   return input;
 }
 
-// The GLFW window with its OpenGL 2.1 context current and the GL entry points loaded; closing it
-// terminates GLFW.
-class ViewerWindow {
- public:
-  static Result<std::unique_ptr<ViewerWindow>> open(const ViewerOptions& options) {
-    glfwSetErrorCallback([](int code, const char* text) {
-      std::cerr << "glfw error " << code << ": " << text << "\n";
-    });
-    if (!glfwInit()) return Error{"no display for a window (set DISPLAY, or run under xvfb-run)"};
-    glfwWindowHint(GLFW_CONTEXT_VERSION_MAJOR, 2);
-    glfwWindowHint(GLFW_CONTEXT_VERSION_MINOR, 1);
-    glfwWindowHint(GLFW_SAMPLES, 4);
-    GLFWwindow* window =
-        glfwCreateWindow(options.width, options.height, ("torsion view: " + options.scene).c_str(),
-                         nullptr, nullptr);
-    if (!window) {
-      glfwTerminate();
-      return Error{"could not open an OpenGL 2.1 window"};
-    }
-    auto opened = std::make_unique<ViewerWindow>(window);
-    glfwMakeContextCurrent(window);
-    glfwSwapInterval(options.frames > 0 ? 0 : 1);
-    const std::string missing = render::loadGlApi(opened->gl_, [](const char* name) -> void* {
-      return reinterpret_cast<void*>(glfwGetProcAddress(name));
-    });
-    if (!missing.empty()) return Error{"the OpenGL context lacks " + missing};
-    opened->gl_.Enable(GL_MULTISAMPLE);
-    return opened;
-  }
-  explicit ViewerWindow(GLFWwindow* window) : window_(window) {}  ///< takes the window
-  ~ViewerWindow() {
-    glfwDestroyWindow(window_);
-    glfwTerminate();
-  }
-  ViewerWindow(const ViewerWindow&) = delete;
-  ViewerWindow& operator=(const ViewerWindow&) = delete;
-
-  GLFWwindow* handle() const { return window_; }
-  const render::GlApi& gl() const { return gl_; }
-
- private:
-  GLFWwindow* window_;
-  render::GlApi gl_;
-};
-
-// Keys, drags (Ctrl for the hand) and the wheel reach the viewer through the window's state.
-void connectInput(GLFWwindow* window, WindowState& state) {
-  glfwSetWindowUserPointer(window, &state);
-  glfwSetKeyCallback(window, [](GLFWwindow* w, int key, int, int action, int mods) {
-    if (action == GLFW_PRESS || action == GLFW_REPEAT)
-      stateOf(w)->viewer->onKey(key, (mods & GLFW_MOD_SHIFT) != 0);
-  });
-  glfwSetCursorPosCallback(window, [](GLFWwindow* w, double x, double y) {
-    WindowState& s = *stateOf(w);
-    const double dx = x - s.last_x, dy = y - s.last_y;
-    s.last_x = x;
-    s.last_y = y;
-    const bool ctrl = glfwGetKey(w, GLFW_KEY_LEFT_CONTROL) == GLFW_PRESS ||
-                      glfwGetKey(w, GLFW_KEY_RIGHT_CONTROL) == GLFW_PRESS;
-    for (int b : {GLFW_MOUSE_BUTTON_LEFT, GLFW_MOUSE_BUTTON_RIGHT, GLFW_MOUSE_BUTTON_MIDDLE}) {
-      if (glfwGetMouseButton(w, b) == GLFW_PRESS) {
-        s.viewer->onDrag(b, dx, dy, ctrl, s.height);
-        break;
-      }
-    }
-  });
-  glfwSetScrollCallback(window,
-                        [](GLFWwindow* w, double, double dy) { stateOf(w)->viewer->onScroll(dy); });
-}
-
-// The framebuffer as drawn (GL rows go bottom to top) into a PNG.
-void writeScreenshot(const render::GlApi& gl, int width, int height, const std::string& path) {
-  render::Image image;
-  image.width = width;
-  image.height = height;
-  std::vector<unsigned char> pixels(static_cast<size_t>(width) * static_cast<size_t>(height) * 3);
-  gl.PixelStorei(GL_PACK_ALIGNMENT, 1);
-  gl.ReadPixels(0, 0, width, height, GL_RGB, GL_UNSIGNED_BYTE, pixels.data());
-  image.rgb.resize(pixels.size());
-  for (int y = 0; y < height; ++y) {
-    std::copy_n(&pixels[3 * static_cast<size_t>(height - 1 - y) * static_cast<size_t>(width)],
-                3 * static_cast<size_t>(width), image.pixel(0, y));
-  }
-  if (Status w = render::writePng(image, path); !w)
+// The framebuffer as drawn into a PNG.
+void writeScreenshot(const ViewerWindow& window, int width, int height, const std::string& path) {
+  if (Status w = render::writePng(window.readPixels(width, height), path); !w)
     std::cerr << "error: " << w.error().message << "\n";
 }
 
 // Frames until the window closes, Q, or --frames: script events due, reframe, one advance of the
 // simulation, draw, and on the last frame the screenshot. Returns the frames shown.
-int showFrames(Viewer& viewer, ViewerWindow& window, WindowState& state,
-               const std::vector<InputEvent>& script, const ViewerOptions& options) {
+int showFrames(Viewer& viewer, ViewerWindow& window, const std::vector<InputEvent>& script,
+               const ViewerOptions& options) {
   render::Renderer renderer(window.gl());
-  GLFWwindow* w = window.handle();
   int width = 0, height = 0;
-  glfwGetFramebufferSize(w, &width, &height);
+  window.framebufferSize(width, height);
   viewer.frameAll(width, height);
   size_t next_event = 0;
   int frames = 0;
-  while (!glfwWindowShouldClose(w) && !viewer.quit()) {
-    glfwPollEvents();
+  auto last_frame = std::chrono::steady_clock::now();
+  while (!window.closeRequested() && !viewer.quit()) {
+    ViewerWindow::pollEvents();
     while (next_event < script.size() && script[next_event].frame <= frames)
       viewer.apply(script[next_event++], height);
-    glfwGetFramebufferSize(w, &width, &height);
-    state.height = height;
+    window.framebufferSize(width, height);
     if (viewer.takeReframe()) viewer.frameAll(width, height);
-    viewer.advance();
+    const auto now = std::chrono::steady_clock::now();
+    viewer.advanceFrame(std::chrono::duration<double>(now - last_frame).count());
+    last_frame = now;
     render::RenderOptions ro;
     renderer.draw(viewer.frame(), viewer.camera(), width, height, ro);
     ++frames;
     const bool last = options.frames > 0 && frames >= options.frames;
     if ((last || viewer.quit()) && !options.screenshot.empty())
-      writeScreenshot(window.gl(), width, height, options.screenshot);
-    glfwSwapBuffers(w);
+      writeScreenshot(window, width, height, options.screenshot);
+    window.swapBuffers();
     if (last) break;
   }
   return frames;
@@ -674,15 +619,18 @@ int runViewer(const ViewerOptions& options) {
     std::cerr << line << "\n";
   int frames = 0;
   {
-    Result<std::unique_ptr<ViewerWindow>> window = ViewerWindow::open(options);
+    WindowSettings settings;
+    settings.width = options.width;
+    settings.height = options.height;
+    settings.title = "torsion view: " + options.scene;
+    settings.vsync = options.frames <= 0;
+    Result<std::unique_ptr<ViewerWindow>> window = ViewerWindow::open(settings);
     if (!window) {
       std::cerr << "error: " << window.error().message << "\n";
       return 1;
     }
-    WindowState state;
-    state.viewer = &viewer;
-    connectInput(window.value()->handle(), state);
-    frames = showFrames(viewer, *window.value(), state, input.value().script, options);
+    window.value()->connect(viewer);
+    frames = showFrames(viewer, *window.value(), input.value().script, options);
   }  // the window closes before the report
   printExitReport(viewer, frames);
   return viewer.stable() ? 0 : 3;

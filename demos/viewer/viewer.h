@@ -11,6 +11,9 @@
 //            change takes effect at the next step of the running simulation (no restart), is
 //            logged on stdout ("viewer: live edit, world at step N, t = T s; DT ...") and kept
 //            by a reset
+// Simulated time follows the wall clock (pacing.h): several steps a frame when dt is shorter than
+// a frame, slow motion when the steps cannot keep up ("0.4x REAL TIME" on the HUD), never more
+// steps than fit in a frame's budget; --steps-per-frame N takes N steps a frame instead (tests).
 // The HUD shows the live settings and a scrolling plot of the first hand's force and torque.
 // Hands with a device (the scene's `device`, or --device HAND=TYPE[:ARG] as for `torsion run`)
 // follow it through their haptic loops; M, G, U and the hand keys leave such a hand to its device.
@@ -26,6 +29,7 @@ struct ViewerOptions {
   int width = 1024, height = 720;
   int threads = -1;
   int frames = 0;                  ///< > 0: quit after this many frames (tests)
+  int steps_per_frame = 0;         ///< > 0: this many steps a frame; 0: real-time pacing
   std::string script;              ///< synthetic input, one event per line (see viewer.cpp)
   std::string screenshot;          ///< PNG of the last frame, written on exit
   scene::DeviceOverrides devices;  ///< --device / --haptics, as for `torsion run`

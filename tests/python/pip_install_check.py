@@ -199,7 +199,7 @@ def main():
     names = zipfile.ZipFile(wheels[0]).namelist()
     outside = [n for n in names if not n.startswith(("torsion/", "torsion-"))]
     expected = ["torsion/__init__.py", "torsion/__init__.pyi", "torsion/errors.py",
-                "torsion/py.typed", "torsion/data/demos/scenes/drop.json",
+                "torsion/viewer.py", "torsion/py.typed", "torsion/data/demos/scenes/drop.json",
                 "torsion/data/assets/meshes/cylinder_2430.node"]
     missing = [n for n in expected if n not in names]
     modules = [n for n in names if re.fullmatch(r"torsion/_torsion\..*\.so", n)]

@@ -17,7 +17,10 @@ set -u
 torsion=$1 scene=$2 trajectory=$3
 command -v xvfb-run >/dev/null || { echo "xvfb-run not found (Debian: xvfb): skipped"; exit 77; }
 fail() { echo "FAIL: $*"; exit 1; }
-view() { timeout 120 xvfb-run -a -s "-screen 0 640x480x24" "$torsion" view "$scene" --size 320x240 "$@" 2>&1; }
+view() {
+  timeout 120 xvfb-run -a -s "-screen 0 640x480x24" "$torsion" view "$scene" --size 320x240 \
+    --steps-per-frame 1 "$@" 2>&1
+}
 
 # 1. A scripted device drives the hand.
 keys=$(mktemp)

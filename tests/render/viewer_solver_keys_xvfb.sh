@@ -10,7 +10,7 @@ keys=$(mktemp)
 trap 'rm -f "$keys"' EXIT
 printf '2 key C\n4 key C\n6 key C\n8 key C\n10 key C\n12 key C\n14 key C shift\n' > "$keys"
 out=$(timeout 120 xvfb-run -a -s "-screen 0 1024x768x24" \
-      "$torsion" view "$scene" --frames 18 --script "$keys" --size 320x240 2>&1)
+      "$torsion" view "$scene" --frames 18 --steps-per-frame 1 --script "$keys" --size 320x240 2>&1)
 rc=$?
 echo "$out"
 fail() { echo "FAIL: $*"; exit 1; }

@@ -10,7 +10,8 @@ torsion=$1 scene=$2 script=$3 shot=$4
 command -v xvfb-run >/dev/null || { echo "xvfb-run not found (Debian: xvfb): skipped"; exit 77; }
 rm -f "$shot"
 out=$(timeout 120 xvfb-run -a -s "-screen 0 1024x768x24" \
-      "$torsion" view "$scene" --frames 30 --script "$script" --screenshot "$shot" --size 640x480 2>&1)
+      "$torsion" view "$scene" --frames 30 --steps-per-frame 1 --script "$script" \
+      --screenshot "$shot" --size 640x480 2>&1)
 rc=$?
 echo "$out"
 fail() { echo "FAIL: $*"; exit 1; }

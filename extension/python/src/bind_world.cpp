@@ -12,6 +12,7 @@
 #include "offscreen.h"
 #include "py_contacts.h"
 #include "py_convert.h"
+#include "py_frame.h"
 #include "scene_builder.h"
 #include "torsion/format_number.h"
 #include "torsion/mesh/mesh_io.h"
@@ -626,7 +627,7 @@ void bindWorld(py::module_& m) {
           [](PyWorld& w, int width, int height, py::object camera, bool hud) {
             if (width <= 0 || height <= 0) throw py::value_error("render: width and height > 0");
             WorldGuard guard(w);
-            render::FrameData frame = render::captureFrame(w.scene());
+            render::FrameData frame = captureWorldFrame(w);
             Result<std::unique_ptr<render::OffscreenRenderer>> renderer =
                 render::OffscreenRenderer::create(width, height);
             if (!renderer) throw std::runtime_error("render: " + renderer.error().message);

@@ -77,5 +77,6 @@ struct RigidHandle {
 void bindTypes(py::module_& m);
 void bindParts(py::module_& m);
 void bindWorld(py::module_& m);
+void bindViewer(py::module_& m);
 
 }  // namespace torsion::python

@@ -20,4 +20,5 @@ PYBIND11_MODULE(_torsion, m) {
   torsion::python::bindTypes(m);
   torsion::python::bindParts(m);
   torsion::python::bindWorld(m);
+  torsion::python::bindViewer(m);
 }

@@ -6,12 +6,13 @@
     x = world.body("cylinder").positions # (n, 3) float64, read-only view, m
     w = world.hand("hand").wrench        # (6,) force N, torque N m
 
-See docs/python.md for the API by example, views vs copies and threading.
+See docs/python.md for the API by example, views vs copies and threading; torsion.viewer
+(launch_passive) shows a world the script steps in a window.
 """
 
 import pathlib
 
-from . import _torsion
+from . import _torsion, viewer
 from .errors import Error, MeshError, SceneError, UnstableError
 from ._torsion import (
     Body,

@@ -7,6 +7,8 @@ from typing import Optional, Sequence, Union
 import numpy as np
 import numpy.typing as npt
 
+from . import viewer as viewer  # launch_passive: a window on a world the script steps (viewer.py, typed)
+
 __version__: str
 bullet_precision: str  # "double" or "float": the btScalar of the Bullet the module links
 
