@@ -1,6 +1,7 @@
 """The torsion Python package built by pip (`pip install --no-build-isolation .`) through
-scikit-build: CMake builds the library, the demos' scene loader and renderer and the module, and
-installs the package with its demo data (extension/python/CMakeLists.txt, `if(SKBUILD)`).
+scikit-build: CMake builds the library, the demos' scene loader, renderer and series writer, and
+the module, and installs the package with its demo data (extension/python/CMakeLists.txt,
+`if(SKBUILD)`).
 
 Only the package goes into the wheel: the rest of what `cmake --install` would put into a prefix
 (headers, static libraries, the CMake package) stays in scikit-build's scratch folder (_skbuild/).

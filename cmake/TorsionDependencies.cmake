@@ -11,5 +11,5 @@ find_package(TBB REQUIRED)
 find_package(CLI11 REQUIRED)  # headers only: the torsion tool and the haptic peer's options
 if(TORSION_BUILD_DEMOS)
   find_package(nlohmann_json 3.10 REQUIRED)
-  find_package(ZLIB)  # optional: compresses the ParaView series (demos/cli/vtu_writer.h)
+  find_package(ZLIB)  # optional: compresses the ParaView series (demos/series/vtu_writer.h)
 endif()

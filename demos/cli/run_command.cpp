@@ -21,6 +21,8 @@ namespace torsion::cli {
 
 namespace {
 
+using series::VtkSeries;
+
 struct RunArguments {
   std::string scene;
   std::string out = "results";

@@ -179,6 +179,53 @@ std::unique_ptr<PyWorld> worldFromDescription(const py::tuple& t) {
   return std::move(built).value();
 }
 
+// World.record_series and the rest of the ParaView series (PyWorld::recordSeries).
+void bindSeries(py::class_<PyWorld>& world) {
+  world
+      .def(
+          "record_series",
+          [](PyWorld& w, py::object directory, int every) {
+            py::object path = py::module_::import("os").attr("fspath")(directory);
+            if (!py::isinstance<py::str>(path))
+              throw py::type_error("record_series: directory must be a str or a path, not bytes");
+            const std::string dir = path.cast<std::string>();
+            FailureKind kind;
+            Status started = Ok{};
+            {
+              WorldGuard guard(w);
+              py::gil_scoped_release release;
+              started = w.recordSeries(dir, every, &kind);
+            }
+            if (!started) raise(kind, started.error().message);
+          },
+          py::arg("directory"), py::arg("every") = 1,
+          "Starts the ParaView time series of `torsion run --vtk-every`: directory/series.pvd "
+          "and one .vtu per body and rigid body per written step in directory/series/ (emptied "
+          "of .vtu files first). The state now is the first entry; step() then writes every "
+          "every-th step after it, inside the step loop. ValueError, changing nothing: every < "
+          "1, a series already recorded, a directory that cannot be created. OSError (naming the "
+          "file) when a file cannot be written, here or in step(); the series then ends.")
+      .def(
+          "stop_series",
+          [](PyWorld& w) {
+            Status stopped = Ok{};
+            {
+              WorldGuard guard(w);
+              py::gil_scoped_release release;
+              stopped = w.stopSeries();
+            }
+            if (!stopped) raise(FailureKind::kOutput, stopped.error().message);
+          },
+          "Writes the state now unless it was the last written and ends the series (nothing "
+          "without one). OSError naming the file when it cannot be written; the series ends.")
+      .def_property_readonly(
+          "recording_series", [](PyWorld& w) { return w.recordingSeries(); },
+          "Whether record_series started a series that has not ended")
+      .def_property_readonly(
+          "series_steps_written", [](PyWorld& w) { return w.seriesStepsWritten(); },
+          "Steps written by the series recorded now, else by the last one (0 without any)");
+}
+
 }  // namespace
 
 void bindWorld(py::module_& m) {
@@ -694,6 +741,8 @@ void bindWorld(py::module_& m) {
           py::arg("path"), py::arg("body") = py::none(),
           "The body's current mesh with its displacement (legacy VTK, %.17g: reads back bit for "
           "bit), as `torsion run` writes <body>.vtk. Default: the first body.");
+  py::class_<PyWorld> world = py::reinterpret_borrow<py::class_<PyWorld>>(m.attr("World"));
+  bindSeries(world);
 }
 
 }  // namespace torsion::python

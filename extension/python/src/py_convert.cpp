@@ -10,6 +10,10 @@ namespace torsion::python {
 
 void raise(FailureKind kind, const std::string& message) {
   if (kind == FailureKind::kValue) throw py::value_error(message);
+  if (kind == FailureKind::kOutput) {
+    PyErr_SetString(PyExc_OSError, message.c_str());
+    throw py::error_already_set();
+  }
   const char* name = kind == FailureKind::kScene  ? "SceneError"
                      : kind == FailureKind::kMesh ? "MeshError"
                                                   : "UnstableError";

@@ -19,7 +19,8 @@ namespace torsion::python {
 
 namespace py = pybind11;
 
-/// Raises torsion.SceneError / MeshError / UnstableError, or ValueError for kValue.
+/// Raises torsion.SceneError / MeshError / UnstableError, ValueError for kValue, OSError for
+/// kOutput.
 [[noreturn]] void raise(FailureKind kind, const std::string& message);
 
 /// A read-only (rows, cols) numpy view of row-major storage owned by C++; `owner` (the Python

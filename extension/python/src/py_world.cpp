@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <filesystem>
 #include <sstream>
 
 #include "arithmetic_bounds.h"
@@ -204,9 +205,51 @@ Result<Ok> PyWorld::step(int n, FailureKind* kind, const std::function<bool()>& 
     if (auto fault = findUnhealthyRigidBody(rigid))
       return failWith("step " + std::to_string(report.step) + ": " + fault->message);
     if (!report.ok) return failWith(report.message);
+    if (series_) {
+      if (Status written = series_->onStep(*scene_, world().stepCount(), -1); !written) {
+        *kind = FailureKind::kOutput;
+        return endSeriesWith(written.error().message);
+      }
+    }
     if (interrupted && interrupted()) break;
   }
   return Ok{};
+}
+
+Status PyWorld::recordSeries(const std::string& directory, int every, FailureKind* kind) {
+  *kind = FailureKind::kValue;
+  if (every < 1) return Error{"record_series: every must be >= 1, not " + std::to_string(every)};
+  if (directory.empty()) return Error{"record_series: directory is empty"};
+  if (series_)
+    return Error{"record_series: a series is being recorded (stop_series() ends it first)"};
+  // Created here, so a directory that cannot be is a bad argument and nothing was changed.
+  const std::filesystem::path dir = std::filesystem::path(directory) / "series";
+  std::error_code ec;
+  std::filesystem::create_directories(dir, ec);
+  if (ec) return Error{"record_series: " + dir.string() + ": cannot create: " + ec.message()};
+  *kind = FailureKind::kOutput;
+  Result<std::unique_ptr<series::VtkSeries>> started =
+      series::VtkSeries::start(directory, every, *scene_, world().stepCount());
+  if (!started) return Error{"record_series: " + started.error().message};
+  if (Status listed = started.value()->writeIndex(); !listed)
+    return Error{"record_series: " + listed.error().message};
+  series_ = std::move(started).value();
+  return Ok{};
+}
+
+Status PyWorld::stopSeries() {
+  if (!series_) return Ok{};
+  if (Status written = series_->finish(*scene_, world().stepCount()); !written)
+    return endSeriesWith(written.error().message);
+  series_steps_written_ = series_->stepsWritten();
+  series_.reset();
+  return Ok{};
+}
+
+Error PyWorld::endSeriesWith(const std::string& message) {
+  series_steps_written_ = series_->stepsWritten();
+  series_.reset();
+  return Error{"record_series: " + message};
 }
 
 void PyWorld::applyRigidInputs(const std::vector<RigidLoad>& loads) {

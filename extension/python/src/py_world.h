@@ -19,11 +19,13 @@
 #include "torsion/bullet/hand.h"
 #include "torsion/constraints/carried_nodes.h"
 #include "torsion/result.h"
+#include "vtk_series.h"
 
 namespace torsion::python {
 
 /// Why a call failed, so the bindings raise the matching exception.
-enum class FailureKind { kScene, kMesh, kUnstable, kValue };
+/// kOutput: a file that could not be written (OSError).
+enum class FailureKind { kScene, kMesh, kUnstable, kValue, kOutput };
 
 struct Failure {
   FailureKind kind = FailureKind::kValue;
@@ -88,7 +90,25 @@ class PyWorld {
   /// message until restoreState().
   /// `interrupted`, when given, is asked after every step; true stops the run there, at a step
   /// boundary (the world as after a shorter step(n)), and step returns Ok.
+  /// While a series is recorded (recordSeries), each step due is written inside the loop; a
+  /// file that cannot be written ends the series and step with kOutput (the world is as after
+  /// the steps done).
   Result<Ok> step(int n, FailureKind* kind, const std::function<bool()>& interrupted = {});
+
+  /// Starts the ParaView series of `torsion run --vtk-every` (demos/series/vtk_series.h) in
+  /// `directory`: series/ emptied of .vtu files, the state now written as its first entry, and
+  /// then every `every`-th step after it. Errors, changing nothing, with kValue: every < 1, a
+  /// series already recorded, a directory that cannot be created; with kOutput: a file that
+  /// cannot be written (the series is not started).
+  Status recordSeries(const std::string& directory, int every, FailureKind* kind);
+  /// Writes the state now unless it was the last written and ends the series (nothing without
+  /// one). An error (kOutput) names the file; the series ends all the same.
+  Status stopSeries();
+  bool recordingSeries() const { return series_ != nullptr; }
+  /// Steps written by the series recorded now, else by the last one (0 without any).
+  int seriesStepsWritten() const {
+    return series_ ? series_->stepsWritten() : series_steps_written_;
+  }
 
   /// Adds a body from a mesh file (MeshError on a bad file) or from a built mesh. Names of
   /// bodies, node sets, hands and rigid bodies follow the scene file's rule (scene::nameFault)
@@ -220,6 +240,10 @@ class PyWorld {
   };
   std::map<size_t, std::shared_ptr<NodeSetDrive>> drives_;  // by node set index
   bool fem_contact_changed_ = false;
+  std::unique_ptr<series::VtkSeries> series_;  // recordSeries() until stopSeries()
+  int series_steps_written_ = 0;               // by the last series ended
+  /// Ends the series after a write error: "record_series: <message>".
+  Error endSeriesWith(const std::string& message);
   std::mutex busy_;
 };
 

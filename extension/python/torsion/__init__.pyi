@@ -1,6 +1,7 @@
 # Type stubs of the torsion package. Units are SI throughout: m, s, kg, N, N m, Pa, rad.
 # Arrays are numpy float64 unless said otherwise; "view" means a read-only array over the
 # solver's own storage that changes as the world steps (copy() it to keep a moment).
+import os
 import pathlib
 from typing import Optional, Sequence, Union
 
@@ -191,6 +192,12 @@ class World:
     def __setstate__(self, state: tuple[str, int, tuple[float, float, float], float,
                                         bytes]) -> None: ...
     def step(self, n: int = 1) -> None: ...  # releases the GIL; Ctrl-C stops it between steps
+    # ParaView time series (as `torsion run --vtk-every`): directory/series.pvd + series/*.vtu.
+    # ValueError: every < 1, already recording, directory cannot be created; OSError: a write.
+    def record_series(self, directory: Union[str, os.PathLike[str]], every: int = 1) -> None: ...
+    def stop_series(self) -> None: ...  # writes the state now unless already written; OSError
+    recording_series: bool
+    series_steps_written: int
     time: float  # s
     step_count: int
     dt: float  # s; settable between steps, in [1e-6, 1] (not with device hands)

@@ -12,7 +12,7 @@
 #include "torsion/device/file_io.h"
 #include "torsion/fem/corotated_element.h"
 
-namespace torsion::cli {
+namespace torsion::series {
 
 namespace {
 
@@ -144,7 +144,8 @@ std::string stepName(const std::string& prefix, int step) {
 }  // namespace
 
 Result<std::unique_ptr<VtkSeries>> VtkSeries::start(const std::string& out_dir, int every,
-                                                    const scene::BuiltScene& scene) {
+                                                    const scene::BuiltScene& scene,
+                                                    int first_step) {
   const fs::path dir = fs::path(out_dir) / "series";
   std::error_code ec;
   fs::create_directories(dir, ec);
@@ -157,14 +158,29 @@ Result<std::unique_ptr<VtkSeries>> VtkSeries::start(const std::string& out_dir, 
   const std::string left = device::removeStaleTemporaries(
       dir.string(), [](const std::string& name) { return fs::path(name).extension() == ".vtu"; });
   if (!left.empty()) return Error{left};
-  std::unique_ptr<VtkSeries> series(new VtkSeries(out_dir, every));
-  if (Status written = series->write(scene, 0); !written) return written.error();
+  std::unique_ptr<VtkSeries> series(new VtkSeries(out_dir, every, first_step));
+  if (Status written = series->write(scene, first_step); !written) return written.error();
+  series->last_written_ = first_step;
   return series;
 }
 
 Status VtkSeries::onStep(const scene::BuiltScene& scene, int step, int total) {
-  if (step % every_ != 0 && step != total) return Ok{};
+  if ((step - first_step_) % every_ != 0 && step != total) return Ok{};
+  return writeStep(scene, step);
+}
+
+Status VtkSeries::finish(const scene::BuiltScene& scene, int step) {
+  if (step == last_written_) return Ok{};
+  return writeStep(scene, step);
+}
+
+Status VtkSeries::writeStep(const scene::BuiltScene& scene, int step) {
   if (Status s = write(scene, step); !s) return s;
+  last_written_ = step;
+  return writeIndex();
+}
+
+Status VtkSeries::writeIndex() const {
   const std::string pvd = (fs::path(out_dir_) / "series.pvd").string();
   if (std::string error = device::writeFileAtomically(pvd, pvdText(entries_)); !error.empty())
     return Error{error};
@@ -191,4 +207,4 @@ Status VtkSeries::write(const scene::BuiltScene& scene, int step) {
   return Ok{};
 }
 
-}  // namespace torsion::cli
+}  // namespace torsion::series

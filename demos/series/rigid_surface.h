@@ -10,7 +10,7 @@
 
 #include "rigid_geometry.h"
 
-namespace torsion::cli {
+namespace torsion::series {
 
 struct RigidSurface {
   std::vector<Eigen::Vector3d> vertices;  ///< world coordinates, m
@@ -19,4 +19,4 @@ struct RigidSurface {
 
 RigidSurface rigidSurface(const render::RigidDrawData& rigid);
 
-}  // namespace torsion::cli
+}  // namespace torsion::series

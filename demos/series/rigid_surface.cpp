@@ -2,7 +2,7 @@
 
 #include <cmath>
 
-namespace torsion::cli {
+namespace torsion::series {
 
 namespace {
 
@@ -90,4 +90,4 @@ RigidSurface rigidSurface(const render::RigidDrawData& rigid) {
   return s;
 }
 
-}  // namespace torsion::cli
+}  // namespace torsion::series

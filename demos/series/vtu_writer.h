@@ -10,7 +10,7 @@
 #include <string>
 #include <vector>
 
-namespace torsion::cli {
+namespace torsion::series {
 
 /// VTK cell types used here.
 enum class VtkCellType : std::uint8_t { kTriangle = 5, kTetra = 10, kQuadraticTetra = 24 };
@@ -56,4 +56,4 @@ struct PvdEntry {
 /// A ParaView collection (.pvd) listing the files of a time series.
 std::string pvdText(const std::vector<PvdEntry>& entries);
 
-}  // namespace torsion::cli
+}  // namespace torsion::series

@@ -7,7 +7,7 @@
 #include <zlib.h>
 #endif
 
-namespace torsion::cli {
+namespace torsion::series {
 
 namespace {
 
@@ -142,4 +142,4 @@ std::string pvdText(const std::vector<PvdEntry>& entries) {
   return xml.str();
 }
 
-}  // namespace torsion::cli
+}  // namespace torsion::series
