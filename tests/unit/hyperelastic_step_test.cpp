@@ -80,8 +80,8 @@ double backwardEulerResidual(const FemModel& model, const FemState& start, const
       x[a] = end.position(tet[a]);
     const TetRestData& rest = model.tetRestData()[static_cast<size_t>(t)];
     const HyperelasticTetResponse r = m.law == MaterialLaw::kMooneyRivlin
-                                          ? hyperelasticTet(mr, x, rest, false)
-                                          : hyperelasticTet(neo, x, rest, false);
+                                          ? hyperelasticTet(mr, x, rest, TetStiffnessKind::kNone)
+                                          : hyperelasticTet(neo, x, rest, TetStiffnessKind::kNone);
     for (size_t a = 0; a < 4; ++a)
       f.segment<3>(3 * tet[a]) += r.forces[a];
   }

@@ -1,9 +1,11 @@
 #include "torsion/fem/hyperelastic.h"
 
 #include <Eigen/Eigenvalues>
+#include <algorithm>
 #include <cmath>
 
 #include "torsion/fem/corotated_element.h"
+#include "torsion/fem/polar_rotation.h"
 
 namespace torsion {
 
@@ -57,36 +59,109 @@ std::array<Eigen::Vector3d, 4> hyperelasticNodeForces(const Eigen::Matrix3d& P,
   return {-(H.col(0) + H.col(1) + H.col(2)), H.col(0), H.col(1), H.col(2)};
 }
 
-// K_ab = V sum_ij g_a[i] g_b[j] A(i, j) (3x3 blocks of A; column i of dF is sum_a g_a[i] dx_a).
-TetStiffness hyperelasticNodeStiffness(const PiolaTangent& A, const TetRestData& rest) {
-  const Eigen::Matrix3d& B = rest.rest_shape_inverse;
-  Eigen::Matrix<double, 4, 3> g;
-  g.row(0) = -(B.row(0) + B.row(1) + B.row(2));
-  g.bottomRows<3>() = B;
-  TetStiffness K;
-  for (int a = 0; a < 4; ++a) {
-    for (int b = 0; b < 4; ++b) {
-      Eigen::Matrix3d block = Eigen::Matrix3d::Zero();
-      for (int i = 0; i < 3; ++i)
-        for (int j = 0; j < 3; ++j)
-          block += (g(a, i) * g(b, j)) * A.block<3, 3>(3 * i, 3 * j);
-      K.block<3, 3>(3 * a, 3 * b) = rest.volume * block;
+// The pair (i, j) of singular axes without k.
+constexpr int kPairFirst[3] = {1, 2, 0};
+constexpr int kPairSecond[3] = {2, 0, 1};
+
+void signedSvd(const Eigen::Matrix3d& F, PrincipalTangent& t) {
+  const SignedSvd svd = torsion::signedSvd(F);
+  t.U = svd.U;
+  t.V = svd.V;
+  t.sigma = svd.sigma;
+}
+
+// The terms every law here shares: l'/2 (J - alpha)^2, whose gradient in sigma is
+// pressure * (J / sigma_i) and whose pair quotients are +- pressure * sigma_k.
+void addVolumetric(double lambda, double alpha, PrincipalTangent& t) {
+  const Eigen::Vector3d& s = t.sigma;
+  const double pressure = lambda * (s.prod() - alpha);
+  const Eigen::Vector3d others(s(1) * s(2), s(0) * s(2), s(0) * s(1));  // J / sigma_i
+  t.stretch += lambda * others * others.transpose();
+  for (int k = 0; k < 3; ++k) {
+    t.stretch(kPairFirst[k], kPairSecond[k]) += pressure * s(k);
+    t.stretch(kPairSecond[k], kPairFirst[k]) += pressure * s(k);
+  }
+  t.rotation += pressure * s;
+  t.shear -= pressure * s;
+}
+
+// The nearest positive semi-definite matrix to the 3x3 stretch block; unchanged when positive
+// definite (the usual case: checked by its leading minors, no decomposition).
+Eigen::Matrix3d projectStretch(const Eigen::Matrix3d& H) {
+  const double minor2 = H(0, 0) * H(1, 1) - H(0, 1) * H(1, 0);
+  if (H(0, 0) > 0 && minor2 > 0 && H.determinant() > 0) return H;
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eigen(H);
+  return eigen.eigenvectors() * eigen.eigenvalues().cwiseMax(0.0).asDiagonal() *
+         eigen.eigenvectors().transpose();
+}
+
+// The 9 eigenmodes' images on the tet's nodes 1-3 (node 0's is minus their sum: g_0 = -sum g_a):
+// row m, columns 3 (a - 1) .. 3 a - 1 hold Q_m g_a; m = i the stretch mode U e_i e_i^T V^T,
+// 3 + k the rotation and 6 + k the shear mode of the pair without k.
+using ModeGradients = Eigen::Matrix<double, 9, 9>;
+ModeGradients modeGradients(const PrincipalTangent& t, const Eigen::Matrix3d& rest_shape_inverse) {
+  ModeGradients Z;
+  const double half_root = std::sqrt(0.5);
+  const Eigen::Matrix3d W = t.V.transpose() * rest_shape_inverse.transpose();  // column a: V^T g_a
+  for (int a = 0; a < 3; ++a) {
+    const Eigen::Vector3d w = W.col(a);
+    for (int i = 0; i < 3; ++i)
+      Z.block<1, 3>(i, 3 * a) = w(i) * t.U.col(i).transpose();
+    for (int k = 0; k < 3; ++k) {
+      const int i = kPairFirst[k], j = kPairSecond[k];
+      const Eigen::Vector3d first = t.U.col(i) * w(j), second = t.U.col(j) * w(i);
+      Z.block<1, 3>(3 + k, 3 * a) = half_root * (first - second).transpose();
+      Z.block<1, 3>(6 + k, 3 * a) = half_root * (first + second).transpose();
     }
   }
+  return Z;
+}
+
+// V Z^T D Z, D = diag(stretch block, rotation values, shear values): nodes 1-3 from the modes
+// (the upper triangle, mirrored), node 0's rows and columns from translation invariance (the
+// rows of a block column sum to zero), so that K is symmetric to the bit.
+TetStiffness modeStiffness(const ModeGradients& Z, const Eigen::Matrix3d& stretch,
+                           const Eigen::Vector3d& rotation, const Eigen::Vector3d& shear,
+                           double volume) {
+  ModeGradients DZ;
+  DZ.topRows<3>() = volume * stretch * Z.topRows<3>();
+  DZ.middleRows<3>(3) = (volume * rotation).asDiagonal() * Z.middleRows<3>(3);
+  DZ.bottomRows<3>() = (volume * shear).asDiagonal() * Z.bottomRows<3>();
+  TetStiffness K;
+  for (int c = 0; c < 9; ++c) {
+    for (int r = 0; r <= c; ++r) {
+      K(3 + r, 3 + c) = Z.col(r).dot(DZ.col(c));
+      K(3 + c, 3 + r) = K(3 + r, 3 + c);
+    }
+  }
+  for (int c = 3; c < 12; ++c) {
+    for (int r = 0; r < 3; ++r) {
+      K(r, c) = -(K(3 + r, c) + K(6 + r, c) + K(9 + r, c));
+      K(c, r) = K(r, c);
+    }
+  }
+  const Eigen::Matrix3d corner = -(K.block<3, 3>(0, 3) + K.block<3, 3>(0, 6) + K.block<3, 3>(0, 9));
+  K.topLeftCorner<3, 3>() = 0.5 * (corner + corner.transpose());
   return K;
 }
 
 template <typename Law>
 HyperelasticTetResponse hyperelasticResponse(const Law& law,
                                              const std::array<Eigen::Vector3d, 4>& x,
-                                             const TetRestData& rest, bool project) {
+                                             const TetRestData& rest, TetStiffnessKind kind) {
   const Eigen::Matrix3d F = deformationGradient(x, rest.rest_shape_inverse);
   HyperelasticTetResponse response;
   response.energy = rest.volume * energyDensity(law, F);
   response.forces = hyperelasticNodeForces(firstPiola(law, F), rest);
-  const PiolaTangent A = firstPiolaDerivative(law, F);
-  response.stiffness =
-      hyperelasticNodeStiffness(project ? projectPositiveSemiDefinite(A) : A, rest);
+  if (kind == TetStiffnessKind::kNone) return response;
+  const PrincipalTangent t = principalTangent(law, F);
+  const ModeGradients Z = modeGradients(t, rest.rest_shape_inverse);
+  if (kind != TetStiffnessKind::kExact) {
+    response.projected_stiffness = modeStiffness(
+        Z, projectStretch(t.stretch), t.rotation.cwiseMax(0.0), t.shear.cwiseMax(0.0), rest.volume);
+  }
+  if (kind != TetStiffnessKind::kProjected)
+    response.exact_stiffness = modeStiffness(Z, t.stretch, t.rotation, t.shear, rest.volume);
   return response;
 }
 
@@ -181,22 +256,80 @@ PiolaTangent firstPiolaDerivative(const MooneyRivlin& law, const Eigen::Matrix3d
   });
 }
 
-PiolaTangent projectPositiveSemiDefinite(const PiolaTangent& A) {
-  const Eigen::SelfAdjointEigenSolver<PiolaTangent> eigen(0.5 * (A + A.transpose()));
-  const PiolaVector clamped = eigen.eigenvalues().cwiseMax(0.0);
-  return eigen.eigenvectors() * clamped.asDiagonal() * eigen.eigenvectors().transpose();
+PrincipalTangent principalTangent(const StableNeoHookean& law, const Eigen::Matrix3d& F) {
+  PrincipalTangent t;
+  signedSvd(F, t);
+  const Eigen::Vector3d& s = t.sigma;
+  // mu'/2 (I_C - 3) [- mu'/2 log(I_C + 1)]: psi_i = shear sigma_i, shear = mu' [(1 - 1/(I_C + 1))].
+  const double ic1 = s.squaredNorm() + 1.0;
+  const double shear = law.log_term ? law.mu * (1.0 - 1.0 / ic1) : law.mu;
+  const double curvature = law.log_term ? 2.0 * law.mu / (ic1 * ic1) : 0.0;
+  t.stretch = shear * Eigen::Matrix3d::Identity() + curvature * s * s.transpose();
+  t.rotation = Eigen::Vector3d::Constant(shear);
+  t.shear = Eigen::Vector3d::Constant(shear);
+  addVolumetric(law.lambda, law.alpha, t);
+  return t;
+}
+
+PrincipalTangent principalTangent(const MooneyRivlin& law, const Eigen::Matrix3d& F) {
+  PrincipalTangent t;
+  signedSvd(F, t);
+  const Eigen::Vector3d& s = t.sigma;
+  const Eigen::Vector3d sq = s.cwiseAbs2();
+  // C1 I_C + C2 II_C: psi_i = 2 C1 s_i + 2 C2 s_i (s_j^2 + s_k^2).
+  for (int i = 0; i < 3; ++i) {
+    t.stretch(i, i) = 2.0 * law.c1 + 2.0 * law.c2 * (sq.sum() - sq(i));
+    for (int j = 0; j < 3; ++j)
+      if (j != i) t.stretch(i, j) = 4.0 * law.c2 * s(i) * s(j);
+  }
+  for (int k = 0; k < 3; ++k) {
+    const double product = s(kPairFirst[k]) * s(kPairSecond[k]);
+    t.rotation(k) = 2.0 * law.c1 + 2.0 * law.c2 * (product + sq(k));
+    t.shear(k) = 2.0 * law.c1 + 2.0 * law.c2 * (sq(k) - product);
+  }
+  addVolumetric(law.lambda, law.alpha, t);
+  return t;
+}
+
+PiolaTangent tangentOf(const PrincipalTangent& t, bool project) {
+  const Eigen::Matrix3d stretch = project ? projectStretch(t.stretch) : t.stretch;
+  std::array<PiolaVector, 9> modes;
+  std::array<Eigen::Matrix3d, 9> Q;
+  for (int i = 0; i < 3; ++i)
+    Q[static_cast<size_t>(i)] = t.U.col(i) * t.V.col(i).transpose();
+  for (int k = 0; k < 3; ++k) {
+    const int i = kPairFirst[k], j = kPairSecond[k];
+    const Eigen::Matrix3d a = t.U.col(i) * t.V.col(j).transpose();
+    const Eigen::Matrix3d b = t.U.col(j) * t.V.col(i).transpose();
+    Q[static_cast<size_t>(3 + k)] = std::sqrt(0.5) * (a - b);
+    Q[static_cast<size_t>(6 + k)] = std::sqrt(0.5) * (a + b);
+  }
+  for (size_t m = 0; m < 9; ++m)
+    modes[m] = Eigen::Map<const PiolaVector>(Q[m].data());
+  PiolaTangent A = PiolaTangent::Zero();
+  for (size_t i = 0; i < 3; ++i)
+    for (size_t j = 0; j < 3; ++j)
+      A += stretch(static_cast<int>(i), static_cast<int>(j)) * modes[i] * modes[j].transpose();
+  for (int k = 0; k < 3; ++k) {
+    const double rotation = project ? std::max(t.rotation(k), 0.0) : t.rotation(k);
+    const double shear = project ? std::max(t.shear(k), 0.0) : t.shear(k);
+    A += rotation * modes[static_cast<size_t>(3 + k)] *
+         modes[static_cast<size_t>(3 + k)].transpose();
+    A += shear * modes[static_cast<size_t>(6 + k)] * modes[static_cast<size_t>(6 + k)].transpose();
+  }
+  return A;
 }
 
 HyperelasticTetResponse hyperelasticTet(const StableNeoHookean& law,
                                         const std::array<Eigen::Vector3d, 4>& x,
-                                        const TetRestData& rest, bool project) {
-  return hyperelasticResponse(law, x, rest, project);
+                                        const TetRestData& rest, TetStiffnessKind kind) {
+  return hyperelasticResponse(law, x, rest, kind);
 }
 
 HyperelasticTetResponse hyperelasticTet(const MooneyRivlin& law,
                                         const std::array<Eigen::Vector3d, 4>& x,
-                                        const TetRestData& rest, bool project) {
-  return hyperelasticResponse(law, x, rest, project);
+                                        const TetRestData& rest, TetStiffnessKind kind) {
+  return hyperelasticResponse(law, x, rest, kind);
 }
 
 }  // namespace torsion

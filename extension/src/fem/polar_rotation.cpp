@@ -5,15 +5,25 @@
 
 namespace torsion {
 
-Eigen::Matrix3d rotationBySvd(const Eigen::Matrix3d& F) {
+SignedSvd signedSvd(const Eigen::Matrix3d& F) {
   Eigen::JacobiSVD<Eigen::Matrix3d> svd(F, Eigen::ComputeFullU | Eigen::ComputeFullV);
-  Eigen::Matrix3d U = svd.matrixU();
-  Eigen::Matrix3d V = svd.matrixV();
+  SignedSvd result{svd.matrixU(), svd.singularValues(), svd.matrixV()};
   // Singular values come sorted descending, so column 2 carries the smallest: flipping it moves
   // the reflection onto the least-stretched direction (Irving et al. 2004, section 5).
-  if (U.determinant() < 0) U.col(2) *= -1;
-  if (V.determinant() < 0) V.col(2) *= -1;
-  return U * V.transpose();
+  if (result.U.determinant() < 0) {
+    result.U.col(2) *= -1;
+    result.sigma(2) *= -1;
+  }
+  if (result.V.determinant() < 0) {
+    result.V.col(2) *= -1;
+    result.sigma(2) *= -1;
+  }
+  return result;
+}
+
+Eigen::Matrix3d rotationBySvd(const Eigen::Matrix3d& F) {
+  const SignedSvd svd = signedSvd(F);
+  return svd.U * svd.V.transpose();
 }
 
 Eigen::Matrix3d extractRotation(const Eigen::Matrix3d& F, Eigen::Quaterniond& q, int max_iterations,

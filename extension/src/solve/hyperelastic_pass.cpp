@@ -1,5 +1,8 @@
 #include "hyperelastic_pass.h"
 
+#include <algorithm>
+#include <cstring>
+
 #include "torsion/fem/corotated_element.h"
 
 namespace torsion {
@@ -42,59 +45,65 @@ double HyperelasticLaw::energyDensity(const Eigen::Matrix3d& F) const {
 }
 
 HyperelasticTetResponse HyperelasticLaw::tet(const std::array<Eigen::Vector3d, 4>& x,
-                                             const TetRestData& rest, bool project) const {
-  return kind == MaterialLaw::kMooneyRivlin ? hyperelasticTet(mooney_rivlin, x, rest, project)
-                                            : hyperelasticTet(neo_hookean, x, rest, project);
+                                             const TetRestData& rest,
+                                             TetStiffnessKind stiffness) const {
+  return kind == MaterialLaw::kMooneyRivlin ? hyperelasticTet(mooney_rivlin, x, rest, stiffness)
+                                            : hyperelasticTet(neo_hookean, x, rest, stiffness);
 }
 
 double HyperelasticPass::evaluate(const FemModel& model, const Eigen::VectorXd& positions,
-                                  const Parallel& parallel, bool stiffness, bool project) {
+                                  const Parallel& parallel, TetStiffnessKind kind) {
   const HyperelasticLaw law = HyperelasticLaw::of(model.material());
   const VolumeBarrier barrier = volumeBarrierOf(model.material());
   const std::vector<int>& nodes = model.elementNodes();
   const std::vector<TetRestData>& rest = model.tetRestData();
   const size_t tets = rest.size();
+  const bool projected =
+      kind == TetStiffnessKind::kProjected || kind == TetStiffnessKind::kProjectedAndExact;
+  const bool exact =
+      kind == TetStiffnessKind::kExact || kind == TetStiffnessKind::kProjectedAndExact;
   forces_.resize(4 * tets);
   energy_.resize(tets);
   in_barrier_.assign(tets, 0);
-  if (stiffness) stiffness_.resize(tets);
+  if (projected) projected_.resize(tets);
+  if (exact) exact_.resize(tets);
   parallel.forRange(static_cast<int>(tets), kHyperelasticTetGrain, [&](int begin, int end) {
     for (size_t t = static_cast<size_t>(begin); t < static_cast<size_t>(end); ++t) {
       const std::array<Eigen::Vector3d, 4> x = tetPositions(positions, nodes, t);
-      // The stiffness (a 9x9 eigen-decomposition) only when asked: forces are the cheap part.
-      HyperelasticTetResponse response;
+      HyperelasticTetResponse response = law.tet(x, rest[t], kind);
       const Eigen::Matrix3d F = deformationGradient(x, rest[t].rest_shape_inverse);
-      if (stiffness) {
-        response = law.tet(x, rest[t], project);
-      } else {
-        const Eigen::Matrix3d P = law.kind == MaterialLaw::kMooneyRivlin
-                                      ? firstPiola(law.mooney_rivlin, F)
-                                      : firstPiola(law.neo_hookean, F);
-        const Eigen::Matrix3d H = -rest[t].volume * P * rest[t].rest_shape_inverse.transpose();
-        response.forces = {-(H.col(0) + H.col(1) + H.col(2)), H.col(0), H.col(1), H.col(2)};
-        response.energy = rest[t].volume * law.energyDensity(F);
-      }
       if (barrier.threshold > 0 && barrier.pressure > 0 && barrier.active(F.determinant())) {
         in_barrier_[t] = 1;
         response.energy += volumeBarrierEnergy(F, rest[t], barrier);
         const std::array<Eigen::Vector3d, 4> f = volumeBarrierForces(F, rest[t], barrier);
         for (size_t a = 0; a < 4; ++a)
           response.forces[a] += f[a];
-        if (stiffness) {
-          response.stiffness += project ? volumeBarrierStiffness(F, rest[t], barrier)
-                                        : volumeBarrierHessian(F, rest[t], barrier);
-        }
+        if (projected) response.projected_stiffness += volumeBarrierStiffness(F, rest[t], barrier);
+        if (exact) response.exact_stiffness += volumeBarrierHessian(F, rest[t], barrier);
       }
       std::copy(response.forces.begin(), response.forces.end(),
                 forces_.begin() + static_cast<std::ptrdiff_t>(4 * t));
       energy_[t] = response.energy;
-      if (stiffness) stiffness_[t] = response.stiffness;
+      if (projected) projected_[t] = response.projected_stiffness;
+      if (exact) exact_[t] = response.exact_stiffness;
     }
   });
   barrier_tets_ = 0;
   for (unsigned char in : in_barrier_)
     barrier_tets_ += in;
-  return sumInOrder(energy_);
+  evaluated_positions_ = positions;
+  evaluated_kind_ = kind;
+  evaluated_energy_ = sumInOrder(energy_);
+  return evaluated_energy_;
+}
+
+bool HyperelasticPass::holdsProjectedAt(const Eigen::VectorXd& positions) const {
+  const bool projected = evaluated_kind_ == TetStiffnessKind::kProjected ||
+                         evaluated_kind_ == TetStiffnessKind::kProjectedAndExact;
+  // The bits, not the values: -0 and 0 (or two NaNs) are not the same start.
+  return projected && evaluated_positions_.size() == positions.size() &&
+         std::memcmp(positions.data(), evaluated_positions_.data(),
+                     sizeof(double) * static_cast<size_t>(positions.size())) == 0;
 }
 
 double HyperelasticPass::energy(const FemModel& model, const Eigen::VectorXd& positions,

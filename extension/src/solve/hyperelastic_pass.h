@@ -25,36 +25,52 @@ struct HyperelasticLaw {
   static HyperelasticLaw of(const Material& material);
   double energyDensity(const Eigen::Matrix3d& F) const;
   HyperelasticTetResponse tet(const std::array<Eigen::Vector3d, 4>& x, const TetRestData& rest,
-                              bool project) const;
+                              TetStiffnessKind kind) const;
 };
 
 class HyperelasticPass {
  public:
-  /// Energy, forces (elementForces()) and, with `stiffness`, the element stiffnesses
-  /// (elementStiffnesses()) at `positions` (3n): from the projected tangent (positive
-  /// semi-definite), or with `project` false the exact Hessians. Returns the energy, J.
+  /// Energy, forces (elementForces()) and the element stiffnesses `kind` asks for
+  /// (projectedStiffnesses(): from the projected tangent, positive semi-definite;
+  /// exactStiffnesses(): the exact Hessians) at `positions` (3n). Returns the energy, J.
   double evaluate(const FemModel& model, const Eigen::VectorXd& positions, const Parallel& parallel,
-                  bool stiffness, bool project = true);
-  /// The energy alone at `positions`, J (a line search's trial point).
+                  TetStiffnessKind kind);
+  /// The energy alone at `positions`, J (a line search's trial point); the last evaluate()'s
+  /// results stay.
   double energy(const FemModel& model, const Eigen::VectorXd& positions, const Parallel& parallel);
+
+  /// Whether the last evaluate() was at exactly `positions` with the projected stiffnesses: a
+  /// step that ends there starts the next with them (the same bits as evaluating again).
+  bool holdsProjectedAt(const Eigen::VectorXd& positions) const;
+  /// Forgets the last evaluate() (the material changed).
+  void forget() { evaluated_positions_.resize(0); }
+  /// The last evaluate()'s energy, J.
+  double evaluatedEnergy() const { return evaluated_energy_; }
 
   /// Four per tet, index 4 t + a: the force on the tet's node a, N (SystemOperator::gather).
   const std::vector<Eigen::Vector3d>& elementForces() const { return forces_; }
-  /// One per tet: d2E/dx2, N/m (the last evaluate() with stiffness).
-  const std::vector<TetStiffness>& elementStiffnesses() const { return stiffness_; }
-  /// Keeps the last evaluate()'s stiffnesses as the step's start stiffnesses (a swap, no copy);
-  /// the next evaluate() with stiffness writes elsewhere.
-  void keepAsStartStiffnesses() { std::swap(stiffness_, start_stiffness_); }
+  /// One per tet, N/m (the last evaluate() that computed them).
+  const std::vector<TetStiffness>& projectedStiffnesses() const { return projected_; }
+  const std::vector<TetStiffness>& exactStiffnesses() const { return exact_; }
+  /// Keeps the last evaluate()'s projected stiffnesses as the step's start stiffnesses (a swap,
+  /// no copy); the next evaluate() writes elsewhere.
+  void keepAsStartStiffnesses() {
+    std::swap(projected_, start_stiffness_);
+    evaluated_positions_.resize(0);
+  }
   const std::vector<TetStiffness>& startStiffnesses() const { return start_stiffness_; }
   /// Tets below the volume barrier's threshold at the last evaluate().
   int barrierTets() const { return barrier_tets_; }
 
  private:
   std::vector<Eigen::Vector3d> forces_;
-  std::vector<TetStiffness> stiffness_, start_stiffness_;
+  std::vector<TetStiffness> projected_, exact_, start_stiffness_;
   std::vector<double> energy_;
   std::vector<unsigned char> in_barrier_;
   int barrier_tets_ = 0;
+  Eigen::VectorXd evaluated_positions_;
+  TetStiffnessKind evaluated_kind_ = TetStiffnessKind::kNone;
+  double evaluated_energy_ = 0;
 };
 
 }  // namespace torsion

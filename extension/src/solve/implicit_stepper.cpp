@@ -391,6 +391,7 @@ void ImplicitStepper::replaceModel(std::shared_ptr<const FemModel> model) {
   internalForces();  // freeze the last step's forces before K and beta change under them
   model_ = std::move(model);
   system_.replaceModel(model_);
+  hyperelastic_->forget();  // its stiffnesses are the old material's
 }
 
 }  // namespace torsion

@@ -33,7 +33,11 @@ void addSolve(LinearSolveReport& total, const LinearSolveReport& solve) {
 }  // namespace
 
 double ImplicitStepper::computeHyperelasticForces(const FemState& state) {
-  const double energy = hyperelastic_->evaluate(*model_, state.positions, parallel_, true);
+  // The last step's final iterate is usually this step's start: its projected stiffnesses, forces
+  // and energy are already there (bit for bit what evaluating again gives).
+  if (!hyperelastic_->holdsProjectedAt(state.positions))
+    hyperelastic_->evaluate(*model_, state.positions, parallel_, TetStiffnessKind::kProjected);
+  const double energy = hyperelastic_->evaluatedEnergy();
   barrier_tets_ = hyperelastic_->barrierTets();
   system_.setStiffnessAdditions({});
   system_.setLaggedStiffness(nullptr, 0.0);
@@ -72,7 +76,11 @@ double ImplicitStepper::evaluateIterate(const Eigen::VectorXd& v) {
   const Material& material = model_->material();
   const double dt = last_dt_;
   trial_ = start_positions_ + dt * v;
-  const double energy = hyperelastic_->evaluate(*model_, trial_, parallel_, false);
+  // The iterate's stiffnesses with its forces, in one pass over the tets: the exact ones for the
+  // next Newton direction (the projected where that fails), the projected ones for the next
+  // step's start if this iterate ends the step.
+  const double energy =
+      hyperelastic_->evaluate(*model_, trial_, parallel_, TetStiffnessKind::kProjectedAndExact);
   system_.gather(hyperelastic_->elementForces(), 1.0, iterate_forces_);
   if (material.stiffness_damping > 0) {
     system_.multiplyBlocks(start_stiffness_, v, lagged_product_);
@@ -127,14 +135,12 @@ LinearSolveReport ImplicitStepper::newtonDirection(const Eigen::VectorXd& free_r
   // iterations for a quarter turn of the statics twist, docs/materials.md). Where the system is
   // not positive definite (the factorisation or CG breaks down) or dv is no descent direction,
   // the projected Hessian, positive semi-definite per element.
-  hyperelastic_->evaluate(*model_, trial_, parallel_, true, false);
-  system_.setElementStiffnesses(&hyperelastic_->elementStiffnesses());
+  system_.setElementStiffnesses(&hyperelastic_->exactStiffnesses());
   dv.setZero(free_residual.size());
   LinearSolveReport exact = linearSolve(newton_constraints_, free_residual, dv);
   if (!exact.breakdown && dv.allFinite() && newton_residual_.dot(dv) > 0) return exact;
   ++newton_.projected_iterations;
-  hyperelastic_->evaluate(*model_, trial_, parallel_, true, true);
-  system_.setElementStiffnesses(&hyperelastic_->elementStiffnesses());
+  system_.setElementStiffnesses(&hyperelastic_->projectedStiffnesses());
   dv.setZero(free_residual.size());
   LinearSolveReport projected = linearSolve(newton_constraints_, free_residual, dv);
   projected.iterations += exact.iterations;

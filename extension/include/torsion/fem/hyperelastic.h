@@ -1,7 +1,7 @@
 #pragma once
 // Hyperelastic material laws and the linear tet built on them, as pure functions
-// (docs/materials.md). Not yet used by the time step (it runs the corotated law of
-// corotated_element.h).
+// (docs/materials.md). The implicit step of a hyperelastic body runs them per tet
+// (src/solve/hyperelastic_pass.h).
 //
 // F is the deformation gradient, J = det F, I_C = |F|^2 = tr C, C = F^T F, cof F = dJ/dF
 // (cofactor(), volume_barrier.h). 3x3 matrices are vectorised by columns, vec(F) = [f_0; f_1;
@@ -25,9 +25,20 @@
 // Small strain: mu = 2 (C1 + C2), lambda as given (lambda = kappa - 2 mu / 3). At J = 1 it is
 // the incompressible Mooney-Rivlin law (simple shear: sigma_12 = 2 (C1 + C2) gamma exactly).
 //
-// Psi_rest (the energy at F = I) is subtracted so that Psi(I) = 0. The stiffness the implicit
-// solve gets is the tangent projected onto its non-negative eigenvalues
-// (projectPositiveSemiDefinite), then mapped to the tet's nodes.
+// Psi_rest (the energy at F = I) is subtracted so that Psi(I) = 0.
+//
+// The tangent's eigensystem in closed form (Smith, de Goes & Kim 2019, "Analytic Eigensystems
+// for Isotropic Distortion Energies"; Teran et al. 2005). With F = U diag(s) V^T, U and V
+// rotations and s signed (s_2 < 0 when det F < 0), an isotropic Psi(s_0, s_1, s_2) has, for each
+// pair (i, j) with k the third axis, the eigenvectors U (e_i e_j^T -+ e_j e_i^T) V^T / sqrt 2:
+//   rotation (antisymmetric):  (psi_i + psi_j) / (s_i + s_j)
+//   shear    (symmetric):      (psi_i - psi_j) / (s_i - s_j)        (psi_i = dPsi/ds_i)
+// and on U diag(.) V^T the 3x3 block d2Psi/ds_i ds_j. For both laws the two quotients are
+// polynomials in s (no division: they hold through repeated and zero singular values), e.g.
+// stable neo-Hookean: mu' + l'(J - alpha) s_k and mu' - l'(J - alpha) s_k. The stiffness the
+// implicit solve gets is the tangent projected onto its non-negative eigenvalues (each quotient
+// clamped at zero, the 3x3 block projected), mapped to the tet's nodes; the exact tangent is the
+// same sum unclamped.
 
 #include <Eigen/Core>
 #include <array>
@@ -78,24 +89,41 @@ Eigen::Matrix3d firstPiola(const MooneyRivlin& law, const Eigen::Matrix3d& F);
 PiolaTangent firstPiolaDerivative(const StableNeoHookean& law, const Eigen::Matrix3d& F);
 PiolaTangent firstPiolaDerivative(const MooneyRivlin& law, const Eigen::Matrix3d& F);
 
-/// The symmetric matrix with A's eigenvectors and its eigenvalues clamped at zero: the nearest
-/// positive semi-definite matrix to A (Frobenius norm). A is symmetrised first.
-PiolaTangent projectPositiveSemiDefinite(const PiolaTangent& A);
+/// The tangent dP/dF in the frame of F's singular values (the header's closed forms).
+struct PrincipalTangent {
+  Eigen::Matrix3d U, V;     ///< rotations (det +1), F = U diag(sigma) V^T
+  Eigen::Vector3d sigma;    ///< signed singular values: sigma(2) < 0 when det F < 0
+  Eigen::Matrix3d stretch;  ///< d2Psi / dsigma_i dsigma_j, Pa
+  /// Index k: the eigenvalue of the mode of the pair (i, j) without k, Pa: `rotation` of
+  /// U (e_i e_j^T - e_j e_i^T) V^T / sqrt 2, `shear` of U (e_i e_j^T + e_j e_i^T) V^T / sqrt 2.
+  Eigen::Vector3d rotation, shear;
+};
+PrincipalTangent principalTangent(const StableNeoHookean& law, const Eigen::Matrix3d& F);
+PrincipalTangent principalTangent(const MooneyRivlin& law, const Eigen::Matrix3d& F);
+/// dP/dF rebuilt from its eigensystem: exact, or with `project` the nearest positive
+/// semi-definite matrix (every eigenvalue clamped at zero).
+PiolaTangent tangentOf(const PrincipalTangent& tangent, bool project);
 
-/// One linear tet: energy V Psi (J), forces f_a = -dE/dx_a (N), stiffness d2E/dx2 (N/m).
+/// Which stiffnesses hyperelasticTet computes (the forces and the energy always).
+enum class TetStiffnessKind { kNone, kProjected, kExact, kProjectedAndExact };
+
+/// One linear tet: energy V Psi (J), forces f_a = -dE/dx_a (N), stiffness d2E/dx2 (N/m): the
+/// exact Hessian, and built from the projected tangent (positive semi-definite).
 struct HyperelasticTetResponse {
   double energy = 0;
   std::array<Eigen::Vector3d, 4> forces;
-  TetStiffness stiffness = TetStiffness::Zero();
+  TetStiffness projected_stiffness = TetStiffness::Zero();
+  TetStiffness exact_stiffness = TetStiffness::Zero();
 };
-/// What the implicit step assembles, at node positions x (rest data from FemModel). With
-/// `project` the stiffness is built from the projected tangent (positive semi-definite);
-/// without, it is the exact Hessian of the energy.
+/// What the implicit step assembles, at node positions x (rest data from FemModel). The
+/// projected stiffness has the same bits whether or not the exact one is computed with it.
 HyperelasticTetResponse hyperelasticTet(const StableNeoHookean& law,
                                         const std::array<Eigen::Vector3d, 4>& x,
-                                        const TetRestData& rest, bool project = true);
+                                        const TetRestData& rest,
+                                        TetStiffnessKind kind = TetStiffnessKind::kProjected);
 HyperelasticTetResponse hyperelasticTet(const MooneyRivlin& law,
                                         const std::array<Eigen::Vector3d, 4>& x,
-                                        const TetRestData& rest, bool project = true);
+                                        const TetRestData& rest,
+                                        TetStiffnessKind kind = TetStiffnessKind::kProjected);
 
 }  // namespace torsion

@@ -23,6 +23,15 @@ namespace torsion {
 Eigen::Matrix3d extractRotation(const Eigen::Matrix3d& F, Eigen::Quaterniond& q,
                                 int max_iterations = 20, double tolerance = 1e-6);
 
+/// F = U diag(sigma) V^T with U and V rotations (det +1): sigma descending in magnitude, its last
+/// entry negative when det F < 0 (Irving et al. 2004).
+struct SignedSvd {
+  Eigen::Matrix3d U;
+  Eigen::Vector3d sigma;
+  Eigen::Matrix3d V;
+};
+SignedSvd signedSvd(const Eigen::Matrix3d& F);
+
 /// The SVD path alone (Irving et al. 2004), for tests and inverted tets.
 Eigen::Matrix3d rotationBySvd(const Eigen::Matrix3d& F);
 

@@ -206,8 +206,8 @@ class ImplicitStepper {
   // Phi at v from the elastic energy there and the step's quadratic terms.
   double incrementalPotential(const Eigen::VectorXd& v, double elastic_energy,
                               const Eigen::VectorXd& lagged_v) const;
-  // A Newton direction dv at the iterate (trial_ holds its positions): S r solved with the exact
-  // Hessian, or the projected one where that is not positive definite.
+  // A Newton direction dv at the last evaluated iterate: S r solved with the exact Hessian, or the
+  // projected one where that is not positive definite.
   LinearSolveReport newtonDirection(const Eigen::VectorXd& free_residual, Eigen::VectorXd& dv);
   // Backtracks along dv from v (Phi(v) = phi); on success v and phi move to the accepted point.
   bool lineSearch(Eigen::VectorXd& v, const Eigen::VectorXd& dv, double& phi);
