@@ -119,6 +119,9 @@ SolverSettings readSolver(const JsonObject& s) {
   settings.refactor_iterations = s.integer("refactor_iterations", settings.refactor_iterations);
   settings.tolerance = s.number("tolerance", settings.tolerance);
   settings.max_iterations = s.integer("max_iterations", settings.max_iterations);
+  settings.newton_tolerance = s.number("newton_tolerance", settings.newton_tolerance);
+  settings.newton_max_iterations =
+      s.integer("newton_max_iterations", settings.newton_max_iterations);
   settings.threads = s.integer("threads", settings.threads);
   settings.max_speed = s.number("max_speed", settings.max_speed);
   s.finish();

@@ -43,6 +43,7 @@ constexpr const char* kFile = "fuzz.json";
 constexpr long kMaxMeshBytes = 40 * 1000;
 constexpr long kMaxTet10MeshBytes = 8 * 1000;
 constexpr int kSteps = 2;
+constexpr int kMaxNewtonIterations = 3;
 constexpr int kMaxIterations = 15;
 
 // What a user reads: it names the file, and it is valid UTF-8 (the scene's strings are JSON, so
@@ -109,6 +110,9 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   // solve) took 10 s at 40 iterations.
   int& iterations = spec.value().world.solver.max_iterations;
   iterations = std::min(iterations, kMaxIterations);
+  // A hyperelastic body's step is up to newton_max_iterations such solves.
+  int& newton_iterations = spec.value().world.solver.newton_max_iterations;
+  newton_iterations = std::min(newton_iterations, kMaxNewtonIterations);
 
   auto built = torsion::scene::buildScene(std::move(spec).value(), 1);
   if (!built.ok()) {

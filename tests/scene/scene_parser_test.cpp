@@ -212,6 +212,29 @@ TEST(SceneParser, ReadsALaggedPreconditionerAndItsRefactorisationPolicy) {
   EXPECT_EQ(r.value().world.solver.refactor_iterations, 5);
 }
 
+TEST(SceneParser, ReadsTheNewtonSolveOfHyperelasticBodies) {
+  Result<SceneSpec> defaults = parse(kValid);
+  ASSERT_TRUE(defaults.ok()) << defaults.error().message;
+  EXPECT_EQ(defaults.value().world.solver.newton_tolerance, SolverSettings{}.newton_tolerance);
+  EXPECT_EQ(defaults.value().world.solver.newton_max_iterations,
+            SolverSettings{}.newton_max_iterations);
+  Result<SceneSpec> r = parse(replaced(kValid, "\"tolerance\": 1e-6,",
+                                       "\"tolerance\": 1e-6, \"newton_tolerance\": 1e-8, "
+                                       "\"newton_max_iterations\": 12,"));
+  ASSERT_TRUE(r.ok()) << r.error().message;
+  EXPECT_EQ(r.value().world.solver.newton_tolerance, 1e-8);
+  EXPECT_EQ(r.value().world.solver.newton_max_iterations, 12);
+  EXPECT_TRUE(failsWith(parse(replaced(kValid, "\"tolerance\": 1e-6,",
+                                       "\"tolerance\": 1e-6, \"newton_tolerance\": 0,")),
+                        {"s.json: solver", "newton_tolerance = 0"}));
+  EXPECT_TRUE(failsWith(parse(replaced(kValid, "\"tolerance\": 1e-6,",
+                                       "\"tolerance\": 1e-6, \"newton_max_iterations\": 0,")),
+                        {"s.json: solver", "newton_max_iterations = 0"}));
+  EXPECT_TRUE(failsWith(parse(replaced(kValid, "\"tolerance\": 1e-6,",
+                                       "\"tolerance\": 1e-6, \"newton_max_iterations\": 2.5,")),
+                        {"solver.newton_max_iterations"}));
+}
+
 TEST(SceneParserFaults, UnknownPreconditionerAndZeroRefactorInterval) {
   EXPECT_TRUE(failsWith(parse(replaced(kValid, "\"tolerance\": 1e-6,",
                                        "\"tolerance\": 1e-6, \"preconditioner\": \"ilu\",")),

@@ -251,6 +251,10 @@ void bindParts(py::module_& m) {
       .def_property_readonly(
           "solver_iterations", [](const B& b) { return b.body->lastReport().solve.iterations; },
           "CG iterations of the last step")
+      .def_property_readonly(
+          "newton_iterations", [](const B& b) { return b.body->lastReport().newton.iterations; },
+          "Newton iterations (linear solves) of the last step: 0 for corotated bodies, whose step "
+          "is one linear solve")
       .def("__repr__", [](const B& b) {
         return "<torsion.Body '" + b.body->name() +
                "': " + std::to_string(b.body->model().nodeCount()) + " nodes>";

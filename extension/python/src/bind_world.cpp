@@ -294,7 +294,8 @@ void bindWorld(py::module_& m) {
 
   py::class_<PyWorld>(m, "World", "Bullet world with FEM soft bodies, hands and rigid bodies.")
       .def(py::init([](py::object gravity, double dt, double tolerance, int max_iterations,
-                       const std::string& linear_solver, int threads, double max_speed) {
+                       const std::string& linear_solver, int threads, double max_speed,
+                       double newton_tolerance, int newton_max_iterations) {
              WorldSettings settings;
              settings.gravity = toVector3(gravity, "gravity");
              settings.solver.time_step = dt;
@@ -302,6 +303,8 @@ void bindWorld(py::module_& m) {
              settings.solver.max_iterations = max_iterations;
              settings.solver.threads = threads;
              settings.solver.max_speed = max_speed;
+             settings.solver.newton_tolerance = newton_tolerance;
+             settings.solver.newton_max_iterations = newton_max_iterations;
              if (linear_solver == "cholmod") {
                settings.solver.linear_solver = LinearSolverKind::kCholmod;
              } else if (linear_solver != "cg") {
@@ -315,8 +318,12 @@ void bindWorld(py::module_& m) {
            py::arg("gravity") = py::make_tuple(0.0, 0.0, -9.81), py::arg("dt") = 0.01,
            py::arg("tolerance") = 1e-4, py::arg("max_iterations") = 300,
            py::arg("linear_solver") = "cg", py::arg("threads") = 0, py::arg("max_speed") = 1e3,
+           py::arg("newton_tolerance") = SolverSettings{}.newton_tolerance,
+           py::arg("newton_max_iterations") = SolverSettings{}.newton_max_iterations,
            "An empty world. gravity: m/s^2; dt: s; tolerance: CG relative residual; threads: "
-           "solver worker threads (0: all cores); max_speed: m/s, a faster node fails the step.")
+           "solver worker threads (0: all cores); max_speed: m/s, a faster node fails the step; "
+           "newton_tolerance, newton_max_iterations: the Newton solve of hyperelastic bodies' "
+           "steps (docs/materials.md).")
       .def_static(
           "from_scene",
           [](const std::string& scene, int threads, py::object devices, const std::string& haptics,

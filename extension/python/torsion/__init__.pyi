@@ -107,6 +107,7 @@ class Body:
     external_forces: npt.NDArray[np.float64]  # (n, 3) N, copy
     kinetic_energy: float  # J, end of the last step
     solver_iterations: int  # CG iterations of the last step
+    newton_iterations: int  # Newton iterations of the last step (0: corotated, one solve)
     def set_material(self, material: Material) -> None: ...
     def set_external_forces(self, forces: ArrayLike) -> None: ...  # (n, 3) N, kept every step
     def set_velocity(self, velocity: ArrayLike) -> None: ...  # (3,) m/s, every node
@@ -180,7 +181,8 @@ class Contacts:
 class World:
     def __init__(self, gravity: ArrayLike = (0, 0, -9.81), dt: float = 0.01,
                  tolerance: float = 1e-4, max_iterations: int = 300,
-                 linear_solver: str = "cg", threads: int = 0, max_speed: float = 1e3) -> None: ...
+                 linear_solver: str = "cg", threads: int = 0, max_speed: float = 1e3,
+                 newton_tolerance: float = 1e-6, newton_max_iterations: int = 30) -> None: ...
     @staticmethod
     def from_scene(scene: str, threads: int = -1, *,
                    devices: Union[dict[str, str], Sequence[str], None] = None,
