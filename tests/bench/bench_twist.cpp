@@ -6,6 +6,8 @@
 //   bench_twist --solver torsion-cg --mesh cylinder_8332 --E 1e5 --threads 2 --tolerance 1e-4
 //   bench_twist --solver bullet-implicit --mesh cylinder_8332 --tolerance 1e-8
 //   --mass-preconditioner bench_twist --solver bullet-explicit --mesh cylinder_8332 --substeps 4
+//   bench_twist --solver torsion-cg --law neo_hookean --mesh cylinder_8332 --curve nh.csv
+//   bench_twist --solver bullet-implicit --law neo_hookean --mesh cylinder_8332 --newton 2
 
 #include <CLI/CLI.hpp>
 #include <cmath>
@@ -56,6 +58,9 @@ int main(int argc, char** argv) {
   std::string mesh_name;
   std::string label;
   std::string dump_path;
+  std::string curve_path;
+  std::string law = "corotated";
+  int bullet_newton = 1;
   TwistProtocol protocol;
   int threads = 1;
   double tolerance = std::numeric_limits<double>::quiet_NaN();
@@ -116,6 +121,22 @@ int main(int argc, char** argv) {
   app.add_option("--amplitude", protocol.final_angle,
                  "rad: the final twist angle, or the oscillation's amplitude")
       ->capture_default_str();
+  app.add_option("--law", law,
+                 "corotated (ours corotated; Bullet linear-elasticity implicit, corotated "
+                 "explicit) | neo_hookean (our stable neo-Hookean, Newton step; Bullet "
+                 "btDeformableNeoHookeanForce)")
+      ->check(CLI::IsMember({"corotated", "neo_hookean"}))
+      ->capture_default_str();
+  app.add_option("--newton", bullet_newton,
+                 "bullet-implicit: Newton iterations per step (m_maxNewtonIterations; Bullet's "
+                 "default 1; always all taken here)")
+      ->capture_default_str();
+  app.add_option("--newton-tolerance", torsion_options.newton_tolerance,
+                 "ours, neo_hookean: SolverSettings::newton_tolerance")
+      ->capture_default_str();
+  app.add_option("--curve", curve_path,
+                 "write step,time,angle,torque per step (torque about z the driver applies at "
+                 "the turned end, N m), measured outside the timing");
   app.add_option("--label", label, "free text copied into the JSON");
   app.add_option("--dump-positions", dump_path, "write final positions (x y z per line) here");
   std::string node_order = "file";
@@ -136,6 +157,9 @@ int main(int argc, char** argv) {
       node_order == "rcm" ? torsion::inCacheFriendlyOrder(loaded.value().mesh)
                           : std::move(loaded.value().mesh));
 
+  protocol.law =
+      law == "neo_hookean" ? TwistProtocol::Law::kNeoHookean : TwistProtocol::Law::kCorotated;
+  protocol.record_curve = !curve_path.empty();
   TwistResult result;
   double reported_tolerance = tolerance;
   if (solver == "torsion-cg" || solver == "torsion-cholmod") {
@@ -161,6 +185,7 @@ int main(int argc, char** argv) {
     options.cg_max_iterations = max_iterations;
     options.mass_preconditioner = mass_preconditioner;
     options.substeps = substeps;
+    options.newton_iterations = bullet_newton;
     threads = 1;
     if (!options.implicit) reported_tolerance = std::numeric_limits<double>::quiet_NaN();
     result = torsion::bench::runBulletTwist(protocol, *mesh, options);
@@ -174,6 +199,12 @@ int main(int argc, char** argv) {
     iterations_max = std::max(iterations_max, it);
   }
   const double steps_done = std::max(1, result.steps_done);
+  long newton_total = 0;
+  int newton_max = 0;
+  for (int it : result.step_newton) {
+    newton_total += it;
+    newton_max = std::max(newton_max, it);
+  }
 
   nlohmann::json j;
   j["solver"] = solver;
@@ -212,6 +243,25 @@ int main(int argc, char** argv) {
   j["iterations_mean"] = static_cast<double>(iterations_total) / steps_done;
   j["iterations_max"] = iterations_max;
   j["not_converged_steps"] = result.not_converged_steps;
+  j["law"] = law;
+  // Newton: ours with the neo-Hookean law; Bullet implicit (its fixed count). iterations_* above
+  // are then the CG iterations of all Newton solves together.
+  if (!result.step_newton.empty()) {
+    j["newton_total"] = newton_total;
+    j["newton_mean"] = static_cast<double>(newton_total) / steps_done;
+    j["newton_max"] = newton_max;
+  } else {
+    j["newton_total"] = nullptr;
+    j["newton_mean"] = nullptr;
+    j["newton_max"] = nullptr;
+  }
+  j["newton_not_converged_steps"] = result.newton_not_converged_steps;
+  j["line_search_cuts"] = result.line_search_cuts;
+  j["projected_iterations"] = result.projected_iterations;
+  j["end_torque"] = number(result.end_torque);
+  const double end_angle = protocol.angle(result.steps_done * protocol.time_step);
+  j["torque_st_venant"] = number(torsion::bench::stVenantTorque(protocol, mesh->boundsMax().x(),
+                                                                mesh->boundsMax().z(), end_angle));
   j["peak_rss_mb"] = static_cast<double>(result.peak_rss_kb) / 1024;
   j["setup_rss_mb"] = static_cast<double>(result.setup_rss_kb) / 1024;
   j["max_speed"] = number(result.max_speed);
@@ -235,6 +285,14 @@ int main(int argc, char** argv) {
       out << result.final_positions[i] << ' ' << result.final_positions[i + 1] << ' '
           << result.final_positions[i + 2] << '\n';
     }
+  }
+  if (!curve_path.empty()) {
+    std::ofstream out(curve_path);
+    out.precision(10);
+    out << "step,time,angle,torque\n";
+    for (const TwistResult::CurvePoint& p : result.curve)
+      out << p.step << ',' << p.step * protocol.time_step << ',' << p.angle << ',' << p.torque
+          << '\n';
   }
   return result.status == torsion::bench::RunStatus::kSetupFailed ? 2 : 0;
 }

@@ -22,7 +22,9 @@
 #include "BulletSoftBody/btDeformableLinearElasticityForce.h"
 #include "BulletSoftBody/btDeformableMultiBodyConstraintSolver.h"
 #include "BulletSoftBody/btDeformableMultiBodyDynamicsWorld.h"
+#include "BulletSoftBody/btDeformableNeoHookeanForce.h"
 #include "BulletSoftBody/btSoftBodyRigidBodyCollisionConfiguration.h"
+#include "LinearMath/btPolarDecomposition.h"
 #include "LinearMath/btQuickprof.h"
 #include "btBulletDynamicsCommon.h"
 #if defined(__GNUC__)

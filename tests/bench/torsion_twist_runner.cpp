@@ -1,5 +1,11 @@
 // Our side of the cylinder twist: torsion::ImplicitStepper, driven ends as prescribed velocities
 // through NodeConstraints (the same mechanism as twistedRun in implicit_stepper_test.cpp).
+// TwistProtocol::Law::kNeoHookean sets Material::law = kStableNeoHookean (same E, nu, rho and
+// Rayleigh damping); the stepper then takes its Newton step by itself (docs/materials.md). The end
+// torque is drivenTorqueZ of ImplicitStepper::internalForcesAt(driven) after the step, outside
+// the timing: elastic + stiffness-damping forces at the end of the step (exact for the
+// hyperelastic law, f(x') - beta K_n v'; linearised for the corotated one,
+// f(x) - (dt + beta) K v').
 
 #include <chrono>
 #include <cmath>
@@ -28,6 +34,8 @@ TwistResult runTorsionTwist(const TwistProtocol& protocol, std::shared_ptr<const
   material.density = protocol.density;
   material.mass_damping = 0;
   material.stiffness_damping = protocol.stiffness_damping;
+  if (protocol.law == TwistProtocol::Law::kNeoHookean)
+    material.law = MaterialLaw::kStableNeoHookean;
   auto created =
       FemModel::create(mesh, material, options.tet10 ? ElementKind::kTet10 : ElementKind::kTet4);
   if (!created.ok()) {
@@ -45,6 +53,7 @@ TwistResult runTorsionTwist(const TwistProtocol& protocol, std::shared_ptr<const
   settings.preconditioner = options.preconditioner;
   settings.refactor_interval = options.refactor_interval;
   settings.refactor_iterations = options.refactor_iterations;
+  settings.newton_tolerance = options.newton_tolerance;
   settings.threads = options.threads;
   settings.max_speed = protocol.max_speed;
   if (Status valid = settings.validate(); !valid.ok()) {
@@ -57,6 +66,9 @@ TwistResult runTorsionTwist(const TwistProtocol& protocol, std::shared_ptr<const
     detail << "cholmod";
   } else {
     detail << "cg " << toString(settings.preconditioner) << " tol " << settings.tolerance;
+  }
+  if (material.hyperelastic()) {
+    detail << ", " << toString(material.law) << " newton tol " << settings.newton_tolerance;
   }
   detail << (options.tet10 ? ", tet10" : "") << ", threads " << options.threads;
   result.solver_detail = detail.str();
@@ -83,6 +95,9 @@ TwistResult runTorsionTwist(const TwistProtocol& protocol, std::shared_ptr<const
 
   result.step_ms.reserve(static_cast<size_t>(protocol.total_steps));
   result.step_iterations.reserve(static_cast<size_t>(protocol.total_steps));
+  if (material.hyperelastic())
+    result.step_newton.reserve(static_cast<size_t>(protocol.total_steps));
+  double outside_cpu = 0;  // CPU seconds of the torque curve, taken out of the loop's CPU time
   const double cpu_start = processCpuSeconds();
   for (int k = 0; k < protocol.total_steps; ++k) {
     const Clock::time_point t0 = Clock::now();
@@ -95,6 +110,12 @@ TwistResult runTorsionTwist(const TwistProtocol& protocol, std::shared_ptr<const
     const Clock::time_point t1 = Clock::now();
     result.step_ms.push_back(std::chrono::duration<double, std::milli>(t1 - t0).count());
     result.step_iterations.push_back(report.solve.iterations);
+    if (material.hyperelastic()) {
+      result.step_newton.push_back(report.newton.iterations);
+      if (!report.newton.converged) ++result.newton_not_converged_steps;
+      result.line_search_cuts += report.newton.line_search_cuts;
+      result.projected_iterations += report.newton.projected_iterations;
+    }
     result.steps_done = k + 1;
     result.max_speed = std::max(result.max_speed, report.max_speed);
     if (report.health == StepHealth::kSolverNotConverged) ++result.not_converged_steps;
@@ -105,8 +126,17 @@ TwistResult runTorsionTwist(const TwistProtocol& protocol, std::shared_ptr<const
       result.message = "step " + std::to_string(k) + ": " + report.message;
       break;
     }
+    if (protocol.record_curve) {
+      const double c0 = processCpuSeconds();
+      result.curve.push_back(
+          {k + 1, angle, drivenTorqueZ(state.positions, stepper.internalForcesAt(driven), driven)});
+      outside_cpu += processCpuSeconds() - c0;
+    }
   }
-  result.loop_cpu_seconds = processCpuSeconds() - cpu_start;
+  result.loop_cpu_seconds = processCpuSeconds() - cpu_start - outside_cpu;
+  if (result.status == RunStatus::kOk) {
+    result.end_torque = drivenTorqueZ(state.positions, stepper.internalForcesAt(driven), driven);
+  }
   result.peak_rss_kb = peakRssKb();
   result.final_positions = state.positions;
   measureTwist(protocol, nodes_mesh, scene, state.positions, result);

@@ -37,6 +37,23 @@ TwistScene classifyNodes(const TetMesh& mesh) {
   return scene;
 }
 
+double drivenTorqueZ(const Eigen::VectorXd& positions, const Eigen::VectorXd& internal_forces,
+                     const std::vector<int>& driven) {
+  double torque = 0;
+  for (int i : driven) {
+    const Eigen::Vector3d x = positions.segment<3>(3 * i);
+    const Eigen::Vector3d f = internal_forces.segment<3>(3 * i);
+    torque -= x.x() * f.y() - x.y() * f.x();
+  }
+  return torque;
+}
+
+double stVenantTorque(const TwistProtocol& protocol, double radius, double length, double angle) {
+  const double mu = protocol.youngs_modulus / (2 * (1 + protocol.poisson_ratio));
+  const double polar_moment = 3.141592653589793 / 2 * std::pow(radius, 4);
+  return mu * polar_moment * angle / length;
+}
+
 Eigen::Vector3d turnedAboutZ(const Eigen::Vector3d& rest, double angle) {
   const double c = std::cos(angle), s = std::sin(angle);
   return {c * rest.x() - s * rest.y(), s * rest.x() + c * rest.y(), rest.z()};

@@ -11,6 +11,7 @@
 
 #include <Eigen/Core>
 #include <cstdint>
+#include <limits>
 #include <memory>
 #include <string>
 #include <vector>
@@ -34,6 +35,13 @@ struct TwistProtocol {
   /// Rayleigh stiffness damping beta, s (C = beta K). Ours: Material::stiffness_damping; Bullet's
   /// btDeformableLinearElasticityForce: damping_beta (same meaning, see bullet_twist_runner.cpp).
   double stiffness_damping = 0.01;
+  /// The constitutive law on both sides (same E, nu, rho, beta): kCorotated is ours corotated
+  /// against Bullet's btDeformableLinearElasticityForce (implicit) or btDeformableCorotatedForce
+  /// (explicit); kNeoHookean is our stable neo-Hookean (Material::law, Newton step) against
+  /// Bullet's btDeformableNeoHookeanForce (bullet_twist_runner.cpp: parameters and damping).
+  enum class Law { kCorotated, kNeoHookean } law = Law::kCorotated;
+  /// Record the end torque after every step (TwistResult::curve), outside the timed region.
+  bool record_curve = false;
   double max_speed = 100;             ///< m/s: a faster node means the run is unstable
   double slice_half_thickness = 0.3;  ///< m, half thickness of the measuring slices
   std::vector<double> slice_fractions{0.25, 0.5, 0.75};  ///< slice z / L
@@ -53,6 +61,17 @@ struct TwistScene {
 };
 TwistScene classifyNodes(const TetMesh& mesh);
 
+/// Torque about the z axis that the driver applies to the body through the driven nodes, N m:
+/// -sum_i (x_i x f_i)_z over `driven`, f_i the force the body's elements (elastic + damping) exert
+/// on node i (3n vectors; only the driven rows are read). Positive turns the body the way the
+/// protocol turns it.
+double drivenTorqueZ(const Eigen::VectorXd& positions, const Eigen::VectorXd& internal_forces,
+                     const std::vector<int>& driven);
+
+/// St-Venant's torque for the protocol's end angle on a circular section of radius `radius`:
+/// mu (pi radius^4 / 2) angle / L (linear elasticity; tet4 meshes are stiffer), N m.
+double stVenantTorque(const TwistProtocol& protocol, double radius, double length, double angle);
+
 /// Rest position turned about the z axis (through x = y = 0) by `angle`.
 Eigen::Vector3d turnedAboutZ(const Eigen::Vector3d& rest, double angle);
 
@@ -70,10 +89,26 @@ struct TwistResult {
   double loop_cpu_seconds = 0;       ///< process CPU time (all threads) of the stepping loop
   std::vector<int> step_iterations;  ///< linear-solver iterations per step (sum over substeps)
   int not_converged_steps = 0;       ///< steps whose solver stopped above tolerance (ours)
-  double max_speed = 0;              ///< largest node speed seen at the end of any step, m/s
-  double driven_error = 0;           ///< max |x - target| of driven nodes at the end, m
-  long setup_rss_kb = 0;             ///< peak RSS before the first step
-  long peak_rss_kb = 0;              ///< peak RSS at the end
+  /// Newton iterations (linear solves) per step: ours with a hyperelastic law
+  /// (StepReport::newton.iterations); Bullet implicit: its solves per step (a fixed count, see
+  /// BulletOptions::newton_iterations). Empty otherwise.
+  std::vector<int> step_newton;
+  int newton_not_converged_steps = 0;  ///< ours: steps whose Newton solve missed its tolerance
+  long line_search_cuts = 0;           ///< ours: Newton step halvings over the run
+  long projected_iterations = 0;       ///< ours: Newton directions with the projected Hessian
+  /// Torque about z the driver applies at the end of the last step (drivenTorqueZ), N m; NaN
+  /// where not measured (Bullet explicit).
+  double end_torque = std::numeric_limits<double>::quiet_NaN();
+  struct CurvePoint {
+    int step = 0;       ///< 1-based: the state at the end of this step
+    double angle = 0;   ///< prescribed angle of the driven end, rad
+    double torque = 0;  ///< drivenTorqueZ, N m
+  };
+  std::vector<CurvePoint> curve;  ///< every step, when TwistProtocol::record_curve
+  double max_speed = 0;           ///< largest node speed seen at the end of any step, m/s
+  double driven_error = 0;        ///< max |x - target| of driven nodes at the end, m
+  long setup_rss_kb = 0;          ///< peak RSS before the first step
+  long peak_rss_kb = 0;           ///< peak RSS at the end
   // Final twist profile
   std::vector<double> slice_z, slice_angle, slice_expected, slice_error;
   std::vector<int> slice_nodes;
@@ -105,6 +140,7 @@ struct TorsionOptions {
   PreconditionerKind preconditioner = PreconditionerKind::kBlockJacobi;
   int refactor_interval = SolverSettings{}.refactor_interval;
   int refactor_iterations = SolverSettings{}.refactor_iterations;
+  double newton_tolerance = SolverSettings{}.newton_tolerance;  ///< hyperelastic laws only
 };
 TwistResult runTorsionTwist(const TwistProtocol& protocol, std::shared_ptr<const TetMesh> mesh,
                             const TorsionOptions& options);
@@ -117,6 +153,10 @@ struct BulletOptions {
   int cg_max_iterations = 300;       ///< Bullet's default (kMaxConjugateGradientIterations)
   bool mass_preconditioner = false;  ///< initialise the mass preconditioner (memo section 3)
   int substeps = 1;                  ///< explicit: stepSimulation calls of dt / substeps per step
+  /// Implicit: btDeformableBodySolver::m_maxNewtonIterations (Bullet's default 1). Its stop test
+  /// (absolute residual norm < 1e-4, the unprojected forces on held nodes included) never fires
+  /// in this scene, so every step takes exactly this many linearised solves.
+  int newton_iterations = 1;
 };
 TwistResult runBulletTwist(const TwistProtocol& protocol, const TetMesh& mesh,
                            const BulletOptions& options);
