@@ -2,10 +2,10 @@
 // The exact torsion of a compressible hyperelastic cylinder held at its length, reduced to one
 // dimension and solved to high accuracy: the reference the FEM twist is checked against.
 //
-// Helical symmetry makes the semi-inverse field x = rho(R) e_r(Theta + psi Z) + Z e_z exact for
-// any isotropic law at fixed length: in the orthonormal bases (E_R, E_Theta, E_Z) and
-// (e_r, e_theta, e_z)
-//   F = [[rho', 0, 0], [0, rho / R, rho psi], [0, 0, 1]],
+// Helical symmetry makes the semi-inverse field x = rho(R) e_r(Theta + psi Z) + lambda Z e_z
+// exact for any isotropic law at a given length (lambda = 1: held at its length; the lambda with
+// N = 0: the free bar): in the orthonormal bases (E_R, E_Theta, E_Z) and (e_r, e_theta, e_z)
+//   F = [[rho', 0, 0], [0, rho / R, rho psi], [0, 0, lambda]],
 // C has no (R, Z) or (R, Theta) entries, so neither has the stress: the theta and z equilibrium
 // equations hold identically and only the radial one is left. It is the stationarity of the
 // energy per unit length 2 pi int_0^a Psi(F) R dR over rho(R) (rho(0) = 0, R = a free), solved
@@ -30,8 +30,11 @@ struct TorsionLoads {
   double max_radial_change = 0;  ///< max |rho / R - 1|
 };
 
+// `twist_rate` is per unit rest length; `axial_stretch` the bar's length over its rest length (1:
+// held at its length).
 template <class Law>
-TorsionLoads exactTorsion(const Law& law, double radius, double twist_rate, int intervals = 400) {
+TorsionLoads exactTorsion(const Law& law, double radius, double twist_rate, int intervals = 400,
+                          double axial_stretch = 1.0) {
   const int n = intervals;
   const double h = radius / n;
   // rho at nodes 1..n (node 0 is the axis, rho = 0).
@@ -43,7 +46,7 @@ TorsionLoads exactTorsion(const Law& law, double radius, double twist_rate, int 
     F(0, 0) = dr;
     F(1, 1) = r / ((m + 0.5) * h);
     F(1, 2) = r * twist_rate;
-    F(2, 2) = 1;
+    F(2, 2) = axial_stretch;
     return F;
   };
   for (int iteration = 0; iteration < 30; ++iteration) {
