@@ -356,10 +356,6 @@ BodySpec readBody(const JsonObject& b, const SceneSpec& scene, const std::string
       body.material.volumetric_strain == VolumetricStrain::kNodalAverage) {
     b.fail("material", "volumetric_strain nodal_average is a tet4 option (tet10 does not lock)");
   }
-  if (body.element == ElementKind::kTet10 && body.material.hyperelastic()) {
-    b.fail("material",
-           std::string("law ") + toString(body.material.law) + " is stepped on tet4 elements only");
-  }
   if (b.has("self_contact")) {
     const JsonObject c = b.object("self_contact");
     SelfContactSettings self;

@@ -44,10 +44,14 @@ TEST(SceneMaterialLawKey, BadValuesAndUnsupportedCombinationsAreRefusedNamingThe
           sceneWithLaw(R"(, "law": "stable_neo_hookean", "volumetric_strain": "nodal_average")"),
           "s.json", "/base"),
       {"s.json: bodies[0].material.volumetric_strain", "corotated option"}));
-  EXPECT_TRUE(test::failsWith(
-      parseScene(sceneWithLaw(R"(, "law": "mooney_rivlin")", R"( "element": "tet10",)"), "s.json",
-                 "/base"),
-      {"s.json: bodies[0].material", "tet4 elements only"}));
+}
+
+TEST(SceneMaterialLawKey, HyperelasticLawsRunOnQuadraticTets) {
+  Result<SceneSpec> tet10 = parseScene(
+      sceneWithLaw(R"(, "law": "mooney_rivlin")", R"( "element": "tet10",)"), "s.json", "/base");
+  ASSERT_TRUE(tet10.ok()) << tet10.error().message;
+  EXPECT_EQ(tet10.value().bodies[0].element, ElementKind::kTet10);
+  EXPECT_EQ(tet10.value().bodies[0].material.law, MaterialLaw::kMooneyRivlin);
 }
 
 }  // namespace

@@ -3,8 +3,9 @@
 // linear elasticity of (E, nu), uniaxial tension and simple shear against the closed forms of
 // rubber elasticity, the closed-form eigensystem rebuilds the tangent and its projection (a
 // numerical 9x9 decomposition as reference, also at repeated and zero singular values), the
-// projected tangent is positive semi-definite (also inverted), and the linear tet's forces and
-// stiffness are the derivatives of its energy. Figures: docs/materials.md.
+// projected tangent is positive semi-definite (also inverted), and the linear and quadratic tets'
+// forces and stiffness are the derivatives of their energy (the quadratic tet's stiffness at rest
+// is the corotated P2 element's). Figures: docs/materials.md.
 #include "torsion/fem/hyperelastic.h"
 
 #include <gtest/gtest.h>
@@ -15,6 +16,8 @@
 #include <functional>
 #include <random>
 #include <vector>
+
+#include "torsion/mesh/quadratic_tet_mesh.h"
 
 // A named namespace: its helpers cannot clash with another source's in a unity batch.
 namespace torsion::hyperelastic_test {
@@ -390,6 +393,149 @@ TEST(HyperelasticTet, ForcesAndStiffnessAreDerivativesOfTheEnergy) {
   EXPECT_NEAR(at_rest.energy, 0.0, 1e-12 * kE * rest.volume);
   for (const Eigen::Vector3d& f : at_rest.forces)
     EXPECT_LE(f.norm(), 1e-10 * kE);
+}
+
+// ---- The quadratic (10-node) tet ----
+
+using Nodes10 = Tet10Vectors;
+
+// Corners X, mid-edge nodes at the edge midpoints (the straight-sided rest element).
+Nodes10 tet10Nodes(const Nodes& X) {
+  Nodes10 x;
+  for (size_t a = 0; a < 4; ++a)
+    x[a] = X[a];
+  for (size_t e = 0; e < 6; ++e) {
+    x[4 + e] = 0.5 * (X[static_cast<size_t>(kTet10Edges[e][0])] +
+                      X[static_cast<size_t>(kTet10Edges[e][1])]);
+  }
+  return x;
+}
+
+QuadraticRestData tet10Rest(const Nodes& X) {
+  const TetRestData corner = tetRest(X);
+  return quadraticRestData(corner.rest_shape_inverse, corner.volume);
+}
+
+template <typename L>
+void checkTet10(const L& law, const Nodes10& x, const QuadraticRestData& rest) {
+  const HyperelasticTet10Response r =
+      hyperelasticTet10(law, x, rest, TetStiffnessKind::kProjectedAndExact);
+  // Either stiffness alone has the bits it has beside the other (the pass relies on it).
+  EXPECT_EQ(hyperelasticTet10(law, x, rest, TetStiffnessKind::kProjected).projected_stiffness,
+            r.projected_stiffness);
+  EXPECT_EQ(hyperelasticTet10(law, x, rest, TetStiffnessKind::kExact).exact_stiffness,
+            r.exact_stiffness);
+  double force_scale = 0;
+  Eigen::Vector3d sum = Eigen::Vector3d::Zero(), torque = Eigen::Vector3d::Zero();
+  for (size_t a = 0; a < 10; ++a) {
+    force_scale += r.forces[a].norm();
+    sum += r.forces[a];
+    torque += x[a].cross(r.forces[a]);
+  }
+  ASSERT_GT(force_scale, 0.0);
+  EXPECT_LE(sum.norm(), 1e-12 * force_scale);
+  EXPECT_LE(torque.norm(), 1e-12 * force_scale * 2.0);  // |x| < 2
+  // Central differences, step 1e-6 m on O(1) m positions: truncation (h^2 / 6) E^(3) ~ 1e-13 and
+  // rounding eps |E| / h ~ 1e-10 relative to the force scale, four orders under the tolerance.
+  const double h = 1e-6;
+  const double stiffness_scale = r.exact_stiffness.norm();
+  for (int k = 0; k < 30; ++k) {
+    Nodes10 plus = x, minus = x;
+    plus[static_cast<size_t>(k / 3)][k % 3] += h;
+    minus[static_cast<size_t>(k / 3)][k % 3] -= h;
+    const HyperelasticTet10Response p = hyperelasticTet10(law, plus, rest, TetStiffnessKind::kNone);
+    const HyperelasticTet10Response m =
+        hyperelasticTet10(law, minus, rest, TetStiffnessKind::kNone);
+    const double dE = (p.energy - m.energy) / (2 * h);
+    EXPECT_NEAR(r.forces[static_cast<size_t>(k / 3)][k % 3], -dE, 1e-6 * force_scale);
+    for (int i = 0; i < 30; ++i) {
+      const double df =
+          p.forces[static_cast<size_t>(i / 3)][i % 3] - m.forces[static_cast<size_t>(i / 3)][i % 3];
+      EXPECT_NEAR(r.exact_stiffness(i, k), -df / (2 * h), 1e-6 * stiffness_scale)
+          << "entry " << i << ", " << k;
+    }
+  }
+  const Tet10Stiffness& K = r.projected_stiffness;
+  EXPECT_EQ(K, K.transpose());
+  EXPECT_EQ(r.exact_stiffness, r.exact_stiffness.transpose());
+  const double smallest = Eigen::SelfAdjointEigenSolver<Tet10Stiffness>(K).eigenvalues()(0);
+  EXPECT_GE(smallest, -1e-12 * K.norm());
+  // The projection only removes: K_exact - K_projected is negative semi-definite.
+  const double largest_removed =
+      Eigen::SelfAdjointEigenSolver<Tet10Stiffness>(r.exact_stiffness - K).eigenvalues()(29);
+  EXPECT_LE(largest_removed, 1e-12 * K.norm());
+}
+
+Nodes tet10Corners() {
+  return {Eigen::Vector3d(0, 0, 0), Eigen::Vector3d(1, 0.1, 0), Eigen::Vector3d(0.2, 0.9, 0.1),
+          Eigen::Vector3d(0.1, 0.2, 1.1)};
+}
+
+TEST(HyperelasticTet10, ForcesAndStiffnessAreDerivativesOfTheEnergy) {
+  const Nodes X = tet10Corners();
+  const QuadraticRestData rest = tet10Rest(X);
+  const Nodes10 at_rest = tet10Nodes(X);
+  // Distorted: every node moved differently (curved edges: F differs at each quadrature point).
+  Nodes10 distorted = at_rest;
+  std::mt19937 random(7);
+  std::uniform_real_distribution<double> offset(-0.12, 0.12);
+  for (Eigen::Vector3d& p : distorted)
+    p += Eigen::Vector3d(offset(random), offset(random), offset(random));
+  // Stretched: 40 % along x, 15 % lateral contraction, a shear, and one mid-edge node bent.
+  Eigen::Matrix3d G;
+  G << 1.4, 0.2, 0, 0, 0.85, 0.1, 0, 0, 0.85;
+  Nodes10 stretched;
+  for (size_t a = 0; a < 10; ++a)
+    stretched[a] = G * at_rest[a];
+  stretched[6] += Eigen::Vector3d(0.05, -0.08, 0.02);
+  for (const Nodes10& x : {distorted, stretched}) {
+    checkTet10(StableNeoHookean::fromYoungPoisson(kE, 0.3), x, rest);
+    checkTet10(StableNeoHookean::fromYoungPoisson(kE, 0.45, true), x, rest);
+    checkTet10(MooneyRivlin::fromConstants(2e4, 1e4, 3e5), x, rest);
+  }
+  // At rest, and moved rigidly: zero energy, zero forces.
+  const Eigen::Matrix3d R = rotation(0.9, Eigen::Vector3d(1, -0.3, 0.5));
+  Nodes10 moved;
+  for (size_t a = 0; a < 10; ++a)
+    moved[a] = R * at_rest[a] + Eigen::Vector3d(0.3, -1, 2);
+  for (const Nodes10& x : {at_rest, moved}) {
+    const HyperelasticTet10Response r =
+        hyperelasticTet10(MooneyRivlin::fromYoungPoisson(kE, 0.45, 0.3), x, rest);
+    EXPECT_NEAR(r.energy, 0.0, 1e-12 * kE * rest.volume);
+    for (const Eigen::Vector3d& f : r.forces)
+      EXPECT_LE(f.norm(), 1e-10 * kE);
+  }
+}
+
+// At rest every law's tangent is linear elasticity of (E, nu), and both P2 elements use the same
+// 4-point rule: the hyperelastic tet10 stiffness is the corotated one (quadratic_element.h) to
+// rounding, also for a rotated element (then the corotated one with that R).
+TEST(HyperelasticTet10, StiffnessAtRestIsTheCorotatedElementStiffness) {
+  const Nodes X = tet10Corners();
+  const QuadraticRestData rest = tet10Rest(X);
+  const Eigen::Matrix3d R = rotation(0.6, Eigen::Vector3d(0.2, 1, -0.4));
+  Nodes10 x = tet10Nodes(X);
+  for (Eigen::Vector3d& p : x)
+    p = R * p;
+  for (double nu : {0.3, 0.45, 0.499}) {
+    Tet10Stiffness corotated;
+    for (int a = 0; a < 10; ++a)
+      for (int b = 0; b < 10; ++b)
+        corotated.block<3, 3>(3 * a, 3 * b) =
+            quadraticStiffnessBlock(R, rest, shearModulus(nu), lameLambda(nu), a, b);
+    const std::vector<HyperelasticTet10Response> responses = {
+        hyperelasticTet10(StableNeoHookean::fromYoungPoisson(kE, nu), x, rest,
+                          TetStiffnessKind::kProjectedAndExact),
+        hyperelasticTet10(StableNeoHookean::fromYoungPoisson(kE, nu, true), x, rest,
+                          TetStiffnessKind::kProjectedAndExact),
+        hyperelasticTet10(MooneyRivlin::fromYoungPoisson(kE, nu, 0.3), x, rest,
+                          TetStiffnessKind::kProjectedAndExact)};
+    for (const HyperelasticTet10Response& r : responses) {
+      EXPECT_LE((r.exact_stiffness - corotated).norm(), 1e-10 * corotated.norm()) << "nu " << nu;
+      EXPECT_LE((r.projected_stiffness - corotated).norm(), 1e-10 * corotated.norm())
+          << "nu " << nu;
+    }
+  }
 }
 
 TEST(HyperelasticParameters, ShiftedLameParametersOfThePapers) {

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <random>
+#include <vector>
 
 namespace torsion {
 namespace {
@@ -62,6 +63,48 @@ TEST(PolarRotation, FlatTetGivesProperRotation) {
   Eigen::Quaterniond q = Eigen::Quaterniond::Identity();
   const Eigen::Matrix3d R = extractRotation(Eigen::Vector3d(1, 1, 0).asDiagonal(), q);
   EXPECT_TRUE(isRotation(R));
+}
+
+// The signed SVD: rotations U and V, F rebuilt to rounding, the singular values descending in
+// magnitude with det F's sign on the last, also where they repeat, cluster or vanish (the
+// hyperelastic tangent's frame, fem/hyperelastic.h).
+TEST(SignedSvd, RebuildsFWithRotationsAndSignedSingularValues) {
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> u(-1, 1);
+  std::vector<Eigen::Matrix3d> Fs;
+  for (int trial = 0; trial < 200; ++trial) {
+    Eigen::Matrix3d F = Eigen::Matrix3d::Identity();
+    for (int i = 0; i < 9; ++i)
+      F(i / 3, i % 3) += 0.5 * u(rng);
+    Fs.push_back(F);
+  }
+  for (int trial = 0; trial < 20; ++trial) {
+    const Eigen::Matrix3d R =
+        Eigen::Quaterniond(1, u(rng), u(rng), u(rng)).normalized().toRotationMatrix();
+    const Eigen::Matrix3d Q =
+        Eigen::Quaterniond(u(rng), 1, u(rng), u(rng)).normalized().toRotationMatrix();
+    for (double d : {1e-3, 1e-8, 1e-14, 0.0}) {
+      for (const Eigen::Vector3d& s :
+           {Eigen::Vector3d(1, 1 + d, 1 - d), Eigen::Vector3d(1.3, 1.3 + d, 0.2),
+            Eigen::Vector3d(1.3, 0.5, -0.5 + d), Eigen::Vector3d(1.3, d, -d),
+            Eigen::Vector3d(d, d, d)})
+        Fs.push_back(R * s.asDiagonal() * Q);
+    }
+  }
+  for (const Eigen::Matrix3d& F : Fs) {
+    const SignedSvd svd = signedSvd(F);
+    EXPECT_TRUE(isRotation(svd.U) && isRotation(svd.V)) << F;
+    EXPECT_LE((svd.U * svd.sigma.asDiagonal() * svd.V.transpose() - F).norm(),
+              1e-14 * std::max(F.norm(), 1.0))
+        << F;
+    // Descending to rounding (equal singular values may come in either order).
+    const double rounding = 1e-14 * std::max(F.norm(), 1.0);
+    EXPECT_GE(svd.sigma(0) + rounding, svd.sigma(1));
+    EXPECT_GE(svd.sigma(1) + rounding, std::abs(svd.sigma(2)));
+    if (std::abs(F.determinant()) > 1e-12) {
+      EXPECT_EQ(svd.sigma(2) < 0, F.determinant() < 0) << F;
+    }
+  }
 }
 
 }  // namespace

@@ -29,10 +29,6 @@ Status checkElementSupports(const Material& material, ElementKind element) {
         "material: volumetric_strain = nodal_average is a tet4 option (quadratic tets do not "
         "lock)"};
   }
-  if (material.hyperelastic() && element != ElementKind::kTet4) {
-    return Error{std::string("material: law = ") + toString(material.law) +
-                 " is stepped on tet4 elements only"};
-  }
   if (material.hyperelastic() && material.volumetric_strain == VolumetricStrain::kNodalAverage) {
     return Error{std::string("material: law = ") + toString(material.law) +
                  " takes volumetric_strain = element only (its volume term is per tet)"};

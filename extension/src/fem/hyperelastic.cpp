@@ -165,6 +165,84 @@ HyperelasticTetResponse hyperelasticResponse(const Law& law,
   return response;
 }
 
+// The P2 element's modes, all four quadrature points stacked: rows 9 q .. 9 q + 8 are point q's
+// nine modes (ordered as in modeGradients), columns 3 a .. 3 a + 2 their images Q_m g_qa on local
+// node a (no node is eliminated: the ten gradients of a point sum to zero only to rounding).
+using Tet10Modes = Eigen::Matrix<double, 9 * kTet10QuadraturePoints, 30>;
+
+void tet10PointModes(const PrincipalTangent& t, const std::array<Eigen::Vector3d, 10>& g, int q,
+                     Tet10Modes& Z) {
+  const double half_root = std::sqrt(0.5);
+  const int row = 9 * q;
+  for (int a = 0; a < 10; ++a) {
+    const Eigen::Vector3d w = t.V.transpose() * g[static_cast<size_t>(a)];  // V^T g_qa
+    for (int i = 0; i < 3; ++i)
+      Z.block<1, 3>(row + i, 3 * a) = w(i) * t.U.col(i).transpose();
+    for (int k = 0; k < 3; ++k) {
+      const int i = kPairFirst[k], j = kPairSecond[k];
+      const Eigen::Vector3d first = t.U.col(i) * w(j), second = t.U.col(j) * w(i);
+      Z.block<1, 3>(row + 3 + k, 3 * a) = half_root * (first - second).transpose();
+      Z.block<1, 3>(row + 6 + k, 3 * a) = half_root * (first + second).transpose();
+    }
+  }
+}
+
+// Point q's rows of D Z (weight w = V / 4): the stretch block and the pair eigenvalues.
+void tet10PointWeightedModes(const Tet10Modes& Z, int q, double weight,
+                             const Eigen::Matrix3d& stretch, const Eigen::Vector3d& rotation,
+                             const Eigen::Vector3d& shear, Tet10Modes& DZ) {
+  const int row = 9 * q;
+  DZ.middleRows<3>(row) = (weight * stretch) * Z.middleRows<3>(row);
+  DZ.middleRows<3>(row + 3) = (weight * rotation).asDiagonal() * Z.middleRows<3>(row + 3);
+  DZ.middleRows<3>(row + 6) = (weight * shear).asDiagonal() * Z.middleRows<3>(row + 6);
+}
+
+// sum_q w Z_q^T D_q Z_q = Z^T (D Z): the upper triangle, mirrored (symmetric to the bit).
+Tet10Stiffness tet10ModeStiffness(const Tet10Modes& Z, const Tet10Modes& DZ) {
+  Tet10Stiffness K;
+  for (int c = 0; c < 30; ++c) {
+    for (int r = 0; r <= c; ++r) {
+      K(r, c) = Z.col(r).dot(DZ.col(c));
+      K(c, r) = K(r, c);
+    }
+  }
+  return K;
+}
+
+template <typename Law>
+HyperelasticTet10Response hyperelasticTet10Response(const Law& law, const Tet10Vectors& x,
+                                                    const QuadraticRestData& rest,
+                                                    TetStiffnessKind kind) {
+  HyperelasticTet10Response response;
+  for (Eigen::Vector3d& f : response.forces)
+    f.setZero();
+  const bool projected =
+      kind == TetStiffnessKind::kProjected || kind == TetStiffnessKind::kProjectedAndExact;
+  const bool exact =
+      kind == TetStiffnessKind::kExact || kind == TetStiffnessKind::kProjectedAndExact;
+  const double weight = rest.volume / kTet10QuadraturePoints;
+  Tet10Modes Z, projected_modes, exact_modes;
+  for (int q = 0; q < kTet10QuadraturePoints; ++q) {
+    const std::array<Eigen::Vector3d, 10>& g = rest.gradients[static_cast<size_t>(q)];
+    const Eigen::Matrix3d F = quadraticDeformationGradient(x, rest, q);
+    response.energy += weight * energyDensity(law, F);
+    const Eigen::Matrix3d P = weight * firstPiola(law, F);
+    for (size_t a = 0; a < 10; ++a)
+      response.forces[a].noalias() -= P * g[a];
+    if (kind == TetStiffnessKind::kNone) continue;
+    const PrincipalTangent t = principalTangent(law, F);
+    tet10PointModes(t, g, q, Z);
+    if (projected) {
+      tet10PointWeightedModes(Z, q, weight, projectStretch(t.stretch), t.rotation.cwiseMax(0.0),
+                              t.shear.cwiseMax(0.0), projected_modes);
+    }
+    if (exact) tet10PointWeightedModes(Z, q, weight, t.stretch, t.rotation, t.shear, exact_modes);
+  }
+  if (projected) response.projected_stiffness = tet10ModeStiffness(Z, projected_modes);
+  if (exact) response.exact_stiffness = tet10ModeStiffness(Z, exact_modes);
+  return response;
+}
+
 }  // namespace
 
 StableNeoHookean StableNeoHookean::fromYoungPoisson(double youngs_modulus, double poisson_ratio,
@@ -330,6 +408,16 @@ HyperelasticTetResponse hyperelasticTet(const MooneyRivlin& law,
                                         const std::array<Eigen::Vector3d, 4>& x,
                                         const TetRestData& rest, TetStiffnessKind kind) {
   return hyperelasticResponse(law, x, rest, kind);
+}
+
+HyperelasticTet10Response hyperelasticTet10(const StableNeoHookean& law, const Tet10Vectors& x,
+                                            const QuadraticRestData& rest, TetStiffnessKind kind) {
+  return hyperelasticTet10Response(law, x, rest, kind);
+}
+
+HyperelasticTet10Response hyperelasticTet10(const MooneyRivlin& law, const Tet10Vectors& x,
+                                            const QuadraticRestData& rest, TetStiffnessKind kind) {
+  return hyperelasticTet10Response(law, x, rest, kind);
 }
 
 }  // namespace torsion

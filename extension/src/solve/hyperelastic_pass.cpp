@@ -9,6 +9,7 @@ namespace torsion {
 
 namespace {
 constexpr int kHyperelasticTetGrain = 128;
+constexpr int kHyperelasticTet10Grain = 32;
 
 std::array<Eigen::Vector3d, 4> tetPositions(const Eigen::VectorXd& positions,
                                             const std::vector<int>& nodes, size_t t) {
@@ -18,11 +19,78 @@ std::array<Eigen::Vector3d, 4> tetPositions(const Eigen::VectorXd& positions,
   return x;
 }
 
+std::array<Eigen::Vector3d, 4> tetPositions(const Eigen::VectorXd& positions, const Tet& tet) {
+  std::array<Eigen::Vector3d, 4> x;
+  for (size_t a = 0; a < 4; ++a)
+    x[a] = positions.segment<3>(3 * tet[a]);
+  return x;
+}
+
 double sumInOrder(const std::vector<double>& values) {
   double sum = 0;
   for (double v : values)
     sum += v;
   return sum;
+}
+
+Tet10Vectors elementPositions(const Eigen::VectorXd& positions, const std::vector<int>& nodes,
+                              size_t e) {
+  Tet10Vectors x;
+  for (size_t a = 0; a < 10; ++a)
+    x[a] = positions.segment<3>(3 * nodes[10 * e + a]);
+  return x;
+}
+
+bool barrierOn(const VolumeBarrier& barrier) {
+  return barrier.threshold > 0 && barrier.pressure > 0;
+}
+
+// The volume barrier of a tet10 element's 8 linear sub-tets (tets 8 e .. 8 e + 7 of mesh()),
+// added to the element's energy, forces and stiffnesses (sub-tet nodes mapped to the element's
+// local nodes). Returns how many sub-tets are below the threshold.
+int addSubTetBarrier(const FemModel& model, const Eigen::VectorXd& positions,
+                     const VolumeBarrier& barrier, size_t e, bool projected, bool exact,
+                     double& energy, Tet10Vectors& forces, Tet10Stiffness* projected_stiffness,
+                     Tet10Stiffness* exact_stiffness) {
+  const std::vector<int>& nodes = model.elementNodes();
+  const std::vector<Tet>& tets = model.mesh().tets();
+  const std::vector<TetRestData>& rest = model.tetRestData();
+  int active = 0;
+  for (size_t s = 8 * e; s < 8 * e + 8; ++s) {
+    const std::array<Eigen::Vector3d, 4> x = tetPositions(positions, model.mesh().tets()[s]);
+    const Eigen::Matrix3d F = deformationGradient(x, rest[s].rest_shape_inverse);
+    if (!barrier.active(F.determinant())) continue;
+    ++active;
+    std::array<size_t, 4> local{};
+    for (size_t a = 0; a < 4; ++a)
+      for (size_t b = 0; b < 10; ++b)
+        if (nodes[10 * e + b] == tets[s][a]) local[a] = b;
+    energy += volumeBarrierEnergy(F, rest[s], barrier);
+    const std::array<Eigen::Vector3d, 4> f = volumeBarrierForces(F, rest[s], barrier);
+    for (size_t a = 0; a < 4; ++a)
+      forces[local[a]] += f[a];
+    auto add = [&](const TetStiffness& K, Tet10Stiffness& target) {
+      for (size_t a = 0; a < 4; ++a)
+        for (size_t b = 0; b < 4; ++b)
+          target.block<3, 3>(3 * static_cast<int>(local[a]), 3 * static_cast<int>(local[b])) +=
+              K.block<3, 3>(3 * static_cast<int>(a), 3 * static_cast<int>(b));
+    };
+    if (projected) add(volumeBarrierStiffness(F, rest[s], barrier), *projected_stiffness);
+    if (exact) add(volumeBarrierHessian(F, rest[s], barrier), *exact_stiffness);
+  }
+  return active;
+}
+
+double subTetBarrierEnergy(const FemModel& model, const Eigen::VectorXd& positions,
+                           const VolumeBarrier& barrier, size_t e) {
+  double energy = 0;
+  for (size_t s = 8 * e; s < 8 * e + 8; ++s) {
+    const Eigen::Matrix3d F = deformationGradient(tetPositions(positions, model.mesh().tets()[s]),
+                                                  model.tetRestData()[s].rest_shape_inverse);
+    if (barrier.active(F.determinant()))
+      energy += volumeBarrierEnergy(F, model.tetRestData()[s], barrier);
+  }
+  return energy;
 }
 }  // namespace
 
@@ -51,8 +119,17 @@ HyperelasticTetResponse HyperelasticLaw::tet(const std::array<Eigen::Vector3d, 4
                                             : hyperelasticTet(neo_hookean, x, rest, stiffness);
 }
 
+HyperelasticTet10Response HyperelasticLaw::tet10(const Tet10Vectors& x,
+                                                 const QuadraticRestData& rest,
+                                                 TetStiffnessKind stiffness) const {
+  return kind == MaterialLaw::kMooneyRivlin ? hyperelasticTet10(mooney_rivlin, x, rest, stiffness)
+                                            : hyperelasticTet10(neo_hookean, x, rest, stiffness);
+}
+
 double HyperelasticPass::evaluate(const FemModel& model, const Eigen::VectorXd& positions,
                                   const Parallel& parallel, TetStiffnessKind kind) {
+  if (model.elementKind() == ElementKind::kTet10)
+    return evaluateTet10(model, positions, parallel, kind);
   const HyperelasticLaw law = HyperelasticLaw::of(model.material());
   const VolumeBarrier barrier = volumeBarrierOf(model.material());
   const std::vector<int>& nodes = model.elementNodes();
@@ -65,8 +142,8 @@ double HyperelasticPass::evaluate(const FemModel& model, const Eigen::VectorXd& 
   forces_.resize(4 * tets);
   energy_.resize(tets);
   in_barrier_.assign(tets, 0);
-  if (projected) projected_.resize(tets);
-  if (exact) exact_.resize(tets);
+  if (projected) projected_.tet4.resize(tets);
+  if (exact) exact_.tet4.resize(tets);
   parallel.forRange(static_cast<int>(tets), kHyperelasticTetGrain, [&](int begin, int end) {
     for (size_t t = static_cast<size_t>(begin); t < static_cast<size_t>(end); ++t) {
       const std::array<Eigen::Vector3d, 4> x = tetPositions(positions, nodes, t);
@@ -84,8 +161,49 @@ double HyperelasticPass::evaluate(const FemModel& model, const Eigen::VectorXd& 
       std::copy(response.forces.begin(), response.forces.end(),
                 forces_.begin() + static_cast<std::ptrdiff_t>(4 * t));
       energy_[t] = response.energy;
-      if (projected) projected_[t] = response.projected_stiffness;
-      if (exact) exact_[t] = response.exact_stiffness;
+      if (projected) projected_.tet4[t] = response.projected_stiffness;
+      if (exact) exact_.tet4[t] = response.exact_stiffness;
+    }
+  });
+  barrier_tets_ = 0;
+  for (unsigned char in : in_barrier_)
+    barrier_tets_ += in;
+  evaluated_positions_ = positions;
+  evaluated_kind_ = kind;
+  evaluated_energy_ = sumInOrder(energy_);
+  return evaluated_energy_;
+}
+
+double HyperelasticPass::evaluateTet10(const FemModel& model, const Eigen::VectorXd& positions,
+                                       const Parallel& parallel, TetStiffnessKind kind) {
+  const HyperelasticLaw law = HyperelasticLaw::of(model.material());
+  const VolumeBarrier barrier = volumeBarrierOf(model.material());
+  const std::vector<int>& nodes = model.elementNodes();
+  const std::vector<QuadraticRestData>& rest = model.quadraticRestData();
+  const size_t elements = rest.size();
+  const bool projected =
+      kind == TetStiffnessKind::kProjected || kind == TetStiffnessKind::kProjectedAndExact;
+  const bool exact =
+      kind == TetStiffnessKind::kExact || kind == TetStiffnessKind::kProjectedAndExact;
+  forces_.resize(10 * elements);
+  energy_.resize(elements);
+  in_barrier_.assign(elements, 0);
+  if (projected) projected_.tet10.resize(elements);
+  if (exact) exact_.tet10.resize(elements);
+  parallel.forRange(static_cast<int>(elements), kHyperelasticTet10Grain, [&](int begin, int end) {
+    for (size_t e = static_cast<size_t>(begin); e < static_cast<size_t>(end); ++e) {
+      HyperelasticTet10Response response =
+          law.tet10(elementPositions(positions, nodes, e), rest[e], kind);
+      if (barrierOn(barrier)) {
+        in_barrier_[e] = static_cast<unsigned char>(addSubTetBarrier(
+            model, positions, barrier, e, projected, exact, response.energy, response.forces,
+            &response.projected_stiffness, &response.exact_stiffness));
+      }
+      std::copy(response.forces.begin(), response.forces.end(),
+                forces_.begin() + static_cast<std::ptrdiff_t>(10 * e));
+      energy_[e] = response.energy;
+      if (projected) projected_.tet10[e] = response.projected_stiffness;
+      if (exact) exact_.tet10[e] = response.exact_stiffness;
     }
   });
   barrier_tets_ = 0;
@@ -111,6 +229,26 @@ double HyperelasticPass::energy(const FemModel& model, const Eigen::VectorXd& po
   const HyperelasticLaw law = HyperelasticLaw::of(model.material());
   const VolumeBarrier barrier = volumeBarrierOf(model.material());
   const std::vector<int>& nodes = model.elementNodes();
+  if (model.elementKind() == ElementKind::kTet10) {
+    // The energy of evaluateTet10(), term for term in the same order (the same bits).
+    const std::vector<QuadraticRestData>& quadratic = model.quadraticRestData();
+    energy_.resize(quadratic.size());
+    parallel.forRange(
+        static_cast<int>(quadratic.size()), kHyperelasticTet10Grain, [&](int begin, int end) {
+          for (size_t e = static_cast<size_t>(begin); e < static_cast<size_t>(end); ++e) {
+            const Tet10Vectors x = elementPositions(positions, nodes, e);
+            const double weight = quadratic[e].volume / kTet10QuadraturePoints;
+            double energy = 0;
+            for (int q = 0; q < kTet10QuadraturePoints; ++q) {
+              energy +=
+                  weight * law.energyDensity(quadraticDeformationGradient(x, quadratic[e], q));
+            }
+            if (barrierOn(barrier)) energy += subTetBarrierEnergy(model, positions, barrier, e);
+            energy_[e] = energy;
+          }
+        });
+    return sumInOrder(energy_);
+  }
   const std::vector<TetRestData>& rest = model.tetRestData();
   energy_.resize(rest.size());
   parallel.forRange(static_cast<int>(rest.size()), kHyperelasticTetGrain, [&](int begin, int end) {

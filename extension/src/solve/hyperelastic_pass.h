@@ -1,9 +1,11 @@
 #pragma once
-// The element pass of a hyperelastic tet4 body (fem/hyperelastic.h): per tet its energy, forces
-// and positive semi-definite stiffness at given node positions, with the volume barrier of the
-// tets below its threshold (fem/volume_barrier.h) added to the same tet. Each tet writes only its
-// own entries, and sums run in tet order, so every result is identical for any thread count.
-// Private to the implicit step (solve/implicit_stepper.h).
+// The element pass of a hyperelastic body (fem/hyperelastic.h), tet4 or tet10: per element its
+// energy, forces and element stiffnesses at given node positions, with the volume barrier
+// (fem/volume_barrier.h) of the linear tets below its threshold added to the same element (tet4:
+// the element itself; tet10: its 8 linear sub-tets, FemModel::mesh(), as for a corotated tet10
+// body). Each element writes only its own entries, and sums run in element order, so every
+// result is identical for any thread count. Private to the implicit step
+// (solve/implicit_stepper.h).
 
 #include <Eigen/Core>
 #include <utility>
@@ -13,6 +15,7 @@
 #include "torsion/fem/hyperelastic.h"
 #include "torsion/fem/volume_barrier.h"
 #include "torsion/solve/parallel.h"
+#include "torsion/solve/system_operator.h"
 
 namespace torsion {
 
@@ -26,6 +29,8 @@ struct HyperelasticLaw {
   double energyDensity(const Eigen::Matrix3d& F) const;
   HyperelasticTetResponse tet(const std::array<Eigen::Vector3d, 4>& x, const TetRestData& rest,
                               TetStiffnessKind kind) const;
+  HyperelasticTet10Response tet10(const Tet10Vectors& x, const QuadraticRestData& rest,
+                                  TetStiffnessKind kind) const;
 };
 
 class HyperelasticPass {
@@ -47,26 +52,31 @@ class HyperelasticPass {
   /// The last evaluate()'s energy, J.
   double evaluatedEnergy() const { return evaluated_energy_; }
 
-  /// Four per tet, index 4 t + a: the force on the tet's node a, N (SystemOperator::gather).
+  /// N per element (4 for tet4, 10 for tet10), index N e + a: the force on the element's node a,
+  /// N (SystemOperator::gather).
   const std::vector<Eigen::Vector3d>& elementForces() const { return forces_; }
-  /// One per tet, N/m (the last evaluate() that computed them).
-  const std::vector<TetStiffness>& projectedStiffnesses() const { return projected_; }
-  const std::vector<TetStiffness>& exactStiffnesses() const { return exact_; }
+  /// One per element in the member of the model's element kind, N/m (the last evaluate() that
+  /// computed them).
+  const ElementStiffnesses& projectedStiffnesses() const { return projected_; }
+  const ElementStiffnesses& exactStiffnesses() const { return exact_; }
   /// Keeps the last evaluate()'s projected stiffnesses as the step's start stiffnesses (a swap,
   /// no copy); the next evaluate() writes elsewhere.
   void keepAsStartStiffnesses() {
     std::swap(projected_, start_stiffness_);
     evaluated_positions_.resize(0);
   }
-  const std::vector<TetStiffness>& startStiffnesses() const { return start_stiffness_; }
-  /// Tets below the volume barrier's threshold at the last evaluate().
+  const ElementStiffnesses& startStiffnesses() const { return start_stiffness_; }
+  /// Linear tets below the volume barrier's threshold at the last evaluate() (tet10: sub-tets).
   int barrierTets() const { return barrier_tets_; }
 
  private:
+  double evaluateTet10(const FemModel& model, const Eigen::VectorXd& positions,
+                       const Parallel& parallel, TetStiffnessKind kind);
+
   std::vector<Eigen::Vector3d> forces_;
-  std::vector<TetStiffness> projected_, exact_, start_stiffness_;
+  ElementStiffnesses projected_, exact_, start_stiffness_;
   std::vector<double> energy_;
-  std::vector<unsigned char> in_barrier_;
+  std::vector<unsigned char> in_barrier_;  // per element: its linear tets below the threshold
   int barrier_tets_ = 0;
   Eigen::VectorXd evaluated_positions_;
   TetStiffnessKind evaluated_kind_ = TetStiffnessKind::kNone;

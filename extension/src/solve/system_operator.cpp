@@ -190,9 +190,12 @@ void SystemOperator::buildPattern() {
   assembled_ = false;
 }
 
-void SystemOperator::setElementStiffnesses(const std::vector<TetStiffness>* stiffnesses) {
-  assert((stiffnesses == nullptr || model_->elementKind() == ElementKind::kTet4) &&
-         "element stiffnesses are tet4 matrices");
+void SystemOperator::setElementStiffnesses(const ElementStiffnesses* stiffnesses) {
+  assert((stiffnesses == nullptr ||
+          (model_->elementKind() == ElementKind::kTet10
+               ? stiffnesses->tet10.size()
+               : stiffnesses->tet4.size()) == static_cast<size_t>(model_->elementCount())) &&
+         "one element stiffness of the model's element kind per element");
   element_stiffnesses_ = stiffnesses;
   assembled_ = false;
 }
@@ -213,20 +216,23 @@ void SystemOperator::multiplyBlocks(const std::vector<Eigen::Matrix3d>& blocks,
                      [&](int begin, int end) { kernels_->block_product(in, begin, end); });
 }
 
-void SystemOperator::assembleElementStiffnesses() const {
+template <typename Stiffness>
+void SystemOperator::assembleElementStiffnesses(const std::vector<Stiffness>& stiffness) const {
+  constexpr int N = Stiffness::RowsAtCompileTime / 3;  // nodes per element
+  assert(N == nodes_per_element_ && "element stiffnesses of the model's element kind");
   // Row n holds the blocks (n, b >= n) of every element of n: written by row n alone.
-  const std::vector<TetStiffness>& stiffness = *element_stiffnesses_;
   parallel_.forRange(model_->nodeCount(), kNodeGrain, [&](int begin, int end) {
     for (size_t row = static_cast<size_t>(begin); row < static_cast<size_t>(end); ++row) {
       for (int s = row_offsets_[row]; s < row_offsets_[row + 1]; ++s)
         block_values_[static_cast<size_t>(s)].setZero();
       for (int k = node_offsets_[row]; k < node_offsets_[row + 1]; ++k) {
         const int entry = node_entries_[static_cast<size_t>(k)];
-        const TetStiffness& K = stiffness[static_cast<size_t>(entry / 4)];
-        const int a = entry % 4;
-        for (int b = 0; b < 4; ++b) {
-          const int slot = entry_slots_[4 * static_cast<size_t>(k) + static_cast<size_t>(b)];
-          if (slot >= 0) block_values_[static_cast<size_t>(slot)] += K.block<3, 3>(3 * a, 3 * b);
+        const Stiffness& K = stiffness[static_cast<size_t>(entry / N)];
+        const int a = entry % N;
+        for (int b = 0; b < N; ++b) {
+          const int slot = entry_slots_[N * static_cast<size_t>(k) + static_cast<size_t>(b)];
+          if (slot >= 0)
+            block_values_[static_cast<size_t>(slot)] += K.template block<3, 3>(3 * a, 3 * b);
         }
       }
     }
@@ -236,7 +242,11 @@ void SystemOperator::assembleElementStiffnesses() const {
 void SystemOperator::assemble() const {
   if (assembled_) return;
   if (element_stiffnesses_ != nullptr) {
-    assembleElementStiffnesses();
+    if (model_->elementKind() == ElementKind::kTet10) {
+      assembleElementStiffnesses(element_stiffnesses_->tet10);
+    } else {
+      assembleElementStiffnesses(element_stiffnesses_->tet4);
+    }
     for (const SlotBlock& addition : stiffness_additions_)
       block_values_[static_cast<size_t>(addition.slot)] += addition.block;
     if (lagged_blocks_ != nullptr) {

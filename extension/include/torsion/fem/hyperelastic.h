@@ -1,5 +1,5 @@
 #pragma once
-// Hyperelastic material laws and the linear tet built on them, as pure functions
+// Hyperelastic material laws and the linear and quadratic tets built on them, as pure functions
 // (docs/materials.md). The implicit step of a hyperelastic body runs them per tet
 // (src/solve/hyperelastic_pass.h).
 //
@@ -44,6 +44,7 @@
 #include <array>
 
 #include "torsion/fem/fem_model.h"
+#include "torsion/fem/quadratic_element.h"
 #include "torsion/fem/volume_barrier.h"
 
 namespace torsion {
@@ -125,5 +126,28 @@ HyperelasticTetResponse hyperelasticTet(const MooneyRivlin& law,
                                         const std::array<Eigen::Vector3d, 4>& x,
                                         const TetRestData& rest,
                                         TetStiffnessKind kind = TetStiffnessKind::kProjected);
+
+/// One quadratic (10-node) tet (quadratic_element.h): at each of the 4 quadrature points q of the
+/// corotated P2 element (weight V / 4, shape gradients g_qa = rest.gradients[q][a]),
+/// F_q = sum_a x_a g_qa^T, and
+///   E = (V / 4) sum_q Psi(F_q),   f_a = -(V / 4) sum_q P(F_q) g_qa,
+///   K = (V / 4) sum_q Z_q^T D_q Z_q   (Z_q(m, a) = Q_m g_qa, D_q from principalTangent(F_q)),
+/// the tet's mode stiffness at each point, with D_q clamped for the projected stiffness. The
+/// projected stiffness has the same bits whether or not the exact one is computed with it; both
+/// are symmetric to the bit. F is linear over the element, so the rule is exact for a quadratic
+/// energy (small strain: the corotated P2 element's stiffness); at finite strain Psi(F) is a
+/// polynomial of higher degree and the rule is the corotated element's, not exact.
+struct HyperelasticTet10Response {
+  double energy = 0;
+  Tet10Vectors forces;
+  Tet10Stiffness projected_stiffness = Tet10Stiffness::Zero();
+  Tet10Stiffness exact_stiffness = Tet10Stiffness::Zero();
+};
+HyperelasticTet10Response hyperelasticTet10(const StableNeoHookean& law, const Tet10Vectors& x,
+                                            const QuadraticRestData& rest,
+                                            TetStiffnessKind kind = TetStiffnessKind::kProjected);
+HyperelasticTet10Response hyperelasticTet10(const MooneyRivlin& law, const Tet10Vectors& x,
+                                            const QuadraticRestData& rest,
+                                            TetStiffnessKind kind = TetStiffnessKind::kProjected);
 
 }  // namespace torsion

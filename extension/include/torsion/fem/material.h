@@ -23,8 +23,9 @@ const char* toString(VolumetricStrain kind);
 std::optional<VolumetricStrain> parseVolumetricStrain(const std::string& name);
 
 /// The constitutive law of a body (docs/materials.md). The corotated linear law steps with one
-/// linearised backward-Euler solve; the hyperelastic laws (tet4, per-element volumetric strain
-/// only) with a Newton solve of the step's incremental potential (solve/implicit_stepper.h).
+/// linearised backward-Euler solve; the hyperelastic laws (tet4 and tet10, per-element
+/// volumetric strain only) with a Newton solve of the step's incremental potential
+/// (solve/implicit_stepper.h).
 enum class MaterialLaw {
   kCorotated,         ///< corotated linear elasticity (Mueller & Gross 2004), the default
   kStableNeoHookean,  ///< stable neo-Hookean (Smith, de Goes & Kim 2018), no log term

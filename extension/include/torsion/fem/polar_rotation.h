@@ -24,7 +24,8 @@ Eigen::Matrix3d extractRotation(const Eigen::Matrix3d& F, Eigen::Quaterniond& q,
                                 int max_iterations = 20, double tolerance = 1e-6);
 
 /// F = U diag(sigma) V^T with U and V rotations (det +1): sigma descending in magnitude, its last
-/// entry negative when det F < 0 (Irving et al. 2004).
+/// entry negative when det F < 0 (Irving et al. 2004). Accurate to rounding in F's norm, also at
+/// repeated and zero singular values.
 struct SignedSvd {
   Eigen::Matrix3d U;
   Eigen::Vector3d sigma;

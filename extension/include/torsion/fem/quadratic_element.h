@@ -60,6 +60,8 @@ using Tet10GradientCoefficients =
 const Tet10GradientCoefficients& quadraticGradientCoefficients();
 
 using Tet10Vectors = std::array<Eigen::Vector3d, 10>;
+/// 30x30 stiffness of one P2 element: blocks K(3a.., 3b..) for local nodes a, b, N/m.
+using Tet10Stiffness = Eigen::Matrix<double, 30, 30>;
 
 /// F at quadrature point q: sum_a x_a g_qa^T.
 Eigen::Matrix3d quadraticDeformationGradient(const Tet10Vectors& x, const QuadraticRestData& rest,

@@ -39,6 +39,14 @@ struct BlockTerm;
 struct ProductInput;
 }  // namespace system_kernels
 
+/// Element stiffness matrices (SystemOperator::setElementStiffnesses), one per element, in the
+/// member of the model's element kind: `tet4` (12x12) for tet4 models, `tet10` (30x30) for tet10
+/// models (the other member unused).
+struct ElementStiffnesses {
+  std::vector<TetStiffness> tet4;
+  std::vector<Tet10Stiffness> tet10;
+};
+
 class SystemOperator {
  public:
   SystemOperator(std::shared_ptr<const FemModel> model, const Parallel& parallel);
@@ -79,11 +87,12 @@ class SystemOperator {
   /// tets below its threshold, fem/volume_barrier.h): they enter every product, the diagonal
   /// blocks and stiffnessBlocks(). Added in the given order, so K stays deterministic.
   void setStiffnessAdditions(std::vector<SlotBlock> additions);
-  /// Hyperelastic tet4 bodies (fem/hyperelastic.h; not owned, nullptr for the corotated
-  /// assembly): K is assembled from these 12x12 element stiffnesses, one per element, instead of
-  /// from the rotations, per block row over the row node's elements in ascending order (identical
-  /// for any thread count). Marks K stale: call again whenever their values change.
-  void setElementStiffnesses(const std::vector<TetStiffness>* stiffnesses);
+  /// Hyperelastic bodies (fem/hyperelastic.h; not owned, nullptr for the corotated assembly): K
+  /// is assembled from these element stiffnesses, one (3N)x(3N) matrix per element (N nodes per
+  /// element: the `tet4` member for tet4, `tet10` for tet10), instead of from the rotations, per
+  /// block row over the row node's elements in ascending order (identical for any thread count).
+  /// Marks K stale: call again whenever their values change.
+  void setElementStiffnesses(const ElementStiffnesses* stiffnesses);
   /// Blocks in this operator's pattern (not owned; nullptr: none) added to K, times `weight`,
   /// after each assembly: a hyperelastic step's stiffness damping, lagged at the step's start.
   void setLaggedStiffness(const std::vector<Eigen::Matrix3d>* blocks, double weight);
@@ -176,8 +185,9 @@ class SystemOperator {
   void buildPatches();
   // Fills block_values_ from this step's rotations (if stale).
   void assemble() const;
-  // Fills block_values_ from element_stiffnesses_.
-  void assembleElementStiffnesses() const;
+  // Fills block_values_ from element stiffnesses (12x12 or 30x30, one per element).
+  template <typename Stiffness>
+  void assembleElementStiffnesses(const std::vector<Stiffness>& stiffnesses) const;
   // tet10: the terms of every block (a, b) (system_kernels::BlockTerm), once per operator.
   void buildTet10Terms();
 
@@ -185,7 +195,7 @@ class SystemOperator {
   const Parallel& parallel_;
   std::vector<Eigen::Matrix3d> rotations_;
   std::vector<SlotBlock> stiffness_additions_;
-  const std::vector<TetStiffness>* element_stiffnesses_ = nullptr;
+  const ElementStiffnesses* element_stiffnesses_ = nullptr;
   const std::vector<Eigen::Matrix3d>* lagged_blocks_ = nullptr;
   double lagged_weight_ = 0;
   double mass_coefficient_ = 1;
