@@ -313,10 +313,12 @@ TEST(RivlinTorsionTet10, NearlyIncompressibleTwistMatchesTheExactSolution) {
 }
 
 // The dynamic twist of a hand-held end (dt = 0.01 s, the default CG at 1e-4, beta = 0.01 s): the
-// end turned at 1 rad/s for 2 rad, 200 steps, 2430 tets. Each step's Newton solve converges with
-// one correction after the linearised step (measured: 2 iterations every step, no projected
-// direction, no halving); at most 4 is asserted. The time per step is printed, not asserted.
-TEST(RivlinTorsionDynamic, TwistAtOneRadianPerSecondTakesTwoNewtonIterationsPerStep) {
+// end turned at 1 rad/s for 2 rad, 200 steps, 2430 tets. From the second step on, the prediction
+// puts the turned end on its target and one Newton direction from it converges (measured: 1.06
+// directions a step on average, 2 at most: the first step starts from rest and takes the
+// linearised step and one correction; no projected direction, no halving); asserted: a mean of at
+// most 1.2 and at most 4 in any step. The time per step is printed, not asserted.
+TEST(RivlinTorsionDynamic, TwistAtOneRadianPerSecondTakesOneNewtonDirectionPerStep) {
   const TetMesh mesh = rivlinCylinder(2430);
   WorldSettings settings;
   settings.gravity.setZero();
@@ -354,6 +356,7 @@ TEST(RivlinTorsionDynamic, TwistAtOneRadianPerSecondTakesTwoNewtonIterationsPerS
       "per step\n",
       most, double(total) / steps, projected, halvings, 1000 * seconds / steps);
   EXPECT_LE(most, 4);
+  EXPECT_LE(double(total) / steps, 1.2);
 }
 
 }  // namespace

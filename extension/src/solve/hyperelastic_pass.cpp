@@ -81,17 +81,6 @@ int addSubTetBarrier(const FemModel& model, const Eigen::VectorXd& positions,
   return active;
 }
 
-double subTetBarrierEnergy(const FemModel& model, const Eigen::VectorXd& positions,
-                           const VolumeBarrier& barrier, size_t e) {
-  double energy = 0;
-  for (size_t s = 8 * e; s < 8 * e + 8; ++s) {
-    const Eigen::Matrix3d F = deformationGradient(tetPositions(positions, model.mesh().tets()[s]),
-                                                  model.tetRestData()[s].rest_shape_inverse);
-    if (barrier.active(F.determinant()))
-      energy += volumeBarrierEnergy(F, model.tetRestData()[s], barrier);
-  }
-  return energy;
-}
 }  // namespace
 
 HyperelasticLaw HyperelasticLaw::of(const Material& material) {
@@ -170,6 +159,7 @@ double HyperelasticPass::evaluate(const FemModel& model, const Eigen::VectorXd& 
     barrier_tets_ += in;
   evaluated_positions_ = positions;
   evaluated_kind_ = kind;
+  projected_kept_ = false;
   evaluated_energy_ = sumInOrder(energy_);
   return evaluated_energy_;
 }
@@ -211,57 +201,20 @@ double HyperelasticPass::evaluateTet10(const FemModel& model, const Eigen::Vecto
     barrier_tets_ += in;
   evaluated_positions_ = positions;
   evaluated_kind_ = kind;
+  projected_kept_ = false;
   evaluated_energy_ = sumInOrder(energy_);
   return evaluated_energy_;
 }
 
-bool HyperelasticPass::holdsProjectedAt(const Eigen::VectorXd& positions) const {
-  const bool projected = evaluated_kind_ == TetStiffnessKind::kProjected ||
-                         evaluated_kind_ == TetStiffnessKind::kProjectedAndExact;
-  // The bits, not the values: -0 and 0 (or two NaNs) are not the same start.
-  return projected && evaluated_positions_.size() == positions.size() &&
+bool HyperelasticPass::holdsForcesAt(const Eigen::VectorXd& positions) const {
+  // The bits, not the values: -0 and 0 (or two NaNs) are not the same positions.
+  return evaluated_positions_.size() == positions.size() &&
          std::memcmp(positions.data(), evaluated_positions_.data(),
                      sizeof(double) * static_cast<size_t>(positions.size())) == 0;
 }
 
-double HyperelasticPass::energy(const FemModel& model, const Eigen::VectorXd& positions,
-                                const Parallel& parallel) {
-  const HyperelasticLaw law = HyperelasticLaw::of(model.material());
-  const VolumeBarrier barrier = volumeBarrierOf(model.material());
-  const std::vector<int>& nodes = model.elementNodes();
-  if (model.elementKind() == ElementKind::kTet10) {
-    // The energy of evaluateTet10(), term for term in the same order (the same bits).
-    const std::vector<QuadraticRestData>& quadratic = model.quadraticRestData();
-    energy_.resize(quadratic.size());
-    parallel.forRange(
-        static_cast<int>(quadratic.size()), kHyperelasticTet10Grain, [&](int begin, int end) {
-          for (size_t e = static_cast<size_t>(begin); e < static_cast<size_t>(end); ++e) {
-            const Tet10Vectors x = elementPositions(positions, nodes, e);
-            const double weight = quadratic[e].volume / kTet10QuadraturePoints;
-            double energy = 0;
-            for (int q = 0; q < kTet10QuadraturePoints; ++q) {
-              energy +=
-                  weight * law.energyDensity(quadraticDeformationGradient(x, quadratic[e], q));
-            }
-            if (barrierOn(barrier)) energy += subTetBarrierEnergy(model, positions, barrier, e);
-            energy_[e] = energy;
-          }
-        });
-    return sumInOrder(energy_);
-  }
-  const std::vector<TetRestData>& rest = model.tetRestData();
-  energy_.resize(rest.size());
-  parallel.forRange(static_cast<int>(rest.size()), kHyperelasticTetGrain, [&](int begin, int end) {
-    for (size_t t = static_cast<size_t>(begin); t < static_cast<size_t>(end); ++t) {
-      const Eigen::Matrix3d F =
-          deformationGradient(tetPositions(positions, nodes, t), rest[t].rest_shape_inverse);
-      double e = rest[t].volume * law.energyDensity(F);
-      if (barrier.threshold > 0 && barrier.pressure > 0 && barrier.active(F.determinant()))
-        e += volumeBarrierEnergy(F, rest[t], barrier);
-      energy_[t] = e;
-    }
-  });
-  return sumInOrder(energy_);
+bool HyperelasticPass::holdsStiffnessesAt(const Eigen::VectorXd& positions) const {
+  return evaluated_kind_ == TetStiffnessKind::kProjectedAndExact && holdsForcesAt(positions);
 }
 
 }  // namespace torsion

@@ -40,13 +40,11 @@ class HyperelasticPass {
   /// exactStiffnesses(): the exact Hessians) at `positions` (3n). Returns the energy, J.
   double evaluate(const FemModel& model, const Eigen::VectorXd& positions, const Parallel& parallel,
                   TetStiffnessKind kind);
-  /// The energy alone at `positions`, J (a line search's trial point); the last evaluate()'s
-  /// results stay.
-  double energy(const FemModel& model, const Eigen::VectorXd& positions, const Parallel& parallel);
-
-  /// Whether the last evaluate() was at exactly `positions` with the projected stiffnesses: a
-  /// step that ends there starts the next with them (the same bits as evaluating again).
-  bool holdsProjectedAt(const Eigen::VectorXd& positions) const;
+  /// Whether the last evaluate() was at exactly `positions` (the bits: -0 and 0 differ): its
+  /// forces and energy are those there (a step that ends there starts the next with them, the same
+  /// bits as evaluating again); and with both stiffnesses.
+  bool holdsForcesAt(const Eigen::VectorXd& positions) const;
+  bool holdsStiffnessesAt(const Eigen::VectorXd& positions) const;
   /// Forgets the last evaluate() (the material changed).
   void forget() { evaluated_positions_.resize(0); }
   /// The last evaluate()'s energy, J.
@@ -55,15 +53,17 @@ class HyperelasticPass {
   /// N per element (4 for tet4, 10 for tet10), index N e + a: the force on the element's node a,
   /// N (SystemOperator::gather).
   const std::vector<Eigen::Vector3d>& elementForces() const { return forces_; }
-  /// One per element in the member of the model's element kind, N/m (the last evaluate() that
-  /// computed them).
-  const ElementStiffnesses& projectedStiffnesses() const { return projected_; }
+  /// One per element in the member of the model's element kind, N/m, at the last evaluate()'s
+  /// positions (the projected ones moved to startStiffnesses() if kept as the start).
+  const ElementStiffnesses& projectedStiffnesses() const {
+    return projected_kept_ ? start_stiffness_ : projected_;
+  }
   const ElementStiffnesses& exactStiffnesses() const { return exact_; }
   /// Keeps the last evaluate()'s projected stiffnesses as the step's start stiffnesses (a swap,
-  /// no copy); the next evaluate() writes elsewhere.
+  /// no copy): they stay there through the next evaluate(), which writes elsewhere.
   void keepAsStartStiffnesses() {
     std::swap(projected_, start_stiffness_);
-    evaluated_positions_.resize(0);
+    projected_kept_ = true;
   }
   const ElementStiffnesses& startStiffnesses() const { return start_stiffness_; }
   /// Linear tets below the volume barrier's threshold at the last evaluate() (tet10: sub-tets).
@@ -80,6 +80,7 @@ class HyperelasticPass {
   int barrier_tets_ = 0;
   Eigen::VectorXd evaluated_positions_;
   TetStiffnessKind evaluated_kind_ = TetStiffnessKind::kNone;
+  bool projected_kept_ = false;  // the last evaluate()'s projected are in start_stiffness_
   double evaluated_energy_ = 0;
 };
 

@@ -59,10 +59,11 @@ namespace torsion {
 
 class CholmodSolver;
 class HyperelasticPass;
+enum class TetStiffnessKind;  // fem/hyperelastic.h
 
 /// The Newton solve of a hyperelastic body's step (all zero for corotated bodies).
 struct NewtonReport {
-  int iterations = 0;  ///< linear solves, the prepared one included
+  int iterations = 0;  ///< Newton directions (linear solves); 0: the predicted velocity solved it
   /// |S r| of the accepted iterate over its scale, |S(b - A v_prescribed)| of the step's first
   /// system plus dt |f(x_n)| (SolverSettings::newton_tolerance).
   double relative_residual = 0;
@@ -198,11 +199,18 @@ class ImplicitStepper {
   double computeHyperelasticForces(const FemState& state);
   // Stage 4 of a hyperelastic body: the Newton solve, v' into velocity_next_.
   LinearSolveReport solveNewton();
+  // Whether the warm start's prediction puts the prescribed nodes near their targets (the first
+  // Newton iterate then starts from it).
+  bool predictionFits() const;
   // A linear solve by settings_.linear_solver of A v = b under `constraints`.
   LinearSolveReport linearSolve(const NodeConstraints& constraints, const Eigen::VectorXd& b,
                                 Eigen::VectorXd& v);
-  // Forces at x_n + dt v, newton_residual_ = r(v); returns Phi(v).
-  double evaluateIterate(const Eigen::VectorXd& v);
+  // The pass at x_n + dt v (into trial_) with the stiffnesses `stiffness` asks for, then
+  // iterateResidual: returns Phi(v).
+  double evaluateIterate(const Eigen::VectorXd& v, TetStiffnessKind stiffness);
+  // From the pass's forces at v and its elastic `energy`: iterate_forces_, lagged_product_
+  // (K_0 v) and newton_residual_ = r(v); returns Phi(v).
+  double iterateResidual(const Eigen::VectorXd& v, double energy);
   // Phi at v from the elastic energy there and the step's quadratic terms.
   double incrementalPotential(const Eigen::VectorXd& v, double elastic_energy,
                               const Eigen::VectorXd& lagged_v) const;
