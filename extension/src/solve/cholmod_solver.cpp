@@ -60,7 +60,22 @@ struct SparseCholesky::Impl {
   Eigen::Index rows = -1, entries = -1;  // the analysed pattern
 };
 
-SparseCholesky::SparseCholesky() : impl_(std::make_unique<Impl>()) {}
+#if TORSION_WITH_CHOLMOD
+namespace {
+// A matrix that is not positive definite is an outcome the callers report (a hyperelastic Newton
+// direction falls back to the projected stiffness, a lagged preconditioner refactorises), not a
+// message for the user's terminal: CHOLMOD's own printing is off.
+void silence(cholmod_common& common) {
+  common.print = 0;
+}
+}  // namespace
+#endif
+
+SparseCholesky::SparseCholesky() : impl_(std::make_unique<Impl>()) {
+#if TORSION_WITH_CHOLMOD
+  silence(impl_->factor.cholmod());
+#endif
+}
 SparseCholesky::~SparseCholesky() = default;
 
 bool SparseCholesky::factorize(const Eigen::SparseMatrix<double>& lower) {
@@ -97,7 +112,11 @@ long SparseCholesky::factorEntries() const {
 #endif
 }
 
-CholmodSolver::CholmodSolver() : impl_(std::make_unique<Impl>()) {}
+CholmodSolver::CholmodSolver() : impl_(std::make_unique<Impl>()) {
+#if TORSION_WITH_CHOLMOD
+  silence(impl_->factor.cholmod());
+#endif
+}
 CholmodSolver::~CholmodSolver() = default;
 
 const char* CholmodSolver::backend() {
