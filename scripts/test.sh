@@ -50,9 +50,12 @@ configure build-float -DCMAKE_BUILD_TYPE=Release -DTORSION_WARNINGS_AS_ERRORS=ON
   -DTORSION_BUILD_DEMOS=OFF -DTORSION_BUILD_BENCHMARKS=OFF
 build build-float
 
+# ctest runs $jobs tests at once: each takes one thread (TORSION_THREADS, the default of a world
+# that asks for 0, i.e. all cores), so that two-thread worlds do not contend for the same cores
+# (a third more CPU time, measured). A test that is about threads asks for its count itself.
 stage "Test suite (build/)"
 seed_test_costs build tests/ctest_costs/release.txt
-ctest --test-dir build -j"$jobs" --output-on-failure
+TORSION_THREADS=1 ctest --test-dir build -j"$jobs" --output-on-failure
 # The pytest suite is one CTest test (python.pytest); its own count of tests:
 grep -hEo "^[0-9]+ passed.* in [0-9.]+s" build/Testing/Temporary/LastTest.log | tail -1 |
   sed 's/^/== pytest (label python): /' || true
@@ -82,5 +85,5 @@ configure build-asan "${sanitizer_flags[@]}" "${fast_only[@]}" -DTORSION_SANITIZ
   -DTORSION_FUZZ=ON -DTORSION_BULLET_PRECISION=float
 build build-asan
 seed_test_costs build-asan tests/ctest_costs/sanitizers.txt
-ASAN_OPTIONS=detect_leaks=1 UBSAN_OPTIONS=print_stacktrace=1 \
+TORSION_THREADS=1 ASAN_OPTIONS=detect_leaks=1 UBSAN_OPTIONS=print_stacktrace=1 \
   ctest --test-dir build-asan -j"$jobs" --output-on-failure -L "unit|cli|fuzz"

@@ -4,6 +4,7 @@
 
 #include <CLI/CLI.hpp>
 #include <cmath>
+#include <cstdlib>
 #include <iostream>
 
 #include "../scene/build_info.h"
@@ -12,6 +13,8 @@
 #include "run_command.h"
 #include "text_only_stderr.h"
 #include "torsion/device/file_io.h"
+#include "torsion/device/json_check.h"
+#include "torsion/solve/parallel.h"
 #include "verbosity.h"
 #include "view_command.h"
 
@@ -49,6 +52,15 @@ int main(int argc, char** argv) {
     // Usage errors exit 1 like every other error, on one "error:" line (CLI11 uses 104-114).
     std::cerr << "error: " << e.what() << "\nrun '" << argv[0]
               << " --help' (or '<command> --help') for usage\n";
+    return 1;
+  }
+  // The library ignores a malformed TORSION_THREADS (it has no one to tell); the tool says so.
+  if (const char* threads = std::getenv(torsion::kThreadsVariable);
+      threads != nullptr && *threads != '\0' && !torsion::threadsFromEnvironment()) {
+    std::cerr << "error: " << torsion::kThreadsVariable << "='"
+              << torsion::device::printableExcerpt(threads)
+              << "' is not a whole number of threads from 1 to " << torsion::kMaxThreads
+              << " (unset it to use every core)\n";
     return 1;
   }
   return chosen ? chosen() : 0;

@@ -331,8 +331,16 @@ case "$case_name" in
     used=$(sed -n 's/^warning: .* using \([0-9]*\)$/\1/p' <<<"$out")
     [[ $used -ge 1 && $used -le $cores ]] || fail "using $used threads on $cores cores"
     [[ $(json_field out/summary.json threads) == "$used" ]] || fail "summary does not report $used threads"
-    run "$torsion" run drop.json --out out --steps 2 --threads 0
+    # 0 is every core unless TORSION_THREADS says otherwise (a test run sets it to 1).
+    TORSION_THREADS= run "$torsion" run drop.json --out out --steps 2 --threads 0
     [[ $(json_field out/summary.json threads) == "$used" ]] || fail "--threads 0 is not all $used cores"
+    TORSION_THREADS=1 run "$torsion" run drop.json --out out --steps 2 --threads 0
+    [[ $(json_field out/summary.json threads) == 1 ]] || fail "TORSION_THREADS=1 is not 1 thread"
+    TORSION_THREADS=1 run "$torsion" run drop.json --out out --steps 2 --threads $cores
+    [[ $(json_field out/summary.json threads) == "$cores" ]] || fail "--threads lost to TORSION_THREADS"
+    TORSION_THREADS=two run "$torsion" run drop.json --out out --steps 2
+    expect_rc 1
+    expect_out "^error: TORSION_THREADS='two' is not a whole number of threads from 1 to 4096"
     ;;
   huge_step_count_reserves_nothing)
     # --steps 2e9 used to reserve 16 GB of step timings up front; memory now grows with the steps

@@ -158,7 +158,7 @@ void bindTypes(py::module_& m) {
            "mass_damping: 1/s; stiffness_damping: s; barrier_threshold: the volume ratio J below "
            "which the volume barrier against inverted tets acts, in [0, 1), 0 turns it off; "
            "barrier_stiffness: its pressure at J = 0 in bulk moduli; law: 'corotated', "
-           "'stable_neo_hookean' or 'mooney_rivlin' (hyperelastic: tet4, no contact; "
+           "'stable_neo_hookean' or 'mooney_rivlin' (hyperelastic, on tet4 or tet10; "
            "docs/materials.md); mooney_rivlin_c2_fraction: C2 / (C1 + C2) in [0, 1].")
       .def_readonly("E", &Material::youngs_modulus, "Young's modulus, Pa")
       .def_readonly("nu", &Material::poisson_ratio, "Poisson's ratio")

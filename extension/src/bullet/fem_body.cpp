@@ -219,18 +219,21 @@ bool FemBody::prepare(const StepContext& ctx, bool touches_fem_bodies) {
   // or not.
   const bool self = self_contact_ != nullptr;
   if (self) self_contact_->detect(state_, constraints_, dt);
-  if (model_->material().hyperelastic() && (rigid_contact_ || self || touches_fem_bodies)) {
-    // The Newton step has no contact solve yet: refused, never stepped without its contacts.
-    last_report_ = StepReport{};
-    last_report_.health = StepHealth::kSolverFailed;
-    last_report_.message = std::string(
-                               "contact is solved for corotated bodies only; this body's "
-                               "law is ") +
-                           toString(model_->material().law) + " (docs/materials.md)";
-    return false;
-  }
   last_report_ = stepper_.prepare(state_, constraints_, step_forces_, dt);
-  return !isFatal(last_report_.health);
+  if (isFatal(last_report_.health)) return false;
+  if (model_->material().hyperelastic() && (rigid_contact_ || self || touches_fem_bodies)) {
+    // The Newton solve finds the free motion; the island solves the contacts about it.
+    const LinearSolveReport free = stepper_.linearizeAboutFreeMotion();
+    if (free.breakdown || !stepper_.prepared().v->allFinite()) {
+      last_report_.solve = free;
+      last_report_.health = StepHealth::kSolverFailed;
+      last_report_.message =
+          std::string("the Newton solve of the free motion broke down") +
+          (free.breakdown_reason ? std::string(": ") + free.breakdown_reason : std::string());
+      return false;
+    }
+  }
+  return true;
 }
 
 const StepReport& FemBody::finish(const Eigen::Ref<const Eigen::VectorXd>& velocities,

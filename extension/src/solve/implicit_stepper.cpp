@@ -221,6 +221,7 @@ StepReport ImplicitStepper::prepare(FemState& state, const NodeConstraints& cons
   if (!buildRightHandSide(state, external_forces, dt, report)) return report;
   prepareSystem(state, dt);
   newton_ = NewtonReport{};
+  linearized_ = false;
   if (model_->material().hyperelastic()) {
     start_positions_ = state.positions;
     start_velocities_ = state.velocities;
@@ -244,6 +245,12 @@ void ImplicitStepper::finish(FemState& state, const Eigen::Ref<const Eigen::Vect
                              StepReport& report) {
   // v' stays in velocity_next_: the internal forces and the next warm start read it.
   if (velocities.data() != velocity_next_.data()) velocity_next_ = velocities;
+  if (linearized_ && internal_forces_valid_) {
+    // The contacts moved the step off its free motion v*, where the Newton solve left the exact
+    // internal forces: they follow the linearisation, -(dt + beta) K (v' - v*).
+    system_.multiplyStiffness(velocity_next_ - free_velocity_, scratch_);
+    internal_forces_ -= (last_dt_ + model_->material().stiffness_damping) * scratch_;
+  }
   integratePositions(state, last_dt_);
   report.newton = newton_;
   checkHealth(state, report);
@@ -286,7 +293,7 @@ void ImplicitStepper::prepareSystem(const FemState& state, double dt) {
 }
 
 LinearSolveReport ImplicitStepper::solve() {
-  if (model_->material().hyperelastic()) return solveNewton();
+  if (model_->material().hyperelastic() && !linearized_) return solveNewton();
   if (settings_.linear_solver == LinearSolverKind::kCholmod) {
     if (!cholmod_) cholmod_ = std::make_unique<CholmodSolver>();
     return cholmod_->solve(system_, *constraints_, rhs_, velocity_next_);

@@ -237,6 +237,22 @@ LinearSolveReport ImplicitStepper::solveNewton() {
   return total;
 }
 
+LinearSolveReport ImplicitStepper::linearizeAboutFreeMotion() {
+  const LinearSolveReport free = solveNewton();
+  linearized_ = true;
+  free_velocity_ = velocity_next_;
+  if (free.breakdown || !velocity_next_.allFinite()) return free;
+  // K at the free motion's end, projected: the contact solve minimises a convex quadratic, and
+  // K_h and the internal forces' correction linearise about the same point. (K_0, the step's
+  // first iterate's, differs from it by the whole step's Newton correction.)
+  trial_ = start_positions_ + last_dt_ * velocity_next_;
+  hyperelastic_->evaluate(*model_, trial_, parallel_, TetStiffnessKind::kProjected);
+  hyperelastic_->keepAsStartStiffnesses();
+  system_.setElementStiffnesses(&hyperelastic_->startStiffnesses());
+  system_.multiply(velocity_next_, rhs_);
+  return free;
+}
+
 void ImplicitStepper::judgeNewton(StepReport& report) const {
   const NewtonReport& n = report.newton;
   if (n.converged) return;

@@ -191,9 +191,17 @@ TEST(SapRandom, RandomIslandsConvergeAndRepeatBitForBit) {
   checkRandomIslands(kOrdinary, 1, 60, 1e-2);
 }
 
+// Under AddressSanitizer (25 times slower here) the memory checks need a few islands, not the
+// statistics: the Release suite solves all 200.
+#if defined(__SANITIZE_ADDRESS__) || (defined(__has_feature) && __has_feature(address_sanitizer))
+constexpr unsigned kExtremeIslands = 40;
+#else
+constexpr unsigned kExtremeIslands = 200;
+#endif
+
 // Seed 1506 once had a frictionless row at rest with an opening gap stuck at a negative impulse.
 TEST(SapRandom, ExtremeIslandsConvergeAndRepeatBitForBit) {
-  checkRandomIslands(kExtreme, 1401, 200, 1e-2);
+  checkRandomIslands(kExtreme, 1401, kExtremeIslands, 1e-2);
 }
 
 // The cap is reported, never passed off as a solution.

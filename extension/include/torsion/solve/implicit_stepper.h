@@ -144,8 +144,15 @@ class ImplicitStepper {
   /// The prepared step's system and its warm start (valid until the next prepare()).
   PreparedSystem prepared();
   /// Stage 4 without contacts: CG or CHOLMOD (settings().linear_solver) on the prepared system,
-  /// v' over prepared().v.
+  /// v' over prepared().v (a hyperelastic body: its Newton solve, unless linearised below).
   LinearSolveReport solve();
+  /// A hyperelastic body that may touch something, after prepare(): the step solved without its
+  /// contacts (Newton: the free motion v*), then the prepared system made the step's potential
+  /// linearised about v*: K the projected stiffness at x_n + dt v*, b = A v*, the warm start v*.
+  /// A contact solve of that system with the contact rows is one Newton step from v* with the
+  /// contacts (docs/contact.md, "Hyperelastic bodies"); solve() of it alone gives v* back. Returns
+  /// the Newton solve's report (a breakdown: the step cannot go on).
+  LinearSolveReport linearizeAboutFreeMotion();
   /// Stages 5-6: v = v' (`velocities`, 3n, from any solve of the prepared system; may be
   /// *prepared().v itself), x += dt v', and the health into `report`: prepare()'s, with
   /// report.solve set to that solve's report (a broken-down or unconverged solve is judged here).
@@ -262,6 +269,9 @@ class ImplicitStepper {
   std::vector<Eigen::Matrix3d> start_stiffness_;
   Eigen::VectorXd iterate_forces_, newton_residual_, lagged_product_, trial_;
   NewtonReport newton_;
+  // linearizeAboutFreeMotion(): the prepared system is the linearisation about free_velocity_.
+  bool linearized_ = false;
+  Eigen::VectorXd free_velocity_;
   bool internal_forces_valid_ = false;
   double last_dt_;  // s, dt of the last step (the internal forces' linearisation uses it)
 };

@@ -12,14 +12,28 @@
 #include <cstddef>
 #include <cstdint>
 #include <memory>
+#include <optional>
 
 namespace torsion {
 
+/// The environment variable that sets the default thread count (a request of 0), as
+/// OMP_NUM_THREADS does for OpenMP programs: for runs side by side (a test suite, a Dask
+/// fan-out, several simulations on one machine), each of which would otherwise take every core.
+inline constexpr const char* kThreadsVariable = "TORSION_THREADS";
+inline constexpr int kMaxThreads = 4096;
+
+/// TORSION_THREADS as a count: nothing when it is unset or empty, or not a whole number from 1
+/// to kMaxThreads (the command-line tool refuses such a value with a message; the library, which
+/// has no one to tell, ignores it).
+std::optional<int> threadsFromEnvironment();
+
 class Parallel {
  public:
-  /// threads <= 0: as many as the machine has; more than it has: as many as it has.
+  /// threads <= 0: TORSION_THREADS when set, else as many as the machine has; more than it has:
+  /// as many as it has.
   explicit Parallel(int threads = 0);
-  /// The threads a request gets: min(requested, cores), all cores for requested <= 0.
+  /// The threads a request gets: min(requested, cores); for requested <= 0, TORSION_THREADS
+  /// (capped the same way) or all cores.
   static int usableThreads(int requested);
 
   int threads() const { return threads_; }

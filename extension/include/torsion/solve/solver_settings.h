@@ -46,7 +46,7 @@ struct SolverSettings {
   /// solve that took more than refactor_iterations CG iterations.
   int refactor_interval = 100;
   int refactor_iterations = 8;
-  int threads = 0;  ///< worker threads; 0: all cores
+  int threads = 0;  ///< worker threads; 0: TORSION_THREADS when set, else all cores
   /// A node faster than this (m/s) means the simulation blew up; the run stops.
   double max_speed = 1e3;
   /// Hyperelastic bodies (Material::law): the step's Newton solve stops when the free part of
