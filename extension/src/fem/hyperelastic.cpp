@@ -216,10 +216,7 @@ HyperelasticTet10Response hyperelasticTet10Response(const Law& law, const Tet10V
   HyperelasticTet10Response response;
   for (Eigen::Vector3d& f : response.forces)
     f.setZero();
-  const bool projected =
-      kind == TetStiffnessKind::kProjected || kind == TetStiffnessKind::kProjectedAndExact;
-  const bool exact =
-      kind == TetStiffnessKind::kExact || kind == TetStiffnessKind::kProjectedAndExact;
+  const bool projected = projectedAsked(kind), exact = exactAsked(kind);
   const double weight = rest.volume / kTet10QuadraturePoints;
   Tet10Modes Z, projected_modes, exact_modes;
   for (int q = 0; q < kTet10QuadraturePoints; ++q) {

@@ -115,85 +115,88 @@ HyperelasticTet10Response HyperelasticLaw::tet10(const Tet10Vectors& x,
                                             : hyperelasticTet10(neo_hookean, x, rest, stiffness);
 }
 
+namespace {
+
+// What differs between the element kinds: the nodes per element, the chunk a thread takes, the
+// law's element function and where the volume barrier acts. respond() returns the element's
+// energy, forces and stiffnesses with its barrier added, and sets how many of its linear tets are
+// below the barrier's threshold.
+struct Tet4Elements {
+  static constexpr size_t kNodes = 4;
+  static constexpr int kGrain = 128;
+  using Response = HyperelasticTetResponse;
+  static size_t count(const FemModel& model) { return model.tetRestData().size(); }
+  static std::vector<TetStiffness>& of(ElementStiffnesses& s) { return s.tet4; }
+  static Response respond(const FemModel& model, const HyperelasticLaw& law,
+                          const VolumeBarrier& barrier, const Eigen::VectorXd& positions, size_t t,
+                          TetStiffnessKind kind, unsigned char& in_barrier) {
+    const TetRestData& rest = model.tetRestData()[t];
+    const std::array<Eigen::Vector3d, 4> x = tetPositions(positions, model.elementNodes(), t);
+    Response response = law.tet(x, rest, kind);
+    const Eigen::Matrix3d F = deformationGradient(x, rest.rest_shape_inverse);
+    if (!barrierOn(barrier) || !barrier.active(F.determinant())) return response;
+    in_barrier = 1;
+    response.energy += volumeBarrierEnergy(F, rest, barrier);
+    const std::array<Eigen::Vector3d, 4> f = volumeBarrierForces(F, rest, barrier);
+    for (size_t a = 0; a < 4; ++a)
+      response.forces[a] += f[a];
+    if (projectedAsked(kind))
+      response.projected_stiffness += volumeBarrierStiffness(F, rest, barrier);
+    if (exactAsked(kind)) response.exact_stiffness += volumeBarrierHessian(F, rest, barrier);
+    return response;
+  }
+};
+
+struct Tet10Elements {
+  static constexpr size_t kNodes = 10;
+  static constexpr int kGrain = 32;
+  using Response = HyperelasticTet10Response;
+  static size_t count(const FemModel& model) { return model.quadraticRestData().size(); }
+  static std::vector<Tet10Stiffness>& of(ElementStiffnesses& s) { return s.tet10; }
+  static Response respond(const FemModel& model, const HyperelasticLaw& law,
+                          const VolumeBarrier& barrier, const Eigen::VectorXd& positions, size_t e,
+                          TetStiffnessKind kind, unsigned char& in_barrier) {
+    Response response = law.tet10(elementPositions(positions, model.elementNodes(), e),
+                                  model.quadraticRestData()[e], kind);
+    if (barrierOn(barrier)) {
+      in_barrier = static_cast<unsigned char>(addSubTetBarrier(
+          model, positions, barrier, e, projectedAsked(kind), exactAsked(kind), response.energy,
+          response.forces, &response.projected_stiffness, &response.exact_stiffness));
+    }
+    return response;
+  }
+};
+
+}  // namespace
+
 double HyperelasticPass::evaluate(const FemModel& model, const Eigen::VectorXd& positions,
                                   const Parallel& parallel, TetStiffnessKind kind) {
-  if (model.elementKind() == ElementKind::kTet10)
-    return evaluateTet10(model, positions, parallel, kind);
-  const HyperelasticLaw law = HyperelasticLaw::of(model.material());
-  const VolumeBarrier barrier = volumeBarrierOf(model.material());
-  const std::vector<int>& nodes = model.elementNodes();
-  const std::vector<TetRestData>& rest = model.tetRestData();
-  const size_t tets = rest.size();
-  const bool projected =
-      kind == TetStiffnessKind::kProjected || kind == TetStiffnessKind::kProjectedAndExact;
-  const bool exact =
-      kind == TetStiffnessKind::kExact || kind == TetStiffnessKind::kProjectedAndExact;
-  forces_.resize(4 * tets);
-  energy_.resize(tets);
-  in_barrier_.assign(tets, 0);
-  if (projected) projected_.tet4.resize(tets);
-  if (exact) exact_.tet4.resize(tets);
-  parallel.forRange(static_cast<int>(tets), kHyperelasticTetGrain, [&](int begin, int end) {
-    for (size_t t = static_cast<size_t>(begin); t < static_cast<size_t>(end); ++t) {
-      const std::array<Eigen::Vector3d, 4> x = tetPositions(positions, nodes, t);
-      HyperelasticTetResponse response = law.tet(x, rest[t], kind);
-      const Eigen::Matrix3d F = deformationGradient(x, rest[t].rest_shape_inverse);
-      if (barrier.threshold > 0 && barrier.pressure > 0 && barrier.active(F.determinant())) {
-        in_barrier_[t] = 1;
-        response.energy += volumeBarrierEnergy(F, rest[t], barrier);
-        const std::array<Eigen::Vector3d, 4> f = volumeBarrierForces(F, rest[t], barrier);
-        for (size_t a = 0; a < 4; ++a)
-          response.forces[a] += f[a];
-        if (projected) response.projected_stiffness += volumeBarrierStiffness(F, rest[t], barrier);
-        if (exact) response.exact_stiffness += volumeBarrierHessian(F, rest[t], barrier);
-      }
-      std::copy(response.forces.begin(), response.forces.end(),
-                forces_.begin() + static_cast<std::ptrdiff_t>(4 * t));
-      energy_[t] = response.energy;
-      if (projected) projected_.tet4[t] = response.projected_stiffness;
-      if (exact) exact_.tet4[t] = response.exact_stiffness;
-    }
-  });
-  barrier_tets_ = 0;
-  for (unsigned char in : in_barrier_)
-    barrier_tets_ += in;
-  evaluated_positions_ = positions;
-  evaluated_kind_ = kind;
-  projected_kept_ = false;
-  evaluated_energy_ = sumInOrder(energy_);
-  return evaluated_energy_;
+  return model.elementKind() == ElementKind::kTet10
+             ? evaluateAs<Tet10Elements>(model, positions, parallel, kind)
+             : evaluateAs<Tet4Elements>(model, positions, parallel, kind);
 }
 
-double HyperelasticPass::evaluateTet10(const FemModel& model, const Eigen::VectorXd& positions,
-                                       const Parallel& parallel, TetStiffnessKind kind) {
+template <class Elements>
+double HyperelasticPass::evaluateAs(const FemModel& model, const Eigen::VectorXd& positions,
+                                    const Parallel& parallel, TetStiffnessKind kind) {
   const HyperelasticLaw law = HyperelasticLaw::of(model.material());
   const VolumeBarrier barrier = volumeBarrierOf(model.material());
-  const std::vector<int>& nodes = model.elementNodes();
-  const std::vector<QuadraticRestData>& rest = model.quadraticRestData();
-  const size_t elements = rest.size();
-  const bool projected =
-      kind == TetStiffnessKind::kProjected || kind == TetStiffnessKind::kProjectedAndExact;
-  const bool exact =
-      kind == TetStiffnessKind::kExact || kind == TetStiffnessKind::kProjectedAndExact;
-  forces_.resize(10 * elements);
+  const size_t elements = Elements::count(model);
+  const bool projected = projectedAsked(kind), exact = exactAsked(kind);
+  forces_.resize(Elements::kNodes * elements);
   energy_.resize(elements);
   in_barrier_.assign(elements, 0);
-  if (projected) projected_.tet10.resize(elements);
-  if (exact) exact_.tet10.resize(elements);
-  parallel.forRange(static_cast<int>(elements), kHyperelasticTet10Grain, [&](int begin, int end) {
+  if (projected) Elements::of(projected_).resize(elements);
+  if (exact) Elements::of(exact_).resize(elements);
+  parallel.forRange(static_cast<int>(elements), Elements::kGrain, [&](int begin, int end) {
     for (size_t e = static_cast<size_t>(begin); e < static_cast<size_t>(end); ++e) {
-      HyperelasticTet10Response response =
-          law.tet10(elementPositions(positions, nodes, e), rest[e], kind);
-      if (barrierOn(barrier)) {
-        in_barrier_[e] = static_cast<unsigned char>(addSubTetBarrier(
-            model, positions, barrier, e, projected, exact, response.energy, response.forces,
-            &response.projected_stiffness, &response.exact_stiffness));
-      }
+      typename Elements::Response response =
+          Elements::respond(model, law, barrier, positions, e, kind, in_barrier_[e]);
       std::copy(response.forces.begin(), response.forces.end(),
-                forces_.begin() + static_cast<std::ptrdiff_t>(10 * e));
+                forces_.begin() + static_cast<std::ptrdiff_t>(Elements::kNodes * e));
       energy_[e] = response.energy;
-      if (projected) projected_.tet10[e] = response.projected_stiffness;
-      if (exact) exact_.tet10[e] = response.exact_stiffness;
+      if (projected) Elements::of(projected_)[e] = response.projected_stiffness;
+      if (exact) Elements::of(exact_)[e] = response.exact_stiffness;
     }
   });
   barrier_tets_ = 0;

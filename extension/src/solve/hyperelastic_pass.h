@@ -70,8 +70,10 @@ class HyperelasticPass {
   int barrierTets() const { return barrier_tets_; }
 
  private:
-  double evaluateTet10(const FemModel& model, const Eigen::VectorXd& positions,
-                       const Parallel& parallel, TetStiffnessKind kind);
+  /// evaluate() for one element kind (Tet4Elements or Tet10Elements, hyperelastic_pass.cpp).
+  template <class Elements>
+  double evaluateAs(const FemModel& model, const Eigen::VectorXd& positions,
+                    const Parallel& parallel, TetStiffnessKind kind);
 
   std::vector<Eigen::Vector3d> forces_;
   ElementStiffnesses projected_, exact_, start_stiffness_;

@@ -107,6 +107,13 @@ PiolaTangent tangentOf(const PrincipalTangent& tangent, bool project);
 
 /// Which stiffnesses hyperelasticTet computes (the forces and the energy always).
 enum class TetStiffnessKind { kNone, kProjected, kExact, kProjectedAndExact };
+/// Whether `kind` asks for the projected, or the exact, stiffness.
+inline bool projectedAsked(TetStiffnessKind kind) {
+  return kind == TetStiffnessKind::kProjected || kind == TetStiffnessKind::kProjectedAndExact;
+}
+inline bool exactAsked(TetStiffnessKind kind) {
+  return kind == TetStiffnessKind::kExact || kind == TetStiffnessKind::kProjectedAndExact;
+}
 
 /// One linear tet: energy V Psi (J), forces f_a = -dE/dx_a (N), stiffness d2E/dx2 (N/m): the
 /// exact Hessian, and built from the projected tangent (positive semi-definite).
