@@ -114,6 +114,21 @@ double slideDistance(double theta, double mu, double seconds, NewtonWatch& newto
   return centreOfMass(*block).x() - x0;
 }
 
+// The impact tests' world and blocks: no gravity, dt = 1 ms; neo-Hookean, E = 1 MPa.
+WorldSettings impactSettings() {
+  WorldSettings settings;
+  settings.gravity.setZero();
+  settings.solver.time_step = 1e-3;
+  return settings;
+}
+
+Material impactMaterial() {
+  Material material = softMaterial(1e6, 1000);
+  material.stiffness_damping = 1e-3;
+  material.law = MaterialLaw::kStableNeoHookean;
+  return material;
+}
+
 TEST(HyperelasticContact, ABlockOnASlopeHoldsBelowTheFrictionAngleAndSlidesAsCoulombSaysAbove) {
   const double mu = 0.5;  // friction angle 26.6 degrees
   const double t = 1.0;
@@ -139,13 +154,8 @@ TEST(HyperelasticContact, ABlockOnASlopeHoldsBelowTheFrictionAngleAndSlidesAsCou
 // corotated law). Their contact rows couple both bodies' linearised steps in one island solve, so
 // the momentum handed over is exact to the solve's tolerance.
 TEST(HyperelasticContact, ANeoHookeanBlockThrownAtAnotherHandsOverItsMomentum) {
-  WorldSettings settings;
-  settings.gravity.setZero();
-  settings.solver.time_step = 1e-3;
-  FemWorld world(settings);
-  Material material = softMaterial(1e6, 1000);
-  material.stiffness_damping = 1e-3;
-  material.law = MaterialLaw::kStableNeoHookean;
+  FemWorld world(impactSettings());
+  const Material material = impactMaterial();
   FemBody* struck =
       world.addBody("struck", makeBoxTetMesh({0, 0, 0}, {0.1, 0.1, 0.1}, 3, 3, 3).value(), material)
           .value();
@@ -201,13 +211,8 @@ TEST(HyperelasticContact, ANeoHookeanBodyStruckByItselfKeepsItsMomentum) {
     tets.push_back(t);
   }
   const TetMesh mesh(std::move(positions), std::move(tets));
-  WorldSettings settings;
-  settings.gravity.setZero();
-  settings.solver.time_step = 1e-3;
-  FemWorld world(settings);
-  Material material = softMaterial(1e6, 1000);
-  material.stiffness_damping = 1e-3;
-  material.law = MaterialLaw::kStableNeoHookean;
+  FemWorld world(impactSettings());
+  const Material material = impactMaterial();
   FemBody* body = world.addBody("blocks", mesh, material).value();
   ASSERT_TRUE(body->enableSelfContact(SelfContactSettings{}).ok());
   FemBodyCheckpoint start = body->checkpoint();

@@ -7,6 +7,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <memory>
@@ -76,20 +77,52 @@ double lateralStretch(const Material& m, double stretch) {
 }
 
 struct Loaded {
-  std::shared_ptr<const FemModel> model;
-  FemState state;
   double max_position_error = 0;  ///< m, against the homogeneous deformation
   double end_force = 0;           ///< N, or J (simple shear: the elastic energy)
   int newton_max = 0;
   bool converged = true;
 };
 
-std::shared_ptr<const FemModel> boxModel(const Material& m, ElementKind element,
-                                         const Eigen::Vector3d& hi, int nx, int ny, int nz) {
-  auto mesh =
-      std::make_shared<TetMesh>(makeBoxTetMesh(Eigen::Vector3d::Zero(), hi, nx, ny, nz).value());
-  return FemModel::create(mesh, m, element).value();
-}
+// A box [0, hi] of nx x ny x nz cells stepped in statics by its own implicit stepper; step()
+// records each step's Newton verdict in `loaded`.
+struct StaticBox {
+  StaticBox(const Material& m, ElementKind element, const Eigen::Vector3d& hi, int nx, int ny,
+            int nz)
+      : model(FemModel::create(std::make_shared<TetMesh>(
+                                   makeBoxTetMesh(Eigen::Vector3d::Zero(), hi, nx, ny, nz).value()),
+                               m, element)
+                  .value()),
+        stepper(model, statics(), parallel),
+        state(FemState::atRest(*model)) {}
+
+  const std::vector<Eigen::Vector3d>& rest() const { return model->mesh().restPositions(); }
+  // The velocity that takes node i to `target` over the step.
+  Eigen::Vector3d towards(int i, const Eigen::Vector3d& target) const {
+    return (target - state.position(i)) / statics().time_step;
+  }
+  StepReport step(const NodeConstraints& c) {
+    const StepReport report = stepper.step(state, c, Eigen::VectorXd::Zero(3 * model->nodeCount()));
+    EXPECT_EQ(report.health, StepHealth::kOk) << report.message;
+    loaded.converged = loaded.converged && report.newton.converged;
+    loaded.newton_max = std::max(loaded.newton_max, report.newton.iterations);
+    return report;
+  }
+  // The farthest node from where `exact` (of its rest position) puts it, m.
+  template <class Exact>
+  void measureAgainst(Exact exact) {
+    for (int i = 0; i < model->nodeCount(); ++i) {
+      const Eigen::Vector3d target = exact(rest()[static_cast<size_t>(i)]);
+      loaded.max_position_error =
+          std::max(loaded.max_position_error, (state.position(i) - target).norm());
+    }
+  }
+
+  std::shared_ptr<const FemModel> model;
+  Parallel parallel{1};
+  ImplicitStepper stepper;
+  FemState state;
+  Loaded loaded;
+};
 
 // A 1 x 1 x 2 bar (2 x 2 x 4 cells) stretched along z to `stretch` in `increments` statics steps.
 // Rollers: the base's nodes move in x and y only, the top's too while it rises; the node at the
@@ -97,47 +130,53 @@ std::shared_ptr<const FemModel> boxModel(const Material& m, ElementKind element,
 // no constraint the homogeneous stretch does not meet with zero reaction). Reports the force the
 // top nodes carry along z, against P_33 of the law times the rest area 1 m^2.
 Loaded stretchBar(const Material& m, ElementKind element, double stretch, int increments) {
-  Loaded r;
-  r.model = boxModel(m, element, Eigen::Vector3d(1, 1, 2), 2, 2, 4);
-  const FemModel& model = *r.model;
-  const SolverSettings settings = statics();
-  Parallel parallel(1);
-  ImplicitStepper stepper(r.model, settings, parallel);
-  r.state = FemState::atRest(model);
-  const Eigen::VectorXd no_load = Eigen::VectorXd::Zero(3 * model.nodeCount());
-  const std::vector<Eigen::Vector3d>& rest = model.mesh().restPositions();
+  StaticBox bar(m, element, Eigen::Vector3d(1, 1, 2), 2, 2, 4);
+  const std::vector<Eigen::Vector3d>& rest = bar.rest();
+  const int n = bar.model->nodeCount();
   for (int k = 1; k <= increments; ++k) {
     const double length = 2 * (1 + (stretch - 1) * k / increments);
-    NodeConstraints c(model.nodeCount());
-    for (int i = 0; i < model.nodeCount(); ++i) {
+    NodeConstraints c(n);
+    for (int i = 0; i < n; ++i) {
       const Eigen::Vector3d& x = rest[static_cast<size_t>(i)];
       if (x.z() < 1e-9) c.prescribeDirection(i, Eigen::Vector3d::UnitZ(), 0);
       if (x.z() > 2 - 1e-9) {
         c.prescribeDirection(i, Eigen::Vector3d::UnitZ(),
-                             (length - r.state.position(i).z()) / settings.time_step);
+                             bar.towards(i, Eigen::Vector3d(0, 0, length)).z());
       }
     }
-    for (int i = 0; i < model.nodeCount(); ++i) {
+    for (int i = 0; i < n; ++i) {
       const Eigen::Vector3d& x = rest[static_cast<size_t>(i)];
       if (x.norm() < 1e-9) c.prescribeVelocity(i, Eigen::Vector3d::Zero());
       if ((x - Eigen::Vector3d(1, 0, 1)).norm() < 1e-9)
         c.prescribeDirection(i, Eigen::Vector3d::UnitY(), 0);
     }
-    const StepReport report = stepper.step(r.state, c, no_load);
-    EXPECT_EQ(report.health, StepHealth::kOk) << "increment " << k << ": " << report.message;
-    r.converged = r.converged && report.newton.converged;
-    r.newton_max = std::max(r.newton_max, report.newton.iterations);
+    bar.step(c);
   }
   const double s = lateralStretch(m, stretch);
-  const Eigen::Vector3d scale(s, s, stretch);
-  for (int i = 0; i < model.nodeCount(); ++i) {
-    const Eigen::Vector3d exact = scale.cwiseProduct(rest[static_cast<size_t>(i)]);
-    r.max_position_error = std::max(r.max_position_error, (r.state.position(i) - exact).norm());
+  bar.measureAgainst([&](const Eigen::Vector3d& x) {
+    return Eigen::Vector3d(s * x.x(), s * x.y(), stretch * x.z());
+  });
+  const Eigen::VectorXd& f = bar.stepper.internalForces();
+  for (int i = 0; i < n; ++i)
+    if (rest[static_cast<size_t>(i)].z() > 2 - 1e-9) bar.loaded.end_force -= f(3 * i + 2);
+  return bar.loaded;
+}
+
+// Every case of the homogeneous tests: both laws, nu = 0.3 and 0.499, each element of kElements;
+// check(material, element, label).
+template <class Check>
+void forEveryCase(Check check) {
+  for (MaterialLaw law : {MaterialLaw::kStableNeoHookean, MaterialLaw::kMooneyRivlin}) {
+    for (double nu : {0.3, 0.499}) {
+      for (ElementKind element : kElements) {
+        char label[64];
+        std::snprintf(label, sizeof label, "%s nu %.3f %s", toString(law), nu,
+                      element == ElementKind::kTet10 ? "tet10" : "tet4");
+        SCOPED_TRACE(label);
+        check(rubber(law, nu), element, label);
+      }
+    }
   }
-  const Eigen::VectorXd& f = stepper.internalForces();
-  for (int i = 0; i < model.nodeCount(); ++i)
-    if (rest[static_cast<size_t>(i)].z() > 2 - 1e-9) r.end_force -= f(3 * i + 2);
-  return r;
 }
 
 // Stretch 2 at nu = 0.3 and 0.499, both laws, tet4 and tet10: every node where the homogeneous
@@ -149,37 +188,31 @@ Loaded stretchBar(const Material& m, ElementKind element, double stretch, int in
 // +1.85e-5 from the incompressible forms.
 TEST(HyperelasticHomogeneous, UniaxialTensionToStretchTwoCarriesTheLawsNominalStress) {
   const double l = 2.0;
-  for (MaterialLaw law : {MaterialLaw::kStableNeoHookean, MaterialLaw::kMooneyRivlin}) {
-    for (double nu : {0.3, 0.499}) {
-      for (ElementKind element : kElements) {
-        const Material m = rubber(law, nu);
-        const Loaded r = stretchBar(m, element, l, 8);
-        const double s = lateralStretch(m, l);
-        const double nominal = piola(m, Eigen::Vector3d(s, s, l).asDiagonal())(2, 2);
-        const MooneyRivlin mr = MooneyRivlin::fromYoungPoisson(kYoung, nu, 0.3);
-        const double incompressible = law == MaterialLaw::kMooneyRivlin
-                                          ? 2 * (mr.c1 + mr.c2 / l) * (l - 1 / (l * l))
-                                          : m.mu() * (l - 1 / (l * l));
-        std::printf(
-            "%s nu %.3f %s: end force %.6f N, law's P_33 %.6f Pa, incompressible %.6f Pa "
-            "(%+.2e), lateral stretch %.6f, node error %.1e m, Newton max %d\n",
-            toString(law), nu, element == ElementKind::kTet10 ? "tet10" : "tet4", r.end_force,
-            nominal, incompressible, nominal / incompressible - 1, s, r.max_position_error,
-            r.newton_max);
-        EXPECT_TRUE(r.converged);
-        EXPECT_LT(r.max_position_error, 2e-9);
-        EXPECT_NEAR(r.end_force, nominal, 1e-8 * nominal);
-        if (nu > 0.49) {
-          // Neo-Hookean: relative (mu / l')(1 - 1/l) / (l^3 - 1) = 1/7000 (hyperelastic_test.cpp).
-          const double lp = StableNeoHookean::fromYoungPoisson(kYoung, nu).lambda;
-          const double bound = law == MaterialLaw::kMooneyRivlin
-                                   ? 1e-4
-                                   : 1.01 * (m.mu() / lp) * (1 - 1 / l) / (l * l * l - 1);
-          EXPECT_NEAR(nominal / incompressible, 1, bound);
-        }
-      }
+  forEveryCase([l](const Material& m, ElementKind element, const char* label) {
+    const Loaded r = stretchBar(m, element, l, 8);
+    const double s = lateralStretch(m, l);
+    const double nominal = piola(m, Eigen::Vector3d(s, s, l).asDiagonal())(2, 2);
+    const MooneyRivlin mr = MooneyRivlin::fromYoungPoisson(kYoung, m.poisson_ratio, 0.3);
+    const double incompressible = m.law == MaterialLaw::kMooneyRivlin
+                                      ? 2 * (mr.c1 + mr.c2 / l) * (l - 1 / (l * l))
+                                      : m.mu() * (l - 1 / (l * l));
+    std::printf(
+        "%s: end force %.6f N, law's P_33 %.6f Pa, incompressible %.6f Pa (%+.2e), lateral "
+        "stretch %.6f, node error %.1e m, Newton max %d\n",
+        label, r.end_force, nominal, incompressible, nominal / incompressible - 1, s,
+        r.max_position_error, r.newton_max);
+    EXPECT_TRUE(r.converged);
+    EXPECT_LT(r.max_position_error, 2e-9);
+    EXPECT_NEAR(r.end_force, nominal, 1e-8 * nominal);
+    if (m.poisson_ratio > 0.49) {
+      // Neo-Hookean: relative (mu / l')(1 - 1/l) / (l^3 - 1) = 1/7000 (hyperelastic_test.cpp).
+      const double lp = StableNeoHookean::fromYoungPoisson(kYoung, m.poisson_ratio).lambda;
+      const double bound = m.law == MaterialLaw::kMooneyRivlin
+                               ? 1e-4
+                               : 1.01 * (m.mu() / lp) * (1 - 1 / l) / (l * l * l - 1);
+      EXPECT_NEAR(nominal / incompressible, 1, bound);
     }
-  }
+  });
 }
 
 // A unit cube (2 x 2 x 2 cells) sheared to x = X + gamma Y with every boundary node carried there
@@ -189,15 +222,7 @@ TEST(HyperelasticHomogeneous, UniaxialTensionToStretchTwoCarriesTheLawsNominalSt
 // shear stress mu gamma (hyperelastic_test.cpp checks the stress and the normal stress
 // differences at the law level).
 Loaded shearCube(const Material& m, ElementKind element, double gamma, int increments) {
-  Loaded r;
-  r.model = boxModel(m, element, Eigen::Vector3d::Ones(), 2, 2, 2);
-  const FemModel& model = *r.model;
-  const SolverSettings settings = statics();
-  Parallel parallel(1);
-  ImplicitStepper stepper(r.model, settings, parallel);
-  r.state = FemState::atRest(model);
-  const Eigen::VectorXd no_load = Eigen::VectorXd::Zero(3 * model.nodeCount());
-  const std::vector<Eigen::Vector3d>& rest = model.mesh().restPositions();
+  StaticBox cube(m, element, Eigen::Vector3d::Ones(), 2, 2, 2);
   auto onBoundary = [](const Eigen::Vector3d& x) {
     return x.minCoeff() < 1e-9 || x.maxCoeff() > 1 - 1e-9;
   };
@@ -207,44 +232,28 @@ Loaded shearCube(const Material& m, ElementKind element, double gamma, int incre
   // One more step at the final gamma: its start's elastic energy is the sheared cube's.
   for (int k = 1; k <= increments + 1; ++k) {
     const double g = gamma * std::min(k, increments) / increments;
-    NodeConstraints c(model.nodeCount());
-    for (int i = 0; i < model.nodeCount(); ++i) {
-      const Eigen::Vector3d& x = rest[static_cast<size_t>(i)];
-      if (onBoundary(x))
-        c.prescribeVelocity(i, (sheared(x, g) - r.state.position(i)) / settings.time_step);
+    NodeConstraints c(cube.model->nodeCount());
+    for (int i = 0; i < cube.model->nodeCount(); ++i) {
+      const Eigen::Vector3d& x = cube.rest()[static_cast<size_t>(i)];
+      if (onBoundary(x)) c.prescribeVelocity(i, cube.towards(i, sheared(x, g)));
     }
-    const StepReport report = stepper.step(r.state, c, no_load);
-    EXPECT_EQ(report.health, StepHealth::kOk) << "increment " << k << ": " << report.message;
-    r.converged = r.converged && report.newton.converged;
-    r.newton_max = std::max(r.newton_max, report.newton.iterations);
-    r.end_force = report.elastic_energy;
+    cube.loaded.end_force = cube.step(c).elastic_energy;
   }
-  for (int i = 0; i < model.nodeCount(); ++i) {
-    const Eigen::Vector3d exact = sheared(rest[static_cast<size_t>(i)], gamma);
-    r.max_position_error = std::max(r.max_position_error, (r.state.position(i) - exact).norm());
-  }
-  return r;
+  cube.measureAgainst([&](const Eigen::Vector3d& x) { return sheared(x, gamma); });
+  return cube.loaded;
 }
 
 TEST(HyperelasticHomogeneous, SimpleShearToGammaOneStoresMuGammaSquaredOverTwo) {
   const double gamma = 1.0;
-  for (MaterialLaw law : {MaterialLaw::kStableNeoHookean, MaterialLaw::kMooneyRivlin}) {
-    for (double nu : {0.3, 0.499}) {
-      for (ElementKind element : kElements) {
-        const Material m = rubber(law, nu);
-        const Loaded r = shearCube(m, element, gamma, 4);
-        const double exact = m.mu() * gamma * gamma / 2;  // J, on the 1 m^3 cube
-        std::printf(
-            "%s nu %.3f %s: energy %.6f J, mu gamma^2 V / 2 = %.6f J, node error %.1e m, "
-            "Newton max %d\n",
-            toString(law), nu, element == ElementKind::kTet10 ? "tet10" : "tet4", r.end_force,
-            exact, r.max_position_error, r.newton_max);
-        EXPECT_TRUE(r.converged);
-        EXPECT_LT(r.max_position_error, 1e-9);
-        EXPECT_NEAR(r.end_force, exact, 1e-8 * exact);
-      }
-    }
-  }
+  forEveryCase([gamma](const Material& m, ElementKind element, const char* label) {
+    const Loaded r = shearCube(m, element, gamma, 4);
+    const double exact = m.mu() * gamma * gamma / 2;  // J, on the 1 m^3 cube
+    std::printf("%s: energy %.6f J, mu gamma^2 V / 2 = %.6f J, node error %.1e m, Newton max %d\n",
+                label, r.end_force, exact, r.max_position_error, r.newton_max);
+    EXPECT_TRUE(r.converged);
+    EXPECT_LT(r.max_position_error, 1e-9);
+    EXPECT_NEAR(r.end_force, exact, 1e-8 * exact);
+  });
 }
 
 }  // namespace homogeneous

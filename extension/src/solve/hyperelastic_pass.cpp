@@ -123,7 +123,7 @@ namespace {
 // below the barrier's threshold.
 struct Tet4Elements {
   static constexpr size_t kNodes = 4;
-  static constexpr int kGrain = 128;
+  static constexpr int kGrain = kHyperelasticTetGrain;
   using Response = HyperelasticTetResponse;
   static size_t count(const FemModel& model) { return model.tetRestData().size(); }
   static std::vector<TetStiffness>& of(ElementStiffnesses& s) { return s.tet4; }
@@ -149,7 +149,7 @@ struct Tet4Elements {
 
 struct Tet10Elements {
   static constexpr size_t kNodes = 10;
-  static constexpr int kGrain = 32;
+  static constexpr int kGrain = kHyperelasticTet10Grain;
   using Response = HyperelasticTet10Response;
   static size_t count(const FemModel& model) { return model.quadraticRestData().size(); }
   static std::vector<Tet10Stiffness>& of(ElementStiffnesses& s) { return s.tet10; }
