@@ -190,6 +190,7 @@ void Island::gatherRows() {
     if (island_body_[k] < 0) continue;
     fem_.push_back(std::make_unique<sap::FemIslandBody>(*systems_[k].op, *systems_[k].constraints,
                                                         *systems_[k].b));
+    fem_.back()->useCoarseSpace(group_[k]->state().positions);
     bodies_.push_back(fem_.back().get());
   }
   // Each present body's share, its rigid bodies after all the FEM bodies.

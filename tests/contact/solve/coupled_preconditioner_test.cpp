@@ -6,7 +6,11 @@
 //     held still, the eigenvalues of P H lie within [min(alpha, 1), max(beta, 1)], alpha and beta
 //     the extreme eigenvalues of D^-1 A (block-Jacobi on the chain alone): contacts however stiff
 //     do not worsen the conditioning CG sees. Block-Jacobi with only the rows' diagonal blocks
-//     (the preconditioner it replaced) is shown far outside those bounds on the same chain.
+//     (the preconditioner it replaced) is shown far outside those bounds on the same chain;
+//   - on a slender FEM bar folded onto itself, the coarse correction (coarse_correction.h) only
+//     adds: the smallest eigenvalue of P H does not fall, the largest rises by at most 1 (Z E^-1
+//     Z^T H is an H-orthogonal projection), and the condition number falls by an order of
+//     magnitude; the solve finds the same velocities in far fewer CG iterations.
 #include "torsion/contact/solve/coupled_preconditioner.h"
 
 #include <gtest/gtest.h>
@@ -17,6 +21,10 @@
 #include <vector>
 
 #include "sap_test_support.h"
+#include "torsion/contact/solve/fem_island_body.h"
+#include "torsion/fem/fem_model.h"
+#include "torsion/mesh/box_mesh.h"
+#include "torsion/solve/parallel.h"
 
 namespace torsion::sap {
 namespace {
@@ -199,6 +207,85 @@ TEST(CoupledPreconditioner, KeepsTheChainsConditioningWhateverTheContacts) {
   std::printf("chain: D^-1 A in [%.3g, %.3g]; P H condition %.3g, diagonal blocks only %.3g\n",
               alpha, beta, coupled, diagonal_only);
   EXPECT_GT(diagonal_only, 10 * coupled);
+}
+
+// A 2.4 m bar of 48 cubic cells (0.05 m, E 10 MPa), its end x = 0 held, folded on itself: rows
+// press nodes a quarter and three quarters along it together. The same island with and without
+// the bar's coarse space (its default: 32 aggregates).
+TEST(CoupledPreconditioner, CoarseSpaceConditionsASlenderBarAsAShortOne) {
+  constexpr int kCells = 48;
+  constexpr double kStep = 1e-2;
+  auto mesh = std::make_shared<const TetMesh>(
+      makeBoxTetMesh(Eigen::Vector3d::Zero(), Eigen::Vector3d(0.05 * kCells, 0.05, 0.05), kCells, 1,
+                     1)
+          .value());
+  Material material;
+  material.youngs_modulus = 1e7;
+  material.density = 1000;
+  const std::shared_ptr<const FemModel> model = FemModel::create(mesh, material).value();
+  const int n = model->nodeCount();
+  Parallel parallel(1);
+  SystemOperator system(model, parallel);
+  system.setCoefficients(1.0, kStep * kStep);
+  NodeConstraints constraints(n);
+  Eigen::VectorXd x(3 * n), b(3 * n);
+  std::vector<int> free;
+  for (int i = 0; i < n; ++i) {
+    const Eigen::Vector3d& p = mesh->restPositions()[static_cast<size_t>(i)];
+    x.segment<3>(3 * i) = p;
+    b.segment<3>(3 * i) =
+        kStep * model->nodeMasses()[static_cast<size_t>(i)] * Eigen::Vector3d(0, 0, -9.81);
+    if (p.x() < 1e-9) {
+      constraints.prescribeVelocity(i, Eigen::Vector3d::Zero());
+    } else {
+      for (int d = 0; d < 3; ++d)
+        free.push_back(3 * i + d);
+    }
+  }
+  // The node nearest a point of the bar.
+  const auto nodeAt = [&](const Eigen::Vector3d& point) {
+    int best = 0;
+    for (int i = 1; i < n; ++i)
+      if ((x.segment<3>(3 * i) - point).norm() < (x.segment<3>(3 * best) - point).norm()) best = i;
+    return best;
+  };
+  std::vector<ContactRow> rows;
+  for (double y : {0.0, 0.05})
+    rows.push_back(
+        pairRow(nodeAt({0.6, y, 0.05}), nodeAt({1.8, y, 0.05}), Eigen::Vector3d::UnitZ()));
+  FemIslandBody plain(system, constraints, b), coarse(system, constraints, b);
+  coarse.useCoarseSpace(x);
+  ASSERT_NE(coarse.coarseSpace(), nullptr);
+  const SapProblem plain_problem = SapProblem::create({&plain}, rows, kStep).value();
+  const SapProblem coarse_problem = SapProblem::create({&coarse}, rows, kStep).value();
+  const Eigen::VectorXd v0 = Eigen::VectorXd::Zero(3 * n);
+  const Operators plain_ops = operatorsAt(plain_problem, v0);
+  const Operators coarse_ops = operatorsAt(coarse_problem, v0);
+  const Eigen::VectorXd plain_lambda =
+      pencilEigenvalues(plain_ops.h, inverseOn(plain_ops.p, free), free);
+  const Eigen::VectorXd coarse_lambda =
+      pencilEigenvalues(coarse_ops.h, inverseOn(coarse_ops.p, free), free);
+  EXPECT_GE(coarse_lambda.minCoeff(), plain_lambda.minCoeff() * (1 - 1e-9));
+  EXPECT_LE(coarse_lambda.maxCoeff(), plain_lambda.maxCoeff() + 1 + 1e-9);
+  const double plain_condition = plain_lambda.maxCoeff() / plain_lambda.minCoeff();
+  const double coarse_condition = coarse_lambda.maxCoeff() / coarse_lambda.minCoeff();
+  // The solves: the same minimiser, to the solver's tolerance.
+  SapSolver solver;
+  Eigen::VectorXd plain_v, coarse_v;
+  const SapReport plain_report = solver.solve(plain_problem, plain_v);
+  const SapReport coarse_report = solver.solve(coarse_problem, coarse_v);
+  ASSERT_TRUE(plain_report.converged);
+  ASSERT_TRUE(coarse_report.converged);
+  test::expectCoulombAndComplementarity(coarse_problem, coarse_report);
+  const double difference = (coarse_v - plain_v).norm() / plain_v.norm();
+  std::printf(
+      "slender bar: P H condition %.4g plain, %.4g with the coarse space; CG %d / %d over "
+      "%d / %d Newton iterations; velocities differ by %.2g (relative)\n",
+      plain_condition, coarse_condition, plain_report.cg_iterations, coarse_report.cg_iterations,
+      plain_report.newton_iterations, coarse_report.newton_iterations, difference);
+  EXPECT_LT(10 * coarse_condition, plain_condition);
+  EXPECT_LT(2 * coarse_report.cg_iterations, plain_report.cg_iterations);
+  EXPECT_LT(difference, 1e-4);
 }
 
 }  // namespace

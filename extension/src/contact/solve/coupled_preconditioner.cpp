@@ -69,7 +69,11 @@ void CoupledPreconditioner::assemble(const SapProblem& problem, const SapEvaluat
 }
 
 void CoupledPreconditioner::prepare(const SapProblem& problem, const SapEvaluation& e) {
-  if (packed_for_ != &problem) packFreeInverses(problem);
+  if (packed_for_ != &problem) {
+    packFreeInverses(problem);
+    coarse_.gather(problem);
+  }
+  coarse_.prepare(problem, e);
   gatherCoupledBlocks(problem, e);
   if (coupled_.empty()) {
     factorised_ = false;
@@ -123,14 +127,16 @@ void CoupledPreconditioner::apply(const SapProblem& problem, const Eigen::Vector
     }
     inverse += n * n;
   }
-  if (!factorised_) return;
-  local_z_ = factor_.solve(local_r_);
-  for (int j : coupled_) {
-    const DiagonalBlock& s = problem.blockProjector(j);
-    const auto n = s.rows();
-    z.segment(problem.blockOffset(j), n) =
-        s * local_z_.segment(local_of_block_[static_cast<std::size_t>(j)], n);
+  if (factorised_) {
+    local_z_ = factor_.solve(local_r_);
+    for (int j : coupled_) {
+      const DiagonalBlock& s = problem.blockProjector(j);
+      const auto n = s.rows();
+      z.segment(problem.blockOffset(j), n) =
+          s * local_z_.segment(local_of_block_[static_cast<std::size_t>(j)], n);
+    }
   }
+  coarse_.applyAdd(problem, r, z);
 }
 
 }  // namespace torsion::sap

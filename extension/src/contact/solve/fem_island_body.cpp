@@ -45,3 +45,15 @@ void FemIslandBody::applyPreconditioner(const Eigen::VectorXd& r, Eigen::VectorX
 }
 
 }  // namespace torsion::sap
+
+namespace torsion::sap {
+
+void FemIslandBody::useCoarseSpace(const Eigen::VectorXd& positions, int aggregates) {
+  const FemModel& model = system_.model();
+  const std::vector<Eigen::Vector3d>& rest = model.mesh().restPositions();
+  const int count = aggregates > 0 ? aggregates : aggregateCountFor(rest);
+  coarse_ = std::make_unique<NodeCoarseSpace>(system_, constraints_, positions,
+                                              bisectIntoAggregates(rest, count), count);
+}
+
+}  // namespace torsion::sap

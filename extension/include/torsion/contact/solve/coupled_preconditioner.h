@@ -18,6 +18,10 @@
 // A rigid body's 6x6 block links all its rows: it ends up last in the ordering, a dense border
 // of 6 columns.
 //
+// To that the island's coarse correction is added (coarse_correction.h): the exact solve on the
+// rigid modes of the FEM bodies' aggregates, which block-Jacobi reaches only one neighbourhood
+// per iteration (a slender rod's bending and twisting).
+//
 // Deterministic: rows, terms and blocks are visited in order; nothing is threaded.
 
 #include <Eigen/Core>
@@ -25,6 +29,7 @@
 #include <Eigen/SparseCore>
 #include <vector>
 
+#include "torsion/contact/solve/coarse_correction.h"
 #include "torsion/contact/solve/sap_problem.h"
 
 namespace torsion::sap {
@@ -39,6 +44,8 @@ class CoupledPreconditioner {
   void apply(const SapProblem& problem, const Eigen::VectorXd& r, Eigen::VectorXd& z) const;
   /// The dofs of the coupled part at the last prepare (0: block-Jacobi alone).
   int coupledDofs() const { return static_cast<int>(local_r_.size()); }
+  /// The coarse correction's dofs at the last prepare (0: none).
+  int coarseDofs() const { return coarse_.dofs(); }
 
  private:
   // The blocks active rows act on, in block order, and their local dofs; the active rows.
@@ -56,6 +63,7 @@ class CoupledPreconditioner {
   Eigen::SparseMatrix<double> matrix_;
   Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> factor_;
   bool factorised_ = false;  // the factor holds this evaluation's matrix
+  CoarseCorrection coarse_;
   mutable Eigen::VectorXd local_r_, local_z_;
 };
 

@@ -12,10 +12,15 @@
 // Not owned: it must hold this step's factor for as long as the body is solved with. (The body's
 // incomplete Cholesky factor was measured in that place and lost to block-Jacobi everywhere:
 // docs/contact-solve.md, "Cost".)
+//
+// useCoarseSpace() gives it the rigid modes of its aggregates (coarse_space.h) for the island's
+// block-Jacobi CG.
 
 #include <Eigen/Core>
+#include <memory>
 #include <vector>
 
+#include "torsion/contact/solve/coarse_space.h"
 #include "torsion/contact/solve/island_body.h"
 #include "torsion/solve/cholmod_solver.h"
 #include "torsion/solve/node_constraints.h"
@@ -43,12 +48,18 @@ class FemIslandBody final : public IslandBody {
   bool hasPreconditioner() const override { return factor_ != nullptr; }
   void applyPreconditioner(const Eigen::VectorXd& r, Eigen::VectorXd& z) const override;
 
+  /// Builds the body's coarse space at `positions` (3n, the step's current node positions) with
+  /// `aggregates` aggregates of the mesh's rest shape (0: aggregateCountFor its rest shape).
+  void useCoarseSpace(const Eigen::VectorXd& positions, int aggregates = 0);
+  const NodeCoarseSpace* coarseSpace() const override { return coarse_.get(); }
+
  private:
   const SystemOperator& system_;
   const NodeConstraints& constraints_;
   Eigen::VectorXd momentum_;
   std::vector<Eigen::Matrix3d> blocks_;
   const CholmodSolver* factor_ = nullptr;
+  std::unique_ptr<NodeCoarseSpace> coarse_;
 };
 
 }  // namespace torsion::sap

@@ -21,6 +21,8 @@
 
 namespace torsion::sap {
 
+class NodeCoarseSpace;
+
 /// A square diagonal block of A, at most 6 x 6, stored inline.
 using DiagonalBlock = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::ColMajor, 6, 6>;
 
@@ -50,6 +52,9 @@ class IslandBody {
   /// z = S P S r, P symmetric positive definite on the free dofs, approximating A^-1 there (the
   /// step's Cholesky factor: exactly A^-1). Called only when hasPreconditioner(). Default: z = S r.
   virtual void applyPreconditioner(const Eigen::VectorXd& r, Eigen::VectorXd& z) const;
+  /// The body's coarse space in the island's block-Jacobi CG (coarse_space.h), or nullptr
+  /// (default): none.
+  virtual const NodeCoarseSpace* coarseSpace() const { return nullptr; }
 };
 
 /// A body given by an assembled sparse SPD matrix (tests; spring networks), 3x3 blocks, with

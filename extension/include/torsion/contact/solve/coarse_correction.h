@@ -1,0 +1,55 @@
+#pragma once
+// The island's coarse correction (coarse_space.h): the exact solve of the island's Newton system
+// on the span of its FEM bodies' coarse spaces, added to block-Jacobi with the contacts
+// (coupled_preconditioner.h):
+//
+//     z += Z E^-1 Z^T r,   E = Z^T H Z = blockdiag(Z_b^T A_b Z_b) + sum_i (J_i Z)^T G_i (J_i Z),
+//
+// Z = blockdiag(Z_b) over the bodies that have a coarse space (zero on the others' dofs: a rigid
+// body's modes are block-Jacobi's own 6x6 block). The bodies' parts come once per step with their
+// coarse spaces; the rows' part when the rows in contact change (prepare), with E's dense
+// Cholesky factorisation (at most kMaxAggregates x 6 dofs a body).
+//
+// Deterministic: bodies, rows and terms are visited in order; nothing is threaded.
+
+#include <Eigen/Cholesky>
+#include <Eigen/Core>
+#include <vector>
+
+#include "torsion/contact/solve/coarse_space.h"
+#include "torsion/contact/solve/sap_problem.h"
+
+namespace torsion::sap {
+
+class CoarseCorrection {
+ public:
+  /// The problem's bodies with a coarse space (a new problem).
+  void gather(const SapProblem& problem);
+  /// E at the evaluation's G blocks, factorised, unless the rows in contact are those of the E in
+  /// use. Without coarse dofs, or should E not factorise (a non-finite G), the correction is off
+  /// until the next prepare.
+  void prepare(const SapProblem& problem, const SapEvaluation& e);
+  /// z += Z E^-1 Z^T r (r, z: island dofs).
+  void applyAdd(const SapProblem& problem, const Eigen::VectorXd& r, Eigen::VectorXd& z) const;
+  /// The coarse dofs in use (0: off).
+  int dofs() const { return active_ ? static_cast<int>(coarse_r_.size()) : 0; }
+
+ private:
+  // Row i's J_i Z, one 3 x k piece per term on a body with a coarse space.
+  struct Piece {
+    int column = 0;
+    Eigen::Matrix<double, 3, 6> block;
+    int columns = 0;
+  };
+  void rowPieces(const SapProblem& problem, int row);
+
+  std::vector<int> body_first_;  // per island body: its first coarse dof, or -1
+  std::vector<Piece> pieces_;
+  Eigen::MatrixXd matrix_;
+  Eigen::LLT<Eigen::MatrixXd> factor_;
+  bool active_ = false;
+  std::vector<int> active_rows_, factorised_rows_;  // the rows in contact now, and in E
+  mutable Eigen::VectorXd coarse_r_, coarse_z_;
+};
+
+}  // namespace torsion::sap
