@@ -97,6 +97,12 @@ class ClampedBeam {
 
   /// One step; returns its report.
   StepReport step() { return stepper_.step(state_, constraints_, gravity_); }
+  /// One step without the load (the beam released).
+  StepReport stepUnloaded() {
+    return stepper_.step(state_, constraints_, Eigen::VectorXd::Zero(gravity_.size()));
+  }
+  FemState& state() { return state_; }
+  ImplicitStepper& stepper() { return stepper_; }
 
   /// Quasi-static loading until the tip's vertical deflection changes by < 1e-9 relative (at most
   /// 30 steps); returns the last step's report.
@@ -123,6 +129,7 @@ class ClampedBeam {
   }
 
   const FemModel& model() const { return *model_; }
+  const std::shared_ptr<const FemModel>& sharedModel() const { return model_; }
   const BeamSpec& spec() const { return spec_; }
 
  private:

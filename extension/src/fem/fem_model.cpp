@@ -93,6 +93,9 @@ Result<std::shared_ptr<const FemModel>> FemModel::withMaterial(const Material& m
 void FemModel::computeMasses() {
   node_mass_.assign(static_cast<size_t>(mesh_->nodeCount()), 0.0);
   total_mass_ = 0;
+  total_volume_ = 0;
+  for (const TetRestData& tet : rest_)
+    total_volume_ += tet.volume;
   const double density = material_.density;
   if (element_kind_ == ElementKind::kTet4) {
     for (size_t t = 0; t < rest_.size(); ++t) {

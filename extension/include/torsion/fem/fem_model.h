@@ -68,6 +68,8 @@ class FemModel {
   /// Lumped node masses, kg: rho V / 4 per corner for tet4; HRZ for tet10 (quadratic_element.h).
   const std::vector<double>& nodeMasses() const { return node_mass_; }
   double totalMass() const { return total_mass_; }
+  /// The rest volume, m^3.
+  double totalVolume() const { return total_volume_; }
 
  private:
   FemModel() = default;
@@ -83,6 +85,7 @@ class FemModel {
   std::vector<double> node_volume_;
   std::vector<double> node_mass_;
   double total_mass_ = 0;
+  double total_volume_ = 0;
 };
 
 }  // namespace torsion
