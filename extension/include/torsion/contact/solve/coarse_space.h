@@ -22,7 +22,8 @@
 // rigid modes of aggregates): SPD, so CG stays CG.
 //
 // This body's part of E, Z^T A Z, is made here once per step from the operator's assembled blocks;
-// the contacts' part, (J Z)^T G (J Z), by the island at each Newton iteration.
+// the contacts' part, (J Z)^T G (J Z), by the island when its rows in contact change
+// (coarse_correction.h).
 
 #include <Eigen/Core>
 #include <vector>
