@@ -58,17 +58,27 @@ TEST(CoarseSpace, AggregatesAreBalancedSlicesOfALongBar) {
     for (size_t k = 0; k + 1 < order.size(); ++k)
       EXPECT_LE(hi[order[k]], lo[order[k + 1]]) << count << " aggregates";
   }
-  // The count: one slice per thickness of a slender bar (40 cells long, 1 thick), one
-  // aggregate per kNodesPerAggregate nodes of a cube, at most kMaxAggregates.
+  // The count: one slice per thickness of a slender bar (40 cells long, 1 thick; 12 long), one
+  // aggregate per kNodesPerAggregate nodes of a long box with many nodes, at most kMaxAggregates;
+  // none for a body less slender than kMinSlenderness (a bar of 6, a cube, a plate).
   EXPECT_EQ(aggregateCountFor(points), 32);
   EXPECT_EQ(aggregateCountFor(barModel(12)->mesh().restPositions()), 12);
-  std::vector<Eigen::Vector3d> cube;
+  EXPECT_EQ(aggregateCountFor(barModel(6)->mesh().restPositions()), 0);
+  std::vector<Eigen::Vector3d> rod, cube, plate;
+  for (int i = 0; i < 40; ++i)
+    for (int j = 0; j < 5; ++j)
+      for (int k = 0; k < 5; ++k)
+        rod.emplace_back(i, j, k);  // 39 x 4 x 4: slenderness 9.75, 1000 nodes
   for (int i = 0; i < 10; ++i)
     for (int j = 0; j < 10; ++j)
-      for (int k = 0; k < 10; ++k)
+      for (int k = 0; k < 10; ++k) {
         cube.emplace_back(i, j, k);
-  EXPECT_EQ(aggregateCountFor(cube), (1000 + kNodesPerAggregate - 1) / kNodesPerAggregate);
-  EXPECT_EQ(aggregateCountFor({Eigen::Vector3d::Zero()}), 1);
+        plate.emplace_back(i, j, 0.01 * k);
+      }
+  EXPECT_EQ(aggregateCountFor(rod), (1000 + kNodesPerAggregate - 1) / kNodesPerAggregate);
+  EXPECT_EQ(aggregateCountFor(cube), 0);
+  EXPECT_EQ(aggregateCountFor(plate), 0);
+  EXPECT_EQ(aggregateCountFor({Eigen::Vector3d::Zero()}), 0);
 }
 
 // Z as a dense matrix: prolongAdd of each unit coarse vector.

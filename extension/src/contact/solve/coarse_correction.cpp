@@ -38,16 +38,10 @@ void CoarseCorrection::rowPieces(const SapProblem& problem, int row) {
 void CoarseCorrection::prepare(const SapProblem& problem, const SapEvaluation& e) {
   const auto dofs = coarse_r_.size();
   if (dofs == 0) return;
-  // E is made again when the rows in contact change, not at every Newton iteration: between,
-  // only their G moves (a sliding row's), and an E a few iterations old is still SPD, still the
-  // exact solve on the coarse span of a nearby Hessian. Measured on the plectoneme's coils: 11 %
-  // more CG iterations, a third of the factorisations.
   active_rows_.clear();
   for (int i = 0; i < problem.rowCount(); ++i)
     if (e.rows[static_cast<std::size_t>(i)].state != ContactState::kSeparated)
       active_rows_.push_back(i);
-  if (active_ && active_rows_ == factorised_rows_) return;
-  factorised_rows_ = active_rows_;
   active_ = false;
   matrix_.setZero(dofs, dofs);
   for (int b = 0; b < problem.bodyCount(); ++b) {

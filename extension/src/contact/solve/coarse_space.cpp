@@ -48,18 +48,21 @@ void bisect(const std::vector<Eigen::Vector3d>& points, std::vector<int>::iterat
 }  // namespace
 
 int aggregateCountFor(const std::vector<Eigen::Vector3d>& rest_points) {
-  if (rest_points.empty()) return 1;
+  if (rest_points.empty()) return 0;
   Eigen::Vector3d lo = rest_points.front(), hi = lo;
   for (const Eigen::Vector3d& p : rest_points) {
     lo = lo.cwiseMin(p);
     hi = hi.cwiseMax(p);
   }
-  const Eigen::Vector3d side = hi - lo;
-  const auto nodes = static_cast<double>(rest_points.size());
-  double count = nodes / kNodesPerAggregate;
-  if (side.minCoeff() > 0) count = std::max(count, side.maxCoeff() / side.minCoeff());
+  Eigen::Vector3d side = hi - lo;
+  std::sort(side.data(), side.data() + 3);
+  if (!(side[1] > 0)) return 0;                  // a line of nodes: not a solid
+  const double slenderness = side[2] / side[1];  // the longest side over the second longest
+  if (slenderness < kMinSlenderness) return 0;
+  const double count =
+      std::max(static_cast<double>(rest_points.size()) / kNodesPerAggregate, slenderness);
   // Rounded up, but a ratio of 12 that rounding made 12.000000001 stays 12.
-  return static_cast<int>(std::clamp(std::ceil(count - 1e-9), 1.0, double{kMaxAggregates}));
+  return static_cast<int>(std::min(std::ceil(count - 1e-9), double{kMaxAggregates}));
 }
 
 std::vector<int> bisectIntoAggregates(const std::vector<Eigen::Vector3d>& points, int count) {

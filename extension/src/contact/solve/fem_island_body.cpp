@@ -52,6 +52,10 @@ void FemIslandBody::useCoarseSpace(const Eigen::VectorXd& positions, int aggrega
   const FemModel& model = system_.model();
   const std::vector<Eigen::Vector3d>& rest = model.mesh().restPositions();
   const int count = aggregates > 0 ? aggregates : aggregateCountFor(rest);
+  if (count == 0) {
+    coarse_.reset();  // a chunky body: block-Jacobi alone
+    return;
+  }
   coarse_ = std::make_unique<NodeCoarseSpace>(system_, constraints_, positions,
                                               bisectIntoAggregates(rest, count), count);
 }

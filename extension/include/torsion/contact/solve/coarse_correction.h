@@ -7,8 +7,11 @@
 //
 // Z = blockdiag(Z_b) over the bodies that have a coarse space (zero on the others' dofs: a rigid
 // body's modes are block-Jacobi's own 6x6 block). The bodies' parts come once per step with their
-// coarse spaces; the rows' part when the rows in contact change (prepare), with E's dense
-// Cholesky factorisation (at most kMaxAggregates x 6 dofs a body).
+// coarse spaces; the rows' part at each Newton iteration (G changes), with E's dense Cholesky
+// factorisation (at most kMaxAggregates x 6 dofs a body). E must be the Galerkin matrix of the
+// current Hessian: then Z E^-1 Z^T H is an H-orthogonal projection and adds at most 1 to the
+// largest eigenvalue of P H. One kept from an earlier iteration was measured to raise the CG
+// iterations where a row changes between stick and slide (G by orders of magnitude).
 //
 // Deterministic: bodies, rows and terms are visited in order; nothing is threaded.
 
@@ -25,9 +28,8 @@ class CoarseCorrection {
  public:
   /// The problem's bodies with a coarse space (a new problem).
   void gather(const SapProblem& problem);
-  /// E at the evaluation's G blocks, factorised, unless the rows in contact are those of the E in
-  /// use. Without coarse dofs, or should E not factorise (a non-finite G), the correction is off
-  /// until the next prepare.
+  /// E at the evaluation's G blocks, factorised. Without coarse dofs, or should E not factorise
+  /// (a non-finite G), the correction is off until the next prepare.
   void prepare(const SapProblem& problem, const SapEvaluation& e);
   /// z += Z E^-1 Z^T r (r, z: island dofs).
   void applyAdd(const SapProblem& problem, const Eigen::VectorXd& r, Eigen::VectorXd& z) const;
@@ -48,7 +50,7 @@ class CoarseCorrection {
   Eigen::MatrixXd matrix_;
   Eigen::LLT<Eigen::MatrixXd> factor_;
   bool active_ = false;
-  std::vector<int> active_rows_, factorised_rows_;  // the rows in contact now, and in E
+  std::vector<int> active_rows_;  // the rows in contact at the last prepare
   mutable Eigen::VectorXd coarse_r_, coarse_z_;
 };
 

@@ -22,7 +22,7 @@
 // rigid modes of aggregates): SPD, so CG stays CG.
 //
 // This body's part of E, Z^T A Z, is made here once per step from the operator's assembled blocks;
-// the contacts' part, (J Z)^T G (J Z), by the island when its rows in contact change
+// the contacts' part, (J Z)^T G (J Z), by the island at each Newton iteration
 // (coarse_correction.h).
 
 #include <Eigen/Core>
@@ -33,14 +33,22 @@
 
 namespace torsion::sap {
 
+/// Only a body at least this slender, a rod (the longest side of its rest bounding box over the
+/// second longest), gets a coarse space. Block-Jacobi's CG iterations grow with a rod's length in
+/// elements, and its slow modes, bending and twisting, are the aggregates' rigid motions: measured,
+/// rods of slenderness 15 to 21 (the Greenhill rod, the plectoneme) halve their CG iterations.
+/// Elsewhere they are not the slow modes: the 8332-tet cylinder (slenderness 5) resting on the
+/// ground took 50 CG iterations a step with a coarse space instead of 34, and slabs held at their
+/// base under a resting sphere 1.3 to 1.6 times the time.
+inline constexpr double kMinSlenderness = 8;
 /// One aggregate per this many nodes at least ...
 inline constexpr int kNodesPerAggregate = 64;
-/// ... and at most this many aggregates: E is dense, factorised whenever the contacts change.
+/// ... and at most this many aggregates: E is dense, factorised at every Newton iteration.
 inline constexpr int kMaxAggregates = 32;
 
-/// The aggregate count for a body's rest shape: the larger of nodes / kNodesPerAggregate and the
-/// ratio of the longest to the shortest side of its bounding box (a slender rod's aggregate is
-/// then a slice about as long as the rod is thick), rounded up, from 1 to kMaxAggregates.
+/// The aggregate count for a body's rest shape: 0 (no coarse space) below kMinSlenderness, else
+/// the larger of nodes / kNodesPerAggregate and the slenderness (an aggregate is then a slice
+/// about as long as the rod is thick), rounded up, at most kMaxAggregates.
 int aggregateCountFor(const std::vector<Eigen::Vector3d>& rest_points);
 
 /// Node i's aggregate (0 .. count - 1) for `count` aggregates of nearly equal size: the points are

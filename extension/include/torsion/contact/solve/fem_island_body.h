@@ -49,7 +49,8 @@ class FemIslandBody final : public IslandBody {
   void applyPreconditioner(const Eigen::VectorXd& r, Eigen::VectorXd& z) const override;
 
   /// Builds the body's coarse space at `positions` (3n, the step's current node positions) with
-  /// `aggregates` aggregates of the mesh's rest shape (0: aggregateCountFor its rest shape).
+  /// `aggregates` aggregates of the mesh's rest shape (0: aggregateCountFor its rest shape, which
+  /// gives a body less slender than kMinSlenderness none).
   void useCoarseSpace(const Eigen::VectorXd& positions, int aggregates = 0);
   const NodeCoarseSpace* coarseSpace() const override { return coarse_.get(); }
 
