@@ -12,27 +12,14 @@
 #include <memory>
 #include <vector>
 
-#include "torsion/fem/fem_model.h"
-#include "torsion/mesh/box_mesh.h"
+#include "sap_test_support.h"
 #include "torsion/solve/parallel.h"
 
 namespace torsion::sap {
 namespace {
 
-std::shared_ptr<const FemModel> barModel(int cells) {
-  auto mesh = std::make_shared<const TetMesh>(
-      makeBoxTetMesh(Eigen::Vector3d::Zero(), Eigen::Vector3d(0.05 * cells, 0.05, 0.05), cells, 1,
-                     1)
-          .value());
-  Material material;
-  material.youngs_modulus = 1e7;
-  material.density = 1000;
-  material.stiffness_damping = 0.01;
-  return FemModel::create(mesh, material).value();
-}
-
 TEST(CoarseSpace, AggregatesAreBalancedSlicesOfALongBar) {
-  const std::shared_ptr<const FemModel> model = barModel(40);
+  const std::shared_ptr<const FemModel> model = test::slenderBarModel(40);
   const std::vector<Eigen::Vector3d>& points = model->mesh().restPositions();
   for (int count : {1, 3, 8, 13}) {
     const std::vector<int> aggregate = bisectIntoAggregates(points, count);
@@ -62,8 +49,8 @@ TEST(CoarseSpace, AggregatesAreBalancedSlicesOfALongBar) {
   // aggregate per kNodesPerAggregate nodes of a long box with many nodes, at most kMaxAggregates;
   // none for a body less slender than kMinSlenderness (a bar of 6, a cube, a plate).
   EXPECT_EQ(aggregateCountFor(points), 32);
-  EXPECT_EQ(aggregateCountFor(barModel(12)->mesh().restPositions()), 12);
-  EXPECT_EQ(aggregateCountFor(barModel(6)->mesh().restPositions()), 0);
+  EXPECT_EQ(aggregateCountFor(test::slenderBarModel(12)->mesh().restPositions()), 12);
+  EXPECT_EQ(aggregateCountFor(test::slenderBarModel(6)->mesh().restPositions()), 0);
   std::vector<Eigen::Vector3d> rod, cube, plate;
   for (int i = 0; i < 40; ++i)
     for (int j = 0; j < 5; ++j)
@@ -93,7 +80,7 @@ Eigen::MatrixXd denseBasis(const NodeCoarseSpace& space, int nodes) {
 }
 
 TEST(CoarseSpace, IsTheFilteredRigidModesOfEachAggregateWithTheirGalerkinSystem) {
-  const std::shared_ptr<const FemModel> model = barModel(24);
+  const std::shared_ptr<const FemModel> model = test::slenderBarModel(24);
   const int n = model->nodeCount();
   constexpr int kAggregates = 6;
   Parallel parallel(1);

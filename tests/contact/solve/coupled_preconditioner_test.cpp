@@ -22,8 +22,6 @@
 
 #include "sap_test_support.h"
 #include "torsion/contact/solve/fem_island_body.h"
-#include "torsion/fem/fem_model.h"
-#include "torsion/mesh/box_mesh.h"
 #include "torsion/solve/parallel.h"
 
 namespace torsion::sap {
@@ -215,14 +213,8 @@ TEST(CoupledPreconditioner, KeepsTheChainsConditioningWhateverTheContacts) {
 TEST(CoupledPreconditioner, CoarseSpaceConditionsASlenderBarAsAShortOne) {
   constexpr int kCells = 48;
   constexpr double kStep = 1e-2;
-  auto mesh = std::make_shared<const TetMesh>(
-      makeBoxTetMesh(Eigen::Vector3d::Zero(), Eigen::Vector3d(0.05 * kCells, 0.05, 0.05), kCells, 1,
-                     1)
-          .value());
-  Material material;
-  material.youngs_modulus = 1e7;
-  material.density = 1000;
-  const std::shared_ptr<const FemModel> model = FemModel::create(mesh, material).value();
+  const std::shared_ptr<const FemModel> model = test::slenderBarModel(kCells);
+  const TetMesh& mesh = model->mesh();
   const int n = model->nodeCount();
   Parallel parallel(1);
   SystemOperator system(model, parallel);
@@ -231,7 +223,7 @@ TEST(CoupledPreconditioner, CoarseSpaceConditionsASlenderBarAsAShortOne) {
   Eigen::VectorXd x(3 * n), b(3 * n);
   std::vector<int> free;
   for (int i = 0; i < n; ++i) {
-    const Eigen::Vector3d& p = mesh->restPositions()[static_cast<size_t>(i)];
+    const Eigen::Vector3d& p = mesh.restPositions()[static_cast<size_t>(i)];
     x.segment<3>(3 * i) = p;
     b.segment<3>(3 * i) =
         kStep * model->nodeMasses()[static_cast<size_t>(i)] * Eigen::Vector3d(0, 0, -9.81);

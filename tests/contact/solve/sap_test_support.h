@@ -8,12 +8,28 @@
 #include <Eigen/SparseCore>
 #include <algorithm>
 #include <cmath>
+#include <memory>
 #include <vector>
 
 #include "torsion/contact/solve/sap_problem.h"
 #include "torsion/contact/solve/sap_solver.h"
+#include "torsion/fem/fem_model.h"
+#include "torsion/mesh/box_mesh.h"
 
 namespace torsion::sap::test {
+
+/// A slender bar along x of `cells` cubic cells of 0.05 m, one across (E 10 MPa, 1000 kg/m^3):
+/// the coarse space's tests (a rod for aggregateCountFor from 8 cells on).
+inline std::shared_ptr<const FemModel> slenderBarModel(int cells) {
+  auto mesh = std::make_shared<const TetMesh>(
+      makeBoxTetMesh(Eigen::Vector3d::Zero(), Eigen::Vector3d(0.05 * cells, 0.05, 0.05), cells, 1,
+                     1)
+          .value());
+  Material material;
+  material.youngs_modulus = 1e7;
+  material.density = 1000;
+  return FemModel::create(mesh, material).value();
+}
 
 constexpr double kGravity = 9.81;
 

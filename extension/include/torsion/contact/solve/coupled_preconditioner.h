@@ -19,7 +19,7 @@
 // of 6 columns.
 //
 // To that the island's coarse correction is added (coarse_correction.h): the exact solve on the
-// rigid modes of the FEM bodies' aggregates, which block-Jacobi reaches only one neighbourhood
+// rigid modes of the aggregates of each rod, which block-Jacobi reaches only one neighbourhood
 // per iteration (a slender rod's bending and twisting).
 //
 // Deterministic: rows, terms and blocks are visited in order; nothing is threaded.
