@@ -66,11 +66,9 @@ set(TORSION_TEST_OPTIMIZATION "-O1" CACHE STRING
     "Optimisation flag for the test and benchmark-free test executables (empty: the build type's)")
 # With TORSION_UNITY_BUILD the GoogleTest executables compile in unity batches too, this many
 # sources a batch: small enough that the larger executables still give ninja several batches to
-# run side by side and that an edited test recompiles only its batch. A source whose helpers clash
-# with another's (the same name in an anonymous namespace, a macro) is left out of the batches
-# where its target is defined (SKIP_UNITY_BUILD_INCLUSION). tests/contact/ is left out whole
-# while the contact code is rewritten: its files change daily, and a clash seen only in the unity
-# build (CI's, not a developer's default build) would break CI for a new helper's name.
+# run side by side and that an edited test recompiles only its batch. Sources of one batch share a
+# translation unit, so their anonymous namespaces are one: a test source whose helpers would clash
+# with another's (kDt, parse, sceneWith, ...) keeps them in a namespace named after its file.
 set(TORSION_TEST_UNITY_BATCH_SIZE 4 CACHE STRING
     "Sources per unity batch of a test executable (TORSION_UNITY_BUILD)")
 function(torsion_tune_test_targets dir)
@@ -87,8 +85,7 @@ function(torsion_tune_test_targets dir)
       if(TORSION_TEST_OPTIMIZATION)
         target_compile_options(${target} PRIVATE ${TORSION_TEST_OPTIMIZATION})
       endif()
-      get_target_property(source_dir ${target} SOURCE_DIR)
-      if(TORSION_UNITY_BUILD AND NOT source_dir MATCHES "/tests/contact$")
+      if(TORSION_UNITY_BUILD)
         set_target_properties(${target} PROPERTIES UNITY_BUILD ON
                               UNITY_BUILD_BATCH_SIZE ${TORSION_TEST_UNITY_BATCH_SIZE})
       endif()

@@ -8,7 +8,8 @@
 #include "torsion/mesh/box_mesh.h"
 
 namespace torsion {
-namespace {
+// Named, not anonymous: its helpers share a unity batch with other files' (TORSION_UNITY_BUILD).
+namespace anchor_test {
 
 using testing::MultibodyWorld;
 
@@ -312,5 +313,5 @@ TEST(Anchors, BadAnchorRequestsAreErrorsNamingTheProblem) {
   EXPECT_TRUE(bar->anchorNodes({2}, box).ok()) << "a removed anchor frees its nodes";
 }
 
-}  // namespace
+}  // namespace anchor_test
 }  // namespace torsion

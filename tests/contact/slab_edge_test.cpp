@@ -13,7 +13,8 @@
 #include "contact_fixtures.h"
 
 namespace torsion::test {
-namespace {
+// Named, not anonymous: its constants share a unity batch with other files' (TORSION_UNITY_BUILD).
+namespace slab_edge_test {
 
 constexpr double kDt = 0.005;
 constexpr double kHalf = 0.05;  // the box's half size, m
@@ -99,5 +100,5 @@ TEST(SlabEdge, AFrictionlessBoxSlidesOffASlabsEdgeKeepingItsSpeed) {
   }
 }
 
-}  // namespace
+}  // namespace slab_edge_test
 }  // namespace torsion::test

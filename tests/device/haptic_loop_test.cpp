@@ -15,7 +15,8 @@
 // The loop driven by a fake 1 kHz clock (tick(now)), with a stand-in simulation that answers
 // every `sim_every` ticks with a spring about the grab pose.
 namespace torsion::device {
-namespace {
+// Named, not anonymous: its helpers share a unity batch with other files' (TORSION_UNITY_BUILD).
+namespace haptic_loop_test {
 
 constexpr double kDt = 0.001;
 
@@ -379,5 +380,5 @@ TEST(HapticLoop, ThreadStartsTicksAndStopsWithZeroOutput) {
   EXPECT_FALSE(loop.running());
 }
 
-}  // namespace
+}  // namespace haptic_loop_test
 }  // namespace torsion::device

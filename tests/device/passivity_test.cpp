@@ -18,7 +18,8 @@
 // simulation runs at 100 Hz and whose wrench reaches the loop `delay` late, all on a fake 1 kHz
 // clock (docs/haptics.md, "Passivity" has the numbers).
 namespace torsion::device {
-namespace {
+// Named, not anonymous: its helpers share a unity batch with other files' (TORSION_UNITY_BUILD).
+namespace passivity_test {
 
 constexpr double kDt = 0.001;
 
@@ -406,5 +407,5 @@ TEST(Passivity, ASlowTwistFeelsTheSameTorqueWithTheController) {
   EXPECT_LT(worst, 0.02 * peak);
 }
 
-}  // namespace
+}  // namespace passivity_test
 }  // namespace torsion::device

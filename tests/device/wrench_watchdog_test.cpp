@@ -13,7 +13,8 @@
 // The device side's watchdog on a fake clock: what a device renders when the simulation's
 // wrenches stop arriving (docs/haptics.md, "When the simulation dies").
 namespace torsion::device {
-namespace {
+// Named, not anonymous: its helpers share a unity batch with other files' (TORSION_UNITY_BUILD).
+namespace wrench_watchdog_test {
 
 constexpr double kDt = 0.001;
 
@@ -173,5 +174,5 @@ TEST(NetworkPeer, TheRenderedWrenchFadesWhenTheSimulationStopsSending) {
   EXPECT_EQ(p.newestWrench().force.x, kHeld.force.x);  // what last arrived, for the record
 }
 
-}  // namespace
+}  // namespace wrench_watchdog_test
 }  // namespace torsion::device

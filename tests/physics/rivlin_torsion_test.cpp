@@ -22,7 +22,8 @@
 #include "validation_output.h"
 
 namespace torsion {
-namespace {
+// Named, not anonymous: its helpers share a unity batch with other files' (TORSION_UNITY_BUILD).
+namespace rivlin_torsion_test {
 
 constexpr double kRivlinLength = 10;
 
@@ -359,5 +360,5 @@ TEST(RivlinTorsionDynamic, TwistAtOneRadianPerSecondTakesOneNewtonDirectionPerSt
   EXPECT_LE(double(total) / steps, 1.2);
 }
 
-}  // namespace
+}  // namespace rivlin_torsion_test
 }  // namespace torsion

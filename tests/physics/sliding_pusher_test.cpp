@@ -16,7 +16,8 @@
 #include "torsion/mesh/box_mesh.h"
 
 namespace torsion::test {
-namespace {
+// Named, not anonymous: its helpers share a unity batch with other files' (TORSION_UNITY_BUILD).
+namespace sliding_pusher_test {
 
 constexpr double kGravity = 9.81;
 constexpr double kDt = 0.01;
@@ -147,5 +148,5 @@ TEST(SlidingPusher, PushingABoxAcrossASoftSlabTakesCoulombsForce) {
   EXPECT_NEAR(p.pusher_force_n, coulomb, 0.05 * coulomb);
 }
 
-}  // namespace
+}  // namespace sliding_pusher_test
 }  // namespace torsion::test

@@ -39,7 +39,8 @@
 #include "torsion/bullet/fem_world.h"
 
 namespace torsion {
-namespace {
+// Named, not anonymous: its helpers share a unity batch with other files' (TORSION_UNITY_BUILD).
+namespace twist_buckling_test {
 
 constexpr double kRadius = 0.01;  // m
 constexpr double kLength = 0.4;   // m
@@ -411,5 +412,5 @@ TEST(TwistBuckling, Tet4RodBucklesEarlyBecauseItsTorsionIsTooStiff) {
   EXPECT_EQ(run.crossing_steps, 0) << "first at step " << run.first_crossing_step;
 }
 
-}  // namespace
+}  // namespace twist_buckling_test
 }  // namespace torsion

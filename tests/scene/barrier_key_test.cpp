@@ -6,7 +6,8 @@
 #include "scene_parser.h"
 
 namespace torsion::scene {
-namespace {
+// Named, not anonymous: its helpers share a unity batch with other files' (TORSION_UNITY_BUILD).
+namespace barrier_key_test {
 
 std::string sceneWith(const std::string& material_entry) {
   return R"({"bodies": [{"name": "beam", "mesh": "beam.node",)"
@@ -35,5 +36,5 @@ TEST(SceneBarrierKeys, OutOfRangeValuesAreRefusedNamingTheField) {
                       {"s.json: bodies[0].material", "barrier_stiffness = -2: must be >= 0"}));
 }
 
-}  // namespace
+}  // namespace barrier_key_test
 }  // namespace torsion::scene

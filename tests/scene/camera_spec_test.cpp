@@ -8,7 +8,8 @@
 #include "scene_parser.h"
 
 namespace torsion::scene {
-namespace {
+// Named, not anonymous: its helpers share a unity batch with other files' (TORSION_UNITY_BUILD).
+namespace camera_spec_test {
 
 using test::failsWith;
 
@@ -51,5 +52,5 @@ TEST(CameraSpec, BadValuesNameTheKey) {
   EXPECT_TRUE(failsWith(parse(R"({"distance": 3})"), {"s.json: camera", "distance"}));
 }
 
-}  // namespace
+}  // namespace camera_spec_test
 }  // namespace torsion::scene

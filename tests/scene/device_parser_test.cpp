@@ -8,7 +8,8 @@
 #include "scene_parser.h"
 
 namespace torsion::scene {
-namespace {
+// Named, not anonymous: its helpers share a unity batch with other files' (TORSION_UNITY_BUILD).
+namespace device_parser_test {
 
 using test::failsWith;
 
@@ -201,5 +202,5 @@ TEST(DeviceOverride, KeepsTheScenesMappingAndNamesFaults) {
   EXPECT_TRUE(parseHapticsMode("threaded").ok());
 }
 
-}  // namespace
+}  // namespace device_parser_test
 }  // namespace torsion::scene

@@ -16,7 +16,8 @@
 #include "torsion/bt_conversions.h"
 
 namespace torsion::scene {
-namespace {
+// Named, not anonymous: its helpers share a unity batch with other files' (TORSION_UNITY_BUILD).
+namespace rigid_scene_test {
 
 using test::failsWith;
 
@@ -184,5 +185,5 @@ TEST(RigidScene, KinematicPlateFollowsItsScriptAndRunWritesOutputs) {
   std::filesystem::remove_all(out);
 }
 
-}  // namespace
+}  // namespace rigid_scene_test
 }  // namespace torsion::scene

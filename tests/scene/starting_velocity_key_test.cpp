@@ -7,7 +7,8 @@
 #include "scene_parser.h"
 
 namespace torsion::scene {
-namespace {
+// Named, not anonymous: its helpers share a unity batch with other files' (TORSION_UNITY_BUILD).
+namespace starting_velocity_key_test {
 
 std::string sceneWith(const std::string& entries) {
   return R"({"gravity": [0, 0, 0], "bodies": [{"name": "cube", "mesh": "cube_384.node",)" +
@@ -78,5 +79,5 @@ TEST(SceneStartingVelocityKeys, TheBuiltBodyMovesRigidlyAboutItsCentreOfMass) {
   EXPECT_NEAR((l - inertia * omega).norm(), 0, 1e-9 * l.norm());
 }
 
-}  // namespace
+}  // namespace starting_velocity_key_test
 }  // namespace torsion::scene

@@ -6,7 +6,8 @@
 #include "scene_parser.h"
 
 namespace torsion::scene {
-namespace {
+// Named, not anonymous: its helpers share a unity batch with other files' (TORSION_UNITY_BUILD).
+namespace volumetric_strain_key_test {
 
 std::string sceneWith(const std::string& material_entry, const std::string& body_entry = "") {
   return R"({"bodies": [{"name": "beam", "mesh": "beam.node",)" + body_entry +
@@ -35,5 +36,5 @@ TEST(SceneVolumetricStrainKey, UnknownValueAndTet10AreRefusedNamingTheKey) {
       {"s.json: bodies[0].material", "tet4 option"}));
 }
 
-}  // namespace
+}  // namespace volumetric_strain_key_test
 }  // namespace torsion::scene

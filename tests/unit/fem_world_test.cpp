@@ -9,7 +9,8 @@
 #include "torsion/mesh/box_mesh.h"
 
 namespace torsion {
-namespace {
+// Named, not anonymous: its helpers share a unity batch with other files' (TORSION_UNITY_BUILD).
+namespace fem_world_test {
 
 TetMesh beam() {
   return makeBoxTetMesh({0, 0, 0}, {4, 1, 1}, 8, 2, 2).value();
@@ -302,5 +303,5 @@ TEST(FemWorld, ScriptedRotationCarriesNodesExactly) {
   EXPECT_LT(w.torque.x(), 0);
 }
 
-}  // namespace
+}  // namespace fem_world_test
 }  // namespace torsion

@@ -18,7 +18,8 @@
 #include "torsion/solve/implicit_stepper.h"
 
 namespace torsion {
-namespace {
+// Named, not anonymous: its helpers share a unity batch with other files' (TORSION_UNITY_BUILD).
+namespace hyperelastic_step_test {
 
 Material rubber(MaterialLaw law) {
   Material m;
@@ -406,5 +407,5 @@ TEST(HyperelasticStep, HandTwistsItAsItTwistsACorotatedBody) {
     EXPECT_NEAR(handTorque(law) / corotated, 1.0, 0.01) << toString(law);
 }
 
-}  // namespace
+}  // namespace hyperelastic_step_test
 }  // namespace torsion

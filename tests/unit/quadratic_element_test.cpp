@@ -16,7 +16,8 @@
 #include "torsion/mesh/quadratic_tet_mesh.h"
 
 namespace torsion {
-namespace {
+// Named, not anonymous: its helpers share a unity batch with other files' (TORSION_UNITY_BUILD).
+namespace quadratic_element_test {
 
 constexpr double kMu = 3.846e4;  // E = 1e5, nu = 0.3
 constexpr double kLambda = 5.769e4;
@@ -301,5 +302,5 @@ TEST(QuadraticElement, HrzMassesAreTheScaledConsistentDiagonal) {
   EXPECT_GT(kTet10CornerMassFraction, 0);  // row-sum lumping would give -1/20 here
 }
 
-}  // namespace
+}  // namespace quadratic_element_test
 }  // namespace torsion

@@ -11,7 +11,8 @@
 #include "torsion/mesh/tetgen_format.h"
 
 namespace torsion {
-namespace {
+// Named, not anonymous: its helpers share a unity batch with other files' (TORSION_UNITY_BUILD).
+namespace vtk_format_test {
 
 using test::failsWith;
 
@@ -483,5 +484,5 @@ TEST(VtkFaults, RandomEditsFailCleanly) {
   }
 }
 
-}  // namespace
+}  // namespace vtk_format_test
 }  // namespace torsion

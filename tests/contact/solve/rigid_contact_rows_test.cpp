@@ -20,7 +20,8 @@
 #include "torsion/contact/solve/sap_solver.h"
 
 namespace torsion::sap {
-namespace {
+// Named, not anonymous: its constants share a unity batch with other files' (TORSION_UNITY_BUILD).
+namespace rigid_contact_rows_test {
 
 constexpr double kDt = 0.01;
 constexpr double kG = 9.81;
@@ -301,5 +302,5 @@ TEST(RigidContactRows, SolvedRowsCarryTheColumnAndWriteBackWhatTheVelocitiesCarr
   }
 }
 
-}  // namespace
+}  // namespace rigid_contact_rows_test
 }  // namespace torsion::sap

@@ -10,7 +10,8 @@
 #include "sap_test_support.h"
 
 namespace torsion::sap {
-namespace {
+// Named, not anonymous: its constants share a unity batch with other files' (TORSION_UNITY_BUILD).
+namespace sap_particle_test {
 
 constexpr double kMass = 1.0;
 constexpr double kDt = 1e-3;
@@ -242,5 +243,5 @@ TEST(SapParticle, AnAnchoredParticlePulledAsideReturnsWithoutOvershoot) {
   EXPECT_LT(run.x.norm(), 1e-6);
   EXPECT_LT(run.overshoot, 1e-4);  // 1 % of the pull
 }
-}  // namespace
+}  // namespace sap_particle_test
 }  // namespace torsion::sap

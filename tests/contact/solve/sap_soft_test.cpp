@@ -17,7 +17,8 @@
 #include "torsion/solve/system_operator.h"
 
 namespace torsion::sap {
-namespace {
+// Named, not anonymous: its constants share a unity batch with other files' (TORSION_UNITY_BUILD).
+namespace sap_soft_test {
 
 using test::kGravity;
 
@@ -386,5 +387,5 @@ TEST(SapFemBar, FollowsACarriedEndAgainstFriction) {
   }
 }
 
-}  // namespace
+}  // namespace sap_soft_test
 }  // namespace torsion::sap
