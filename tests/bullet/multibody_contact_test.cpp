@@ -200,6 +200,7 @@ TEST(MultibodyContact, MotorGripperLiftsASoftBlockAndHoldsItWithoutSlip) {
   // corrects a fraction kp of the position error per step), so the load it carries does not make
   // it drift.
   double lift_target = 0, lift_speed = 0;
+  long newton = 0;  // the contact solves' Newton iterations, summed over the steps run
   auto run = [&](double seconds) {
     const int steps = static_cast<int>(std::lround(seconds / kDt));
     for (int k = 0; k < steps; ++k) {
@@ -208,6 +209,7 @@ TEST(MultibodyContact, MotorGripperLiftsASoftBlockAndHoldsItWithoutSlip) {
       g.lift->setPositionTarget(lift_target, 0.2);
       user.world.stepSimulation(kDt, 0);
       ASSERT_TRUE(user.fem.status().ok) << user.fem.status().message;
+      newton += block->contacts().stats().newton_iterations;
     }
   };
   // Close: each finger motor drives inward until the block stops it, then squeezes with its
@@ -237,7 +239,15 @@ TEST(MultibodyContact, MotorGripperLiftsASoftBlockAndHoldsItWithoutSlip) {
   const Eigen::Vector3d held = femCentre(*block) - fingersMidpoint(g);
   EXPECT_GT(femCentre(*block).z() - start.z(), 0.04) << "the block went up with the gripper";
   // Hold 5 s against gravity.
+  newton = 0;
   run(5.0);
+  // The hold's contact solves: 70 rows, all sliding at each step's warm start and sticking at
+  // its solution. 17-20 Newton iterations a step, up to three solves (the friction bounds
+  // matched); 40-57 when the Newton model kept no curvature along a sliding row's slip
+  // (sap_solver.h), one or two rows sticking per iteration.
+  const double newton_per_step = static_cast<double>(newton) / std::lround(5.0 / kDt);
+  std::printf("[figures] gripper hold: %.1f Newton iterations a step\n", newton_per_step);
+  EXPECT_LT(newton_per_step, 30);
   const Eigen::Vector3d slip = femCentre(*block) - fingersMidpoint(g) - held;
   EXPECT_LT(slip.norm(), 1e-3) << "slip " << slip.transpose();
   EXPECT_GT(femCentre(*block).z() - start.z(), 0.04) << "still up after 5 s";

@@ -48,6 +48,53 @@ TEST(SapProjection, RegionsFollowTheCompliantLawAndTheDisk) {
   }
 }
 
+// The slip curvature (the Newton model after a short step, sap_solver.h): on a sliding row, G's
+// tangential block becomes r / |v_t| I, the curvature of the quadratic that touches the friction
+// cost r |v_t| - R_t r^2 / 2 at v_t and lies above it; G stays symmetric positive semidefinite and
+// its normal part is untouched. A sticking row, a frictionless one and a joint row keep G.
+TEST(SapProjection, SlipCurvatureIsThatOfTheQuadraticAboveTheFrictionCost) {
+  const RowModel m = someModel(0.5);
+  const Eigen::Vector3d vc(0.03, -0.04, -0.002);  // |v_t| = 0.05 m/s: sliding
+  const RowResponse r = projectImpulse(m, vc);
+  ASSERT_EQ(r.state, ContactState::kSlide);
+  Eigen::Matrix3d g = r.g;
+  addSlipCurvature(m, vc, g);
+  const double curvature = m.radius / 0.05;
+  const Eigen::Matrix2d tangential = g.topLeftCorner<2, 2>();
+  EXPECT_TRUE(tangential.isApprox(curvature * Eigen::Matrix2d::Identity(), 1e-12)) << tangential;
+  EXPECT_EQ(g.col(2), r.g.col(2));
+  EXPECT_EQ(g.row(2), r.g.row(2));
+  EXPECT_GE(Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(g).eigenvalues().minCoeff(), 0.0);
+  // Along the slip, from v_t: the quadratic with that curvature, touching the cost (same value,
+  // same slope -gamma_t) at v_t, is above the cost everywhere and meets it only there.
+  const Eigen::Vector2d t = vc.head<2>().normalized();
+  const double normal_cost = projectImpulse(m, Eigen::Vector3d(0, 0, vc(2))).cost;
+  const auto friction_cost = [&](double s) {
+    Eigen::Vector3d v = vc;
+    v.head<2>() = s * t;
+    return projectImpulse(m, v).cost - normal_cost;
+  };
+  const double s0 = 0.05, slope = m.radius;  // d/ds of r |v_t| along t
+  for (double s : {-0.2, -0.05, 0.0, 1e-6, 0.01, 0.049, 0.051, 0.2, 1.0}) {
+    const double quadratic =
+        friction_cost(s0) + slope * (s - s0) + 0.5 * curvature * (s - s0) * (s - s0);
+    EXPECT_GE(quadratic, friction_cost(s) - 1e-12) << "s = " << s;
+  }
+  // Rows whose G is whole keep it.
+  for (const Eigen::Vector3d& stuck :
+       {Eigen::Vector3d(1e-6, 0, -0.002), Eigen::Vector3d(0, 0, 0)}) {
+    const RowResponse s = projectImpulse(m, stuck);
+    ASSERT_EQ(s.state, ContactState::kStick);
+    Eigen::Matrix3d same = s.g;
+    addSlipCurvature(m, stuck, same);
+    EXPECT_EQ(same, s.g);
+  }
+  const RowModel frictionless = someModel(0.0);
+  Eigen::Matrix3d same = projectImpulse(frictionless, vc).g;
+  addSlipCurvature(frictionless, vc, same);
+  EXPECT_EQ(same, projectImpulse(frictionless, vc).g);
+}
+
 // Without friction a contact with no tangential velocity at all (a cold start at v = 0) still
 // separates when the normal velocity opens the gap: no negative normal impulse.
 TEST(SapProjection, FrictionlessContactWithoutSlipSeparates) {

@@ -119,6 +119,15 @@ RowResponse projectImpulse(const RowModel& m, const Eigen::Vector3d& vc) {
   return out;
 }
 
+void addSlipCurvature(const RowModel& m, const Eigen::Vector3d& vc, Eigen::Matrix3d& g) {
+  if (m.kind != RowKind::kContact || !(m.radius > 0)) return;
+  const Eigen::Vector2d yt = -vc.head<2>() / m.rt;
+  const double yr = yt.norm();
+  if (!(yr > m.radius)) return;  // sticking: G is whole
+  const Eigen::Vector2d t = yt / yr;
+  g.topLeftCorner<2, 2>() += (m.radius / (yr * m.rt)) * t * t.transpose();
+}
+
 Result<SapProblem> SapProblem::create(std::vector<const IslandBody*> bodies,
                                       std::vector<ContactRow> rows, double dt,
                                       const SapParameters& parameters) {

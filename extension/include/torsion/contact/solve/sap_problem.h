@@ -128,6 +128,16 @@ struct RowResponse {
 /// gamma(v_c) with its G and cost (the lagged model above).
 RowResponse projectImpulse(const RowModel& model, const Eigen::Vector3d& contact_velocity);
 
+/// For a sliding contact row, the curvature its cost lacks along the slip: adds
+/// r / (y_r R_t) t t^T to the tangential block of `g` (a no-op for any other row). A sliding row's
+/// friction cost r |v_t| - R_t r^2 / 2 is linear along the slip direction t, so its exact G has no
+/// curvature there; r / |v_t| = r / (y_r R_t) is the curvature of the quadratic that touches that
+/// cost at v_t and lies above it everywhere (the majoriser of iteratively reweighted least
+/// squares). G stays symmetric positive semidefinite. The Newton direction uses it where the exact
+/// one failed (sap_solver.h); the cost and the line search never do.
+void addSlipCurvature(const RowModel& model, const Eigen::Vector3d& contact_velocity,
+                      Eigen::Matrix3d& g);
+
 /// Everything the solver needs at one v.
 struct SapEvaluation {
   Eigen::VectorXd v;

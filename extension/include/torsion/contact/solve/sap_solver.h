@@ -8,7 +8,12 @@
 //      started from dv = 0 and stopped at a relative residual eta_k = min(0.1, sqrt(r_k / r_0))
 //      (inexact Newton, tightening as it converges; never tighter than the tolerance needs).
 //      CG from zero on an SPD system returns a descent direction (g . dv < 0) after any number of
-//      iterations; should rounding break that, the preconditioned gradient step replaces it;
+//      iterations; should rounding break that, the preconditioned gradient step replaces it.
+//      After a step the line search cut short (alpha < 1/2), H takes each sliding row's
+//      curvature along its slip as well (addSlipCurvature in sap_problem.h): the exact G has none
+//      there, so from a warm start where rows slide that end the solve sticking, each exact
+//      direction overshoots into the stick regions and is cut where the first rows meet them,
+//      a few rows a step. H stays SPD, so every direction is still a descent direction;
 //   3. an exact line search: alpha minimising the convex cost along dv, by safeguarded 1-D Newton
 //      on ell'(alpha) with bisection (the Hessian is only piecewise continuous). ell' is
 //      monotone, so the bracket always holds the minimiser, and the cost never increases.
@@ -97,6 +102,9 @@ class SapSolver {
  private:
   // The CG solve of S H S dv = -g to relative tolerance eta; returns its iterations.
   int newtonDirection(const SapProblem& problem, double eta, Eigen::VectorXd& dv);
+  // The sliding rows' slip curvature added to evaluation_'s G (the Newton model after a short
+  // step).
+  void addSlipCurvature(const SapProblem& problem);
   // The capacitance correction's Y and W, once per solve (a body brings its preconditioner).
   void prepareCorrection(const SapProblem& problem);
   // The preconditioner at evaluation_ (its blocks, or I + G W factorised).
