@@ -15,10 +15,10 @@ constexpr double kSlopeTolerance = 1e-10;
 constexpr double kSlopeRounding = 1e-13;
 // A Newton step the line search cut below this fraction: the next direction takes the sliding
 // rows' slip curvature (addSlipCurvature). Measured with `torsion run`, 1 thread, most Newton
-// iterations in a step without -> with: soft_stack 86 -> 48 (CPU 2.02 -> 1.58 s), soft_grasp
-// 80 -> 62, rigid_mix 42 -> 28, bullet_boxes 46 -> 32; a motor gripper holding a soft block (70
-// rows sliding at the warm start, sticking at the solution) 50 -> 17-20 a step; the plectoneme's
-// slowly sliding coils 7 % fewer. Only after a short step: from the start, on rows that go on
+// iterations in a step without -> with: soft_stack 86 -> 48, soft_grasp 80 -> 62, rigid_mix
+// 42 -> 28, bullet_boxes 46 -> 32; a motor gripper holding a soft block (70 rows sliding at the
+// warm start, sticking at the solution) 50 -> 18.5 a step; the plectoneme's slowly sliding coils
+// 9 % fewer (docs/performance.md). Only after a short step: from the start, on rows that go on
 // sliding, the exact model converges faster (the plectoneme: 5.6 times the iterations).
 constexpr double kShortStep = 0.5;
 
