@@ -1,11 +1,11 @@
 #!/usr/bin/env bash
 # The whole test suite, from a fresh machine. `.ci/run` calls exactly this. Stages:
 #   1. set-up (scripts/setup.sh: the Debian packages, only those missing);
-#   2. Release build (build/, gcc, double Bullet, warnings as errors);
+#   2. Release build (build/ci/release/, gcc, double Bullet, warnings as errors);
 #   3. the float-Bullet library without CHOLMOD (build-float/): the package tests install it
-#      beside build/'s (a consumer links each precision from one prefix) and alone (a consumer's
+#      beside the Release build's (a consumer links each precision from one prefix) and alone (a consumer's
 #      direct solver works without CHOLMOD);
-#   4. every CTest test of build/;
+#   4. every CTest test of the Release build;
 #   5. clang-tidy over extension/ and device/;
 #   6. ThreadSanitizer (build-tsan/): the haptic loop's thread, its buffers, the runtime, and the
 #      device fault cases (bad readings, dead peers, hung plug-ins, watchdogs);
@@ -36,10 +36,15 @@ sanitizer_flags=(-DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_CXX_COMPILER=clang++
 stage "Set-up (scripts/setup.sh)"
 bash scripts/setup.sh
 
-stage "Release build (build/)"
-configure build -DCMAKE_BUILD_TYPE=Release -DTORSION_WARNINGS_AS_ERRORS=ON "${unity[@]}" \
+# The Release build lies three folders below the tree, as deep as scikit-build's own build folder
+# (_skbuild/<platform>/cmake-build) lies below its copy of the tree in the pip test
+# (python.pip_install): ccache writes the paths under its base directory relative to the compile's
+# folder, so only at equal depths are pip's compilations this build's, and hit the cache.
+release=build/ci/release
+stage "Release build ($release/)"
+configure "$release" -DCMAKE_BUILD_TYPE=Release -DTORSION_WARNINGS_AS_ERRORS=ON "${unity[@]}" \
   -DTORSION_CONSUMER_ALSO_INSTALL="$PWD/build-float" -DTORSION_CONSUMER_WITHOUT_CHOLMOD="$PWD/build-float"
-build build
+build "$release"
 
 # The libraries a consumer links, once more in the two settings a package may differ in: float
 # Bullet and no CHOLMOD (the GPL-free build). Float Bullet's behaviour (the tests) is checked in
@@ -53,11 +58,11 @@ build build-float
 # ctest runs $jobs tests at once: each takes one thread (TORSION_THREADS, the default of a world
 # that asks for 0, i.e. all cores), so that two-thread worlds do not contend for the same cores
 # (a third more CPU time, measured). A test that is about threads asks for its count itself.
-stage "Test suite (build/)"
-seed_test_costs build tests/ctest_costs/release.txt
-TORSION_THREADS=1 ctest --test-dir build -j"$jobs" --output-on-failure
+stage "Test suite ($release/)"
+seed_test_costs "$release" tests/ctest_costs/release.txt
+TORSION_THREADS=1 ctest --test-dir "$release" -j"$jobs" --output-on-failure
 # The pytest suite is one CTest test (python.pytest); its own count of tests:
-grep -hEo "^[0-9]+ passed.* in [0-9.]+s" build/Testing/Temporary/LastTest.log | tail -1 |
+grep -hEo "^[0-9]+ passed.* in [0-9.]+s" "$release"/Testing/Temporary/LastTest.log | tail -1 |
   sed 's/^/== pytest (label python): /' || true
 
 stage "clang-tidy (.clang-tidy) over extension/ and device/"
