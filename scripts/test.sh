@@ -4,8 +4,7 @@
 #   2. Release build (build/ci/release/, gcc, double Bullet, warnings as errors);
 #   3. the float-Bullet library without CHOLMOD (build-float/): the package tests install it
 #      beside the Release build's (a consumer links each precision from one prefix) and alone (a
-#      consumer's
-#      direct solver works without CHOLMOD);
+#      consumer's direct solver works without CHOLMOD);
 #   4. every CTest test of the Release build;
 #   5. clang-tidy over extension/ and device/;
 #   6. ThreadSanitizer (build-tsan/): the haptic loop's thread, its buffers, the runtime, and the
