@@ -17,6 +17,7 @@
 #include "scene_builder.h"
 #include "torsion/device/haptic_device.h"
 #include "torsion/device/haptic_loop.h"
+#include "torsion/haptics/hand_coupling.h"
 #include "torsion/haptics/haptic_runtime.h"
 
 namespace torsion::scene {

@@ -60,6 +60,7 @@ HapticLoop::HapticLoop(HapticDevice& device, const HapticLoopSettings& settings)
       twist_(settings.twist_cutoff_hz),
       passivity_(settings.passivity),
       blend_(settings.step_blend_hz) {
+  force_enabled_ = !settings.buttons_switch_force;
   log_.reserve(settings.log_capacity);
 }
 
@@ -88,7 +89,7 @@ void HapticLoop::tick(double now, double deadline) {
   }
   if (pressed & kButton2) {
     ++release_requests_;
-    force_enabled_ = false;
+    force_enabled_ = !settings_.buttons_switch_force;
   }
   // The motion since the last accepted reading, over the time it took: the twist estimate and
   // the port's energy book the motion that happened, and a refused tick (no motion known) books

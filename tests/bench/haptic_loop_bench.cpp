@@ -32,6 +32,7 @@
 #include "torsion/bullet/fem_world.h"
 #include "torsion/bullet/hand.h"
 #include "torsion/device/scripted_device.h"
+#include "torsion/haptics/hand_coupling.h"
 #include "torsion/haptics/haptic_runtime.h"
 #include "torsion/mesh/mesh_io.h"
 

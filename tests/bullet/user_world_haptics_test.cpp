@@ -5,6 +5,7 @@
 
 #include "torsion/bullet/hand.h"
 #include "torsion/device/scripted_device.h"
+#include "torsion/haptics/hand_coupling.h"
 #include "torsion/haptics/haptic_runtime.h"
 #include "torsion/mesh/box_mesh.h"
 #include "user_world.h"

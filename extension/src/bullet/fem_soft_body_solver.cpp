@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cmath>
 #include <sstream>
+#include <utility>
 
 #include "soft_body_touch.h"
 #include "torsion/bt_conversions.h"
@@ -249,10 +250,25 @@ void FemSoftBodySolver::optimize(btAlignedObjectArray<btSoftBody*>& soft_bodies,
   bullet_solver_.optimize(bullet_bodies_, force_update);
 }
 
+StepContext FemSoftBodySolver::substepContext(double dt) const {
+  StepContext ctx;
+  ctx.time = time_;
+  ctx.dt = dt;
+  ctx.index = steps_ + 1;
+  if (world_ != nullptr) ctx.gravity = toEigen(world_->getGravity());
+  return ctx;
+}
+
 void FemSoftBodySolver::predictMotion(btScalar solver_dt) {
   // Bullet's worlds pass float(dt) here (the exact dt arrives in solveConstraints): it only
   // predicts the motion that collision detection looks along.
   const double dt = static_cast<double>(solver_dt);
+  if (status_.ok && !listeners_.empty()) {
+    rigid_step_announced_ = true;
+    const StepContext ctx = substepContext(dt);
+    for (StepListener* listener : listeners_)
+      listener->beforeRigidStep(ctx);
+  }
   if (status_.ok) {
     // A body alone in the world, without anchors, cannot touch anything this step: its node tree
     // (read only by contact detection) waits until something can.
@@ -271,14 +287,16 @@ void FemSoftBodySolver::predictMotion(btScalar solver_dt) {
 
 void FemSoftBodySolver::solveConstraints(btScalar solver_dt) {
   bullet_solver_.solveConstraints(solver_dt);
+  StepContext ctx = substepContext(static_cast<double>(solver_dt));
+  const bool announced = std::exchange(rigid_step_announced_, false);
   // A substep without FEM bodies is still a step of the FEM clock (stepCount() counts substeps).
-  if (!status_.ok || !(solver_dt > 0)) return;
-
-  StepContext ctx;
-  ctx.time = time_;
-  ctx.dt = static_cast<double>(solver_dt);
-  ctx.index = steps_ + 1;
-  ctx.gravity = toEigen(world_->getGravity());
+  if (!status_.ok || !(solver_dt > 0)) {
+    if (announced) {  // the detection failed the substep: listeners get back what they lent
+      for (StepListener* listener : listeners_)
+        listener->afterFemStep(ctx, false);
+    }
+    return;
+  }
   joint_ledger_.refresh(*world_);
   ctx.joints = &joint_ledger_;
 

@@ -13,6 +13,11 @@ device::Vec3 toDevice(const Eigen::Vector3d& v) {
 
 }  // namespace
 
+Eigen::Vector3d rotationVector(const Eigen::Quaterniond& q) {
+  const Eigen::AngleAxisd aa(q.w() < 0 ? Eigen::Quaterniond(-q.coeffs()) : q);
+  return aa.angle() * aa.axis();
+}
+
 Frame DeviceMapping::toWorld(const device::Pose& pose) const {
   const device::Quat& q = pose.orientation;
   Frame f;

@@ -7,15 +7,6 @@
 
 namespace torsion::haptics {
 
-namespace {
-
-Eigen::Vector3d rotationVector(const Eigen::Quaterniond& q) {
-  const Eigen::AngleAxisd aa(q.w() < 0 ? Eigen::Quaterniond(-q.coeffs()) : q);
-  return aa.angle() * aa.axis();
-}
-
-}  // namespace
-
 const char* toString(Rendering rendering) {
   return rendering == Rendering::kInternalForce ? "internal_force" : "frame_difference";
 }

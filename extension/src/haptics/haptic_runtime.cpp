@@ -25,22 +25,32 @@ HapticRuntime::~HapticRuntime() {
   fem_.removeStepListener(this);
 }
 
-void HapticRuntime::beforeFemStep(const StepContext& ctx) {
+void HapticRuntime::beforeRigidStep(const StepContext& ctx) {
   if (lockstep_) {
-    // Tick k happens at k / rate: count ticks rather than add up periods, so no drift.
+    // Tick k happens at k / rate: count ticks rather than add up periods, so no drift. Bullet
+    // hands predictMotion the substep's length rounded to float: its end is known to within a
+    // nanosecond.
+    constexpr double kEndTolerance = 1e-9;  // s
     const double rate = bindings_.empty() ? 1000 : bindings_.front().rate_hz;
-    while (static_cast<double>(lockstep_ticks_) / rate < ctx.endTime() - 1e-12) {
+    while (static_cast<double>(lockstep_ticks_) / rate < ctx.endTime() - kEndTolerance) {
       const double now = static_cast<double>(lockstep_ticks_) / rate;
       for (HapticBinding& b : bindings_)
         b.loop->tick(now);
       ++lockstep_ticks_;
     }
   }
-  for (HapticBinding& b : bindings_) {
-    device::HandCommand command;
-    b.loop->commands().read(command);
+  commands_.resize(bindings_.size());
+  for (std::size_t i = 0; i < bindings_.size(); ++i) {
+    bindings_[i].loop->commands().read(commands_[i]);
+    bindings_[i].coupling->beforeRigidStep(commands_[i], ctx);
+  }
+}
+
+void HapticRuntime::beforeFemStep(const StepContext& ctx) {
+  for (std::size_t i = 0; i < bindings_.size() && i < commands_.size(); ++i) {
+    const device::HandCommand& command = commands_[i];
     if (command.tick == 0) continue;  // the loop has not ticked yet
-    Status applied = b.coupling->apply(command, ctx.time);
+    Status applied = bindings_[i].coupling->beforeFemStep(command, ctx);
     if (!applied && warnings_.size() < 100) {
       warnings_.push_back("t = " + std::to_string(ctx.time) +
                           " s: grab failed: " + applied.error().message);
@@ -49,6 +59,8 @@ void HapticRuntime::beforeFemStep(const StepContext& ctx) {
 }
 
 void HapticRuntime::afterFemStep(const StepContext& ctx, bool ok) {
+  for (HapticBinding& b : bindings_)
+    b.coupling->afterFemStep(ctx, ok);
   if (!ok) return;  // a failed step has no wrench to render; the loops fade on their own
   for (HapticBinding& b : bindings_)
     b.loop->wrenches().write(b.coupling->publish(static_cast<std::uint64_t>(ctx.index)));

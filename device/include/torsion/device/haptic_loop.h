@@ -48,6 +48,9 @@ struct HapticLoopSettings {
   /// carries a local stiffness K_h (without one the whole rendering would be low-passed); 0:
   /// off. 8 by default: a stiff body under delay is felt as without delay (docs/haptics.md).
   double step_blend_hz = 8;
+  /// true: button 1 turns the force on and button 2 off (a hand grabs and releases); false: the
+  /// force is on from the first tick and buttons only count (a tool is always held).
+  bool buttons_switch_force = true;
   std::size_t log_capacity = 0;  ///< rows kept in memory (one per tick); 0: no log
   /// SCHED_FIFO priority (1-99) the loop's thread asks for; it keeps the default policy,
   /// silently, when that is not permitted (LoopStats::realtime says which). 0: do not ask.

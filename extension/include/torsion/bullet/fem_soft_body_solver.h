@@ -63,6 +63,9 @@ class SoftBodyTouch;
 class StepListener {
  public:
   virtual ~StepListener() = default;
+  /// Before Bullet's rigid solve of the substep (predictMotion), while the solver is healthy;
+  /// afterFemStep follows in the same substep. `ctx.joints` is null here.
+  virtual void beforeRigidStep(const StepContext& /*ctx*/) {}
   virtual void beforeFemStep(const StepContext& /*ctx*/) {}
   /// `ok`: every FEM body's step succeeded.
   virtual void afterFemStep(const StepContext& /*ctx*/, bool /*ok*/) {}
@@ -178,6 +181,8 @@ class FemSoftBodySolver : public btSoftBodySolver {
 
  private:
   FemBody* femBodyOf(const btSoftBody* soft) const;
+  /// The coming substep's clock and gravity (no joints).
+  StepContext substepContext(double dt) const;
   Status bindWorld(btDiscreteDynamicsWorld* world, btSoftBodyWorldInfo* info,
                    std::function<void(btSoftBody*)> add, std::function<void(btSoftBody*)> remove);
   void unsupportedPair(const btSoftBody* a, const btSoftBody* b);
@@ -198,6 +203,7 @@ class FemSoftBodySolver : public btSoftBodySolver {
   std::unique_ptr<FemContactIslands> fem_contact_;  // nullptr: FEM-FEM contact off
   std::unique_ptr<SoftBodyTouch> soft_touch_;       // whether Bullet's soft bodies touch ours
   std::vector<StepListener*> listeners_;
+  bool rigid_step_announced_ = false;  // beforeRigidStep went out this substep
 
   double time_ = 0;
   double last_dt_ = 0;

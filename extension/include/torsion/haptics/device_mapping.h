@@ -6,6 +6,7 @@
 // by `force_scale` / `torque_scale` (1: the user feels the simulated newtons).
 
 #include <Eigen/Core>
+#include <Eigen/Geometry>
 
 #include "torsion/constraints/carried_nodes.h"
 #include "torsion/constraints/frame.h"
@@ -27,5 +28,8 @@ struct DeviceMapping {
   /// dW/dpose (world, about the hand's origin) -> device units, row-major into out[36].
   void stiffnessToDevice(const Matrix6d& world, double out[36]) const;
 };
+
+/// The rotation vector (axis times angle, |angle| <= pi) of a unit quaternion.
+Eigen::Vector3d rotationVector(const Eigen::Quaterniond& q);
 
 }  // namespace torsion::haptics

@@ -32,6 +32,7 @@
 
 #include "torsion/bullet/hand.h"
 #include "torsion/device/device_types.h"
+#include "torsion/haptics/device_coupling.h"
 #include "torsion/haptics/device_mapping.h"
 #include "torsion/haptics/patch_stiffness.h"
 #include "torsion/result.h"
@@ -66,7 +67,7 @@ struct CouplingSettings {
   Status validate() const;
 };
 
-class HandCoupling {
+class HandCoupling : public DeviceCoupling {
  public:
   /// The hand must outlive the coupling. Settings must be valid.
   HandCoupling(Hand& hand, const DeviceMapping& mapping, const CouplingSettings& settings);
@@ -76,13 +77,17 @@ class HandCoupling {
   /// A pose whose world frame (after the mapping's scale) is not finite or farther than
   /// kMaxHandReach from the origin is dropped and counted: the last goal is held.
   Status apply(const device::HandCommand& command, double now);
+  /// DeviceCoupling: apply() at the step's start.
+  Status beforeFemStep(const device::HandCommand& command, const StepContext& ctx) override {
+    return apply(command, ctx.time);
+  }
   /// Poses dropped by apply() because their mapped frame was out of reach or not finite.
-  std::uint64_t rejectedPoses() const { return rejected_poses_; }
+  std::uint64_t rejectedPoses() const override { return rejected_poses_; }
 
   /// m: a device pose mapped beyond this is refused (a packet may carry 1.7e308).
   static constexpr double kMaxHandReach = 1e6;
   /// After the step: the wrench for the loop, in device units. `step` is the world's step count.
-  device::SimulationWrench publish(std::uint64_t step);
+  device::SimulationWrench publish(std::uint64_t step) override;
 
   /// The rendered wrench of the last publish(), world frame, about the device frame's origin.
   const Wrench& worldWrench() const { return world_wrench_; }

@@ -1,11 +1,13 @@
 #pragma once
-// Ties the FEM solver, the hand couplings and their haptic loops together. It listens to the
-// solver's steps (FemSoftBodySolver::addStepListener), so it works in any world the solver is
-// attached to, whoever calls stepSimulation and with whatever substeps:
-//   before each FEM step   newest command of each loop -> its coupling, at the step's time (and,
-//                          in lockstep mode, every loop ticked on the simulated clock up to the
-//                          step's end first);
-//   after each FEM step    each coupling publishes its wrench to its loop.
+// Ties the FEM solver, the device couplings (hand planes and tools, device_coupling.h) and their
+// haptic loops together. It listens to the solver's steps (FemSoftBodySolver::addStepListener),
+// so it works in any world the solver is attached to, whoever calls stepSimulation and with
+// whatever substeps:
+//   before the rigid solve  in lockstep mode, every loop ticked on the simulated clock up to the
+//                           substep's end; then each loop's newest command is taken, and handed
+//                           to its coupling (a tool acts here);
+//   before each FEM step    the same command again (a hand acts here);
+//   after each FEM step     each coupling closes the step, and publishes its wrench to its loop.
 // Two ways to run:
 //   - threaded (interactive): each HapticLoop ticks on its own thread at 1 kHz (startThreads()),
 //     and the thread that steps the world is the simulation thread, handing poses and wrenches
@@ -27,12 +29,12 @@
 #include "torsion/bullet/fem_soft_body_solver.h"
 #include "torsion/bullet/fem_world.h"
 #include "torsion/device/haptic_loop.h"
-#include "torsion/haptics/hand_coupling.h"
+#include "torsion/haptics/device_coupling.h"
 
 namespace torsion::haptics {
 
 struct HapticBinding {
-  HandCoupling* coupling = nullptr;
+  DeviceCoupling* coupling = nullptr;
   device::HapticLoop* loop = nullptr;
   double rate_hz = 1000;  ///< the loop's rate, for lockstep ticking
 };
@@ -52,6 +54,7 @@ class HapticRuntime : public StepListener {
   void setLockstep(bool lockstep) { lockstep_ = lockstep; }
 
   // ---- StepListener (called by the solver inside stepSimulation) ----
+  void beforeRigidStep(const StepContext& ctx) override;
   void beforeFemStep(const StepContext& ctx) override;
   void afterFemStep(const StepContext& ctx, bool ok) override;
 
@@ -96,6 +99,7 @@ class HapticRuntime : public StepListener {
   FemSoftBodySolver& fem_;
   FemWorld* world_ = nullptr;  // set when built on a FemWorld
   std::vector<HapticBinding> bindings_;
+  std::vector<device::HandCommand> commands_;  // each loop's newest, taken before the rigid solve
   std::vector<std::string> warnings_;
   bool lockstep_ = false;
   std::chrono::steady_clock::time_point threads_origin_;

@@ -1,0 +1,125 @@
+#pragma once
+// A rigid tool held by a haptic device: a dynamic Bullet body of its own mass, pulled toward the
+// device's pose by a 6-DoF spring-damper, the virtual coupling of Colgate et al. (1995) and
+// Adams & Hannaford (1999). The tool stops at surfaces instead of passing into them, and the
+// device renders the coupling's force. docs/haptics.md, "Tools".
+//
+// The coupling is integrated implicitly with the tool, inside each substep's solves. Before
+// Bullet's rigid solve (beforeRigidStep), for step h, device goal (x_d, R_d) at the step's end,
+// its velocity (v_d, w_d) and the tool's (m, I; x, v, R, w; external force and torque f, t):
+//   (m + c) v' = m v + h (k (x_d - x) + b v_d + f),        c   = h (h k + b)
+//   (I + c_r) w' = I w + h (k_r theta + b_r w_d + t),       c_r = h (h k_r + b_r),
+// theta the rotation vector of R_d R^T. The tool enters the step with velocity (v', w') and, for
+// the step only, mass m + c and inertia I + c_r (its forces folded into v', w'): that is the
+// backward-Euler step of body and spring together, so Bullet's rigid solve and the FEM contact
+// island push on the tool and its spring as one body, and the contact impulses balance the
+// coupling force (at rest, exactly). afterFemStep gives the tool back its mass, inertia and
+// forces and takes the coupling force at the step's end,
+//   F = k (x_d - x) + b (v_d - v),   T = k_r theta + b_r (w_d - w),
+// of which the device renders the reaction -(F + m g) (the tool's weight compensated unless
+// `feel_weight`), about the device frame's origin.
+//
+// Between steps the loop predicts with K_h = -(K_c - K_c (K_c + K_e)^-1 K_c): the coupling K_c in
+// series with the stiffness K_e of the tool's contacts with rigid bodies (Bullet's manifolds; a
+// touching point counts as a spring kRigidContactStiffness along its normal), so a rigid wall
+// feels as stiff as the coupling at the loop's rate; in free space K_h = 0. Contacts with FEM
+// bodies add nothing to K_e: their change reaches the device at the simulation's rate.
+// Simulation thread only.
+
+#include <memory>
+
+#include "torsion/constraints/carried_nodes.h"
+#include "torsion/constraints/frame.h"
+#include "torsion/haptics/device_coupling.h"
+#include "torsion/haptics/device_mapping.h"
+
+class btRigidBody;
+class btDispatcher;
+
+namespace torsion::haptics {
+
+struct ToolCouplingSettings {
+  double stiffness = 1000;        ///< N/m, k
+  double angular_stiffness = 10;  ///< N m/rad, k_r
+  /// Damping as a fraction of critical for the tool's own mass and inertia:
+  /// b = 2 zeta sqrt(k m), b_r = 2 zeta sqrt(k_r I_max).
+  double damping_ratio = 1;
+  /// N and N m: the spring's pull is capped here (a device far from a jammed tool cannot push it
+  /// through what holds it with an unbounded force).
+  double max_force = 100;
+  double max_torque = 10;
+  bool feel_weight = false;  ///< render the tool's weight too (false: the contacts only)
+  /// Publish only K_h's passive part (device/passive_stiffness.h).
+  bool passive_stiffness = true;
+
+  Status validate() const;
+};
+
+class ToolCoupling : public DeviceCoupling {
+ public:
+  /// N/m: a touching rigid contact point in K_e, far stiffer than any coupling, so that K_h is
+  /// the coupling's own stiffness along the contact normals.
+  static constexpr double kRigidContactStiffness = 1e7;
+  /// m: a device pose mapped beyond this is refused.
+  static constexpr double kMaxReach = 1e6;
+
+  /// `tool` must be dynamic (mass > 0) and outlive the coupling; `dispatcher` is its world's
+  /// (its contacts with rigid bodies, for K_h; null: none). The device's zero pose sits at
+  /// mapping.anchor. Settings must be valid. The tool is kept awake (a sleeping body would not
+  /// follow the device).
+  static Result<std::unique_ptr<ToolCoupling>> create(btRigidBody& tool, btDispatcher* dispatcher,
+                                                      const DeviceMapping& mapping,
+                                                      const ToolCouplingSettings& settings);
+
+  void beforeRigidStep(const device::HandCommand& command, const StepContext& ctx) override;
+  void afterFemStep(const StepContext& ctx, bool ok) override;
+  device::SimulationWrench publish(std::uint64_t step) override;
+  std::uint64_t rejectedPoses() const override { return rejected_poses_; }
+
+  /// The device's frame in the world: where the coupling pulls the tool.
+  const Frame& goal() const { return goal_; }
+  /// The coupling's pull on the tool at the last step's end (world, about the tool's centre).
+  const Wrench& couplingWrench() const { return coupling_; }
+  /// The rendered wrench of the last step, world frame: -(coupling + weight unless felt).
+  const Wrench& worldWrench() const { return world_wrench_; }
+  /// K_h of the last publish(), world frame.
+  const Matrix6d& worldStiffness() const { return world_stiffness_; }
+  btRigidBody& tool() { return tool_; }
+
+ private:
+  ToolCoupling(btRigidBody& tool, btDispatcher* dispatcher, const DeviceMapping& mapping,
+               const ToolCouplingSettings& settings);
+  /// The goal from a command; a dead device or a refused pose holds the last one.
+  void takeGoal(const device::HandCommand& command);
+  /// The stiffness of the tool's touching contacts with rigid bodies (world, about its centre).
+  Matrix6d rigidContactStiffness() const;
+  void restoreMass();
+
+  btRigidBody& tool_;
+  btDispatcher* dispatcher_;
+  DeviceMapping mapping_;
+  ToolCouplingSettings settings_;
+  double mass_ = 0;                                          // the tool's own, kg
+  Eigen::Vector3d local_inertia_ = Eigen::Vector3d::Zero();  // its principal moments, kg m^2
+  double linear_damping_ = 0, angular_damping_ = 0;          // b, b_r
+  // The goal and its velocity over the step
+  Frame goal_;
+  Frame previous_goal_;
+  bool have_previous_goal_ = false;
+  Eigen::Vector3d goal_velocity_ = Eigen::Vector3d::Zero();
+  Eigen::Vector3d goal_angular_velocity_ = Eigen::Vector3d::Zero();
+  device::Pose goal_pose_;
+  std::uint64_t command_tick_ = 0;
+  double command_time_ = 0;
+  std::uint64_t rejected_poses_ = 0;
+  // What the step borrowed: the tool's forces, and that its mass is swapped
+  bool lent_ = false;
+  Eigen::Vector3d saved_force_ = Eigen::Vector3d::Zero(), saved_torque_ = Eigen::Vector3d::Zero();
+  Eigen::Vector3d gravity_ = Eigen::Vector3d::Zero();
+  // Results of the last step
+  Wrench coupling_;
+  Wrench world_wrench_;
+  Matrix6d world_stiffness_ = Matrix6d::Zero();
+};
+
+}  // namespace torsion::haptics
