@@ -1,0 +1,179 @@
+// A rigid tool held by a scripted device through the virtual coupling (tool_coupling.h), the
+// whole path a scene takes: ScriptedDevice -> HapticLoop (lockstep, 1 kHz) -> HapticRuntime ->
+// ToolCoupling -> Bullet's rigid solve and the FEM contact island -> the wrench the loop renders.
+
+#include <btBulletDynamicsCommon.h>
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <memory>
+#include <vector>
+
+#include "torsion/bt_conversions.h"
+#include "torsion/bullet/fem_world.h"
+#include "torsion/device/haptic_loop.h"
+#include "torsion/device/scripted_device.h"
+#include "torsion/haptics/haptic_runtime.h"
+#include "torsion/haptics/tool_coupling.h"
+#include "torsion/mesh/box_mesh.h"
+
+namespace torsion::haptics {
+namespace tool_coupling_test {
+
+btTransform at(const Eigen::Vector3d& p) {
+  btTransform t;
+  t.setIdentity();
+  t.setOrigin(toBt(p));
+  return t;
+}
+
+device::Pose devicePose(double x, double y, double z) {
+  device::Pose pose;
+  pose.position = {x, y, z};
+  return pose;
+}
+
+// A soft slab (0.1 x 0.1 x 0.02 m, base held at z = 0) and a sphere probe (radius 1 cm) held by a
+// scripted device whose zero pose is the probe's start, 5 mm above the slab.
+struct ProbeRig {
+  static constexpr double kRadius = 0.01;    // m
+  static constexpr double kProbeMass = 0.02;  // kg
+  static constexpr double kTop = 0.02;       // m, the slab's top face
+  std::unique_ptr<FemWorld> world;
+  FemBody* slab = nullptr;
+  int base_group = -1;
+  btRigidBody* probe = nullptr;
+  std::unique_ptr<ToolCoupling> coupling;
+  std::unique_ptr<device::ScriptedDevice> device;
+  std::unique_ptr<device::HapticLoop> loop;
+  std::unique_ptr<HapticRuntime> runtime;
+
+  ProbeRig(const std::vector<device::TrajectoryKeyframe>& keyframes, double gravity,
+           const ToolCouplingSettings& settings = {}, double friction = 0.5) {
+    WorldSettings ws;
+    ws.gravity = Eigen::Vector3d(0, 0, -gravity);
+    ws.solver.time_step = 0.01;
+    ws.solver.threads = 1;
+    world = std::make_unique<FemWorld>(ws);
+    Material material;
+    material.youngs_modulus = 1e5;
+    material.poisson_ratio = 0.3;
+    material.density = 1000;
+    material.stiffness_damping = 0.001;
+    slab = world
+               ->addBody("slab",
+                         makeBoxTetMesh({-0.05, -0.05, 0}, {0.05, 0.05, kTop}, 10, 10, 2).value(),
+                         material)
+               .value();
+    std::vector<int> base;
+    for (int i = 0; i < slab->model().nodeCount(); ++i)
+      if (slab->state().position(i).z() < 1e-9) base.push_back(i);
+    base_group = slab->carryNodes(
+        "base", base, [](double) { return Frame{}; }, 0);
+    const Eigen::Vector3d start(0, 0, kTop + kRadius + 0.005);
+    probe = world->addRigidBody(std::make_unique<btSphereShape>(btScalar(kRadius)), kProbeMass,
+                                at(start));
+    probe->setFriction(btScalar(friction));
+    DeviceMapping mapping;
+    mapping.anchor.origin = start;
+    coupling = ToolCoupling::create(*probe, world->bulletWorld().getDispatcher(), mapping,
+                                    settings)
+                   .value();
+    device = std::make_unique<device::ScriptedDevice>(
+        device::Trajectory(keyframes, {}), device::defaultDeviceLimits(), "probe");
+    device::HapticLoopSettings loop_settings;
+    loop_settings.buttons_switch_force = false;
+    loop = std::make_unique<device::HapticLoop>(*device, loop_settings);
+    runtime = std::make_unique<HapticRuntime>(
+        *world, std::vector<HapticBinding>{{coupling.get(), loop.get(), 1000}});
+    runtime->setLockstep(true);
+  }
+
+  void run(double seconds) {
+    const int steps = static_cast<int>(std::lround(seconds / 0.01));
+    for (int k = 0; k < steps; ++k)
+      ASSERT_TRUE(runtime->step().ok) << "step " << k;
+  }
+  Eigen::Vector3d probeCentre() const { return toEigen(probe->getCenterOfMassPosition()); }
+  /// The force the slab's base carries (what the body pushes its held base nodes with).
+  Eigen::Vector3d baseForce() { return slab->groupWrench(base_group, Eigen::Vector3d::Zero()).force; }
+};
+
+std::vector<device::TrajectoryKeyframe> pressThenHold(double depth) {
+  return {{0, devicePose(0, 0, 0)}, {0.5, devicePose(0, 0, -depth)}, {9, devicePose(0, 0, -depth)}};
+}
+
+TEST(ToolCoupling, TheDeviceFeelsWhatTheSlabsBaseCarriesAtEquilibrium) {
+  // The device goes 8 mm down from the probe's start, 5 mm above the slab, over 0.5 s and
+  // holds: the probe indents the slab. At rest the wrench the device renders and the force on the
+  // slab's held base are one force (no gravity): the coupling and the contact impulses agree.
+  ProbeRig rig(pressThenHold(0.008), 0.0);
+  rig.run(3.0);
+  const Eigen::Vector3d felt = rig.coupling->worldWrench().force;
+  const Eigen::Vector3d base = rig.baseForce();
+  ASSERT_GT(felt.z(), 0.5);  // N: pushed back up
+  EXPECT_NEAR(felt.z(), -base.z(), 0.01 * felt.z());
+  EXPECT_LT((felt + base).norm(), 0.01 * felt.z());
+  EXPECT_LT(rig.probeCentre().z(), ProbeRig::kTop + ProbeRig::kRadius);  // m: it indents
+  EXPECT_GT(rig.probeCentre().z(), ProbeRig::kTop + ProbeRig::kRadius - 0.003);
+}
+
+TEST(ToolCoupling, UnderGravityTheWeightIsCompensatedUnlessFelt) {
+  // Under gravity, at rest on the slab: with the weight compensated (the default) the device
+  // feels the contact only, the base's force less the slab's own weight; with feel_weight it
+  // feels the probe's weight on top.
+  for (bool feel_weight : {false, true}) {
+    ToolCouplingSettings settings;
+    settings.feel_weight = feel_weight;
+    ProbeRig rig(pressThenHold(0.008), 9.81, settings);
+    rig.run(3.0);
+    // The held base carries the weight of the nodes above it (its own nodes' weight is not an
+    // elastic force) and the probe's push.
+    double carried_mass = 0;
+    for (int i = 0; i < rig.slab->model().nodeCount(); ++i) {
+      if (rig.slab->model().mesh().restPositions()[static_cast<size_t>(i)].z() > 1e-9)
+        carried_mass += rig.slab->model().nodeMasses()[static_cast<size_t>(i)];
+    }
+    const double contact = -rig.baseForce().z() - 9.81 * carried_mass;  // N, the probe's push
+    const double weight = 9.81 * ProbeRig::kProbeMass;
+    ASSERT_GT(contact, 0.5);
+    EXPECT_NEAR(rig.coupling->worldWrench().force.z(), contact - (feel_weight ? weight : 0),
+                0.01 * contact)
+        << (feel_weight ? "weight felt" : "weight compensated");
+  }
+}
+
+TEST(ToolCoupling, SlidingOverTheSlabTheDeviceFeelsMuTimesTheNormalForce) {
+  // Pressed in, then dragged 3 cm sideways at 1 cm/s at a constant device height: the probe
+  // slides (the coupling holds its orientation), and the device feels Coulomb's law, the
+  // tangential force mu times the normal one. Both are averaged over the last two centimetres,
+  // two whole cells of the mesh: over one cell the ratio swings by a quarter either way as the
+  // contact patch (about 5 mm across) crosses the 1 cm grid of surface nodes. The drag of the
+  // frictionless probe (the slab's damping and its surface pushed ahead) is measured apart.
+  auto slidingRatio = [](double mu) {
+    ProbeRig rig({{0, devicePose(0, 0, 0)},
+                  {0.5, devicePose(0, 0, -0.0075)},
+                  {1.0, devicePose(0, 0, -0.0075)},
+                  {4.0, devicePose(0.03, 0, -0.0075)}},
+                 0.0, {}, mu);
+    rig.run(2.0);  // pressed, then the first centimetre: sliding under way
+    Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+    for (int k = 0; k < 200; ++k) {
+      rig.run(0.01);
+      sum += rig.coupling->worldWrench().force;
+    }
+    EXPECT_GT(rig.probeCentre().x(), 0.028);  // m: it followed the device
+    EXPECT_GT(sum.z(), 0);
+    EXPECT_LT(std::abs(sum.y()), 1e-3 * sum.z());
+    return -sum.x() / sum.z();
+  };
+  constexpr double kMu = 0.4;  // the probe's friction (the slab's is 1)
+  const double with_friction = slidingRatio(kMu);
+  const double drag = slidingRatio(0.0);
+  EXPECT_NEAR(with_friction, kMu, 0.05 * kMu);
+  EXPECT_LT(drag, 0.02);
+  EXPECT_NEAR(with_friction - drag, kMu, 0.01 * kMu);
+}
+
+}  // namespace tool_coupling_test
+}  // namespace torsion::haptics
