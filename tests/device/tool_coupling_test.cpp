@@ -175,5 +175,87 @@ TEST(ToolCoupling, SlidingOverTheSlabTheDeviceFeelsMuTimesTheNormalForce) {
   EXPECT_NEAR(with_friction - drag, kMu, 0.01 * kMu);
 }
 
+// The probe 5 mm above a static rigid box (its top at z = 0), the device's zero pose at the
+// probe's start; the loop logs every tick.
+struct WallRig {
+  static constexpr double kRadius = 0.01;  // m
+  static constexpr double kStiffness = 1000;  // N/m, the coupling's
+  std::unique_ptr<FemWorld> world;
+  btRigidBody* probe = nullptr;
+  std::unique_ptr<ToolCoupling> coupling;
+  std::unique_ptr<device::ScriptedDevice> device;
+  std::unique_ptr<device::HapticLoop> loop;
+  std::unique_ptr<HapticRuntime> runtime;
+
+  explicit WallRig(const std::vector<device::TrajectoryKeyframe>& keyframes) {
+    WorldSettings ws;
+    ws.gravity.setZero();
+    ws.solver.time_step = 0.01;
+    world = std::make_unique<FemWorld>(ws);
+    world->addRigidBody(std::make_unique<btBoxShape>(btVector3(0.1, 0.1, 0.05)), 0,
+                        at({0, 0, -0.05}));
+    const Eigen::Vector3d start(0, 0, kRadius + 0.005);
+    probe = world->addRigidBody(std::make_unique<btSphereShape>(btScalar(kRadius)), 0.02,
+                                at(start));
+    DeviceMapping mapping;
+    mapping.anchor.origin = start;
+    ToolCouplingSettings settings;
+    settings.stiffness = kStiffness;
+    coupling = ToolCoupling::create(*probe, world->bulletWorld().getDispatcher(), mapping,
+                                    settings)
+                   .value();
+    device = std::make_unique<device::ScriptedDevice>(
+        device::Trajectory(keyframes, {}), device::defaultDeviceLimits(), "probe");
+    device::HapticLoopSettings loop_settings;
+    loop_settings.buttons_switch_force = false;
+    loop_settings.log_capacity = 10000;
+    loop = std::make_unique<device::HapticLoop>(*device, loop_settings);
+    runtime = std::make_unique<HapticRuntime>(
+        *world, std::vector<HapticBinding>{{coupling.get(), loop.get(), 1000}});
+    runtime->setLockstep(true);
+  }
+  void run(double seconds) {
+    const int steps = static_cast<int>(std::lround(seconds / 0.01));
+    for (int k = 0; k < steps; ++k)
+      ASSERT_TRUE(runtime->step().ok) << "step " << k;
+  }
+};
+
+TEST(ToolCoupling, ARigidWallFeelsAsStiffAsTheCouplingAtTheLoopsRate) {
+  // The device goes 1 cm down at 1 cm/s, 5 mm into the wall, holds 0.5 s and comes back. The
+  // probe stops at the wall; between steps the loop predicts with K_h = -k along the wall's
+  // normal, so each tick's force is the coupling's k times the device's depth in the wall, not
+  // a 100 Hz staircase (whose steps would be k v dt = 0.1 N). The port stays passive.
+  WallRig rig({{0, devicePose(0, 0, 0)},
+               {1.0, devicePose(0, 0, -0.01)},
+               {1.5, devicePose(0, 0, -0.01)},
+               {2.5, devicePose(0, 0, 0)}});
+  rig.run(1.2);
+  const Matrix6d& k_h = rig.coupling->worldStiffness();
+  EXPECT_NEAR(k_h(2, 2), -WallRig::kStiffness, 0.01 * WallRig::kStiffness);
+  EXPECT_LT(std::abs(k_h(0, 0)), 1e-3 * WallRig::kStiffness);  // slides freely sideways
+  EXPECT_LT(std::abs(k_h(1, 1)), 1e-3 * WallRig::kStiffness);
+  const double sink = WallRig::kRadius - toEigen(rig.probe->getCenterOfMassPosition()).z();
+  std::printf("probe sinks %.3g mm\n", 1e3 * sink);
+  EXPECT_LT(sink, 5e-4);  // m, Bullet's contact slop and the step's
+  // The coupling's damper, b = 2 sqrt(k m) (critical), adds b v while the device moves on.
+  const double damper = 2 * std::sqrt(WallRig::kStiffness * 0.02);  // N s/m
+  EXPECT_NEAR(rig.coupling->worldWrench().force.z(), WallRig::kStiffness * 0.005, 1e-3);
+  rig.run(1.6);
+
+  // Each tick of the press (device 1-5 mm into the wall, t in [0.6, 1.0] s): the rendered force
+  // against k times the depth then.
+  double worst = 0;
+  for (const device::LoopLogRow& row : rig.loop->log()) {
+    if (row.time < 0.6 || row.time > 1.0) continue;
+    const double depth = -0.005 - row.pose.position.z;  // m, the device below the wall's contact
+    const double ideal = WallRig::kStiffness * depth + damper * 0.01;  // N, at 1 cm/s
+    worst = std::max(worst, std::abs(row.output.force.z - ideal));
+  }
+  EXPECT_LT(worst, 0.02);  // N, a fifth of a step's staircase
+  // Passive: the port gives back at most 1 % of the 12.5 mJ the coupling held at 5 mm.
+  EXPECT_LE(rig.loop->stats().max_port_energy.load(), 1.25e-4);
+}
+
 }  // namespace tool_coupling_test
 }  // namespace torsion::haptics
