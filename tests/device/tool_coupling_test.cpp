@@ -257,5 +257,79 @@ TEST(ToolCoupling, ARigidWallFeelsAsStiffAsTheCouplingAtTheLoopsRate) {
   EXPECT_LE(rig.loop->stats().max_port_energy.load(), 1.25e-4);
 }
 
+TEST(ToolCoupling, ADeviceLostMidPressFadesToZeroWithoutAJumpAndTheToolHolds) {
+  // The device dies 5 mm deep in the wall: the loop fades its output to zero within fade_time
+  // (0.2 s) at the filter's rate limit, and the tool stays where the last goal held it.
+  WallRig rig({{0, devicePose(0, 0, 0)}, {1.0, devicePose(0, 0, -0.01)}, {3, devicePose(0, 0, -0.01)}});
+  rig.device->dieAt(1.2);
+  rig.run(2.0);
+  const device::SafetySettings safety;
+  double largest_change = 0, output_at_death = -1;
+  device::Wrench previous;
+  for (const device::LoopLogRow& row : rig.loop->log()) {
+    largest_change = std::max(largest_change, std::abs(row.output.force.z - previous.force.z));
+    previous = row.output;
+    if (output_at_death < 0 && row.time >= 1.2) output_at_death = row.output.force.z;
+    if (row.time >= 1.2 + safety.fade_time + 0.002) {
+      EXPECT_EQ(row.output.force.z, 0.0) << "t = " << row.time;
+    }
+  }
+  EXPECT_GT(output_at_death, 4.0);  // N: it was pressing
+  EXPECT_LE(largest_change, safety.max_force_rate * 0.001 + 1e-9);  // N per tick: no jump
+  EXPECT_NEAR(toEigen(rig.probe->getCenterOfMassPosition()).z(), WallRig::kRadius, 5e-4);
+  EXPECT_NEAR(rig.coupling->worldWrench().force.z(), 5.0, 1e-3);  // the last goal still held
+}
+
+TEST(ToolCoupling, AJammedToolIsPushedWithAtMostMaxForceAndTheDeviceAtItsLimit) {
+  // The device goes 1 m into the wall: the spring would pull with 1000 N; capped at max_force
+  // (100 N) the probe stays on the wall, and the device renders at most its own limit (30 N).
+  WallRig rig({{0, devicePose(0, 0, 0)}, {1.0, devicePose(0, 0, -1.0)}, {3, devicePose(0, 0, -1.0)}});
+  rig.run(2.0);
+  EXPECT_NEAR(rig.coupling->couplingWrench().force.z(), -100.0, 1e-6);
+  EXPECT_NEAR(toEigen(rig.probe->getCenterOfMassPosition()).z(), WallRig::kRadius, 5e-4);
+  for (const device::LoopLogRow& row : rig.loop->log()) {
+    ASSERT_LE(std::hypot(row.output.force.x, row.output.force.y, row.output.force.z),
+              device::defaultDeviceLimits().max_force + 1e-9);
+  }
+  EXPECT_NEAR(rig.loop->lastOutput().force.z, device::defaultDeviceLimits().max_force, 1e-9);
+}
+
+TEST(ToolCoupling, AStiffCouplingOnALightToolIsStableInFreeSpace) {
+  // k = 1e6 N/m on a 20 g probe at dt = 0.01 s: k dt^2 / m = 5000, far past any explicit
+  // spring's limit. Integrated with the tool, it follows a device that jerks 5 cm sideways in
+  // one step without overshoot, and feels nothing once they move together.
+  ProbeRig rig({{0, devicePose(0, 0, 0)}, {0.5, devicePose(0, 0, 0)}, {0.51, devicePose(0.05, 0, 0.01)},
+                {2, devicePose(0.05, 0, 0.01)}},
+               9.81, [] {
+                 ToolCouplingSettings s;
+                 s.stiffness = 1e6;
+                 s.max_force = 1e6;
+                 return s;
+               }());
+  double overshoot = 0;
+  for (int k = 0; k < 150; ++k) {
+    rig.run(0.01);
+    overshoot = std::max(overshoot, rig.probeCentre().x() - 0.05);
+  }
+  EXPECT_LT(overshoot, 1e-4);  // m
+  EXPECT_NEAR(rig.probeCentre().x(), 0.05, 1e-5);
+  EXPECT_LT(rig.coupling->worldWrench().force.norm(), 1e-3);  // N: weight compensated, at rest
+}
+
+TEST(ToolCoupling, OnlyADynamicBodyWithValidSettingsCanBeATool) {
+  WallRig rig({{0, devicePose(0, 0, 0)}});
+  btRigidBody* wall = rig.world->rigidBodies().front();
+  Result<std::unique_ptr<ToolCoupling>> fixed =
+      ToolCoupling::create(*wall, nullptr, DeviceMapping{}, ToolCouplingSettings{});
+  ASSERT_FALSE(fixed.ok());
+  EXPECT_NE(fixed.error().message.find("dynamic"), std::string::npos) << fixed.error().message;
+  ToolCouplingSettings bad;
+  bad.stiffness = -1;
+  Result<std::unique_ptr<ToolCoupling>> refused =
+      ToolCoupling::create(*rig.probe, nullptr, DeviceMapping{}, bad);
+  ASSERT_FALSE(refused.ok());
+  EXPECT_NE(refused.error().message.find("stiffness"), std::string::npos);
+}
+
 }  // namespace tool_coupling_test
 }  // namespace torsion::haptics
