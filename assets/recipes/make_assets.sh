@@ -88,6 +88,11 @@ echo "== rod_1200, rod_slender_7951, slab_768, block_162, paddle_108, ball_384"
   -o "$meshes/paddle_108.node"
 "$torsion" mesh ball --radius 0.25 --cells 4 -o "$meshes/ball_384.node"
 
+# ---- Tool scenes (demos/scenes/palpation.json, tool_and_hand.json): a soft organ-sized block ----
+echo "== organ_1728"
+"$torsion" mesh box --min -0.06 -0.04 0 --max 0.06 0.04 0.03 --cells 12 8 3 \
+  -o "$meshes/organ_1728.node"
+
 # ---- Bullet's deformable demos re-created (demos/scenes/bullet_*.json): soft cube, sheet ----
 echo "== cube_384, sheet_1536"
 "$torsion" mesh box --min -2 -2 -2 --max 2 2 2 --cells 4 4 4 -o "$meshes/cube_384.node"
@@ -97,7 +102,7 @@ echo "== torsion mesh info"
 for f in "$meshes"/cylinder_2430.node "$meshes"/cylinder_4323.node "$meshes"/cylinder_8332.node \
   "$meshes"/cylinder_31558.node "$meshes"/dragon_4300.node "$meshes"/rod_1200.node "$meshes"/rod_slender_7951.node \
   "$meshes"/slab_768.node "$meshes"/block_162.node "$meshes"/paddle_108.node \
-  "$meshes"/ball_384.node "$meshes"/cube_384.node \
+  "$meshes"/ball_384.node "$meshes"/organ_1728.node "$meshes"/cube_384.node \
   "$meshes"/sheet_1536.node; do
   (cd "$meshes" && "$torsion" mesh info "$(basename "$f")")
   echo

@@ -4,9 +4,10 @@ namespace torsion::cli {
 
 void addDeviceOptions(CLI::App& command, scene::DeviceOverrides& into) {
   command.add_option("--device", into.devices,
-                     "Drive a hand with a device instead of its script (repeatable): "
-                     "HAND=scripted:FILE, HAND=replay:LOG.csv, HAND=network[:[HOST:]PORT], "
-                     "HAND=spacemouse");
+                     "Drive a hand with a device instead of its script, or hold a dynamic "
+                     "rigid body with one as a tool (repeatable): NAME=scripted:FILE, "
+                     "NAME=replay:LOG.csv, NAME=network[:[HOST:]PORT], NAME=spacemouse, "
+                     "NAME=plugin:LIBRARY[:CONFIG]");
   command.add_option("--haptics", into.haptics,
                      "Haptic loops: lockstep (simulated clock, deterministic; default for "
                      "scripted and replay devices) or threaded (1 kHz threads, simulation paced "

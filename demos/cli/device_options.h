@@ -1,5 +1,5 @@
 #pragma once
-// `--device HAND=TYPE[:ARG]` (repeatable) and `--haptics MODE`: one definition for the commands
+// `--device NAME=TYPE[:ARG]` (repeatable) and `--haptics MODE`: one definition for the commands
 // that step a scene (`torsion run`, `torsion view`); scene::applyDeviceOverrides applies them.
 
 #include <CLI/CLI.hpp>

@@ -33,7 +33,7 @@ struct RunArguments {
   int render_every = 10;
   bool stop_on_anomaly = false;
   int vtk_every = -1;  // --vtk-every N: a ParaView series every N steps (vtk_series.h); -1: scene's
-  scene::DeviceOverrides devices;  // --device HAND=TYPE[:ARG] (repeatable), --haptics MODE
+  scene::DeviceOverrides devices;  // --device NAME=TYPE[:ARG] (repeatable), --haptics MODE
 };
 
 // The signal that asked the run to stop, 0 while none has. Written by the handler only.
@@ -227,7 +227,7 @@ int reportOutcome(const RunArguments& args, const scene::BuiltScene& s, const Ra
   std::cerr << "done: " << outcome.steps_done << " steps; results in " << args.out
             << "/ (summary.json, wrench.csv, energy.csv, "
             << (s.rigid_bodies.empty() ? "" : "rigid.csv, ") << "one .vtk per body"
-            << (s.haptics ? ", haptic_<hand>.csv per device hand" : "") << ")\n";
+            << (s.haptics ? ", haptic_<name>.csv per device" : "") << ")\n";
   return 0;
 }
 

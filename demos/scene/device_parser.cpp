@@ -117,6 +117,67 @@ void readLoop(const JsonObject& d, DeviceSpec& spec) {
   }
 }
 
+// What every device entry has: its type and the type's keys, playback speed, limits and mapping.
+DeviceSpec readDeviceKind(const JsonObject& d, const std::string& base_directory) {
+  DeviceSpec spec;
+  const std::string type = d.string("type");
+  if (type == "scripted") {
+    spec.kind = DeviceSpec::Kind::kScripted;
+    spec.file = resolve(d.string("trajectory"), base_directory);
+  } else if (type == "replay") {
+    spec.kind = DeviceSpec::Kind::kReplay;
+    spec.file = resolve(d.string("log"), base_directory);
+  } else if (type == "network") {
+    spec.kind = DeviceSpec::Kind::kNetwork;
+    readNetwork(d, spec, base_directory);
+  } else if (type == "spacemouse") {
+    spec.kind = DeviceSpec::Kind::kSpaceMouse;
+    readSpaceMouse(d, spec);
+  } else if (type == "plugin") {
+    spec.kind = DeviceSpec::Kind::kPlugin;
+    spec.file = resolve(d.string("library"), base_directory);
+    spec.config = d.string("config", "");
+    spec.isolated = d.boolean("isolated", spec.isolated);
+  } else {
+    d.fail("type", "'" + type + "' is not one of: scripted, replay, network, spacemouse, plugin");
+  }
+  if (spec.kind == DeviceSpec::Kind::kScripted || spec.kind == DeviceSpec::Kind::kReplay)
+    spec.speed = positive(d, "speed", spec.speed, " (playback speed)");
+  if (spec.kind != DeviceSpec::Kind::kSpaceMouse && d.has("limits")) {
+    // A SpaceMouse has no motors: it takes no force limits.
+    const JsonObject o = d.object("limits");
+    spec.max_force = nonNegative(o, "max_force", spec.max_force, " N");
+    spec.max_torque = nonNegative(o, "max_torque", spec.max_torque, " N m");
+    o.finish();
+  }
+  if (d.has("mapping")) {
+    const JsonObject o = d.object("mapping");
+    spec.position_scale =
+        positive(o, "position_scale", spec.position_scale, " (world m per device m)");
+    spec.force_scale = nonNegative(o, "force_scale", spec.force_scale, " (device N per world N)");
+    spec.torque_scale = nonNegative(o, "torque_scale", spec.torque_scale, "");
+    o.finish();
+  }
+  return spec;
+}
+
+// A tool's "coupling": the virtual coupling's spring and damper (tool_coupling.h).
+void readToolCoupling(const JsonObject& d, DeviceSpec& spec) {
+  if (d.has("rendering"))
+    d.fail("rendering", "a tool renders its coupling's force; 'rendering' is a hand's key");
+  if (!d.has("coupling")) return;
+  const JsonObject o = d.object("coupling");
+  haptics::ToolCouplingSettings& t = spec.tool;
+  t.stiffness = positive(o, "stiffness", t.stiffness, " N/m");
+  t.angular_stiffness = positive(o, "angular_stiffness", t.angular_stiffness, " N m/rad");
+  t.damping_ratio = nonNegative(o, "damping_ratio", t.damping_ratio, " (1: critical)");
+  t.max_force = positive(o, "max_force", t.max_force, " N");
+  t.max_torque = positive(o, "max_torque", t.max_torque, " N m");
+  t.feel_weight = o.boolean("feel_weight", t.feel_weight);
+  o.finish();
+  if (Status ok = t.validate(); !ok) d.fail("coupling", ok.error().message);
+}
+
 // A key file in the scene, or a key in the environment (device_factory.cpp loads it; a key that
 // fails to load stops the run there).
 bool authenticated(const DeviceSpec& spec) {
@@ -165,47 +226,19 @@ DeviceSpec readDevice(const JsonObject& hand, const std::string& base_directory)
     }
   }
   const JsonObject d = hand.object("device");
-  DeviceSpec spec;
-  const std::string type = d.string("type");
-  if (type == "scripted") {
-    spec.kind = DeviceSpec::Kind::kScripted;
-    spec.file = resolve(d.string("trajectory"), base_directory);
-  } else if (type == "replay") {
-    spec.kind = DeviceSpec::Kind::kReplay;
-    spec.file = resolve(d.string("log"), base_directory);
-  } else if (type == "network") {
-    spec.kind = DeviceSpec::Kind::kNetwork;
-    readNetwork(d, spec, base_directory);
-  } else if (type == "spacemouse") {
-    spec.kind = DeviceSpec::Kind::kSpaceMouse;
-    readSpaceMouse(d, spec);
-  } else if (type == "plugin") {
-    spec.kind = DeviceSpec::Kind::kPlugin;
-    spec.file = resolve(d.string("library"), base_directory);
-    spec.config = d.string("config", "");
-    spec.isolated = d.boolean("isolated", spec.isolated);
-  } else {
-    d.fail("type", "'" + type + "' is not one of: scripted, replay, network, spacemouse, plugin");
-  }
-  if (spec.kind == DeviceSpec::Kind::kScripted || spec.kind == DeviceSpec::Kind::kReplay)
-    spec.speed = positive(d, "speed", spec.speed, " (playback speed)");
-  if (spec.kind != DeviceSpec::Kind::kSpaceMouse && d.has("limits")) {
-    // A SpaceMouse has no motors: it takes no force limits.
-    const JsonObject o = d.object("limits");
-    spec.max_force = nonNegative(o, "max_force", spec.max_force, " N");
-    spec.max_torque = nonNegative(o, "max_torque", spec.max_torque, " N m");
-    o.finish();
-  }
-  if (d.has("mapping")) {
-    const JsonObject o = d.object("mapping");
-    spec.position_scale =
-        positive(o, "position_scale", spec.position_scale, " (world m per device m)");
-    spec.force_scale = nonNegative(o, "force_scale", spec.force_scale, " (device N per world N)");
-    spec.torque_scale = nonNegative(o, "torque_scale", spec.torque_scale, "");
-    o.finish();
-  }
+  DeviceSpec spec = readDeviceKind(d, base_directory);
   readCoupling(d, spec);
   readLoop(d, spec);
+  d.finish();
+  return spec;
+}
+
+DeviceSpec readToolDevice(const JsonObject& body, const std::string& base_directory) {
+  const JsonObject d = body.object("device");
+  DeviceSpec spec = readDeviceKind(d, base_directory);
+  readToolCoupling(d, spec);
+  readLoop(d, spec);
+  spec.loop.buttons_switch_force = false;  // a tool is always held
   d.finish();
   return spec;
 }
@@ -215,25 +248,37 @@ Status applyDeviceOverride(SceneSpec& scene, const std::string& text) {
   const size_t equals = text.find('=');
   if (equals == std::string::npos || equals == 0) {
     return Error{flag +
-                 ": expected HAND=TYPE[:ARG], e.g. hand=network:5750 or hand=replay:log.csv"};
+                 ": expected NAME=TYPE[:ARG] (NAME a hand or a dynamic rigid body), e.g. "
+                 "hand=network:5750 or probe=replay:log.csv"};
   }
   const std::string name = text.substr(0, equals);
   HandSpec* hand = nullptr;
+  RigidBodySpec* tool = nullptr;
   std::string names;
   for (HandSpec& h : scene.hands) {
     if (h.name == name) hand = &h;
-    names += (names.empty() ? "'" : ", '") + h.name + "'";
+    names += (names.empty() ? "hands: '" : ", '") + h.name + "'";
   }
-  if (!hand) {
-    return Error{flag + ": the scene has no hand named '" + name + "'" +
-                 (names.empty() ? std::string(" (it has no hands)") : " (hands: " + names + ")")};
+  std::string dynamic_names;
+  for (RigidBodySpec& r : scene.rigid_bodies) {
+    if (r.mass <= 0) continue;
+    if (r.name == name && !hand) tool = &r;
+    dynamic_names += (dynamic_names.empty() ? "dynamic rigid bodies: '" : ", '") + r.name + "'";
   }
+  if (!hand && !tool) {
+    std::string known = names;
+    if (!dynamic_names.empty()) known += (known.empty() ? "" : "; ") + dynamic_names;
+    return Error{flag + ": the scene has no hand or dynamic rigid body named '" + name + "'" +
+                 (known.empty() ? std::string(" (it has neither)") : " (" + known + ")")};
+  }
+  const std::optional<DeviceSpec>& current = hand ? hand->device : tool->device;
   const std::string value = text.substr(equals + 1);
   const size_t colon = value.find(':');
   const std::string type = value.substr(0, colon);
   const std::string arg = colon == std::string::npos ? "" : value.substr(colon + 1);
 
-  DeviceSpec spec = hand->device ? *hand->device : DeviceSpec{};
+  DeviceSpec spec = current ? *current : DeviceSpec{};
+  if (tool && !current) spec.loop.buttons_switch_force = false;  // a tool is always held
   spec.file.clear();
   if (type == "scripted" || type == "replay") {
     if (arg.empty()) return Error{flag + ": " + type + " needs a file: " + type + ":FILE"};
@@ -278,6 +323,10 @@ Status applyDeviceOverride(SceneSpec& scene, const std::string& text) {
     return Error{flag + ": unknown device type '" + type +
                  "' (known: scripted, replay, network, spacemouse, plugin, plugin-inproc)"};
   }
+  if (tool) {
+    tool->device = spec;
+    return Ok{};
+  }
   if (!hand->keyframes.empty()) {  // the scripted motion gives way; its start is the anchor
     hand->initial = hand->keyframes.front().second;
     hand->keyframes.clear();
@@ -310,18 +359,30 @@ Status applyDeviceOverrides(SceneSpec& scene, const DeviceOverrides& overrides) 
   }
   scene.simulation_priority = overrides.simulation_priority;
   if (!overrides.allow_remote_devices) {
-    for (size_t h = 0; h < scene.hands.size(); ++h) {
-      const HandSpec& hand = scene.hands[h];
-      if (!hand.device || hand.device->kind != DeviceSpec::Kind::kNetwork ||
-          isLoopback(hand.device->host) || authenticated(*hand.device))
-        continue;
-      return Error{scene.file + ": hands[" + std::to_string(h) + "] '" + hand.name +
-                   "': device host " + hand.device->host +
-                   " is not loopback: anyone who can reach that port could drive the hand (the "
-                   "packets are not authenticated); give the device a key_file (or set " +
+    auto exposed = [](const std::optional<DeviceSpec>& d) {
+      return d && d->kind == DeviceSpec::Kind::kNetwork && !isLoopback(d->host) &&
+             !authenticated(*d);
+    };
+    auto refuse = [&scene](const std::string& entry, const std::string& what,
+                           const std::string& host) {
+      return Error{scene.file + ": " + entry + ": device host " + host +
+                   " is not loopback: anyone who can reach that port could drive the " + what +
+                   " (the packets are not authenticated); give the device a key_file (or set " +
                    device::kKeyFileVariable +
                    ", docs/haptics.md), or pass "
                    "--allow-remote-device to listen there unauthenticated"};
+    };
+    for (size_t h = 0; h < scene.hands.size(); ++h) {
+      const HandSpec& hand = scene.hands[h];
+      if (exposed(hand.device))
+        return refuse("hands[" + std::to_string(h) + "] '" + hand.name + "'", "hand",
+                      hand.device->host);
+    }
+    for (size_t r = 0; r < scene.rigid_bodies.size(); ++r) {
+      const RigidBodySpec& body = scene.rigid_bodies[r];
+      if (exposed(body.device))
+        return refuse("rigid_bodies[" + std::to_string(r) + "] '" + body.name + "'", "tool",
+                      body.device->host);
     }
   }
   return Ok{};
@@ -329,17 +390,19 @@ Status applyDeviceOverrides(SceneSpec& scene, const DeviceOverrides& overrides) 
 
 std::vector<std::string> remoteDeviceWarnings(const SceneSpec& scene) {
   std::vector<std::string> warnings;
-  for (const HandSpec& hand : scene.hands) {
-    if (hand.device && hand.device->kind == DeviceSpec::Kind::kNetwork &&
-        !isLoopback(hand.device->host)) {
-      warnings.push_back(
-          "hand '" + hand.name + "': the network device listens on " + hand.device->host +
-          (authenticated(*hand.device)
-               ? ", outside loopback: only peers holding the shared key are heard; the packets "
-                 "are signed, not encrypted (docs/haptics.md)"
-               : ", outside loopback: its first peer is bound, unauthenticated (docs/haptics.md)"));
-    }
-  }
+  auto warn = [&warnings](const std::string& holder, const std::optional<DeviceSpec>& d) {
+    if (!d || d->kind != DeviceSpec::Kind::kNetwork || isLoopback(d->host)) return;
+    warnings.push_back(
+        holder + ": the network device listens on " + d->host +
+        (authenticated(*d)
+             ? ", outside loopback: only peers holding the shared key are heard; the packets "
+               "are signed, not encrypted (docs/haptics.md)"
+             : ", outside loopback: its first peer is bound, unauthenticated (docs/haptics.md)"));
+  };
+  for (const HandSpec& hand : scene.hands)
+    warn("hand '" + hand.name + "'", hand.device);
+  for (const RigidBodySpec& body : scene.rigid_bodies)
+    warn("tool '" + body.name + "'", body.device);
   return warnings;
 }
 

@@ -1,14 +1,18 @@
 #pragma once
-// A hand's haptic device as a scene names it (docs/scene-format.md, "hands[].device"), plain data
-// with paths resolved; device_factory opens it, scene_haptics wires it to the hand. A hand with a
-// device has no scripted motion: its `frame` is where the device's zero pose sits in the world,
-// and the device's buttons grab and release (the report's section 5.4).
+// A haptic device as a scene names it (docs/scene-format.md, "hands[].device" and
+// "rigid_bodies[].device"), plain data with paths resolved; device_factory opens it,
+// scene_haptics wires it to what it holds. A hand with a device has no scripted motion: its
+// `frame` is where the device's zero pose sits in the world, and the device's buttons grab and
+// release (the report's section 5.4). A rigid body with a device is a tool: the device's zero
+// pose sits at the body's starting pose, and a virtual coupling pulls the body toward the device
+// (torsion/haptics/tool_coupling.h).
 
 #include <string>
 
 #include "torsion/device/haptic_loop.h"
 #include "torsion/device/spacemouse_integrator.h"
 #include "torsion/haptics/hand_coupling.h"
+#include "torsion/haptics/tool_coupling.h"
 
 namespace torsion::scene {
 
@@ -27,13 +31,14 @@ struct DeviceSpec {
   /// TORSION_HAPTIC_KEY from the environment, else unauthenticated packets)
   std::string key_file;
   device::SpaceMouseSettings spacemouse;
-  double max_force = 30;      ///< N, the device's limit (a plug-in: at most its own)
-  double max_torque = 3;      ///< N m
-  double position_scale = 1;  ///< world m per device m
-  double force_scale = 1;     ///< device N per world N
-  double torque_scale = 1;    ///< device N m per world N m
-  haptics::CouplingSettings coupling;
-  device::HapticLoopSettings loop;  ///< rate, damper, safety (log capacity set by the run)
+  double max_force = 30;               ///< N, the device's limit (a plug-in: at most its own)
+  double max_torque = 3;               ///< N m
+  double position_scale = 1;           ///< world m per device m
+  double force_scale = 1;              ///< device N per world N
+  double torque_scale = 1;             ///< device N m per world N m
+  haptics::CouplingSettings coupling;  ///< a hand's
+  haptics::ToolCouplingSettings tool;  ///< a tool's
+  device::HapticLoopSettings loop;     ///< rate, damper, safety (log capacity set by the run)
 };
 
 const char* toString(DeviceSpec::Kind kind);

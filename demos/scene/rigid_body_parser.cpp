@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "arithmetic_bounds.h"
+#include "device_parser.h"
 #include "torsion/format_number.h"
 
 namespace torsion::scene {
@@ -107,7 +108,8 @@ double readCoefficient(const JsonObject& r, const std::string& key, double fallb
 
 }  // namespace
 
-RigidBodySpec readRigidBody(const JsonObject& r, const std::vector<RigidBodySpec>& earlier) {
+RigidBodySpec readRigidBody(const JsonObject& r, const std::vector<RigidBodySpec>& earlier,
+                            const std::string& base_directory) {
   RigidBodySpec spec;
   spec.name = r.name("name");
   for (const RigidBodySpec& other : earlier) {
@@ -145,6 +147,14 @@ RigidBodySpec readRigidBody(const JsonObject& r, const std::vector<RigidBodySpec
   spec.friction = readCoefficient(r, "friction", spec.friction);
   spec.restitution = readCoefficient(r, "restitution", spec.restitution);
   if (spec.restitution > 1) r.fail("restitution", "must be <= 1");
+  if (r.has("device")) {
+    if (spec.mass == 0) {
+      r.fail("device",
+             "a tool must be a dynamic body (mass > 0): the device pulls it through a spring, "
+             "and what it touches stops it");
+    }
+    spec.device = readToolDevice(r, base_directory);  // device_parser.cpp
+  }
   r.finish();
   return spec;
 }

@@ -11,8 +11,10 @@
 
 namespace torsion::scene {
 
-/// rigid_bodies[i]; `earlier` are the entries already read (names must be unique).
-RigidBodySpec readRigidBody(const JsonObject& r, const std::vector<RigidBodySpec>& earlier);
+/// rigid_bodies[i]; `earlier` are the entries already read (names must be unique). A device's
+/// relative paths are resolved against `base_directory`.
+RigidBodySpec readRigidBody(const JsonObject& r, const std::vector<RigidBodySpec>& earlier,
+                            const std::string& base_directory);
 /// "ground": {"height", "friction", "restitution"}: a static plane z = height.
 RigidBodySpec readGround(const JsonObject& g);
 

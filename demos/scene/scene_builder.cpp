@@ -133,12 +133,15 @@ Result<std::unique_ptr<BuiltScene>> buildScene(SceneSpec spec, int threads_overr
     built->rigid_bodies.push_back(addSceneRigidBody(world, r));
   if (spec.ground) addSceneRigidBody(world, *spec.ground);
   built->spec = std::move(spec);
-  for (const SceneHand& h : built->hands) {
-    if (!h.spec.device) continue;
+  bool devices = false;
+  for (const SceneHand& h : built->hands)
+    devices = devices || h.spec.device.has_value();
+  for (const RigidBodySpec& r : built->spec.rigid_bodies)
+    devices = devices || r.isTool();
+  if (devices) {
     Result<std::unique_ptr<SceneHaptics>> haptics = SceneHaptics::attach(*built);
     if (!haptics) return Error{built->spec.file + ": " + haptics.error().message};
     built->haptics = std::move(haptics).value();
-    break;
   }
   return built;
 }

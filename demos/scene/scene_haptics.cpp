@@ -51,48 +51,83 @@ std::string fileSafe(const std::string& name) {
 
 }  // namespace
 
+Result<SceneHaptics::Channel> SceneHaptics::openChannel(const DeviceSpec& spec,
+                                                        const std::string& entry,
+                                                        double first_rate_hz) const {
+  if (mode_ == HapticsMode::kLockstep && livesInWallClockTime(spec.kind)) {
+    return Error{entry + ": a " + std::string(toString(spec.kind)) +
+                 " device lives in wall-clock time and cannot tick in lockstep: use "
+                 "--haptics threaded"};
+  }
+  if (first_rate_hz > 0 && mode_ == HapticsMode::kLockstep && spec.loop.rate_hz != first_rate_hz)
+    return Error{entry + ".rate_hz: in lockstep every device ticks at the same rate"};
+  if (std::string bad = spec.loop.validate(); !bad.empty()) return Error{entry + ": " + bad};
+  Result<std::unique_ptr<device::HapticDevice>> opened =
+      openDevice(spec, mode_ == HapticsMode::kLockstep);
+  if (!opened) return Error{entry + ": " + opened.error().message};
+  Channel c;
+  c.device = std::move(opened).value();
+  c.loop = std::make_unique<device::HapticLoop>(*c.device, spec.loop);
+  c.rate_hz = spec.loop.rate_hz;
+  return c;
+}
+
 Result<std::unique_ptr<SceneHaptics>> SceneHaptics::attach(BuiltScene& scene) {
   std::unique_ptr<SceneHaptics> h(new SceneHaptics());
   h->dt_ = scene.world->settings().solver.time_step;
   bool live = false;
   for (const SceneHand& s : scene.hands)
     live = live || (s.spec.device && prefersWallClockTime(s.spec.device->kind));
+  for (const RigidBodySpec& r : scene.spec.rigid_bodies)
+    live = live || (r.device && prefersWallClockTime(r.device->kind));
   h->mode_ = scene.spec.haptics_mode;
   if (h->mode_ == HapticsMode::kAuto)
     h->mode_ = live ? HapticsMode::kThreaded : HapticsMode::kLockstep;
 
   std::vector<haptics::HapticBinding> bindings;
+  auto firstRate = [&bindings] { return bindings.empty() ? 0.0 : bindings.front().rate_hz; };
+  auto mappingFor = [](const DeviceSpec& spec, const Frame& anchor) {
+    haptics::DeviceMapping mapping;
+    mapping.anchor = anchor;
+    mapping.position_scale = spec.position_scale;
+    mapping.force_scale = spec.force_scale;
+    mapping.torque_scale = spec.torque_scale;
+    return mapping;
+  };
   for (size_t i = 0; i < scene.hands.size(); ++i) {
     SceneHand& s = scene.hands[i];
     if (!s.spec.device) continue;
     const DeviceSpec& spec = *s.spec.device;
     const std::string entry = "hands[" + std::to_string(i) + "] '" + s.spec.name + "': device";
-    if (h->mode_ == HapticsMode::kLockstep && livesInWallClockTime(spec.kind)) {
-      return Error{entry + ": a " + std::string(toString(spec.kind)) +
-                   " device lives in wall-clock time and cannot tick in lockstep: use "
-                   "--haptics threaded"};
-    }
-    if (!bindings.empty() && h->mode_ == HapticsMode::kLockstep &&
-        spec.loop.rate_hz != bindings.front().rate_hz) {
-      return Error{entry + ".rate_hz: in lockstep every device hand ticks at the same rate"};
-    }
     if (Status ok = spec.coupling.validate(); !ok) return Error{entry + ": " + ok.error().message};
-    if (std::string bad = spec.loop.validate(); !bad.empty()) return Error{entry + ": " + bad};
-    Result<std::unique_ptr<device::HapticDevice>> opened =
-        openDevice(spec, h->mode_ == HapticsMode::kLockstep);
-    if (!opened) return Error{entry + ": " + opened.error().message};
-
-    Channel c;
-    c.hand = s.spec.name;
-    c.device = std::move(opened).value();
-    haptics::DeviceMapping mapping;
-    mapping.anchor = s.spec.initial;
-    mapping.position_scale = spec.position_scale;
-    mapping.force_scale = spec.force_scale;
-    mapping.torque_scale = spec.torque_scale;
-    c.coupling = std::make_unique<haptics::HandCoupling>(*s.hand, mapping, spec.coupling);
-    c.loop = std::make_unique<device::HapticLoop>(*c.device, spec.loop);
-    c.rate_hz = spec.loop.rate_hz;
+    Result<Channel> opened = h->openChannel(spec, entry, firstRate());
+    if (!opened) return opened.error();
+    Channel c = std::move(opened).value();
+    c.name = s.spec.name;
+    c.coupling = std::make_unique<haptics::HandCoupling>(*s.hand, mappingFor(spec, s.spec.initial),
+                                                         spec.coupling);
+    bindings.push_back({c.coupling.get(), c.loop.get(), c.rate_hz});
+    h->channels_.push_back(std::move(c));
+  }
+  for (size_t i = 0; i < scene.spec.rigid_bodies.size() && i < scene.rigid_bodies.size(); ++i) {
+    const RigidBodySpec& r = scene.spec.rigid_bodies[i];
+    if (!r.device) continue;
+    const std::string entry = "rigid_bodies[" + std::to_string(i) + "] '" + r.name + "': device";
+    for (const Channel& other : h->channels_) {
+      if (fileSafe(other.name) == fileSafe(r.name))
+        return Error{entry + ": its log haptic_" + fileSafe(r.name) + ".csv would be hand '" +
+                     other.name + "''s too: rename one"};
+    }
+    Result<Channel> opened = h->openChannel(*r.device, entry, firstRate());
+    if (!opened) return opened.error();
+    Channel c = std::move(opened).value();
+    c.name = r.name;
+    c.tool = true;
+    Result<std::unique_ptr<haptics::ToolCoupling>> coupling = haptics::ToolCoupling::create(
+        *scene.rigid_bodies[i].body, scene.world->bulletWorld().getDispatcher(),
+        mappingFor(*r.device, r.pose), r.device->tool);
+    if (!coupling) return Error{entry + ": " + coupling.error().message};
+    c.coupling = std::move(coupling).value();
     bindings.push_back({c.coupling.get(), c.loop.get(), c.rate_hz});
     h->channels_.push_back(std::move(c));
   }
@@ -157,11 +192,11 @@ nlohmann::json SceneHaptics::statistics(const Channel& c) const {
   const double span = log.size() > 1 ? log.back().time - log.front().time : 0;
   const device::LoopStats& st = c.loop->stats();
   nlohmann::json j = {
-      {"hand", c.hand},
+      {c.tool ? "tool" : "hand", c.name},
       {"device", c.device->name()},
       {"mode", toString(mode_)},
       {"clock", mode_ == HapticsMode::kLockstep ? "simulated" : "wall"},
-      {"log", "haptic_" + fileSafe(c.hand) + ".csv"},
+      {"log", "haptic_" + fileSafe(c.name) + ".csv"},
       {"rate_hz", c.rate_hz},
       {"achieved_rate_hz", span > 0 ? static_cast<double>(log.size() - 1) / span : 0.0},
       {"ticks", st.ticks.load()},
@@ -223,7 +258,7 @@ Result<nlohmann::json> SceneHaptics::finish(const std::string& directory) {
   nlohmann::json hands = nlohmann::json::array();
   for (const Channel& c : channels_) {
     const std::filesystem::path path =
-        std::filesystem::path(directory) / ("haptic_" + fileSafe(c.hand) + ".csv");
+        std::filesystem::path(directory) / ("haptic_" + fileSafe(c.name) + ".csv");
     if (std::string error; !c.loop->writeLog(path.string(), &error)) return Error{error};
     hands.push_back(statistics(c));
   }
@@ -233,15 +268,16 @@ Result<nlohmann::json> SceneHaptics::finish(const std::string& directory) {
 std::vector<std::string> SceneHaptics::logFileNames() const {
   std::vector<std::string> names;
   for (const Channel& c : channels_)
-    names.push_back("haptic_" + fileSafe(c.hand) + ".csv");
+    names.push_back("haptic_" + fileSafe(c.name) + ".csv");
   return names;
 }
 
 std::vector<std::string> SceneHaptics::describe() const {
   std::vector<std::string> lines;
   for (const Channel& c : channels_) {
-    lines.push_back("hand '" + c.hand + "': device " + c.device->name() + ", " + toString(mode_) +
-                    " haptic loop at " + std::to_string(static_cast<int>(c.rate_hz)) + " Hz");
+    lines.push_back(std::string(c.tool ? "tool '" : "hand '") + c.name + "': device " +
+                    c.device->name() + ", " + toString(mode_) + " haptic loop at " +
+                    std::to_string(static_cast<int>(c.rate_hz)) + " Hz");
   }
   return lines;
 }

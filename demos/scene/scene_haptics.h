@@ -1,12 +1,13 @@
 #pragma once
-// The haptic side of a scene: for every hand with a device, the open device, its 1 kHz
-// HapticLoop and the HandCoupling between them, run by one HapticRuntime in lockstep or threaded
-// mode (device_spec.h). buildScene attaches it; stepScene steps a scene with or without it.
+// The haptic side of a scene: for every hand and every tool (a rigid body) with a device, the
+// open device, its 1 kHz HapticLoop and the coupling between them (HandCoupling, ToolCoupling),
+// run by one HapticRuntime in lockstep or threaded mode (device_spec.h). buildScene attaches it;
+// stepScene steps a scene with or without it.
 //
 //   Threads (threaded mode) | may touch
 //   simulation (the caller of stepScene / finish) | the world, hands, couplings; the loops'
 //       buffers as reader of commands and writer of wrenches
-//   one haptic thread per device hand | its device; its loop's buffers as the other side
+//   one haptic thread per device (hand or tool) | its device; its loop's buffers as the other side
 // In lockstep mode everything runs on the caller's thread.
 
 #include <memory>
@@ -24,7 +25,8 @@ namespace torsion::scene {
 
 class SceneHaptics {
  public:
-  /// Opens the devices of the scene's device hands and couples them. Errors name the hand.
+  /// Opens the devices of the scene's device hands and tools and couples them. Errors name the
+  /// hand or the rigid body.
   static Result<std::unique_ptr<SceneHaptics>> attach(BuiltScene& scene);
   ~SceneHaptics();
 
@@ -38,27 +40,34 @@ class SceneHaptics {
   /// wall-clock time (step() does it too; call it first to keep the wait out of a step's
   /// timing). Lockstep: nothing.
   void pace();
-  /// Stops the threads (zero wrench to every device), writes haptic_<hand>.csv per device hand
-  /// into `directory` and returns per-hand statistics for summary.json.
+  /// Stops the threads (zero wrench to every device), writes haptic_<name>.csv per device (hand
+  /// or tool) into `directory` and returns per-device statistics for summary.json.
   Result<nlohmann::json> finish(const std::string& directory);
 
-  /// The names of the logs finish() writes, "haptic_<hand>.csv" per device hand.
+  /// The names of the logs finish() writes, "haptic_<name>.csv" per device.
   std::vector<std::string> logFileNames() const;
 
-  /// One line per device hand: "hand 'h': device scripted(f.json), lockstep at 1000 Hz".
+  /// One line per device: "hand 'h': device scripted(f.json), lockstep haptic loop at 1000 Hz"
+  /// ("tool 'probe': ..." for a tool).
   std::vector<std::string> describe() const;
   /// The runtime's warnings, and a refused --sim-priority.
   std::vector<std::string> warnings() const;
 
  private:
   struct Channel {
-    std::string hand;
+    std::string name;  ///< the hand's or the tool's
+    bool tool = false;
     std::unique_ptr<device::HapticDevice> device;
-    std::unique_ptr<haptics::HandCoupling> coupling;
+    std::unique_ptr<haptics::DeviceCoupling> coupling;
     std::unique_ptr<device::HapticLoop> loop;
     double rate_hz = 1000;
   };
   SceneHaptics() = default;
+  /// `spec`'s device, opened, and its loop (the coupling is the caller's); `entry` names it in
+  /// errors. In lockstep every loop must tick at the rate of the first (`first_rate_hz`, 0: none
+  /// yet).
+  Result<Channel> openChannel(const DeviceSpec& spec, const std::string& entry,
+                              double first_rate_hz) const;
   nlohmann::json statistics(const Channel& channel) const;
 
   HapticsMode mode_ = HapticsMode::kLockstep;

@@ -404,8 +404,8 @@ HandSpec readSceneHand(const JsonObject& h, const SceneSpec& scene,
 }
 
 // A rigid body of rigid_bodies or of the .bullet file, checked against those read before it.
-void readSceneRigidBody(const JsonObject& r, SceneSpec& scene) {
-  scene.rigid_bodies.push_back(readRigidBody(r, scene.rigid_bodies));
+void readSceneRigidBody(const JsonObject& r, const std::string& base_directory, SceneSpec& scene) {
+  scene.rigid_bodies.push_back(readRigidBody(r, scene.rigid_bodies, base_directory));
   // The series names a rigid body's files "rigid_<name>_<step>.vtu", a FEM body's
   // "<name>_<step>.vtu" (docs/outputs.md): FEM body "rigid_X" and rigid body "X" would share
   // them.
@@ -421,7 +421,7 @@ void readSceneRigidBody(const JsonObject& r, SceneSpec& scene) {
 // Rigid bodies, the ground, a .bullet file's rigid bodies and the camera.
 void readSurroundings(const JsonObject& root, const std::string& base_directory, SceneSpec& scene) {
   for (const JsonObject& r : root.objects("rigid_bodies"))
-    readSceneRigidBody(r, scene);
+    readSceneRigidBody(r, base_directory, scene);
   if (root.has("ground")) scene.ground = readGround(root.object("ground"));
   if (root.has("bullet_file")) {
     scene.bullet_file = resolved(root.string("bullet_file"), base_directory);
@@ -431,7 +431,7 @@ void readSurroundings(const JsonObject& root, const std::string& base_directory,
     const std::string where = scene.file + ": bullet_file: " + scene.bullet_file;
     const JsonObject file(imported.value(), "", where);
     for (const JsonObject& r : file.objects("rigid_bodies"))
-      readSceneRigidBody(r, scene);
+      readSceneRigidBody(r, base_directory, scene);
     file.finish();
   }
   scene.camera = readCameraSpec(root);

@@ -8,7 +8,7 @@
 //   energy.csv    per step, per body: kinetic and elastic energy
 //   <body>.vtk    final mesh of each body with its displacement (last good state on failure)
 //   rigid.csv     per step, per rigid body: pose and velocity (scenes with rigid bodies)
-//   haptic_<hand>.csv  the haptic loop's log per device hand
+//   haptic_<name>.csv  the haptic loop's log per device (hand or tool)
 // How the directory is kept consistent across runs and stops (completed, error, signal, kill):
 // run_directory.h and docs/outputs.md.
 

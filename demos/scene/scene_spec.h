@@ -114,8 +114,12 @@ struct RigidBodySpec {
   double friction = 0.5;              ///< Bullet's default; a pair's coefficient is the product
   double restitution = 0;             ///< rigid-rigid only (FEM-rigid contact is inelastic)
   std::vector<MotionSpec> kinematic;  ///< non-empty: kinematic, motions composed in order
+  /// A device holds the body: it is a tool, pulled toward the device's pose by a virtual
+  /// coupling; the device's zero pose sits at `pose` (device_spec.h). Dynamic bodies only.
+  std::optional<DeviceSpec> device;
 
   bool isKinematic() const { return !kinematic.empty(); }
+  bool isTool() const { return device.has_value(); }
   /// The scripted pose at time t (kinematic), else `pose`.
   Frame poseAt(double t) const;
 };

@@ -566,7 +566,7 @@ EOF
     expect_out "^error: twist.json: hands\[0\] 'hand': device: missing.json: cannot open: No such file or directory$"
     run "$torsion" run twist.json --device foot=spacemouse --out out --steps 5
     expect_rc nonzero
-    expect_out "^error: --device 'foot=spacemouse': the scene has no hand named 'foot' \(hands: 'hand'\)$"
+    expect_out "^error: --device 'foot=spacemouse': the scene has no hand or dynamic rigid body named 'foot' \(hands: 'hand'\)$"
     # No spacenavd runs here: the SpaceMouse says what is missing (daemon, or libspnav itself).
     if [[ ! -e /var/run/spnav.sock ]]; then
       run "$torsion" run twist.json --device hand=spacemouse --out out --steps 5

@@ -2,6 +2,8 @@
 // whole path a scene takes: ScriptedDevice -> HapticLoop (lockstep, 1 kHz) -> HapticRuntime ->
 // ToolCoupling -> Bullet's rigid solve and the FEM contact island -> the wrench the loop renders.
 
+#include "torsion/haptics/tool_coupling.h"
+
 #include <btBulletDynamicsCommon.h>
 #include <gtest/gtest.h>
 
@@ -14,7 +16,6 @@
 #include "torsion/device/haptic_loop.h"
 #include "torsion/device/scripted_device.h"
 #include "torsion/haptics/haptic_runtime.h"
-#include "torsion/haptics/tool_coupling.h"
 #include "torsion/mesh/box_mesh.h"
 
 namespace torsion::haptics {
@@ -36,9 +37,9 @@ device::Pose devicePose(double x, double y, double z) {
 // A soft slab (0.1 x 0.1 x 0.02 m, base held at z = 0) and a sphere probe (radius 1 cm) held by a
 // scripted device whose zero pose is the probe's start, 5 mm above the slab.
 struct ProbeRig {
-  static constexpr double kRadius = 0.01;    // m
+  static constexpr double kRadius = 0.01;     // m
   static constexpr double kProbeMass = 0.02;  // kg
-  static constexpr double kTop = 0.02;       // m, the slab's top face
+  static constexpr double kTop = 0.02;        // m, the slab's top face
   std::unique_ptr<FemWorld> world;
   FemBody* slab = nullptr;
   int base_group = -1;
@@ -76,11 +77,10 @@ struct ProbeRig {
     probe->setFriction(btScalar(friction));
     DeviceMapping mapping;
     mapping.anchor.origin = start;
-    coupling = ToolCoupling::create(*probe, world->bulletWorld().getDispatcher(), mapping,
-                                    settings)
+    coupling = ToolCoupling::create(*probe, world->bulletWorld().getDispatcher(), mapping, settings)
                    .value();
-    device = std::make_unique<device::ScriptedDevice>(
-        device::Trajectory(keyframes, {}), device::defaultDeviceLimits(), "probe");
+    device = std::make_unique<device::ScriptedDevice>(device::Trajectory(keyframes, {}),
+                                                      device::defaultDeviceLimits(), "probe");
     device::HapticLoopSettings loop_settings;
     loop_settings.buttons_switch_force = false;
     loop = std::make_unique<device::HapticLoop>(*device, loop_settings);
@@ -96,7 +96,9 @@ struct ProbeRig {
   }
   Eigen::Vector3d probeCentre() const { return toEigen(probe->getCenterOfMassPosition()); }
   /// The force the slab's base carries (what the body pushes its held base nodes with).
-  Eigen::Vector3d baseForce() { return slab->groupWrench(base_group, Eigen::Vector3d::Zero()).force; }
+  Eigen::Vector3d baseForce() {
+    return slab->groupWrench(base_group, Eigen::Vector3d::Zero()).force;
+  }
 };
 
 std::vector<device::TrajectoryKeyframe> pressThenHold(double depth) {
@@ -178,7 +180,7 @@ TEST(ToolCoupling, SlidingOverTheSlabTheDeviceFeelsMuTimesTheNormalForce) {
 // The probe 5 mm above a static rigid box (its top at z = 0), the device's zero pose at the
 // probe's start; the loop logs every tick.
 struct WallRig {
-  static constexpr double kRadius = 0.01;  // m
+  static constexpr double kRadius = 0.01;     // m
   static constexpr double kStiffness = 1000;  // N/m, the coupling's
   std::unique_ptr<FemWorld> world;
   btRigidBody* probe = nullptr;
@@ -195,17 +197,16 @@ struct WallRig {
     world->addRigidBody(std::make_unique<btBoxShape>(btVector3(0.1, 0.1, 0.05)), 0,
                         at({0, 0, -0.05}));
     const Eigen::Vector3d start(0, 0, kRadius + 0.005);
-    probe = world->addRigidBody(std::make_unique<btSphereShape>(btScalar(kRadius)), 0.02,
-                                at(start));
+    probe =
+        world->addRigidBody(std::make_unique<btSphereShape>(btScalar(kRadius)), 0.02, at(start));
     DeviceMapping mapping;
     mapping.anchor.origin = start;
     ToolCouplingSettings settings;
     settings.stiffness = kStiffness;
-    coupling = ToolCoupling::create(*probe, world->bulletWorld().getDispatcher(), mapping,
-                                    settings)
+    coupling = ToolCoupling::create(*probe, world->bulletWorld().getDispatcher(), mapping, settings)
                    .value();
-    device = std::make_unique<device::ScriptedDevice>(
-        device::Trajectory(keyframes, {}), device::defaultDeviceLimits(), "probe");
+    device = std::make_unique<device::ScriptedDevice>(device::Trajectory(keyframes, {}),
+                                                      device::defaultDeviceLimits(), "probe");
     device::HapticLoopSettings loop_settings;
     loop_settings.buttons_switch_force = false;
     loop_settings.log_capacity = 10000;
@@ -260,7 +261,8 @@ TEST(ToolCoupling, ARigidWallFeelsAsStiffAsTheCouplingAtTheLoopsRate) {
 TEST(ToolCoupling, ADeviceLostMidPressFadesToZeroWithoutAJumpAndTheToolHolds) {
   // The device dies 5 mm deep in the wall: the loop fades its output to zero within fade_time
   // (0.2 s) at the filter's rate limit, and the tool stays where the last goal held it.
-  WallRig rig({{0, devicePose(0, 0, 0)}, {1.0, devicePose(0, 0, -0.01)}, {3, devicePose(0, 0, -0.01)}});
+  WallRig rig(
+      {{0, devicePose(0, 0, 0)}, {1.0, devicePose(0, 0, -0.01)}, {3, devicePose(0, 0, -0.01)}});
   rig.device->dieAt(1.2);
   rig.run(2.0);
   const device::SafetySettings safety;
@@ -274,7 +276,7 @@ TEST(ToolCoupling, ADeviceLostMidPressFadesToZeroWithoutAJumpAndTheToolHolds) {
       EXPECT_EQ(row.output.force.z, 0.0) << "t = " << row.time;
     }
   }
-  EXPECT_GT(output_at_death, 4.0);  // N: it was pressing
+  EXPECT_GT(output_at_death, 4.0);                                  // N: it was pressing
   EXPECT_LE(largest_change, safety.max_force_rate * 0.001 + 1e-9);  // N per tick: no jump
   EXPECT_NEAR(toEigen(rig.probe->getCenterOfMassPosition()).z(), WallRig::kRadius, 5e-4);
   EXPECT_NEAR(rig.coupling->worldWrench().force.z(), 5.0, 1e-3);  // the last goal still held
@@ -283,7 +285,8 @@ TEST(ToolCoupling, ADeviceLostMidPressFadesToZeroWithoutAJumpAndTheToolHolds) {
 TEST(ToolCoupling, AJammedToolIsPushedWithAtMostMaxForceAndTheDeviceAtItsLimit) {
   // The device goes 1 m into the wall: the spring would pull with 1000 N; capped at max_force
   // (100 N) the probe stays on the wall, and the device renders at most its own limit (30 N).
-  WallRig rig({{0, devicePose(0, 0, 0)}, {1.0, devicePose(0, 0, -1.0)}, {3, devicePose(0, 0, -1.0)}});
+  WallRig rig(
+      {{0, devicePose(0, 0, 0)}, {1.0, devicePose(0, 0, -1.0)}, {3, devicePose(0, 0, -1.0)}});
   rig.run(2.0);
   EXPECT_NEAR(rig.coupling->couplingWrench().force.z(), -100.0, 1e-6);
   EXPECT_NEAR(toEigen(rig.probe->getCenterOfMassPosition()).z(), WallRig::kRadius, 5e-4);
@@ -298,7 +301,9 @@ TEST(ToolCoupling, AStiffCouplingOnALightToolIsStableInFreeSpace) {
   // k = 1e6 N/m on a 20 g probe at dt = 0.01 s: k dt^2 / m = 5000, far past any explicit
   // spring's limit. Integrated with the tool, it follows a device that jerks 5 cm sideways in
   // one step without overshoot, and feels nothing once they move together.
-  ProbeRig rig({{0, devicePose(0, 0, 0)}, {0.5, devicePose(0, 0, 0)}, {0.51, devicePose(0.05, 0, 0.01)},
+  ProbeRig rig({{0, devicePose(0, 0, 0)},
+                {0.5, devicePose(0, 0, 0)},
+                {0.51, devicePose(0.05, 0, 0.01)},
                 {2, devicePose(0.05, 0, 0.01)}},
                9.81, [] {
                  ToolCouplingSettings s;

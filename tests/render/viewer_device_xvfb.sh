@@ -90,6 +90,6 @@ out=$(view --frames 5 --device foot=spacemouse)
 rc=$?
 echo "$out"
 [ $rc -eq 1 ] || fail "unknown hand: exit code $rc, expected 1"
-echo "$out" | grep -qx "error: --device 'foot=spacemouse': the scene has no hand named 'foot' (hands: 'hand')" ||
+echo "$out" | grep -qx "error: --device 'foot=spacemouse': the scene has no hand or dynamic rigid body named 'foot' (hands: 'hand')" ||
   fail "unknown hand: unexpected message"
 echo "PASS: unknown hand refused"

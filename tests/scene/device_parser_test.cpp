@@ -188,9 +188,10 @@ TEST(DeviceOverride, KeepsTheScenesMappingAndNamesFaults) {
   EXPECT_EQ(s.hands[0].device->kind, DeviceSpec::Kind::kSpaceMouse);
   EXPECT_EQ(s.hands[0].device->position_scale, 10);
 
-  EXPECT_TRUE(failsWith(applyDeviceOverride(s, "foot=network:1"),
-                        {"--device 'foot=network:1'", "no hand named 'foot'", "'hand'"}));
-  EXPECT_TRUE(failsWith(applyDeviceOverride(s, "network:1"), {"expected HAND=TYPE[:ARG]"}));
+  EXPECT_TRUE(failsWith(
+      applyDeviceOverride(s, "foot=network:1"),
+      {"--device 'foot=network:1'", "no hand or dynamic rigid body named 'foot'", "'hand'"}));
+  EXPECT_TRUE(failsWith(applyDeviceOverride(s, "network:1"), {"expected NAME=TYPE[:ARG]"}));
   EXPECT_TRUE(
       failsWith(applyDeviceOverride(s, "hand=network:port"), {"port 'port' is not a number"}));
   EXPECT_TRUE(failsWith(applyDeviceOverride(s, "hand=scripted"), {"scripted needs a file"}));
@@ -200,6 +201,72 @@ TEST(DeviceOverride, KeepsTheScenesMappingAndNamesFaults) {
                         {"plugin-inproc needs a shared library: plugin-inproc:LIBRARY[:CONFIG]"}));
   EXPECT_TRUE(failsWith(parseHapticsMode("fast"), {"--haptics 'fast'", "lockstep or threaded"}));
   EXPECT_TRUE(parseHapticsMode("threaded").ok());
+}
+
+// A scene with one rigid body `body` (JSON object text) beside the hand of sceneWith("").
+std::string sceneWithRigidBody(const std::string& body) {
+  std::string scene = sceneWith("");
+  scene.pop_back();  // the closing brace
+  return scene + R"(, "rigid_bodies": [)" + body + "]}";
+}
+
+TEST(ToolDevice, ADynamicRigidBodyWithADeviceIsATool) {
+  Result<SceneSpec> r = parse(sceneWithRigidBody(R"({"name": "probe", "mass": 0.02,
+      "shape": {"sphere": {"radius": 0.01}},
+      "device": {"type": "scripted", "trajectory": "t/p.json", "limits": {"max_force": 8},
+                 "coupling": {"stiffness": 700, "angular_stiffness": 2, "damping_ratio": 0.5,
+                              "max_force": 40, "max_torque": 4, "feel_weight": true},
+                 "rate_hz": 500}})"));
+  ASSERT_TRUE(r.ok()) << r.error().message;
+  const RigidBodySpec& probe = r.value().rigid_bodies.at(0);
+  ASSERT_TRUE(probe.isTool());
+  const DeviceSpec& d = *probe.device;
+  EXPECT_EQ(d.file, "/base/t/p.json");
+  EXPECT_EQ(d.max_force, 8);
+  EXPECT_EQ(d.tool.stiffness, 700);
+  EXPECT_EQ(d.tool.angular_stiffness, 2);
+  EXPECT_EQ(d.tool.damping_ratio, 0.5);
+  EXPECT_EQ(d.tool.max_force, 40);
+  EXPECT_EQ(d.tool.max_torque, 4);
+  EXPECT_TRUE(d.tool.feel_weight);
+  EXPECT_EQ(d.loop.rate_hz, 500);
+  EXPECT_FALSE(d.loop.buttons_switch_force) << "a tool is held from the start";
+}
+
+TEST(ToolDevice, FaultsNameTheRigidBodyAndTheKey) {
+  const std::string sphere = R"("shape": {"sphere": {"radius": 0.01}})";
+  const std::string device = R"("device": {"type": "scripted", "trajectory": "p.json")";
+  EXPECT_TRUE(failsWith(
+      parse(sceneWithRigidBody(R"({"name": "wall", "mass": 0, )" + sphere + ", " + device + "}}")),
+      {"s.json", "rigid_bodies[0]", "device", "must be a dynamic body (mass > 0)"}));
+  EXPECT_TRUE(failsWith(parse(sceneWithRigidBody(R"({"name": "p", "mass": 1, )" + sphere + ", " +
+                                                 device + R"(, "rendering": "internal_force"}})")),
+                        {"rigid_bodies[0]", "rendering", "a hand's key"}));
+  EXPECT_TRUE(failsWith(parse(sceneWithRigidBody(R"({"name": "p", "mass": 1, )" + sphere + ", " +
+                                                 device + R"(, "coupling": {"stiffness": 0}}})")),
+                        {"rigid_bodies[0]", "coupling", "stiffness", "must be > 0"}));
+  EXPECT_TRUE(
+      failsWith(parse(sceneWithRigidBody(R"({"name": "p", "mass": 1, )" + sphere + ", " + device +
+                                         R"(, "coupling": {"force_coefficient": 0.1}}})")),
+                {"rigid_bodies[0]", "coupling", "force_coefficient"}));
+}
+
+TEST(ToolDevice, TheCommandLineHandsADynamicRigidBodyADevice) {
+  Result<SceneSpec> r = parse(sceneWithRigidBody(
+      R"({"name": "probe", "mass": 0.02, "shape": {"sphere": {"radius": 0.01}}},
+         {"name": "wall", "mass": 0, "shape": {"box": {"half_extents": [1, 1, 1]}}})"));
+  ASSERT_TRUE(r.ok()) << r.error().message;
+  SceneSpec s = r.value();
+  ASSERT_TRUE(applyDeviceOverride(s, "probe=network:5751").ok());
+  ASSERT_TRUE(s.rigid_bodies[0].isTool());
+  EXPECT_EQ(s.rigid_bodies[0].device->kind, DeviceSpec::Kind::kNetwork);
+  EXPECT_EQ(s.rigid_bodies[0].device->port, 5751);
+  EXPECT_FALSE(s.rigid_bodies[0].device->loop.buttons_switch_force);
+  EXPECT_FALSE(s.hands[0].device.has_value());
+  // A static body cannot be a tool; the message lists what can.
+  EXPECT_TRUE(failsWith(applyDeviceOverride(s, "wall=spacemouse"),
+                        {"no hand or dynamic rigid body named 'wall'", "hands: 'hand'",
+                         "dynamic rigid bodies: 'probe'"}));
 }
 
 }  // namespace device_parser_test
