@@ -113,6 +113,7 @@ void HapticLoop::tick(double now, double deadline) {
   command.time = now;
   command.pose = sample.pose;
   command.alive = sample.alive;
+  command.buttons = previous_buttons_;
   command.grab_requests = grab_requests_;
   command.release_requests = release_requests_;
   commands_.write(command);

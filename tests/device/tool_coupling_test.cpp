@@ -15,6 +15,7 @@
 #include "torsion/bullet/fem_world.h"
 #include "torsion/device/haptic_loop.h"
 #include "torsion/device/scripted_device.h"
+#include "torsion/haptics/grasper_coupling.h"
 #include "torsion/haptics/haptic_runtime.h"
 #include "torsion/mesh/box_mesh.h"
 
@@ -334,6 +335,115 @@ TEST(ToolCoupling, OnlyADynamicBodyWithValidSettingsCanBeATool) {
       ToolCoupling::create(*rig.probe, nullptr, DeviceMapping{}, bad);
   ASSERT_FALSE(refused.ok());
   EXPECT_NE(refused.error().message.find("stiffness"), std::string::npos);
+}
+
+// A soft block (0.1 m cube, E 5e4 Pa, 0.2 kg) on the ground and a grasper above it: a palm
+// (0.5 kg) with two jaws (0.1 kg, 2 x 8 x 8 cm) 14 cm apart, on a scripted device that lowers
+// it 0.1 m over 1 s, holds button 1 from 1.2 s, lifts 0.15 m over 1 s from 2 s and holds.
+struct GraspRig {
+  std::unique_ptr<FemWorld> world;
+  FemBody* block = nullptr;
+  btRigidBody* palm = nullptr;
+  std::array<btRigidBody*, 2> jaws{};
+  std::unique_ptr<GrasperCoupling> grasper;
+  std::unique_ptr<device::ScriptedDevice> device;
+  std::unique_ptr<device::HapticLoop> loop;
+  std::unique_ptr<HapticRuntime> runtime;
+
+  GraspRig() {
+    WorldSettings ws;
+    ws.solver.time_step = 0.01;
+    ws.solver.threads = 1;
+    world = std::make_unique<FemWorld>(ws);
+    btRigidBody* ground = world->addRigidBody(
+        std::make_unique<btStaticPlaneShape>(btVector3(0, 0, 1), 0), 0, at({0, 0, 0}));
+    ground->setFriction(0.5);
+    Material material;
+    material.youngs_modulus = 5e4;
+    material.density = 200;
+    material.mass_damping = 1;
+    material.stiffness_damping = 0.01;
+    block = world
+                ->addBody("block", makeBoxTetMesh({-0.05, -0.05, 0}, {0.05, 0.05, 0.1}, 4, 4, 4).value(),
+                          material)
+                .value();
+    const Eigen::Vector3d palm_at(0, 0, 0.24);
+    palm = world->addRigidBody(std::make_unique<btBoxShape>(btVector3(0.1, 0.04, 0.01)), 0.5,
+                               at(palm_at));
+    for (int side : {0, 1}) {
+      const double x = (side == 0 ? -1 : 1) * (0.07 + 0.01);
+      jaws[static_cast<size_t>(side)] = world->addRigidBody(
+          std::make_unique<btBoxShape>(btVector3(0.01, 0.04, 0.04)), 0.1,
+          at(palm_at + Eigen::Vector3d(x, 0, -0.05)));
+      jaws[static_cast<size_t>(side)]->setFriction(0.8);
+    }
+    DeviceMapping mapping;
+    mapping.anchor.origin = palm_at;
+    ToolCouplingSettings coupling;
+    coupling.stiffness = 2000;
+    coupling.angular_stiffness = 50;
+    GrasperSettings settings;
+    settings.opening = 0.14;
+    settings.grip_force = 20;
+    grasper = GrasperCoupling::create(world->bulletWorld(), *palm, jaws, mapping, coupling,
+                                      settings)
+                  .value();
+    device = std::make_unique<device::ScriptedDevice>(
+        device::Trajectory({{0, devicePose(0, 0, 0)},
+                            {1.0, devicePose(0, 0, -0.1)},
+                            {2.0, devicePose(0, 0, -0.1)},
+                            {3.0, devicePose(0, 0, 0.05)},
+                            {20, devicePose(0, 0, 0.05)}},
+                           {{0, 0u}, {1.2, 1u}}),
+        device::defaultDeviceLimits(), "grasper");
+    device::HapticLoopSettings loop_settings;
+    loop_settings.buttons_switch_force = false;
+    loop = std::make_unique<device::HapticLoop>(*device, loop_settings);
+    runtime = std::make_unique<HapticRuntime>(
+        *world, std::vector<HapticBinding>{{grasper.get(), loop.get(), 1000}});
+    runtime->setLockstep(true);
+  }
+  void run(double seconds) {
+    const int steps = static_cast<int>(std::lround(seconds / 0.01));
+    for (int k = 0; k < steps; ++k)
+      ASSERT_TRUE(runtime->step().ok) << "step " << k;
+  }
+  Eigen::Vector3d blockCentre() const {
+    Eigen::Vector3d c = Eigen::Vector3d::Zero();
+    double m = 0;
+    for (int i = 0; i < block->model().nodeCount(); ++i) {
+      c += block->model().nodeMasses()[static_cast<size_t>(i)] * block->state().position(i);
+      m += block->model().nodeMasses()[static_cast<size_t>(i)];
+    }
+    return c / m;
+  }
+  Eigen::Vector3d palmCentre() const { return toEigen(palm->getCenterOfMassPosition()); }
+};
+
+TEST(GrasperCoupling, LiftsASoftBlockByFrictionAndHoldsIt5sWithoutSlipping) {
+  GraspRig rig;
+  rig.run(1.1);
+  EXPECT_FALSE(rig.grasper->closing());
+  EXPECT_NEAR(rig.grasper->gap(), 0.14, 1e-3);  // m: open
+  rig.run(0.9);  // closed on the block
+  EXPECT_TRUE(rig.grasper->closing());
+  EXPECT_LT(rig.grasper->gap(), 0.1);  // m: squeezing the 0.1 m block
+  rig.run(1.5);  // lifted 0.15 m
+  const double lifted = rig.blockCentre().z() - 0.05;
+  std::printf("block lifted %.4f m, gap %.4f m, felt %.3f N\n", lifted, rig.grasper->gap(),
+              rig.grasper->palm().worldWrench().force.z());
+  ASSERT_GT(lifted, 0.12);
+  const Eigen::Vector3d held = rig.blockCentre() - rig.palmCentre();
+  rig.run(5.0);
+  const double slip = (rig.blockCentre() - rig.palmCentre() - held).norm();
+  std::printf("slip over 5 s: %.3g mm\n", 1e3 * slip);
+  EXPECT_LT(slip, 1e-3);  // m
+  // The device feels the block's weight (the grasper's own compensated), pulling down.
+  double block_mass = 0;
+  for (double m : rig.block->model().nodeMasses())
+    block_mass += m;
+  EXPECT_NEAR(rig.grasper->palm().worldWrench().force.z(), -9.81 * block_mass,
+              0.02 * 9.81 * block_mass);
 }
 
 }  // namespace tool_coupling_test

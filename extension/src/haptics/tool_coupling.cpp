@@ -162,7 +162,7 @@ void ToolCoupling::afterFemStep(const StepContext& /*ctx*/, bool /*ok*/) {
       angular_damping_ * (goal_angular_velocity_ - toEigen(tool_.getAngularVelocity()));
   world_wrench_.force = -coupling_.force;
   world_wrench_.torque = -coupling_.torque;
-  if (!settings_.feel_weight) world_wrench_.force -= mass_ * gravity_;
+  if (!settings_.feel_weight) world_wrench_.force -= (mass_ + carried_mass_) * gravity_;
 
   Matrix6d k_c = Matrix6d::Zero();
   k_c.topLeftCorner<3, 3>().diagonal().setConstant(settings_.stiffness);

@@ -53,6 +53,9 @@ struct HandCommand {
   double time = 0;         ///< s, loop clock
   Pose pose;
   bool alive = false;                  ///< the device answered this tick
+  /// Buttons held (bit k: button k+1), as last read from a live device (a grasper's jaws close
+  /// while its button is held; a dead device's last buttons stand).
+  std::uint32_t buttons = 0;
   std::uint32_t grab_requests = 0;     ///< button 1 presses so far (report section 5.4)
   std::uint32_t release_requests = 0;  ///< button 2 presses so far
 };

@@ -76,6 +76,9 @@ class ToolCoupling : public DeviceCoupling {
   device::SimulationWrench publish(std::uint64_t step) override;
   std::uint64_t rejectedPoses() const override { return rejected_poses_; }
 
+  /// Parts carried with the tool (a grasper's jaws): their weight is compensated with its own
+  /// unless `feel_weight`.
+  void addCarriedMass(double kg) { carried_mass_ += kg; }
   /// The device's frame in the world: where the coupling pulls the tool.
   const Frame& goal() const { return goal_; }
   /// The coupling's pull on the tool at the last step's end (world, about the tool's centre).
@@ -85,6 +88,7 @@ class ToolCoupling : public DeviceCoupling {
   /// K_h of the last publish(), world frame.
   const Matrix6d& worldStiffness() const { return world_stiffness_; }
   btRigidBody& tool() { return tool_; }
+  const btRigidBody& tool() const { return tool_; }
 
  private:
   ToolCoupling(btRigidBody& tool, btDispatcher* dispatcher, const DeviceMapping& mapping,
@@ -100,6 +104,7 @@ class ToolCoupling : public DeviceCoupling {
   DeviceMapping mapping_;
   ToolCouplingSettings settings_;
   double mass_ = 0;                                          // the tool's own, kg
+  double carried_mass_ = 0;  // kg, carried parts whose weight is compensated with it
   Eigen::Vector3d local_inertia_ = Eigen::Vector3d::Zero();  // its principal moments, kg m^2
   double linear_damping_ = 0, angular_damping_ = 0;          // b, b_r
   // The goal and its velocity over the step
