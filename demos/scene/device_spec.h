@@ -11,6 +11,7 @@
 
 #include "torsion/device/haptic_loop.h"
 #include "torsion/device/spacemouse_integrator.h"
+#include "torsion/haptics/grasper_coupling.h"
 #include "torsion/haptics/hand_coupling.h"
 #include "torsion/haptics/tool_coupling.h"
 

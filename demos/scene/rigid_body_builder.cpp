@@ -109,6 +109,20 @@ SceneRigidBody addSceneRigidBody(FemWorld& world, const RigidBodySpec& spec) {
     added.script = std::move(script);
   }
   added.body = body;
+  if (spec.grasper) {
+    // The jaws hang below the palm's bottom face, open: their inner faces `opening` apart.
+    const GrasperSpec& g = *spec.grasper;
+    const double x = 0.5 * g.settings.opening + g.jaw_half_extents.x();
+    const double z = -(spec.half_extents.z() + g.jaw_half_extents.z());
+    for (int side : {0, 1}) {
+      Frame pose = spec.pose;
+      pose.origin = spec.pose.toWorld(Eigen::Vector3d(side == 0 ? -x : x, 0, z));
+      auto shape = std::make_unique<btBoxShape>(toBt(g.jaw_half_extents));
+      btRigidBody* jaw = world.addRigidBody(std::move(shape), g.jaw_mass, toTransform(pose));
+      jaw->setFriction(toBtScalar(g.jaw_friction));
+      added.jaws[static_cast<size_t>(side)] = jaw;
+    }
+  }
   return added;
 }
 

@@ -6,6 +6,7 @@
 
 #include <BulletDynamics/Dynamics/btRigidBody.h>
 
+#include <array>
 #include <memory>
 #include <string>
 
@@ -14,13 +15,15 @@
 
 namespace torsion::scene {
 
-/// A scene rigid body: its name (rigid.csv columns), the live body, and for a kinematic one the
-/// motion state that scripts it (owned here; the body points to it).
+/// A scene rigid body: its name (rigid.csv columns), the live body, for a kinematic one the
+/// motion state that scripts it (owned here; the body points to it), for a grasper its jaws
+/// (bodies of the world; their joints are the grasper coupling's).
 struct SceneRigidBody {
   std::string name;
   btRigidBody* body = nullptr;
   bool kinematic = false;
   std::unique_ptr<btMotionState> script;
+  std::array<btRigidBody*, 2> jaws{};
 };
 
 /// The collision shape of `spec` (also used by tests/bench to build the same bodies in Bullet's own

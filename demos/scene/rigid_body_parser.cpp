@@ -106,6 +106,36 @@ double readCoefficient(const JsonObject& r, const std::string& key, double fallb
   return value;
 }
 
+// rigid_bodies[].grasper: {"opening", "closing_speed", "grip_force", "button", "jaw":
+// {"half_extents", "mass", "friction"}}.
+GrasperSpec readGrasper(const JsonObject& g) {
+  GrasperSpec spec;
+  haptics::GrasperSettings& s = spec.settings;
+  s.opening = g.number("opening", s.opening);
+  if (!(s.opening > 0)) g.fail("opening", "must be > 0 m (the gap between the open jaws)");
+  s.closing_speed = g.number("closing_speed", s.closing_speed);
+  if (!(s.closing_speed > 0)) g.fail("closing_speed", "must be > 0 m/s");
+  s.grip_force = g.number("grip_force", s.grip_force);
+  if (!(s.grip_force > 0)) g.fail("grip_force", "must be > 0 N");
+  s.button = g.integer("button", s.button);
+  if (s.button < 1 || s.button > 32) g.fail("button", "must be in [1, 32]");
+  if (g.has("jaw")) {
+    const JsonObject j = g.object("jaw");
+    spec.jaw_half_extents = j.vector3("half_extents", spec.jaw_half_extents);
+    if (!(spec.jaw_half_extents.minCoeff() > 0)) j.fail("half_extents", "must be > 0");
+    if (!(spec.jaw_half_extents.maxCoeff() <= 1e6)) j.fail("half_extents", "must be at most 1e6 m");
+    spec.jaw_mass = j.number("mass", spec.jaw_mass);
+    if (!(spec.jaw_mass >= kMinRigidMass && spec.jaw_mass <= kMaxRigidMass)) {
+      j.fail("mass", formatNumber(spec.jaw_mass) + " kg is outside [" +
+                         formatNumber(kMinRigidMass) + ", " + formatNumber(kMaxRigidMass) + "] kg");
+    }
+    spec.jaw_friction = readCoefficient(j, "friction", spec.jaw_friction);
+    j.finish();
+  }
+  g.finish();
+  return spec;
+}
+
 }  // namespace
 
 RigidBodySpec readRigidBody(const JsonObject& r, const std::vector<RigidBodySpec>& earlier,
@@ -154,6 +184,12 @@ RigidBodySpec readRigidBody(const JsonObject& r, const std::vector<RigidBodySpec
              "and what it touches stops it");
     }
     spec.device = readToolDevice(r, base_directory);  // device_parser.cpp
+  }
+  if (r.has("grasper")) {
+    if (!spec.device) r.fail("grasper", "a grasper is held by a device: give the body a 'device'");
+    if (spec.shape != RigidBodySpec::Shape::kBox)
+      r.fail("grasper", "a grasper's palm is a box (its jaws hang below its bottom face)");
+    spec.grasper = readGrasper(r.object("grasper"));
   }
   r.finish();
   return spec;

@@ -123,11 +123,20 @@ Result<std::unique_ptr<SceneHaptics>> SceneHaptics::attach(BuiltScene& scene) {
     Channel c = std::move(opened).value();
     c.name = r.name;
     c.tool = true;
-    Result<std::unique_ptr<haptics::ToolCoupling>> coupling = haptics::ToolCoupling::create(
-        *scene.rigid_bodies[i].body, scene.world->bulletWorld().getDispatcher(),
-        mappingFor(*r.device, r.pose), r.device->tool);
-    if (!coupling) return Error{entry + ": " + coupling.error().message};
-    c.coupling = std::move(coupling).value();
+    const SceneRigidBody& built = scene.rigid_bodies[i];
+    if (r.grasper) {
+      Result<std::unique_ptr<haptics::GrasperCoupling>> grasper = haptics::GrasperCoupling::create(
+          scene.world->bulletWorld(), *built.body, built.jaws, mappingFor(*r.device, r.pose),
+          r.device->tool, r.grasper->settings);
+      if (!grasper) return Error{entry + ": " + grasper.error().message};
+      c.coupling = std::move(grasper).value();
+    } else {
+      Result<std::unique_ptr<haptics::ToolCoupling>> tool =
+          haptics::ToolCoupling::create(*built.body, scene.world->bulletWorld().getDispatcher(),
+                                        mappingFor(*r.device, r.pose), r.device->tool);
+      if (!tool) return Error{entry + ": " + tool.error().message};
+      c.coupling = std::move(tool).value();
+    }
     bindings.push_back({c.coupling.get(), c.loop.get(), c.rate_hz});
     h->channels_.push_back(std::move(c));
   }

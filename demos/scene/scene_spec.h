@@ -91,6 +91,16 @@ struct HandSpec {
   Frame frameAt(double t) const;
 };
 
+/// A tool's two jaws (docs/scene-format.md, rigid_bodies[].grasper): boxes hanging below a box
+/// palm on prismatic joints along the palm's local x, closed while the device's button is held
+/// (torsion/haptics/grasper_coupling.h).
+struct GrasperSpec {
+  haptics::GrasperSettings settings;
+  Eigen::Vector3d jaw_half_extents = Eigen::Vector3d(0.01, 0.03, 0.03);  ///< m
+  double jaw_mass = 0.05;                                                ///< kg, each
+  double jaw_friction = 0.8;
+};
+
 /// A Bullet rigid body (docs/scene-format.md, rigid_bodies[]). Dynamic when mass > 0, static when
 /// mass is 0, kinematic when `kinematic` holds a motion: its pose is then scripted (the motions
 /// composed in order, applied to `pose`) and it pushes FEM and rigid bodies without being pushed.
@@ -117,6 +127,8 @@ struct RigidBodySpec {
   /// A device holds the body: it is a tool, pulled toward the device's pose by a virtual
   /// coupling; the device's zero pose sits at `pose` (device_spec.h). Dynamic bodies only.
   std::optional<DeviceSpec> device;
+  /// With a device on a box: the tool is a grasper, with two jaws below the box.
+  std::optional<GrasperSpec> grasper;
 
   bool isKinematic() const { return !kinematic.empty(); }
   bool isTool() const { return device.has_value(); }

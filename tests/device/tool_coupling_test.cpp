@@ -364,7 +364,8 @@ struct GraspRig {
     material.mass_damping = 1;
     material.stiffness_damping = 0.01;
     block = world
-                ->addBody("block", makeBoxTetMesh({-0.05, -0.05, 0}, {0.05, 0.05, 0.1}, 4, 4, 4).value(),
+                ->addBody("block",
+                          makeBoxTetMesh({-0.05, -0.05, 0}, {0.05, 0.05, 0.1}, 4, 4, 4).value(),
                           material)
                 .value();
     const Eigen::Vector3d palm_at(0, 0, 0.24);
@@ -372,9 +373,9 @@ struct GraspRig {
                                at(palm_at));
     for (int side : {0, 1}) {
       const double x = (side == 0 ? -1 : 1) * (0.07 + 0.01);
-      jaws[static_cast<size_t>(side)] = world->addRigidBody(
-          std::make_unique<btBoxShape>(btVector3(0.01, 0.04, 0.04)), 0.1,
-          at(palm_at + Eigen::Vector3d(x, 0, -0.05)));
+      jaws[static_cast<size_t>(side)] =
+          world->addRigidBody(std::make_unique<btBoxShape>(btVector3(0.01, 0.04, 0.04)), 0.1,
+                              at(palm_at + Eigen::Vector3d(x, 0, -0.05)));
       jaws[static_cast<size_t>(side)]->setFriction(0.8);
     }
     DeviceMapping mapping;
@@ -385,17 +386,17 @@ struct GraspRig {
     GrasperSettings settings;
     settings.opening = 0.14;
     settings.grip_force = 20;
-    grasper = GrasperCoupling::create(world->bulletWorld(), *palm, jaws, mapping, coupling,
-                                      settings)
-                  .value();
-    device = std::make_unique<device::ScriptedDevice>(
-        device::Trajectory({{0, devicePose(0, 0, 0)},
-                            {1.0, devicePose(0, 0, -0.1)},
-                            {2.0, devicePose(0, 0, -0.1)},
-                            {3.0, devicePose(0, 0, 0.05)},
-                            {20, devicePose(0, 0, 0.05)}},
-                           {{0, 0u}, {1.2, 1u}}),
-        device::defaultDeviceLimits(), "grasper");
+    grasper =
+        GrasperCoupling::create(world->bulletWorld(), *palm, jaws, mapping, coupling, settings)
+            .value();
+    device =
+        std::make_unique<device::ScriptedDevice>(device::Trajectory({{0, devicePose(0, 0, 0)},
+                                                                     {1.0, devicePose(0, 0, -0.1)},
+                                                                     {2.0, devicePose(0, 0, -0.1)},
+                                                                     {3.0, devicePose(0, 0, 0.05)},
+                                                                     {20, devicePose(0, 0, 0.05)}},
+                                                                    {{0, 0u}, {1.2, 1u}}),
+                                                 device::defaultDeviceLimits(), "grasper");
     device::HapticLoopSettings loop_settings;
     loop_settings.buttons_switch_force = false;
     loop = std::make_unique<device::HapticLoop>(*device, loop_settings);
@@ -425,10 +426,10 @@ TEST(GrasperCoupling, LiftsASoftBlockByFrictionAndHoldsIt5sWithoutSlipping) {
   rig.run(1.1);
   EXPECT_FALSE(rig.grasper->closing());
   EXPECT_NEAR(rig.grasper->gap(), 0.14, 1e-3);  // m: open
-  rig.run(0.9);  // closed on the block
+  rig.run(0.9);                                 // closed on the block
   EXPECT_TRUE(rig.grasper->closing());
   EXPECT_LT(rig.grasper->gap(), 0.1);  // m: squeezing the 0.1 m block
-  rig.run(1.5);  // lifted 0.15 m
+  rig.run(1.5);                        // lifted 0.15 m
   const double lifted = rig.blockCentre().z() - 0.05;
   std::printf("block lifted %.4f m, gap %.4f m, felt %.3f N\n", lifted, rig.grasper->gap(),
               rig.grasper->palm().worldWrench().force.z());

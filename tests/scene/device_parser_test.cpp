@@ -269,5 +269,44 @@ TEST(ToolDevice, TheCommandLineHandsADynamicRigidBodyADevice) {
                          "dynamic rigid bodies: 'probe'"}));
 }
 
+TEST(ToolDevice, AGrasperIsABoxPalmWithADeviceAndJaws) {
+  const std::string device = R"("device": {"type": "scripted", "trajectory": "p.json"})";
+  Result<SceneSpec> r = parse(sceneWithRigidBody(
+      R"({"name": "g", "mass": 0.5, "shape": {"box": {"half_extents": [0.2, 0.06, 0.02]}}, )" +
+      device +
+      R"(, "grasper": {"opening": 0.3, "closing_speed": 0.1, "grip_force": 30, "button": 2,
+                       "jaw": {"half_extents": [0.015, 0.06, 0.07], "mass": 0.1, "friction": 0.9}}})"));
+  ASSERT_TRUE(r.ok()) << r.error().message;
+  const RigidBodySpec& g = r.value().rigid_bodies.at(0);
+  ASSERT_TRUE(g.grasper.has_value());
+  EXPECT_EQ(g.grasper->settings.opening, 0.3);
+  EXPECT_EQ(g.grasper->settings.closing_speed, 0.1);
+  EXPECT_EQ(g.grasper->settings.grip_force, 30);
+  EXPECT_EQ(g.grasper->settings.button, 2);
+  EXPECT_EQ(g.grasper->jaw_half_extents, Eigen::Vector3d(0.015, 0.06, 0.07));
+  EXPECT_EQ(g.grasper->jaw_mass, 0.1);
+  EXPECT_EQ(g.grasper->jaw_friction, 0.9);
+
+  EXPECT_TRUE(failsWith(
+      parse(sceneWithRigidBody(
+          R"({"name": "g", "mass": 0.5, "shape": {"box": {"half_extents": [0.2, 0.06, 0.02]}},
+                                   "grasper": {}})")),
+      {"rigid_bodies[0]", "grasper", "give the body a 'device'"}));
+  EXPECT_TRUE(failsWith(parse(sceneWithRigidBody(
+                            R"({"name": "g", "mass": 0.5, "shape": {"sphere": {"radius": 0.1}}, )" +
+                            device + R"(, "grasper": {}})")),
+                        {"rigid_bodies[0]", "grasper", "a grasper's palm is a box"}));
+  EXPECT_TRUE(failsWith(
+      parse(sceneWithRigidBody(
+          R"({"name": "g", "mass": 0.5, "shape": {"box": {"half_extents": [0.2, 0.06, 0.02]}}, )" +
+          device + R"(, "grasper": {"grip_force": -1}})")),
+      {"rigid_bodies[0]", "grasper", "grip_force", "must be > 0 N"}));
+  EXPECT_TRUE(failsWith(
+      parse(sceneWithRigidBody(
+          R"({"name": "g", "mass": 0.5, "shape": {"box": {"half_extents": [0.2, 0.06, 0.02]}}, )" +
+          device + R"(, "grasper": {"jaw": {"mass": 0}}})")),
+      {"rigid_bodies[0]", "grasper", "jaw", "mass", "kg is outside"}));
+}
+
 }  // namespace device_parser_test
 }  // namespace torsion::scene

@@ -53,8 +53,7 @@ Result<std::unique_ptr<GrasperCoupling>> GrasperCoupling::create(
 }
 
 GrasperCoupling::GrasperCoupling(btDynamicsWorld& world, std::unique_ptr<ToolCoupling> palm,
-                                 std::array<btRigidBody*, 2> jaws,
-                                 const GrasperSettings& settings)
+                                 std::array<btRigidBody*, 2> jaws, const GrasperSettings& settings)
     : world_(world), palm_(std::move(palm)), jaws_(jaws), settings_(settings) {
   btRigidBody& body = palm_->tool();
   const btTransform palm_pose = body.getCenterOfMassTransform();

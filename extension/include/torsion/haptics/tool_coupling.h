@@ -103,7 +103,7 @@ class ToolCoupling : public DeviceCoupling {
   btDispatcher* dispatcher_;
   DeviceMapping mapping_;
   ToolCouplingSettings settings_;
-  double mass_ = 0;                                          // the tool's own, kg
+  double mass_ = 0;          // the tool's own, kg
   double carried_mass_ = 0;  // kg, carried parts whose weight is compensated with it
   Eigen::Vector3d local_inertia_ = Eigen::Vector3d::Zero();  // its principal moments, kg m^2
   double linear_damping_ = 0, angular_damping_ = 0;          // b, b_r
