@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "scene_haptics.h"
 #include "torsion/fem/corotated_element.h"
 #include "torsion/fem/hyperelastic.h"
 
@@ -257,6 +258,10 @@ FrameData captureFrame(scene::BuiltScene& scene, double steps_per_second) {
   for (scene::NodeSetHandle& s : scene.node_sets) {
     const Wrench w = s.body->groupWrench(s.group, s.wrench_about);
     frame.wrenches.push_back({s.name, w.force, w.torque});
+  }
+  if (scene.haptics) {
+    for (const auto& [name, w] : scene.haptics->toolWrenches())
+      frame.wrenches.push_back({name, w.force, w.torque});  // what the tool's device renders
   }
   for (const btRigidBody* rb : world.rigidBodies()) {
     frame.rigids.push_back(rigidDrawData(*rb));

@@ -291,6 +291,14 @@ std::vector<std::string> SceneHaptics::describe() const {
   return lines;
 }
 
+std::vector<std::pair<std::string, Wrench>> SceneHaptics::toolWrenches() const {
+  std::vector<std::pair<std::string, Wrench>> wrenches;
+  for (const Channel& c : channels_) {
+    if (c.tool) wrenches.emplace_back(c.name, c.coupling->worldWrench());
+  }
+  return wrenches;
+}
+
 Result<WorldStepReport> stepScene(BuiltScene& scene) {
   Status driven = driveHands(scene);
   if (!driven) return driven.error();

@@ -50,6 +50,8 @@ class SceneHaptics {
   /// One line per device: "hand 'h': device scripted(f.json), lockstep haptic loop at 1000 Hz"
   /// ("tool 'probe': ..." for a tool).
   std::vector<std::string> describe() const;
+  /// Each tool's name and the wrench its device renders (world frame, last step).
+  std::vector<std::pair<std::string, Wrench>> toolWrenches() const;
   /// The runtime's warnings, and a refused --sim-priority.
   std::vector<std::string> warnings() const;
 

@@ -24,6 +24,9 @@ declare -A STEPS=(
   [haptic_cylinder]=700        # device at 70 s of Figure 6.7 (speed 10): turned 0.5 rad about z
   [haptic_dragon]=350          # neck turned 90 degrees and held; button 2 releases it at 4 s
   [soft_grasp]=150             # the block lifted 0.3 m between the fingers
+  [palpation]=300              # the probe halfway along its slide over the organ
+  [tool_and_hand]=350          # the probe pressed into the twisting bar
+  [grasp_lift]=350             # the block lifted 0.2 m between the jaws
 )
 
 scenes=("$@")

@@ -15,6 +15,7 @@
 #include <cstdint>
 
 #include "torsion/bullet/step_context.h"
+#include "torsion/constraints/carried_nodes.h"
 #include "torsion/device/device_types.h"
 #include "torsion/result.h"
 
@@ -31,6 +32,9 @@ class DeviceCoupling {
   }
   virtual void afterFemStep(const StepContext& /*ctx*/, bool /*ok*/) {}
   virtual device::SimulationWrench publish(std::uint64_t step) = 0;
+  /// The wrench of the last publish() in the world frame (what the device renders, before the
+  /// mapping's scales and the loop's local model).
+  virtual const Wrench& worldWrench() const = 0;
   /// Device poses refused because they were not finite or out of reach once mapped.
   virtual std::uint64_t rejectedPoses() const = 0;
 };

@@ -47,6 +47,7 @@ class GrasperCoupling : public DeviceCoupling {
   void afterFemStep(const StepContext& ctx, bool ok) override { palm_->afterFemStep(ctx, ok); }
   device::SimulationWrench publish(std::uint64_t step) override { return palm_->publish(step); }
   std::uint64_t rejectedPoses() const override { return palm_->rejectedPoses(); }
+  const Wrench& worldWrench() const override { return palm_->worldWrench(); }
 
   /// The jaws are closing (the button was held at the last step).
   bool closing() const { return closing_; }

@@ -90,7 +90,7 @@ class HandCoupling : public DeviceCoupling {
   device::SimulationWrench publish(std::uint64_t step) override;
 
   /// The rendered wrench of the last publish(), world frame, about the device frame's origin.
-  const Wrench& worldWrench() const { return world_wrench_; }
+  const Wrench& worldWrench() const override { return world_wrench_; }
   /// K_h of the last publish(), world frame.
   const Matrix6d& worldStiffness() const { return world_stiffness_; }
   /// The device's frame in the world (the goal given to the hand).

@@ -84,7 +84,7 @@ class ToolCoupling : public DeviceCoupling {
   /// The coupling's pull on the tool at the last step's end (world, about the tool's centre).
   const Wrench& couplingWrench() const { return coupling_; }
   /// The rendered wrench of the last step, world frame: -(coupling + weight unless felt).
-  const Wrench& worldWrench() const { return world_wrench_; }
+  const Wrench& worldWrench() const override { return world_wrench_; }
   /// K_h of the last publish(), world frame.
   const Matrix6d& worldStiffness() const { return world_stiffness_; }
   btRigidBody& tool() { return tool_; }
