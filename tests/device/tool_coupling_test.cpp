@@ -447,5 +447,89 @@ TEST(GrasperCoupling, LiftsASoftBlockByFrictionAndHoldsIt5sWithoutSlipping) {
               0.02 * 9.81 * block_mass);
 }
 
+// Hertz's force for a rigid sphere (radius r) pressed `depth` into an elastic layer of
+// thickness h bonded to a rigid base, frictionless: F = 4/3 E/(1 - nu^2) sqrt(r) d^1.5 times the
+// finite-thickness correction of Dimitriadis et al. (2002), a polynomial in chi = sqrt(r d) / h.
+double hertzOnBondedLayer(double e, double nu, double r, double depth, double h) {
+  const double pi = 3.14159265358979323846;
+  const double alpha = -(1.2876 - 1.4678 * nu + 1.3442 * nu * nu) / (1 - nu);
+  const double beta = (0.6387 - 1.0277 * nu + 1.5164 * nu * nu) / (1 - nu);
+  const double chi = std::sqrt(r * depth) / h;
+  const double correction =
+      1 - 2 * alpha / pi * chi + 4 * alpha * alpha / (pi * pi) * chi * chi -
+      8 / (pi * pi * pi) * (alpha * alpha * alpha + 4 * pi * pi * beta / 15) * chi * chi * chi +
+      16 * alpha / (pi * pi * pi * pi) * (alpha * alpha * alpha + 3 * pi * pi * beta / 5) *
+          std::pow(chi, 4);
+  return 4.0 / 3.0 * e / (1 - nu * nu) * std::sqrt(r) * std::pow(depth, 1.5) * correction;
+}
+
+TEST(ToolCoupling, IndentationFollowsHertzOnAFiniteLayer) {
+  // A frictionless sphere probe (r = 1 cm) pressed by its device into a soft layer (E 1e4 Pa,
+  // nu 0.3, 1 cm thick, 4 x 4 cm, base held) at 0.57 mm/s: the force the device renders
+  // against the probe's depth at 1.28 and 1.44 mm (chi = sqrt(r d) / h 0.36 and 0.38), within
+  // 5 % of Hertz on the bonded layer; the device's force and the base's are one force (1 %).
+  // The mesh, 27 x 27 x 10 cells of 1.5 x 1.5 x 1 mm (43740 tets), puts 2.5 cells across the
+  // contact radius: shallower, fewer nodes carry the contact and the error grows (+4.7 % at
+  // 1.12 mm, +19 % at 0.3 mm; on a 6 x 6 cm layer of 40 x 40 x 10 cells +7.0, +2.6 and +0.6 % at
+  // 1.12, 1.28 and 1.44 mm). docs/validation.md, "Tools".
+  constexpr double kE = 1e4, kNu = 0.3, kR = 0.01, kH = 0.01, kHalf = 0.02;
+  WorldSettings ws;
+  ws.gravity.setZero();
+  ws.solver.time_step = 0.01;
+  ws.solver.threads = 2;
+  ws.solver.tolerance = 1e-6;
+  FemWorld world(ws);
+  Material material;
+  material.youngs_modulus = kE;
+  material.poisson_ratio = kNu;
+  material.density = 1000;
+  material.stiffness_damping = 0.01;
+  material.mass_damping = 5;  // 1/s: quasi-static
+  FemBody* slab =
+      world
+          .addBody("slab",
+                   makeBoxTetMesh({-kHalf, -kHalf, 0}, {kHalf, kHalf, kH}, 27, 27, 10).value(),
+                   material)
+          .value();
+  std::vector<int> base;
+  for (int i = 0; i < slab->model().nodeCount(); ++i)
+    if (slab->state().position(i).z() < 1e-9) base.push_back(i);
+  const int base_group = slab->carryNodes(
+      "base", base, [](double) { return Frame{}; }, 0);
+  const Eigen::Vector3d start(0, 0, kH + kR + 0.0002);
+  btRigidBody* probe =
+      world.addRigidBody(std::make_unique<btSphereShape>(btScalar(kR)), 0.01, at(start));
+  probe->setFriction(0);
+  DeviceMapping mapping;
+  mapping.anchor.origin = start;
+  ToolCouplingSettings settings;
+  settings.stiffness = 2000;
+  auto coupling =
+      ToolCoupling::create(*probe, world.bulletWorld().getDispatcher(), mapping, settings).value();
+  device::ScriptedDevice scripted(
+      device::Trajectory({{0, devicePose(0, 0, 0)}, {3.0, devicePose(0, 0, -0.0017)}}, {}),
+      device::defaultDeviceLimits(), "probe");
+  device::HapticLoopSettings loop_settings;
+  loop_settings.buttons_switch_force = false;
+  device::HapticLoop loop(scripted, loop_settings);
+  HapticRuntime runtime(world, {{coupling.get(), &loop, 1000}});
+  runtime.setLockstep(true);
+  int checked = 0;
+  for (int k = 0; k < 300; ++k) {
+    ASSERT_TRUE(runtime.step().ok);
+    if (k < 269 || k % 30 != 29) continue;  // 2.7 and 3 s: depths 1.28 and 1.44 mm
+    const double depth = kH + kR - toEigen(probe->getCenterOfMassPosition()).z();
+    const double felt = coupling->worldWrench().force.z();
+    const double base_force = -slab->groupWrench(base_group, Eigen::Vector3d::Zero()).force.z();
+    const double hertz = hertzOnBondedLayer(kE, kNu, kR, depth, kH);
+    std::printf("depth %.3f mm: device %.5f N, base %.5f N, Hertz %.5f N (%+.1f %%)\n",
+                1e3 * depth, felt, base_force, hertz, 100 * (felt / hertz - 1));
+    EXPECT_NEAR(felt, hertz, 0.05 * hertz) << "depth " << depth;
+    EXPECT_NEAR(felt, base_force, 0.01 * felt);
+    ++checked;
+  }
+  EXPECT_EQ(checked, 2);
+}
+
 }  // namespace tool_coupling_test
 }  // namespace torsion::haptics
