@@ -7,6 +7,7 @@
 #include "torsion/device/scripted_device.h"
 #include "torsion/haptics/hand_coupling.h"
 #include "torsion/haptics/haptic_runtime.h"
+#include "torsion/haptics/tool_coupling.h"
 #include "torsion/mesh/box_mesh.h"
 #include "user_world.h"
 
@@ -56,6 +57,54 @@ TEST(UserWorldHaptics, LockstepLoopTicksThroughEverySubstepAndFeelsThePush) {
   // so the last tick rendered the last-but-one FEM step.
   EXPECT_EQ(loop.log().back().sim_step, static_cast<std::uint64_t>(user.fem.stepCount() - 1));
   EXPECT_LT(scripted.lastWritten().force.x, -0.1);  // N: the bar resists the push along x
+}
+
+TEST(UserWorldHaptics, ATorsionToolInTheUsersWorldPressesThroughEverySubstep) {
+  // The user's world under gravity, stepped at 1/60 s with four substeps: a 0.1 kg sphere held
+  // by a scripted device goes 5 mm into a static box. Through every substep the coupling moves
+  // with Bullet's clock: the device feels the wall's push on the tool, k times the depth plus the
+  // tool's weight (its weight compensated, the device feels the contact), and
+  // a force the user put on the tool before stepSimulation is still on it (Bullet clears it after
+  // the call, not the coupling).
+  UserWorld user;
+  btRigidBody* wall =
+      user.addRigid(std::make_unique<btBoxShape>(btVector3(1, 1, 0.5)), 0, btVector3(0, 0, -0.5));
+  (void)wall;
+  btRigidBody* tool =
+      user.addRigid(std::make_unique<btSphereShape>(btScalar(0.05)), 0.1, btVector3(0, 0, 0.06));
+  haptics::DeviceMapping mapping;
+  mapping.anchor.origin = Eigen::Vector3d(0, 0, 0.06);
+  haptics::ToolCouplingSettings settings;
+  settings.stiffness = 1000;
+  std::unique_ptr<haptics::ToolCoupling> coupling =
+      haptics::ToolCoupling::create(*tool, user.world.getDispatcher(), mapping, settings).value();
+  device::Pose pressed;
+  pressed.position.z = -0.015;  // 1 cm to the wall, 5 mm into it
+  device::ScriptedDevice scripted(device::Trajectory({{0, device::Pose{}}, {0.5, pressed}}, {}),
+                                  device::defaultDeviceLimits(), "press");
+  device::HapticLoopSettings loop_settings;
+  loop_settings.buttons_switch_force = false;
+  device::HapticLoop loop(scripted, loop_settings);
+  haptics::HapticRuntime runtime(user.fem, {{coupling.get(), &loop, 1000}});
+  runtime.setLockstep(true);
+  for (int call = 0; call < 60; ++call) {
+    tool->applyCentralForce(btVector3(0, 0, 0));  // the user's own forces ride along
+    user.world.stepSimulation(btScalar(1 / 60.), 10, btScalar(1 / 240.));
+    ASSERT_TRUE(user.fem.status().ok) << user.fem.status().message;
+  }
+  EXPECT_EQ(user.fem.stepCount(), 240);
+  EXPECT_NEAR(tool->getCenterOfMassPosition().z(), 0.05, 1e-3);  // m: on the wall
+  EXPECT_NEAR(coupling->worldWrench().force.z(), 1000 * 0.005 + 0.1 * 9.81, 0.05);
+  EXPECT_NEAR(1.0 / tool->getInvMass(), 0.1, 1e-12) << "the tool's own mass between steps";
+
+  // The user's force (10 N up, lifting more than the 5 N press) is applied in each substep.
+  for (int call = 0; call < 30; ++call) {
+    tool->applyCentralForce(btVector3(0, 0, 10));
+    user.world.stepSimulation(btScalar(1 / 60.), 10, btScalar(1 / 240.));
+  }
+  EXPECT_GT(tool->getCenterOfMassPosition().z(), 0.05 + 1e-3);  // lifted off the wall
+  // At rest off the wall the spring balances the user's 10 N (the weight compensated).
+  EXPECT_NEAR(coupling->worldWrench().force.z(), 10.0, 0.1);
 }
 
 // A bar (0.4 x 0.4 x 2 m, 1 x 1 x 4 cells, E = 1e5 Pa) free in a user's world without gravity,

@@ -522,8 +522,8 @@ TEST(ToolCoupling, IndentationFollowsHertzOnAFiniteLayer) {
     const double felt = coupling->worldWrench().force.z();
     const double base_force = -slab->groupWrench(base_group, Eigen::Vector3d::Zero()).force.z();
     const double hertz = hertzOnBondedLayer(kE, kNu, kR, depth, kH);
-    std::printf("depth %.3f mm: device %.5f N, base %.5f N, Hertz %.5f N (%+.1f %%)\n",
-                1e3 * depth, felt, base_force, hertz, 100 * (felt / hertz - 1));
+    std::printf("depth %.3f mm: device %.5f N, base %.5f N, Hertz %.5f N (%+.1f %%)\n", 1e3 * depth,
+                felt, base_force, hertz, 100 * (felt / hertz - 1));
     EXPECT_NEAR(felt, hertz, 0.05 * hertz) << "depth " << depth;
     EXPECT_NEAR(felt, base_force, 0.01 * felt);
     ++checked;
