@@ -291,6 +291,13 @@ std::vector<std::string> SceneHaptics::describe() const {
   return lines;
 }
 
+std::optional<Wrench> SceneHaptics::deviceWrench(const std::string& name) const {
+  for (const Channel& c : channels_) {
+    if (c.name == name) return c.coupling->worldWrench();
+  }
+  return std::nullopt;
+}
+
 std::vector<std::pair<std::string, Wrench>> SceneHaptics::toolWrenches() const {
   std::vector<std::pair<std::string, Wrench>> wrenches;
   for (const Channel& c : channels_) {

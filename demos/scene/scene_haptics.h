@@ -12,6 +12,7 @@
 
 #include <memory>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -50,6 +51,9 @@ class SceneHaptics {
   /// One line per device: "hand 'h': device scripted(f.json), lockstep haptic loop at 1000 Hz"
   /// ("tool 'probe': ..." for a tool).
   std::vector<std::string> describe() const;
+  /// The wrench the device of hand or tool `name` renders (world frame, last step); nullopt when
+  /// nothing of that name has a device.
+  std::optional<Wrench> deviceWrench(const std::string& name) const;
   /// Each tool's name and the wrench its device renders (world frame, last step).
   std::vector<std::pair<std::string, Wrench>> toolWrenches() const;
   /// The runtime's warnings, and a refused --sim-priority.

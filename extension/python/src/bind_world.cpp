@@ -5,6 +5,7 @@
 #include <chrono>
 #include <cmath>
 #include <filesystem>
+#include <optional>
 
 #include "camera.h"
 #include "frame_data.h"
@@ -14,6 +15,7 @@
 #include "py_convert.h"
 #include "py_frame.h"
 #include "scene_builder.h"
+#include "scene_haptics.h"
 #include "torsion/format_number.h"
 #include "torsion/mesh/mesh_io.h"
 #include "torsion/mesh/tet_mesh_builder.h"
@@ -461,6 +463,20 @@ void bindWorld(py::module_& m) {
             throw py::key_error("no hand named '" + name + "'");
           },
           py::arg("name"))
+      .def(
+          "device_wrench",
+          [](py::object owner, const std::string& name) {
+            const scene::BuiltScene& built = self(owner).scene();
+            std::optional<Wrench> w;
+            if (built.haptics) w = built.haptics->deviceWrench(name);
+            if (!w) throw py::key_error("no hand or tool named '" + name + "' has a device");
+            return wrenchArray(*w);
+          },
+          py::arg("name"),
+          "The wrench the device of hand or tool `name` renders after the last step: a 6-vector "
+          "(force N, torque N m) in the world frame, before the device mapping's scales and the "
+          "haptic loop's local model. A tool's is its contacts' push (its weight compensated "
+          "unless feel_weight).")
       .def_property_readonly(
           "rigid_bodies",
           [](py::object owner) {
