@@ -126,13 +126,13 @@ Result<std::unique_ptr<SceneHaptics>> SceneHaptics::attach(BuiltScene& scene) {
     const SceneRigidBody& built = scene.rigid_bodies[i];
     if (r.grasper) {
       Result<std::unique_ptr<haptics::GrasperCoupling>> grasper = haptics::GrasperCoupling::create(
-          scene.world->bulletWorld(), *built.body, built.jaws, mappingFor(*r.device, r.pose),
+          scene.world->femSolver(), *built.body, built.jaws, mappingFor(*r.device, r.pose),
           r.device->tool, r.grasper->settings);
       if (!grasper) return Error{entry + ": " + grasper.error().message};
       c.coupling = std::move(grasper).value();
     } else {
       Result<std::unique_ptr<haptics::ToolCoupling>> tool =
-          haptics::ToolCoupling::create(*built.body, scene.world->bulletWorld().getDispatcher(),
+          haptics::ToolCoupling::create(*built.body, scene.world->femSolver(),
                                         mappingFor(*r.device, r.pose), r.device->tool);
       if (!tool) return Error{entry + ": " + tool.error().message};
       c.coupling = std::move(tool).value();

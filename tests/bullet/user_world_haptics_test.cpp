@@ -77,7 +77,7 @@ TEST(UserWorldHaptics, ATorsionToolInTheUsersWorldPressesThroughEverySubstep) {
   haptics::ToolCouplingSettings settings;
   settings.stiffness = 1000;
   std::unique_ptr<haptics::ToolCoupling> coupling =
-      haptics::ToolCoupling::create(*tool, user.world.getDispatcher(), mapping, settings).value();
+      haptics::ToolCoupling::create(*tool, user.fem, mapping, settings).value();
   device::Pose pressed;
   pressed.position.z = -0.015;  // 1 cm to the wall, 5 mm into it
   device::ScriptedDevice scripted(device::Trajectory({{0, device::Pose{}}, {0.5, pressed}}, {}),

@@ -1,7 +1,7 @@
 #include "torsion/haptics/grasper_coupling.h"
 
 #include <BulletDynamics/ConstraintSolver/btSliderConstraint.h>
-#include <BulletDynamics/Dynamics/btDynamicsWorld.h>
+#include <BulletDynamics/Dynamics/btDiscreteDynamicsWorld.h>
 #include <BulletDynamics/Dynamics/btRigidBody.h>
 
 #include <cmath>
@@ -37,16 +37,18 @@ Status GrasperSettings::validate() const {
 }
 
 Result<std::unique_ptr<GrasperCoupling>> GrasperCoupling::create(
-    btDynamicsWorld& world, btRigidBody& palm, std::array<btRigidBody*, 2> jaws,
+    const FemSoftBodySolver& solver, btRigidBody& palm, std::array<btRigidBody*, 2> jaws,
     const DeviceMapping& mapping, const ToolCouplingSettings& coupling,
     const GrasperSettings& settings) {
   if (Status ok = settings.validate(); !ok) return ok.error();
+  if (solver.world() == nullptr) return Error{"the FEM solver is not attached to a world"};
+  btDynamicsWorld& world = *solver.world();
   for (btRigidBody* jaw : jaws) {
     if (jaw == nullptr || !isDynamic(*jaw))
       return Error{"a grasper's jaws must be dynamic rigid bodies (mass > 0)"};
   }
   Result<std::unique_ptr<ToolCoupling>> held =
-      ToolCoupling::create(palm, world.getDispatcher(), mapping, coupling);
+      ToolCoupling::create(palm, solver, mapping, coupling);
   if (!held) return held.error();
   return std::unique_ptr<GrasperCoupling>(
       new GrasperCoupling(world, std::move(held).value(), jaws, settings));

@@ -2,6 +2,7 @@
 
 #include <BulletCollision/BroadphaseCollision/btDispatcher.h>
 #include <BulletCollision/NarrowPhaseCollision/btPersistentManifold.h>
+#include <BulletDynamics/Dynamics/btDiscreteDynamicsWorld.h>
 #include <BulletDynamics/Dynamics/btRigidBody.h>
 
 #include <Eigen/Cholesky>
@@ -42,23 +43,27 @@ Status ToolCouplingSettings::validate() const {
     return Error{"damping_ratio must be a non-negative number (1: critical)"};
   if (!(max_force > 0) || !(max_torque > 0))
     return Error{"max_force and max_torque must be positive (N, N m)"};
+  if (contact_stiffness_refresh_steps < 0)
+    return Error{"contact_stiffness_refresh_steps must be >= 0 (0: rigid contacts only)"};
+  if (!(contact_stiffness_tolerance > 0 && contact_stiffness_tolerance < 1))
+    return Error{"contact_stiffness_tolerance must be in (0, 1)"};
   return Ok{};
 }
 
 Result<std::unique_ptr<ToolCoupling>> ToolCoupling::create(btRigidBody& tool,
-                                                           btDispatcher* dispatcher,
+                                                           const FemSoftBodySolver& solver,
                                                            const DeviceMapping& mapping,
                                                            const ToolCouplingSettings& settings) {
   if (Status ok = settings.validate(); !ok) return ok.error();
   if (tool.isStaticOrKinematicObject() || !(tool.getInvMass() > 0))
     return Error{"a tool must be a dynamic rigid body (mass > 0)"};
-  return std::unique_ptr<ToolCoupling>(new ToolCoupling(tool, dispatcher, mapping, settings));
+  return std::unique_ptr<ToolCoupling>(new ToolCoupling(tool, solver, mapping, settings));
 }
 
-ToolCoupling::ToolCoupling(btRigidBody& tool, btDispatcher* dispatcher,
+ToolCoupling::ToolCoupling(btRigidBody& tool, const FemSoftBodySolver& solver,
                            const DeviceMapping& mapping, const ToolCouplingSettings& settings)
     : tool_(tool),
-      dispatcher_(dispatcher),
+      solver_(solver),
       mapping_(mapping),
       settings_(settings),
       goal_(mapping.anchor) {
@@ -167,16 +172,43 @@ void ToolCoupling::afterFemStep(const StepContext& /*ctx*/, bool /*ok*/) {
   Matrix6d k_c = Matrix6d::Zero();
   k_c.topLeftCorner<3, 3>().diagonal().setConstant(settings_.stiffness);
   k_c.bottomRightCorner<3, 3>().diagonal().setConstant(settings_.angular_stiffness);
-  const Matrix6d k_e = rigidContactStiffness();
+  const Matrix6d k_e = rigidContactStiffness() + femContactStiffness();
   world_stiffness_ = -(k_c - k_c * (k_c + k_e).ldlt().solve(k_c));
+}
+
+Matrix6d ToolCoupling::femContactStiffness() {
+  Matrix6d k_e = Matrix6d::Zero();
+  if (settings_.contact_stiffness_refresh_steps <= 0) return k_e;
+  const bool due = ++steps_since_refresh_ >= settings_.contact_stiffness_refresh_steps;
+  if (due) steps_since_refresh_ = 0;
+  const Eigen::Vector3d centre = toEigen(tool_.getCenterOfMassPosition());
+  for (const auto& body : solver_.bodies()) {
+    const std::optional<ContactPatch> patch = contactPatch(*body, tool_);
+    if (!patch) {
+      patch_stiffness_.erase(body.get());  // a new touch starts with a fresh solve
+      continue;
+    }
+    auto known = patch_stiffness_.find(body.get());
+    if (due || known == patch_stiffness_.end()) {
+      const double k_n = contact_stiffness_.normalStiffness(
+          *body, *patch, settings_.contact_stiffness_tolerance);
+      known = patch_stiffness_.insert_or_assign(body.get(), k_n).first;
+    }
+    // The body pushes back along -N through the patch's centre.
+    Eigen::Matrix<double, 6, 1> j;
+    j << patch->normal, (patch->centre - centre).cross(patch->normal);
+    k_e += known->second * j * j.transpose();
+  }
+  return k_e;
 }
 
 Matrix6d ToolCoupling::rigidContactStiffness() const {
   Matrix6d k_e = Matrix6d::Zero();
-  if (dispatcher_ == nullptr) return k_e;
+  btDispatcher* dispatcher = solver_.world() != nullptr ? solver_.world()->getDispatcher() : nullptr;
+  if (dispatcher == nullptr) return k_e;
   const Eigen::Vector3d centre = toEigen(tool_.getCenterOfMassPosition());
-  for (int m = 0; m < dispatcher_->getNumManifolds(); ++m) {
-    const btPersistentManifold* manifold = dispatcher_->getManifoldByIndexInternal(m);
+  for (int m = 0; m < dispatcher->getNumManifolds(); ++m) {
+    const btPersistentManifold* manifold = dispatcher->getManifoldByIndexInternal(m);
     const bool first = manifold->getBody0() == &tool_;
     if (!first && manifold->getBody1() != &tool_) continue;
     for (int p = 0; p < manifold->getNumContacts(); ++p) {

@@ -20,21 +20,24 @@
 // `feel_weight`), about the device frame's origin.
 //
 // Between steps the loop predicts with K_h = -(K_c - K_c (K_c + K_e)^-1 K_c): the coupling K_c in
-// series with the stiffness K_e of the tool's contacts with rigid bodies (Bullet's manifolds; a
+// series with the stiffness K_e of the tool's contacts: with rigid bodies, Bullet's manifolds (a
 // touching point counts as a spring kRigidContactStiffness along its normal), so a rigid wall
-// feels as stiff as the coupling at the loop's rate; in free space K_h = 0. Contacts with FEM
-// bodies add nothing to K_e: their change reaches the device at the simulation's rate.
+// feels as stiff as the coupling at the loop's rate; with FEM bodies, each touching patch's normal
+// stiffness from the body's step system (contact_stiffness.h), refreshed every
+// `contact_stiffness_refresh_steps` steps. In free space K_h = 0.
 // Simulation thread only.
 
 #include <memory>
+#include <unordered_map>
 
 #include "torsion/constraints/carried_nodes.h"
 #include "torsion/constraints/frame.h"
+#include "torsion/bullet/fem_soft_body_solver.h"
+#include "torsion/haptics/contact_stiffness.h"
 #include "torsion/haptics/device_coupling.h"
 #include "torsion/haptics/device_mapping.h"
 
 class btRigidBody;
-class btDispatcher;
 
 namespace torsion::haptics {
 
@@ -49,6 +52,10 @@ struct ToolCouplingSettings {
   double max_force = 100;
   double max_torque = 10;
   bool feel_weight = false;  ///< render the tool's weight too (false: the contacts only)
+  /// K_e's FEM part every this many steps (one CG solve per touching body); 0: rigid contacts
+  /// only.
+  int contact_stiffness_refresh_steps = 5;
+  double contact_stiffness_tolerance = 1e-3;  ///< relative CG tolerance of those solves
   /// Publish only K_h's passive part (device/passive_stiffness.h).
   bool passive_stiffness = true;
 
@@ -63,11 +70,12 @@ class ToolCoupling : public DeviceCoupling {
   /// m: a device pose mapped beyond this is refused.
   static constexpr double kMaxReach = 1e6;
 
-  /// `tool` must be dynamic (mass > 0) and outlive the coupling; `dispatcher` is its world's
-  /// (its contacts with rigid bodies, for K_h; null: none). The device's zero pose sits at
-  /// mapping.anchor. Settings must be valid. The tool is kept awake (a sleeping body would not
-  /// follow the device).
-  static Result<std::unique_ptr<ToolCoupling>> create(btRigidBody& tool, btDispatcher* dispatcher,
+  /// `tool` must be a dynamic body (mass > 0) of the world `solver` is attached to, and both must
+  /// outlive the coupling (the solver's FEM bodies and the world's manifolds give K_e). The
+  /// device's zero pose sits at mapping.anchor. Settings must be valid. The tool is kept awake (a
+  /// sleeping body would not follow the device).
+  static Result<std::unique_ptr<ToolCoupling>> create(btRigidBody& tool,
+                                                      const FemSoftBodySolver& solver,
                                                       const DeviceMapping& mapping,
                                                       const ToolCouplingSettings& settings);
 
@@ -91,16 +99,18 @@ class ToolCoupling : public DeviceCoupling {
   const btRigidBody& tool() const { return tool_; }
 
  private:
-  ToolCoupling(btRigidBody& tool, btDispatcher* dispatcher, const DeviceMapping& mapping,
+  ToolCoupling(btRigidBody& tool, const FemSoftBodySolver& solver, const DeviceMapping& mapping,
                const ToolCouplingSettings& settings);
   /// The goal from a command; a dead device or a refused pose holds the last one.
   void takeGoal(const device::HandCommand& command);
   /// The stiffness of the tool's touching contacts with rigid bodies (world, about its centre).
   Matrix6d rigidContactStiffness() const;
+  /// With FEM bodies: each touching patch's k_n along its normal through its centre.
+  Matrix6d femContactStiffness();
   void restoreMass();
 
   btRigidBody& tool_;
-  btDispatcher* dispatcher_;
+  const FemSoftBodySolver& solver_;
   DeviceMapping mapping_;
   ToolCouplingSettings settings_;
   double mass_ = 0;          // the tool's own, kg
@@ -125,6 +135,10 @@ class ToolCoupling : public DeviceCoupling {
   Wrench coupling_;
   Wrench world_wrench_;
   Matrix6d world_stiffness_ = Matrix6d::Zero();
+  // K_e's FEM part: each touching body's patch stiffness, refreshed every few steps
+  ContactStiffness contact_stiffness_;
+  std::unordered_map<const FemBody*, double> patch_stiffness_;  // N/m
+  int steps_since_refresh_ = 0;
 };
 
 }  // namespace torsion::haptics
