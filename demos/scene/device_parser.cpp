@@ -174,6 +174,10 @@ void readToolCoupling(const JsonObject& d, DeviceSpec& spec) {
   t.max_force = positive(o, "max_force", t.max_force, " N");
   t.max_torque = positive(o, "max_torque", t.max_torque, " N m");
   t.feel_weight = o.boolean("feel_weight", t.feel_weight);
+  t.contact_stiffness_refresh_steps =
+      o.integer("contact_stiffness_refresh_steps", t.contact_stiffness_refresh_steps);
+  if (t.contact_stiffness_refresh_steps < 0)
+    o.fail("contact_stiffness_refresh_steps", "must be >= 0 (0: rigid contacts only)");
   o.finish();
   if (Status ok = t.validate(); !ok) d.fail("coupling", ok.error().message);
 }
