@@ -131,9 +131,8 @@ Result<std::unique_ptr<SceneHaptics>> SceneHaptics::attach(BuiltScene& scene) {
       if (!grasper) return Error{entry + ": " + grasper.error().message};
       c.coupling = std::move(grasper).value();
     } else {
-      Result<std::unique_ptr<haptics::ToolCoupling>> tool =
-          haptics::ToolCoupling::create(*built.body, scene.world->femSolver(),
-                                        mappingFor(*r.device, r.pose), r.device->tool);
+      Result<std::unique_ptr<haptics::ToolCoupling>> tool = haptics::ToolCoupling::create(
+          *built.body, scene.world->femSolver(), mappingFor(*r.device, r.pose), r.device->tool);
       if (!tool) return Error{entry + ": " + tool.error().message};
       c.coupling = std::move(tool).value();
     }

@@ -8,9 +8,11 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <deque>
 #include <memory>
 #include <vector>
 
+#include "arm_device.h"
 #include "torsion/bt_conversions.h"
 #include "torsion/bullet/fem_world.h"
 #include "torsion/device/haptic_loop.h"
@@ -78,8 +80,7 @@ struct ProbeRig {
     probe->setFriction(btScalar(friction));
     DeviceMapping mapping;
     mapping.anchor.origin = start;
-    coupling = ToolCoupling::create(*probe, world->femSolver(), mapping, settings)
-                   .value();
+    coupling = ToolCoupling::create(*probe, world->femSolver(), mapping, settings).value();
     device = std::make_unique<device::ScriptedDevice>(device::Trajectory(keyframes, {}),
                                                       device::defaultDeviceLimits(), "probe");
     device::HapticLoopSettings loop_settings;
@@ -229,8 +230,7 @@ struct WallRig {
     mapping.anchor.origin = start;
     ToolCouplingSettings settings;
     settings.stiffness = kStiffness;
-    coupling = ToolCoupling::create(*probe, world->femSolver(), mapping, settings)
-                   .value();
+    coupling = ToolCoupling::create(*probe, world->femSolver(), mapping, settings).value();
     device = std::make_unique<device::ScriptedDevice>(device::Trajectory(keyframes, {}),
                                                       device::defaultDeviceLimits(), "probe");
     device::HapticLoopSettings loop_settings;
@@ -282,6 +282,97 @@ TEST(ToolCoupling, ARigidWallFeelsAsStiffAsTheCouplingAtTheLoopsRate) {
   EXPECT_LT(worst, 0.02);  // N, a fifth of a step's staircase
   // Passive: the port gives back at most 1 % of the 12.5 mJ the coupling held at 5 mm.
   EXPECT_LE(rig.loop->stats().max_port_energy.load(), 1.25e-4);
+}
+
+// Between the solver and the loop: the coupling's stages at the solver's moments, its wrench
+// reaching the loop `delay` after the step that made it (a slow or remote simulation).
+struct DelayedToolLink : StepListener {
+  ToolCoupling& coupling;
+  device::HapticLoop& loop;
+  double delay;
+  std::deque<std::pair<double, device::SimulationWrench>> in_flight;
+  DelayedToolLink(ToolCoupling& c, device::HapticLoop& l, double d)
+      : coupling(c), loop(l), delay(d) {}
+  void beforeRigidStep(const StepContext& ctx) override {
+    device::HandCommand command;
+    loop.commands().read(command);
+    coupling.beforeRigidStep(command, ctx);
+  }
+  void afterFemStep(const StepContext& ctx, bool ok) override {
+    coupling.afterFemStep(ctx, ok);
+    if (ok)
+      in_flight.emplace_back(ctx.endTime() + delay,
+                             coupling.publish(static_cast<std::uint64_t>(ctx.index)));
+  }
+  void tick(double now) {
+    while (!in_flight.empty() && in_flight.front().first <= now + 1e-9) {
+      loop.wrenches().write(in_flight.front().second);
+      in_flight.pop_front();
+    }
+    loop.tick(now);
+  }
+};
+
+TEST(ToolCoupling, AnOperatorPushingIntoARigidWallStaysPassiveAndShallowEvenUnderDelay) {
+  // A simulated operator (arm 300 N/m toward an intent 4 cm past the wall, 1 kg; device 0.3 kg,
+  // 200 Hz motors, 10 N) pushes the probe into a rigid wall 1 cm away, closing at 5 cm/s, and
+  // holds; the simulation's wrench reaches the loop 0 or 20 ms after its step. At rest the
+  // operator and the coupling share the push: the device sits k_arm 4 cm / (k_arm + k) = 9.2 mm
+  // past the wall, feeling 9.2 N. The device never goes more than a fifth deeper than that, the
+  // port gives back at most 1 % of the 42 mJ the coupling then holds, and the motion settles.
+  for (double delay : {0.0, 0.02}) {
+    SCOPED_TRACE(delay);
+    WorldSettings ws;
+    ws.gravity.setZero();
+    ws.solver.time_step = 0.01;
+    FemWorld world(ws);
+    world.addRigidBody(std::make_unique<btBoxShape>(btVector3(0.05, 0.1, 0.1)), 0,
+                       at({0.02 + 0.05, 0, 0}));
+    btRigidBody* probe =
+        world.addRigidBody(std::make_unique<btSphereShape>(btScalar(0.01)), 0.02, at({0, 0, 0}));
+    ToolCouplingSettings settings;
+    settings.stiffness = 1000;
+    auto coupling =
+        ToolCoupling::create(*probe, world.femSolver(), DeviceMapping{}, settings).value();
+    simulated::SimulatedArmSettings arm;
+    arm.intent = simulated::SimulatedArmSettings::Intent::kPush;
+    arm.intent_rate = 0.05;
+    arm.intent_start = 0.1;
+    arm.intent_time = 1.0;
+    arm.grab_time = -1;
+    device::ArmDevice device(arm);
+    device::HapticLoopSettings loop_settings;
+    loop_settings.buttons_switch_force = false;
+    loop_settings.log_capacity = 3100;
+    device::HapticLoop loop(device, loop_settings);
+    DelayedToolLink link(*coupling, loop, delay);
+    world.femSolver().addStepListener(&link);
+    int tick = 0;
+    while (world.time() < 3.0 - 1e-9) {
+      for (int k = 0; k < 10; ++k, ++tick)
+        link.tick(tick * 1e-3);
+      ASSERT_TRUE(world.step().ok);
+    }
+    world.femSolver().removeStepListener(&link);
+    const double settled = 300 * 0.04 / (300 + 1000);  // m past the wall
+    double deepest = 0, late_swing_lo = 1e9, late_swing_hi = -1e9;
+    for (const device::LoopLogRow& row : loop.log()) {
+      const double past_wall = row.pose.position.x - 0.01;
+      deepest = std::max(deepest, past_wall);
+      if (row.time > 2.5) {
+        late_swing_lo = std::min(late_swing_lo, past_wall);
+        late_swing_hi = std::max(late_swing_hi, past_wall);
+      }
+    }
+    std::printf("delay %.0f ms: deepest %.2f mm (settled %.2f), late swing %.3f mm, port %.3g J\n",
+                1e3 * delay, 1e3 * deepest, 1e3 * settled, 1e3 * (late_swing_hi - late_swing_lo),
+                loop.stats().max_port_energy.load());
+    EXPECT_NEAR(toEigen(probe->getCenterOfMassPosition()).x(), 0.01, 5e-4);  // on the wall
+    EXPECT_LT(deepest, 1.2 * settled);
+    EXPECT_NEAR(late_swing_lo, settled, 0.1 * settled);
+    EXPECT_LT(late_swing_hi - late_swing_lo, 0.05 * settled);
+    EXPECT_LE(loop.stats().max_port_energy.load(), 0.01 * 0.5 * 1000 * settled * settled);
+  }
 }
 
 TEST(ToolCoupling, ADeviceLostMidPressFadesToZeroWithoutAJumpAndTheToolHolds) {
@@ -411,9 +502,8 @@ struct GraspRig {
     GrasperSettings settings;
     settings.opening = 0.14;
     settings.grip_force = 20;
-    grasper =
-        GrasperCoupling::create(world->femSolver(), *palm, jaws, mapping, coupling, settings)
-            .value();
+    grasper = GrasperCoupling::create(world->femSolver(), *palm, jaws, mapping, coupling, settings)
+                  .value();
     device =
         std::make_unique<device::ScriptedDevice>(device::Trajectory({{0, devicePose(0, 0, 0)},
                                                                      {1.0, devicePose(0, 0, -0.1)},
@@ -529,8 +619,7 @@ TEST(ToolCoupling, IndentationFollowsHertzOnAFiniteLayer) {
   mapping.anchor.origin = start;
   ToolCouplingSettings settings;
   settings.stiffness = 2000;
-  auto coupling =
-      ToolCoupling::create(*probe, world.femSolver(), mapping, settings).value();
+  auto coupling = ToolCoupling::create(*probe, world.femSolver(), mapping, settings).value();
   device::ScriptedDevice scripted(
       device::Trajectory({{0, devicePose(0, 0, 0)}, {3.0, devicePose(0, 0, -0.0017)}}, {}),
       device::defaultDeviceLimits(), "probe");

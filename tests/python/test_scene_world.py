@@ -201,7 +201,7 @@ def test_a_device_override_replaces_a_hands_script_as_the_device_option_does(sou
         world.step(30)
     assert np.array_equal(driven.body("cylinder").positions, as_list.body("cylinder").positions)
     assert not np.array_equal(driven.body("cylinder").positions, scripted.body("cylinder").positions)
-    with pytest.raises(ValueError, match="no hand named 'nohand'"):
+    with pytest.raises(ValueError, match="no hand or dynamic rigid body named 'nohand'"):
         torsion.World.from_scene("twist_cylinder_2430", devices={"nohand": "scripted:" + trajectory})
 
 

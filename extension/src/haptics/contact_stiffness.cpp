@@ -23,7 +23,8 @@ std::optional<ContactPatch> contactPatch(const FemBody& body, const btCollisionO
   for (const FaceContact& f : contacts.solvedFaceContacts()) {
     if (!touches(f.partner) || f.state == FaceContact::State::kInactive) continue;
     for (int k = 0; k < 3; ++k) {
-      if (f.weights[k] > 0) share[f.nodes[static_cast<std::size_t>(k)]] += f.weights[k] * f.impulse.norm();
+      if (f.weights[k] > 0)
+        share[f.nodes[static_cast<std::size_t>(k)]] += f.weights[k] * f.impulse.norm();
     }
     push -= f.impulse;
   }

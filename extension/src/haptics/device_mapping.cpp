@@ -4,7 +4,7 @@ namespace torsion::haptics {
 
 namespace {
 
-Eigen::Vector3d toEigen(const device::Vec3& v) {
+Eigen::Vector3d fromDevice(const device::Vec3& v) {
   return {v.x, v.y, v.z};
 }
 device::Vec3 toDevice(const Eigen::Vector3d& v) {
@@ -21,7 +21,7 @@ Eigen::Vector3d rotationVector(const Eigen::Quaterniond& q) {
 Frame DeviceMapping::toWorld(const device::Pose& pose) const {
   const device::Quat& q = pose.orientation;
   Frame f;
-  f.origin = anchor.toWorld(position_scale * toEigen(pose.position));
+  f.origin = anchor.toWorld(position_scale * fromDevice(pose.position));
   f.rotation = (anchor.rotation * Eigen::Quaterniond(q.w, q.x, q.y, q.z)).normalized();
   return f;
 }

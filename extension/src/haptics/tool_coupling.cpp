@@ -62,11 +62,7 @@ Result<std::unique_ptr<ToolCoupling>> ToolCoupling::create(btRigidBody& tool,
 
 ToolCoupling::ToolCoupling(btRigidBody& tool, const FemSoftBodySolver& solver,
                            const DeviceMapping& mapping, const ToolCouplingSettings& settings)
-    : tool_(tool),
-      solver_(solver),
-      mapping_(mapping),
-      settings_(settings),
-      goal_(mapping.anchor) {
+    : tool_(tool), solver_(solver), mapping_(mapping), settings_(settings), goal_(mapping.anchor) {
   mass_ = 1.0 / toDouble(tool.getInvMass());
   const Eigen::Vector3d inverse = toEigen(tool.getInvInertiaDiagLocal());
   for (int i = 0; i < 3; ++i)
@@ -190,8 +186,8 @@ Matrix6d ToolCoupling::femContactStiffness() {
     }
     auto known = patch_stiffness_.find(body.get());
     if (due || known == patch_stiffness_.end()) {
-      const double k_n = contact_stiffness_.normalStiffness(
-          *body, *patch, settings_.contact_stiffness_tolerance);
+      const double k_n =
+          contact_stiffness_.normalStiffness(*body, *patch, settings_.contact_stiffness_tolerance);
       known = patch_stiffness_.insert_or_assign(body.get(), k_n).first;
     }
     // The body pushes back along -N through the patch's centre.
@@ -204,7 +200,8 @@ Matrix6d ToolCoupling::femContactStiffness() {
 
 Matrix6d ToolCoupling::rigidContactStiffness() const {
   Matrix6d k_e = Matrix6d::Zero();
-  btDispatcher* dispatcher = solver_.world() != nullptr ? solver_.world()->getDispatcher() : nullptr;
+  btDispatcher* dispatcher =
+      solver_.world() != nullptr ? solver_.world()->getDispatcher() : nullptr;
   if (dispatcher == nullptr) return k_e;
   const Eigen::Vector3d centre = toEigen(tool_.getCenterOfMassPosition());
   for (int m = 0; m < dispatcher->getNumManifolds(); ++m) {

@@ -34,10 +34,12 @@ class GrasperCoupling : public DeviceCoupling {
   /// outlive the coupling; the jaws start open, each `settings.opening / 2` plus its half width
   /// from the palm's centre plane along the palm's local x (jaws[0] on the -x side). The joints
   /// are added to the world here and removed by the destructor.
-  static Result<std::unique_ptr<GrasperCoupling>> create(
-      const FemSoftBodySolver& solver, btRigidBody& palm, std::array<btRigidBody*, 2> jaws,
-      const DeviceMapping& mapping, const ToolCouplingSettings& coupling,
-      const GrasperSettings& settings);
+  static Result<std::unique_ptr<GrasperCoupling>> create(const FemSoftBodySolver& solver,
+                                                         btRigidBody& palm,
+                                                         std::array<btRigidBody*, 2> jaws,
+                                                         const DeviceMapping& mapping,
+                                                         const ToolCouplingSettings& coupling,
+                                                         const GrasperSettings& settings);
   ~GrasperCoupling() override;
   GrasperCoupling(const GrasperCoupling&) = delete;
   GrasperCoupling& operator=(const GrasperCoupling&) = delete;

@@ -30,9 +30,9 @@
 #include <memory>
 #include <unordered_map>
 
+#include "torsion/bullet/fem_soft_body_solver.h"
 #include "torsion/constraints/carried_nodes.h"
 #include "torsion/constraints/frame.h"
-#include "torsion/bullet/fem_soft_body_solver.h"
 #include "torsion/haptics/contact_stiffness.h"
 #include "torsion/haptics/device_coupling.h"
 #include "torsion/haptics/device_mapping.h"
