@@ -70,8 +70,8 @@ TEST(UserWorldHaptics, ATorsionToolInTheUsersWorldPressesThroughEverySubstep) {
   btRigidBody* wall =
       user.addRigid(std::make_unique<btBoxShape>(btVector3(1, 1, 0.5)), 0, btVector3(0, 0, -0.5));
   (void)wall;
-  btRigidBody* tool =
-      user.addRigid(std::make_unique<btSphereShape>(btScalar(0.05)), 0.1, btVector3(0, 0, 0.06));
+  btRigidBody* tool = user.addRigid(std::make_unique<btSphereShape>(btScalar(0.05)), 0.1,
+                                    btVector3(0, 0, btScalar(0.06)));
   haptics::DeviceMapping mapping;
   mapping.anchor.origin = Eigen::Vector3d(0, 0, 0.06);
   haptics::ToolCouplingSettings settings;
