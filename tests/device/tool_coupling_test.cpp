@@ -9,6 +9,7 @@
 
 #include <cmath>
 #include <deque>
+#include <limits>
 #include <memory>
 #include <vector>
 
@@ -37,6 +38,33 @@ device::Pose devicePose(double x, double y, double z) {
   return pose;
 }
 
+// A scripted device playing `trajectory`, its 1 kHz loop (a tool's: force on from the start)
+// and the runtime that ticks it in lockstep with `world`'s steps through `coupling`.
+struct ScriptedDeviceLoop {
+  std::unique_ptr<device::ScriptedDevice> device;
+  std::unique_ptr<device::HapticLoop> loop;
+  std::unique_ptr<HapticRuntime> runtime;
+
+  ScriptedDeviceLoop(FemWorld& world, DeviceCoupling& coupling, device::Trajectory trajectory,
+                     std::size_t log_capacity = 0) {
+    device = std::make_unique<device::ScriptedDevice>(std::move(trajectory),
+                                                      device::defaultDeviceLimits(), "tool");
+    device::HapticLoopSettings settings;
+    settings.buttons_switch_force = false;
+    settings.log_capacity = log_capacity;
+    loop = std::make_unique<device::HapticLoop>(*device, settings);
+    runtime = std::make_unique<HapticRuntime>(
+        world, std::vector<HapticBinding>{{&coupling, loop.get(), 1000}});
+    runtime->setLockstep(true);
+  }
+  /// `seconds` of 0.01 s steps; each must succeed.
+  void run(double seconds) {
+    const int steps = static_cast<int>(std::lround(seconds / 0.01));
+    for (int k = 0; k < steps; ++k)
+      ASSERT_TRUE(runtime->step().ok) << "step " << k;
+  }
+};
+
 // A soft slab (0.1 x 0.1 x 0.02 m, base held at z = 0) and a sphere probe (radius 1 cm) held by a
 // scripted device whose zero pose is the probe's start, 5 mm above the slab.
 struct ProbeRig {
@@ -48,9 +76,7 @@ struct ProbeRig {
   int base_group = -1;
   btRigidBody* probe = nullptr;
   std::unique_ptr<ToolCoupling> coupling;
-  std::unique_ptr<device::ScriptedDevice> device;
-  std::unique_ptr<device::HapticLoop> loop;
-  std::unique_ptr<HapticRuntime> runtime;
+  std::unique_ptr<ScriptedDeviceLoop> link;
 
   ProbeRig(const std::vector<device::TrajectoryKeyframe>& keyframes, double gravity,
            const ToolCouplingSettings& settings = {}, double friction = 0.5) {
@@ -81,21 +107,11 @@ struct ProbeRig {
     DeviceMapping mapping;
     mapping.anchor.origin = start;
     coupling = ToolCoupling::create(*probe, world->femSolver(), mapping, settings).value();
-    device = std::make_unique<device::ScriptedDevice>(device::Trajectory(keyframes, {}),
-                                                      device::defaultDeviceLimits(), "probe");
-    device::HapticLoopSettings loop_settings;
-    loop_settings.buttons_switch_force = false;
-    loop = std::make_unique<device::HapticLoop>(*device, loop_settings);
-    runtime = std::make_unique<HapticRuntime>(
-        *world, std::vector<HapticBinding>{{coupling.get(), loop.get(), 1000}});
-    runtime->setLockstep(true);
+    link =
+        std::make_unique<ScriptedDeviceLoop>(*world, *coupling, device::Trajectory(keyframes, {}));
   }
 
-  void run(double seconds) {
-    const int steps = static_cast<int>(std::lround(seconds / 0.01));
-    for (int k = 0; k < steps; ++k)
-      ASSERT_TRUE(runtime->step().ok) << "step " << k;
-  }
+  void run(double seconds) { link->run(seconds); }
   Eigen::Vector3d probeCentre() const { return toEigen(probe->getCenterOfMassPosition()); }
   /// The force the slab's base carries (what the body pushes its held base nodes with).
   Eigen::Vector3d baseForce() {
@@ -212,9 +228,7 @@ struct WallRig {
   std::unique_ptr<FemWorld> world;
   btRigidBody* probe = nullptr;
   std::unique_ptr<ToolCoupling> coupling;
-  std::unique_ptr<device::ScriptedDevice> device;
-  std::unique_ptr<device::HapticLoop> loop;
-  std::unique_ptr<HapticRuntime> runtime;
+  std::unique_ptr<ScriptedDeviceLoop> link;
 
   explicit WallRig(const std::vector<device::TrajectoryKeyframe>& keyframes) {
     WorldSettings ws;
@@ -231,21 +245,10 @@ struct WallRig {
     ToolCouplingSettings settings;
     settings.stiffness = kStiffness;
     coupling = ToolCoupling::create(*probe, world->femSolver(), mapping, settings).value();
-    device = std::make_unique<device::ScriptedDevice>(device::Trajectory(keyframes, {}),
-                                                      device::defaultDeviceLimits(), "probe");
-    device::HapticLoopSettings loop_settings;
-    loop_settings.buttons_switch_force = false;
-    loop_settings.log_capacity = 10000;
-    loop = std::make_unique<device::HapticLoop>(*device, loop_settings);
-    runtime = std::make_unique<HapticRuntime>(
-        *world, std::vector<HapticBinding>{{coupling.get(), loop.get(), 1000}});
-    runtime->setLockstep(true);
+    link = std::make_unique<ScriptedDeviceLoop>(*world, *coupling,
+                                                device::Trajectory(keyframes, {}), 10000);
   }
-  void run(double seconds) {
-    const int steps = static_cast<int>(std::lround(seconds / 0.01));
-    for (int k = 0; k < steps; ++k)
-      ASSERT_TRUE(runtime->step().ok) << "step " << k;
-  }
+  void run(double seconds) { link->run(seconds); }
 };
 
 TEST(ToolCoupling, ARigidWallFeelsAsStiffAsTheCouplingAtTheLoopsRate) {
@@ -273,7 +276,7 @@ TEST(ToolCoupling, ARigidWallFeelsAsStiffAsTheCouplingAtTheLoopsRate) {
   // Each tick of the press (device 1-5 mm into the wall, t in [0.6, 1.0] s): the rendered force
   // against k times the depth then.
   double worst = 0;
-  for (const device::LoopLogRow& row : rig.loop->log()) {
+  for (const device::LoopLogRow& row : rig.link->loop->log()) {
     if (row.time < 0.6 || row.time > 1.0) continue;
     const double depth = -0.005 - row.pose.position.z;  // m, the device below the wall's contact
     const double ideal = WallRig::kStiffness * depth + damper * 0.01;  // N, at 1 cm/s
@@ -281,7 +284,7 @@ TEST(ToolCoupling, ARigidWallFeelsAsStiffAsTheCouplingAtTheLoopsRate) {
   }
   EXPECT_LT(worst, 0.02);  // N, a fifth of a step's staircase
   // Passive: the port gives back at most 1 % of the 12.5 mJ the coupling held at 5 mm.
-  EXPECT_LE(rig.loop->stats().max_port_energy.load(), 1.25e-4);
+  EXPECT_LE(rig.link->loop->stats().max_port_energy.load(), 1.25e-4);
 }
 
 // Between the solver and the loop: the coupling's stages at the solver's moments, its wrench
@@ -380,12 +383,12 @@ TEST(ToolCoupling, ADeviceLostMidPressFadesToZeroWithoutAJumpAndTheToolHolds) {
   // (0.2 s) at the filter's rate limit, and the tool stays where the last goal held it.
   WallRig rig(
       {{0, devicePose(0, 0, 0)}, {1.0, devicePose(0, 0, -0.01)}, {3, devicePose(0, 0, -0.01)}});
-  rig.device->dieAt(1.2);
+  rig.link->device->dieAt(1.2);
   rig.run(2.0);
   const device::SafetySettings safety;
   double largest_change = 0, output_at_death = -1;
   device::Wrench previous;
-  for (const device::LoopLogRow& row : rig.loop->log()) {
+  for (const device::LoopLogRow& row : rig.link->loop->log()) {
     largest_change = std::max(largest_change, std::abs(row.output.force.z - previous.force.z));
     previous = row.output;
     if (output_at_death < 0 && row.time >= 1.2) output_at_death = row.output.force.z;
@@ -407,11 +410,11 @@ TEST(ToolCoupling, AJammedToolIsPushedWithAtMostMaxForceAndTheDeviceAtItsLimit) 
   rig.run(2.0);
   EXPECT_NEAR(rig.coupling->couplingWrench().force.z(), -100.0, 1e-6);
   EXPECT_NEAR(toEigen(rig.probe->getCenterOfMassPosition()).z(), WallRig::kRadius, 5e-4);
-  for (const device::LoopLogRow& row : rig.loop->log()) {
+  for (const device::LoopLogRow& row : rig.link->loop->log()) {
     ASSERT_LE(std::hypot(row.output.force.x, row.output.force.y, row.output.force.z),
               device::defaultDeviceLimits().max_force + 1e-9);
   }
-  EXPECT_NEAR(rig.loop->lastOutput().force.z, device::defaultDeviceLimits().max_force, 1e-9);
+  EXPECT_NEAR(rig.link->loop->lastOutput().force.z, device::defaultDeviceLimits().max_force, 1e-9);
 }
 
 TEST(ToolCoupling, AStiffCouplingOnALightToolIsStableInFreeSpace) {
@@ -438,6 +441,24 @@ TEST(ToolCoupling, AStiffCouplingOnALightToolIsStableInFreeSpace) {
   EXPECT_LT(rig.coupling->worldWrench().force.norm(), 1e-3);  // N: weight compensated, at rest
 }
 
+TEST(ToolCoupling, APoseOutOfReachOrNotFiniteIsRefusedAndTheLastGoalHeld) {
+  WallRig rig({{0, devicePose(0, 0, 0)}});
+  const Eigen::Vector3d held = rig.coupling->goal().origin;
+  StepContext ctx;
+  ctx.dt = 0.01;
+  device::HandCommand command;
+  command.tick = 1;
+  command.alive = true;
+  for (double x : {1.7e308, std::numeric_limits<double>::quiet_NaN()}) {
+    command.pose.position.x = x;
+    rig.coupling->beforeRigidStep(command, ctx);
+    rig.coupling->afterFemStep(ctx, true);
+  }
+  EXPECT_EQ(rig.coupling->rejectedPoses(), 2u);
+  EXPECT_EQ(rig.coupling->goal().origin, held);
+  EXPECT_NEAR(1.0 / toDouble(rig.probe->getInvMass()), 0.02, 1e-12) << "its own mass back";
+}
+
 TEST(ToolCoupling, OnlyADynamicBodyWithValidSettingsCanBeATool) {
   WallRig rig({{0, devicePose(0, 0, 0)}});
   btRigidBody* wall = rig.world->rigidBodies().front();
@@ -462,9 +483,7 @@ struct GraspRig {
   btRigidBody* palm = nullptr;
   std::array<btRigidBody*, 2> jaws{};
   std::unique_ptr<GrasperCoupling> grasper;
-  std::unique_ptr<device::ScriptedDevice> device;
-  std::unique_ptr<device::HapticLoop> loop;
-  std::unique_ptr<HapticRuntime> runtime;
+  std::unique_ptr<ScriptedDeviceLoop> link;
 
   GraspRig() {
     WorldSettings ws;
@@ -504,26 +523,15 @@ struct GraspRig {
     settings.grip_force = 20;
     grasper = GrasperCoupling::create(world->femSolver(), *palm, jaws, mapping, coupling, settings)
                   .value();
-    device =
-        std::make_unique<device::ScriptedDevice>(device::Trajectory({{0, devicePose(0, 0, 0)},
-                                                                     {1.0, devicePose(0, 0, -0.1)},
-                                                                     {2.0, devicePose(0, 0, -0.1)},
-                                                                     {3.0, devicePose(0, 0, 0.05)},
-                                                                     {20, devicePose(0, 0, 0.05)}},
-                                                                    {{0, 0u}, {1.2, 1u}}),
-                                                 device::defaultDeviceLimits(), "grasper");
-    device::HapticLoopSettings loop_settings;
-    loop_settings.buttons_switch_force = false;
-    loop = std::make_unique<device::HapticLoop>(*device, loop_settings);
-    runtime = std::make_unique<HapticRuntime>(
-        *world, std::vector<HapticBinding>{{grasper.get(), loop.get(), 1000}});
-    runtime->setLockstep(true);
+    link = std::make_unique<ScriptedDeviceLoop>(*world, *grasper,
+                                                device::Trajectory({{0, devicePose(0, 0, 0)},
+                                                                    {1.0, devicePose(0, 0, -0.1)},
+                                                                    {2.0, devicePose(0, 0, -0.1)},
+                                                                    {3.0, devicePose(0, 0, 0.05)},
+                                                                    {20, devicePose(0, 0, 0.05)}},
+                                                                   {{0, 0u}, {1.2, 1u}}));
   }
-  void run(double seconds) {
-    const int steps = static_cast<int>(std::lround(seconds / 0.01));
-    for (int k = 0; k < steps; ++k)
-      ASSERT_TRUE(runtime->step().ok) << "step " << k;
-  }
+  void run(double seconds) { link->run(seconds); }
   Eigen::Vector3d blockCentre() const {
     Eigen::Vector3d c = Eigen::Vector3d::Zero();
     double m = 0;
@@ -620,17 +628,12 @@ TEST(ToolCoupling, IndentationFollowsHertzOnAFiniteLayer) {
   ToolCouplingSettings settings;
   settings.stiffness = 2000;
   auto coupling = ToolCoupling::create(*probe, world.femSolver(), mapping, settings).value();
-  device::ScriptedDevice scripted(
-      device::Trajectory({{0, devicePose(0, 0, 0)}, {3.0, devicePose(0, 0, -0.0017)}}, {}),
-      device::defaultDeviceLimits(), "probe");
-  device::HapticLoopSettings loop_settings;
-  loop_settings.buttons_switch_force = false;
-  device::HapticLoop loop(scripted, loop_settings);
-  HapticRuntime runtime(world, {{coupling.get(), &loop, 1000}});
-  runtime.setLockstep(true);
+  ScriptedDeviceLoop link(
+      world, *coupling,
+      device::Trajectory({{0, devicePose(0, 0, 0)}, {3.0, devicePose(0, 0, -0.0017)}}, {}));
   int checked = 0;
   for (int k = 0; k < 300; ++k) {
-    ASSERT_TRUE(runtime.step().ok);
+    ASSERT_TRUE(link.runtime->step().ok);
     if (k < 269 || k % 30 != 29) continue;  // 2.7 and 3 s: depths 1.28 and 1.44 mm
     const double depth = kH + kR - toEigen(probe->getCenterOfMassPosition()).z();
     const double felt = coupling->worldWrench().force.z();

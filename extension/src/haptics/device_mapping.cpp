@@ -26,6 +26,14 @@ Frame DeviceMapping::toWorld(const device::Pose& pose) const {
   return f;
 }
 
+std::optional<Frame> DeviceMapping::toWorldWithinReach(const device::Pose& pose) const {
+  const Frame mapped = toWorld(pose);
+  if (mapped.origin.allFinite() && mapped.origin.cwiseAbs().maxCoeff() <= kMaxReach &&
+      mapped.rotation.coeffs().allFinite())
+    return mapped;
+  return std::nullopt;
+}
+
 device::Pose DeviceMapping::toDevice(const Frame& frame) const {
   const Eigen::Quaterniond q = anchor.rotation.conjugate() * frame.rotation;
   return {haptics::toDevice(anchor.toLocal(frame.origin) / position_scale),

@@ -37,12 +37,9 @@ Status HandCoupling::apply(const device::HandCommand& command, double now) {
   command_time_ = command.time;
   now_ = now;
   if (command.alive) {  // a dead device's pose is stale: hold the last goal
-    // Validated after the mapping: a finite but enormous packet position overflows once scaled.
-    const Frame mapped = mapping_.toWorld(command.pose);
-    if (mapped.origin.allFinite() && mapped.origin.cwiseAbs().maxCoeff() <= kMaxHandReach &&
-        mapped.rotation.coeffs().allFinite()) {
+    if (const std::optional<Frame> mapped = mapping_.toWorldWithinReach(command.pose)) {
       goal_pose_ = command.pose;
-      goal_ = mapped;
+      goal_ = *mapped;
     } else {
       ++rejected_poses_;
     }

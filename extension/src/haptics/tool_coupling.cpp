@@ -78,10 +78,8 @@ void ToolCoupling::takeGoal(const device::HandCommand& command) {
   command_tick_ = command.tick;
   command_time_ = command.time;
   if (!command.alive) return;  // a dead device's pose is stale: hold the last goal
-  const Frame mapped = mapping_.toWorld(command.pose);
-  if (mapped.origin.allFinite() && mapped.origin.cwiseAbs().maxCoeff() <= kMaxReach &&
-      mapped.rotation.coeffs().allFinite()) {
-    goal_ = mapped;
+  if (const std::optional<Frame> mapped = mapping_.toWorldWithinReach(command.pose)) {
+    goal_ = *mapped;
     goal_pose_ = command.pose;
   } else {
     ++rejected_poses_;

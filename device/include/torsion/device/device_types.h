@@ -52,7 +52,7 @@ struct HandCommand {
   std::uint64_t tick = 0;  ///< the loop's tick that wrote it
   double time = 0;         ///< s, loop clock
   Pose pose;
-  bool alive = false;                  ///< the device answered this tick
+  bool alive = false;  ///< the device answered this tick
   /// Buttons held (bit k: button k+1), as last read from a live device (a grasper's jaws close
   /// while its button is held; a dead device's last buttons stand).
   std::uint32_t buttons = 0;

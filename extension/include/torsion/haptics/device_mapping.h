@@ -7,6 +7,7 @@
 
 #include <Eigen/Core>
 #include <Eigen/Geometry>
+#include <optional>
 
 #include "torsion/constraints/carried_nodes.h"
 #include "torsion/constraints/frame.h"
@@ -22,7 +23,13 @@ struct DeviceMapping {
   double force_scale = 1;     ///< device N per world N
   double torque_scale = 1;    ///< device N m per world N m
 
+  /// m: a device pose mapped beyond this from the origin is refused (a packet may carry 1.7e308).
+  static constexpr double kMaxReach = 1e6;
+
   Frame toWorld(const device::Pose& pose) const;
+  /// toWorld(pose) when its origin is finite and within kMaxReach and its rotation finite (checked
+  /// after the scale: a finite but enormous position overflows once scaled); else nullopt.
+  std::optional<Frame> toWorldWithinReach(const device::Pose& pose) const;
   device::Pose toDevice(const Frame& frame) const;
   device::Wrench wrenchToDevice(const Wrench& world) const;
   /// dW/dpose (world, about the hand's origin) -> device units, row-major into out[36].

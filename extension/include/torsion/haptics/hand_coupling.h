@@ -75,7 +75,7 @@ class HandCoupling : public DeviceCoupling {
   /// Before FemWorld::step(): acts on `command` (grab, release, move). `now` is the world time.
   /// Returns an error when a requested grab found nothing to hold (the hand stays empty).
   /// A pose whose world frame (after the mapping's scale) is not finite or farther than
-  /// kMaxHandReach from the origin is dropped and counted: the last goal is held.
+  /// DeviceMapping::kMaxReach from the origin is dropped and counted: the last goal is held.
   Status apply(const device::HandCommand& command, double now);
   /// DeviceCoupling: apply() at the step's start.
   Status beforeFemStep(const device::HandCommand& command, const StepContext& ctx) override {
@@ -84,8 +84,6 @@ class HandCoupling : public DeviceCoupling {
   /// Poses dropped by apply() because their mapped frame was out of reach or not finite.
   std::uint64_t rejectedPoses() const override { return rejected_poses_; }
 
-  /// m: a device pose mapped beyond this is refused (a packet may carry 1.7e308).
-  static constexpr double kMaxHandReach = 1e6;
   /// After the step: the wrench for the loop, in device units. `step` is the world's step count.
   device::SimulationWrench publish(std::uint64_t step) override;
 

@@ -67,8 +67,6 @@ class ToolCoupling : public DeviceCoupling {
   /// N/m: a touching rigid contact point in K_e, far stiffer than any coupling, so that K_h is
   /// the coupling's own stiffness along the contact normals.
   static constexpr double kRigidContactStiffness = 1e7;
-  /// m: a device pose mapped beyond this is refused.
-  static constexpr double kMaxReach = 1e6;
 
   /// `tool` must be a dynamic body (mass > 0) of the world `solver` is attached to, and both must
   /// outlive the coupling (the solver's FEM bodies and the world's manifolds give K_e). The
