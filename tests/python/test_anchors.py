@@ -90,8 +90,8 @@ def test_an_anchor_to_another_worlds_body_and_a_double_anchor_are_refused():
 
 
 def test_restoring_a_state_keeps_the_anchors_there_are_now():
-    # Anchors are part of the world around the bodies (docs/python.md, "Anchors"): one made after
-    # a save still holds after the restore, and the nodes follow the plate.
+    # Anchors are part of the world around the bodies (docs/python-api.md, "Anchors"): one made
+    # after a save still holds after the restore, and the nodes follow the plate.
     world, cube, plate, top = hanging_cube()
     state = world.save_state()
     cube.anchor(top, plate)

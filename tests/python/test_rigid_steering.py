@@ -323,7 +323,7 @@ def test_dt_stays_with_device_hands_whose_haptic_loops_run_at_it():
 
 def test_a_step_that_fails_after_a_force_rewinds_to_what_the_good_steps_made_with_it():
     # After a failed step the world replays its good steps from an earlier checkpoint
-    # (docs/python.md, Argument checks). The force queued for the first of them is replayed with
+    # (docs/python-api.md, Argument checks). The force queued for the first of them is replayed with
     # it: the rewound world is bit for bit the one that took the good steps.
     def build():
         world, ball, _ = free_world()

@@ -20,7 +20,7 @@ def snapshot(world):
 
 
 # Scenes with hands, node sets and FEM-rigid contact. Not rigid-rigid contact: Bullet's persistent
-# manifolds (its contact warm starts) are not part of a checkpoint (docs/python.md).
+# manifolds (its contact warm starts) are not part of a checkpoint (docs/python-checkpoints.md).
 @pytest.mark.parametrize("scene", ["twist_cylinder_2430", "drop", "two_hands"])
 def test_restoring_a_saved_state_repeats_the_continuation_bit_for_bit(scene):
     world = torsion.World.from_scene(scene, threads=1)
