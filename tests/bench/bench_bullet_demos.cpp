@@ -1,5 +1,5 @@
-// Bullet's deformable demos side by side (docs/performance.md, "Bullet's deformable demos, side by
-// side"): each scene file runs in Torsion (FemWorld, one thread) and in Bullet's
+// Bullet's deformable demos side by side (docs/performance-contact.md, "Bullet's deformable
+// demos, side by side"): each scene file runs in Torsion (FemWorld, one thread) and in Bullet's
 // btDeformableMultiBodyDynamicsWorld (bullet_rigid_mix_runner.cpp: same meshes, node sets, rigid
 // bodies with their kinematic scripts, gravity and dt), and both end states face the same checks
 // (bench_demo_checks.h: exploded, sank, passed through, the demo's defining outcome).

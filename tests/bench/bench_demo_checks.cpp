@@ -115,7 +115,7 @@ Verdict judge(const scene::SceneSpec& spec, const std::vector<TetMesh>& rest, co
   v.passed_through = deepest > tolerance;
   d << "deepest node in a box " << deepest << " m; ";
 
-  // The defining outcome of each re-created demo (docs/performance.md).
+  // The defining outcome of each re-created demo (docs/performance-contact.md).
   const std::vector<Eigen::Vector3d>& cube = end.nodes.front();  // the demo's one soft body
   const Eigen::Vector3d c = centroid(cube);
   d << "soft body centroid (" << c.x() << ", " << c.y() << ", " << c.z() << "), z " << lowestZ(cube)

@@ -1,5 +1,5 @@
-// Contact between FEM bodies, side by side (docs/performance.md, "Contact between FEM bodies:
-// cost and Bullet side by side"): each scene runs
+// Contact between FEM bodies, side by side (docs/performance-contact.md, "Contact between FEM
+// bodies: cost, and Bullet side by side"): each scene runs
 //   torsion                 as `torsion run` builds it (FemWorld, one thread), with the cost of
 //                           detecting FEM pair contacts per step measured on the side
 //   torsion_no_fem_contact  the same scene with "fem_contact" off: what the contact costs

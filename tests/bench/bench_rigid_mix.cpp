@@ -1,4 +1,4 @@
-// rigid_mix benchmark (docs/performance.md): steps per second of a scene with FEM bodies
+// rigid_mix benchmark (docs/performance-contact.md): steps per second of a scene with FEM bodies
 // and rigid bodies, run three ways on one thread:
 //   torsion           the scene as it is (contacts on)
 //   torsion_no_rigid  the same FEM bodies and node sets, rigid bodies and ground removed

@@ -1,9 +1,9 @@
-// Self-contact over a whole scene (docs/performance.md, "Self-contact on the plectoneme rod";
-// docs/contact.md, "Self-contact"): steps/s, and per body with self-contact the steps whose
+// Self-contact over a whole scene (docs/performance-contact.md, "Self-contact on the plectoneme
+// rod"; docs/contact.md, "Self-contact"): steps/s, and per body with self-contact the steps whose
 // contact solve stopped unconverged, the most active contacts, the deepest linearised end-of-step
 // penetration, the tree searches, the island's Newton iterations, and every `--check-every` steps
-// whether any two surface
-// triangles intersect (analysis/surface_intersections.h, exact). One JSON line on stdout.
+// whether any two surface triangles intersect (analysis/surface_intersections.h, exact). One JSON
+// line on stdout.
 //
 //   bench_self_contact SCENE [--steps N] [--threads T] [--check-every K]
 //                            [--save-at K FILE] [--resume FILE] [--self-contact off]

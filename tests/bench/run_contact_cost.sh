@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
-# What a rigid body resting on a large soft body costs (docs/performance.md, "What contact costs on
-# a large body"): each scene twice, with the rigid body and without it (the same body's step
-# without that contact), in Torsion (`torsion run`, one thread: median and p95 ms per step from
+# What a rigid body resting on a large soft body costs (docs/performance-contact.md, "The contact
+# island on rigid bodies"): each scene twice, with the rigid body and without it (the same body's
+# step without that contact), in Torsion (`torsion run`, one thread: median and p95 ms per step from
 # summary.json, the median of REPS runs) and in Bullet's btDeformableMultiBodyDynamicsWorld on the
 # same mesh (bench_bullet_demos, one JSON line per engine).
 #

@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
-# Contact between FEM bodies, side by side (docs/performance.md, "Contact between FEM bodies: cost,
-# and Bullet side by side"): timings of bench_fem_contact, then, with --instructions, the
-# instruction counts (callgrind: exact, whatever the machine's load) of each run's step and of
+# Contact between FEM bodies, side by side (docs/performance-contact.md, "Contact between FEM
+# bodies: cost, and Bullet side by side"): timings of bench_fem_contact, then, with --instructions,
+# the instruction counts (callgrind: exact, whatever the machine's load) of each run's step and of
 # its contact detection.
 #
 #   tests/bench/run_fem_contact.sh [--instructions [--instruction-steps N]] [SCENE...]

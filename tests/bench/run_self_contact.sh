@@ -1,8 +1,8 @@
 #!/usr/bin/env bash
-# The plectoneme's self-contact figures of docs/performance.md ("Self-contact on the plectoneme
-# rod") in one command: the whole scene with self-contact on and off (steps/s, CPU per step, the
-# searches' wall time per step, Newton iterations, unconverged steps, end penetration, crossings),
-# then its contact phase alone (steps 2801-3200, from a checkpoint the first run saves).
+# The plectoneme's self-contact figures of docs/performance-contact.md ("Self-contact on the
+# plectoneme rod") in one command: the whole scene with self-contact on and off (steps/s, CPU per
+# step, the searches' wall time per step, Newton iterations, unconverged steps, end penetration,
+# crossings), then its contact phase alone (steps 2801-3200, from a checkpoint the first run saves).
 #
 # Usage: bash tests/bench/run_self_contact.sh RESULTS_DIR
 # Environment (defaults in brackets):

@@ -2,7 +2,7 @@
 // docs/scene-format.md): each runs to its end as `torsion run` runs it (buildScene, then
 // driveHands and FemWorld::step per step) and the demo's defining outcome holds. Label "physics".
 // bullet_deformable_rigid is left to bench_bullet_demos: five boxes resting on a 1536-tet sheet
-// take minutes in Release (docs/performance.md).
+// take minutes in Release (docs/performance-contact.md).
 
 #include <gtest/gtest.h>
 

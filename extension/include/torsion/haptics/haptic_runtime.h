@@ -72,8 +72,8 @@ class HapticRuntime : public StepListener {
   void startThreads();
   /// SCHED_FIFO priority (1-99) the thread that calls startThreads() asks for until
   /// stopThreads(), so that on a loaded machine the steps run at the speed of an idle one and
-  /// the wrench the loop renders stays young (docs/performance.md: wrench age p99 10 ms at
-  /// 31558 tets under load 13, against 100 ms without). Keep it below the loops' (80) so that
+  /// the wrench the loop renders stays young (docs/performance-haptics.md: wrench age p99 10 ms
+  /// at 31558 tets under load 13, against 100 ms without). Keep it below the loops' (80) so that
   /// they still preempt the simulation. The solver's worker threads inherit it when the thread
   /// starts them (their first parallel step). Linux caps real-time threads at 95 % of the CPU
   /// (sched_rt_runtime_us), so a simulation slower than real time cannot lock the machine.

@@ -18,8 +18,8 @@ constexpr double kSlopeRounding = 1e-13;
 // iterations in a step without -> with: soft_stack 86 -> 48, soft_grasp 80 -> 62, rigid_mix
 // 42 -> 28, bullet_boxes 46 -> 32; a motor gripper holding a soft block (70 rows sliding at the
 // warm start, sticking at the solution) 50 -> 18.5 a step; the plectoneme's slowly sliding coils
-// 9 % fewer (docs/performance.md). Only after a short step: from the start, on rows that go on
-// sliding, the exact model converges faster (the plectoneme: 5.6 times the iterations).
+// 9 % fewer (docs/performance-contact.md). Only after a short step: from the start, on rows that
+// go on sliding, the exact model converges faster (the plectoneme: 5.6 times the iterations).
 constexpr double kShortStep = 0.5;
 
 }  // namespace
