@@ -1,4 +1,4 @@
-// The SAP contact solve's cost against the same body's plain step (docs/contact-solve.md, "Cost").
+// The SAP contact solve's cost against the same body's plain step (docs/contact-sap.md, "Cost").
 // A 0.4 x 0.4 x 0.1 m slab (16 x 16 x 4 cells, 1445 nodes), E = 1e5 or 1e8 Pa, one step of 1 ms
 // from rest under gravity: a rigid 2 kg box resting on four top nodes ("box", 4 rows), or that
 // box and every bottom node on the ground ("ground", 293 rows). Times per solve:

@@ -82,7 +82,7 @@ TEST(ContactPhysics, BoxRestsOnSlabWithStaticSag) {
   // The slab follows the box: no node under it hangs below it by more than 10 % of the sag (the
   // box is carried by the 25 nodes under it; its edges lie 1 mm beyond the rim row, so the face
   // points along them are held by the rim nodes, which carry over 90 % of their weights, and the
-  // face contacts sit out: docs/contact.md, "Sliding over nodes").
+  // face contacts sit out: docs/contact-pipeline.md, "Sliding over nodes").
   EXPECT_LT(run.largest_gap_under_box, 0.1 * run.sag);
   EXPECT_GT(run.contacts, 0);
 }
@@ -155,7 +155,8 @@ TEST(ContactPhysics, FrictionHoldsBelowAngleSlidesAbove) {
 // the cube stays in place, never exceeds a sane speed, and comes to rest. The plate is made the
 // way Bullet's demos make kinematic bodies (mass 0, then CF_KINEMATIC_OBJECT), so it carries
 // CF_STATIC_OBJECT too: taking it for static made the nodes lag a step behind it and, when it
-// stopped, lose it and spring 2 cm into it at 1.9 m/s (docs/contact.md, "the kinematic press").
+// stopped, lose it and spring 2 cm into it at 1.9 m/s (docs/contact-pipeline.md, "The kinematic
+// press").
 TEST(ContactPhysics, PressedCubeStaysPut) {
   FemWorld world(contactSettings(0.01));
   addGround(world, 0.8);
@@ -238,7 +239,7 @@ TEST(ContactPhysics, SqueezedBoxUnderHeldBlockIsStable) {
   const int hand = block->carryNodes("hand", top, frame, 0.0);
   (void)hand;
   // The box's speed as its motion over each step (its velocity state carries, for one step, the
-  // impulse that Bullet's ground contact then cancels: docs/contact.md, supported bodies).
+  // impulse that Bullet's ground contact then cancels: docs/contact-pipeline.md, supported bodies).
   double fastest_box = 0, deepest = 0, worst_held = 0;
   Eigen::Vector3d last = toEigen(box->getCenterOfMassPosition());
   for (int k = 0; k < 200; ++k) {

@@ -20,7 +20,7 @@ struct RestingBoxRun {
   double box_speed = 0;          ///< m/s, at the end
   double off_centre = 0;         ///< m, horizontal drift of the box's centre
   int contacts = 0;              ///< active node contacts at the end
-  int face_contacts = 0;         ///< face contacts (docs/contact.md), not in `contacts`
+  int face_contacts = 0;         ///< face contacts (docs/contact-pipeline.md), not in `contacts`
   int corner_contacts = 0;       ///< of which at nodes of the linear mesh (tet10: element corners)
   /// m, at the end: the largest distance of a node under the box (top nodes within its
   /// footprint) below the box's bottom face: how well the slab's surface follows the box.

@@ -1,6 +1,7 @@
 // A rigid box pushed across a soft FEM slab by a kinematic pusher at constant speed
-// (docs/contact.md, "Sliding over nodes"): once it slides steadily, the slab's friction on it is
-// Coulomb's mu m g, and so is the force the pusher needs, whatever nodes and faces it passes over.
+// (docs/contact-pipeline.md, "Sliding over nodes"): once it slides steadily, the slab's friction on
+// it is Coulomb's mu m g, and so is the force the pusher needs, whatever nodes and faces it passes
+// over.
 
 #include <btBulletDynamicsCommon.h>
 #include <gtest/gtest.h>

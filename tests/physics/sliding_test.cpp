@@ -1,7 +1,7 @@
-// A rigid box sliding over an FEM slab (docs/contact.md, "Sliding over nodes"): gravity tilted by
-// the slope angle a, the slab's base held. Coulomb's law gives the distance after t seconds,
-// d = 0.5 g (sin a - mu cos a) t^2, whatever the slab's mesh spacing or stiffness: the box must
-// feel only the normal force and its friction, not the rows of surface nodes it passes over.
+// A rigid box sliding over an FEM slab (docs/contact-pipeline.md, "Sliding over nodes"): gravity
+// tilted by the slope angle a, the slab's base held. Coulomb's law gives the distance after t
+// seconds, d = 0.5 g (sin a - mu cos a) t^2, whatever the slab's mesh spacing or stiffness: the box
+// must feel only the normal force and its friction, not the rows of surface nodes it passes over.
 
 #include <btBulletDynamicsCommon.h>
 #include <gtest/gtest.h>
@@ -185,7 +185,7 @@ TEST(Sliding, FrictionlessBoxSlidesOverACoarseTet10Slab) {
 // the fixes it moved 66 % of Coulomb's distance at 20 deg with mu = 0.3: face contacts at its
 // edges ended steps stuck beyond Coulomb's cone or pulling, and a face and the node contacts at its
 // corners split the load as a push and a pull whose push alone bounded the friction
-// (docs/contact.md, "Sliding over nodes"). The distance magnifies a friction error by
+// (docs/contact-pipeline.md, "Sliding over nodes"). The distance magnifies a friction error by
 // mu cos a / (sin a - mu cos a): 4.5 at 20 deg with mu = 0.3.
 TEST(Sliding, BoxWithFrictionSlidesAsCoulombSaysOnAStiffSlab) {
   const std::pair<double, double> cases[] = {{10, 0.1}, {20, 0.3}};
@@ -244,9 +244,9 @@ TEST(Sliding, StiffSlabHoldsTheBoxBelowTheFrictionAngleAndLetsItSlideAbove) {
 // Coulomb's distance whatever the slab: soft (E = 1e5 Pa) and stiff (1e8), node rows 0.2 m (the
 // box's length), 0.1 m and 0.05 m apart, tet4 and tet10, two slopes by two coefficients
 // (docs/validation.md, "Sliding over an FEM slab"). Before the sliding-body rules
-// (docs/contact.md, "Sliding over nodes") the soft slab gave -64 % at 20 deg with mu = 0.3; before
-// the friction's slip resistance node rows as long as the box gave +6.4 % (soft) and +5.0 %
-// (stiff) at 20 deg with mu = 0.3, and the box on the stiff coarse tet10 slab at 25 deg with
+// (docs/contact-pipeline.md, "Sliding over nodes") the soft slab gave -64 % at 20 deg with
+// mu = 0.3; before the friction's slip resistance node rows as long as the box gave +6.4 % (soft) and
+// +5.0 % (stiff) at 20 deg with mu = 0.3, and the box on the stiff coarse tet10 slab at 25 deg with
 // mu = 0.2 stopped dead at a node row at 2 m/s (-15 %).
 TEST(Sliding, BoxWithFrictionSlidesAsCoulombSaysOverSoftStiffCoarseFineTet4AndTet10Slabs) {
   struct Case {

@@ -1,7 +1,7 @@
-// The FEM-rigid contact step (docs/contact.md, "Pipeline, per step"): candidates from Bullet's
-// broadphase, the narrow phase (rigid_contact_detection.cpp), the rows of the body's island and
-// its answer (rigid_contact_convex.cpp), and the rigid bodies' new velocities. detect reads as
-// the list of its stages.
+// The FEM-rigid contact step (docs/contact-pipeline.md, "Pipeline, per step"): candidates from
+// Bullet's broadphase, the narrow phase (rigid_contact_detection.cpp), the rows of the body's
+// island and its answer (rigid_contact_convex.cpp), and the rigid bodies' new velocities. detect
+// reads as the list of its stages.
 
 #include "torsion/contact/rigid_contact.h"
 

@@ -1,6 +1,6 @@
-// Narrow phase of the FEM-rigid contact (docs/contact.md, "Narrow phase"): the candidate objects
-// of Bullet's broadphase against the body's node tree and surface triangles, each touched object
-// made a partner of the solve, and the warm active set carried over from the last step.
+// Narrow phase of the FEM-rigid contact (docs/contact-pipeline.md, "Narrow phase"): the candidate
+// objects of Bullet's broadphase against the body's node tree and surface triangles, each touched
+// object made a partner of the solve, and the warm active set carried over from the last step.
 
 #include <BulletCollision/BroadphaseCollision/btDbvt.h>
 #include <BulletCollision/BroadphaseCollision/btDispatcher.h>
@@ -44,7 +44,7 @@ btTransform startPose(const btCollisionObject& object, double dt) {
   // Kinematic first: a mass-0 body made kinematic (Bullet's own recipe) keeps CF_STATIC_OBJECT
   // too, yet Bullet has moved it to its end pose. Taking that pose as the start pose shifted the
   // plate by one step's motion: nodes lagged a step behind a pressing plate and, when it stopped,
-  // were taken as separating and dropped (docs/contact.md, the kinematic press).
+  // were taken as separating and dropped (docs/contact-pipeline.md, the kinematic press).
   if (body == nullptr || (!body->isKinematicObject() && body->isStaticObject()))
     return object.getWorldTransform();
   btTransform start;
@@ -150,7 +150,7 @@ void RigidContactSolver::chooseSupportPlane(const btCollisionShape& shape,
   // end the step outside it. The nearest feature's plane is exact at the start of the step but
   // not over it: a node on a flat surface just ahead of a sliding box sees the box's front face
   // (a horizontal normal), and the linearised end gap along it, d - v dt, stops the box at the
-  // node as at a wall, although the box's bottom edge would pass over it (docs/contact.md,
+  // node as at a wall, although the box's bottom edge would pass over it (docs/contact-pipeline.md,
   // "Sliding over nodes"). The supporting plane facing the soft surface (normal minus the node's
   // surface normal: the bottom face's plane for a box on a slab) is as valid a bound. Of these,
   // the one the predicted motion (the node's velocity, the rigid body's velocity after Bullet's

@@ -1,4 +1,4 @@
-// A particle resting on a plane under gravity (docs/contact-solve.md): it sticks below Coulomb's
+// A particle resting on a plane under gravity (docs/contact-sap.md): it sticks below Coulomb's
 // threshold, slides with Coulomb's deceleration above it at its rest height, keeps its speed
 // without friction. Every loop carries each contact's normal impulse to the next step's row (the
 // lagged model's friction bound).

@@ -1,4 +1,4 @@
-// Rigid bodies in SAP islands (docs/contact-solve.md): a box on an incline sticks below the
+// Rigid bodies in SAP islands (docs/contact-sap.md): a box on an incline sticks below the
 // friction angle and slides with Coulomb's acceleration above it; a node squeezed between two
 // rigid plates holds or slides as Coulomb says; a stack of three boxes stands at its static
 // deflection.
@@ -171,7 +171,7 @@ TEST(SapRigidBox, NearRigidContactRestsWithoutChatter) {
 // withholds only the last step's share: the loss is mu (sum of normal impulses - the last step's)
 // to 1e-6. (Bounding the first step's friction by that step's own normal impulse instead, from a
 // first solve without friction, counts the impact twice, this step and the next: it exceeds
-// Coulomb's total by 3 % at k = 1e5 N/m and 17 % near-rigid; docs/contact-solve.md, "Limits".)
+// Coulomb's total by 3 % at k = 1e5 N/m and 17 % near-rigid; docs/contact-sap.md, "Limits".)
 struct LandingRun {
   double coulomb_total = 0;  // mu times the sum of normal impulses, N s
   double lagged_total = 0;   // mu times the sum of all but the last step's

@@ -1,4 +1,4 @@
-// Deformable bodies in SAP islands (docs/contact-solve.md): a spring-network block (a sparse SPD
+// Deformable bodies in SAP islands (docs/contact-sap.md): a spring-network block (a sparse SPD
 // system over 8 nodes) slides down an incline as Coulomb says, with and without friction; a
 // particle on another body's face loads its nodes by their barycentric weights; a FEM bar
 // (SystemOperator + NodeConstraints through FemIslandBody) rests, holds and slides on a plane.

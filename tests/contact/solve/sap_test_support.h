@@ -1,5 +1,5 @@
 #pragma once
-// Shared checks and small builders of the SAP tests (docs/contact-solve.md).
+// Shared checks and small builders of the SAP tests (docs/contact-sap.md).
 
 #include <gtest/gtest.h>
 
@@ -62,7 +62,7 @@ inline void expectCoulombAndComplementarity(const SapProblem& problem, const Sap
   }
 }
 
-/// The lagged model's loop (docs/contact-solve.md): each row's lagged normal impulse is the
+/// The lagged model's loop (docs/contact-sap.md): each row's lagged normal impulse is the
 /// previous step's normal impulse of the same contact, rows[i] of this step being lagged[i]'s;
 /// lagged is empty or shorter at the first step (new contacts: 0).
 inline void carryLaggedImpulses(const std::vector<double>& lagged, std::vector<ContactRow>& rows) {

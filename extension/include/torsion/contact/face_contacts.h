@@ -1,8 +1,8 @@
 #pragma once
-// Face contacts (docs/contact.md, "Face contacts"): a rigid shape against the inside of an FEM
-// surface triangle or edge. Node contacts hold a rigid surface only at nodes; a rigid corner, an
-// edge or a sphere smaller than the mesh spacing would sink between them. A face contact holds the
-// face's point nearest the shape (barycentric weights w on its nodes) against the rigid point
+// Face contacts (docs/contact-pipeline.md, "Face contacts"): a rigid shape against the inside of an
+// FEM surface triangle or edge. Node contacts hold a rigid surface only at nodes; a rigid corner,
+// an edge or a sphere smaller than the mesh spacing would sink between them. A face contact holds
+// the face's point nearest the shape (barycentric weights w on its nodes) against the rigid point
 // nearest it. Touched only by the simulation thread.
 //
 // Relative velocity u = sum_j w_j v_j - J V (J V the rigid point's velocity) and the end-of-step

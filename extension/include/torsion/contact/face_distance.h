@@ -1,8 +1,8 @@
 #pragma once
 // Signed distance from a Bullet collision shape to one triangle of an FEM body's surface: the
-// narrow phase of face contacts (docs/contact.md). Node contacts alone let a rigid feature smaller
-// than the mesh spacing (a corner, an edge, a small sphere) sink between the nodes; a face contact
-// holds the triangle at the point nearest the shape.
+// narrow phase of face contacts (docs/contact-pipeline.md). Node contacts alone let a rigid feature
+// smaller than the mesh spacing (a corner, an edge, a small sphere) sink between the nodes; a face
+// contact holds the triangle at the point nearest the shape.
 //
 //   sphere                    closed form (closest point of the triangle to the centre)
 //   other convex shapes       Bullet's GJK (btGjkEpaSolver2::Distance) on the shape without its

@@ -1,7 +1,7 @@
 #pragma once
 // Signed distance from a point to a Bullet collision shape: the narrow phase of FEM-rigid contact
-// (docs/contact.md). Positive outside, negative inside; the normal is the unit direction, in
-// world coordinates, in which the point leaves the shape fastest (from the shape's surface
+// (docs/contact-pipeline.md). Positive outside, negative inside; the normal is the unit direction,
+// in world coordinates, in which the point leaves the shape fastest (from the shape's surface
 // towards the point).
 //
 //   sphere, box, capsule (X/Y/Z), static plane   closed form, exact

@@ -1,5 +1,5 @@
 #pragma once
-// The rows of an island's contact problem (docs/contact-solve.md): one row per contact point, a
+// The rows of an island's contact problem (docs/contact-sap.md): one row per contact point, a
 // 3-row Jacobian J_i that maps the island's velocities v to the relative contact velocity
 //
 //     v_c,i = J_i v = (v_t1, v_t2, v_n)   (m/s, in the contact frame: two tangents, normal last)
@@ -58,7 +58,7 @@ struct ContactRow {
   double gap = 0;               ///< phi0, m, negative when penetrating
   /// gamma_n of this contact in the previous step's solve (N s, >= 0; SapReport::impulses(2)):
   /// friction is bounded by the disk |gamma_t| <= mu times it. 0 for a new contact, which then
-  /// has no friction in its first step (docs/contact-solve.md, "Limits").
+  /// has no friction in its first step (docs/contact-sap.md, "Limits").
   double lagged_normal_impulse = 0;
   /// The part of v_c that no island dof moves (m/s, contact frame): the motion of a kinematic
   /// partner's point (a moving hand, a conveyor), entered as B's minus A's. v_c = J v + this.

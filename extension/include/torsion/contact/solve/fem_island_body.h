@@ -11,7 +11,7 @@
 // exactly, to which the solver adds the contacts by the capacitance correction (sap_solver.h).
 // Not owned: it must hold this step's factor for as long as the body is solved with. (The body's
 // incomplete Cholesky factor was measured in that place and lost to block-Jacobi everywhere:
-// docs/contact-solve.md, "Cost".)
+// docs/contact-sap.md, "Cost".)
 //
 // useCoarseSpace() gives it the rigid modes of its aggregates (coarse_space.h) for the island's
 // block-Jacobi CG.

@@ -2,7 +2,7 @@
 // One convex problem per contact island: SAP, the Semi-Analytic Primal formulation of
 // A. M. Castro, F. N. Permenter, X. Han, "An Unconstrained Convex Formulation of Compliant
 // Contact", IEEE Transactions on Robotics, 2023 (arXiv:2110.10107, 2022); Drake's SAP
-// solver. docs/contact-solve.md explains the model; this header gives the formulas.
+// solver. docs/contact-sap.md explains the model; this header gives the formulas.
 //
 // Unknowns: v, every velocity dof of the island's bodies (island_body.h), stacked body by body.
 // The velocities after the step minimise the strictly convex, C1 cost

@@ -32,7 +32,7 @@
 // (a body's Cholesky factor, a rigid body's mass) P = H^-1: one CG iteration per direction.
 // Both fold the contacts in whole: with only their diagonal blocks, the stiff, spread eigenvalues
 // of J^T G J (G ~ 1/R up to 1e3 times A's blocks) cost up to rank + 1 CG iterations per
-// direction (docs/contact-solve.md, "Cost").
+// direction (docs/contact-sap.md, "Cost").
 //
 // The cost is strictly convex and C1 with a piecewise-smooth gradient: Newton with exact line
 // search converges from any start. It stops on the paper's optimality criterion,
@@ -68,7 +68,7 @@ struct SapSolverSettings {
   /// row; above this many rows the island is preconditioned by block-Jacobi with the contacts
   /// (coupled_preconditioner.h) for every body. 32: on a 1445-node slab one CHOLMOD solve costs
   /// about 1/60 of its factorisation, so 32 rows add at most about 1.6 factorisations
-  /// (docs/contact-solve.md, "Cost").
+  /// (docs/contact-sap.md, "Cost").
   int max_correction_rows = 32;
 };
 
