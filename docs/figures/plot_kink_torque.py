@@ -1,6 +1,6 @@
 #!/usr/bin/python3
 """Hand torque and elastic energy of the 2430-tet cylinder twisted past its kink, from the
-`--print` lines of tests/bench/bench_kink_self_contact (docs/validation.md, "Twisting past the
+`--print` lines of tests/bench/bench_kink_self_contact (docs/validation-twist.md, "Twisting past the
 kink"). Usage: plot_kink_torque.py OUT.png LABEL=LOG [LABEL=LOG ...]
 """
 import re

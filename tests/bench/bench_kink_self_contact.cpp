@@ -1,7 +1,7 @@
-// The 2430-tet cylinder twisted past its kink with self-contact on (docs/validation.md, "Twisting
-// past the kink"): the test scene of tests/physics/twist_past_kink_test.cpp (r = 1, L = 10,
-// E = 1e5 Pa, dt = 0.01 s, 0.5 rad/s up to 4 pi, then held), with the body's self-contact. After
-// every step from --check-from on, the exact surface-intersection checker
+// The 2430-tet cylinder twisted past its kink with self-contact on (docs/validation-twist.md,
+// "Twisting past the kink"): the test scene of tests/physics/twist_past_kink_test.cpp (r = 1, L =
+// 10, E = 1e5 Pa, dt = 0.01 s, 0.5 rad/s up to 4 pi, then held), with the body's self-contact.
+// After every step from --check-from on, the exact surface-intersection checker
 // (analysis/surface_intersections.h) looks for crossing surface triangles; the first crossing
 // pairs are printed with their rest positions (are they neighbours folding, or the loop passing
 // through the bar?), and every --print steps the twist state: hand torque, elastic and kinetic

@@ -594,7 +594,7 @@ TEST(ToolCoupling, IndentationFollowsHertzOnAFiniteLayer) {
   // The mesh, 27 x 27 x 10 cells of 1.5 x 1.5 x 1 mm (43740 tets), puts 2.5 cells across the
   // contact radius: shallower, fewer nodes carry the contact and the error grows (+4.7 % at
   // 1.12 mm, +19 % at 0.3 mm; on a 6 x 6 cm layer of 40 x 40 x 10 cells +7.0, +2.6 and +0.6 % at
-  // 1.12, 1.28 and 1.44 mm). docs/validation.md, "Tools".
+  // 1.12, 1.28 and 1.44 mm). docs/validation-contact.md, "Tools".
   constexpr double kE = 1e4, kNu = 0.3, kR = 0.01, kH = 0.01, kHalf = 0.02;
   WorldSettings ws;
   ws.gravity.setZero();

@@ -243,7 +243,7 @@ TEST(Sliding, StiffSlabHoldsTheBoxBelowTheFrictionAngleAndLetsItSlideAbove) {
 
 // Coulomb's distance whatever the slab: soft (E = 1e5 Pa) and stiff (1e8), node rows 0.2 m (the
 // box's length), 0.1 m and 0.05 m apart, tet4 and tet10, two slopes by two coefficients
-// (docs/validation.md, "Sliding over an FEM slab"). Before the sliding-body rules
+// (docs/validation-contact.md, "Sliding over an FEM slab"). Before the sliding-body rules
 // (docs/contact-pipeline.md, "Sliding over nodes") the soft slab gave -64 % at 20 deg with
 // mu = 0.3; before the friction's slip resistance node rows as long as the box gave +6.4 % (soft) and
 // +5.0 % (stiff) at 20 deg with mu = 0.3, and the box on the stiff coarse tet10 slab at 25 deg with

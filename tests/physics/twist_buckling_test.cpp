@@ -1,5 +1,5 @@
 // A slender rod clamped at both ends and twisted buckles sideways (Greenhill 1883; Timoshenko &
-// Gere, Theory of Elastic Stability, 2nd ed., chapter 2): docs/validation.md, "Twist buckling
+// Gere, Theory of Elastic Stability, 2nd ed., chapter 2): docs/validation-twist.md, "Twist buckling
 // against Greenhill" (with the derivation for clamped ends). With no axial force and both ends
 // clamped, the straight twisted rod loses stability at the twisting moment
 //   M_cr = 8.9868 E I / L   (2 x 4.4934, 4.4934 the first root of tan x = x; 2.86 pi E I / L),
@@ -364,7 +364,7 @@ TEST(TwistBuckling, Tet10CriticalTwistMatchesGreenhillWithinFivePercent) {
 // the end in over half the length: the helix coils and its loop closes onto the rod, which the
 // open helix of the test above never does. No levels (the straight phase is the test above's);
 // the ramp at 2 rad/s. Self-contact holds the loop. The exact check after every step still finds
-// surface triangles crossing in some steps (40 of 684, docs/validation.md, "Twist buckling
+// surface triangles crossing in some steps (40 of 684, docs/validation-twist.md, "Twist buckling
 // against Greenhill"): shallow edge pairs sliding across each other within a step, never more
 // than 0.15 mm deep. Before the contact thickness, the search along the solved motion and the gap
 // correction (docs/contact.md, "Contact thickness"), the closing loop passed 3.4 to 6.2 mm through
@@ -388,8 +388,8 @@ TEST(TwistBuckling, Tet10RodTwistedOnToTwiceTheCriticalTwistHoldsItsClosedLoopOu
 }
 
 // The same rod on tet4, 4 x 4 x 60 cells (the tet10 mesh's nodes: 5 x 5 x 61), levels lower
-// down. Reported in docs/validation.md; asserted only loosely: linear tets are far too stiff in
-// torsion on this section, so the rod buckles well before Greenhill's twist.
+// down. Reported in docs/validation-twist.md; asserted only loosely: linear tets are far too stiff
+// in torsion on this section, so the rod buckles well before Greenhill's twist.
 TEST(TwistBuckling, Tet4RodBucklesEarlyBecauseItsTorsionIsTooStiff) {
   BucklingSpec spec;
   spec.element = ElementKind::kTet4;

@@ -1,5 +1,5 @@
-// A bar twisted past its kink (docs/validation.md, "Twisting past the kink"). A bar clamped at
-// both ends and twisted at fixed length buckles into a loop once the twist passes a few pi
+// A bar twisted past its kink (docs/validation-twist.md, "Twisting past the kink"). A bar clamped
+// at both ends and twisted at fixed length buckles into a loop once the twist passes a few pi
 // (Greenhill: at a twist moment of about 2.9 pi EI / L, i.e. a twist angle of about
 // 2.9 pi EI / GJ = 3.7 pi for a round bar at nu = 0.3). In the plain corotated material (no volume
 // barrier) the kink's crease then flattens its tets through zero volume and the loop passes

@@ -37,7 +37,7 @@ enum class AnomalyKind {
 /// "inverted_elements", "energy_release", "speed_burst".
 const char* toString(AnomalyKind kind);
 
-/// Defaults and why they are what they are: docs/validation.md, "Twisting past the kink".
+/// Defaults and why they are what they are: docs/validation-twist.md, "Twisting past the kink".
 struct AnomalyThresholds {
   /// Energy release: within the last `energy_window_steps` steps the kinetic energy rose by more
   /// than `energy_release_fraction` of the elastic energy the body had held through the

@@ -7,7 +7,7 @@
 // Fedkiw 2004) the force does point back toward positive volume, but a tet squeezed flat
 // (one singular value 0) stores only V (mu + lambda / 2) and pushes back with a pressure of about
 // lambda + 2 mu, so a kink's crease under a large twist flattens its tets through zero volume
-// (docs/validation.md, "Twisting past the kink"). Hyperelastic laws (neo-Hookean: -mu log J +
+// (docs/validation-twist.md, "Twisting past the kink"). Hyperelastic laws (neo-Hookean: -mu log J +
 // lambda / 2 log^2 J) stiffen without bound as J -> 0; this term adds that stiffening where the
 // linear law is far outside its range, and nothing elsewhere.
 //
