@@ -7,7 +7,8 @@ void addDeviceOptions(CLI::App& command, scene::DeviceOverrides& into) {
                      "Drive a hand with a device instead of its script, or hold a dynamic "
                      "rigid body with one as a tool (repeatable): NAME=scripted:FILE, "
                      "NAME=replay:LOG.csv, NAME=network[:[HOST:]PORT], NAME=spacemouse, "
-                     "NAME=plugin:LIBRARY[:CONFIG]");
+                     "NAME=plugin:LIBRARY[:CONFIG], or (torsion view, a tool) NAME=manual: "
+                     "moved by the viewer's mouse and keys");
   command.add_option("--haptics", into.haptics,
                      "Haptic loops: lockstep (simulated clock, deterministic; default for "
                      "scripted and replay devices) or threaded (1 kHz threads, simulation paced "

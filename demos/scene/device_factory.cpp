@@ -3,6 +3,7 @@
 #include <filesystem>
 
 #include "data_directory.h"
+#include "torsion/device/manual_device.h"
 #include "torsion/device/network_device.h"
 #include "torsion/device/plugin_device.h"
 #include "torsion/device/scripted_device.h"
@@ -119,6 +120,9 @@ Result<std::unique_ptr<device::HapticDevice>> openDevice(const DeviceSpec& spec,
       if (!opened) return Error{opened.error};
       return std::unique_ptr<device::HapticDevice>(std::move(*opened.value));
     }
+    case DeviceSpec::Kind::kManual:  // the viewer sets its pose (SceneHaptics::manualTool)
+      return std::unique_ptr<device::HapticDevice>(
+          std::make_unique<device::ManualDevice>(limitsOf(spec)));
   }
   return Error{"unknown device kind"};
 }

@@ -138,8 +138,11 @@ DeviceSpec readDeviceKind(const JsonObject& d, const std::string& base_directory
     spec.file = resolve(d.string("library"), base_directory);
     spec.config = d.string("config", "");
     spec.isolated = d.boolean("isolated", spec.isolated);
+  } else if (type == "manual") {
+    spec.kind = DeviceSpec::Kind::kManual;
   } else {
-    d.fail("type", "'" + type + "' is not one of: scripted, replay, network, spacemouse, plugin");
+    d.fail("type",
+           "'" + type + "' is not one of: scripted, replay, network, spacemouse, plugin, manual");
   }
   if (spec.kind == DeviceSpec::Kind::kScripted || spec.kind == DeviceSpec::Kind::kReplay)
     spec.speed = positive(d, "speed", spec.speed, " (playback speed)");
@@ -204,6 +207,8 @@ const char* toString(DeviceSpec::Kind kind) {
       return "spacemouse";
     case DeviceSpec::Kind::kPlugin:
       return "plugin";
+    case DeviceSpec::Kind::kManual:
+      return "manual";
   }
   return "?";
 }
@@ -231,6 +236,10 @@ DeviceSpec readDevice(const JsonObject& hand, const std::string& base_directory)
   }
   const JsonObject d = hand.object("device");
   DeviceSpec spec = readDeviceKind(d, base_directory);
+  if (spec.kind == DeviceSpec::Kind::kManual) {
+    d.fail("type",
+           "'manual' moves a tool (a rigid body's device); torsion view's M key takes a hand");
+  }
   readCoupling(d, spec);
   readLoop(d, spec);
   d.finish();
@@ -323,13 +332,23 @@ Status applyDeviceOverride(SceneSpec& scene, const std::string& text) {
     spec.config = config == std::string::npos ? "" : arg.substr(config + 1);
     if (spec.file.empty())
       return Error{flag + ": " + type + " needs a shared library: " + type + ":LIBRARY[:CONFIG]"};
+  } else if (type == "manual") {
+    if (!arg.empty()) return Error{flag + ": manual takes no argument"};
+    spec.kind = DeviceSpec::Kind::kManual;
   } else {
     return Error{flag + ": unknown device type '" + type +
-                 "' (known: scripted, replay, network, spacemouse, plugin, plugin-inproc)"};
+                 "' (known: scripted, replay, network, spacemouse, plugin, plugin-inproc, "
+                 "manual)"};
   }
   if (tool) {
     tool->device = spec;
     return Ok{};
+  }
+  if (spec.kind == DeviceSpec::Kind::kManual) {
+    return Error{flag +
+                 ": manual moves a tool (a dynamic rigid body); torsion view's M key takes "
+                 "hand '" +
+                 name + "'"};
   }
   if (!hand->keyframes.empty()) {  // the scripted motion gives way; its start is the anchor
     hand->initial = hand->keyframes.front().second;

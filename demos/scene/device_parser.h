@@ -19,7 +19,8 @@ DeviceSpec readDevice(const JsonObject& hand, const std::string& base_directory)
 DeviceSpec readToolDevice(const JsonObject& body, const std::string& base_directory);
 
 /// Applies `--device NAME=TYPE[:ARG]`: scripted:FILE, replay:FILE, network[:PORT] or
-/// network:HOST:PORT, spacemouse, plugin:LIBRARY[:CONFIG] (CONFIG: the rest, colons included).
+/// network:HOST:PORT, spacemouse, plugin:LIBRARY[:CONFIG] (CONFIG: the rest, colons included),
+/// manual (torsion view's mouse and keys).
 /// NAME is a hand, else a dynamic rigid body, which becomes a tool. A hand that had a scripted
 /// motion keeps its starting frame as the device's anchor; one that had a device keeps its
 /// mapping, limits and coupling, and so does a tool. FILE is relative to the working directory.

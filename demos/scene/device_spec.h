@@ -18,7 +18,16 @@
 namespace torsion::scene {
 
 struct DeviceSpec {
-  enum class Kind { kScripted, kReplay, kNetwork, kSpaceMouse, kPlugin } kind = Kind::kScripted;
+  /// kManual: moved by `torsion view`'s mouse and keys (device/manual_device.h); only the viewer
+  /// has them, so buildScene refuses it unless BuildOptions::manual_devices says otherwise.
+  enum class Kind {
+    kScripted,
+    kReplay,
+    kNetwork,
+    kSpaceMouse,
+    kPlugin,
+    kManual
+  } kind = Kind::kScripted;
   std::string file;    ///< scripted: trajectory JSON; replay: loop log CSV; plugin: shared library
   std::string config;  ///< plugin: the text handed to the plug-in's open()
   /// plugin: run it in its own process (torsion_device_host), so that its crash ends only that

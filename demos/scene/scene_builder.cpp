@@ -58,9 +58,34 @@ Status driveHands(BuiltScene& scene) {
   return Ok{};
 }
 
+namespace {
+
+// A manual device without the viewer would hold its tool still for the whole run: refuse it
+// with the kinds that can move a tool there.
+Status refuseManualDevices(const SceneSpec& spec) {
+  for (const RigidBodySpec& r : spec.rigid_bodies) {
+    if (!r.device || r.device->kind != DeviceSpec::Kind::kManual) continue;
+    return Error{spec.file + ": device 'manual' of tool '" + r.name +
+                 "' is moved by torsion view's mouse and keys; torsion run has none: use "
+                 "scripted, replay, network, spacemouse or plugin"};
+  }
+  return Ok{};
+}
+
+}  // namespace
+
 Result<std::unique_ptr<BuiltScene>> buildScene(SceneSpec spec, int threads_override) {
+  BuildOptions options;
+  options.threads = threads_override;
+  return buildScene(std::move(spec), options);
+}
+
+Result<std::unique_ptr<BuiltScene>> buildScene(SceneSpec spec, const BuildOptions& options) {
+  if (!options.manual_devices) {
+    if (Status refused = refuseManualDevices(spec); !refused) return refused.error();
+  }
   auto built = std::make_unique<BuiltScene>();
-  if (threads_override >= 0) spec.world.solver.threads = threads_override;
+  if (options.threads >= 0) spec.world.solver.threads = options.threads;
   built->world = std::make_unique<FemWorld>(spec.world);
   FemWorld& world = *built->world;
   if (Status contact = world.femSolver().setFemContact(spec.fem_contact); !contact)

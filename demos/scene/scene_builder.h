@@ -54,6 +54,16 @@ std::vector<int> selectNodes(const TetMesh& mesh, const NodeSelection& selection
 /// whose plane misses the body.
 Status driveHands(BuiltScene& scene);
 
+/// How buildScene builds for its caller.
+struct BuildOptions {
+  int threads = -1;  ///< >= 0: overrides the scene's solver.threads
+  /// Tools may have `manual` devices: only `torsion view` has the mouse and keys that move them
+  /// (it finds them with SceneHaptics::manualTool). Off, such a scene is an error naming the
+  /// tool, before anything is loaded.
+  bool manual_devices = false;
+};
+
+Result<std::unique_ptr<BuiltScene>> buildScene(SceneSpec spec, const BuildOptions& options);
 /// threads >= 0 overrides the scene's solver.threads.
 Result<std::unique_ptr<BuiltScene>> buildScene(SceneSpec spec, int threads_override = -1);
 

@@ -66,6 +66,7 @@ Result<SceneHaptics::Channel> SceneHaptics::openChannel(const DeviceSpec& spec,
       openDevice(spec, mode_ == HapticsMode::kLockstep);
   if (!opened) return Error{entry + ": " + opened.error().message};
   Channel c;
+  c.kind = spec.kind;
   c.device = std::move(opened).value();
   c.loop = std::make_unique<device::HapticLoop>(*c.device, spec.loop);
   c.rate_hz = spec.loop.rate_hz;
@@ -104,8 +105,8 @@ Result<std::unique_ptr<SceneHaptics>> SceneHaptics::attach(BuiltScene& scene) {
     if (!opened) return opened.error();
     Channel c = std::move(opened).value();
     c.name = s.spec.name;
-    c.coupling = std::make_unique<haptics::HandCoupling>(*s.hand, mappingFor(spec, s.spec.initial),
-                                                         spec.coupling);
+    c.mapping = mappingFor(spec, s.spec.initial);
+    c.coupling = std::make_unique<haptics::HandCoupling>(*s.hand, c.mapping, spec.coupling);
     bindings.push_back({c.coupling.get(), c.loop.get(), c.rate_hz});
     h->channels_.push_back(std::move(c));
   }
@@ -123,16 +124,17 @@ Result<std::unique_ptr<SceneHaptics>> SceneHaptics::attach(BuiltScene& scene) {
     Channel c = std::move(opened).value();
     c.name = r.name;
     c.tool = true;
+    c.mapping = mappingFor(*r.device, r.pose);
     const SceneRigidBody& built = scene.rigid_bodies[i];
     if (r.grasper) {
-      Result<std::unique_ptr<haptics::GrasperCoupling>> grasper = haptics::GrasperCoupling::create(
-          scene.world->femSolver(), *built.body, built.jaws, mappingFor(*r.device, r.pose),
-          r.device->tool, r.grasper->settings);
+      Result<std::unique_ptr<haptics::GrasperCoupling>> grasper =
+          haptics::GrasperCoupling::create(scene.world->femSolver(), *built.body, built.jaws,
+                                           c.mapping, r.device->tool, r.grasper->settings);
       if (!grasper) return Error{entry + ": " + grasper.error().message};
       c.coupling = std::move(grasper).value();
     } else {
       Result<std::unique_ptr<haptics::ToolCoupling>> tool = haptics::ToolCoupling::create(
-          *built.body, scene.world->femSolver(), mappingFor(*r.device, r.pose), r.device->tool);
+          *built.body, scene.world->femSolver(), c.mapping, r.device->tool);
       if (!tool) return Error{entry + ": " + tool.error().message};
       c.coupling = std::move(tool).value();
     }
@@ -303,6 +305,38 @@ std::vector<std::pair<std::string, Wrench>> SceneHaptics::toolWrenches() const {
     if (c.tool) wrenches.emplace_back(c.name, c.coupling->worldWrench());
   }
   return wrenches;
+}
+
+std::vector<SceneHaptics::ToolState> SceneHaptics::tools() const {
+  std::vector<ToolState> tools;
+  for (const Channel& c : channels_) {
+    if (!c.tool) continue;
+    ToolState t;
+    t.name = c.name;
+    t.kind = c.kind;
+    if (const auto* g = dynamic_cast<const haptics::GrasperCoupling*>(c.coupling.get())) {
+      t.goal = g->palm().goal();
+      t.jaw_gap = g->gap();
+    } else if (const auto* tool = dynamic_cast<const haptics::ToolCoupling*>(c.coupling.get())) {
+      t.goal = tool->goal();
+    }
+    tools.push_back(t);
+  }
+  return tools;
+}
+
+std::optional<SceneHaptics::ManualTool> SceneHaptics::manualTool() const {
+  for (const Channel& c : channels_) {
+    auto* manual = dynamic_cast<device::ManualDevice*>(c.device.get());
+    if (!c.tool || !manual) continue;
+    ManualTool m;
+    m.name = c.name;
+    m.device = manual;
+    m.mapping = c.mapping;
+    m.grasper = dynamic_cast<const haptics::GrasperCoupling*>(c.coupling.get()) != nullptr;
+    return m;
+  }
+  return std::nullopt;
 }
 
 Result<WorldStepReport> stepScene(BuiltScene& scene) {

@@ -19,6 +19,7 @@
 #include "scene_builder.h"
 #include "torsion/device/haptic_device.h"
 #include "torsion/device/haptic_loop.h"
+#include "torsion/device/manual_device.h"
 #include "torsion/haptics/hand_coupling.h"
 #include "torsion/haptics/haptic_runtime.h"
 
@@ -59,10 +60,34 @@ class SceneHaptics {
   /// The runtime's warnings, and a refused --sim-priority.
   std::vector<std::string> warnings() const;
 
+  /// A tool as the viewer reports it (simulation thread).
+  struct ToolState {
+    std::string name;
+    DeviceSpec::Kind kind = DeviceSpec::Kind::kScripted;
+    Frame goal;                     ///< the device's frame in the world, where the tool is pulled
+    std::optional<double> jaw_gap;  ///< m, between a grasper's jaws
+  };
+  /// Each tool with a device, in the scene's order.
+  std::vector<ToolState> tools() const;
+
+  /// The tool whose manual device the viewer moves: set `device`'s pose to
+  /// mapping.toDevice(wanted world frame) and its buttons (a grasper closes while button 1 is
+  /// held). Valid while this SceneHaptics lives.
+  struct ManualTool {
+    std::string name;
+    device::ManualDevice* device = nullptr;
+    haptics::DeviceMapping mapping;
+    bool grasper = false;
+  };
+  /// The first tool with a manual device; nullopt when none has one.
+  std::optional<ManualTool> manualTool() const;
+
  private:
   struct Channel {
     std::string name;  ///< the hand's or the tool's
     bool tool = false;
+    DeviceSpec::Kind kind = DeviceSpec::Kind::kScripted;
+    haptics::DeviceMapping mapping;
     std::unique_ptr<device::HapticDevice> device;
     std::unique_ptr<haptics::DeviceCoupling> coupling;
     std::unique_ptr<device::HapticLoop> loop;

@@ -16,11 +16,13 @@
 #include "camera.h"
 #include "frame_data.h"
 #include "image.h"
+#include "manual_tool.h"
 #include "pacing.h"
 #include "renderer.h"
 #include "scene_builder.h"
 #include "scene_haptics.h"
 #include "scene_parser.h"
+#include "torsion/bt_conversions.h"
 #include "viewer_window.h"
 
 namespace torsion::viewer {
@@ -125,15 +127,32 @@ Result<std::vector<InputEvent>> readScript(const std::string& path) {
   return events;
 }
 
+// A frame as origin and rotation vector (angle times axis of R = [i j k]), for the exit report.
+std::string poseText(const Frame& f) {
+  const Eigen::AngleAxisd turn(f.rotation);
+  const Eigen::Vector3d r = turn.angle() * turn.axis();
+  char buf[160];
+  std::snprintf(buf, sizeof buf, "at (%.6g, %.6g, %.6g) m turned (%.6g, %.6g, %.6g) rad",
+                f.origin.x(), f.origin.y(), f.origin.z(), r.x(), r.y(), r.z());
+  return buf;
+}
+
 class Viewer : public InputSink {
  public:
   Viewer(const ViewerOptions& options, scene::SceneSpec spec)
       : options_(options), spec_(std::move(spec)) {}
 
   Status rebuild() {
-    auto built = scene::buildScene(spec_, options_.threads);
+    scene::BuildOptions build;
+    build.threads = options_.threads;
+    build.manual_devices = true;  // this viewer's input moves them
+    auto built = scene::buildScene(spec_, build);
     if (!built) return built.error();
+    tool_.reset();  // its device goes with the old scene
     scene_ = std::move(built).value();
+    if (scene_->haptics) {
+      if (auto manual = scene_->haptics->manualTool()) tool_.emplace(*manual);
+    }
     manual_ = false;
     unstable_.clear();
     history_ = render::WrenchHistory{};
@@ -178,10 +197,18 @@ class Viewer : public InputSink {
         toggleManual();
         break;
       case GLFW_KEY_G:
-        grab();
+        if (toolHasKeys()) {
+          holdToolButton(true);
+        } else {
+          grab();
+        }
         break;
       case GLFW_KEY_U:
-        if (manual_ && hand()) hand()->hand->release();
+        if (toolHasKeys()) {
+          holdToolButton(false);
+        } else if (manual_ && hand()) {
+          hand()->hand->release();
+        }
         break;
       case GLFW_KEY_LEFT:
       case GLFW_KEY_RIGHT:
@@ -189,13 +216,13 @@ class Viewer : public InputSink {
       case GLFW_KEY_DOWN:
       case GLFW_KEY_PAGE_UP:
       case GLFW_KEY_PAGE_DOWN:
-        if (!manual_ && !toggleManual()) break;
-        if (shift) {
-          manual_frame_.rotation =
-              (Eigen::AngleAxisd(sign * angle, axis) * manual_frame_.rotation).normalized();
-        } else {
-          manual_frame_.origin += sign * step * axis;
-        }
+        moveManual([&](Frame& f) {
+          if (shift) {
+            f.rotation = (Eigen::AngleAxisd(sign * angle, axis) * f.rotation).normalized();
+          } else {
+            f.origin += sign * step * axis;
+          }
+        });
         break;
       case GLFW_KEY_T:
         editSolver([&](SolverSettings& s) { s.time_step *= shift ? 0.5 : 2.0; });
@@ -222,12 +249,12 @@ class Viewer : public InputSink {
   // dx, dy in pixels of a window `height` pixels high.
   void onDrag(int button, double dx, double dy, bool ctrl, int height) override {
     if (ctrl && button == GLFW_MOUSE_BUTTON_LEFT) {
-      if (!manual_ && !toggleManual()) return;
       const Eigen::Matrix4d v = camera_.view();
       const double visible = 2 * camera_.distance * std::tan(camera_.fov_y / 2);
-      manual_frame_.origin +=
+      const Eigen::Vector3d shift =
           visible / std::max(1, height) *
           (dx * v.block<1, 3>(0, 0).transpose() - dy * v.block<1, 3>(1, 0).transpose());
+      moveManual([&](Frame& f) { f.origin += shift; });
     } else {
       dragCamera(camera_, button, dx, dy, height);
     }
@@ -329,10 +356,7 @@ class Viewer : public InputSink {
     render::FrameData f = render::captureFrame(*scene_, rate_);
     f.notes.push_back(settingsText());
     if (!history_.times.empty()) f.plots.push_back(history_);
-    f.notes.push_back(std::string(paused_ ? "PAUSED" : "RUNNING") +
-                      (manual_        ? "  HAND: MANUAL (G GRAB, U RELEASE)"
-                       : deviceHand() ? "  HAND: DEVICE"
-                                      : "  HAND: SCRIPT (M MANUAL)"));
+    f.notes.push_back(std::string(paused_ ? "PAUSED" : "RUNNING") + "  " + controlNote());
     if (!unstable_.empty()) {
       f.notes.push_back("STOPPED: " + unstable_.substr(0, 60));
     } else if (!paused_) {
@@ -372,31 +396,32 @@ class Viewer : public InputSink {
     return !scene_->hands.empty() && scene_->hands.front().spec.device.has_value();
   }
   /// One line per hand: where its goal (the device's or the script's frame) and its grabbed
-  /// patch are, as origin and rotation vector (angle times axis of R = [i j k]).
+  /// patch are (poseText).
   std::vector<std::string> handReport() const {
-    auto pose = [](const Frame& f) {
-      const Eigen::AngleAxisd turn(f.rotation);
-      const Eigen::Vector3d r = turn.angle() * turn.axis();
-      char buf[160];
-      std::snprintf(buf, sizeof buf, "at (%.6g, %.6g, %.6g) m turned (%.6g, %.6g, %.6g) rad",
-                    f.origin.x(), f.origin.y(), f.origin.z(), r.x(), r.y(), r.z());
-      return std::string(buf);
-    };
     std::vector<std::string> lines;
     for (const scene::SceneHand& h : scene_->hands) {
       std::string line = "hand '" + h.spec.name + "' (" +
                          (h.spec.device                             ? "device"
                           : manual_ && &h == &scene_->hands.front() ? "manual"
                                                                     : "scripted") +
-                         "): goal " + pose(h.hand->goal());
+                         "): goal " + poseText(h.hand->goal());
       if (h.hand->grabbed()) {
-        line += ", patch " + pose(h.hand->frame()) + ", " +
+        line += ", patch " + poseText(h.hand->frame()) + ", " +
                 std::to_string(h.hand->grabbedNodes().size()) + " nodes grabbed";
       } else {
         line += ", nothing grabbed";
       }
       lines.push_back(line);
     }
+    return lines;
+  }
+  /// One line per tool with a device: its device's kind, where the device holds it (the goal)
+  /// and where its body is (poseText), and a grasper's jaw gap.
+  std::vector<std::string> toolReport() const {
+    std::vector<std::string> lines;
+    if (!scene_->haptics) return lines;
+    for (const scene::SceneHaptics::ToolState& t : scene_->haptics->tools())
+      lines.push_back(toolText(t));
     return lines;
   }
   int grabbedNodes() {
@@ -415,6 +440,68 @@ class Viewer : public InputSink {
   }
 
   scene::SceneHand* hand() { return scene_->hands.empty() ? nullptr : &scene_->hands.front(); }
+
+  // The manual input moves the tool with the manual device unless M took a hand.
+  bool toolHasKeys() const { return tool_ && !manual_; }
+
+  // Applies `change` to the world frame the manual input moves: the manual tool's, else the
+  // hand taken with M (the first hand, taken now if needed).
+  template <class Change>
+  void moveManual(Change change) {
+    if (toolHasKeys()) {
+      Frame goal = tool_->goal();
+      change(goal);
+      tool_->moveTo(goal);
+      return;
+    }
+    if (!manual_ && !toggleManual()) return;
+    change(manual_frame_);
+  }
+
+  // G / U on the manual tool, logged with the moment and, for a grasper, the jaws' gap then.
+  void holdToolButton(bool held) {
+    tool_->holdButton(held);
+    char when[64];
+    std::snprintf(when, sizeof when, " at step %d, t = %.6g s", scene_->world->stepCount(),
+                  scene_->world->time());
+    std::string line =
+        "viewer: tool '" + tool_->name() + "': button 1 " + (held ? "held" : "let go") + when;
+    for (const scene::SceneHaptics::ToolState& t : scene_->haptics->tools()) {
+      if (t.name == tool_->name() && t.jaw_gap) line += "; jaws " + gapText(*t.jaw_gap);
+    }
+    std::cout << line << std::endl;
+  }
+
+  static std::string gapText(double gap) {
+    char buf[48];
+    std::snprintf(buf, sizeof buf, "%.6g m apart", gap);
+    return buf;
+  }
+
+  // "tool 'probe' (manual): goal at ... , body at ...[, jaws ... m apart]"
+  std::string toolText(const scene::SceneHaptics::ToolState& t) const {
+    std::string line =
+        "tool '" + t.name + "' (" + scene::toString(t.kind) + "): goal " + poseText(t.goal);
+    for (const scene::SceneRigidBody& r : scene_->rigid_bodies) {
+      if (r.name != t.name) continue;
+      const btTransform& pose = r.body->getCenterOfMassTransform();
+      Frame body;
+      body.origin = toEigen(pose.getOrigin());
+      body.rotation = toEigen(pose.getRotation());
+      line += ", body " + poseText(body);
+    }
+    if (t.jaw_gap) line += ", jaws " + gapText(*t.jaw_gap);
+    return line;
+  }
+
+  // The HUD's word on what the manual input moves.
+  std::string controlNote() const {
+    if (manual_)
+      return tool_ ? "HAND: MANUAL (G GRAB, U RELEASE, M TOOL)"
+                   : "HAND: MANUAL (G GRAB, U RELEASE)";
+    if (tool_) return tool_->grasper() ? "TOOL: MANUAL (G CLOSE, U OPEN)" : "TOOL: MANUAL";
+    return deviceHand() ? "HAND: DEVICE" : "HAND: SCRIPT (M MANUAL)";
+  }
 
   // Returns whether the hand is under manual control now.
   bool toggleManual() {
@@ -489,12 +576,15 @@ class Viewer : public InputSink {
     std::cout << "viewer: live edit, " << worldText() << std::endl;
   }
 
-  // The first hand's wrench after each step, for the scrolling plot (the last kHistory steps).
+  // After each step, for the scrolling plot (the last kHistory steps): the wrench the manual
+  // tool's device renders while the manual input moves the tool, else the first hand's.
   void recordWrench() {
     static constexpr size_t kHistory = 300;
-    if (!hand()) return;
-    const Wrench w = hand()->hand->wrench();
-    history_.name = hand()->spec.name;
+    if (!toolHasKeys() && !hand()) return;
+    const Wrench w = toolHasKeys() ? tool_->rendered() : hand()->hand->wrench();
+    const std::string& name = toolHasKeys() ? tool_->name() : hand()->spec.name;
+    if (history_.name != name) history_ = render::WrenchHistory{};  // one series at a time
+    history_.name = name;
     history_.times.push_back(scene_->world->time());
     history_.forces.push_back(w.force);
     history_.torques.push_back(w.torque);
@@ -512,6 +602,7 @@ class Viewer : public InputSink {
   ViewerOptions options_;
   scene::SceneSpec spec_;
   std::unique_ptr<scene::BuiltScene> scene_;
+  std::optional<ManualToolControl> tool_;  // the tool with a manual device (rebuild)
   Camera camera_;
   Frame manual_frame_;
   bool manual_ = false, paused_ = false, single_step_ = false, quit_ = false, reframe_ = false;
@@ -585,8 +676,8 @@ int showFrames(Viewer& viewer, ViewerWindow& window, const std::vector<InputEven
   return frames;
 }
 
-// On stdout at exit: frames, steps, the hand's mode and hold, stability, the live settings and
-// each hand's goal and patch.
+// On stdout at exit: frames, steps, the hand's mode and hold, stability, the live settings,
+// each hand's goal and patch, and each tool's goal and body.
 void printExitReport(Viewer& viewer, int frames) {
   std::cout << "viewer: " << frames << " frames, " << viewer.steps() << " steps, hand "
             << (viewer.manual()       ? "manual"
@@ -596,6 +687,8 @@ void printExitReport(Viewer& viewer, int frames) {
             << (viewer.stable() ? "stable" : "unstable: " + viewer.failure()) << "\n";
   std::cout << "viewer: " << viewer.worldText() << "\n";
   for (const std::string& line : viewer.handReport())
+    std::cout << "viewer: " << line << "\n";
+  for (const std::string& line : viewer.toolReport())
     std::cout << "viewer: " << line << "\n";
 }
 

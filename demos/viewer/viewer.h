@@ -17,6 +17,10 @@
 // The HUD shows the live settings and a scrolling plot of the first hand's force and torque.
 // Hands with a device (the scene's `device`, or --device HAND=TYPE[:ARG] as for `torsion run`)
 // follow it through their haptic loops; M, G, U and the hand keys leave such a hand to its device.
+//   tool     a tool (rigid body) with a `manual` device (--device TOOL=manual) takes the hand
+//            keys and Ctrl + left drag instead: they move its device (manual_tool.h), G / U hold
+//            and let go of its button 1 (a grasper closes and opens); M takes the first hand as
+//            above, and M again gives the keys back to the tool
 
 #include <string>
 

@@ -576,6 +576,27 @@ EOF
     [[ ! -e out/summary.json ]] || fail "no output may be written when a device cannot open"
     ;;
 
+  run_haptic_manual)
+    # A manual device is moved by `torsion view`'s mouse and keys: `torsion run` has none and
+    # refuses it, from --device or from the scene file, naming the tool, before any output.
+    run "$torsion" run "$scenes/palpation.json" --device probe=manual --out out --steps 5
+    expect_rc nonzero
+    expect_out "^error: .*palpation\.json: device 'manual' of tool 'probe' is moved by torsion view's mouse and keys; torsion run has none: use scripted, replay, network, spacemouse or plugin$"
+    sed -e "s|../../assets|$assets/..|" \
+        -e 's|"type": "scripted", "trajectory": "[^"]*",|"type": "manual",|' \
+        "$scenes/palpation.json" > manual.json
+    grep -q '"type": "manual"' manual.json || fail "manual.json: the device was not replaced"
+    run "$torsion" run manual.json --out out --steps 5
+    expect_rc nonzero
+    expect_out "^error: manual\.json: device 'manual' of tool 'probe' is moved by torsion view's mouse and keys; torsion run has none: use scripted, replay, network, spacemouse or plugin$"
+    # Manual devices move tools; the viewer's M key takes a hand.
+    sed "s|../../assets/meshes|$assets|" "$scenes/twist_cylinder_2430.json" > twist.json
+    run "$torsion" run twist.json --device hand=manual --out out --steps 5
+    expect_rc nonzero
+    expect_out "^error: --device 'hand=manual': manual moves a tool \(a dynamic rigid body\); torsion view's M key takes hand 'hand'$"
+    [[ ! -e out ]] || fail "no output may be written when a device is refused"
+    ;;
+
   run_haptic_plugin)
     # The example device plug-in (a simulated arm whose operator turns the wrist 0.3 rad, presses
     # button 2 at 0.8 s) loaded at run time, ticking in lockstep; then a wrong library.

@@ -43,3 +43,11 @@ def test_a_dynamic_rigid_body_gets_a_device_by_name_and_only_what_has_one_has_a_
         world.device_wrench("slab_crate")
     with pytest.raises(ValueError, match="no hand or dynamic rigid body named 'slab'"):
         torsion.World.from_scene("rigid_mix", threads=1, devices={"slab": "scripted:" + trajectory})
+
+
+def test_a_manual_device_is_torsion_views_only_and_refused_naming_the_tool():
+    # A manual device is moved by torsion view's mouse and keys: a scene built here has none.
+    with pytest.raises(torsion.SceneError,
+                       match="device 'manual' of tool 'probe' is moved by torsion view's mouse "
+                             "and keys"):
+        torsion.World.from_scene("palpation", threads=1, devices={"probe": "manual"})

@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include "../unit/error_matchers.h"
+#include "scene_builder.h"
 #include "scene_parser.h"
 
 namespace torsion::scene {
@@ -267,6 +268,45 @@ TEST(ToolDevice, TheCommandLineHandsADynamicRigidBodyADevice) {
   EXPECT_TRUE(failsWith(applyDeviceOverride(s, "wall=spacemouse"),
                         {"no hand or dynamic rigid body named 'wall'", "hands: 'hand'",
                          "dynamic rigid bodies: 'probe'"}));
+}
+
+// `manual`: a tool's device that torsion view's mouse and keys move. Only the viewer builds it
+// (BuildOptions::manual_devices); everything else refuses it naming the tool, before any mesh is
+// read (this scene's cyl.node does not exist). A hand is taken with the viewer's M key instead.
+TEST(ToolDevice, AManualDeviceMovesAToolInTheViewerOnly) {
+  Result<SceneSpec> r = parse(sceneWithRigidBody(R"({"name": "probe", "mass": 0.02,
+      "shape": {"sphere": {"radius": 0.01}},
+      "device": {"type": "manual", "limits": {"max_force": 8}}})"));
+  ASSERT_TRUE(r.ok()) << r.error().message;
+  const DeviceSpec& d = *r.value().rigid_bodies.at(0).device;
+  EXPECT_EQ(d.kind, DeviceSpec::Kind::kManual);
+  EXPECT_STREQ(toString(d.kind), "manual");
+  EXPECT_EQ(d.max_force, 8);
+  EXPECT_TRUE(failsWith(buildScene(r.value()),
+                        {"s.json: device 'manual' of tool 'probe' is moved by torsion view's "
+                         "mouse and keys; torsion run has none: use scripted, replay, network, "
+                         "spacemouse or plugin"}));
+  BuildOptions viewer;
+  viewer.manual_devices = true;
+  EXPECT_TRUE(failsWith(buildScene(r.value(), viewer), {"cyl.node"}))
+      << "the viewer's build goes on to the (missing) mesh";
+
+  EXPECT_TRUE(failsWith(parse(sceneWith(R"({"type": "manual"})")),
+                        {"hands[0]", "type", "'manual' moves a tool", "M key takes a hand"}));
+
+  Result<SceneSpec> scripted = parse(sceneWithRigidBody(
+      R"({"name": "probe", "mass": 0.02, "shape": {"sphere": {"radius": 0.01}}})"));
+  ASSERT_TRUE(scripted.ok()) << scripted.error().message;
+  SceneSpec s = scripted.value();
+  ASSERT_TRUE(applyDeviceOverride(s, "probe=manual").ok());
+  EXPECT_EQ(s.rigid_bodies[0].device->kind, DeviceSpec::Kind::kManual);
+  EXPECT_FALSE(s.rigid_bodies[0].device->loop.buttons_switch_force) << "a tool is always held";
+  EXPECT_TRUE(failsWith(applyDeviceOverride(s, "probe=manual:5"),
+                        {"--device 'probe=manual:5'", "manual takes no argument"}));
+  EXPECT_TRUE(
+      failsWith(applyDeviceOverride(s, "hand=manual"),
+                {"--device 'hand=manual'", "manual moves a tool", "M key takes hand 'hand'"}));
+  EXPECT_FALSE(s.hands[0].device.has_value());
 }
 
 TEST(ToolDevice, AGrasperIsABoxPalmWithADeviceAndJaws) {
