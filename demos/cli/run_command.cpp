@@ -86,7 +86,7 @@ Result<std::unique_ptr<scene::BuiltScene>> loadAndBuild(const RunArguments& args
     return applied.error();
   for (const std::string& w : scene::remoteDeviceWarnings(spec.value()))
     std::cerr << "warning: " << w << "\n";
-  return scene::buildScene(std::move(spec).value(), args.threads);
+  return scene::buildScene(std::move(spec).value(), scene::BuildOptions{args.threads});
 }
 
 // On stderr: the build's warnings, the threads used, and unless --quiet each body's size and each

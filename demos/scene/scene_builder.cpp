@@ -37,6 +37,7 @@ Status driveHands(BuiltScene& scene) {
   for (size_t h = 0; h < scene.hands.size(); ++h) {
     SceneHand& s = scene.hands[h];
     if (s.spec.device) continue;  // moved by its device through SceneHaptics
+    if (!s.scripted) continue;
     if (s.hand->grabbed() && reached >= s.spec.release_at) {
       s.hand->release();
       s.released = true;
@@ -66,19 +67,13 @@ Status refuseManualDevices(const SceneSpec& spec) {
   for (const RigidBodySpec& r : spec.rigid_bodies) {
     if (!r.device || r.device->kind != DeviceSpec::Kind::kManual) continue;
     return Error{spec.file + ": device 'manual' of tool '" + r.name +
-                 "' is moved by torsion view's mouse and keys; torsion run has none: use "
-                 "scripted, replay, network, spacemouse or plugin"};
+                 "' is moved by the mouse and keys of torsion view, which this run has not: "
+                 "use scripted, replay, network, spacemouse or plugin"};
   }
   return Ok{};
 }
 
 }  // namespace
-
-Result<std::unique_ptr<BuiltScene>> buildScene(SceneSpec spec, int threads_override) {
-  BuildOptions options;
-  options.threads = threads_override;
-  return buildScene(std::move(spec), options);
-}
 
 Result<std::unique_ptr<BuiltScene>> buildScene(SceneSpec spec, const BuildOptions& options) {
   if (!options.manual_devices) {

@@ -28,6 +28,9 @@ struct SceneHand {
   HandSpec spec;
   std::unique_ptr<Hand> hand;
   bool released = false;
+  /// false: its script neither grabs, moves nor releases it any more (the viewer took it): it
+  /// stays where its last mover left it.
+  bool scripted = true;
 };
 
 class SceneHaptics;  // scene_haptics.h
@@ -63,8 +66,6 @@ struct BuildOptions {
   bool manual_devices = false;
 };
 
-Result<std::unique_ptr<BuiltScene>> buildScene(SceneSpec spec, const BuildOptions& options);
-/// threads >= 0 overrides the scene's solver.threads.
-Result<std::unique_ptr<BuiltScene>> buildScene(SceneSpec spec, int threads_override = -1);
+Result<std::unique_ptr<BuiltScene>> buildScene(SceneSpec spec, const BuildOptions& options = {});
 
 }  // namespace torsion::scene

@@ -528,8 +528,7 @@ class Viewer : public InputSink {
       scene_->hands.push_back(std::move(h));
     }
     scene::SceneHand& h = *hand();
-    h.released = true;  // the script neither grabs nor moves it any more
-    h.spec.release_at = std::numeric_limits<double>::infinity();
+    h.scripted = false;  // from now on it stays where the keys leave it, even after M again
     manual_frame_ = h.hand->grabbed() ? h.hand->frame() : h.spec.frameAt(scene_->world->time());
     manual_ = true;
     return true;

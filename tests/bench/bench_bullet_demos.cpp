@@ -33,7 +33,7 @@ struct Timed {
 
 Timed runTorsion(const scene::SceneSpec& spec, int steps) {
   Timed run;
-  auto built = scene::buildScene(spec, 1);
+  auto built = scene::buildScene(spec, scene::BuildOptions{1});
   if (!built) {
     run.error = built.error().message;
     return run;

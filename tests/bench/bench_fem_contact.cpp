@@ -106,7 +106,7 @@ Eigen::AlignedBox3d sweptBox(const FemBody& body, double dt) {
 Run runTorsion(const scene::SceneSpec& spec, int steps, const std::vector<TetMesh>& rest,
                double tolerance) {
   Run run;
-  auto built = scene::buildScene(spec, 1);
+  auto built = scene::buildScene(spec, scene::BuildOptions{1});
   if (!built) {
     run.error = built.error().message;
     return run;

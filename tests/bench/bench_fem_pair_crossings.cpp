@@ -47,7 +47,7 @@ int main(int argc, char** argv) {
   }
   const bool edge_edge = contact && contact->edge_edge;
   const double thickness = contact ? contact->thickness_factor : 0;
-  Result<std::unique_ptr<BuiltScene>> built = buildScene(std::move(spec.value()), 1);
+  Result<std::unique_ptr<BuiltScene>> built = buildScene(std::move(spec.value()), BuildOptions{1});
   if (!built) {
     std::fprintf(stderr, "%s\n", built.error().message.c_str());
     return 1;

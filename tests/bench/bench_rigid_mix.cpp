@@ -51,7 +51,7 @@ nlohmann::json runTorsion(scene::SceneSpec spec, int steps, bool rigid, const st
     spec.rigid_bodies.clear();
     spec.ground.reset();
   }
-  auto built = scene::buildScene(std::move(spec), 1);
+  auto built = scene::buildScene(std::move(spec), scene::BuildOptions{1});
   if (!built) return {{"run", name}, {"error", built.error().message}};
   scene::BuiltScene& s = *built.value();
   std::vector<double> ms;

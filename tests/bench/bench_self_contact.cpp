@@ -72,7 +72,8 @@ int main(int argc, char** argv) {
     return 1;
   }
   if (steps < 0) steps = spec.value().steps;
-  Result<std::unique_ptr<BuiltScene>> built = buildScene(std::move(spec.value()), threads);
+  Result<std::unique_ptr<BuiltScene>> built =
+      buildScene(std::move(spec.value()), BuildOptions{threads});
   if (!built) {
     std::fprintf(stderr, "%s\n", built.error().message.c_str());
     return 1;

@@ -581,14 +581,14 @@ EOF
     # refuses it, from --device or from the scene file, naming the tool, before any output.
     run "$torsion" run "$scenes/palpation.json" --device probe=manual --out out --steps 5
     expect_rc nonzero
-    expect_out "^error: .*palpation\.json: device 'manual' of tool 'probe' is moved by torsion view's mouse and keys; torsion run has none: use scripted, replay, network, spacemouse or plugin$"
+    expect_out "^error: .*palpation\.json: device 'manual' of tool 'probe' is moved by the mouse and keys of torsion view, which this run has not: use scripted, replay, network, spacemouse or plugin$"
     sed -e "s|../../assets|$assets/..|" \
         -e 's|"type": "scripted", "trajectory": "[^"]*",|"type": "manual",|' \
         "$scenes/palpation.json" > manual.json
     grep -q '"type": "manual"' manual.json || fail "manual.json: the device was not replaced"
     run "$torsion" run manual.json --out out --steps 5
     expect_rc nonzero
-    expect_out "^error: manual\.json: device 'manual' of tool 'probe' is moved by torsion view's mouse and keys; torsion run has none: use scripted, replay, network, spacemouse or plugin$"
+    expect_out "^error: manual\.json: device 'manual' of tool 'probe' is moved by the mouse and keys of torsion view, which this run has not: use scripted, replay, network, spacemouse or plugin$"
     # Manual devices move tools; the viewer's M key takes a hand.
     sed "s|../../assets/meshes|$assets|" "$scenes/twist_cylinder_2430.json" > twist.json
     run "$torsion" run twist.json --device hand=manual --out out --steps 5

@@ -28,7 +28,8 @@ TEST(SoftGrasp, ASoftBlockSqueezedBetweenTwoSoftFingersRisesWithThemWithoutSlipp
   Result<scene::SceneSpec> spec = scene::loadScene(TORSION_SCENES_DIR "/soft_grasp.json");
   ASSERT_TRUE(spec.ok()) << spec.error().message;
   const int steps = spec.value().steps;
-  Result<std::unique_ptr<scene::BuiltScene>> built = scene::buildScene(std::move(spec.value()), 1);
+  Result<std::unique_ptr<scene::BuiltScene>> built =
+      scene::buildScene(std::move(spec.value()), scene::BuildOptions{1});
   ASSERT_TRUE(built.ok()) << built.error().message;
   scene::BuiltScene& s = *built.value();
   const FemBody* object = s.world->body("object");

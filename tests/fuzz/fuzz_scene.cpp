@@ -114,7 +114,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   int& newton_iterations = spec.value().world.solver.newton_max_iterations;
   newton_iterations = std::min(newton_iterations, kMaxNewtonIterations);
 
-  auto built = torsion::scene::buildScene(std::move(spec).value(), 1);
+  auto built = torsion::scene::buildScene(std::move(spec).value(), torsion::scene::BuildOptions{1});
   if (!built.ok()) {
     checkMessage(built.error().message);
     return 0;

@@ -48,6 +48,6 @@ def test_a_dynamic_rigid_body_gets_a_device_by_name_and_only_what_has_one_has_a_
 def test_a_manual_device_is_torsion_views_only_and_refused_naming_the_tool():
     # A manual device is moved by torsion view's mouse and keys: a scene built here has none.
     with pytest.raises(torsion.SceneError,
-                       match="device 'manual' of tool 'probe' is moved by torsion view's mouse "
-                             "and keys"):
+                       match="device 'manual' of tool 'probe' is moved by the mouse and keys "
+                             "of torsion view, which this run has not"):
         torsion.World.from_scene("palpation", threads=1, devices={"probe": "manual"})

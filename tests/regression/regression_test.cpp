@@ -111,7 +111,7 @@ Metrics runScenePath(const std::string& path, int steps, int threads, double sti
   }
   for (BodySpec& b : spec.value().bodies)
     b.material.youngs_modulus *= stiffness_factor;
-  auto built = buildScene(std::move(spec).value(), threads);
+  auto built = buildScene(std::move(spec).value(), BuildOptions{threads});
   if (!built) {
     ADD_FAILURE() << built.error().message;
     return m;

@@ -44,7 +44,7 @@ Rendered loadAndCapture(const std::string& name, int steps) {
     ADD_FAILURE() << spec.error().message;
     return {};
   }
-  auto built = scene::buildScene(std::move(spec).value(), 1);
+  auto built = scene::buildScene(std::move(spec).value(), scene::BuildOptions{1});
   if (!built.ok()) {
     ADD_FAILURE() << built.error().message;
     return {};

@@ -14,6 +14,7 @@
 #  4. tool_and_hand, probe=manual: RIGHT moves the tool; M takes the hand and M again gives the
 #     keys back to the tool, whose goal the next RIGHT moves; M takes the hand once more and the
 #     last RIGHT moves the hand: two key steps for the tool, one for the hand.
+#  6. tool_and_hand: a hand given up with M stays where the keys left it.
 # Skipped (77) without xvfb-run.
 # Usage: viewer_tool_xvfb.sh TORSION SCENES_DIR
 set -u
@@ -162,6 +163,24 @@ check(abs(tool_moved[0] - 2 * hand_moved[0]) < 0.02 * hand_moved[0]
       f"after M again), the hand's one was {hand_moved[0]}")
 print(f"PASS: the keys moved the tool {tool_moved[0]:.4g} m and, after M, the hand "
       f"{hand_moved[0]:.4g} m")
+PY
+
+# 6. A hand left with M stays where the keys left it: its script no longer moves it (it would
+#    jump back to the script's frame, at x = 0).
+view tool_and_hand.json 30 '5 key M\n6 key RIGHT\n8 key M\n' --device probe=manual
+python3 - "$out" <<'PY' || exit 1
+import re, sys
+out = sys.argv[1]
+num = r'([0-9.e+-]+)'
+hand = re.search(rf"^viewer: hand 'hand' \([a-z]+\): goal at \({num}, {num}, {num}\) m", out, re.M)
+if not hand:
+    print("FAIL: missing hand line"); sys.exit(1)
+x = float(hand.group(1))
+if not x > 0.01:
+    print(f"FAIL: the hand's goal is at x = {x} at exit, 22 steps after M gave it up: it went "
+          f"back to its script (x = 0) instead of staying one key step along x")
+    sys.exit(1)
+print(f"PASS: the hand left with M stayed at x = {x:.4g} m")
 PY
 
 # 5. Manual devices move tools only.

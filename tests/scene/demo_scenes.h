@@ -18,7 +18,7 @@ inline std::unique_ptr<BuiltScene> buildDemoScene(const std::string& name) {
   Result<SceneSpec> spec = loadScene(std::string(TORSION_SCENES_DIR) + "/" + name + ".json");
   EXPECT_TRUE(spec) << (spec ? "" : spec.error().message);
   if (!spec) return nullptr;
-  auto built = buildScene(std::move(spec).value(), 1);
+  auto built = buildScene(std::move(spec).value(), BuildOptions{1});
   EXPECT_TRUE(built) << (built ? "" : built.error().message);
   return built ? std::move(built).value() : nullptr;
 }

@@ -283,9 +283,9 @@ TEST(ToolDevice, AManualDeviceMovesAToolInTheViewerOnly) {
   EXPECT_STREQ(toString(d.kind), "manual");
   EXPECT_EQ(d.max_force, 8);
   EXPECT_TRUE(failsWith(buildScene(r.value()),
-                        {"s.json: device 'manual' of tool 'probe' is moved by torsion view's "
-                         "mouse and keys; torsion run has none: use scripted, replay, network, "
-                         "spacemouse or plugin"}));
+                        {"s.json: device 'manual' of tool 'probe' is moved by the mouse and keys "
+                         "of torsion view, which this run has not: use scripted, replay, "
+                         "network, spacemouse or plugin"}));
   BuildOptions viewer;
   viewer.manual_devices = true;
   EXPECT_TRUE(failsWith(buildScene(r.value(), viewer), {"cyl.node"}))

@@ -58,7 +58,7 @@ TEST(PlacementBounds, ValuesAtTheBoundsLoadAndStepToAFiniteState) {
       {"radius": 0.1}}, "mass": 1e-9, "pose": {"position": [0, 1e6, 0]}}])");
   Result<SceneSpec> spec = parse(at_bounds);
   ASSERT_TRUE(spec.ok()) << spec.error().message;
-  auto built = buildScene(std::move(spec).value(), 1);
+  auto built = buildScene(std::move(spec).value(), BuildOptions{1});
   ASSERT_TRUE(built.ok()) << built.error().message;
   BuiltScene& s = *built.value();
   for (int k = 0; k < 3; ++k) {

@@ -55,7 +55,7 @@ TEST(SceneStartingVelocityKeys, TheBuiltBodyMovesRigidlyAboutItsCentreOfMass) {
   Result<SceneSpec> spec = parse(R"( "linear_velocity": [0.5, -1, 15],
                                      "angular_velocity": [0, 2, 1],)");
   ASSERT_TRUE(spec.ok()) << spec.error().message;
-  auto built = buildScene(std::move(spec).value(), 1);
+  auto built = buildScene(std::move(spec).value(), BuildOptions{1});
   ASSERT_TRUE(built) << built.error().message;
   const FemBody& body = *built.value()->world->bodies().front();
   const std::vector<double>& m = body.model().nodeMasses();

@@ -110,7 +110,7 @@ Result<std::unique_ptr<PyWorld>> PyWorld::fromScene(const std::string& name_or_p
   for (const scene::BodySpec& body : spec.value().bodies)
     mesh_paths.push_back(body.mesh_path);
   Result<std::unique_ptr<scene::BuiltScene>> built =
-      scene::buildScene(std::move(spec).value(), threads);
+      scene::buildScene(std::move(spec).value(), scene::BuildOptions{threads});
   if (!built) {
     // A fault inside a body's mesh file names that file and line after the scene entry.
     for (const std::string& path : mesh_paths) {
