@@ -506,6 +506,69 @@ EOF
       exit !(m > 1 && d <= 1e-4 * m) }' || fail "replayed torque $b differs from recorded $a"
     ;;
 
+  run_haptic_tool_devices)
+    # The palpation probe (a tool: a rigid body on a virtual coupling) held by each kind of
+    # device the scene's own scripted one is not: its scripted run's loop log replayed, the
+    # simulated-arm plug-in pushing it, and the reference peer over UDP.
+    [[ -f $plugin && -x $peer ]] || fail "no device plug-in or peer given"
+    sed -e "s|../../assets/meshes|$assets|" -e "s|../../assets/trajectories|$assets/../trajectories|" \
+      "$scenes/palpation.json" > palpation.json
+    probe_at() {  # probe_at DIR COLUMN: the probe's COLUMN (x, z) at the last step, rigid.csv
+      awk -F, -v col="probe.$2" 'NR == 1 { for (i = 1; i <= NF; i++) if ($i == col) c = i }
+        END { print $c }' "$1/rigid.csv"
+    }
+    # 1. Replay: the same poses at the same ticks bring the probe to the same place (the log
+    #    keeps 10 significant digits of each pose): pressed 8.7 mm into the organ by t = 1.5 s.
+    run "$torsion" run palpation.json --out rec --steps 150 --threads 1
+    expect_rc 0
+    run "$torsion" run palpation.json --device probe=replay:rec/haptic_probe.csv --out rep \
+      --steps 150 --threads 1
+    expect_rc 0
+    expect_out "tool 'probe': device replay\(haptic_probe.csv\), lockstep"
+    for c in x z; do
+      awk -v a="$(probe_at rec $c)" -v b="$(probe_at rep $c)" 'BEGIN { d = a - b; if (d < 0) d = -d
+        exit !(d <= 1e-7) }' || fail "replayed probe.$c $(probe_at rep $c) differs from $(probe_at rec $c)"
+    done
+    awk -v z="$(probe_at rec z)" 'BEGIN { exit !(z < 0.040) }' ||
+      fail "the scripted probe did not press into the organ (z = $(probe_at rec z), from 0.045)"
+    # 2. The plug-in's simulated operator pushes the handle 0.05 m/s along x for 0.4 s: the probe,
+    #    in free space above the organ, follows the 2 cm within a tenth (the arm's own dynamics
+    #    and the coupling's lag of a few ms are all that differ).
+    config="intent=push,intent_rate=0.05,intent_start=0.1,intent_time=0.4"
+    run "$torsion" run palpation.json --device "probe=plugin:$plugin:$config" --haptics lockstep \
+      --out plug --steps 100 --threads 1
+    expect_rc 0
+    expect_out "tool 'probe': device plugin\(libtorsion_simulated_device.so: simulated"
+    grep -q '"late": 0' plug/summary.json || fail "plug/summary.json: a plug-in read was late"
+    awk -v x="$(probe_at plug x)" 'BEGIN { d = x + 0.03 - 0.02; if (d < 0) d = -d; exit !(d <= 0.002) }' ||
+      fail "the plug-in moved the probe to x = $(probe_at plug x), expected -0.03 + 0.02"
+    # 3. The reference peer plays the scene's own trajectory over UDP (threaded haptics): the
+    #    probe presses into the organ and the peer receives the contact force.
+    port=$((20000 + RANDOM % 20000))
+    "$torsion" run palpation.json --device "probe=network:$port" --out net --steps 150 \
+      --threads 1 >torsion.log 2>&1 &
+    sim=$!
+    for _ in $(seq 100); do
+      grep -q "device network" torsion.log && break
+      sleep 0.1
+    done
+    grep -q "tool 'probe': device network(udp port $port), threaded haptic loop" torsion.log ||
+      { kill "$sim"; cat torsion.log; fail "torsion did not open the network device"; }
+    "$peer" --trajectory "$assets/../trajectories/palpation.json" --port "$port" --log peer.csv ||
+      fail "the peer failed"
+    wait "$sim"
+    rc=$?
+    out=$(cat torsion.log)
+    printf '%s\n' "$out"
+    expect_rc 0
+    grep -q '"accepted": [1-9][0-9][0-9]' net/summary.json || fail "fewer than 100 poses accepted"
+    awk -v z="$(probe_at net z)" 'BEGIN { exit !(z < 0.040) }' ||
+      fail "the networked probe did not press into the organ (z = $(probe_at net z))"
+    # The organ pushes the probe up: packets whose force along z exceeds 0.1 N.
+    awk -F, 'NR > 1 && $4 > 0.1 { found = 1 } END { exit !found }' peer.csv ||
+      fail "the peer never received the contact force"
+    ;;
+
   run_haptic_sim_priority)
     # --sim-priority asks real-time priority for the stepping thread under threaded haptics: the
     # summary says what was asked and whether it was granted, and a refusal (no privilege) is a
