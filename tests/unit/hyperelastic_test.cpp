@@ -249,11 +249,14 @@ double smallestEigenvalue(const PiolaTangent& A) {
   return Eigen::SelfAdjointEigenSolver<PiolaTangent>(A).eigenvalues()(0);
 }
 
-// The reference projection: a numerical 9x9 eigen-decomposition, eigenvalues clamped at zero.
-PiolaTangent numericalProjection(const PiolaTangent& A) {
+// The reference filters: a numerical 9x9 eigen-decomposition, its eigenvalues clamped at zero or
+// replaced by their magnitudes.
+PiolaTangent numericalFilter(const PiolaTangent& A, EigenvalueFilter filter) {
   const Eigen::SelfAdjointEigenSolver<PiolaTangent> eigen(0.5 * (A + A.transpose()));
-  return eigen.eigenvectors() * eigen.eigenvalues().cwiseMax(0.0).asDiagonal() *
-         eigen.eigenvectors().transpose();
+  const Eigen::Matrix<double, 9, 1> values = filter == EigenvalueFilter::kMirror
+                                                 ? eigen.eigenvalues().cwiseAbs().eval()
+                                                 : eigen.eigenvalues().cwiseMax(0.0).eval();
+  return eigen.eigenvectors() * values.asDiagonal() * eigen.eigenvectors().transpose();
 }
 
 // Gradients where the singular values repeat or vanish, the closed forms' delicate cases (the
@@ -270,7 +273,7 @@ std::vector<Eigen::Matrix3d> degenerateGradients() {
   return Fs;
 }
 
-TEST(HyperelasticEigensystem, ClosedFormsRebuildTheTangentAndItsProjection) {
+TEST(HyperelasticEigensystem, ClosedFormsRebuildTheTangentAndItsFilteredForms) {
   int clamped = 0;
   for (double nu : {0.0, 0.3, 0.45, 0.499}) {
     for (const Law& law : laws(nu)) {
@@ -285,18 +288,25 @@ TEST(HyperelasticEigensystem, ClosedFormsRebuildTheTangentAndItsProjection) {
         EXPECT_NEAR(t.V.determinant(), 1.0, 1e-12);
         EXPECT_LE((t.U * t.sigma.asDiagonal() * t.V.transpose() - F).norm(), 1e-12 * F.norm());
         // Exact: the closed forms give the tangent of the derivative test above (an error in a
-        // quotient or a mode is O(mu)); projected: the numerical decomposition's clamp.
-        EXPECT_LE((tangentOf(t, false) - A).norm(), 1e-10 * A.norm()) << law.name << "\n" << F;
-        const PiolaTangent projected = tangentOf(t, true);
-        EXPECT_LE((projected - numericalProjection(A)).norm(), 1e-9 * A.norm()) << law.name << "\n"
-                                                                                << F;
-        EXPECT_GE(smallestEigenvalue(projected), -1e-12 * A.norm()) << law.name << "\n" << F;
+        // quotient or a mode is O(mu)); clamped and mirrored: the numerical decomposition's.
+        EXPECT_LE((tangentOf(t, EigenvalueFilter::kExact) - A).norm(), 1e-10 * A.norm())
+            << law.name << "\n"
+            << F;
+        for (EigenvalueFilter filter : {EigenvalueFilter::kClamp, EigenvalueFilter::kMirror}) {
+          const PiolaTangent filtered = tangentOf(t, filter);
+          EXPECT_LE((filtered - numericalFilter(A, filter)).norm(), 1e-9 * A.norm())
+              << law.name << "\n"
+              << F;
+          EXPECT_GE(smallestEigenvalue(filtered), -1e-12 * A.norm()) << law.name << "\n" << F;
+        }
         if (smallestEigenvalue(A) < -1e-9 * A.norm()) ++clamped;
       }
       // At rest the tangent is linear elasticity's (PSD, zero on the 3 rotations): unchanged.
       const PrincipalTangent rest = law.principal(Eigen::Matrix3d::Identity());
-      EXPECT_LE((tangentOf(rest, true) - tangentOf(rest, false)).norm(),
-                1e-12 * tangentOf(rest, false).norm());
+      for (EigenvalueFilter filter : {EigenvalueFilter::kClamp, EigenvalueFilter::kMirror}) {
+        EXPECT_LE((tangentOf(rest, filter) - tangentOf(rest, EigenvalueFilter::kExact)).norm(),
+                  1e-12 * tangentOf(rest, EigenvalueFilter::kExact).norm());
+      }
     }
   }
   EXPECT_GT(clamped, 0);  // the samples do exercise the clamp
@@ -310,7 +320,7 @@ TEST(HyperelasticProjection, InvertedGradientGivesFiniteEnergyStressAndPsdTangen
       EXPECT_TRUE(std::isfinite(law.psi(F)));
       EXPECT_GT(law.psi(F), 0.0) << law.name;
       EXPECT_TRUE(law.piola(F).allFinite());
-      const PiolaTangent projected = tangentOf(law.principal(F), true);
+      const PiolaTangent projected = tangentOf(law.principal(F), EigenvalueFilter::kClamp);
       ASSERT_TRUE(projected.allFinite());
       EXPECT_GE(smallestEigenvalue(projected), -1e-12 * projected.norm()) << law.name;
     }

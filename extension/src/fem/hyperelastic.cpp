@@ -85,13 +85,27 @@ void addVolumetric(double lambda, double alpha, PrincipalTangent& t) {
   t.shear -= pressure * s;
 }
 
-// The nearest positive semi-definite matrix to the 3x3 stretch block; unchanged when positive
-// definite (the usual case: checked by its leading minors, no decomposition).
-Eigen::Matrix3d projectStretch(const Eigen::Matrix3d& H) {
+// Eigenvalues as `filter` leaves them (kExact: as they are).
+Eigen::Vector3d filtered(const Eigen::Vector3d& eigenvalues, EigenvalueFilter filter) {
+  switch (filter) {
+    case EigenvalueFilter::kClamp:
+      return eigenvalues.cwiseMax(0.0);
+    case EigenvalueFilter::kMirror:
+      return eigenvalues.cwiseAbs();
+    case EigenvalueFilter::kExact:
+      break;
+  }
+  return eigenvalues;
+}
+
+// The 3x3 stretch block with its eigenvalues filtered; unchanged when positive definite (the
+// usual case: checked by its leading minors, no decomposition) or when `filter` keeps them.
+Eigen::Matrix3d filterStretch(const Eigen::Matrix3d& H, EigenvalueFilter filter) {
+  if (filter == EigenvalueFilter::kExact) return H;
   const double minor2 = H(0, 0) * H(1, 1) - H(0, 1) * H(1, 0);
   if (H(0, 0) > 0 && minor2 > 0 && H.determinant() > 0) return H;
   const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eigen(H);
-  return eigen.eigenvectors() * eigen.eigenvalues().cwiseMax(0.0).asDiagonal() *
+  return eigen.eigenvectors() * filtered(eigen.eigenvalues(), filter).asDiagonal() *
          eigen.eigenvectors().transpose();
 }
 
@@ -157,8 +171,10 @@ HyperelasticTetResponse hyperelasticResponse(const Law& law,
   const PrincipalTangent t = principalTangent(law, F);
   const ModeGradients Z = modeGradients(t, rest.rest_shape_inverse);
   if (kind != TetStiffnessKind::kExact) {
-    response.projected_stiffness = modeStiffness(
-        Z, projectStretch(t.stretch), t.rotation.cwiseMax(0.0), t.shear.cwiseMax(0.0), rest.volume);
+    const EigenvalueFilter filter = projectionOf(kind);
+    response.projected_stiffness =
+        modeStiffness(Z, filterStretch(t.stretch, filter), filtered(t.rotation, filter),
+                      filtered(t.shear, filter), rest.volume);
   }
   if (kind != TetStiffnessKind::kProjected)
     response.exact_stiffness = modeStiffness(Z, t.stretch, t.rotation, t.shear, rest.volume);
@@ -230,8 +246,10 @@ HyperelasticTet10Response hyperelasticTet10Response(const Law& law, const Tet10V
     const PrincipalTangent t = principalTangent(law, F);
     tet10PointModes(t, g, q, Z);
     if (projected) {
-      tet10PointWeightedModes(Z, q, weight, projectStretch(t.stretch), t.rotation.cwiseMax(0.0),
-                              t.shear.cwiseMax(0.0), projected_modes);
+      const EigenvalueFilter filter = projectionOf(kind);
+      tet10PointWeightedModes(Z, q, weight, filterStretch(t.stretch, filter),
+                              filtered(t.rotation, filter), filtered(t.shear, filter),
+                              projected_modes);
     }
     if (exact) tet10PointWeightedModes(Z, q, weight, t.stretch, t.rotation, t.shear, exact_modes);
   }
@@ -366,8 +384,10 @@ PrincipalTangent principalTangent(const MooneyRivlin& law, const Eigen::Matrix3d
   return t;
 }
 
-PiolaTangent tangentOf(const PrincipalTangent& t, bool project) {
-  const Eigen::Matrix3d stretch = project ? projectStretch(t.stretch) : t.stretch;
+PiolaTangent tangentOf(const PrincipalTangent& t, EigenvalueFilter filter) {
+  const Eigen::Matrix3d stretch = filterStretch(t.stretch, filter);
+  const Eigen::Vector3d rotations = filtered(t.rotation, filter),
+                        shears = filtered(t.shear, filter);
   std::array<PiolaVector, 9> modes;
   std::array<Eigen::Matrix3d, 9> Q;
   for (int i = 0; i < 3; ++i)
@@ -386,8 +406,7 @@ PiolaTangent tangentOf(const PrincipalTangent& t, bool project) {
     for (size_t j = 0; j < 3; ++j)
       A += stretch(static_cast<int>(i), static_cast<int>(j)) * modes[i] * modes[j].transpose();
   for (int k = 0; k < 3; ++k) {
-    const double rotation = project ? std::max(t.rotation(k), 0.0) : t.rotation(k);
-    const double shear = project ? std::max(t.shear(k), 0.0) : t.shear(k);
+    const double rotation = rotations(k), shear = shears(k);
     A += rotation * modes[static_cast<size_t>(3 + k)] *
          modes[static_cast<size_t>(3 + k)].transpose();
     A += shear * modes[static_cast<size_t>(6 + k)] * modes[static_cast<size_t>(6 + k)].transpose();

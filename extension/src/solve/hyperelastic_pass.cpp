@@ -217,7 +217,9 @@ bool HyperelasticPass::holdsForcesAt(const Eigen::VectorXd& positions) const {
 }
 
 bool HyperelasticPass::holdsStiffnessesAt(const Eigen::VectorXd& positions) const {
-  return evaluated_kind_ == TetStiffnessKind::kProjectedAndExact && holdsForcesAt(positions);
+  return (evaluated_kind_ == TetStiffnessKind::kProjectedAndExact ||
+          evaluated_kind_ == TetStiffnessKind::kMirroredAndExact) &&
+         holdsForcesAt(positions);
 }
 
 }  // namespace torsion

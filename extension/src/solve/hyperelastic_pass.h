@@ -36,13 +36,14 @@ struct HyperelasticLaw {
 class HyperelasticPass {
  public:
   /// Energy, forces (elementForces()) and the element stiffnesses `kind` asks for
-  /// (projectedStiffnesses(): from the projected tangent, positive semi-definite;
-  /// exactStiffnesses(): the exact Hessians) at `positions` (3n). Returns the energy, J.
+  /// (projectedStiffnesses(): from the clamped, or for kMirroredAndExact the mirrored, tangent,
+  /// positive semi-definite; exactStiffnesses(): the exact Hessians) at `positions` (3n). Returns
+  /// the energy, J.
   double evaluate(const FemModel& model, const Eigen::VectorXd& positions, const Parallel& parallel,
                   TetStiffnessKind kind);
   /// Whether the last evaluate() was at exactly `positions` (the bits: -0 and 0 differ): its
   /// forces and energy are those there (a step that ends there starts the next with them, the same
-  /// bits as evaluating again); and with both stiffnesses.
+  /// bits as evaluating again); and with the exact and a projected stiffness.
   bool holdsForcesAt(const Eigen::VectorXd& positions) const;
   bool holdsStiffnessesAt(const Eigen::VectorXd& positions) const;
   /// Forgets the last evaluate() (the material changed).

@@ -132,10 +132,14 @@ LinearSolveReport ImplicitStepper::newtonDirection(const Eigen::VectorXd& free_r
                                                    Eigen::VectorXd& dv) {
   // The exact Hessian first: where the step's system is positive definite with it (the usual case;
   // element Hessians are indefinite under finite shear, their sum plus M / dt^2 rarely is) Newton
-  // converges quadratically, where the projected one converges only linearly (measured: 20-30
+  // converges quadratically, where a projected one converges only linearly (measured: 20-30
   // iterations for a quarter turn of the statics twist, docs/materials.md). Where the system is
   // not positive definite (the factorisation or CG breaks down) or dv is no descent direction,
-  // the projected Hessian, positive semi-definite per element. Both are the pass's at the iterate.
+  // the pass's positive semi-definite stiffness at the iterate: the mirrored one (negative
+  // eigenvalues replaced by their magnitudes), whose steps stay short where the energy bends down
+  // and which, on the nearly incompressible twist, leaves the fallback after a few iterations
+  // where the clamped one never does (docs/materials.md, "Validation on tet10"). At a predicted
+  // step's first iterate it is the clamped K_0, evaluated with the step's start.
   system_.setElementStiffnesses(&hyperelastic_->exactStiffnesses());
   dv.setZero(free_residual.size());
   LinearSolveReport exact = linearSolve(newton_constraints_, free_residual, dv);
@@ -208,7 +212,7 @@ LinearSolveReport ImplicitStepper::solveNewton() {
   system_.setLaggedStiffness(material.stiffness_damping > 0 ? &start_stiffness_ : nullptr,
                              material.stiffness_damping / dt);
   double phi = predicted ? iterateResidual(v, energy)
-                         : evaluateIterate(v, TetStiffnessKind::kProjectedAndExact);
+                         : evaluateIterate(v, TetStiffnessKind::kMirroredAndExact);
   Eigen::VectorXd free_residual;
   const double rest_volume = model_->totalMass() / material.density;
   const double rounding =
@@ -222,7 +226,7 @@ LinearSolveReport ImplicitStepper::solveNewton() {
     newton_.converged = residual <= settings_.newton_tolerance * reference + rounding;
     if (newton_.converged || newton_.iterations >= settings_.newton_max_iterations) break;
     if (!hyperelastic_->holdsStiffnessesAt(trial_))
-      hyperelastic_->evaluate(*model_, trial_, parallel_, TetStiffnessKind::kProjectedAndExact);
+      hyperelastic_->evaluate(*model_, trial_, parallel_, TetStiffnessKind::kMirroredAndExact);
     addSolve(total, newtonDirection(free_residual, dv));
     ++newton_.iterations;
     if (total.breakdown) break;

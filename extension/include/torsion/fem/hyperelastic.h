@@ -101,18 +101,32 @@ struct PrincipalTangent {
 };
 PrincipalTangent principalTangent(const StableNeoHookean& law, const Eigen::Matrix3d& F);
 PrincipalTangent principalTangent(const MooneyRivlin& law, const Eigen::Matrix3d& F);
-/// dP/dF rebuilt from its eigensystem: exact, or with `project` the nearest positive
-/// semi-definite matrix (every eigenvalue clamped at zero).
-PiolaTangent tangentOf(const PrincipalTangent& tangent, bool project);
+/// What becomes of a tangent's negative eigenvalues: kept (the exact tangent), clamped at zero (the
+/// nearest positive semi-definite matrix), or mirrored (replaced by their magnitudes: positive
+/// semi-definite as well, but keeping the curvature the clamp drops, so that a Newton step along a
+/// direction where the energy bends down stays short; Chen, Liu, Jacobson, Levin and Zheng 2024,
+/// "Trust-Region Eigenvalue Filtering for Projected Newton").
+enum class EigenvalueFilter { kExact, kClamp, kMirror };
 
-/// Which stiffnesses hyperelasticTet computes (the forces and the energy always).
-enum class TetStiffnessKind { kNone, kProjected, kExact, kProjectedAndExact };
-/// Whether `kind` asks for the projected, or the exact, stiffness.
+/// dP/dF rebuilt from its eigensystem, its eigenvalues filtered.
+PiolaTangent tangentOf(const PrincipalTangent& tangent, EigenvalueFilter filter);
+
+/// Which stiffnesses hyperelasticTet computes (the forces and the energy always). The projected
+/// one is built from the clamped tangent, or, for kMirroredAndExact, from the mirrored one.
+enum class TetStiffnessKind { kNone, kProjected, kExact, kProjectedAndExact, kMirroredAndExact };
+/// Whether `kind` asks for the projected (positive semi-definite), or the exact, stiffness.
 inline bool projectedAsked(TetStiffnessKind kind) {
-  return kind == TetStiffnessKind::kProjected || kind == TetStiffnessKind::kProjectedAndExact;
+  return kind == TetStiffnessKind::kProjected || kind == TetStiffnessKind::kProjectedAndExact ||
+         kind == TetStiffnessKind::kMirroredAndExact;
 }
 inline bool exactAsked(TetStiffnessKind kind) {
-  return kind == TetStiffnessKind::kExact || kind == TetStiffnessKind::kProjectedAndExact;
+  return kind == TetStiffnessKind::kExact || kind == TetStiffnessKind::kProjectedAndExact ||
+         kind == TetStiffnessKind::kMirroredAndExact;
+}
+/// The filter that makes `kind`'s projected stiffness.
+inline EigenvalueFilter projectionOf(TetStiffnessKind kind) {
+  return kind == TetStiffnessKind::kMirroredAndExact ? EigenvalueFilter::kMirror
+                                                     : EigenvalueFilter::kClamp;
 }
 
 /// One linear tet: energy V Psi (J), forces f_a = -dE/dx_a (N), stiffness d2E/dx2 (N/m): the
