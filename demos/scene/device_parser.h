@@ -43,7 +43,7 @@ struct DeviceOverrides {
 /// Applies every --device (applyDeviceOverride), then --haptics, to `scene`; the first fault
 /// is the error. A network device on a host outside 127.0.0.0/8 is an error unless its packets
 /// are authenticated (a key_file, or a key in the environment) or `allow_remote_devices`
-/// (docs/haptics.md).
+/// (docs/haptic-devices.md).
 Status applyDeviceOverrides(SceneSpec& scene, const DeviceOverrides& overrides);
 
 /// One warning per network device listening outside loopback (after applyDeviceOverrides).

@@ -1,7 +1,7 @@
 // torsion_device_host LIBRARY CONFIG PARENT_PID: runs one device plug-in for Torsion, in a process
 // of its own so that a plug-in that crashes ends this process, not Torsion's
-// (docs/haptics.md, "Device plug-ins"). Started by PluginDevice (isolated), never by hand: it
-// serves the shared-memory slot it inherits as fd 3 (plugin_host_protocol.h) until Torsion asks
+// (docs/haptic-devices.md, "Device plug-ins"). Started by PluginDevice (isolated), never by hand:
+// it serves the shared-memory slot it inherits as fd 3 (plugin_host_protocol.h) until Torsion asks
 // it to close or Torsion ends. When Torsion's wrenches stop coming (Torsion stopped or hung) or
 // Torsion ends, the host fades the device's wrench to zero itself (wrench_watchdog.h).
 #include <sys/mman.h>

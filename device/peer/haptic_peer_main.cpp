@@ -1,6 +1,7 @@
 // torsion_haptic_peer: the reference peer of the network device. It stands where a vendor's
 // force-feedback driver would: it sends the poses of a scripted trajectory to the simulation at
-// a fixed rate over UDP and receives the wrenches to render (docs/haptics.md, "Packet format").
+// a fixed rate over UDP and receives the wrenches to render (docs/haptic-devices.md,
+// "Packet format").
 //
 //   torsion_haptic_peer --trajectory assets/trajectories/figure_6_7.json [--port 5750]
 //                       [--rate 1000] [--log received.csv] [--key-file FILE]

@@ -1,4 +1,4 @@
-// Trajectory files (JSON, docs/haptics.md):
+// Trajectory files (JSON, docs/haptic-devices.md, "Device kinds"):
 //   {"start": {"position": [x, y, z], "rotation": [rx, ry, rz]},        optional, default zero
 //    "segments": [{"duration": s, "linear_velocity": [..], "angular_velocity": [..]}, ...]
 //      or "keyframes": [{"time": s, "position": [..], "rotation": [..]}, ...],

@@ -1,7 +1,7 @@
 // Round-trip latency of one PluginDevice::read() of the example plug-in, isolated in the device
 // host (shared memory, futex wake-ups both ways) and in process (worker thread, condition
 // variables), paced at the loop's 1 kHz so that each read wakes a sleeping server, as in a run.
-// Not a test: it measures (docs/haptics.md, "Device plug-ins").
+// Not a test: it measures (docs/haptic-devices.md, "Isolated or in process").
 //
 //   bench_plugin_host_latency [READS]   (default 5000 per mode)
 //

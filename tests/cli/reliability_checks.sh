@@ -418,8 +418,8 @@ case "$case_name" in
     ;;
 
   network_device_key)
-    # A shared key (docs/haptics.md, "Authentication"): the signed peer drives the hand while an
-    # unsigned one, sending to the same port at the same time, is refused and counted.
+    # A shared key (docs/haptic-devices.md, "Authentication"): the signed peer drives the hand
+    # while an unsigned one, sending to the same port at the same time, is refused and counted.
     [[ -x $peer ]] || fail "no torsion_haptic_peer given"
     twist_scene > twist.json
     cat > turn.json <<'JSON'

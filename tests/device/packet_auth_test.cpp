@@ -1,5 +1,5 @@
-// Authenticated packets (packet_key.h, docs/haptics.md "Authentication"): hostile UDP peers on
-// loopback against a device and a peer that share a key. Loopback datagrams are queued before
+// Authenticated packets (packet_key.h, docs/haptic-devices.md "Authentication"): hostile UDP peers
+// on loopback against a device and a peer that share a key. Loopback datagrams are queued before
 // sendto returns, so nothing here waits; clocks are fake.
 #include <gtest/gtest.h>
 #include <sys/stat.h>

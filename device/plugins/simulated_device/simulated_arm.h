@@ -1,7 +1,7 @@
 #pragma once
 // A force-feedback device held by a simulated operator, for tests and for the example plug-in
-// (docs/haptics.md, "Simulated device and operator"). One rigid body carries the device's
-// moving mass and the operator's arm (the hand holds the handle firmly):
+// (docs/haptic-devices.md, "The example: a simulated device and operator"). One rigid body
+// carries the device's moving mass and the operator's arm (the hand holds the handle firmly):
 //   (m_d + m_a) a = F_motor + K_a (x_intent - x) - B_a v
 //   (I_d + I_a) alpha = tau_motor + K_w theta(q_intent q^-1) - B_w omega
 // The operator is a spring-damper pulling toward a scripted intent (a twist about z, a push

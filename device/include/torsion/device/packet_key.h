@@ -1,5 +1,5 @@
 #pragma once
-// The shared secret that authenticates network-device packets (docs/haptics.md,
+// The shared secret that authenticates network-device packets (docs/haptic-devices.md,
 // "Authentication"). With a key, every packet carries an HMAC-SHA256 (libsodium) over its header
 // and payload; the device and its peer both hold the same key and drop whatever does not verify.
 //

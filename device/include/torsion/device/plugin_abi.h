@@ -1,7 +1,7 @@
 /* The device plug-in ABI, version 1: a haptic device as a shared library that Torsion loads at
  * run time (dlopen), e.g. `torsion run scene.json --device hand=plugin:/path/libdev.so:CONFIG`.
  * Plain C on purpose: a plug-in may be built by another compiler, against another C++ runtime,
- * over a vendor SDK (docs/haptics.md, "Writing a device plug-in").
+ * over a vendor SDK (docs/haptic-devices.md, "Writing a device plug-in over a vendor SDK").
  *
  * The library exports one function, TORSION_DEVICE_ENTRY_SYMBOL:
  *

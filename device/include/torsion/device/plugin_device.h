@@ -1,6 +1,6 @@
 #pragma once
 // A haptic device in a shared library, loaded at run time through the C ABI of plugin_abi.h
-// (`--device HAND=plugin:/path/libdev.so[:CONFIG]`, docs/haptics.md).
+// (`--device HAND=plugin:/path/libdev.so[:CONFIG]`, docs/haptic-devices.md).
 //
 // Where the plug-in runs:
 //   - isolated (the default): in a process of its own, torsion_device_host (`host_program`),

@@ -2,7 +2,7 @@
 // A scripted device trajectory: poses (device frame) and held buttons as functions of time.
 // Built from keyframes or from piecewise constant-velocity motions; both end up as keyframes
 // (positions interpolated linearly, orientations by slerp, held before the first and after the
-// last). The file format is in docs/haptics.md; assets/trajectories/figure_6_7.json is the
+// last). The file format is in docs/haptic-devices.md; assets/trajectories/figure_6_7.json is the
 // report's Figure 6.7 sequence.
 
 #include <cstdint>

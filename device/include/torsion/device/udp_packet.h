@@ -1,6 +1,6 @@
 #pragma once
-// The network device's wire format (docs/haptics.md, "Packet format"). One UDP datagram is one
-// packet, little-endian. Version 1 (unauthenticated) is exactly kPacketSize bytes:
+// The network device's wire format (docs/haptic-devices.md, "Packet format"). One UDP datagram is
+// one packet, little-endian. Version 1 (unauthenticated) is exactly kPacketSize bytes:
 //
 //   offset size  field
 //   0      4     magic 0x54525348 ("HSRT" in memory; reads "TRSH" as a big-endian word)
