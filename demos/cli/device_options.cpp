@@ -22,7 +22,7 @@ void addDeviceOptions(CLI::App& command, scene::DeviceOverrides& into) {
   command.add_flag("--allow-remote-device", into.allow_remote_devices,
                    "Let a network device without a key listen on an address other than loopback "
                    "(its packets are not authenticated: anyone who can reach the port first "
-                   "drives the hand; docs/haptics.md tells how to give it a key)");
+                   "drives the hand; docs/haptic-devices.md tells how to give it a key)");
 }
 
 }  // namespace torsion::cli

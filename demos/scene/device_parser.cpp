@@ -392,7 +392,7 @@ Status applyDeviceOverrides(SceneSpec& scene, const DeviceOverrides& overrides) 
                    " is not loopback: anyone who can reach that port could drive the " + what +
                    " (the packets are not authenticated); give the device a key_file (or set " +
                    device::kKeyFileVariable +
-                   ", docs/haptics.md), or pass "
+                   ", docs/haptic-devices.md), or pass "
                    "--allow-remote-device to listen there unauthenticated"};
     };
     for (size_t h = 0; h < scene.hands.size(); ++h) {
@@ -419,8 +419,9 @@ std::vector<std::string> remoteDeviceWarnings(const SceneSpec& scene) {
         holder + ": the network device listens on " + d->host +
         (authenticated(*d)
              ? ", outside loopback: only peers holding the shared key are heard; the packets "
-               "are signed, not encrypted (docs/haptics.md)"
-             : ", outside loopback: its first peer is bound, unauthenticated (docs/haptics.md)"));
+               "are signed, not encrypted (docs/haptic-devices.md)"
+             : ", outside loopback: its first peer is bound, unauthenticated "
+               "(docs/haptic-devices.md)"));
   };
   for (const HandSpec& hand : scene.hands)
     warn("hand '" + hand.name + "'", hand.device);

@@ -55,7 +55,7 @@ int runPeer(int argc, char** argv) {
   std::string key_path;
   CLI::App app{
       "torsion_haptic_peer: sends a scripted device trajectory to a simulation's network "
-      "device over UDP and receives the wrenches (docs/haptics.md)"};
+      "device over UDP and receives the wrenches (docs/haptic-devices.md)"};
   app.add_option("--trajectory", trajectory_path, "Trajectory file (JSON)")->required();
   app.add_option("--port", port, "The simulation's UDP port")
       ->check(CLI::Range(1, 65535))
@@ -68,7 +68,7 @@ int runPeer(int argc, char** argv) {
                  "Write the wrench rendered each tick to this CSV file (the one received; faded "
                  "to zero when wrenches stop arriving)");
   app.add_option("--key-file", key_path,
-                 "Shared key file: sign packets (docs/haptics.md, \"Authentication\"); also "
+                 "Shared key file: sign packets (docs/haptic-devices.md, \"Authentication\"); also "
                  "TORSION_HAPTIC_KEY_FILE or TORSION_HAPTIC_KEY in the environment");
   for (int k = 1; k < argc; ++k) {  // refused before parsing: never echoed, never used
     const std::string a = argv[k];
