@@ -491,6 +491,13 @@ class Viewer : public InputSink {
       line += ", body " + poseText(body);
     }
     if (t.jaw_gap) line += ", jaws " + gapText(*t.jaw_gap);
+    if (tool_ && tool_->name() == t.name) {  // what its device renders (device frame)
+      const Wrench w = tool_->rendered();
+      char buf[96];
+      std::snprintf(buf, sizeof buf, ", renders (%.6g, %.6g, %.6g) N", w.force.x(), w.force.y(),
+                    w.force.z());
+      line += buf;
+    }
     return line;
   }
 

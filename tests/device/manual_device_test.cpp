@@ -2,9 +2,11 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <atomic>
 #include <thread>
 
+#include "torsion/device/pose_math.h"
 #include "torsion/device/scripted_device.h"
 
 namespace torsion::device {
@@ -64,9 +66,10 @@ TEST(ManualDevice, ReadsWhatWasSetAndKeepsTheLastWrench) {
 
 // The viewer's thread sets pose k then buttons k while the loop's thread reads: every reading
 // holds one whole pose, never older than the previous reading, and the buttons of that update
-// or the one before (they are set a moment after the pose), always alive.
+// or the one before (they are set a moment after the pose), always alive. Without a glide, so
+// that each reading is a pose as set.
 TEST(ManualDevice, AReaderOnAnotherThreadSeesWholePosesInOrder) {
-  ManualDevice device(defaultDeviceLimits());
+  ManualDevice device(defaultDeviceLimits(), 0.0);
   device.setPose(poseNumbered(0));
   constexpr std::uint32_t kUpdates = 100000;
   std::atomic<bool> done{false};
@@ -96,6 +99,37 @@ TEST(ManualDevice, AReaderOnAnotherThreadSeesWholePosesInOrder) {
   EXPECT_EQ(mismatched, 0);
   EXPECT_EQ(newest, kUpdates);
   EXPECT_EQ(device.read(0).buttons, kUpdates);
+}
+
+// A key press moves the device as a hand would: evenly over the glide time (0.1 s), position
+// along the line and orientation along the arc, ending exactly on the pose set; 1 kHz readings
+// then move at 1 m/s for a 0.1 m press, a tenth of the reading check's bound. A new pose in the
+// middle of a glide starts a new one from where the device is.
+TEST(ManualDevice, APoseSetIsReachedEvenlyOverTheGlideTime) {
+  ManualDevice device(defaultDeviceLimits());
+  EXPECT_EQ(device.read(0.0).pose.position.x, 0);  // the first read is where it was set
+  Pose p;
+  p.position = {0.1, 0, 0};
+  p.orientation = fromRotationVector({0, 0, 0.4});
+  device.setPose(p);
+  double previous = 0, fastest = 0;
+  for (int tick = 1; tick <= 50; ++tick) {
+    const DeviceSample s = device.read(tick * 1e-3);
+    fastest = std::max(fastest, (s.pose.position.x - previous) / 1e-3);
+    previous = s.pose.position.x;
+    EXPECT_NEAR(s.pose.position.x, 0.1 * tick / 100.0, 1e-15) << "tick " << tick;
+    EXPECT_NEAR(toRotationVector(s.pose.orientation).z, 0.4 * tick / 100.0, 1e-12);
+  }
+  EXPECT_NEAR(fastest, 1.0, 1e-9);  // m/s
+  // Retargeted halfway (at 0.05 m): the new glide starts there and ends on the new pose.
+  Pose q = p;
+  q.position = {-0.05, 0, 0};
+  device.setPose(q);
+  EXPECT_NEAR(device.read(0.1).pose.position.x, 0.05 - 0.1 * 0.5, 1e-15);
+  const DeviceSample end = device.read(0.2);
+  EXPECT_EQ(end.pose.position.x, -0.05);  // exactly
+  EXPECT_EQ(device.read(5.0).pose.position.x, -0.05);
+  EXPECT_EQ(device.target().position.x, -0.05);
 }
 
 // The loop's thread writes wrenches while the viewer's thread reads them: each one whole.

@@ -15,6 +15,7 @@
 #     keys back to the tool, whose goal the next RIGHT moves; M takes the hand once more and the
 #     last RIGHT moves the hand: two key steps for the tool, one for the hand.
 #  6. tool_and_hand: a hand given up with M stays where the keys left it.
+#  7. palpation: the probe pressed into the organ, the device renders the organ's push.
 # Skipped (77) without xvfb-run.
 # Usage: viewer_tool_xvfb.sh TORSION SCENES_DIR
 set -u
@@ -51,7 +52,7 @@ def check(ok, what):
 num = r'([0-9.e+-]+)'
 vec = rf'\({num}, {num}, {num}\)'
 m = re.fullmatch(rf"viewer: tool 'probe' \(manual\): goal at {vec} m turned {vec} rad, "
-                 rf"body at {vec} m turned {vec} rad", line)
+                 rf"body at {vec} m turned {vec} rad, renders {vec} N", line)
 check(m is not None, f"unexpected tool line: {line!r}")
 v = [float(x) for x in m.groups()]
 goal, goal_turn, body, body_turn = v[0:3], v[3:6], v[6:9], v[9:12]
@@ -93,7 +94,7 @@ line = sys.argv[1]
 num = r'([0-9.e+-]+)'
 vec = rf'\({num}, {num}, {num}\)'
 m = re.fullmatch(rf"viewer: tool 'probe' \(manual\): goal at {vec} m turned {vec} rad, "
-                 rf"body at {vec} m turned {vec} rad", line)
+                 rf"body at {vec} m turned {vec} rad, renders {vec} N", line)
 if m is None:
     print("FAIL: unexpected tool line:", line); sys.exit(1)
 v = [float(x) for x in m.groups()]
@@ -120,7 +121,7 @@ held = re.search(rf"^viewer: tool 'grasper': button 1 held at step \d+, t = {num
                  rf"jaws {num} m apart$", out, re.M)
 let_go = re.search(rf"^viewer: tool 'grasper': button 1 let go at step \d+, t = {num} s; "
                    rf"jaws {num} m apart$", out, re.M)
-end = re.search(rf"^viewer: tool 'grasper' \(manual\): .*, jaws {num} m apart$", out, re.M)
+end = re.search(rf"^viewer: tool 'grasper' \(manual\): .*, jaws {num} m apart, renders .*$", out, re.M)
 check(held and let_go and end, "missing G, U or exit lines")
 t_g, gap_g = float(held[1]), float(held[2])
 t_u, gap_u = float(let_go[1]), float(let_go[2])
@@ -181,6 +182,31 @@ if not x > 0.01:
           f"back to its script (x = 0) instead of staying one key step along x")
     sys.exit(1)
 print(f"PASS: the hand left with M stayed at x = {x:.4g} m")
+PY
+
+# 7. Pressed into the organ (PageDown twice: 15 mm below its start, 6 mm below the surface),
+#    the probe is held up by the organ and the device renders that push: the coupling's pull
+#    k (z_body - z_goal) plus the weight it carries, m g = 0.196 N, upward, within 10 % (the
+#    device glides to each key's pose over 0.1 s, so the loop's passivity controller has no
+#    jump to take back and renders the whole force).
+view palpation.json 60 '5 key PAGEDOWN\n6 key PAGEDOWN\n' --device probe=manual
+python3 - "$(echo "$out" | grep -E "^viewer: tool 'probe' ")" <<'PY' || exit 1
+import re, sys
+line = sys.argv[1]
+num = r'([0-9.e+-]+)'
+vec = rf'\({num}, {num}, {num}\)'
+m = re.fullmatch(rf"viewer: tool 'probe' \(manual\): goal at {vec} m turned {vec} rad, "
+                 rf"body at {vec} m turned {vec} rad, renders {vec} N", line)
+if m is None:
+    print(f"FAIL: unexpected tool line: {line!r}"); sys.exit(1)
+v = [float(x) for x in m.groups()]
+goal_z, body_z, fz = v[2], v[8], v[14]
+expected = 500 * (body_z - goal_z) + 0.02 * 9.81
+if not (body_z - goal_z > 1e-3 and abs(fz - expected) <= 0.1 * expected):
+    print(f"FAIL: the probe is {body_z - goal_z:.4g} m above its goal and the device renders "
+          f"fz = {fz:.4g} N; expected {expected:.4g} N (k dz + m g) within 10 %")
+    sys.exit(1)
+print(f"PASS: pressed into the organ, the device renders {fz:.4g} N (k dz + m g = {expected:.4g})")
 PY
 
 # 5. Manual devices move tools only.
