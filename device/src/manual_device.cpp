@@ -45,16 +45,6 @@ void ManualDevice::setButtons(std::uint32_t buttons) {
   buttons_ = buttons;
 }
 
-Pose ManualDevice::target() const {
-  std::lock_guard<std::mutex> lock(mutex_);
-  return target_;
-}
-
-std::uint32_t ManualDevice::buttons() const {
-  std::lock_guard<std::mutex> lock(mutex_);
-  return buttons_;
-}
-
 Wrench ManualDevice::lastWritten() const {
   std::lock_guard<std::mutex> lock(mutex_);
   return written_;

@@ -40,3 +40,12 @@ write_short_turn() {
  "buttons": [{"time": 0, "held": [1]}, {"time": 0.8, "held": [2]}]}
 JSON
 }
+
+# wait_for_network_device LOG: waits (up to 10 s) until the run writing LOG says it opened its
+# network device, so that a peer started next finds the port bound.
+wait_for_network_device() {
+  for _ in $(seq 100); do
+    grep -q "device network" "$1" && return
+    sleep 0.1
+  done
+}

@@ -548,10 +548,7 @@ EOF
     "$torsion" run palpation.json --device "probe=network:$port" --out net --steps 150 \
       --threads 1 >torsion.log 2>&1 &
     sim=$!
-    for _ in $(seq 100); do
-      grep -q "device network" torsion.log && break
-      sleep 0.1
-    done
+    wait_for_network_device torsion.log
     grep -q "tool 'probe': device network(udp port $port), threaded haptic loop" torsion.log ||
       { kill "$sim"; cat torsion.log; fail "torsion did not open the network device"; }
     "$peer" --trajectory "$assets/../trajectories/palpation.json" --port "$port" --log peer.csv ||
@@ -600,10 +597,7 @@ EOF
     "$torsion" run twist.json --device "hand=network:$port" --out net --steps 200 --threads 1 \
       >torsion.log 2>&1 &
     sim=$!
-    for _ in $(seq 100); do
-      grep -q "device network" torsion.log && break
-      sleep 0.1
-    done
+    wait_for_network_device torsion.log
     grep -q "hand 'hand': device network(udp port $port), threaded haptic loop" torsion.log ||
       { kill "$sim"; cat torsion.log; fail "torsion did not open the network device"; }
     "$peer" --trajectory turn.json --port "$port" --log peer.csv || fail "the peer failed"

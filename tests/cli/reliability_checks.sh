@@ -63,10 +63,7 @@ peer_holds_the_hand() {
 JSON
   port=$((20000 + RANDOM % 20000))
   start_run out twist.json --device "hand=network:$port" --steps 100000 --threads 1
-  for _ in $(seq 100); do
-    grep -q "device network" run.log && break
-    sleep 0.1
-  done
+  wait_for_network_device run.log
   "$peer" --trajectory hold.json --port "$port" --log peer.csv >peer.log 2>&1 &
   peer_pid=$!
   for _ in $(seq 300); do
@@ -431,10 +428,7 @@ JSON
     TORSION_HAPTIC_KEY_FILE=haptic.key "$torsion" run twist.json --device "hand=network:$port" \
       --out net --steps 150 --threads 1 >torsion.log 2>&1 &
     sim=$!
-    for _ in $(seq 100); do
-      grep -q "device network" torsion.log && break
-      sleep 0.1
-    done
+    wait_for_network_device torsion.log
     grep -q "device network(udp port $port)" torsion.log ||
       { kill "$sim"; cat torsion.log; fail "torsion did not open the network device"; }
     "$peer" --trajectory turn.json --port "$port" --rate 500 >hostile.log 2>&1 &

@@ -245,9 +245,9 @@ TEST(Sliding, StiffSlabHoldsTheBoxBelowTheFrictionAngleAndLetsItSlideAbove) {
 // box's length), 0.1 m and 0.05 m apart, tet4 and tet10, two slopes by two coefficients
 // (docs/validation-contact.md, "Sliding over an FEM slab"). Before the sliding-body rules
 // (docs/contact-pipeline.md, "Sliding over nodes") the soft slab gave -64 % at 20 deg with
-// mu = 0.3; before the friction's slip resistance node rows as long as the box gave +6.4 % (soft) and
-// +5.0 % (stiff) at 20 deg with mu = 0.3, and the box on the stiff coarse tet10 slab at 25 deg with
-// mu = 0.2 stopped dead at a node row at 2 m/s (-15 %).
+// mu = 0.3; before the friction's slip resistance node rows as long as the box gave +6.4 % (soft)
+// and +5.0 % (stiff) at 20 deg with mu = 0.3, and the box on the stiff coarse tet10 slab at 25 deg
+// with mu = 0.2 stopped dead at a node row at 2 m/s (-15 %).
 TEST(Sliding, BoxWithFrictionSlidesAsCoulombSaysOverSoftStiffCoarseFineTet4AndTet10Slabs) {
   struct Case {
     double degrees, mu, youngs_modulus;

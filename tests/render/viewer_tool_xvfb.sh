@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # `torsion view` moving a tool with a manual device (--device NAME=manual), under a virtual X
-# server. The exit report gives each tool's device goal and body pose; G and U log the grasper's
-# jaw gap when pressed.
+# server. The exit report gives each tool's device goal, body pose and (the manual tool's)
+# rendered force; G and U log the grasper's jaw gap when pressed.
 #  1. palpation, probe=manual: RIGHT x3, UP, PAGEUP, Shift+PAGEUP move the device's goal by
 #     exactly those key steps (0.05 of the scene's size each, 5 degrees) and the probe follows:
 #     its coupling (k = 500 N/m on 0.02 kg, critically damped: 1/omega = 6 ms, under one 10 ms
@@ -14,8 +14,9 @@
 #  4. tool_and_hand, probe=manual: RIGHT moves the tool; M takes the hand and M again gives the
 #     keys back to the tool, whose goal the next RIGHT moves; M takes the hand once more and the
 #     last RIGHT moves the hand: two key steps for the tool, one for the hand.
-#  6. tool_and_hand: a hand given up with M stays where the keys left it.
-#  7. palpation: the probe pressed into the organ, the device renders the organ's push.
+#  5. tool_and_hand: a hand given up with M stays where the keys left it.
+#  6. palpation: the probe pressed into the organ, the device renders the organ's push.
+#  7. a manual device on a hand is refused.
 # Skipped (77) without xvfb-run.
 # Usage: viewer_tool_xvfb.sh TORSION SCENES_DIR
 set -u
@@ -38,23 +39,33 @@ view() {
     fail "$scene: unexpected summary"
 }
 
+# The probe's exit line as 15 numbers: goal position, goal turn, body position, body turn (each a
+# rotation vector) and the force its device renders; FAIL on any other line.
+probe_numbers() {
+  python3 - "$(echo "$out" | grep -E "^viewer: tool 'probe' ")" <<'PY'
+import re, sys
+num = r'([0-9.e+-]+)'
+vec = rf'\({num}, {num}, {num}\)'
+m = re.fullmatch(rf"viewer: tool 'probe' \(manual\): goal at {vec} m turned {vec} rad, "
+                 rf"body at {vec} m turned {vec} rad, renders {vec} N", sys.argv[1])
+if m is None:
+    print(f"FAIL: unexpected tool line: {sys.argv[1]!r}", file=sys.stderr); sys.exit(1)
+print(" ".join(m.groups()))
+PY
+}
+
 # 1. Keys.
 view palpation.json 60 '5 key RIGHT\n6 key RIGHT\n7 key RIGHT\n8 key UP\n9 key PAGEUP\n10 key PAGEUP shift\n' \
   --device probe=manual
 echo "$out" | grep -qx "tool 'probe': device manual, lockstep haptic loop at 1000 Hz" ||
   fail "the viewer did not say the probe's device is manual"
-python3 - "$(echo "$out" | grep -E "^viewer: tool 'probe' ")" "$scenes" <<'PY' || exit 1
-import math, re, sys
-line, scenes = sys.argv[1], sys.argv[2]
+numbers=$(probe_numbers) || exit 1
+python3 - "$numbers" "$scenes" <<'PY' || exit 1
+import math, sys
+v, scenes = [float(x) for x in sys.argv[1].split()], sys.argv[2]
 def check(ok, what):
     if not ok:
         print("FAIL:", what); sys.exit(1)
-num = r'([0-9.e+-]+)'
-vec = rf'\({num}, {num}, {num}\)'
-m = re.fullmatch(rf"viewer: tool 'probe' \(manual\): goal at {vec} m turned {vec} rad, "
-                 rf"body at {vec} m turned {vec} rad, renders {vec} N", line)
-check(m is not None, f"unexpected tool line: {line!r}")
-v = [float(x) for x in m.groups()]
 goal, goal_turn, body, body_turn = v[0:3], v[3:6], v[6:9], v[9:12]
 start = (-0.03, 0, 0.045)  # palpation.json's probe pose
 moved = [g - s for g, s in zip(goal, start)]
@@ -88,16 +99,10 @@ PY
 
 # 2. Ctrl + left drag.
 view palpation.json 40 '5 drag left 30 -20 ctrl\n' --device probe=manual
-python3 - "$(echo "$out" | grep -E "^viewer: tool 'probe' ")" <<'PY' || exit 1
-import re, sys
-line = sys.argv[1]
-num = r'([0-9.e+-]+)'
-vec = rf'\({num}, {num}, {num}\)'
-m = re.fullmatch(rf"viewer: tool 'probe' \(manual\): goal at {vec} m turned {vec} rad, "
-                 rf"body at {vec} m turned {vec} rad, renders {vec} N", line)
-if m is None:
-    print("FAIL: unexpected tool line:", line); sys.exit(1)
-v = [float(x) for x in m.groups()]
+numbers=$(probe_numbers) || exit 1
+python3 - "$numbers" <<'PY' || exit 1
+import sys
+v = [float(x) for x in sys.argv[1].split()]
 goal, body = v[0:3], v[6:9]
 moved = sum((g - s) ** 2 for g, s in zip(goal, (-0.03, 0, 0.045))) ** 0.5
 lag = [b - g for b, g in zip(body, goal)]
@@ -166,7 +171,7 @@ print(f"PASS: the keys moved the tool {tool_moved[0]:.4g} m and, after M, the ha
       f"{hand_moved[0]:.4g} m")
 PY
 
-# 6. A hand left with M stays where the keys left it: its script no longer moves it (it would
+# 5. A hand left with M stays where the keys left it: its script no longer moves it (it would
 #    jump back to the script's frame, at x = 0).
 view tool_and_hand.json 30 '5 key M\n6 key RIGHT\n8 key M\n' --device probe=manual
 python3 - "$out" <<'PY' || exit 1
@@ -184,22 +189,16 @@ if not x > 0.01:
 print(f"PASS: the hand left with M stayed at x = {x:.4g} m")
 PY
 
-# 7. Pressed into the organ (PageDown twice: 15 mm below its start, 6 mm below the surface),
+# 6. Pressed into the organ (PageDown twice: 15 mm below its start, 6 mm below the surface),
 #    the probe is held up by the organ and the device renders that push: the coupling's pull
 #    k (z_body - z_goal) plus the weight it carries, m g = 0.196 N, upward, within 10 % (the
 #    device glides to each key's pose over 0.1 s, so the loop's passivity controller has no
 #    jump to take back and renders the whole force).
 view palpation.json 60 '5 key PAGEDOWN\n6 key PAGEDOWN\n' --device probe=manual
-python3 - "$(echo "$out" | grep -E "^viewer: tool 'probe' ")" <<'PY' || exit 1
-import re, sys
-line = sys.argv[1]
-num = r'([0-9.e+-]+)'
-vec = rf'\({num}, {num}, {num}\)'
-m = re.fullmatch(rf"viewer: tool 'probe' \(manual\): goal at {vec} m turned {vec} rad, "
-                 rf"body at {vec} m turned {vec} rad, renders {vec} N", line)
-if m is None:
-    print(f"FAIL: unexpected tool line: {line!r}"); sys.exit(1)
-v = [float(x) for x in m.groups()]
+numbers=$(probe_numbers) || exit 1
+python3 - "$numbers" <<'PY' || exit 1
+import sys
+v = [float(x) for x in sys.argv[1].split()]
 goal_z, body_z, fz = v[2], v[8], v[14]
 expected = 500 * (body_z - goal_z) + 0.02 * 9.81
 if not (body_z - goal_z > 1e-3 and abs(fz - expected) <= 0.1 * expected):
@@ -209,7 +208,7 @@ if not (body_z - goal_z > 1e-3 and abs(fz - expected) <= 0.1 * expected):
 print(f"PASS: pressed into the organ, the device renders {fz:.4g} N (k dz + m g = {expected:.4g})")
 PY
 
-# 5. Manual devices move tools only.
+# 7. Manual devices move tools only.
 printf '' > "$keys"
 out=$(timeout 60 xvfb-run -a -s "-screen 0 640x480x24" "$torsion" view \
       "$scenes/tool_and_hand.json" --frames 2 --device hand=manual 2>&1)

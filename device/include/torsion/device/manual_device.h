@@ -41,9 +41,6 @@ class ManualDevice : public HapticDevice {
   void setPose(const Pose& pose);
   /// Any thread: the buttons held now (bit k: button k+1).
   void setButtons(std::uint32_t buttons);
-  /// Any thread: the last pose set (the glide's end) and the buttons the next read() returns.
-  Pose target() const;
-  std::uint32_t buttons() const;
   /// Any thread: the wrench last written (device frame).
   Wrench lastWritten() const;
 
