@@ -24,6 +24,8 @@ const std::set<std::string> kNotedKeys = {
     "schema_version",    "torsion_version",  "git_commit",     "bullet_precision",
     "threads",           "linear_solver",    "preconditioner", "tolerance",
     "solver_iterations", "final_state_hash", "kernel_path"};
+// The same, for a key of every body (bodies[i].<key>).
+const std::set<std::string> kNotedBodyKeys = {"renumbered"};
 // Keys that differ between any two runs (timings) or name files: not shown.
 const std::set<std::string> kIgnoredKeys = {"ms_per_step", "outputs", "scene_file", "haptics",
                                             "haptic_warnings"};
@@ -92,7 +94,9 @@ void compareSummaries(const nlohmann::json& run, const nlohmann::json& reference
     if (kIgnoredKeys.count(key) != 0) continue;
     const auto r = run_by_path.find(path);
     const auto f = reference_by_path.find(path);
-    const bool noted = kNotedKeys.count(key) != 0;
+    const bool noted =
+        kNotedKeys.count(key) != 0 ||
+        (key == "bodies" && kNotedBodyKeys.count(path.substr(path.find_last_of('.') + 1)) != 0);
     if (r == run_by_path.end() || f == reference_by_path.end()) {
       const std::string side = r == run_by_path.end() ? "reference only" : "run only";
       if (noted) {

@@ -20,8 +20,12 @@ void addProvenance(nlohmann::json& summary) {
 std::string finalStateHash(const BuiltScene& scene,
                            const std::vector<Eigen::VectorXd>& final_positions) {
   Fnv1a fnv;
-  for (const Eigen::VectorXd& x : final_positions)
+  for (size_t b = 0; b < final_positions.size(); ++b) {
+    // In the numbering of the body's mesh file, as in <body>.vtk.
+    const Eigen::VectorXd x =
+        scene.world->bodies()[b]->inputNumbering().nodesToInput(final_positions[b]);
     fnv.add(x.data(), sizeof(double) * static_cast<size_t>(x.size()));
+  }
   for (const SceneRigidBody& r : scene.rigid_bodies) {
     const btTransform& t = r.body->getCenterOfMassTransform();
     const btQuaternion q = t.getRotation();

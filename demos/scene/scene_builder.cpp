@@ -97,8 +97,8 @@ Result<std::unique_ptr<BuiltScene>> buildScene(SceneSpec spec, const BuildOption
             checkStiffnessRatio(body.material, mesh.value().mesh, spec.world.solver.time_step);
         !carried)
       return Error{entry + ": " + carried.error().message};
-    Result<FemBody*> added =
-        world.addBody(body.name, mesh.value().mesh, body.material, body.pose, body.element);
+    Result<FemBody*> added = world.addBody(body.name, mesh.value().mesh, body.material, body.pose,
+                                           body.element, body.numbering);
     if (!added) return Error{entry + ": " + added.error().message};
     if (body.linear_velocity != Eigen::Vector3d::Zero() ||
         body.angular_velocity != Eigen::Vector3d::Zero()) {

@@ -356,6 +356,12 @@ BodySpec readBody(const JsonObject& b, const SceneSpec& scene, const std::string
       body.material.volumetric_strain == VolumetricStrain::kNodalAverage) {
     b.fail("material", "volumetric_strain nodal_average is a tet4 option (tet10 does not lock)");
   }
+  const std::string order = b.string("node_order", "cache_friendly");
+  if (order == "file") {
+    body.numbering = NodeNumbering::kAsGiven;
+  } else if (order != "cache_friendly") {
+    b.fail("node_order", "'" + order + "' is not a node order (cache_friendly or file)");
+  }
   if (b.has("self_contact")) {
     const JsonObject c = b.object("self_contact");
     SelfContactSettings self;

@@ -8,6 +8,7 @@
 #include <nlohmann/json.hpp>
 #include <optional>
 
+#include "body_vtk.h"
 #include "run_directory.h"
 #include "run_provenance.h"
 #include "scene_anomalies.h"
@@ -30,22 +31,6 @@ double percentile(std::vector<double> values, double p) {
   const size_t lo = static_cast<size_t>(rank);
   const size_t hi = std::min(lo + 1, values.size() - 1);
   return values[lo] + (rank - static_cast<double>(lo)) * (values[hi] - values[lo]);
-}
-
-Status writeFinalMesh(const FemBody& body, const Eigen::VectorXd& positions, const fs::path& path) {
-  const TetMesh& mesh = body.model().mesh();
-  std::vector<Eigen::Vector3d> x(static_cast<size_t>(mesh.nodeCount()));
-  MeshField displacement{"displacement", 3, {}};
-  displacement.values.reserve(static_cast<size_t>(3 * mesh.nodeCount()));
-  for (int i = 0; i < mesh.nodeCount(); ++i) {
-    x[static_cast<size_t>(i)] = positions.segment<3>(3 * i);
-    const Eigen::Vector3d u =
-        x[static_cast<size_t>(i)] - mesh.restPositions()[static_cast<size_t>(i)];
-    displacement.values.insert(displacement.values.end(), {u.x(), u.y(), u.z()});
-  }
-  MeshFields fields;
-  fields.node_fields.push_back(std::move(displacement));
-  return writeTextFile(path, formatVtk(mesh, x, fields, body.name()));
 }
 
 // CSV values as a stream with precision(10) writes them ("%.10g"; std::to_chars with a precision
@@ -384,7 +369,8 @@ class Run {
     }
     for (size_t b = 0; b < world_.bodies().size(); ++b) {
       const FemBody& body = *world_.bodies()[b];
-      Status written = writeFinalMesh(body, last_good_[b], dir_->path(body.name() + ".vtk"));
+      Status written =
+          writeTextFile(dir_->path(body.name() + ".vtk"), bodyVtkText(body, last_good_[b]));
       if (!written) return written;
     }
     if (scene_.haptics) {  // stops the haptic threads (zero wrench), writes haptic_<hand>.csv
@@ -434,6 +420,7 @@ class Run {
                                    {"nodes", body->model().nodeCount()},
                                    {"element", toString(body->model().elementKind())},
                                    {"tets", body->model().elementCount()},
+                                   {"renumbered", !body->inputNumbering().identity()},
                                    {"mass_kg", body->model().totalMass()}});
     }
     summary["node_sets"] = nlohmann::json::array();

@@ -34,6 +34,9 @@ struct BodySpec {
   Eigen::Vector3d linear_velocity = Eigen::Vector3d::Zero();
   Eigen::Vector3d angular_velocity = Eigen::Vector3d::Zero();
   ElementKind element = ElementKind::kTet4;  ///< "element": "tet4" | "tet10"
+  /// "node_order": "cache_friendly" (renumbered inside when that pays; outputs in the file's
+  /// numbering) | "file" (the file's numbering inside too).
+  NodeNumbering numbering = NodeNumbering::kCacheFriendly;
   /// "self_contact": {"friction", "gap_tolerance", "thickness_factor"}: on when present
   /// (docs/contact.md).
   std::optional<SelfContactSettings> self_contact;

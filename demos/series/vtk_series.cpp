@@ -30,6 +30,8 @@ std::string bodyFile(const FemBody& body, const scene::BuiltScene& scene, int st
   const FemModel& model = body.model();
   const TetMesh& mesh = model.mesh();
   const FemState& state = body.state();
+  // Points, cells and their data in the numbering of the body's mesh file (input_numbering.h).
+  const InputNumbering& numbering = body.inputNumbering();
   VtuBuilder vtu;
   const int n = mesh.nodeCount();
   std::vector<double> points(static_cast<size_t>(3 * n)), displacement(points.size()),
@@ -38,10 +40,11 @@ std::string bodyFile(const FemBody& body, const scene::BuiltScene& scene, int st
     const Eigen::Vector3d x = state.position(i);
     const Eigen::Vector3d u = x - mesh.restPositions()[static_cast<size_t>(i)];
     const Eigen::Vector3d v = state.velocities.segment<3>(3 * i);
+    const int at = 3 * numbering.inputNode(i);
     for (int c = 0; c < 3; ++c) {
-      points[static_cast<size_t>(3 * i + c)] = x[c];
-      displacement[static_cast<size_t>(3 * i + c)] = u[c];
-      velocity[static_cast<size_t>(3 * i + c)] = v[c];
+      points[static_cast<size_t>(at + c)] = x[c];
+      displacement[static_cast<size_t>(at + c)] = u[c];
+      velocity[static_cast<size_t>(at + c)] = v[c];
     }
   }
   vtu.setPoints(std::move(points));
@@ -52,7 +55,7 @@ std::string bodyFile(const FemBody& body, const scene::BuiltScene& scene, int st
     if (h.spec.body != body.name()) continue;
     std::vector<double> grabbed(static_cast<size_t>(n), 0.0);
     for (int node : h.hand->grabbedNodes())
-      grabbed[static_cast<size_t>(node)] = 1.0;
+      grabbed[static_cast<size_t>(numbering.inputNode(node))] = 1.0;
     vtu.addPointData("grabbed_" + h.spec.name, 1, std::move(grabbed));
   }
 
@@ -78,18 +81,26 @@ std::string bodyFile(const FemBody& body, const scene::BuiltScene& scene, int st
   for (size_t e = 0; e < stress.size(); ++e)
     stress[e] = volume[e] > 0 ? stress[e] / volume[e] : 0.0;
   const int per = model.nodesPerElement();
+  const int tets_per_element = mesh.tetCount() / elements;
   const std::vector<int>& nodes = model.elementNodes();
   std::vector<std::int64_t> cell(static_cast<size_t>(per));
-  for (int e = 0; e < elements; ++e) {
+  std::vector<double> cell_stress(stress.size()), cell_strain(stress.size());
+  std::vector<std::uint8_t> cell_inverted(stress.size());
+  for (int c = 0; c < elements; ++c) {
+    const int e = numbering.bodyElement(c, tets_per_element);
     for (int k = 0; k < per; ++k) {
       const int from = per == 10 ? kVtkFromTorsionTet10[k] : k;
-      cell[static_cast<size_t>(k)] = nodes[static_cast<size_t>(per * e + from)];
+      cell[static_cast<size_t>(k)] =
+          numbering.inputNode(nodes[static_cast<size_t>(per * e + from)]);
     }
     vtu.addCell(per == 10 ? VtkCellType::kQuadraticTetra : VtkCellType::kTetra, cell);
+    cell_stress[static_cast<size_t>(c)] = stress[static_cast<size_t>(e)];
+    cell_strain[static_cast<size_t>(c)] = strain[static_cast<size_t>(e)];
+    cell_inverted[static_cast<size_t>(c)] = inverted[static_cast<size_t>(e)];
   }
-  vtu.addCellData("von_mises", 1, std::move(stress));
-  vtu.addCellData("strain", 1, std::move(strain));
-  vtu.addCellFlags("inverted", std::move(inverted));
+  vtu.addCellData("von_mises", 1, std::move(cell_stress));
+  vtu.addCellData("strain", 1, std::move(cell_strain));
+  vtu.addCellFlags("inverted", std::move(cell_inverted));
 
   vtu.addFieldData("TimeValue", {scene.world->time()});
   vtu.addFieldData("step", {static_cast<double>(step)});

@@ -4,6 +4,7 @@
 #include "frame_data.h"
 #include "handles.h"
 #include "py_convert.h"
+#include "py_numbering.h"
 #include "py_rigid.h"
 #include "torsion/fem/corotated_element.h"
 #include "torsion/format_number.h"
@@ -86,7 +87,7 @@ void bindParts(py::module_& m) {
       .def_property_readonly(
           "positions",
           [](const B& b) {
-            return readOnlyView(b.body->state().positions.data(), b.body->model().nodeCount(), 3,
+            return readOnlyView(b.body->inputPositions().data(), b.body->model().nodeCount(), 3,
                                 b.owner);
           },
           "(n, 3) float64, m. A read-only view of the solver's storage: it changes as the world "
@@ -94,14 +95,17 @@ void bindParts(py::module_& m) {
       .def_property_readonly(
           "velocities",
           [](const B& b) {
-            return readOnlyView(b.body->state().velocities.data(), b.body->model().nodeCount(), 3,
+            return readOnlyView(b.body->inputVelocities().data(), b.body->model().nodeCount(), 3,
                                 b.owner);
           },
           "(n, 3) float64, m/s. A read-only view that changes as the world steps.")
       .def_property_readonly(
           "rest_positions",
           [](const B& b) {
-            const auto& rest = b.body->model().mesh().restPositions();
+            const InputNumbering& numbering = b.body->inputNumbering();
+            const auto& rest =
+                (numbering.identity() ? b.body->model().mesh() : *numbering.inputMesh())
+                    .restPositions();
             return readOnlyView(rest.front().data(), static_cast<py::ssize_t>(rest.size()), 3,
                                 b.owner);
           },
@@ -110,27 +114,33 @@ void bindParts(py::module_& m) {
           "masses",
           [](const B& b) {
             const auto& masses = b.body->model().nodeMasses();
-            return copyArray(masses.data(), static_cast<py::ssize_t>(masses.size()), 1)
-                .attr("reshape")(-1);
+            const Eigen::VectorXd input = b.body->inputNumbering().nodesToInput(
+                Eigen::Map<const Eigen::VectorXd>(masses.data(),
+                                                  static_cast<Eigen::Index>(masses.size())),
+                1);
+            return copyArray(input.data(), input.size(), 1).attr("reshape")(-1);
           },
           "(n,) float64, kg: lumped node masses (a copy).")
       .def_property_readonly(
-          "tets",
-          [](const B& b) {
-            const FemModel& model = b.body->model();
-            return readOnlyView(model.elementNodes().data(), model.elementCount(),
-                                model.nodesPerElement(), b.owner);
-          },
+          "tets", [](const B& b) { return inputElementArray(*b.body); },
           "(m, 4) or (m, 10) int32: the elements' nodes (tet10: 4 corners then 6 mid-edge "
-          "nodes). A read-only view.")
+          "nodes). Read-only.")
       .def_property_readonly(
           "surface_triangles",
           [](const B& b) {
-            const auto& tris = b.body->model().mesh().surfaceTriangles();
+            const InputNumbering& numbering = b.body->inputNumbering();
+            const auto& tris =
+                (numbering.identity() ? b.body->model().mesh() : *numbering.inputMesh())
+                    .surfaceTriangles();
             return readOnlyView(tris.front().data(), static_cast<py::ssize_t>(tris.size()), 3,
                                 b.owner);
           },
           "(k, 3) int32, counter-clockwise seen from outside. A read-only view.")
+      .def_property_readonly(
+          "renumbered", [](const B& b) { return !b.body->inputNumbering().identity(); },
+          "Whether the body numbers its nodes inside otherwise than its mesh, for speed "
+          "(add_body's node_order): every array and node list here is in the mesh's numbers "
+          "either way.")
       .def_property_readonly("material", [](const B& b) { return b.body->model().material(); })
       .def(
           "set_material",
@@ -146,13 +156,16 @@ void bindParts(py::module_& m) {
       .def_property_readonly(
           "external_forces",
           [](const B& b) {
-            return copyArray(b.body->externalForces().data(), b.body->model().nodeCount(), 3);
+            const Eigen::VectorXd f =
+                b.body->inputNumbering().nodesToInput(b.body->externalForces());
+            return copyArray(f.data(), b.body->model().nodeCount(), 3);
           },
           "(n, 3) float64, N: forces besides gravity (a copy).")
       .def(
           "set_external_forces",
           [](const B& b, py::object forces) {
-            Eigen::VectorXd f = toNodeVectors(forces, b.body->model().nodeCount(), "forces");
+            const Eigen::VectorXd f = b.body->inputNumbering().nodesToBody(
+                toNodeVectors(forces, b.body->model().nodeCount(), "forces"));
             WorldGuard guard(*b.world, WorldGuard::kWrite);
             if (Status s = b.body->setExternalForces(f); !s)
               throw py::value_error(s.error().message);
@@ -174,7 +187,11 @@ void bindParts(py::module_& m) {
             if (rigid.world != b.world)
               throw py::value_error("rigid_body: '" + rigid.name + "' is another world's");
             WorldGuard guard(*b.world, WorldGuard::kWrite);
-            Result<int> anchor = b.body->anchorNodes(std::move(a.values), &rigid.live());
+            if (a.values.empty())
+              throw py::value_error("body '" + b.body->name() + "': anchor: no nodes");
+            std::vector<int> body_nodes = bodyNodes(
+                *b.body, std::move(a.values), "body '" + b.body->name() + "': anchor: ", true);
+            Result<int> anchor = b.body->anchorNodes(std::move(body_nodes), &rigid.live());
             if (!anchor) throw py::value_error(anchor.error().message);
             return anchor.value();
           },
@@ -226,7 +243,8 @@ void bindParts(py::module_& m) {
           "von_mises_stress",
           [](const B& b) {
             WorldGuard guard(*b.world);
-            std::vector<double> s = render::tetVonMises(*b.body);
+            std::vector<double> s =
+                b.body->inputNumbering().tetsToInput(render::tetVonMises(*b.body));
             return vectorArray(s.data(), static_cast<py::ssize_t>(s.size()));
           },
           "Per tet of the simulation mesh (tet10: 8 sub-tets per element), Pa: von Mises stress "
@@ -242,6 +260,7 @@ void bindParts(py::module_& m) {
               const Eigen::Matrix3d dev = e - e.trace() / 3 * Eigen::Matrix3d::Identity();
               out.push_back(std::sqrt(2.0 / 3.0 * dev.squaredNorm()));
             }
+            out = b.body->inputNumbering().tetsToInput(out);
             return vectorArray(out.data(), static_cast<py::ssize_t>(out.size()));
           },
           "Per tet, dimensionless: equivalent strain sqrt(2/3 dev(eps):dev(eps)).")
@@ -270,9 +289,8 @@ void bindParts(py::module_& m) {
       .def_property_readonly(
           "nodes",
           [](const N& s) {
-            const auto& nodes = s.set().body->groups()[static_cast<size_t>(s.set().group)]->nodes();
-            return copyArray(nodes.data(), static_cast<py::ssize_t>(nodes.size()), 1)
-                .attr("reshape")(-1);
+            const FemBody& body = *s.set().body;
+            return inputNodeArray(body, body.groups()[static_cast<size_t>(s.set().group)]->nodes());
           },
           "(k,) int32, ascending (a copy)")
       .def_property_readonly(
@@ -367,13 +385,9 @@ void bindParts(py::module_& m) {
           },
           "(6,) [fx, fy, fz, tx, ty, tz]: N and N m the body exerted on the grabbed patch in the "
           "last step, torque about the patch frame's origin; zeros when not grabbing.")
-      .def_property_readonly("grabbed_nodes",
-                             [](const H& h) {
-                               const auto& nodes = h.hand->grabbedNodes();
-                               return copyArray(nodes.data(),
-                                                static_cast<py::ssize_t>(nodes.size()), 1)
-                                   .attr("reshape")(-1);
-                             })
+      .def_property_readonly(
+          "grabbed_nodes",
+          [](const H& h) { return inputNodeArray(h.hand->body(), h.hand->grabbedNodes()); })
       .def_property_readonly(
           "speed_limit", [](const H& h) { return h.hand->speedLimit(); },
           "m/s, grabbed nodes' speed bound (inf when off)")

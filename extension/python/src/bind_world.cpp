@@ -7,6 +7,7 @@
 #include <filesystem>
 #include <optional>
 
+#include "body_vtk.h"
 #include "camera.h"
 #include "frame_data.h"
 #include "handles.h"
@@ -14,6 +15,7 @@
 #include "py_contacts.h"
 #include "py_convert.h"
 #include "py_frame.h"
+#include "py_numbering.h"
 #include "scene_builder.h"
 #include "scene_haptics.h"
 #include "torsion/format_number.h"
@@ -76,14 +78,18 @@ TetMesh meshFromArrays(py::handle nodes, py::handle tets) {
   return std::move(built).value().mesh;
 }
 
-std::vector<int> selectedNodes(const TetMesh& mesh, py::object plane, py::object box,
+std::vector<int> selectedNodes(const FemBody& body, py::object plane, py::object box,
                                py::object sphere, py::object indices, double tolerance) {
+  const TetMesh& mesh = body.model().mesh();
   const int given = !plane.is_none() + !box.is_none() + !sphere.is_none() + !indices.is_none();
   if (given != 1)
     throw py::value_error("add_node_set: give exactly one of plane, box, sphere or indices");
   if (!indices.is_none()) {
     IndexArray a = toIndexArray(indices, "indices");
     if (a.shape.size() != 1) throw py::value_error("indices: expected a 1-D int array");
+    for (int& node : a.values) {  // the mesh's numbers; one out of range is refused as given
+      if (node >= 0 && node < mesh.nodeCount()) node = body.inputNumbering().bodyNode(node);
+    }
     return std::move(a.values);
   }
   scene::NodeSelection selection;
@@ -585,7 +591,7 @@ void bindWorld(py::module_& m) {
           "add_body",
           [](py::object owner, const std::string& name, py::object mesh, py::object nodes,
              py::object tets, const Material& material, py::object frame,
-             const std::string& element) {
+             const std::string& element, const std::string& node_order) {
             PyWorld& w = self(owner);
             TetMesh built;
             if (!mesh.is_none()) {
@@ -600,17 +606,26 @@ void bindWorld(py::module_& m) {
               built = meshFromArrays(nodes, tets);
             }
             const Frame pose = frame.is_none() ? Frame{} : toFrame(frame, "add_body frame");
+            if (node_order != "cache_friendly" && node_order != "file") {
+              throw py::value_error("add_body: node_order '" + node_order +
+                                    "' is not a node order (cache_friendly or file)");
+            }
+            const NodeNumbering numbering =
+                node_order == "file" ? NodeNumbering::kAsGiven : NodeNumbering::kCacheFriendly;
             WorldGuard guard(w, WorldGuard::kWrite);
-            Result<FemBody*> body = w.addBody(name, built, material, pose, toElement(element));
+            Result<FemBody*> body =
+                w.addBody(name, built, material, pose, toElement(element), numbering);
             if (!body) throw py::value_error(body.error().message);
             return BodyHandle{owner, &w, body.value()};
           },
           py::arg("name"), py::arg("mesh") = py::none(), py::kw_only(),
           py::arg("nodes") = py::none(), py::arg("tets") = py::none(),
           py::arg("material") = Material{}, py::arg("frame") = py::none(),
-          py::arg("element") = "tet4",
+          py::arg("element") = "tet4", py::arg("node_order") = "cache_friendly",
           "A body from a mesh file (.node/.ele, .msh, .vtk; MeshError names file and line) or "
-          "from nodes (n, 3) m and tets (m, 4), placed at `frame`.")
+          "from nodes (n, 3) m and tets (m, 4), placed at `frame`. Node and tet numbers are "
+          "the mesh's everywhere; node_order 'cache_friendly' renumbers the nodes inside when "
+          "that pays (faster steps), 'file' keeps the mesh's order inside too.")
       .def(
           "add_node_set",
           [](py::object owner, const std::string& name, py::object body, py::object plane,
@@ -618,8 +633,7 @@ void bindWorld(py::module_& m) {
              py::object wrench_about) {
             PyWorld& w = self(owner);
             FemBody& b = findBody(w, body);
-            std::vector<int> nodes =
-                selectedNodes(b.model().mesh(), plane, box, sphere, indices, tolerance);
+            std::vector<int> nodes = selectedNodes(b, plane, box, sphere, indices, tolerance);
             WorldGuard guard(w, WorldGuard::kWrite);
             Result<int> index =
                 w.addNodeSet(name, b, std::move(nodes), toVector3(wrench_about, "wrench_about"));
@@ -747,18 +761,7 @@ void bindWorld(py::module_& m) {
             if (w.world().bodies().empty())
               throw py::value_error("write_vtk: the world has no body");
             FemBody& b = body.is_none() ? *w.world().bodies().front() : findBody(w, body);
-            const TetMesh& mesh = b.model().mesh();
-            std::vector<Eigen::Vector3d> x(static_cast<size_t>(mesh.nodeCount()));
-            MeshField displacement{"displacement", 3, {}};
-            for (int i = 0; i < mesh.nodeCount(); ++i) {
-              x[static_cast<size_t>(i)] = b.state().position(i);
-              const Eigen::Vector3d u =
-                  x[static_cast<size_t>(i)] - mesh.restPositions()[static_cast<size_t>(i)];
-              displacement.values.insert(displacement.values.end(), {u.x(), u.y(), u.z()});
-            }
-            MeshFields fields;
-            fields.node_fields.push_back(std::move(displacement));
-            if (Status s = writeTextFile(path, formatVtk(mesh, x, fields, b.name())); !s)
+            if (Status s = writeTextFile(path, scene::bodyVtkText(b, b.state().positions)); !s)
               throw std::runtime_error(s.error().message);
           },
           py::arg("path"), py::arg("body") = py::none(),

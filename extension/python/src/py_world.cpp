@@ -310,10 +310,10 @@ const btTransform* PyWorld::kinematicTarget(const btRigidBody& body) const {
 }
 
 Result<FemBody*> PyWorld::addBody(const std::string& name, const TetMesh& mesh,
-                                  const Material& material, const Frame& pose,
-                                  ElementKind element) {
+                                  const Material& material, const Frame& pose, ElementKind element,
+                                  NodeNumbering numbering) {
   if (Status s = checkName("body", name, false); !s) return s.error();
-  Result<FemBody*> body = world().addBody(name, mesh, material, pose, element);
+  Result<FemBody*> body = world().addBody(name, mesh, material, pose, element, numbering);
   if (body) {
     parts_added_ = true;
     recordBuiltMaterials();

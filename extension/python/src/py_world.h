@@ -114,7 +114,7 @@ class PyWorld {
   /// bodies, node sets, hands and rigid bodies follow the scene file's rule (scene::nameFault)
   /// and are unique among their kind.
   Result<FemBody*> addBody(const std::string& name, const TetMesh& mesh, const Material& material,
-                           const Frame& pose, ElementKind element);
+                           const Frame& pose, ElementKind element, NodeNumbering numbering);
   /// A node set (a fixed or carried group) over `nodes` of `body`; returns its index.
   Result<int> addNodeSet(const std::string& name, FemBody& body, std::vector<int> nodes,
                          const Eigen::Vector3d& wrench_about);

@@ -97,11 +97,12 @@ class Body:
     node_count: int
     element_count: int
     element: str  # "tet4" | "tet10"
+    renumbered: bool  # numbered inside otherwise than its mesh (add_body's node_order)
     positions: npt.NDArray[np.float64]  # (n, 3) m, view
     velocities: npt.NDArray[np.float64]  # (n, 3) m/s, view
     rest_positions: npt.NDArray[np.float64]  # (n, 3) m, view (constant)
     masses: npt.NDArray[np.float64]  # (n,) kg, copy
-    tets: npt.NDArray[np.int32]  # (m, 4) or (m, 10), view (constant)
+    tets: npt.NDArray[np.int32]  # (m, 4) or (m, 10), read-only (constant)
     surface_triangles: npt.NDArray[np.int32]  # (k, 3), view (constant)
     material: Material
     external_forces: npt.NDArray[np.float64]  # (n, 3) N, copy
@@ -227,7 +228,8 @@ class World:
     def restore_state(self, state: State) -> None: ...
     def add_body(self, name: str, mesh: Optional[str] = None, *, nodes: Optional[ArrayLike] = None,
                  tets: Optional[ArrayLike] = None, material: Material = ...,
-                 frame: Optional[FrameLike] = None, element: str = "tet4") -> Body: ...
+                 frame: Optional[FrameLike] = None, element: str = "tet4",
+                 node_order: str = "cache_friendly") -> Body: ...
     def add_node_set(self, name: str, body: Union[Body, str], *,
                      plane: Optional[tuple[ArrayLike, ArrayLike]] = None,
                      box: Optional[tuple[ArrayLike, ArrayLike]] = None,

@@ -8,7 +8,8 @@ namespace torsion {
 
 FemBody::FemBody(std::string name, std::shared_ptr<const FemModel> model,
                  const SolverSettings& settings, const Parallel& parallel,
-                 btSoftBodyWorldInfo& world_info, const btCollisionObjectArray& world_objects)
+                 btSoftBodyWorldInfo& world_info, const btCollisionObjectArray& world_objects,
+                 InputNumbering input_numbering)
     : name_(std::move(name)),
       model_(std::move(model)),
       state_(FemState::atRest(*model_)),
@@ -16,7 +17,8 @@ FemBody::FemBody(std::string name, std::shared_ptr<const FemModel> model,
       stepper_(model_, settings, parallel),
       constraints_(model_->nodeCount()),
       external_forces_(Eigen::VectorXd::Zero(3 * model_->nodeCount())),
-      world_objects_(world_objects) {
+      world_objects_(world_objects),
+      input_numbering_(std::move(input_numbering)) {
   const int n = model_->nodeCount();
   std::vector<btVector3> x(static_cast<size_t>(n));
   std::vector<btScalar> m(static_cast<size_t>(n));
@@ -39,6 +41,7 @@ FemBody::FemBody(std::string name, std::shared_ptr<const FemModel> model,
   soft_body_->updateBounds();
   soft_body_->updateNormals();
   contacts_ = std::make_unique<RigidContactSolver>(model_, soft_body_.get());
+  writeBack();  // the input-numbered copy of the state
 }
 
 FemBody::~FemBody() = default;
@@ -350,6 +353,14 @@ void FemBody::writeBack() {
   for (int i = 0; i < model_->nodeCount(); ++i) {
     sb.m_nodes[i].m_x = toBt(state_.position(i));
     sb.m_nodes[i].m_v = toBt(state_.velocity(i));
+  }
+  if (input_numbering_.identity()) return;
+  input_positions_.resize(state_.positions.size());  // no reallocation: the addresses stay
+  input_velocities_.resize(state_.velocities.size());
+  for (int i = 0; i < model_->nodeCount(); ++i) {
+    const int to = 3 * input_numbering_.inputNode(i);
+    input_positions_.segment<3>(to) = state_.positions.segment<3>(3 * i);
+    input_velocities_.segment<3>(to) = state_.velocities.segment<3>(3 * i);
   }
 }
 

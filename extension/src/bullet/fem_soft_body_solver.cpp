@@ -11,6 +11,8 @@
 #include "soft_body_touch.h"
 #include "torsion/bt_conversions.h"
 #include "torsion/bullet/rigid_health.h"
+#include "torsion/mesh/node_ordering.h"
+#include "torsion/mesh/quadratic_tet_mesh.h"
 
 namespace torsion {
 
@@ -32,6 +34,30 @@ bool nodesTouch(btSoftBody& a, btSoftBody& b) {
   if (a.m_ndbvt.m_root == nullptr || b.m_ndbvt.m_root == nullptr) return false;
   a.m_ndbvt.collideTT(a.m_ndbvt.m_root, b.m_ndbvt.m_root, probe);
   return probe.hit;
+}
+
+// How the body made of `renumbered` (from `input`) numbers its nodes and tets against `input`. A
+// tet10 body's mid-edge nodes and sub-tets (FemModel::mesh()) get the numbers the same body made
+// of `input` would give them: the element's node and sub-tet k of body element e are those of
+// input element old_tet[e] (renumbering keeps each tet's own node order).
+InputNumbering inputNumberingOf(const FemModel& body, const TetMesh& input,
+                                const RenumberedMesh& renumbered) {
+  if (body.elementKind() == ElementKind::kTet4)
+    return InputNumbering(renumbered.old_node, renumbered.old_tet, body.mesh());
+  const QuadraticTetMesh input_p2 = buildQuadraticTetMesh(input);
+  std::vector<int> input_node(static_cast<size_t>(body.nodeCount()), -1);
+  std::vector<int> input_tet(static_cast<size_t>(body.mesh().tetCount()), -1);
+  const std::vector<int>& elements = body.elementNodes();
+  for (int e = 0; e < body.elementCount(); ++e) {
+    const int old = renumbered.old_tet[static_cast<size_t>(e)];
+    const Tet10& in = input_p2.elements[static_cast<size_t>(old)];
+    for (int a = 0; a < 10; ++a)
+      input_node[static_cast<size_t>(elements[static_cast<size_t>(10 * e + a)])] =
+          in[static_cast<size_t>(a)];
+    for (int k = 0; k < 8; ++k)
+      input_tet[static_cast<size_t>(8 * e + k)] = 8 * old + k;
+  }
+  return InputNumbering(std::move(input_node), std::move(input_tet), body.mesh());
 }
 
 // A body's pose (constraints/frame.h), its faults named with the body.
@@ -110,7 +136,7 @@ Status FemSoftBodySolver::bindWorld(btDiscreteDynamicsWorld* world, btSoftBodyWo
 
 Result<FemBody*> FemSoftBodySolver::addBody(const std::string& name, const TetMesh& mesh,
                                             const Material& material, const Frame& pose,
-                                            ElementKind element) {
+                                            ElementKind element, NodeNumbering numbering) {
   if (!bound()) {
     return Error{"body '" + name +
                  "': the solver is not attached to a world yet (torsion::attach(world) first)"};
@@ -122,14 +148,20 @@ Result<FemBody*> FemSoftBodySolver::addBody(const std::string& name, const TetMe
   }
   Result<Frame> placement = checkedPose(name, pose);
   if (!placement) return placement.error();
-  std::vector<Eigen::Vector3d> placed = mesh.restPositions();
+  std::optional<RenumberedMesh> renumbered;
+  if (numbering == NodeNumbering::kCacheFriendly) renumbered = cacheFriendlyRenumbering(mesh);
+  const TetMesh& body_mesh = renumbered ? renumbered->mesh : mesh;
+  std::vector<Eigen::Vector3d> placed = body_mesh.restPositions();
   for (Eigen::Vector3d& p : placed)
     p = placement.value().toWorld(p);
-  auto placed_mesh = std::make_shared<const TetMesh>(std::move(placed), mesh.tets());
+  auto placed_mesh = std::make_shared<const TetMesh>(std::move(placed), body_mesh.tets());
   Result<std::shared_ptr<const FemModel>> model = FemModel::create(placed_mesh, material, element);
   if (!model) return Error{"body '" + name + "': " + model.error().message};
-  auto body = std::make_unique<FemBody>(name, std::move(model).value(), settings_, parallel_,
-                                        *world_info_, world_->getCollisionObjectArray());
+  InputNumbering input_numbering;
+  if (renumbered) input_numbering = inputNumberingOf(*model.value(), mesh, *renumbered);
+  auto body =
+      std::make_unique<FemBody>(name, std::move(model).value(), settings_, parallel_, *world_info_,
+                                world_->getCollisionObjectArray(), std::move(input_numbering));
   add_to_world_(body->softBody());
   bodies_.push_back(std::move(body));
   return bodies_.back().get();

@@ -42,9 +42,9 @@ FemWorld::~FemWorld() {
 }
 
 Result<FemBody*> FemWorld::addBody(const std::string& name, const TetMesh& mesh,
-                                   const Material& material, const Frame& pose,
-                                   ElementKind element) {
-  return soft_solver_->addBody(name, mesh, material, pose, element);
+                                   const Material& material, const Frame& pose, ElementKind element,
+                                   NodeNumbering numbering) {
+  return soft_solver_->addBody(name, mesh, material, pose, element, numbering);
 }
 
 btRigidBody* FemWorld::addRigidBody(std::unique_ptr<btCollisionShape> shape, double mass,

@@ -101,7 +101,7 @@ std::vector<int> reverseCuthillMcKeeOrder(const TetMesh& mesh) {
   return order;
 }
 
-TetMesh renumberNodes(const TetMesh& mesh, const std::vector<int>& order) {
+RenumberedMesh renumberedMesh(const TetMesh& mesh, const std::vector<int>& order) {
   const size_t n = static_cast<size_t>(mesh.nodeCount());
   assert(order.size() == n && "order must be a permutation of the nodes");
   std::vector<int> new_index(n, -1);
@@ -111,21 +111,41 @@ TetMesh renumberNodes(const TetMesh& mesh, const std::vector<int>& order) {
     new_index[old] = static_cast<int>(i);
     positions[i] = mesh.restPositions()[old];
   }
-  std::vector<Tet> tets;
-  tets.reserve(mesh.tets().size());
+  std::vector<Tet> renumbered;
+  renumbered.reserve(mesh.tets().size());
   for (const Tet& tet : mesh.tets()) {
-    Tet renumbered;
+    Tet t;
     for (size_t a = 0; a < 4; ++a)
-      renumbered[a] = new_index[static_cast<size_t>(tet[a])];
-    tets.push_back(renumbered);
+      t[a] = new_index[static_cast<size_t>(tet[a])];
+    renumbered.push_back(t);
   }
-  auto key = [](const Tet& t) {
-    return std::make_pair(*std::min_element(t.begin(), t.end()),
-                          *std::max_element(t.begin(), t.end()));
+  auto key = [&](int t) {
+    const Tet& tet = renumbered[static_cast<size_t>(t)];
+    return std::make_pair(*std::min_element(tet.begin(), tet.end()),
+                          *std::max_element(tet.begin(), tet.end()));
   };
-  std::stable_sort(tets.begin(), tets.end(),
-                   [&](const Tet& a, const Tet& b) { return key(a) < key(b); });
-  return TetMesh(std::move(positions), std::move(tets));
+  RenumberedMesh result;
+  result.old_node = order;
+  result.old_tet.resize(renumbered.size());
+  std::iota(result.old_tet.begin(), result.old_tet.end(), 0);
+  std::stable_sort(result.old_tet.begin(), result.old_tet.end(),
+                   [&](int a, int b) { return key(a) < key(b); });
+  std::vector<Tet> tets;
+  tets.reserve(renumbered.size());
+  for (int old : result.old_tet)
+    tets.push_back(renumbered[static_cast<size_t>(old)]);
+  result.mesh = TetMesh(std::move(positions), std::move(tets));
+  return result;
+}
+
+TetMesh renumberNodes(const TetMesh& mesh, const std::vector<int>& order) {
+  return renumberedMesh(mesh, order).mesh;
+}
+
+std::optional<RenumberedMesh> cacheFriendlyRenumbering(const TetMesh& mesh) {
+  RenumberedMesh renumbered = renumberedMesh(mesh, reverseCuthillMcKeeOrder(mesh));
+  if (2 * meanTetIndexSpan(renumbered.mesh) > meanTetIndexSpan(mesh)) return std::nullopt;
+  return renumbered;
 }
 
 TetMesh inCacheFriendlyOrder(const TetMesh& mesh) {

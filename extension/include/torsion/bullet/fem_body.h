@@ -15,6 +15,7 @@
 #include "torsion/contact/rigid_contact.h"
 #include "torsion/contact/self_contact.h"
 #include "torsion/fem/fem_model.h"
+#include "torsion/mesh/input_numbering.h"
 #include "torsion/result.h"
 #include "torsion/solve/implicit_stepper.h"
 
@@ -39,9 +40,10 @@ class FemBody {
  public:
   /// `world_objects`: the collision objects of the world the body is in (checkpoints name rigid
   /// objects by their index there).
+  /// `input_numbering`: how the body's numbers map to those of the mesh it was made of.
   FemBody(std::string name, std::shared_ptr<const FemModel> model, const SolverSettings& settings,
           const Parallel& parallel, btSoftBodyWorldInfo& world_info,
-          const btCollisionObjectArray& world_objects);
+          const btCollisionObjectArray& world_objects, InputNumbering input_numbering = {});
   ~FemBody();
   FemBody(const FemBody&) = delete;
   FemBody& operator=(const FemBody&) = delete;
@@ -52,6 +54,18 @@ class FemBody {
   std::shared_ptr<const FemModel> modelPointer() const { return model_; }
   const FemState& state() const { return state_; }
   btSoftBody* softBody() { return soft_body_.get(); }
+  /// How the body's node and tet numbers (those of model(), state(), softBody() and every
+  /// function here) map to the mesh given to FemWorld::addBody (identity unless it renumbered).
+  const InputNumbering& inputNumbering() const { return input_numbering_; }
+  /// state()'s positions and velocities (3n) in the input's numbering: state()'s own when the
+  /// numbering is the identity, else a copy kept current as Bullet's nodes are (after every step
+  /// that did not fail, a velocity set, a restore), at the same addresses.
+  const Eigen::VectorXd& inputPositions() const {
+    return input_numbering_.identity() ? state_.positions : input_positions_;
+  }
+  const Eigen::VectorXd& inputVelocities() const {
+    return input_numbering_.identity() ? state_.velocities : input_velocities_;
+  }
 
   /// Adds a group of nodes carried rigidly by `motion` (a constant frame fixes them). Returns its
   /// index. p_hat is captured from the nodes' current positions and motion(now).
@@ -187,6 +201,8 @@ class FemBody {
   std::vector<std::unique_ptr<CarriedNodes>> groups_;
   std::unique_ptr<btSoftBody> soft_body_;
   const btCollisionObjectArray& world_objects_;
+  InputNumbering input_numbering_;
+  Eigen::VectorXd input_positions_, input_velocities_;  // inputPositions(), unless identity
   std::unique_ptr<RigidContactSolver> contacts_;
   std::unique_ptr<SelfContactSolver> self_contact_;
   bool rigid_contact_ = false;  // this step found nodes near rigid bodies (prepare)

@@ -122,8 +122,13 @@ class FemSoftBodySolver : public btSoftBodySolver {
   /// `element`, to the bound world. Errors: not bound, an empty mesh (no tets), a pose not finite
   /// or whose quaternion is off unit length by more than 1e-6 (closer, it is normalised), bad
   /// material, a duplicate name.
+  ///
+  /// `numbering` kCacheFriendly renumbers the mesh when that pays (mesh/input_numbering.h): the
+  /// body's node and tet numbers then differ from the mesh's, and FemBody::inputNumbering()
+  /// maps them (scene files and Python do so by default, and translate what they show).
   Result<FemBody*> addBody(const std::string& name, const TetMesh& mesh, const Material& material,
-                           const Frame& pose = {}, ElementKind element = ElementKind::kTet4);
+                           const Frame& pose = {}, ElementKind element = ElementKind::kTet4,
+                           NodeNumbering numbering = NodeNumbering::kAsGiven);
   /// Removes the body from the world and destroys it (pointers to it and its hands are stale).
   void removeBody(FemBody* body);
   FemBody* body(const std::string& name) const;

@@ -64,8 +64,13 @@ class FemWorld {
   /// Adds an FEM body whose rest shape is `mesh` (linear tets) placed at `pose`, discretised with
   /// `element` (tet10: a mid-edge node on every edge, see mesh/quadratic_tet_mesh.h). Errors: bad
   /// material, a duplicate name.
+  ///
+  /// `numbering` kCacheFriendly renumbers the mesh when that pays (mesh/input_numbering.h): the
+  /// body's node and tet numbers then differ from the mesh's, and FemBody::inputNumbering()
+  /// maps them (scene files and Python do so by default, and translate what they show).
   Result<FemBody*> addBody(const std::string& name, const TetMesh& mesh, const Material& material,
-                           const Frame& pose = {}, ElementKind element = ElementKind::kTet4);
+                           const Frame& pose = {}, ElementKind element = ElementKind::kTet4,
+                           NodeNumbering numbering = NodeNumbering::kAsGiven);
   /// Adds a rigid body (mass 0: static). The world owns the shape and the body.
   btRigidBody* addRigidBody(std::unique_ptr<btCollisionShape> shape, double mass,
                             const btTransform& transform);

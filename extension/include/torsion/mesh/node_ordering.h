@@ -8,9 +8,12 @@
 // average (of 6971), and the step costs 25-30 % more CPU time than in this order
 // (docs/performance.md, "Node order").
 //
-// The renumbering changes node ids, so it is applied where a mesh is made (`torsion mesh
-// cylinder`, `torsion mesh tetrahedralize`), not to a mesh a user loads.
+// It is applied where a mesh is made (`torsion mesh cylinder`, `torsion mesh tetrahedralize`),
+// and to a body made from a mesh in another order when it pays (FemWorld::addBody with
+// NodeNumbering::kCacheFriendly, the default of scene files and Python): the body then keeps how
+// its numbers map to the mesh's (input_numbering.h).
 
+#include <optional>
 #include <vector>
 
 #include "torsion/mesh/tet_mesh.h"
@@ -27,6 +30,20 @@ std::vector<int> reverseCuthillMcKeeOrder(const TetMesh& mesh);
 /// node indices) and the tets sorted by their smallest new node index, then their largest (each
 /// tet's own node order, hence its orientation, kept).
 TetMesh renumberNodes(const TetMesh& mesh, const std::vector<int>& order);
+
+/// A renumbered mesh and, per new node and per new tet, its number in the mesh it came from.
+struct RenumberedMesh {
+  TetMesh mesh;
+  std::vector<int> old_node;
+  std::vector<int> old_tet;
+};
+/// renumberNodes(), with the old numbers.
+RenumberedMesh renumberedMesh(const TetMesh& mesh, const std::vector<int>& order);
+
+/// The mesh in reverse Cuthill-McKee order with the old numbers, when that brings the nodes of
+/// its tets at least twice as close on average (meanTetIndexSpan halves); else nothing (a mesh
+/// already in a local order, as every mesh Torsion writes, is left as it is).
+std::optional<RenumberedMesh> cacheFriendlyRenumbering(const TetMesh& mesh);
 
 /// The mesh in reverse Cuthill-McKee order (renumberNodes(mesh, reverseCuthillMcKeeOrder(mesh))).
 TetMesh inCacheFriendlyOrder(const TetMesh& mesh);
