@@ -18,7 +18,7 @@
 namespace torsion {
 
 /// How a body numbers the nodes of the mesh it is made of: as the mesh does, or renumbered for
-/// cache locality when that pays (cacheFriendlyRenumbering, node_ordering.h: 10-30 % of the step
+/// cache locality when that pays (cacheFriendlyRenumbering, node_ordering.h: 5-30 % of the step
 /// on a mesh in a mesher's insertion order, docs/performance.md, "Node order").
 enum class NodeNumbering { kAsGiven, kCacheFriendly };
 
