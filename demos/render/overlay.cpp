@@ -98,7 +98,9 @@ void Renderer::drawOverlay(const FrameData& frame, int width, int height,
     drawHud(frame, ts);
     drawNotes(frame, height, ts);
     if (!frame.plots.empty()) {
-      const double plot_width = 120 * ts;
+      // Wide enough for its titles ("<name> T, NM +-1.23e-04": 8 characters for the magnitude).
+      const double plot_width =
+          std::max(120 * ts, textWidth(frame.plots.front().name + " T, NM +-0.00e+00", ts));
       const double plot_height = 2 * (HudLayout::kLine + 26 + 4) * ts;
       drawWrenchPlot(frame.plots.front(), width - HudLayout::kMargin * ts - plot_width,
                      height - HudLayout::kMargin * ts - plot_height, plot_width, ts);
