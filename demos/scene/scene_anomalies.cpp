@@ -8,7 +8,7 @@ namespace torsion::scene {
 namespace {
 
 std::string describe(AnomalyKind kind, const Anomaly& a, const StepObservation& o) {
-  char text[200];
+  char text[320];
   switch (kind) {
     case AnomalyKind::kInvertedElements:
       std::snprintf(text, sizeof text, "%d inverted tets (det F <= 0)", o.inverted_elements);
@@ -17,7 +17,8 @@ std::string describe(AnomalyKind kind, const Anomaly& a, const StepObservation& 
       std::snprintf(
           text, sizeof text,
           "kinetic energy (%.4g J) rose by %.0f%% of the elastic energy held while that fell: "
-          "stored energy released (a kink passing through itself?)",
+          "stored energy released (the body snapped: a twist buckling into a kink, or a "
+          "contact slipping after it stuck)",
           o.kinetic_energy, 100 * a.peak);
       break;
     case AnomalyKind::kSpeedBurst:
