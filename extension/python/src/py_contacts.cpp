@@ -41,7 +41,7 @@ void addFemRigidContacts(PyWorld& world, const FemBody& body, ContactList& list)
                : std::string();
   };
   // Every contact that gave an impulse: one that let go this step may still carry friction (its
-  // bound lags by a step, docs/contact-solve.md, "Limits").
+  // bound lags by a step, docs/contact-sap.md, "Limits").
   for (const NodeContact& c : solver.contacts()) {
     if (c.anchored || c.impulse.isZero(0)) continue;
     add(list, body.name(), partner(c.partner), body.state().position(c.node), c.normal, c.impulse);
