@@ -13,6 +13,8 @@ peer=${4:-}
 plugin=${5:-}
 faulty_plugin=${6:-}
 scenes=$(cd "$(dirname "$0")/../../demos/scenes" && pwd)
+# Writes a mesh's copy with its nodes scattered as a mesher's insertion order leaves them.
+scatter_mesh=$(cd "$(dirname "$0")/../bench" && pwd)/scatter_mesh.sh
 
 work_name=torsion-cli-test
 source "$(dirname "$0")/case_helpers.sh"
@@ -200,11 +202,7 @@ case $case_name in
         fail "$field changed by --reorder"
     done
     # Scatter the nodes (node i -> i * 263 mod 661) and reorder: the span must shrink 4-fold.
-    { head -n 1 cylinder_2430.node
-      awk 'NR > 1 && NF >= 4 && $1 ~ /^[0-9]+$/ { $1 = ($1 * 263) % 661; print }' \
-        cylinder_2430.node | sort -n -k1,1; } >s.node
-    awk 'NR == 1 { print; next } NF >= 5 && $1 ~ /^[0-9]+$/ {
-           for (i = 2; i <= 5; ++i) $i = ($i * 263) % 661 } { print }' cylinder_2430.ele >s.ele
+    "$scatter_mesh" cylinder_2430.node s.node 263
     run "$torsion" mesh convert --reorder s.node t.node
     expect_rc 0
     read -r before after < <(sed -nE 's/^node order .* per tet ([0-9.]+) -> ([0-9.]+)$/\1 \2/p' <<<"$out")
@@ -420,11 +418,7 @@ EOF
     # A mesh in a mesher's scattered order is renumbered inside (node_order "cache_friendly", the
     # default) and is the same body: its outputs keep the file's numbers, its motion agrees with
     # node_order "file" to rounding, and the series' first frame is the same file.
-    { head -n 1 "$assets/cylinder_2430.node"
-      awk 'NR > 1 && NF >= 4 && $1 ~ /^[0-9]+$/ { $1 = ($1 * 263) % 661; print }' \
-        "$assets/cylinder_2430.node" | sort -n -k1,1; } >s.node
-    awk 'NR == 1 { print; next } NF >= 5 && $1 ~ /^[0-9]+$/ {
-           for (i = 2; i <= 5; ++i) $i = ($i * 263) % 661 } { print }' "$assets/cylinder_2430.ele" >s.ele
+    "$scatter_mesh" "$assets/cylinder_2430.node" s.node 263
     for order in cache_friendly file; do
       sed -e "s|../../assets/meshes/cylinder_2430.node|s.node|" \
           -e "s|\"name\": \"cylinder\", \"mesh\"|\"name\": \"cylinder\", \"node_order\": \"$order\", \"mesh\"|" \
