@@ -9,7 +9,7 @@ namespace torsion::scene {
 
 std::string bodyVtkText(const FemBody& body, const Eigen::VectorXd& positions) {
   const InputNumbering& numbering = body.inputNumbering();
-  const TetMesh& mesh = numbering.identity() ? body.model().mesh() : *numbering.inputMesh();
+  const TetMesh& mesh = body.inputMesh();
   const Eigen::VectorXd input_positions = numbering.nodesToInput(positions);
   std::vector<Eigen::Vector3d> x(static_cast<size_t>(mesh.nodeCount()));
   MeshField displacement{"displacement", 3, {}};

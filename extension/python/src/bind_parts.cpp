@@ -102,10 +102,7 @@ void bindParts(py::module_& m) {
       .def_property_readonly(
           "rest_positions",
           [](const B& b) {
-            const InputNumbering& numbering = b.body->inputNumbering();
-            const auto& rest =
-                (numbering.identity() ? b.body->model().mesh() : *numbering.inputMesh())
-                    .restPositions();
+            const auto& rest = b.body->inputMesh().restPositions();
             return readOnlyView(rest.front().data(), static_cast<py::ssize_t>(rest.size()), 3,
                                 b.owner);
           },
@@ -128,10 +125,7 @@ void bindParts(py::module_& m) {
       .def_property_readonly(
           "surface_triangles",
           [](const B& b) {
-            const InputNumbering& numbering = b.body->inputNumbering();
-            const auto& tris =
-                (numbering.identity() ? b.body->model().mesh() : *numbering.inputMesh())
-                    .surfaceTriangles();
+            const auto& tris = b.body->inputMesh().surfaceTriangles();
             return readOnlyView(tris.front().data(), static_cast<py::ssize_t>(tris.size()), 3,
                                 b.owner);
           },
@@ -187,8 +181,6 @@ void bindParts(py::module_& m) {
             if (rigid.world != b.world)
               throw py::value_error("rigid_body: '" + rigid.name + "' is another world's");
             WorldGuard guard(*b.world, WorldGuard::kWrite);
-            if (a.values.empty())
-              throw py::value_error("body '" + b.body->name() + "': anchor: no nodes");
             std::vector<int> body_nodes = bodyNodes(
                 *b.body, std::move(a.values), "body '" + b.body->name() + "': anchor: ", true);
             Result<int> anchor = b.body->anchorNodes(std::move(body_nodes), &rigid.live());

@@ -57,6 +57,10 @@ class FemBody {
   /// How the body's node and tet numbers (those of model(), state(), softBody() and every
   /// function here) map to the mesh given to FemWorld::addBody (identity unless it renumbered).
   const InputNumbering& inputNumbering() const { return input_numbering_; }
+  /// model().mesh() in the input's numbering (itself when the numbering is the identity).
+  const TetMesh& inputMesh() const {
+    return input_numbering_.identity() ? model_->mesh() : *input_numbering_.inputMesh();
+  }
   /// state()'s positions and velocities (3n) in the input's numbering: state()'s own when the
   /// numbering is the identity, else a copy kept current as Bullet's nodes are (after every step
   /// that did not fail, a velocity set, a restore), at the same addresses.
