@@ -165,6 +165,7 @@ void SystemOperator::buildPattern() {
       }
     }
   }
+  buildSlotTerms();
   // Blocks left of the diagonal of row c: the stored blocks (row r < c, column c), by row.
   lower_offsets_.assign(static_cast<size_t>(n) + 1, 0);
   for (int row = 0; row < n; ++row) {
@@ -188,6 +189,26 @@ void SystemOperator::buildPattern() {
   }
   block_values_.assign(block_columns_.size(), Eigen::Matrix3d::Zero());
   assembled_ = false;
+}
+
+void SystemOperator::buildSlotTerms() {
+  // Each slot's couplings N (N e + a) + b, from its row's entries in order: ascending elements.
+  const int N = nodes_per_element_;
+  slot_term_offsets_.assign(block_columns_.size() + 1, 0);
+  for (int slot : entry_slots_)
+    if (slot >= 0) ++slot_term_offsets_[static_cast<size_t>(slot) + 1];
+  for (size_t s = 0; s + 1 < slot_term_offsets_.size(); ++s)
+    slot_term_offsets_[s + 1] += slot_term_offsets_[s];
+  slot_terms_.assign(static_cast<size_t>(slot_term_offsets_.back()), -1);
+  std::vector<int> fill(slot_term_offsets_.begin(), slot_term_offsets_.end() - 1);
+  for (size_t k = 0; k < node_entries_.size(); ++k) {
+    for (int b = 0; b < N; ++b) {
+      const int slot = entry_slots_[static_cast<size_t>(N) * k + static_cast<size_t>(b)];
+      if (slot >= 0)
+        slot_terms_[static_cast<size_t>(fill[static_cast<size_t>(slot)]++)] =
+            N * node_entries_[k] + b;
+    }
+  }
 }
 
 void SystemOperator::setElementStiffnesses(const ElementStiffnesses* stiffnesses) {
@@ -220,21 +241,18 @@ template <typename Stiffness>
 void SystemOperator::assembleElementStiffnesses(const std::vector<Stiffness>& stiffness) const {
   constexpr int N = Stiffness::RowsAtCompileTime / 3;  // nodes per element
   assert(N == nodes_per_element_ && "element stiffnesses of the model's element kind");
-  // Row n holds the blocks (n, b >= n) of every element of n: written by row n alone.
+  // Each block sums its own terms (elements ascending) in registers and is written once.
   parallel_.forRange(model_->nodeCount(), kNodeGrain, [&](int begin, int end) {
-    for (size_t row = static_cast<size_t>(begin); row < static_cast<size_t>(end); ++row) {
-      for (int s = row_offsets_[row]; s < row_offsets_[row + 1]; ++s)
-        block_values_[static_cast<size_t>(s)].setZero();
-      for (int k = node_offsets_[row]; k < node_offsets_[row + 1]; ++k) {
-        const int entry = node_entries_[static_cast<size_t>(k)];
-        const Stiffness& K = stiffness[static_cast<size_t>(entry / N)];
-        const int a = entry % N;
-        for (int b = 0; b < N; ++b) {
-          const int slot = entry_slots_[N * static_cast<size_t>(k) + static_cast<size_t>(b)];
-          if (slot >= 0)
-            block_values_[static_cast<size_t>(slot)] += K.template block<3, 3>(3 * a, 3 * b);
-        }
+    for (int s = row_offsets_[static_cast<size_t>(begin)];
+         s < row_offsets_[static_cast<size_t>(end)]; ++s) {
+      Eigen::Matrix3d sum = Eigen::Matrix3d::Zero();
+      for (int t = slot_term_offsets_[static_cast<size_t>(s)];
+           t < slot_term_offsets_[static_cast<size_t>(s) + 1]; ++t) {
+        const int term = slot_terms_[static_cast<size_t>(t)];
+        const int a = (term / N) % N, b = term % N;
+        sum += stiffness[static_cast<size_t>(term / (N * N))].template block<3, 3>(3 * a, 3 * b);
       }
+      block_values_[static_cast<size_t>(s)] = sum;
     }
   });
 }
@@ -274,6 +292,8 @@ void SystemOperator::assemble() const {
   // R Ke_ab R^T); tet10 the same integrated over the element (buildTet10Terms()).
   system_kernels::AssemblyInput in;
   in.row_offsets = row_offsets_.data();
+  in.slot_term_offsets = slot_term_offsets_.data();
+  in.slot_terms = slot_terms_.data();
   in.node_offsets = node_offsets_.data();
   in.node_entries = node_entries_.data();
   in.entry_slots = entry_slots_.data();

@@ -16,12 +16,15 @@ struct BlockTerm {
   double coefficient = 0;
 };
 
-/// What the assembly reads and writes. Block row n owns slots [row_offsets[n], row_offsets[n+1]);
-/// node n's element entries are node_entries[node_offsets[n] ..] (N e + local node), and
-/// entry_slots[N k + b] is the slot of entry k's coupling to local node b (-1: stored by another
-/// row).
+/// What the assembly reads and writes. Block row n owns slots [row_offsets[n], row_offsets[n+1]).
+/// tet4 sums each slot's own terms: slot s takes the couplings slot_terms[slot_term_offsets[s]
+/// ..], each 16 e + 4 a + b (element e's local nodes a, b), in ascending elements. tet10 walks
+/// the row's element entries node_entries[node_offsets[n] ..] (N e + local node), entry k's
+/// coupling to local node b landing in slot entry_slots[N k + b] (-1: stored by another row).
 struct AssemblyInput {
   const int* row_offsets = nullptr;
+  const int* slot_term_offsets = nullptr;
+  const int* slot_terms = nullptr;
   const int* node_offsets = nullptr;
   const int* node_entries = nullptr;
   const int* entry_slots = nullptr;

@@ -179,6 +179,7 @@ class SystemOperator {
   system_kernels::ProductInput productInput(const Eigen::VectorXd& y, Eigen::VectorXd& out,
                                             double mass_scale, double stiffness_scale) const;
   void buildPattern();
+  void buildSlotTerms();
   // tet_scalars_[e] = V_e dpbar_e(y), the volumetric stiffness's tet pressures for y.
   void nodalPressureIncrements(const Eigen::VectorXd& y) const;
   void addNodalPressureDiagonal(std::vector<Eigen::Matrix3d>& blocks) const;
@@ -213,6 +214,10 @@ class SystemOperator {
   std::vector<int> block_columns_;
   std::vector<int> entry_slots_;
   std::vector<int> diagonal_slots_;
+  // Slot s sums the couplings slot_terms_[slot_term_offsets_[s] ..], each N (N e + a) + b
+  // (element e's local nodes a, b), ascending elements: the tet4 kernel and element stiffnesses.
+  std::vector<int> slot_term_offsets_;
+  std::vector<int> slot_terms_;
   // Upper-triangle storage: row n also reads the blocks (row r < n, column n) transposed; they
   // are lower_slots_[l] with r = lower_columns_[l], l in [lower_offsets_[n], lower_offsets_[n+1]).
   std::vector<int> lower_offsets_;
