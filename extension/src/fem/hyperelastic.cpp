@@ -109,16 +109,6 @@ Eigen::Matrix3d filterStretch(const Eigen::Matrix3d& H, EigenvalueFilter filter)
          eigen.eigenvectors().transpose();
 }
 
-// Whether `filter` changes any eigenvalue of t: a positive semi-definite tangent (the usual case
-// away from compression) is its own projection.
-bool filterChanges(const PrincipalTangent& t, EigenvalueFilter filter) {
-  if (filter == EigenvalueFilter::kExact) return false;
-  if ((t.rotation.array() < 0).any() || (t.shear.array() < 0).any()) return true;
-  const Eigen::Matrix3d& H = t.stretch;
-  const double minor2 = H(0, 0) * H(1, 1) - H(0, 1) * H(1, 0);
-  return !(H(0, 0) > 0 && minor2 > 0 && H.determinant() > 0);  // filterStretch's own test
-}
-
 // The 9 eigenmodes' images on the tet's nodes 1-3 (node 0's is minus their sum: g_0 = -sum g_a):
 // row m, columns 3 (a - 1) .. 3 a - 1 hold Q_m g_a; m = i the stretch mode U e_i e_i^T V^T,
 // 3 + k the rotation and 6 + k the shear mode of the pair without k.
@@ -180,18 +170,14 @@ HyperelasticTetResponse hyperelasticResponse(const Law& law,
   if (kind == TetStiffnessKind::kNone) return response;
   const PrincipalTangent t = principalTangent(law, F);
   const ModeGradients Z = modeGradients(t, rest.rest_shape_inverse);
-  if (kind != TetStiffnessKind::kProjected)
-    response.exact_stiffness = modeStiffness(Z, t.stretch, t.rotation, t.shear, rest.volume);
   if (kind != TetStiffnessKind::kExact) {
     const EigenvalueFilter filter = projectionOf(kind);
-    if (kind != TetStiffnessKind::kProjected && !filterChanges(t, filter)) {
-      response.projected_stiffness = response.exact_stiffness;  // the same product, done once
-    } else {
-      response.projected_stiffness =
-          modeStiffness(Z, filterStretch(t.stretch, filter), filtered(t.rotation, filter),
-                        filtered(t.shear, filter), rest.volume);
-    }
+    response.projected_stiffness =
+        modeStiffness(Z, filterStretch(t.stretch, filter), filtered(t.rotation, filter),
+                      filtered(t.shear, filter), rest.volume);
   }
+  if (kind != TetStiffnessKind::kProjected)
+    response.exact_stiffness = modeStiffness(Z, t.stretch, t.rotation, t.shear, rest.volume);
   return response;
 }
 
@@ -249,7 +235,6 @@ HyperelasticTet10Response hyperelasticTet10Response(const Law& law, const Tet10V
   const bool projected = projectedAsked(kind), exact = exactAsked(kind);
   const double weight = rest.volume / kTet10QuadraturePoints;
   Tet10Modes Z, projected_modes, exact_modes;
-  bool filter_changes = !exact;  // only the projected one asked: computed as such
   for (int q = 0; q < kTet10QuadraturePoints; ++q) {
     const std::array<Eigen::Vector3d, 10>& g = rest.gradients[static_cast<size_t>(q)];
     const Eigen::Matrix3d F = quadraticDeformationGradient(x, rest, q);
@@ -260,7 +245,6 @@ HyperelasticTet10Response hyperelasticTet10Response(const Law& law, const Tet10V
     if (kind == TetStiffnessKind::kNone) continue;
     const PrincipalTangent t = principalTangent(law, F);
     tet10PointModes(t, g, q, Z);
-    if (projected) filter_changes = filter_changes || filterChanges(t, projectionOf(kind));
     if (projected) {
       const EigenvalueFilter filter = projectionOf(kind);
       tet10PointWeightedModes(Z, q, weight, filterStretch(t.stretch, filter),
@@ -269,11 +253,8 @@ HyperelasticTet10Response hyperelasticTet10Response(const Law& law, const Tet10V
     }
     if (exact) tet10PointWeightedModes(Z, q, weight, t.stretch, t.rotation, t.shear, exact_modes);
   }
+  if (projected) response.projected_stiffness = tet10ModeStiffness(Z, projected_modes);
   if (exact) response.exact_stiffness = tet10ModeStiffness(Z, exact_modes);
-  if (projected) {
-    response.projected_stiffness =
-        filter_changes ? tet10ModeStiffness(Z, projected_modes) : response.exact_stiffness;
-  }
   return response;
 }
 
