@@ -44,13 +44,16 @@ using nlohmann::json;
 // change of the modulus moves the elastic energy and the torque by ~1e-2 and fails (tested
 // below). Components below 1e-3 of the scene's largest force (torque) are round-off and solver
 // residue (e.g. the base before the twist reaches it) and are compared with that floor.
-// Energies likewise: velocities within a relative residual eps of the exact step leave strains of
-// order eps, so elastic energy of order eps^2 of the motion's energy where the body should hold
-// none (a body in free fall: 2.4e-8 of its kinetic energy in bullet_volumetric_deformable, whose
-// contact island stops at the bodies' 1e-4). Energies are compared with a floor of 1e-6 of the
-// scene's stored kinetic plus elastic energy (100 eps^2), at least 1e-9 J.
+// Energies likewise against the scene's energy: the residual is relative to the whole step's
+// right-hand side, so it moves an energy by a fraction of the motion's energy, not of its own.
+// Where one of the two is small the difference shows: the plectoneme at step 50 twists slowly
+// (kinetic energy 1.4 % of the total), and solving it to 1e-6 moved its kinetic energy by 2 % of
+// itself, 2.8e-4 of the scene's; the AVX2 and the baseline kernels differ by 3.4e-5 of it. So each
+// energy is also allowed 5e-4 of the scene's stored kinetic plus elastic energy (about twice that
+// measured effect; a 1 % stiffer material still moves the main scene's energies by 2-3x more than
+// they are allowed), at least 1e-9 J.
 constexpr double kRelative = 2e-3;
-constexpr double kEnergyResidue = 1e-6;
+constexpr double kSceneEnergyShare = 5e-4;
 constexpr double kForceRelative = 5e-2;
 constexpr double kSceneFloor = 1e-3;
 constexpr double kEnergyFloor = 1e-9;  // J
@@ -205,8 +208,8 @@ void checkNear(double expected, double actual, double floor, const std::string& 
 std::vector<std::string> compare(const json& entry, const Metrics& m) {
   std::vector<std::string> failures;
   const double energy_floor =
-      std::max(kEnergyFloor, kEnergyResidue * (entry["kinetic_energy"].get<double>() +
-                                               entry["elastic_energy"].get<double>()));
+      std::max(kEnergyFloor, kSceneEnergyShare * (entry["kinetic_energy"].get<double>() +
+                                                  entry["elastic_energy"].get<double>()));
   checkNear(entry["kinetic_energy"], m.kinetic, energy_floor, "kinetic energy", failures);
   checkNear(entry["elastic_energy"], m.elastic, energy_floor, "elastic energy", failures);
   checkNear(entry["max_displacement"], m.max_displacement, kLengthFloor, "max displacement",
