@@ -25,9 +25,9 @@
 #   BULLET_RELAXED_TOL  relaxed btConjugateGradient tolerance, identity preconditioner [1e-4]
 #   BULLET_PC_TOL       tolerance of the mass-preconditioned row [1e-5]
 #   BULLET_NEWTON2      1: also Bullet with 2 Newton iterations at BULLET_RELAXED_TOL [1]
-#   OURS_ONE_NEWTON     1: also ours with newton_tolerance 1e-3 (one Newton solve per step, like
+#   OURS_ONE_NEWTON     1: also ours with newton_tolerance 1e-4 and 1e-3 (one Newton solve per step, like
 #                       Bullet's default) [1]
-#   REF_TOL      CG tolerance of our reference run [1e-8]
+#   REF_TOL      CG and Newton tolerance of our reference run [1e-8]
 set -euo pipefail
 
 if [[ $# -ne 1 ]]; then
@@ -84,6 +84,7 @@ if [[ $BULLET_NEWTON2 == 1 ]]; then
   CONFIGS+=("Bullet neo-Hookean newton=2 tol=$BULLET_RELAXED_TOL|bullet_nh_newton2|--solver bullet-implicit --law neo_hookean --tolerance $BULLET_RELAXED_TOL --newton 2")
 fi
 if [[ $OURS_ONE_NEWTON == 1 ]]; then
+  CONFIGS+=("ours neo-Hookean CG 1e-4 newton-tol 1e-4|ours_nh_newton1e-4|--solver torsion-cg --law neo_hookean --tolerance 1e-4 --newton-tolerance 1e-4 --threads 1")
   CONFIGS+=("ours neo-Hookean CG 1e-4 newton-tol 1e-3|ours_nh_newton1e-3|--solver torsion-cg --law neo_hookean --tolerance 1e-4 --newton-tolerance 1e-3 --threads 1")
 fi
 
@@ -94,9 +95,10 @@ brief() {
   python3 -c 'import json,sys; j=json.loads(sys.argv[1]); print(j.get("status"), "%.1f steps/s" % (j.get("steps_per_s") or 0), "newton", j.get("newton_mean"), "cg/step %.1f" % (j.get("iterations_mean") or 0), "torque", j.get("end_torque"))' "$1"
 }
 
-# Accuracy references, once: our law solved tightly (CG REF_TOL, Newton at its default 1e-6).
+# Accuracy references, once: our law solved tightly (CG and Newton at REF_TOL: a Newton direction
+# is solved only as far as the Newton tolerance needs).
 echo "reference: ours neo-Hookean CG $REF_TOL" >&2
-line=$(OMP_NUM_THREADS=1 "$BENCH_TWIST" --solver torsion-cg --law neo_hookean --tolerance "$REF_TOL" --threads 1 "${COMMON[@]}" \
+line=$(OMP_NUM_THREADS=1 "$BENCH_TWIST" --solver torsion-cg --law neo_hookean --tolerance "$REF_TOL" --newton-tolerance "$REF_TOL" --threads 1 "${COMMON[@]}" \
          --label reference --curve "$RESULTS_DIR/curves/reference_ours_nh.csv" \
          --dump-positions "$RESULTS_DIR/curves/reference_ours_nh.pos") || line='{"status":"crashed"}'
 annotate "$line" "reference ours neo-Hookean CG $REF_TOL" reference_ours_nh 0 >>"$REF"

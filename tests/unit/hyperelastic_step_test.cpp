@@ -8,6 +8,7 @@
 
 #include <Eigen/Geometry>
 #include <algorithm>
+#include <cstdio>
 #include <numeric>
 
 #include "torsion/bullet/fem_world.h"
@@ -288,6 +289,40 @@ TEST(HyperelasticStep, ConjugateGradientAndCholmodAgreeToTheTolerance) {
   const Stepped iterative = stepTwist(rubber(MaterialLaw::kStableNeoHookean), 0.8, 0.1, cg);
   ASSERT_EQ(iterative.report.health, StepHealth::kOk) << iterative.report.message;
   EXPECT_LT((direct.end.positions - iterative.end.positions).cwiseAbs().maxCoeff(), 1e-6);
+}
+
+// Inexact Newton: each CG direction stops where the Newton tolerance needs it (solveNewton's
+// forcing), not at the CG's own tighter tolerance. The step still ends within the Newton
+// tolerance, with fewer CG iterations than a tight Newton tolerance takes, and its motion is the
+// exact step's to the order of that tolerance: residual r = tol x scale moves v by about
+// A^-1 r, at most |r| / (lowest eigenvalue of A ~ the mass) ~ tol x |v| here.
+TEST(HyperelasticStep, InexactDirectionsEndWithinTheNewtonTolerance) {
+  SolverSettings exact = oneStep();
+  exact.newton_tolerance = 1e-12;
+  SolverSettings loose = oneStep(LinearSolverKind::kConjugateGradient);
+  loose.newton_tolerance = 1e-4;
+  SolverSettings strict = loose;
+  strict.newton_tolerance = 1e-8;
+  const Material law = rubber(MaterialLaw::kStableNeoHookean);
+  const Stepped reference = stepTwist(law, 0.8, 0.1, exact);
+  const Stepped inexact = stepTwist(law, 0.8, 0.1, loose);
+  const Stepped tight = stepTwist(law, 0.8, 0.1, strict);
+  ASSERT_EQ(inexact.report.health, StepHealth::kOk) << inexact.report.message;
+  ASSERT_EQ(tight.report.health, StepHealth::kOk) << tight.report.message;
+  EXPECT_TRUE(inexact.report.newton.converged);
+  EXPECT_LE(inexact.report.newton.relative_residual, loose.newton_tolerance);
+  EXPECT_LT(inexact.report.solve.iterations, tight.report.solve.iterations);
+  const double motion = (reference.end.velocities - reference.start.velocities).norm();
+  const double error = (inexact.end.velocities - reference.end.velocities).norm();
+  const double tight_error = (tight.end.velocities - reference.end.velocities).norm();
+  std::printf(
+      "[figures] CG iterations %d (Newton %d) at newton_tolerance 1e-4, %d (Newton %d) at "
+      "1e-8; velocity error / step's change %.2e and %.2e\n",
+      inexact.report.solve.iterations, inexact.report.newton.iterations,
+      tight.report.solve.iterations, tight.report.newton.iterations, error / motion,
+      tight_error / motion);
+  EXPECT_LE(error, 10 * loose.newton_tolerance * motion);
+  EXPECT_LE(tight_error, 10 * strict.newton_tolerance * motion);
 }
 
 // A Newton solve cut off after its first iteration is reported, never passed off as a step.

@@ -160,23 +160,30 @@ TetStiffness modeStiffness(const ModeGradients& Z, const Eigen::Matrix3d& stretc
 }
 
 template <typename Law>
+HyperelasticTetForces energyAndForces(const Law& law, const Eigen::Matrix3d& F,
+                                      const TetRestData& rest) {
+  return {rest.volume * energyDensity(law, F), hyperelasticNodeForces(firstPiola(law, F), rest)};
+}
+
+template <typename Law>
 HyperelasticTetResponse hyperelasticResponse(const Law& law,
                                              const std::array<Eigen::Vector3d, 4>& x,
                                              const TetRestData& rest, TetStiffnessKind kind) {
   const Eigen::Matrix3d F = deformationGradient(x, rest.rest_shape_inverse);
   HyperelasticTetResponse response;
-  response.energy = rest.volume * energyDensity(law, F);
-  response.forces = hyperelasticNodeForces(firstPiola(law, F), rest);
+  const HyperelasticTetForces forces = energyAndForces(law, F, rest);
+  response.energy = forces.energy;
+  response.forces = forces.forces;
   if (kind == TetStiffnessKind::kNone) return response;
   const PrincipalTangent t = principalTangent(law, F);
   const ModeGradients Z = modeGradients(t, rest.rest_shape_inverse);
-  if (kind != TetStiffnessKind::kExact) {
+  if (projectedAsked(kind)) {
     const EigenvalueFilter filter = projectionOf(kind);
     response.projected_stiffness =
         modeStiffness(Z, filterStretch(t.stretch, filter), filtered(t.rotation, filter),
                       filtered(t.shear, filter), rest.volume);
   }
-  if (kind != TetStiffnessKind::kProjected)
+  if (exactAsked(kind))
     response.exact_stiffness = modeStiffness(Z, t.stretch, t.rotation, t.shear, rest.volume);
   return response;
 }
@@ -424,6 +431,18 @@ HyperelasticTetResponse hyperelasticTet(const MooneyRivlin& law,
                                         const std::array<Eigen::Vector3d, 4>& x,
                                         const TetRestData& rest, TetStiffnessKind kind) {
   return hyperelasticResponse(law, x, rest, kind);
+}
+
+HyperelasticTetForces hyperelasticTetForces(const StableNeoHookean& law,
+                                            const std::array<Eigen::Vector3d, 4>& x,
+                                            const TetRestData& rest) {
+  return energyAndForces(law, deformationGradient(x, rest.rest_shape_inverse), rest);
+}
+
+HyperelasticTetForces hyperelasticTetForces(const MooneyRivlin& law,
+                                            const std::array<Eigen::Vector3d, 4>& x,
+                                            const TetRestData& rest) {
+  return energyAndForces(law, deformationGradient(x, rest.rest_shape_inverse), rest);
 }
 
 HyperelasticTet10Response hyperelasticTet10(const StableNeoHookean& law, const Tet10Vectors& x,

@@ -3,6 +3,8 @@
 #include <Eigen/Eigenvalues>
 #include <algorithm>
 
+#include "torsion/fem/factored_tet_hessian.h"
+
 namespace torsion {
 
 namespace {
@@ -14,12 +16,6 @@ Eigen::Matrix3d cross(const Eigen::Vector3d& v) {
   Eigen::Matrix3d m;
   m << 0, -v.z(), v.y(), v.z(), 0, -v.x(), -v.y(), v.x(), 0;
   return m;
-}
-
-// The shape gradients g_0..g_3: the rows of Bm and minus their sum.
-std::array<Eigen::Vector3d, 4> shapeGradients(const Eigen::Matrix3d& B) {
-  return {Eigen::Vector3d(-(B.row(0) + B.row(1) + B.row(2)).transpose()), B.row(0).transpose(),
-          B.row(1).transpose(), B.row(2).transpose()};
 }
 
 // d2E/dF2 over vec(F) = [f_0; f_1; f_2] (the columns), exact.

@@ -96,6 +96,10 @@ HyperelasticLaw HyperelasticLaw::of(const Material& material) {
   return law;
 }
 
+bool HyperelasticLaw::hasFactoredHessian() const {
+  return kind == MaterialLaw::kStableNeoHookean && !neo_hookean.log_term;
+}
+
 double HyperelasticLaw::energyDensity(const Eigen::Matrix3d& F) const {
   return kind == MaterialLaw::kMooneyRivlin ? torsion::energyDensity(mooney_rivlin, F)
                                             : torsion::energyDensity(neo_hookean, F);
@@ -108,6 +112,12 @@ HyperelasticTetResponse HyperelasticLaw::tet(const std::array<Eigen::Vector3d, 4
                                             : hyperelasticTet(neo_hookean, x, rest, stiffness);
 }
 
+HyperelasticTetForces HyperelasticLaw::tetForces(const std::array<Eigen::Vector3d, 4>& x,
+                                                 const TetRestData& rest) const {
+  return kind == MaterialLaw::kMooneyRivlin ? hyperelasticTetForces(mooney_rivlin, x, rest)
+                                            : hyperelasticTetForces(neo_hookean, x, rest);
+}
+
 HyperelasticTet10Response HyperelasticLaw::tet10(const Tet10Vectors& x,
                                                  const QuadraticRestData& rest,
                                                  TetStiffnessKind stiffness) const {
@@ -117,53 +127,94 @@ HyperelasticTet10Response HyperelasticLaw::tet10(const Tet10Vectors& x,
 
 namespace {
 
+// Where one element's results go: its energy, forces (N of them), and the stiffnesses asked for
+// (null: not asked; `factored` replaces `exact` for a law with that form).
+template <class Stiffness>
+struct ElementOutputs {
+  double& energy;
+  Eigen::Vector3d* forces;
+  Stiffness* projected;
+  Stiffness* exact;
+  FactoredTetHessian* factored;
+  unsigned char& in_barrier;  // tet4: 1 if below the barrier's threshold; tet10: its sub-tets
+};
+
 // What differs between the element kinds: the nodes per element, the chunk a thread takes, the
-// law's element function and where the volume barrier acts. respond() returns the element's
-// energy, forces and stiffnesses with its barrier added, and sets how many of its linear tets are
+// law's element function and where the volume barrier acts. respond() writes the element's
+// energy, forces and stiffnesses with its barrier added, and how many of its linear tets are
 // below the barrier's threshold.
 struct Tet4Elements {
   static constexpr size_t kNodes = 4;
   static constexpr int kGrain = kHyperelasticTetGrain;
-  using Response = HyperelasticTetResponse;
+  using Stiffness = TetStiffness;
   static size_t count(const FemModel& model) { return model.tetRestData().size(); }
   static std::vector<TetStiffness>& of(ElementStiffnesses& s) { return s.tet4; }
-  static Response respond(const FemModel& model, const HyperelasticLaw& law,
-                          const VolumeBarrier& barrier, const Eigen::VectorXd& positions, size_t t,
-                          TetStiffnessKind kind, unsigned char& in_barrier) {
+  static void respond(const FemModel& model, const HyperelasticLaw& law,
+                      const VolumeBarrier& barrier, const Eigen::VectorXd& positions, size_t t,
+                      TetStiffnessKind kind, ElementOutputs<TetStiffness> out) {
     const TetRestData& rest = model.tetRestData()[t];
     const std::array<Eigen::Vector3d, 4> x = tetPositions(positions, model.elementNodes(), t);
-    Response response = law.tet(x, rest, kind);
+    // The 12x12 stiffnesses only where asked for (building them costs most of the element).
+    const TetStiffnessKind element_kind =
+        out.exact != nullptr ? kind
+        : out.projected != nullptr
+            ? (kind == TetStiffnessKind::kMirrored ? kind : TetStiffnessKind::kProjected)
+            : TetStiffnessKind::kNone;
+    if (element_kind == TetStiffnessKind::kNone) {
+      const HyperelasticTetForces response = law.tetForces(x, rest);
+      out.energy = response.energy;
+      std::copy(response.forces.begin(), response.forces.end(), out.forces);
+    } else {
+      const HyperelasticTetResponse response = law.tet(x, rest, element_kind);
+      out.energy = response.energy;
+      std::copy(response.forces.begin(), response.forces.end(), out.forces);
+      if (out.projected != nullptr) *out.projected = response.projected_stiffness;
+      if (out.exact != nullptr) *out.exact = response.exact_stiffness;
+    }
     const Eigen::Matrix3d F = deformationGradient(x, rest.rest_shape_inverse);
-    if (!barrierOn(barrier) || !barrier.active(F.determinant())) return response;
-    in_barrier = 1;
-    response.energy += volumeBarrierEnergy(F, rest, barrier);
+    const double J = F.determinant();
+    const bool barrier_acts = barrierOn(barrier) && barrier.active(J);
+    if (out.factored != nullptr) {
+      const StableNeoHookean& nh = law.neo_hookean;
+      double curvature = nh.lambda, pressure = nh.lambda * (J - nh.alpha);
+      if (barrier_acts) {
+        curvature += barrier.densitySecondDerivative(J);
+        pressure += barrier.densityDerivative(J);
+      }
+      *out.factored = factoredTetHessian(F, shapeGradients(rest.rest_shape_inverse), rest.volume,
+                                         curvature, pressure);
+    }
+    if (!barrier_acts) return;
+    out.in_barrier = 1;
+    out.energy += volumeBarrierEnergy(F, rest, barrier);
     const std::array<Eigen::Vector3d, 4> f = volumeBarrierForces(F, rest, barrier);
     for (size_t a = 0; a < 4; ++a)
-      response.forces[a] += f[a];
-    if (projectedAsked(kind))
-      response.projected_stiffness += volumeBarrierStiffness(F, rest, barrier);
-    if (exactAsked(kind)) response.exact_stiffness += volumeBarrierHessian(F, rest, barrier);
-    return response;
+      out.forces[a] += f[a];
+    if (out.projected != nullptr) *out.projected += volumeBarrierStiffness(F, rest, barrier);
+    if (out.exact != nullptr) *out.exact += volumeBarrierHessian(F, rest, barrier);
   }
 };
 
 struct Tet10Elements {
   static constexpr size_t kNodes = 10;
   static constexpr int kGrain = kHyperelasticTet10Grain;
-  using Response = HyperelasticTet10Response;
+  using Stiffness = Tet10Stiffness;
   static size_t count(const FemModel& model) { return model.quadraticRestData().size(); }
   static std::vector<Tet10Stiffness>& of(ElementStiffnesses& s) { return s.tet10; }
-  static Response respond(const FemModel& model, const HyperelasticLaw& law,
-                          const VolumeBarrier& barrier, const Eigen::VectorXd& positions, size_t e,
-                          TetStiffnessKind kind, unsigned char& in_barrier) {
-    Response response = law.tet10(elementPositions(positions, model.elementNodes(), e),
-                                  model.quadraticRestData()[e], kind);
+  static void respond(const FemModel& model, const HyperelasticLaw& law,
+                      const VolumeBarrier& barrier, const Eigen::VectorXd& positions, size_t e,
+                      TetStiffnessKind kind, ElementOutputs<Tet10Stiffness> out) {
+    HyperelasticTet10Response response = law.tet10(
+        elementPositions(positions, model.elementNodes(), e), model.quadraticRestData()[e], kind);
     if (barrierOn(barrier)) {
-      in_barrier = static_cast<unsigned char>(addSubTetBarrier(
+      out.in_barrier = static_cast<unsigned char>(addSubTetBarrier(
           model, positions, barrier, e, projectedAsked(kind), exactAsked(kind), response.energy,
           response.forces, &response.projected_stiffness, &response.exact_stiffness));
     }
-    return response;
+    out.energy = response.energy;
+    std::copy(response.forces.begin(), response.forces.end(), out.forces);
+    if (out.projected != nullptr) *out.projected = response.projected_stiffness;
+    if (out.exact != nullptr) *out.exact = response.exact_stiffness;
   }
 };
 
@@ -183,28 +234,36 @@ double HyperelasticPass::evaluateAs(const FemModel& model, const Eigen::VectorXd
   const VolumeBarrier barrier = volumeBarrierOf(model.material());
   const size_t elements = Elements::count(model);
   const bool projected = projectedAsked(kind), exact = exactAsked(kind);
+  const bool factored = exact && Elements::kNodes == 4 && law.hasFactoredHessian();
   forces_.resize(Elements::kNodes * elements);
   energy_.resize(elements);
   in_barrier_.assign(elements, 0);
   if (projected) Elements::of(projected_).resize(elements);
-  if (exact) Elements::of(exact_).resize(elements);
+  if (exact) {
+    Elements::of(exact_).resize(factored ? 0 : elements);
+    exact_.factored_tet4.resize(factored ? elements : 0);
+    exact_.factored_shear = factored ? law.neo_hookean.mu : 0.0;
+  }
   parallel.forRange(static_cast<int>(elements), Elements::kGrain, [&](int begin, int end) {
     for (size_t e = static_cast<size_t>(begin); e < static_cast<size_t>(end); ++e) {
-      typename Elements::Response response =
-          Elements::respond(model, law, barrier, positions, e, kind, in_barrier_[e]);
-      std::copy(response.forces.begin(), response.forces.end(),
-                forces_.begin() + static_cast<std::ptrdiff_t>(Elements::kNodes * e));
-      energy_[e] = response.energy;
-      if (projected) Elements::of(projected_)[e] = response.projected_stiffness;
-      if (exact) Elements::of(exact_)[e] = response.exact_stiffness;
+      Elements::respond(model, law, barrier, positions, e, kind,
+                        ElementOutputs<typename Elements::Stiffness>{
+                            energy_[e], forces_.data() + Elements::kNodes * e,
+                            projected ? &Elements::of(projected_)[e] : nullptr,
+                            exact && !factored ? &Elements::of(exact_)[e] : nullptr,
+                            factored ? &exact_.factored_tet4[e] : nullptr, in_barrier_[e]});
     }
   });
   barrier_tets_ = 0;
   for (unsigned char in : in_barrier_)
     barrier_tets_ += in;
-  evaluated_positions_ = positions;
-  evaluated_kind_ = kind;
-  projected_kept_ = false;
+  if (!holdsForcesAt(positions)) {
+    evaluated_positions_ = positions;
+    exact_current_ = false;
+    projected_current_ = false;
+  }
+  exact_current_ = exact_current_ || exact;
+  projected_current_ = projected_current_ || projected;
   evaluated_energy_ = sumInOrder(energy_);
   return evaluated_energy_;
 }
@@ -216,10 +275,12 @@ bool HyperelasticPass::holdsForcesAt(const Eigen::VectorXd& positions) const {
                      sizeof(double) * static_cast<size_t>(positions.size())) == 0;
 }
 
-bool HyperelasticPass::holdsStiffnessesAt(const Eigen::VectorXd& positions) const {
-  return (evaluated_kind_ == TetStiffnessKind::kProjectedAndExact ||
-          evaluated_kind_ == TetStiffnessKind::kMirroredAndExact) &&
-         holdsForcesAt(positions);
+bool HyperelasticPass::holdsExactAt(const Eigen::VectorXd& positions) const {
+  return exact_current_ && holdsForcesAt(positions);
+}
+
+bool HyperelasticPass::holdsProjectedAt(const Eigen::VectorXd& positions) const {
+  return projected_current_ && holdsForcesAt(positions);
 }
 
 }  // namespace torsion

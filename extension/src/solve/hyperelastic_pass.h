@@ -26,9 +26,14 @@ struct HyperelasticLaw {
   MooneyRivlin mooney_rivlin;
 
   static HyperelasticLaw of(const Material& material);
+  /// Whether the exact Hessian of its tet4 has the factored form (fem/factored_tet_hessian.h):
+  /// stable neo-Hookean without the log term.
+  bool hasFactoredHessian() const;
   double energyDensity(const Eigen::Matrix3d& F) const;
   HyperelasticTetResponse tet(const std::array<Eigen::Vector3d, 4>& x, const TetRestData& rest,
                               TetStiffnessKind kind) const;
+  HyperelasticTetForces tetForces(const std::array<Eigen::Vector3d, 4>& x,
+                                  const TetRestData& rest) const;
   HyperelasticTet10Response tet10(const Tet10Vectors& x, const QuadraticRestData& rest,
                                   TetStiffnessKind kind) const;
 };
@@ -36,16 +41,19 @@ struct HyperelasticLaw {
 class HyperelasticPass {
  public:
   /// Energy, forces (elementForces()) and the element stiffnesses `kind` asks for
-  /// (projectedStiffnesses(): from the clamped, or for kMirroredAndExact the mirrored, tangent,
-  /// positive semi-definite; exactStiffnesses(): the exact Hessians) at `positions` (3n). Returns
-  /// the energy, J.
+  /// (projectedStiffnesses(): from the clamped, or for kMirrored the mirrored, tangent, positive
+  /// semi-definite; exactStiffnesses(): the exact Hessians, factored for a law that has the form,
+  /// HyperelasticLaw::hasFactoredHessian) at `positions` (3n). Returns the energy, J. At the
+  /// positions of the last evaluate(), the stiffnesses that one computed are kept (a Newton step
+  /// asks for the projected ones only where the exact ones fail it).
   double evaluate(const FemModel& model, const Eigen::VectorXd& positions, const Parallel& parallel,
                   TetStiffnessKind kind);
   /// Whether the last evaluate() was at exactly `positions` (the bits: -0 and 0 differ): its
   /// forces and energy are those there (a step that ends there starts the next with them, the same
-  /// bits as evaluating again); and with the exact and a projected stiffness.
+  /// bits as evaluating again); and whether the exact, or a projected, stiffness is held there.
   bool holdsForcesAt(const Eigen::VectorXd& positions) const;
-  bool holdsStiffnessesAt(const Eigen::VectorXd& positions) const;
+  bool holdsExactAt(const Eigen::VectorXd& positions) const;
+  bool holdsProjectedAt(const Eigen::VectorXd& positions) const;
   /// Forgets the last evaluate() (the material changed).
   void forget() { evaluated_positions_.resize(0); }
   /// The last evaluate()'s energy, J.
@@ -54,19 +62,10 @@ class HyperelasticPass {
   /// N per element (4 for tet4, 10 for tet10), index N e + a: the force on the element's node a,
   /// N (SystemOperator::gather).
   const std::vector<Eigen::Vector3d>& elementForces() const { return forces_; }
-  /// One per element in the member of the model's element kind, N/m, at the last evaluate()'s
-  /// positions (the projected ones moved to startStiffnesses() if kept as the start).
-  const ElementStiffnesses& projectedStiffnesses() const {
-    return projected_kept_ ? start_stiffness_ : projected_;
-  }
+  /// One per element in the member of the model's element kind, N/m, at the positions of the
+  /// evaluate() that computed them.
+  const ElementStiffnesses& projectedStiffnesses() const { return projected_; }
   const ElementStiffnesses& exactStiffnesses() const { return exact_; }
-  /// Keeps the last evaluate()'s projected stiffnesses as the step's start stiffnesses (a swap,
-  /// no copy): they stay there through the next evaluate(), which writes elsewhere.
-  void keepAsStartStiffnesses() {
-    std::swap(projected_, start_stiffness_);
-    projected_kept_ = true;
-  }
-  const ElementStiffnesses& startStiffnesses() const { return start_stiffness_; }
   /// Linear tets below the volume barrier's threshold at the last evaluate() (tet10: sub-tets).
   int barrierTets() const { return barrier_tets_; }
 
@@ -77,13 +76,13 @@ class HyperelasticPass {
                     const Parallel& parallel, TetStiffnessKind kind);
 
   std::vector<Eigen::Vector3d> forces_;
-  ElementStiffnesses projected_, exact_, start_stiffness_;
+  ElementStiffnesses projected_, exact_;
   std::vector<double> energy_;
   std::vector<unsigned char> in_barrier_;  // per element: its linear tets below the threshold
   int barrier_tets_ = 0;
   Eigen::VectorXd evaluated_positions_;
-  TetStiffnessKind evaluated_kind_ = TetStiffnessKind::kNone;
-  bool projected_kept_ = false;  // the last evaluate()'s projected are in start_stiffness_
+  bool exact_current_ = false;      // exact_ holds the stiffnesses at evaluated_positions_
+  bool projected_current_ = false;  // and projected_ the projected ones
   double evaluated_energy_ = 0;
 };
 

@@ -7,6 +7,7 @@
 #include <cstring>
 
 #include "system_operator_kernels.h"
+#include "torsion/fem/factored_tet_hessian.h"
 #include "torsion/fem/nodal_pressure.h"
 
 namespace torsion {
@@ -14,12 +15,6 @@ namespace torsion {
 namespace {
 constexpr int kTetGrain = 512;
 constexpr int kNodeGrain = 256;
-
-// Shape-function gradients of a tet's four nodes from its inverse rest shape.
-std::array<Eigen::Vector3d, 4> shapeGradients(const Eigen::Matrix3d& B) {
-  return {Eigen::Vector3d(-(B.row(0) + B.row(1) + B.row(2)).transpose()), B.row(0).transpose(),
-          B.row(1).transpose(), B.row(2).transpose()};
-}
 
 bool cpuHasAvx2Fma() {
 #if defined(TORSION_HAVE_AVX2_KERNELS) && (defined(__GNUC__) || defined(__clang__))
@@ -209,13 +204,25 @@ void SystemOperator::buildSlotTerms() {
             N * node_entries_[k] + b;
     }
   }
+  if (N != 4) return;
+  slot_laplacian_.assign(block_columns_.size(), 0.0);
+  for (size_t s = 0; s < block_columns_.size(); ++s) {
+    for (int t = slot_term_offsets_[s]; t < slot_term_offsets_[s + 1]; ++t) {
+      const int term = slot_terms_[static_cast<size_t>(t)];
+      const size_t e = static_cast<size_t>(term >> 4);
+      const size_t a = static_cast<size_t>((term >> 2) & 3), b = static_cast<size_t>(term & 3);
+      slot_laplacian_[s] +=
+          element_volumes_[e] * rest_gradients_[4 * e + a].dot(rest_gradients_[4 * e + b]);
+    }
+  }
 }
 
 void SystemOperator::setElementStiffnesses(const ElementStiffnesses* stiffnesses) {
   assert((stiffnesses == nullptr ||
           (model_->elementKind() == ElementKind::kTet10
                ? stiffnesses->tet10.size()
-               : stiffnesses->tet4.size()) == static_cast<size_t>(model_->elementCount())) &&
+               : stiffnesses->tet4.size() + stiffnesses->factored_tet4.size()) ==
+              static_cast<size_t>(model_->elementCount())) &&
          "one element stiffness of the model's element kind per element");
   element_stiffnesses_ = stiffnesses;
   assembled_ = false;
@@ -257,11 +264,32 @@ void SystemOperator::assembleElementStiffnesses(const std::vector<Stiffness>& st
   });
 }
 
+void SystemOperator::assembleFactoredHessians(const std::vector<FactoredTetHessian>& hessians,
+                                              double shear) const {
+  assert(nodes_per_element_ == 4 && "factored Hessians are tet4's");
+  static_assert(sizeof(FactoredTetHessian) == 30 * sizeof(double), "c_0..c_3 then w, no padding");
+  // Each block sums its own terms (elements ascending) and is written once, as the corotated
+  // assembly's; its terms come from the factors (fem/factored_tet_hessian.h).
+  system_kernels::AssemblyInput in;
+  in.row_offsets = row_offsets_.data();
+  in.slot_term_offsets = slot_term_offsets_.data();
+  in.slot_terms = slot_terms_.data();
+  in.factored = hessians.data()->c[0].data();
+  in.slot_laplacian = slot_laplacian_.data();
+  in.shear = shear;
+  in.blocks = block_values_.data()->data();
+  parallel_.forRange(model_->nodeCount(), kNodeGrain,
+                     [&](int begin, int end) { kernels_->factored_rows(in, begin, end); });
+}
+
 void SystemOperator::assemble() const {
   if (assembled_) return;
   if (element_stiffnesses_ != nullptr) {
     if (model_->elementKind() == ElementKind::kTet10) {
       assembleElementStiffnesses(element_stiffnesses_->tet10);
+    } else if (!element_stiffnesses_->factored_tet4.empty()) {
+      assembleFactoredHessians(element_stiffnesses_->factored_tet4,
+                               element_stiffnesses_->factored_shear);
     } else {
       assembleElementStiffnesses(element_stiffnesses_->tet4);
     }

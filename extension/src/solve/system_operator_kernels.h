@@ -38,6 +38,12 @@ struct AssemblyInput {
   const int* term_offsets = nullptr;
   const BlockTerm* terms = nullptr;
   double* blocks = nullptr;  ///< out: 9 doubles (column-major) per slot
+  /// Factored tet4 Hessians (fem/factored_tet_hessian.h), 30 doubles per element: c_0..c_3, then
+  /// w of the pairs (0,1) (0,2) (0,3) (1,2) (1,3) (2,3); with `shear` (mu, Pa) times the rest
+  /// Laplacian sum of each slot, slot_laplacian[slot] (sum of V (g_a . g_b) over its terms).
+  const double* factored = nullptr;
+  const double* slot_laplacian = nullptr;
+  double shear = 0;
 };
 
 /// out_n = stiffness_scale (K y)_n + mass_scale m_n y_n for block rows n; K is stored as the upper
@@ -86,6 +92,8 @@ struct KernelTable {
   const char* name;  ///< "sse2" or "avx2+fma"
   void (*tet4_rows)(const AssemblyInput&, int row_begin, int row_end);
   void (*tet10_rows)(const AssemblyInput&, int row_begin, int row_end);
+  /// tet4 blocks from factored Hessians: K_ab = shear V (g_a . g_b) I + c_a c_b^T + [+-w]x.
+  void (*factored_rows)(const AssemblyInput&, int row_begin, int row_end);
   void (*block_product)(const ProductInput&, int row_begin, int row_end);
   void (*tet4_forces)(const Tet4ForceInput&, int tet_begin, int tet_end);
 };

@@ -35,10 +35,11 @@
 //   shear    (symmetric):      (psi_i - psi_j) / (s_i - s_j)        (psi_i = dPsi/ds_i)
 // and on U diag(.) V^T the 3x3 block d2Psi/ds_i ds_j. For both laws the two quotients are
 // polynomials in s (no division: they hold through repeated and zero singular values), e.g.
-// stable neo-Hookean: mu' + l'(J - alpha) s_k and mu' - l'(J - alpha) s_k. The stiffness the
-// implicit solve gets is the tangent projected onto its non-negative eigenvalues (each quotient
-// clamped at zero, the 3x3 block projected), mapped to the tet's nodes; the exact tangent is the
-// same sum unclamped.
+// stable neo-Hookean: mu' + l'(J - alpha) s_k and mu' - l'(J - alpha) s_k. The projected
+// stiffness (the implicit step's fallback where the exact Hessian fails a Newton direction) is the
+// tangent with its eigenvalues filtered (each quotient clamped or mirrored, the 3x3 block
+// likewise), mapped to the tet's nodes; the exact tangent is the same sum unfiltered (the step
+// takes stable neo-Hookean's tet4 one in closed form, factored_tet_hessian.h).
 
 #include <Eigen/Core>
 #include <array>
@@ -111,22 +112,21 @@ enum class EigenvalueFilter { kExact, kClamp, kMirror };
 /// dP/dF rebuilt from its eigensystem, its eigenvalues filtered.
 PiolaTangent tangentOf(const PrincipalTangent& tangent, EigenvalueFilter filter);
 
-/// Which stiffnesses hyperelasticTet computes (the forces and the energy always). The projected
-/// one is built from the clamped tangent, or, for kMirroredAndExact, from the mirrored one.
-enum class TetStiffnessKind { kNone, kProjected, kExact, kProjectedAndExact, kMirroredAndExact };
+/// Which stiffnesses hyperelasticTet computes (the forces and the energy always): the projected
+/// one built from the clamped (kProjected, kProjectedAndExact) or the mirrored (kMirrored)
+/// tangent, and the exact one (kExact, kProjectedAndExact).
+enum class TetStiffnessKind { kNone, kProjected, kMirrored, kExact, kProjectedAndExact };
 /// Whether `kind` asks for the projected (positive semi-definite), or the exact, stiffness.
 inline bool projectedAsked(TetStiffnessKind kind) {
-  return kind == TetStiffnessKind::kProjected || kind == TetStiffnessKind::kProjectedAndExact ||
-         kind == TetStiffnessKind::kMirroredAndExact;
+  return kind == TetStiffnessKind::kProjected || kind == TetStiffnessKind::kMirrored ||
+         kind == TetStiffnessKind::kProjectedAndExact;
 }
 inline bool exactAsked(TetStiffnessKind kind) {
-  return kind == TetStiffnessKind::kExact || kind == TetStiffnessKind::kProjectedAndExact ||
-         kind == TetStiffnessKind::kMirroredAndExact;
+  return kind == TetStiffnessKind::kExact || kind == TetStiffnessKind::kProjectedAndExact;
 }
 /// The filter that makes `kind`'s projected stiffness.
 inline EigenvalueFilter projectionOf(TetStiffnessKind kind) {
-  return kind == TetStiffnessKind::kMirroredAndExact ? EigenvalueFilter::kMirror
-                                                     : EigenvalueFilter::kClamp;
+  return kind == TetStiffnessKind::kMirrored ? EigenvalueFilter::kMirror : EigenvalueFilter::kClamp;
 }
 
 /// One linear tet: energy V Psi (J), forces f_a = -dE/dx_a (N), stiffness d2E/dx2 (N/m): the
@@ -147,6 +147,18 @@ HyperelasticTetResponse hyperelasticTet(const MooneyRivlin& law,
                                         const std::array<Eigen::Vector3d, 4>& x,
                                         const TetRestData& rest,
                                         TetStiffnessKind kind = TetStiffnessKind::kProjected);
+
+/// The energy and forces alone (the bits hyperelasticTet gives them).
+struct HyperelasticTetForces {
+  double energy = 0;
+  std::array<Eigen::Vector3d, 4> forces;
+};
+HyperelasticTetForces hyperelasticTetForces(const StableNeoHookean& law,
+                                            const std::array<Eigen::Vector3d, 4>& x,
+                                            const TetRestData& rest);
+HyperelasticTetForces hyperelasticTetForces(const MooneyRivlin& law,
+                                            const std::array<Eigen::Vector3d, 4>& x,
+                                            const TetRestData& rest);
 
 /// One quadratic (10-node) tet (quadratic_element.h): at each of the 4 quadrature points q of the
 /// corotated P2 element (weight V / 4, shape gradients g_qa = rest.gradients[q][a]),

@@ -203,15 +203,16 @@ class ImplicitStepper {
   double addVolumeBarrier(const FemState& state);
   // Stages 1-2 of a hyperelastic body: energy, forces and element stiffnesses at `state`
   // (src/solve/implicit_stepper_newton.cpp, as are the functions below up to the next comment).
-  double computeHyperelasticForces(const FemState& state);
+  double computeHyperelasticForces(FemState& state);
   // Stage 4 of a hyperelastic body: the Newton solve, v' into velocity_next_.
   LinearSolveReport solveNewton();
   // Whether the warm start's prediction puts the prescribed nodes near their targets (the first
   // Newton iterate then starts from it).
   bool predictionFits() const;
-  // A linear solve by settings_.linear_solver of A v = b under `constraints`.
+  // A linear solve by settings_.linear_solver of A v = b under `constraints` (CG to relative
+  // `tolerance`; CHOLMOD exact).
   LinearSolveReport linearSolve(const NodeConstraints& constraints, const Eigen::VectorXd& b,
-                                Eigen::VectorXd& v);
+                                Eigen::VectorXd& v, double tolerance);
   // The pass at x_n + dt v (into trial_) with the stiffnesses `stiffness` asks for, then
   // iterateResidual: returns Phi(v).
   double evaluateIterate(const Eigen::VectorXd& v, TetStiffnessKind stiffness);
@@ -222,8 +223,10 @@ class ImplicitStepper {
   double incrementalPotential(const Eigen::VectorXd& v, double elastic_energy,
                               const Eigen::VectorXd& lagged_v) const;
   // A Newton direction dv at the last evaluated iterate: S r solved with the exact Hessian, or the
-  // projected one where that is not positive definite.
-  LinearSolveReport newtonDirection(const Eigen::VectorXd& free_residual, Eigen::VectorXd& dv);
+  // projected one where that is not positive definite, as accurately as a Newton residual of
+  // `target` needs; its relative residual reported against the step's residual `scale`.
+  LinearSolveReport newtonDirection(const Eigen::VectorXd& free_residual, double target,
+                                    double scale, Eigen::VectorXd& dv);
   // Backtracks along dv from v (Phi(v) = phi); on success v and phi move to the accepted point.
   bool lineSearch(Eigen::VectorXd& v, const Eigen::VectorXd& dv, double& phi);
   // Stage 6's verdict on the Newton solve, into report.

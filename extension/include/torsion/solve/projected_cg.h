@@ -21,7 +21,9 @@ struct PcgScratch {
 
 struct LinearSolveReport {
   int iterations = 0;
-  double relative_residual = 0;  ///< |S(b - A v)| / |S(b - A v_prescribed)|
+  /// |S(b - A v)| / |S(b - A v_prescribed)|; a hyperelastic step's (the largest of its Newton
+  /// solves) against the step's residual scale (SolverSettings::newton_tolerance).
+  double relative_residual = 0;
   bool converged = false;
   /// The solver could not proceed (non-positive curvature, non-finite numbers, failed
   /// factorisation): the result is meaningless, unlike a merely unconverged one.

@@ -27,6 +27,7 @@
 #include <memory>
 #include <vector>
 
+#include "torsion/fem/factored_tet_hessian.h"
 #include "torsion/fem/fem_model.h"
 #include "torsion/fem/volume_barrier.h"
 #include "torsion/solve/parallel.h"
@@ -39,11 +40,13 @@ struct BlockTerm;
 struct ProductInput;
 }  // namespace system_kernels
 
-/// Element stiffness matrices (SystemOperator::setElementStiffnesses), one per element, in the
-/// member of the model's element kind: `tet4` (12x12) for tet4 models, `tet10` (30x30) for tet10
-/// models (the other member unused).
+/// Element stiffnesses (SystemOperator::setElementStiffnesses), one per element, in one member:
+/// `tet4` (12x12) or `factored_tet4` (fem/factored_tet_hessian.h, with the shear modulus
+/// `factored_shear`, Pa) for tet4 models, `tet10` (30x30) for tet10 models (the others empty).
 struct ElementStiffnesses {
   std::vector<TetStiffness> tet4;
+  std::vector<FactoredTetHessian> factored_tet4;
+  double factored_shear = 0;
   std::vector<Tet10Stiffness> tet10;
 };
 
@@ -189,6 +192,8 @@ class SystemOperator {
   // Fills block_values_ from element stiffnesses (12x12 or 30x30, one per element).
   template <typename Stiffness>
   void assembleElementStiffnesses(const std::vector<Stiffness>& stiffnesses) const;
+  void assembleFactoredHessians(const std::vector<FactoredTetHessian>& hessians,
+                                double shear) const;
   // tet10: the terms of every block (a, b) (system_kernels::BlockTerm), once per operator.
   void buildTet10Terms();
 
@@ -218,6 +223,9 @@ class SystemOperator {
   // (element e's local nodes a, b), ascending elements: the tet4 kernel and element stiffnesses.
   std::vector<int> slot_term_offsets_;
   std::vector<int> slot_terms_;
+  // tet4, per slot: sum over its terms of V_e (g_a . g_b), the rest shape's Laplacian block that
+  // the shear term of a factored Hessian scales (assembleFactoredHessians).
+  std::vector<double> slot_laplacian_;
   // Upper-triangle storage: row n also reads the blocks (row r < n, column n) transposed; they
   // are lower_slots_[l] with r = lower_columns_[l], l in [lower_offsets_[n], lower_offsets_[n+1]).
   std::vector<int> lower_offsets_;
