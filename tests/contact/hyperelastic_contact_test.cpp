@@ -17,7 +17,7 @@
 #include "torsion/analysis/surface_intersections.h"
 
 namespace torsion::test {
-namespace {
+namespace hyperelastic_contact_test {
 
 constexpr double kGravity = 9.81;
 constexpr MaterialLaw kHyperelasticLaws[] = {MaterialLaw::kStableNeoHookean,
@@ -247,5 +247,5 @@ TEST(HyperelasticContact, ANeoHookeanBodyStruckByItselfKeepsItsMomentum) {
   EXPECT_EQ(newton.unconverged, 0);
 }
 
-}  // namespace
+}  // namespace hyperelastic_contact_test
 }  // namespace torsion::test

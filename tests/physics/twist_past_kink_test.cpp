@@ -28,7 +28,7 @@
 #include "torsion/mesh/mesh_io.h"
 
 namespace torsion {
-namespace {
+namespace twist_past_kink_test {
 
 constexpr double kLength = 10.0;  // m
 constexpr double kRate = 0.5;     // rad/s of twist (the scenes: 0.1)
@@ -242,5 +242,5 @@ TEST(TwistPastKink, WithSelfContactTheBarKeepsItsFourPi) {
   EXPECT_EQ(run.crossing_steps, 0) << "deepest crossing " << run.deepest << " m";
 }
 
-}  // namespace
+}  // namespace twist_past_kink_test
 }  // namespace torsion

@@ -20,14 +20,7 @@ struct TetFixture {
   std::array<Eigen::Vector3d, 4> rest = {Eigen::Vector3d(0, 0, 0), Eigen::Vector3d(1, 0.1, 0),
                                          Eigen::Vector3d(0.2, 0.9, 0.1),
                                          Eigen::Vector3d(0.1, 0.2, 1.1)};
-  TetRestData data;
-  TetFixture() {
-    Eigen::Matrix3d Dm;
-    for (int k = 0; k < 3; ++k)
-      Dm.col(k) = rest[static_cast<size_t>(k + 1)] - rest[0];
-    data.rest_shape_inverse = Dm.inverse();
-    data.volume = Dm.determinant() / 6;
-  }
+  TetRestData data = tetRestData(rest);
   std::array<Eigen::Vector3d, 4> forces(const std::array<Eigen::Vector3d, 4>& x) const {
     const Eigen::Matrix3d F = deformationGradient(x, data.rest_shape_inverse);
     Eigen::Quaterniond q = Eigen::Quaterniond::Identity();

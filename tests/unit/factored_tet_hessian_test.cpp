@@ -13,16 +13,6 @@ namespace torsion::factored_tet_hessian_test {
 
 using Nodes = std::array<Eigen::Vector3d, 4>;
 
-TetRestData tetRest(const Nodes& X) {
-  Eigen::Matrix3d Dm;
-  for (int k = 0; k < 3; ++k)
-    Dm.col(k) = X[static_cast<size_t>(k + 1)] - X[0];
-  TetRestData rest;
-  rest.rest_shape_inverse = Dm.inverse();
-  rest.volume = Dm.determinant() / 6;
-  return rest;
-}
-
 const Nodes kRest = {Eigen::Vector3d(0, 0, 0), Eigen::Vector3d(1, 0.1, 0),
                      Eigen::Vector3d(0.2, 0.9, 0.1), Eigen::Vector3d(0.1, 0.2, 1.1)};
 
@@ -37,7 +27,7 @@ std::vector<Nodes> shapes() {
 }
 
 TEST(FactoredTetHessian, IsTheStableNeoHookeanExactHessian) {
-  const TetRestData rest = tetRest(kRest);
+  const TetRestData rest = tetRestData(kRest);
   const std::array<Eigen::Vector3d, 4> g = shapeGradients(rest.rest_shape_inverse);
   for (double nu : {0.3, 0.45, 0.499}) {
     const StableNeoHookean law = StableNeoHookean::fromYoungPoisson(1e5, nu);
@@ -57,7 +47,7 @@ TEST(FactoredTetHessian, IsTheStableNeoHookeanExactHessian) {
 }
 
 TEST(FactoredTetHessian, AddsTheVolumeBarrierAsItsJTerms) {
-  const TetRestData rest = tetRest(kRest);
+  const TetRestData rest = tetRestData(kRest);
   const std::array<Eigen::Vector3d, 4> g = shapeGradients(rest.rest_shape_inverse);
   const StableNeoHookean law = StableNeoHookean::fromYoungPoisson(1e5, 0.3);
   const VolumeBarrier barrier{0.5, 3e5};

@@ -329,16 +329,6 @@ TEST(HyperelasticProjection, InvertedGradientGivesFiniteEnergyStressAndPsdTangen
 
 using Nodes = std::array<Eigen::Vector3d, 4>;
 
-TetRestData tetRest(const Nodes& X) {
-  Eigen::Matrix3d Dm;
-  for (int k = 0; k < 3; ++k)
-    Dm.col(k) = X[static_cast<size_t>(k + 1)] - X[0];
-  TetRestData rest;
-  rest.rest_shape_inverse = Dm.inverse();
-  rest.volume = Dm.determinant() / 6;
-  return rest;
-}
-
 template <typename L>
 void checkTet(const L& law, const Nodes& x, const TetRestData& rest) {
   const HyperelasticTetResponse r =
@@ -387,7 +377,7 @@ void checkTet(const L& law, const Nodes& x, const TetRestData& rest) {
 TEST(HyperelasticTet, ForcesAndStiffnessAreDerivativesOfTheEnergy) {
   const Nodes X = {Eigen::Vector3d(0, 0, 0), Eigen::Vector3d(1, 0.1, 0),
                    Eigen::Vector3d(0.2, 0.9, 0.1), Eigen::Vector3d(0.1, 0.2, 1.1)};
-  const TetRestData rest = tetRest(X);
+  const TetRestData rest = tetRestData(X);
   Nodes stretched = X, inverted = X;
   stretched[1] += Eigen::Vector3d(0.4, -0.1, 0.2);
   stretched[3] += Eigen::Vector3d(-0.2, 0.3, 0.3);
@@ -422,7 +412,7 @@ Nodes10 tet10Nodes(const Nodes& X) {
 }
 
 QuadraticRestData tet10Rest(const Nodes& X) {
-  const TetRestData corner = tetRest(X);
+  const TetRestData corner = tetRestData(X);
   return quadraticRestData(corner.rest_shape_inverse, corner.volume);
 }
 

@@ -10,7 +10,7 @@
 #include "torsion/mesh/box_mesh.h"
 
 namespace torsion {
-namespace {
+namespace live_edit_test {
 
 constexpr double kLength = 4;
 
@@ -294,5 +294,5 @@ TEST(LiveEdit, HandSpeedLimitFollowsTheMaterial) {
   EXPECT_NEAR(hand.speedLimit(), 2 * before, 1e-12 * before);
 }
 
-}  // namespace
+}  // namespace live_edit_test
 }  // namespace torsion

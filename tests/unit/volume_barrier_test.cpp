@@ -27,13 +27,7 @@ const Nodes kRest = {Eigen::Vector3d(0, 0, 0), Eigen::Vector3d(1, 0.1, 0),
                      Eigen::Vector3d(0.2, 0.9, 0.1), Eigen::Vector3d(0.1, 0.2, 1.1)};
 
 TetRestData restData() {
-  Eigen::Matrix3d Dm;
-  for (int k = 0; k < 3; ++k)
-    Dm.col(k) = kRest[static_cast<size_t>(k + 1)] - kRest[0];
-  TetRestData data;
-  data.rest_shape_inverse = Dm.inverse();
-  data.volume = Dm.determinant() / 6;
-  return data;
+  return tetRestData(kRest);
 }
 
 VolumeBarrier defaultBarrier() {

@@ -10,14 +10,10 @@ namespace {
 
 TetRestData linearRestData(const TetMesh& mesh, const Tet& tet) {
   const auto& x = mesh.restPositions();
-  Eigen::Matrix3d Dm;
-  for (int k = 0; k < 3; ++k)
-    Dm.col(k) =
-        x[static_cast<size_t>(tet[static_cast<size_t>(k + 1)])] - x[static_cast<size_t>(tet[0])];
-  TetRestData rest;
-  rest.rest_shape_inverse = Dm.inverse();
-  rest.volume = Dm.determinant() / 6.0;  // positive: TetMesh guarantees orientation
-  return rest;
+  std::array<Eigen::Vector3d, 4> corners;
+  for (size_t a = 0; a < 4; ++a)
+    corners[a] = x[static_cast<size_t>(tet[a])];
+  return tetRestData(corners);  // positive volume: TetMesh guarantees orientation
 }
 
 Status checkElementSupports(const Material& material, ElementKind element) {
@@ -37,6 +33,16 @@ Status checkElementSupports(const Material& material, ElementKind element) {
 }
 
 }  // namespace
+
+TetRestData tetRestData(const std::array<Eigen::Vector3d, 4>& corners) {
+  Eigen::Matrix3d Dm;
+  for (size_t k = 0; k < 3; ++k)
+    Dm.col(static_cast<Eigen::Index>(k)) = corners[k + 1] - corners[0];
+  TetRestData rest;
+  rest.rest_shape_inverse = Dm.inverse();
+  rest.volume = Dm.determinant() / 6.0;
+  return rest;
+}
 
 Result<std::shared_ptr<const FemModel>> FemModel::create(std::shared_ptr<const TetMesh> mesh,
                                                          const Material& material,

@@ -6,6 +6,7 @@
 
 #include "hyperelastic_pass.h"
 #include "system_operator_kernels.h"
+#include "tet4_force_input.h"
 #include "torsion/fem/corotated_element.h"
 #include "torsion/fem/nodal_pressure.h"
 #include "torsion/fem/polar_rotation.h"
@@ -72,22 +73,9 @@ double ImplicitStepper::computeElasticForces(FemState& state) {
     tet_strain_.resize(nodal_pressure ? nodes.size() / 4 : 0);
     // Four tets at a time in the operator's kernel build (system_operator_kernels.h); the tets it
     // flags (det F <= 0) go through the SVD path here.
-    static_assert(sizeof(TetRestData) == 10 * sizeof(double), "Bm then V, no padding");
-    static_assert(sizeof(Eigen::Vector3d) == 3 * sizeof(double), "12 doubles per tet");
-    system_kernels::Tet4ForceInput in;
-    in.positions = state.positions.data();
-    in.nodes = nodes.data();
-    in.rest = model_->tetRestData().data()->rest_shape_inverse.data();
-    in.mu = mu;
-    in.lambda = element_lambda;
-    in.quaternions = state.element_rotations.data()->coeffs().data();
-    in.rotations = rotations.data()->data();
-    in.forces = element_forces_.data()->data();
-    in.energy = element_energy_.data();
+    system_kernels::Tet4ForceInput in = tet4ForceInput(
+        *model_, state, mu, element_lambda, outputs, element_forces_, element_energy_, needs_svd_);
     in.volumetric_strain = nodal_pressure ? tet_strain_.data() : nullptr;
-    in.rotated_gradients = outputs.rotated_gradients.data()->data();
-    needs_svd_.resize(static_cast<size_t>(model_->elementCount()));
-    in.needs_svd = needs_svd_.data();
     parallel_.forRange(model_->elementCount(), kTetGrain, [&](int begin, int end) {
       system_.kernels().tet4_forces(in, begin, end);
       for (int t = begin; t < end; ++t) {

@@ -7,6 +7,7 @@
 
 #include "hyperelastic_pass.h"
 #include "system_operator_kernels.h"
+#include "tet4_force_input.h"
 #include "torsion/fem/corotated_element.h"
 #include "torsion/fem/polar_rotation.h"
 #include "torsion/fem/quadratic_element.h"
@@ -58,19 +59,9 @@ double ImplicitStepper::computeHyperelasticForces(FemState& state) {
   const std::vector<int>& nodes = model_->elementNodes();
   if (model_->elementKind() == ElementKind::kTet4) {
     const SystemOperator::RotationOutputs outputs = system_.mutableRotationsAndGradients();
-    system_kernels::Tet4ForceInput in;
-    in.positions = state.positions.data();
-    in.nodes = nodes.data();
-    in.rest = model_->tetRestData().data()->rest_shape_inverse.data();
-    in.mu = model_->material().mu();
-    in.lambda = model_->material().lambda();
-    in.quaternions = state.element_rotations.data()->coeffs().data();
-    in.rotations = outputs.rotations.data()->data();
-    in.forces = element_forces_.data()->data();
-    in.energy = element_energy_.data();
-    in.rotated_gradients = outputs.rotated_gradients.data()->data();
-    needs_svd_.resize(static_cast<size_t>(model_->elementCount()));
-    in.needs_svd = needs_svd_.data();
+    const system_kernels::Tet4ForceInput in =
+        tet4ForceInput(*model_, state, model_->material().mu(), model_->material().lambda(),
+                       outputs, element_forces_, element_energy_, needs_svd_);
     parallel_.forRange(model_->elementCount(), kRotationGrain, [&](int begin, int end) {
       system_.kernels().tet4_forces(in, begin, end);
       for (int t = begin; t < end; ++t) {

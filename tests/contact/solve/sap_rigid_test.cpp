@@ -11,7 +11,7 @@
 #include "sap_test_support.h"
 
 namespace torsion::sap {
-namespace {
+namespace sap_rigid_test {
 
 using test::BoxState;
 using test::kGravity;
@@ -428,5 +428,5 @@ TEST(SapStack, ThreeBoxesStandAtTheirStaticDeflection) {
   std::printf("stack: Newton <= %d\n", max_newton);
 }
 
-}  // namespace
+}  // namespace sap_rigid_test
 }  // namespace torsion::sap

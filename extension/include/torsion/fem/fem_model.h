@@ -10,6 +10,7 @@
 //  - the elements: elementNodes(), nodesPerElement() nodes each; the solver's connectivity.
 
 #include <Eigen/Core>
+#include <array>
 #include <memory>
 #include <vector>
 
@@ -26,6 +27,10 @@ struct TetRestData {
   Eigen::Matrix3d rest_shape_inverse;  ///< Bm = Dm^-1, Dm = [X1-X0, X2-X0, X3-X0]; 1/m
   double volume = 0;                   ///< rest volume V, m^3
 };
+
+/// The rest data of a tet with rest corners X0..X3 (volume positive when X1-X0, X2-X0, X3-X0 are
+/// right-handed, as TetMesh orders them).
+TetRestData tetRestData(const std::array<Eigen::Vector3d, 4>& corners);
 
 class FemModel {
  public:
