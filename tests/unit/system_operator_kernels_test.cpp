@@ -9,9 +9,12 @@
 
 #include <Eigen/Geometry>
 #include <cstring>
+#include <limits>
 #include <random>
 
 #include "torsion/fem/corotated_element.h"
+#include "torsion/fem/factored_tet_hessian.h"
+#include "torsion/fem/hyperelastic.h"
 #include "torsion/fem/polar_rotation.h"
 #include "torsion/mesh/box_mesh.h"
 #include "torsion/solve/implicit_stepper.h"
@@ -170,6 +173,95 @@ TEST(SystemOperatorKernels, BatchedTet4ForcePassMatchesTheElementFunctions) {
       EXPECT_NEAR(strain[t], (R_ref.transpose() * F).trace() - 3.0, 1e-12) << build->name;
     }
     EXPECT_EQ(needs_svd[7], 1);
+  }
+}
+
+// The batched stable neo-Hookean pass against the element functions it replaces, in each build:
+// energy and forces of hyperelasticTetForces and the factors of factoredTetHessian, on large
+// random deformations (stretch, shear and a tet turned inside out: the law is defined there),
+// a short last batch, and the tets below a barrier threshold flagged and left alone.
+TEST(SystemOperatorKernels, BatchedNeoHookeanPassMatchesTheElementFunctions) {
+  auto model = beam(ElementKind::kTet4);
+  const int tets = model->elementCount() - 1;  // a short last batch
+  std::mt19937 rng(11);
+  std::normal_distribution<double> n(0, 1);
+  const Eigen::Matrix3d Q = Eigen::Quaterniond(0.9, 0.3, -0.2, 0.4).normalized().toRotationMatrix();
+  Eigen::Matrix3d stretch;
+  stretch << 1.6, 0.3, 0, 0, 0.8, 0.2, 0.1, 0, 0.7;
+  std::vector<double> positions;
+  for (const Eigen::Vector3d& X : model->mesh().restPositions()) {
+    const Eigen::Vector3d x = Q * stretch * X + 0.05 * Eigen::Vector3d(n(rng), n(rng), n(rng));
+    positions.insert(positions.end(), x.data(), x.data() + 3);
+  }
+  std::vector<int> nodes = model->elementNodes();
+  std::swap(nodes[4 * 7 + 1], nodes[4 * 7 + 2]);  // tet 7 inside out: J < 0, still the law's
+  const StableNeoHookean law = StableNeoHookean::fromYoungPoisson(1e5, 0.45);
+  std::vector<system_kernels::KernelTable const*> builds = {&system_kernels::genericKernels()};
+  if (std::strcmp(SystemOperator::bestKernelPath(), "avx2+fma") == 0)
+    builds.push_back(system_kernels::avx2Kernels());
+  for (const double threshold : {-std::numeric_limits<double>::infinity(), 0.9}) {
+    for (const system_kernels::KernelTable* build : builds) {
+      const size_t count = static_cast<size_t>(tets);
+      std::vector<double> forces(12 * count), energy(count), factors(30 * count);
+      std::vector<unsigned char> needs_scalar(count, 2);
+      system_kernels::NeoHookeanTet4Input in;
+      in.positions = positions.data();
+      in.nodes = nodes.data();
+      in.rest = model->tetRestData().data()->rest_shape_inverse.data();
+      in.mu = law.mu;
+      in.lambda = law.lambda;
+      in.alpha = law.alpha;
+      in.rest_energy = law.rest_energy;
+      in.barrier_threshold = threshold;
+      in.forces = forces.data();
+      in.energy = energy.data();
+      in.factors = factors.data();
+      in.needs_scalar = needs_scalar.data();
+      build->neo_hookean_tet4(in, 0, tets);
+      int flagged = 0;
+      for (size_t t = 0; t < count; ++t) {
+        std::array<Eigen::Vector3d, 4> x;
+        for (size_t a = 0; a < 4; ++a)
+          x[a] = Eigen::Map<const Eigen::Vector3d>(positions.data() + 3 * nodes[4 * t + a]);
+        const TetRestData& rest = model->tetRestData()[t];
+        const Eigen::Matrix3d F = deformationGradient(x, rest.rest_shape_inverse);
+        const double J = F.determinant();
+        ASSERT_EQ(needs_scalar[t], J < threshold ? 1 : 0) << build->name << " tet " << t;
+        if (needs_scalar[t] != 0) {
+          ++flagged;
+          continue;
+        }
+        const HyperelasticTetForces ref = hyperelasticTetForces(law, x, rest);
+        const double scale = ref.forces[0].norm() + ref.forces[1].norm() + 1e-300;
+        for (size_t a = 0; a < 4; ++a)
+          EXPECT_LT(
+              (Eigen::Map<const Eigen::Vector3d>(forces.data() + 12 * t + 3 * a) - ref.forces[a])
+                  .norm(),
+              1e-12 * scale)
+              << build->name << " tet " << t;
+        EXPECT_NEAR(energy[t], ref.energy, 1e-12 * std::abs(ref.energy)) << build->name;
+        const FactoredTetHessian h =
+            factoredTetHessian(F, shapeGradients(rest.rest_shape_inverse), rest.volume, law.lambda,
+                               law.lambda * (J - law.alpha));
+        const double c_scale = h.c[0].norm() + h.c[1].norm();
+        const double w_scale = h.w[0].norm() + h.w[5].norm() + 1e-300;
+        for (size_t a = 0; a < 4; ++a)
+          EXPECT_LT((Eigen::Map<const Eigen::Vector3d>(&factors[30 * t + 3 * a]) - h.c[a]).norm(),
+                    1e-12 * c_scale)
+              << build->name << " tet " << t;
+        for (size_t p = 0; p < 6; ++p)
+          EXPECT_LT(
+              (Eigen::Map<const Eigen::Vector3d>(&factors[30 * t + 12 + 3 * p]) - h.w[p]).norm(),
+              1e-12 * w_scale)
+              << build->name << " tet " << t;
+      }
+      if (threshold > 0) {
+        EXPECT_GT(flagged, 0);  // the inside-out tet at least
+        EXPECT_EQ(needs_scalar[7], 1);
+      } else {
+        EXPECT_EQ(flagged, 0);
+      }
+    }
   }
 }
 

@@ -2,7 +2,9 @@
 
 #include <algorithm>
 #include <cstring>
+#include <limits>
 
+#include "system_operator_kernels.h"
 #include "torsion/fem/corotated_element.h"
 
 namespace torsion {
@@ -127,6 +129,36 @@ HyperelasticTet10Response HyperelasticLaw::tet10(const Tet10Vectors& x,
 
 namespace {
 
+// The linear tets begin..end-1 four at a time, where the kernel can (stable neo-Hookean, no
+// projected stiffness asked): their energies, forces and (if `factored`, the array of all tets'
+// factors, is not null) factored Hessians. Returns false if it cannot, else flags in
+// `needs_scalar` the tets it leaves to Tet4Elements::respond() (the barrier acts on them).
+bool batchNeoHookeanTets(const system_kernels::KernelTable& kernels, const FemModel& model,
+                         const HyperelasticLaw& law, const VolumeBarrier& barrier,
+                         const Eigen::VectorXd& positions, int begin, int end, bool projected,
+                         std::vector<Eigen::Vector3d>& forces, std::vector<double>& energy,
+                         FactoredTetHessian* factored, std::vector<unsigned char>& needs_scalar) {
+  if (projected || !law.hasFactoredHessian()) return false;
+  static_assert(sizeof(FactoredTetHessian) == 30 * sizeof(double), "c_0..c_3, then w");
+  static_assert(sizeof(TetRestData) == 10 * sizeof(double), "Bm then V, no padding");
+  system_kernels::NeoHookeanTet4Input in;
+  in.positions = positions.data();
+  in.nodes = model.elementNodes().data();
+  in.rest = model.tetRestData().data()->rest_shape_inverse.data();
+  in.mu = law.neo_hookean.mu;
+  in.lambda = law.neo_hookean.lambda;
+  in.alpha = law.neo_hookean.alpha;
+  in.rest_energy = law.neo_hookean.rest_energy;
+  in.barrier_threshold =
+      barrierOn(barrier) ? barrier.threshold : -std::numeric_limits<double>::infinity();
+  in.forces = forces.data()->data();
+  in.energy = energy.data();
+  in.factors = factored != nullptr ? factored->c[0].data() : nullptr;
+  in.needs_scalar = needs_scalar.data();
+  kernels.neo_hookean_tet4(in, begin, end);
+  return true;
+}
+
 // Where one element's results go: its energy, forces (N of them), and the stiffnesses asked for
 // (null: not asked; `factored` replaces `exact` for a law with that form).
 template <class Stiffness>
@@ -244,8 +276,16 @@ double HyperelasticPass::evaluateAs(const FemModel& model, const Eigen::VectorXd
     exact_.factored_tet4.resize(factored ? elements : 0);
     exact_.factored_shear = factored ? law.neo_hookean.mu : 0.0;
   }
+  needs_scalar_.resize(elements);
   parallel.forRange(static_cast<int>(elements), Elements::kGrain, [&](int begin, int end) {
+    bool batched = false;
+    if constexpr (Elements::kNodes == 4) {
+      batched = batchNeoHookeanTets(
+          system_->kernels(), model, law, barrier, positions, begin, end, projected, forces_,
+          energy_, factored ? exact_.factored_tet4.data() : nullptr, needs_scalar_);
+    }
     for (size_t e = static_cast<size_t>(begin); e < static_cast<size_t>(end); ++e) {
+      if (batched && needs_scalar_[e] == 0) continue;
       Elements::respond(model, law, barrier, positions, e, kind,
                         ElementOutputs<typename Elements::Stiffness>{
                             energy_[e], forces_.data() + Elements::kNodes * e,

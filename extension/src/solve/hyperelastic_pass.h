@@ -40,6 +40,10 @@ struct HyperelasticLaw {
 
 class HyperelasticPass {
  public:
+  /// The stable neo-Hookean tet4s are computed four at a time by `system`'s kernel build
+  /// (SystemOperator::kernels(), read at each evaluate()).
+  explicit HyperelasticPass(const SystemOperator& system) : system_(&system) {}
+
   /// Energy, forces (elementForces()) and the element stiffnesses `kind` asks for
   /// (projectedStiffnesses(): from the clamped, or for kMirrored the mirrored, tangent, positive
   /// semi-definite; exactStiffnesses(): the exact Hessians, factored for a law that has the form,
@@ -75,10 +79,12 @@ class HyperelasticPass {
   double evaluateAs(const FemModel& model, const Eigen::VectorXd& positions,
                     const Parallel& parallel, TetStiffnessKind kind);
 
+  const SystemOperator* system_;
   std::vector<Eigen::Vector3d> forces_;
   ElementStiffnesses projected_, exact_;
   std::vector<double> energy_;
-  std::vector<unsigned char> in_barrier_;  // per element: its linear tets below the threshold
+  std::vector<unsigned char> in_barrier_;    // per element: its linear tets below the threshold
+  std::vector<unsigned char> needs_scalar_;  // per element: left by the batched kernel
   int barrier_tets_ = 0;
   Eigen::VectorXd evaluated_positions_;
   bool exact_current_ = false;      // exact_ holds the stiffnesses at evaluated_positions_

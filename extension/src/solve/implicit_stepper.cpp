@@ -44,7 +44,7 @@ ImplicitStepper::ImplicitStepper(std::shared_ptr<const FemModel> model,
       settings_(settings),
       parallel_(parallel),
       system_(model_, parallel),
-      hyperelastic_(std::make_unique<HyperelasticPass>()),
+      hyperelastic_(std::make_unique<HyperelasticPass>(system_)),
       last_dt_(settings.time_step) {
   element_forces_.resize(static_cast<size_t>(model_->elementCount()) *
                          static_cast<size_t>(model_->nodesPerElement()));

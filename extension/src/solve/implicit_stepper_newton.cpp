@@ -54,14 +54,16 @@ double ImplicitStepper::computeHyperelasticForces(FemState& state) {
   barrier_tets_ = hyperelastic_->barrierTets();
   system_.gather(hyperelastic_->elementForces(), 1.0, elastic_forces_);
   // K_0's rotations (solveNewton): each element's at x_n, warm-started from its last as a
-  // corotated body's: tet4 by the corotated force kernel (its forces and energy unused; four tets
-  // at a time, and it writes the rotated gradients K_0's assembly reads), tet10 of its mean F.
+  // corotated body's: tet4 by the corotated force kernel (without its forces; four tets at a time,
+  // and it writes the rotated gradients K_0's assembly reads), tet10 of its mean F.
   const std::vector<int>& nodes = model_->elementNodes();
   if (model_->elementKind() == ElementKind::kTet4) {
     const SystemOperator::RotationOutputs outputs = system_.mutableRotationsAndGradients();
-    const system_kernels::Tet4ForceInput in =
+    system_kernels::Tet4ForceInput in =
         tet4ForceInput(*model_, state, model_->material().mu(), model_->material().lambda(),
                        outputs, element_forces_, element_energy_, needs_svd_);
+    in.forces = nullptr;  // the rotations only
+    in.energy = nullptr;
     parallel_.forRange(model_->elementCount(), kRotationGrain, [&](int begin, int end) {
       system_.kernels().tet4_forces(in, begin, end);
       for (int t = begin; t < end; ++t) {

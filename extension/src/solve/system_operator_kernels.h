@@ -76,8 +76,8 @@ struct Tet4ForceInput {
   double tolerance = 1e-6;              ///< rad
   double* quaternions = nullptr;        ///< in/out: x, y, z, w per tet (the last step's rotation)
   double* rotations = nullptr;          ///< out: R, 9 per tet, column-major
-  double* forces = nullptr;             ///< out: 12 per tet, N
-  double* energy = nullptr;             ///< out: per tet, J
+  double* forces = nullptr;             ///< out: 12 per tet, N (null: only R, q and the gradients)
+  double* energy = nullptr;             ///< out: per tet, J (with the forces)
   double* volumetric_strain = nullptr;  ///< out if not null: tr(R^T F) - 3 per tet
   /// out if not null: R g_a for the tet's four shape gradients g_a (g_1..3 the rows of Bm, g_0
   /// minus their sum), 12 per tet: what the assembly of K reads (AssemblyInput::rotated), written
@@ -88,6 +88,26 @@ struct Tet4ForceInput {
   unsigned char* needs_svd = nullptr;  ///< out: per tet
 };
 
+/// The stable neo-Hookean tet4 without the log term (fem/hyperelastic.h), four tets at a time:
+/// energy V (mu/2 (I_C - 3) + lambda/2 (J - alpha)^2 - rest_energy), forces f_a = -V P g_a with
+/// P = mu F + lambda (J - alpha) cof F, and, if `factors` is set, the factors of its exact Hessian
+/// (fem/factored_tet_hessian.h: U'' = lambda, U' = lambda (J - alpha)). A tet whose J is below
+/// `barrier_threshold` (the volume barrier acts on it; -infinity when it is off) or not a number
+/// is only flagged (needs_scalar = 1): the caller redoes it with the barrier, element by element.
+struct NeoHookeanTet4Input {
+  const double* positions = nullptr;  ///< 3 per node, m
+  const int* nodes = nullptr;         ///< 4 per tet
+  const double* rest = nullptr;       ///< per tet: Bm (9, column-major), then V; stride 10
+  double mu = 0, lambda = 0, alpha = 1, rest_energy = 0;  ///< StableNeoHookean's, Pa
+  double barrier_threshold = 0;                           ///< J
+  double* forces = nullptr;                               ///< out: 12 per tet, N
+  double* energy = nullptr;                               ///< out: per tet, J
+  /// out if not null: 30 per tet, FactoredTetHessian's layout (c_0..c_3, then w_ab at
+  /// nodePairIndex(a, b)).
+  double* factors = nullptr;
+  unsigned char* needs_scalar = nullptr;  ///< out: per tet
+};
+
 struct KernelTable {
   const char* name;  ///< "sse2" or "avx2+fma"
   void (*tet4_rows)(const AssemblyInput&, int row_begin, int row_end);
@@ -96,6 +116,7 @@ struct KernelTable {
   void (*factored_rows)(const AssemblyInput&, int row_begin, int row_end);
   void (*block_product)(const ProductInput&, int row_begin, int row_end);
   void (*tet4_forces)(const Tet4ForceInput&, int tet_begin, int tet_end);
+  void (*neo_hookean_tet4)(const NeoHookeanTet4Input&, int tet_begin, int tet_end);
 };
 
 /// The baseline x86-64 (or other architecture's default) build.
