@@ -9,6 +9,7 @@
 
 #include <chrono>
 #include <csignal>
+#include <cstdio>
 #include <fstream>
 #include <functional>
 #include <iostream>
@@ -18,6 +19,7 @@
 #include <random>
 #include <string>
 #include <thread>
+#include <utility>
 #include <vector>
 
 #include "isolated_call.h"
@@ -33,11 +35,20 @@ std::string readBytes(const std::string& path) {
   return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
 }
 
-std::string writeTemp(const std::string& name, const std::string& bytes) {
-  const std::string path =
-      ::testing::TempDir() + "bullet_import_" + std::to_string(getpid()) + "_" + name + ".bullet";
-  std::ofstream(path, std::ios::binary) << bytes;
-  return path;
+// A file in the test's temporary folder, removed when it goes out of scope.
+struct TempFile {
+  std::string path;
+  explicit TempFile(std::string file_path) : path(std::move(file_path)) {}
+  TempFile(const TempFile&) = delete;
+  TempFile& operator=(const TempFile&) = delete;
+  ~TempFile() { std::remove(path.c_str()); }
+};
+
+std::unique_ptr<TempFile> writeTemp(const std::string& name, const std::string& bytes) {
+  auto file = std::make_unique<TempFile>(::testing::TempDir() + "bullet_import_" +
+                                         std::to_string(getpid()) + "_" + name + ".bullet");
+  std::ofstream(file->path, std::ios::binary) << bytes;
+  return file;
 }
 
 // A scene with one FEM body (named `fem_name`) and the .bullet file at `path`.
@@ -128,7 +139,8 @@ TEST(BulletFileImport, AHeaderThatLiesAboutItsDataIsRefused) {
   for (const auto& [offset, byte] : lies) {
     std::string bytes = original;
     bytes[offset] = byte;
-    const std::string path = writeTemp(std::string("header_") + byte, bytes);
+    const auto file = writeTemp(std::string("header_") + byte, bytes);
+    const std::string& path = file->path;
     Result<SceneSpec> spec = parseWith(path);
     ASSERT_FALSE(spec.ok()) << "header byte " << offset << " = " << byte;
     std::cout << "[figures] header byte " << offset << " = '" << byte
@@ -157,7 +169,8 @@ TEST(BulletFileImport, CorruptedFilesEndAsErrorsOrCheckedBodiesNeverAsACrash) {
             static_cast<char>(std::uniform_int_distribution<int>(0, 255)(random));
       }
     }
-    const std::string path = writeTemp("corrupt", bytes);
+    const auto file = writeTemp("corrupt", bytes);
+    const std::string& path = file->path;
     Result<SceneSpec> spec = parseWith(path);
     if (spec.ok()) {
       ++loaded;
@@ -184,7 +197,7 @@ TEST(BulletFileImport, NamesInTheFileGoThroughTheSceneNameChecks) {
   {
     SerializedWorld w;
     w.add(box(0.1), 1, btVector3(0, 0, 1), "../escape");
-    Result<SceneSpec> spec = parseWith(writeTemp("escape", w.bytes()));
+    Result<SceneSpec> spec = parseWith(writeTemp("escape", w.bytes())->path);
     ASSERT_FALSE(spec.ok());
     EXPECT_TRUE(contains(spec.error().message, "rigid_bodies[0].name")) << spec.error().message;
   }
@@ -192,7 +205,7 @@ TEST(BulletFileImport, NamesInTheFileGoThroughTheSceneNameChecks) {
     SerializedWorld w;
     w.add(box(0.1), 1, btVector3(0, 0, 1), "box");
     w.add(box(0.1), 1, btVector3(0, 0, 2), "box");
-    Result<SceneSpec> spec = parseWith(writeTemp("twice", w.bytes()));
+    Result<SceneSpec> spec = parseWith(writeTemp("twice", w.bytes())->path);
     ASSERT_FALSE(spec.ok());
     EXPECT_TRUE(contains(spec.error().message, "duplicate rigid body name 'box'"))
         << spec.error().message;
@@ -201,7 +214,7 @@ TEST(BulletFileImport, NamesInTheFileGoThroughTheSceneNameChecks) {
     // FEM body "rigid_box" and rigid body "box" would write the same series files.
     SerializedWorld w;
     w.add(box(0.1), 1, btVector3(0, 0, 1), "box");
-    Result<SceneSpec> spec = parseWith(writeTemp("series", w.bytes()), "rigid_box");
+    Result<SceneSpec> spec = parseWith(writeTemp("series", w.bytes())->path, "rigid_box");
     ASSERT_FALSE(spec.ok());
     EXPECT_TRUE(contains(spec.error().message, "same series files")) << spec.error().message;
   }
@@ -215,7 +228,7 @@ TEST(BulletFileImport, ConstraintsAndShapesASceneCannotDescribeAreRefusedNamingT
     w.constraints.push_back(std::make_unique<btPoint2PointConstraint>(
         *a, *b, btVector3(0, 0, btScalar(0.5)), btVector3(0, 0, btScalar(-0.5))));
     w.world.addConstraint(w.constraints.back().get());
-    Result<SceneSpec> spec = parseWith(writeTemp("constraint", w.bytes()));
+    Result<SceneSpec> spec = parseWith(writeTemp("constraint", w.bytes())->path);
     ASSERT_FALSE(spec.ok());
     EXPECT_TRUE(contains(spec.error().message, "1 constraint(s)")) << spec.error().message;
   }
@@ -224,7 +237,7 @@ TEST(BulletFileImport, ConstraintsAndShapesASceneCannotDescribeAreRefusedNamingT
     w.add(
         std::make_unique<btCylinderShapeZ>(btVector3(btScalar(0.1), btScalar(0.1), btScalar(0.2))),
         1, btVector3(0, 0, 1), "can");
-    Result<SceneSpec> spec = parseWith(writeTemp("cylinder", w.bytes()));
+    Result<SceneSpec> spec = parseWith(writeTemp("cylinder", w.bytes())->path);
     ASSERT_FALSE(spec.ok());
     EXPECT_TRUE(contains(spec.error().message, "rigid body 0 (\"can\"): its shape is a CylinderZ"))
         << spec.error().message;
@@ -233,7 +246,7 @@ TEST(BulletFileImport, ConstraintsAndShapesASceneCannotDescribeAreRefusedNamingT
     // A body with a mass the scene refuses (Bullet's impulses would overflow).
     SerializedWorld w;
     w.add(box(0.1), 1e-30, btVector3(0, 0, 1), "feather");
-    Result<SceneSpec> spec = parseWith(writeTemp("feather", w.bytes()));
+    Result<SceneSpec> spec = parseWith(writeTemp("feather", w.bytes())->path);
     ASSERT_FALSE(spec.ok());
     EXPECT_TRUE(contains(spec.error().message, "rigid_bodies[0].mass")) << spec.error().message;
   }
