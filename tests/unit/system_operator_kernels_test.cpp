@@ -110,29 +110,63 @@ TEST(SystemOperatorKernels, Tet4ProductsMatchTheElementDifferentialsInEitherBuil
   }
 }
 
+// The kernel builds this machine runs: baseline, and AVX2 + FMA where the CPU has both.
+std::vector<const system_kernels::KernelTable*> kernelBuilds() {
+  std::vector<const system_kernels::KernelTable*> builds = {&system_kernels::genericKernels()};
+  if (std::strcmp(SystemOperator::bestKernelPath(), "avx2+fma") == 0)
+    builds.push_back(system_kernels::avx2Kernels());
+  return builds;
+}
+
+const Eigen::Matrix3d kTurn =
+    Eigen::Quaterniond(0.9, 0.3, -0.2, 0.4).normalized().toRotationMatrix();
+
+// The model's rest positions mapped by `A`, plus normal noise of deviation `noise` (seeded), flat.
+std::vector<double> deformedPositions(const FemModel& model, const Eigen::Matrix3d& A, double noise,
+                                      unsigned seed) {
+  std::mt19937 rng(seed);
+  std::normal_distribution<double> n(0, 1);
+  std::vector<double> positions;
+  for (const Eigen::Vector3d& X : model.mesh().restPositions()) {
+    const Eigen::Vector3d x = A * X + noise * Eigen::Vector3d(n(rng), n(rng), n(rng));
+    positions.insert(positions.end(), x.data(), x.data() + 3);
+  }
+  return positions;
+}
+
+std::array<Eigen::Vector3d, 4> tetCorners(const std::vector<double>& positions,
+                                          const std::vector<int>& nodes, size_t t) {
+  std::array<Eigen::Vector3d, 4> x;
+  for (size_t a = 0; a < 4; ++a)
+    x[a] = Eigen::Map<const Eigen::Vector3d>(positions.data() + 3 * nodes[4 * t + a]);
+  return x;
+}
+
+// A kernel's 12 forces of tet t against the element function's, relative to their size.
+void expectForcesNear(const std::vector<double>& forces, size_t t,
+                      const std::array<Eigen::Vector3d, 4>& expected, double tolerance,
+                      const char* build) {
+  const double scale = expected[0].norm() + expected[1].norm() + 1e-300;
+  for (size_t a = 0; a < 4; ++a)
+    EXPECT_LT(
+        (Eigen::Map<const Eigen::Vector3d>(forces.data() + 12 * t + 3 * a) - expected[a]).norm(),
+        tolerance * scale)
+        << build << " tet " << t;
+}
+
 // The batched per-tet pass (F, rotation, forces, energy, four tets at a time) against the element
 // functions it replaces, in each build: random deformations, warm-started from a nearby rotation,
 // the batch cut short at the end, and inverted tets flagged for the SVD path, not computed.
 TEST(SystemOperatorKernels, BatchedTet4ForcePassMatchesTheElementFunctions) {
   auto model = beam(ElementKind::kTet4);
   const int tets = model->elementCount() - 1;  // a short last batch
-  std::mt19937 rng(5);
-  std::normal_distribution<double> n(0, 1);
-  const Eigen::Matrix3d Q = Eigen::Quaterniond(0.9, 0.3, -0.2, 0.4).normalized().toRotationMatrix();
-  std::vector<double> positions;
-  for (const Eigen::Vector3d& X : model->mesh().restPositions()) {
-    const Eigen::Vector3d x = Q * X + 0.02 * Eigen::Vector3d(n(rng), n(rng), n(rng));
-    positions.insert(positions.end(), x.data(), x.data() + 3);
-  }
+  const std::vector<double> positions = deformedPositions(*model, kTurn, 0.02, 5);
   std::vector<int> nodes = model->elementNodes();
   std::swap(nodes[4 * 7 + 1], nodes[4 * 7 + 2]);  // tet 7 inverted
   const double mu = model->material().mu(), lambda = model->material().lambda();
-  std::vector<system_kernels::KernelTable const*> builds = {&system_kernels::genericKernels()};
-  if (std::strcmp(SystemOperator::bestKernelPath(), "avx2+fma") == 0)
-    builds.push_back(system_kernels::avx2Kernels());
-  for (const system_kernels::KernelTable* build : builds) {
+  for (const system_kernels::KernelTable* build : kernelBuilds()) {
     const Eigen::Quaterniond start(Eigen::AngleAxisd(0.1, Eigen::Vector3d::UnitX()) *
-                                   Eigen::Quaterniond(Q));
+                                   Eigen::Quaterniond(kTurn));
     std::vector<Eigen::Quaterniond> q(static_cast<size_t>(tets), start);
     std::vector<Eigen::Matrix3d> R(q.size());
     std::vector<double> forces(12 * q.size()), energy(q.size()), strain(q.size());
@@ -151,9 +185,7 @@ TEST(SystemOperatorKernels, BatchedTet4ForcePassMatchesTheElementFunctions) {
     in.needs_svd = needs_svd.data();
     build->tet4_forces(in, 0, tets);
     for (size_t t = 0; t < q.size(); ++t) {
-      std::array<Eigen::Vector3d, 4> x;
-      for (size_t a = 0; a < 4; ++a)
-        x[a] = Eigen::Map<const Eigen::Vector3d>(positions.data() + 3 * nodes[4 * t + a]);
+      const std::array<Eigen::Vector3d, 4> x = tetCorners(positions, nodes, t);
       const TetRestData& rest = model->tetRestData()[t];
       const Eigen::Matrix3d F = deformationGradient(x, rest.rest_shape_inverse);
       ASSERT_EQ(needs_svd[t], F.determinant() > 0 ? 0 : 1) << t;
@@ -162,13 +194,7 @@ TEST(SystemOperatorKernels, BatchedTet4ForcePassMatchesTheElementFunctions) {
       const Eigen::Matrix3d R_ref = extractRotation(F, q_ref);
       EXPECT_LT((R[t] - R_ref).norm(), 1e-12) << build->name << " tet " << t;
       const CorotatedResponse ref = corotatedResponse(F, R_ref, rest, mu, lambda);
-      const double scale = ref.forces[0].norm() + ref.forces[1].norm() + 1e-300;
-      for (size_t a = 0; a < 4; ++a)
-        EXPECT_LT(
-            (Eigen::Map<const Eigen::Vector3d>(forces.data() + 12 * t + 3 * a) - ref.forces[a])
-                .norm(),
-            1e-9 * scale)
-            << build->name << " tet " << t;
+      expectForcesNear(forces, t, ref.forces, 1e-9, build->name);
       EXPECT_NEAR(energy[t], ref.energy, 1e-9 * ref.energy) << build->name;
       EXPECT_NEAR(strain[t], (R_ref.transpose() * F).trace() - 3.0, 1e-12) << build->name;
     }
@@ -183,24 +209,14 @@ TEST(SystemOperatorKernels, BatchedTet4ForcePassMatchesTheElementFunctions) {
 TEST(SystemOperatorKernels, BatchedNeoHookeanPassMatchesTheElementFunctions) {
   auto model = beam(ElementKind::kTet4);
   const int tets = model->elementCount() - 1;  // a short last batch
-  std::mt19937 rng(11);
-  std::normal_distribution<double> n(0, 1);
-  const Eigen::Matrix3d Q = Eigen::Quaterniond(0.9, 0.3, -0.2, 0.4).normalized().toRotationMatrix();
   Eigen::Matrix3d stretch;
   stretch << 1.6, 0.3, 0, 0, 0.8, 0.2, 0.1, 0, 0.7;
-  std::vector<double> positions;
-  for (const Eigen::Vector3d& X : model->mesh().restPositions()) {
-    const Eigen::Vector3d x = Q * stretch * X + 0.05 * Eigen::Vector3d(n(rng), n(rng), n(rng));
-    positions.insert(positions.end(), x.data(), x.data() + 3);
-  }
+  const std::vector<double> positions = deformedPositions(*model, kTurn * stretch, 0.05, 11);
   std::vector<int> nodes = model->elementNodes();
   std::swap(nodes[4 * 7 + 1], nodes[4 * 7 + 2]);  // tet 7 inside out: J < 0, still the law's
   const StableNeoHookean law = StableNeoHookean::fromYoungPoisson(1e5, 0.45);
-  std::vector<system_kernels::KernelTable const*> builds = {&system_kernels::genericKernels()};
-  if (std::strcmp(SystemOperator::bestKernelPath(), "avx2+fma") == 0)
-    builds.push_back(system_kernels::avx2Kernels());
   for (const double threshold : {-std::numeric_limits<double>::infinity(), 0.9}) {
-    for (const system_kernels::KernelTable* build : builds) {
+    for (const system_kernels::KernelTable* build : kernelBuilds()) {
       const size_t count = static_cast<size_t>(tets);
       std::vector<double> forces(12 * count), energy(count), factors(30 * count);
       std::vector<unsigned char> needs_scalar(count, 2);
@@ -220,9 +236,7 @@ TEST(SystemOperatorKernels, BatchedNeoHookeanPassMatchesTheElementFunctions) {
       build->neo_hookean_tet4(in, 0, tets);
       int flagged = 0;
       for (size_t t = 0; t < count; ++t) {
-        std::array<Eigen::Vector3d, 4> x;
-        for (size_t a = 0; a < 4; ++a)
-          x[a] = Eigen::Map<const Eigen::Vector3d>(positions.data() + 3 * nodes[4 * t + a]);
+        const std::array<Eigen::Vector3d, 4> x = tetCorners(positions, nodes, t);
         const TetRestData& rest = model->tetRestData()[t];
         const Eigen::Matrix3d F = deformationGradient(x, rest.rest_shape_inverse);
         const double J = F.determinant();
@@ -232,13 +246,7 @@ TEST(SystemOperatorKernels, BatchedNeoHookeanPassMatchesTheElementFunctions) {
           continue;
         }
         const HyperelasticTetForces ref = hyperelasticTetForces(law, x, rest);
-        const double scale = ref.forces[0].norm() + ref.forces[1].norm() + 1e-300;
-        for (size_t a = 0; a < 4; ++a)
-          EXPECT_LT(
-              (Eigen::Map<const Eigen::Vector3d>(forces.data() + 12 * t + 3 * a) - ref.forces[a])
-                  .norm(),
-              1e-12 * scale)
-              << build->name << " tet " << t;
+        expectForcesNear(forces, t, ref.forces, 1e-12, build->name);
         EXPECT_NEAR(energy[t], ref.energy, 1e-12 * std::abs(ref.energy)) << build->name;
         const FactoredTetHessian h =
             factoredTetHessian(F, shapeGradients(rest.rest_shape_inverse), rest.volume, law.lambda,

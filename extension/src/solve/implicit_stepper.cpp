@@ -73,8 +73,11 @@ double ImplicitStepper::computeElasticForces(FemState& state) {
     tet_strain_.resize(nodal_pressure ? nodes.size() / 4 : 0);
     // Four tets at a time in the operator's kernel build (system_operator_kernels.h); the tets it
     // flags (det F <= 0) go through the SVD path here.
-    system_kernels::Tet4ForceInput in = tet4ForceInput(
-        *model_, state, mu, element_lambda, outputs, element_forces_, element_energy_, needs_svd_);
+    static_assert(sizeof(Eigen::Vector3d) == 3 * sizeof(double), "12 doubles per tet");
+    system_kernels::Tet4ForceInput in =
+        tet4ForceInput(*model_, state, mu, element_lambda, outputs, needs_svd_);
+    in.forces = element_forces_.data()->data();
+    in.energy = element_energy_.data();
     in.volumetric_strain = nodal_pressure ? tet_strain_.data() : nullptr;
     parallel_.forRange(model_->elementCount(), kTetGrain, [&](int begin, int end) {
       system_.kernels().tet4_forces(in, begin, end);

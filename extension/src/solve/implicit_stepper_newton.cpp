@@ -59,11 +59,8 @@ double ImplicitStepper::computeHyperelasticForces(FemState& state) {
   const std::vector<int>& nodes = model_->elementNodes();
   if (model_->elementKind() == ElementKind::kTet4) {
     const SystemOperator::RotationOutputs outputs = system_.mutableRotationsAndGradients();
-    system_kernels::Tet4ForceInput in =
-        tet4ForceInput(*model_, state, model_->material().mu(), model_->material().lambda(),
-                       outputs, element_forces_, element_energy_, needs_svd_);
-    in.forces = nullptr;  // the rotations only
-    in.energy = nullptr;
+    const system_kernels::Tet4ForceInput in = tet4ForceInput(
+        *model_, state, model_->material().mu(), model_->material().lambda(), outputs, needs_svd_);
     parallel_.forRange(model_->elementCount(), kRotationGrain, [&](int begin, int end) {
       system_.kernels().tet4_forces(in, begin, end);
       for (int t = begin; t < end; ++t) {

@@ -14,17 +14,15 @@
 
 namespace torsion {
 
-// The kernel's input for `model`'s tets at `state` with Lame constants mu, lambda. It writes
-// `outputs` (rotations and rotated gradients), the element forces and energies, and flags in
-// `needs_svd` (sized here) the tets it leaves to the SVD path.
+// The kernel's input for `model`'s tets at `state` with Lame constants mu, lambda: it writes
+// `outputs` (rotations and rotated gradients) and flags in `needs_svd` (sized here) the tets it
+// leaves to the SVD path. Without `forces` set (the caller's, with `energy`) it computes the
+// rotations only.
 inline system_kernels::Tet4ForceInput tet4ForceInput(const FemModel& model, FemState& state,
                                                      double mu, double lambda,
                                                      const SystemOperator::RotationOutputs& outputs,
-                                                     std::vector<Eigen::Vector3d>& element_forces,
-                                                     std::vector<double>& element_energy,
                                                      std::vector<unsigned char>& needs_svd) {
   static_assert(sizeof(TetRestData) == 10 * sizeof(double), "Bm then V, no padding");
-  static_assert(sizeof(Eigen::Vector3d) == 3 * sizeof(double), "12 doubles per tet");
   needs_svd.resize(static_cast<size_t>(model.elementCount()));
   system_kernels::Tet4ForceInput in;
   in.positions = state.positions.data();
@@ -34,8 +32,6 @@ inline system_kernels::Tet4ForceInput tet4ForceInput(const FemModel& model, FemS
   in.lambda = lambda;
   in.quaternions = state.element_rotations.data()->coeffs().data();
   in.rotations = outputs.rotations.data()->data();
-  in.forces = element_forces.data()->data();
-  in.energy = element_energy.data();
   in.rotated_gradients = outputs.rotated_gradients.data()->data();
   in.needs_svd = needs_svd.data();
   return in;
