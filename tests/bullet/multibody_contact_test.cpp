@@ -245,7 +245,8 @@ TEST(MultibodyContact, MotorGripperLiftsASoftBlockAndHoldsItWithoutSlip) {
   // its solution. 17-20 Newton iterations a step, up to three solves (the friction bounds
   // matched); 40-57 when the Newton model kept no curvature along a sliding row's slip
   // (sap_solver.h), one or two rows sticking per iteration.
-  const double newton_per_step = static_cast<double>(newton) / std::lround(5.0 / kDt);
+  const double newton_per_step =
+      static_cast<double>(newton) / static_cast<double>(std::lround(5.0 / kDt));
   std::printf("[figures] gripper hold: %.1f Newton iterations a step\n", newton_per_step);
   EXPECT_LT(newton_per_step, 30);
   const Eigen::Vector3d slip = femCentre(*block) - fingersMidpoint(g) - held;

@@ -18,6 +18,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <limits>
 #include <vector>
 
 #include "cylinder_torsion_reference.h"
@@ -126,7 +127,7 @@ double axialForceWithEndAt(int tets, const Material& m, double shift) {
   for (int k = 0; k <= kIncrements; ++k) {
     const WorldStepReport r = world.step();
     EXPECT_TRUE(r.ok) << r.message;
-    if (!r.ok) return NAN;
+    if (!r.ok) return std::numeric_limits<double>::quiet_NaN();
     EXPECT_TRUE(m.law == MaterialLaw::kCorotated || body->lastReport().newton.converged)
         << "step " << k << ": " << body->lastReport().message;
   }

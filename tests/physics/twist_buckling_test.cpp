@@ -27,6 +27,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <limits>
 #include <map>
 #include <memory>
 #include <vector>
@@ -137,7 +138,7 @@ double fitCriticalMoment(const std::vector<Level>& levels) {
   double top = 0;
   for (const Level& l : levels)
     top = std::max(top, l.torque);
-  double best = 0, best_residual = INFINITY;
+  double best = 0, best_residual = std::numeric_limits<double>::infinity();
   const int samples = 3000;
   for (int i = 1; i <= samples; ++i) {
     const double mc = top * (1 + 3.0 * i / samples);

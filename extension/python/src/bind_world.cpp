@@ -741,7 +741,7 @@ void bindWorld(py::module_& m) {
               if (!(cam.distance > 0))
                 throw py::value_error("camera distance: must be > 0 m, got " +
                                       formatNumber(cam.distance));
-              if (!(cam.fov_y > 0 && cam.fov_y < EIGEN_PI))
+              if (!(cam.fov_y > 0 && cam.fov_y < M_PI))
                 throw py::value_error("camera fov_y: must be in (0, pi) rad, got " +
                                       formatNumber(cam.fov_y));
               if (!(cam.up.norm() > 0)) throw py::value_error("camera up: must not be zero");

@@ -12,6 +12,7 @@
 #include <utility>
 
 #include "constrained_blocks.h"
+#include "serial_openmp.h"
 
 namespace torsion {
 
@@ -83,6 +84,7 @@ bool SparseCholesky::factorize(const Eigen::SparseMatrix<double>& lower) {
   valid_ = false;
   if (!Eigen::Map<const Eigen::VectorXd>(lower.valuePtr(), lower.nonZeros()).allFinite())
     return false;
+  const detail::SerialOpenMpScope serial;
   if (m.rows != lower.rows() || m.entries != lower.nonZeros()) {
     m.factor.analyzePattern(lower);
     m.rows = lower.rows();
@@ -94,10 +96,12 @@ bool SparseCholesky::factorize(const Eigen::SparseMatrix<double>& lower) {
 }
 
 void SparseCholesky::solve(const Eigen::VectorXd& b, Eigen::VectorXd& x) const {
+  const detail::SerialOpenMpScope serial;
   x = impl_->factor.solve(b);
 }
 
 void SparseCholesky::solve(const Eigen::MatrixXd& B, Eigen::MatrixXd& X) const {
+  const detail::SerialOpenMpScope serial;
   X = impl_->factor.solve(B);
 }
 
@@ -274,6 +278,7 @@ bool CholmodSolver::factorize(const SystemOperator& op, const NodeConstraints& c
   const Eigen::SparseMatrix<double>& A = assemble(op, constraints);
   m.matrix_finite = Eigen::Map<const Eigen::VectorXd>(A.valuePtr(), A.nonZeros()).allFinite();
   if (!m.matrix_finite) return false;
+  const detail::SerialOpenMpScope serial;
   if (!m.analysed) {
     m.factor.analyzePattern(A);
     m.analysed = true;
@@ -291,7 +296,10 @@ void CholmodSolver::applyInverse(const NodeConstraints& constraints, const Eigen
                                  Eigen::VectorXd& z) const {
   Eigen::VectorXd filtered = r;
   constraints.filter(filtered);
-  z = impl_->factor.solve(filtered);
+  {
+    const detail::SerialOpenMpScope serial;
+    z = impl_->factor.solve(filtered);
+  }
   constraints.filter(z);
 }
 
@@ -315,7 +323,10 @@ LinearSolveReport CholmodSolver::solve(const SystemOperator& op, const NodeConst
                                                 "positive definite)"
                                               : "the matrix is not finite (overflow)");
   }
-  m.solution = m.factor.solve(m.rhs);
+  {
+    const detail::SerialOpenMpScope serial;
+    m.solution = m.factor.solve(m.rhs);
+  }
   constraints.filter(m.solution);
   v = m.prescribed + m.solution;
 
