@@ -25,6 +25,20 @@ pattern=$(printf '|%s' "${dirs[@]}")
 pattern="^$root/(${pattern:1})/.*\\.cpp\$|^$build_abs/(${pattern:1})/.*/Unity/unity_[0-9]+_cxx\\.cxx\$"
 files=$(sed -n 's/^ *"file": "\(.*\)",\{0,1\}$/\1/p' "$build/compile_commands.json" | grep -E "$pattern" |
   sort -u)
+# Longest first, so that the two workers end together: a file's cost is the size of the sources it
+# compiles (a unity batch's included .cpp files). In listed order, the largest batch could start
+# last and run alone.
+source_bytes() {
+  local file=$1
+  if [[ $file == "$build_abs"/* ]]; then
+    sed -n 's/^#include "\(.*\)"$/\1/p' "$file" | xargs cat | wc -c
+  else
+    wc -c <"$file"
+  fi
+}
+files=$(while read -r file; do
+  printf '%s %s\n' "$(source_bytes "$file")" "$file"
+done <<<"$files" | sort -rn | cut -d' ' -f2-)
 count=$(wc -l <<<"$files")
 echo "clang-tidy: $count files (sources or unity batches) under ${dirs[*]}"
 
