@@ -273,6 +273,85 @@ TEST(SystemOperatorKernels, BatchedNeoHookeanPassMatchesTheElementFunctions) {
   }
 }
 
+// The exact Hessian assembled from its factors (the kernel a Newton direction runs) against the
+// same Hessians expanded to 12x12 element stiffnesses and assembled block by block, in each
+// build: on large random deformations with a tet inside out, and with lagged blocks (a step's
+// stiffness damping) added by the assembly at a weight, as both forms take them.
+TEST(SystemOperatorKernels, FactoredAssemblyMatchesTheExpandedElementStiffnesses) {
+  auto model = beam(ElementKind::kTet4);
+  Eigen::Matrix3d stretch;
+  stretch << 1.6, 0.3, 0, 0, 0.8, 0.2, 0.1, 0, 0.7;
+  const std::vector<double> positions = deformedPositions(*model, kTurn * stretch, 0.05, 13);
+  const std::vector<int>& nodes = model->elementNodes();
+  const StableNeoHookean law = StableNeoHookean::fromYoungPoisson(1e5, 0.45);
+  ElementStiffnesses factored, expanded;
+  factored.factored_shear = law.mu;
+  for (size_t t = 0; t < static_cast<size_t>(model->elementCount()); ++t) {
+    const std::array<Eigen::Vector3d, 4> x = tetCorners(positions, nodes, t);
+    const TetRestData& rest = model->tetRestData()[t];
+    const Eigen::Matrix3d F = deformationGradient(x, rest.rest_shape_inverse);
+    const std::array<Eigen::Vector3d, 4> g = shapeGradients(rest.rest_shape_inverse);
+    // Tet 7 mirrored: J < 0 (the law is defined there, and its factors change sign).
+    const Eigen::Matrix3d tet_F = t == 7 ? Eigen::Matrix3d(-F) : F;
+    factored.factored_tet4.push_back(factoredTetHessian(
+        tet_F, g, rest.volume, law.lambda, law.lambda * (tet_F.determinant() - law.alpha)));
+    expanded.tet4.push_back(
+        expandFactoredHessian(factored.factored_tet4.back(), g, law.mu * rest.volume));
+  }
+  Parallel parallel(2);
+  SystemOperator corotated(model, parallel);
+  std::mt19937 rng(17);
+  randomRotations(corotated, rng);
+  const std::vector<Eigen::Matrix3d> lagged = corotated.stiffnessBlocks();
+  for (const double weight : {0.0, 3.5}) {
+    SystemOperator reference(model, parallel);
+    reference.setElementStiffnesses(&expanded);
+    if (weight != 0) reference.setLaggedStiffness(&lagged, weight);
+    const std::vector<Eigen::Matrix3d>& want = reference.stiffnessBlocks();
+    double largest = 0;
+    for (const Eigen::Matrix3d& block : want)
+      largest = std::max(largest, block.cwiseAbs().maxCoeff());
+    for (const bool baseline : {false, true}) {
+      SystemOperator op(model, parallel);
+      op.useBaselineKernels(baseline);
+      op.setElementStiffnesses(&factored);
+      if (weight != 0) op.setLaggedStiffness(&lagged, weight);
+      const std::vector<Eigen::Matrix3d>& got = op.stiffnessBlocks();
+      ASSERT_EQ(got.size(), want.size());
+      double difference = 0;
+      for (size_t s = 0; s < got.size(); ++s)
+        difference = std::max(difference, (got[s] - want[s]).cwiseAbs().maxCoeff());
+      EXPECT_LE(difference, 1e-12 * largest) << op.kernelPath() << " weight " << weight;
+    }
+  }
+}
+
+// A step keeps K_0 for its damping by taking the blocks (no copy): the taken blocks are K, and
+// the operator, its storage handed over, assembles the same K again at its next use.
+TEST(SystemOperatorKernels, TakenBlocksAreKAndTheOperatorAssemblesAgain) {
+  auto model = beam(ElementKind::kTet4);
+  Parallel parallel(1);
+  SystemOperator op(model, parallel), fresh(model, parallel);
+  std::mt19937 rng(19);
+  randomRotations(op, rng);
+  fresh.mutableRotations() = op.rotations();
+  op.setCoefficients(1.01, 1e-4);
+  fresh.setCoefficients(1.01, 1e-4);
+  std::vector<Eigen::Matrix3d> taken(3, Eigen::Matrix3d::Constant(7.0));  // storage handed back
+  op.takeStiffnessBlocks(taken);
+  const std::vector<Eigen::Matrix3d>& want = fresh.stiffnessBlocks();
+  ASSERT_EQ(taken.size(), want.size());
+  EXPECT_EQ(std::memcmp(taken.data(), want.data(), want.size() * sizeof(Eigen::Matrix3d)), 0);
+  const Eigen::VectorXd y = randomVector(3 * model->nodeCount(), rng);
+  Eigen::VectorXd a, b;
+  op.multiply(y, a);
+  fresh.multiply(y, b);
+  EXPECT_EQ(std::memcmp(a.data(), b.data(), sizeof(double) * static_cast<size_t>(b.size())), 0);
+  EXPECT_EQ(
+      std::memcmp(op.stiffnessBlocks().data(), want.data(), want.size() * sizeof(Eigen::Matrix3d)),
+      0);
+}
+
 // The tet4 force pass writes the rotated gradients K is assembled from (one pass over the tets
 // instead of two): K must be bit for bit the one the assembly's own pass gives for the same
 // rotations, including a tet the force pass hands to the SVD path (inverted).

@@ -254,6 +254,7 @@ struct Tet10Elements {
 
 double HyperelasticPass::evaluate(const FemModel& model, const Eigen::VectorXd& positions,
                                   const Parallel& parallel, TetStiffnessKind kind) {
+  ++evaluations_;
   return model.elementKind() == ElementKind::kTet10
              ? evaluateAs<Tet10Elements>(model, positions, parallel, kind)
              : evaluateAs<Tet4Elements>(model, positions, parallel, kind);

@@ -62,6 +62,9 @@ class HyperelasticPass {
   void forget() { evaluated_positions_.resize(0); }
   /// The last evaluate()'s energy, J.
   double evaluatedEnergy() const { return evaluated_energy_; }
+  /// How many evaluate() calls this pass has made: a caller's copy of the forces is current
+  /// while this is unchanged.
+  long evaluations() const { return evaluations_; }
 
   /// N per element (4 for tet4, 10 for tet10), index N e + a: the force on the element's node a,
   /// N (SystemOperator::gather).
@@ -90,6 +93,7 @@ class HyperelasticPass {
   bool exact_current_ = false;      // exact_ holds the stiffnesses at evaluated_positions_
   bool projected_current_ = false;  // and projected_ the projected ones
   double evaluated_energy_ = 0;
+  long evaluations_ = 0;
 };
 
 }  // namespace torsion

@@ -52,7 +52,13 @@ double ImplicitStepper::computeHyperelasticForces(FemState& state) {
   if (!hyperelastic_->holdsForcesAt(state.positions))
     hyperelastic_->evaluate(*model_, state.positions, parallel_, TetStiffnessKind::kNone);
   barrier_tets_ = hyperelastic_->barrierTets();
-  system_.gather(hyperelastic_->elementForces(), 1.0, elastic_forces_);
+  system_.setStiffnessAdditions({});  // the pass holds the barrier (a live edit may leave some)
+  // The last residual gathered these forces already when the pass has not evaluated since.
+  if (gathered_evaluation_ == hyperelastic_->evaluations()) {
+    elastic_forces_ = iterate_forces_;
+  } else {
+    system_.gather(hyperelastic_->elementForces(), 1.0, elastic_forces_);
+  }
   // K_0's rotations (solveNewton): each element's at x_n, warm-started from its last as a
   // corotated body's: tet4 by the corotated force kernel (without its forces; four tets at a time,
   // and it writes the rotated gradients K_0's assembly reads), tet10 of its mean F.
@@ -128,6 +134,7 @@ double ImplicitStepper::iterateResidual(const Eigen::VectorXd& v, double energy)
   const Material& material = model_->material();
   const double dt = last_dt_;
   system_.gather(hyperelastic_->elementForces(), 1.0, iterate_forces_);
+  gathered_evaluation_ = hyperelastic_->evaluations();
   if (material.stiffness_damping > 0) {
     system_.multiplyBlocks(start_stiffness_, v, lagged_product_);
   } else {
@@ -253,7 +260,10 @@ LinearSolveReport ImplicitStepper::solveNewton() {
   // equilibrium).
   Eigen::VectorXd prescribed = Eigen::VectorXd::Zero(rhs_.size());
   constraints_->impose(prescribed);
-  system_.multiply(prescribed, scratch_);
+  constrained_nodes_.clear();
+  for (int i = 0; i < model_->nodeCount(); ++i)
+    if (constraints_->isConstrained(i)) constrained_nodes_.push_back(i);
+  system_.multiplyFromNodes(prescribed, constrained_nodes_, scratch_);
   Eigen::VectorXd free_rhs = rhs_ - scratch_;
   constraints_->filter(free_rhs);
   const double reference = free_rhs.norm() + dt * elastic_forces_.norm();
@@ -264,7 +274,7 @@ LinearSolveReport ImplicitStepper::solveNewton() {
     total = linearSolve(*constraints_, rhs_, v, settings_.tolerance);
     newton_.iterations = 1;
   }
-  if (material.stiffness_damping > 0) start_stiffness_ = system_.stiffnessBlocks();
+  if (material.stiffness_damping > 0) system_.takeStiffnessBlocks(start_stiffness_);
   system_.setCoefficients(1.0 + dt * material.mass_damping, dt * dt);
   system_.setLaggedStiffness(material.stiffness_damping > 0 ? &start_stiffness_ : nullptr,
                              material.stiffness_damping / dt);

@@ -259,6 +259,8 @@ void SystemOperator::assembleElementStiffnesses(const std::vector<Stiffness>& st
         const int a = (term / N) % N, b = term % N;
         sum += stiffness[static_cast<size_t>(term / (N * N))].template block<3, 3>(3 * a, 3 * b);
       }
+      if (lagged_blocks_ != nullptr)
+        sum += lagged_weight_ * (*lagged_blocks_)[static_cast<size_t>(s)];
       block_values_[static_cast<size_t>(s)] = sum;
     }
   });
@@ -278,6 +280,10 @@ void SystemOperator::assembleFactoredHessians(const std::vector<FactoredTetHessi
   in.slot_laplacian = slot_laplacian_.data();
   in.shear = shear;
   in.blocks = block_values_.data()->data();
+  if (lagged_blocks_ != nullptr) {
+    in.lagged = lagged_blocks_->data()->data();
+    in.lagged_weight = lagged_weight_;
+  }
   parallel_.forRange(model_->nodeCount(), kNodeGrain,
                      [&](int begin, int end) { kernels_->factored_rows(in, begin, end); });
 }
@@ -293,12 +299,9 @@ void SystemOperator::assemble() const {
     } else {
       assembleElementStiffnesses(element_stiffnesses_->tet4);
     }
+    // (The lagged blocks are added by the assembly itself, in the same pass.)
     for (const SlotBlock& addition : stiffness_additions_)
       block_values_[static_cast<size_t>(addition.slot)] += addition.block;
-    if (lagged_blocks_ != nullptr) {
-      for (size_t s = 0; s < block_values_.size(); ++s)
-        block_values_[s] += lagged_weight_ * (*lagged_blocks_)[s];
-    }
     assembled_ = true;
     return;
   }
@@ -578,6 +581,13 @@ void SystemOperator::addNodalPressureDiagonal(std::vector<Eigen::Matrix3d>& bloc
 const std::vector<Eigen::Matrix3d>& SystemOperator::stiffnessBlocks() const {
   assemble();
   return block_values_;
+}
+
+void SystemOperator::takeStiffnessBlocks(std::vector<Eigen::Matrix3d>& blocks) {
+  assemble();
+  blocks.swap(block_values_);
+  block_values_.resize(blocks.size());  // every assembly writes every block
+  assembled_ = false;
 }
 
 void SystemOperator::volumetricPatch(int node, std::vector<int>& patch_nodes,

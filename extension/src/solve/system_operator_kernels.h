@@ -44,6 +44,10 @@ struct AssemblyInput {
   const double* factored = nullptr;
   const double* slot_laplacian = nullptr;
   double shear = 0;
+  /// Factored tet4: blocks in the same pattern (9 doubles per slot) added to each, times
+  /// `lagged_weight` (a hyperelastic step's stiffness damping); null: none.
+  const double* lagged = nullptr;
+  double lagged_weight = 0;
 };
 
 /// out_n = stiffness_scale (K y)_n + mass_scale m_n y_n for block rows n; K is stored as the upper
@@ -112,7 +116,8 @@ struct KernelTable {
   const char* name;  ///< "sse2" or "avx2+fma"
   void (*tet4_rows)(const AssemblyInput&, int row_begin, int row_end);
   void (*tet10_rows)(const AssemblyInput&, int row_begin, int row_end);
-  /// tet4 blocks from factored Hessians: K_ab = shear V (g_a . g_b) I + c_a c_b^T + [+-w]x.
+  /// tet4 blocks from factored Hessians: K_ab = shear V (g_a . g_b) I + c_a c_b^T + [+-w]x, plus
+  /// lagged_weight times the lagged block.
   void (*factored_rows)(const AssemblyInput&, int row_begin, int row_end);
   void (*block_product)(const ProductInput&, int row_begin, int row_end);
   void (*tet4_forces)(const Tet4ForceInput&, int tet_begin, int tet_end);

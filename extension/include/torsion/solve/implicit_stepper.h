@@ -270,6 +270,10 @@ class ImplicitStepper {
   Eigen::VectorXd start_positions_, start_velocities_, step_external_forces_;
   NodeConstraints newton_constraints_;
   std::vector<Eigen::Matrix3d> start_stiffness_;
+  // The pass's evaluations() when iterate_forces_ was gathered; the constrained nodes of the
+  // Newton residual's scale (their rows of A v_prescribed).
+  long gathered_evaluation_ = -1;
+  std::vector<int> constrained_nodes_;
   Eigen::VectorXd iterate_forces_, newton_residual_, lagged_product_, trial_;
   NewtonReport newton_;
   // linearizeAboutFreeMotion(): the prepared system is the linearisation about free_velocity_.

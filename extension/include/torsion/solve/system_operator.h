@@ -97,7 +97,8 @@ class SystemOperator {
   /// Marks K stale: call again whenever their values change.
   void setElementStiffnesses(const ElementStiffnesses* stiffnesses);
   /// Blocks in this operator's pattern (not owned; nullptr: none) added to K, times `weight`,
-  /// after each assembly: a hyperelastic step's stiffness damping, lagged at the step's start.
+  /// by each assembly from element stiffnesses: a hyperelastic step's stiffness damping, lagged
+  /// at the step's start.
   void setLaggedStiffness(const std::vector<Eigen::Matrix3d>* blocks, double weight);
   /// out = B y for blocks B in this operator's pattern (e.g. a copy of stiffnessBlocks()).
   void multiplyBlocks(const std::vector<Eigen::Matrix3d>& blocks, const Eigen::VectorXd& y,
@@ -140,6 +141,9 @@ class SystemOperator {
   const std::vector<int>& blockRowOffsets() const { return row_offsets_; }
   const std::vector<int>& blockColumns() const { return block_columns_; }
   const std::vector<Eigen::Matrix3d>& stiffnessBlocks() const;
+  /// stiffnessBlocks() moved into `blocks` (its old contents become this operator's storage, so
+  /// a step that keeps K each step copies nothing); K is assembled again at the next use.
+  void takeStiffnessBlocks(std::vector<Eigen::Matrix3d>& blocks);
   /// The assembly and the product run in kernels on plain arrays
   /// (src/solve/system_operator_kernels.h),
   // built twice: for baseline x86-64 and for AVX2 + FMA, chosen at run time (kernelPath()).
