@@ -100,8 +100,13 @@ LinearSolveReport ProjectedCg::solve(const SystemOperator& op, const NodeConstra
   }
 
   constraints.impose(v);
-  op.multiply(v, q_);
-  r_ = b - q_;
+  // A start at zero (a Newton direction) has r = b: no product (A 0 is +-0, and b - +-0 is b).
+  if (v.isZero(0.0)) {
+    r_ = b;
+  } else {
+    op.multiply(v, q_);
+    r_ = b - q_;
+  }
   constraints.filter(r_);
   const LinearSolveReport report = pcgIterations(
       [&](const Eigen::VectorXd& in, Eigen::VectorXd& out) {
