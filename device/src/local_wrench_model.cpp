@@ -1,24 +1,11 @@
 #include "torsion/device/local_wrench_model.h"
 
+#include <algorithm>
 #include <cmath>
 
 #include "torsion/device/pose_math.h"
 
 namespace torsion::device {
-
-namespace {
-
-// Scales v (3) down to norm `limit`, direction kept.
-void clampNorm3(double* v, double limit) {
-  const double n = std::sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
-  if (n > limit && n > 0) {
-    const double s = limit / n;
-    for (int k = 0; k < 3; ++k)
-      v[k] *= s;
-  }
-}
-
-}  // namespace
 
 bool predicts(const SimulationWrench& simulated) {
   for (double k : simulated.stiffness)
@@ -35,8 +22,10 @@ Wrench renderLocalModel(const SimulationWrench& simulated, const Pose& pose, con
     for (int c = 0; c < 6; ++c)
       prediction[r] += simulated.stiffness[6 * r + c] * delta[c];
   if (bound != nullptr) {
-    clampNorm3(prediction, bound->max_force);
-    clampNorm3(prediction + 3, bound->max_torque);
+    const Vec3 force = clampNorm({prediction[0], prediction[1], prediction[2]}, bound->max_force);
+    const Vec3 torque = clampNorm({prediction[3], prediction[4], prediction[5]}, bound->max_torque);
+    const double clamped[6] = {force.x, force.y, force.z, torque.x, torque.y, torque.z};
+    std::copy(clamped, clamped + 6, prediction);
   }
   const double w[6] = {simulated.wrench.force.x + prediction[0] - damper.linear * twist[0],
                        simulated.wrench.force.y + prediction[1] - damper.linear * twist[1],

@@ -42,20 +42,6 @@ Vec3 lerp(const Vec3& a, const Vec3& b, double u) {
   return {a.x + u * (b.x - a.x), a.y + u * (b.y - a.y), a.z + u * (b.z - a.z)};
 }
 
-Vec3 clampNorm(const Vec3& v, double limit) {
-  const double n = norm(v);
-  if (!(n > limit)) return v;
-  const double s = limit / n;
-  return {s * v.x, s * v.y, s * v.z};
-}
-
-// `from` moved toward `to` by at most `step`.
-Vec3 approach(const Vec3& from, const Vec3& to, double step) {
-  const Vec3 d{to.x - from.x, to.y - from.y, to.z - from.z};
-  const Vec3 limited = clampNorm(d, step);
-  return {from.x + limited.x, from.y + limited.y, from.z + limited.z};
-}
-
 // One part (force or torque) of the reserve need: the work of `w` over the coming tick at
 // velocity `v`, plus what ramping |w| to zero at `rate` (per s) could give out at `speed`.
 double partNeed(const Vec3& w, const Vec3& v, double dt, double speed, double rate) {

@@ -26,6 +26,20 @@ double norm(const Vec3& v) {
 bool isFinite(const Vec3& v) {
   return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z);
 }
+Vec3 clampNorm(const Vec3& v, double limit) {
+  if (!(limit > 0) || !isFinite(v)) return {};
+  const double n = norm(v);
+  if (n <= limit) return v;
+  // n may overflow to infinity for finite components near the double range: then zero, too.
+  const double s = limit / n;
+  return {s * v.x, s * v.y, s * v.z};
+}
+Vec3 approach(const Vec3& from, const Vec3& to, double step) {
+  const Vec3 delta = to - from;
+  if (!(step > 0) || !isFinite(delta)) return from;
+  if (norm(delta) <= step * (1 + 1e-9)) return to;
+  return from + clampNorm(delta, step);
+}
 
 Quat operator*(const Quat& a, const Quat& b) {
   return {

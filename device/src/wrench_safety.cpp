@@ -7,17 +7,6 @@
 
 namespace torsion::device {
 
-namespace {
-
-Vec3 clampNorm(const Vec3& v, double max_norm) {
-  const double n = norm(v);
-  if (n <= max_norm) return v;
-  const double scale = max_norm > 0 ? max_norm / n : 0.0;
-  return {v.x * scale, v.y * scale, v.z * scale};
-}
-
-}  // namespace
-
 bool isFinite(const Wrench& wrench) {
   return isFinite(wrench.force) && isFinite(wrench.torque);
 }
@@ -32,15 +21,6 @@ Wrench saturate(const Wrench& wrench, const DeviceLimits& limits) {
 namespace torsion::device {
 
 namespace {
-
-// Moves `from` towards `to` by at most `step` (as a vector).
-Vec3 approach(const Vec3& from, const Vec3& to, double step) {
-  const Vec3 delta{to.x - from.x, to.y - from.y, to.z - from.z};
-  // A hair of slack so that rounding over hundreds of ticks cannot leave 1e-13 N instead of 0.
-  if (norm(delta) <= step * (1 + 1e-9)) return to;
-  const Vec3 limited = clampNorm(delta, step);
-  return {from.x + limited.x, from.y + limited.y, from.z + limited.z};
-}
 
 // Shrinks `v` towards zero by `step` along its own direction.
 Vec3 shrink(const Vec3& v, double step) {

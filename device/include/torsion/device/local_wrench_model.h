@@ -21,7 +21,8 @@ struct CouplingDamper {
 /// With `bound`, the prediction K_h (pose - pose_sim) is scaled down (force and torque each as a
 /// vector, direction kept) to the device's max_force and max_torque: a pose far from the one
 /// the simulation used (a stalled simulation, a jump of the device) cannot extrapolate a
-/// linearisation into a wrench beyond what the device may render.
+/// linearisation into a wrench beyond what the device may render. A prediction that is not
+/// finite is dropped (zero), as the device layer's limiter does (pose_math.h, clampNorm()).
 Wrench renderLocalModel(const SimulationWrench& simulated, const Pose& pose, const double twist[6],
                         const CouplingDamper& damper, const DeviceLimits* bound = nullptr);
 

@@ -13,6 +13,15 @@ double dot(const Vec3& a, const Vec3& b);
 Vec3 cross(const Vec3& a, const Vec3& b);
 double norm(const Vec3& v);
 bool isFinite(const Vec3& v);
+/// v scaled down to norm `limit` where it is longer, its direction kept (v itself, bit for bit,
+/// where it is not). The safe answer elsewhere: zero for a limit that is not positive (0,
+/// negative or NaN) and for a vector that is not finite. The one limiter of the device layer's
+/// force, torque and rate limits.
+Vec3 clampNorm(const Vec3& v, double limit);
+/// `from` moved toward `to` by at most `step` (as a vector): `to` itself, exactly, when it lies
+/// within `step` (a 1e-9 relative slack, so rounding over hundreds of ticks cannot leave a
+/// hair short of it); `from` when the move is not finite or `step` is not positive.
+Vec3 approach(const Vec3& from, const Vec3& to, double step);
 
 Quat operator*(const Quat& a, const Quat& b);
 Quat conjugate(const Quat& q);
