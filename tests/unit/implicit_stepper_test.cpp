@@ -223,6 +223,21 @@ TEST(ImplicitStepper, DirectionConstraintFixesOnlyTheNormalComponent) {
   }
 }
 
+// The constrained nodes, fully or along a direction, in ascending order, and none after a reset;
+// the list a caller passes in is replaced, not appended to.
+TEST(ImplicitStepper, ConstrainedNodesListsHeldAndDirectionNodesAscending) {
+  NodeConstraints constraints(6);
+  constraints.prescribeVelocity(4, Eigen::Vector3d(1, 0, 0));
+  constraints.prescribeDirection(1, Eigen::Vector3d::UnitZ(), 0.0);
+  std::vector<int> nodes = {7, 7, 7};
+  constraints.constrainedNodes(nodes);
+  EXPECT_EQ(nodes, (std::vector<int>{1, 4}));
+  EXPECT_EQ(static_cast<int>(nodes.size()), constraints.constrainedCount());
+  constraints.reset(6);
+  constraints.constrainedNodes(nodes);
+  EXPECT_TRUE(nodes.empty());
+}
+
 FemState twistedRun(int threads, LinearSolverKind kind, int steps = 15,
                     PreconditionerKind preconditioner = PreconditionerKind::kBlockJacobi,
                     std::shared_ptr<const FemModel> model = beamModel(),

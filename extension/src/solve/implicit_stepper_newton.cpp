@@ -268,9 +268,7 @@ LinearSolveReport ImplicitStepper::solveNewton() {
   // equilibrium).
   Eigen::VectorXd prescribed = Eigen::VectorXd::Zero(rhs_.size());
   constraints_->impose(prescribed);
-  constrained_nodes_.clear();
-  for (int i = 0; i < model_->nodeCount(); ++i)
-    if (constraints_->isConstrained(i)) constrained_nodes_.push_back(i);
+  constraints_->constrainedNodes(constrained_nodes_);
   system_.multiplyFromNodes(prescribed, constrained_nodes_, scratch_);
   Eigen::VectorXd free_rhs = rhs_ - scratch_;
   constraints_->filter(free_rhs);

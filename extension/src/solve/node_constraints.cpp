@@ -36,6 +36,12 @@ int NodeConstraints::constrainedCount() const {
   return count;
 }
 
+void NodeConstraints::constrainedNodes(std::vector<int>& nodes) const {
+  nodes.clear();
+  for (size_t i = 0; i < kind_.size(); ++i)
+    if (kind_[i] != Kind::kFree) nodes.push_back(static_cast<int>(i));
+}
+
 Eigen::Vector3d NodeConstraints::filterNode(int node, const Eigen::Vector3d& v) const {
   switch (kind_[static_cast<size_t>(node)]) {
     case Kind::kFree:

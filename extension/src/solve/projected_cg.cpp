@@ -74,9 +74,7 @@ LinearSolveReport ProjectedCg::solve(const SystemOperator& op, const NodeConstra
   // part alone.
   prescribed_only_.setZero(v.size());
   constraints.impose(prescribed_only_);
-  constrained_nodes_.clear();
-  for (int i = 0; i < n; ++i)
-    if (constraints.isConstrained(i)) constrained_nodes_.push_back(i);
+  constraints.constrainedNodes(constrained_nodes_);
   op.multiplyFromNodes(prescribed_only_, constrained_nodes_, q_);
   r_ = b - q_;
   constraints.filter(r_);

@@ -33,6 +33,8 @@ class NodeConstraints {
   Kind kind(int node) const { return kind_[static_cast<size_t>(node)]; }
   bool isConstrained(int node) const { return kind(node) != Kind::kFree; }
   int constrainedCount() const;
+  /// The constrained nodes, ascending, into `nodes` (cleared first; its capacity is kept).
+  void constrainedNodes(std::vector<int>& nodes) const;
 
   /// The same constraints with every prescribed value zero (a Newton correction's: the iterate
   /// already meets the prescriptions).
