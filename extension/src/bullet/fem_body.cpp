@@ -208,6 +208,16 @@ void FemBody::predict(double dt, bool for_contact) {
   contacts_->beginStep(dt);
 }
 
+sap::FemIslandBody& FemBody::islandBody() {
+  const PreparedSystem p = stepper_.prepared();
+  if (island_body_ == nullptr) {
+    island_body_ = std::make_unique<sap::FemIslandBody>(*p.op, *p.constraints, *p.b);
+  } else {
+    island_body_->beginStep(*p.b);
+  }
+  return *island_body_;
+}
+
 bool FemBody::prepare(const StepContext& ctx, bool touches_fem_bodies) {
   const double dt = ctx.dt;
   constraints_.reset(model_->nodeCount());

@@ -142,7 +142,8 @@ std::vector<std::vector<FemBody*>> FemContactIslands::plan(const std::vector<Fem
   return groups;
 }
 
-void FemContactIslands::advance(const std::vector<FemBody*>& group, const StepContext& ctx) {
+void FemContactIslands::advance(const std::vector<FemBody*>& group, const StepContext& ctx,
+                                IslandWorkspace& workspace) {
   auto slot = [&](const FemBody* body) {
     return static_cast<int>(std::find(group.begin(), group.end(), body) - group.begin());
   };
@@ -153,7 +154,7 @@ void FemContactIslands::advance(const std::vector<FemBody*>& group, const StepCo
       continue;
     pairs.push_back({contact, first, second});
   }
-  const IslandPairStats island = stepIsland(group, pairs, ctx);
+  const IslandPairStats island = stepIsland(group, pairs, ctx, workspace);
   if (pairs.empty()) return;
   ++stats_.islands;
   stats_.candidates += island.candidates;

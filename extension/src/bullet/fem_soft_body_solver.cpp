@@ -349,9 +349,9 @@ void FemSoftBodySolver::solveConstraints(btScalar solver_dt) {
   for (const std::vector<FemBody*>& group : groups) {
     if (!ok) break;
     if (fem_contact_) {
-      fem_contact_->advance(group, ctx);
+      fem_contact_->advance(group, ctx, island_workspace_);
     } else {
-      stepIsland(group, {}, ctx);
+      stepIsland(group, {}, ctx, island_workspace_);
     }
     for (FemBody* body : group) {
       const StepReport& report = body->lastReport();

@@ -54,8 +54,12 @@ sap::SapReport restrictedReport(const sap::SapReport& report, const std::vector<
 class Island {
  public:
   Island(const std::vector<FemBody*>& group, const std::vector<IslandPair>& pairs,
-         const StepContext& ctx)
-      : group_(group), pairs_(pairs), ctx_(ctx) {}
+         const StepContext& ctx, IslandWorkspace& workspace)
+      : group_(group), pairs_(pairs), ctx_(ctx), workspace_(workspace) {}
+  // The workspace's problem refers to this island's bodies: it is emptied with them.
+  ~Island() { workspace_.problem.clear(); }
+  Island(const Island&) = delete;
+  Island& operator=(const Island&) = delete;
 
   // Every body up to its solve; false when none got there.
   bool prepare();
@@ -77,6 +81,8 @@ class Island {
                    IslandPairStats& stats);
   void reportFailure(const std::string& message);
   sap::SapSolverSettings solverSettings() const;
+  // The problem made again from rows_ in the workspace's storage; false (reported) on failure.
+  bool makeProblem();
   Eigen::VectorBlock<Eigen::VectorXd> velocitiesOf(int body) {
     const auto b = static_cast<std::size_t>(body);
     return x_.segment(offset_[b], offset_[b + 1] - offset_[b]);
@@ -85,12 +91,12 @@ class Island {
   const std::vector<FemBody*>& group_;
   const std::vector<IslandPair>& pairs_;
   const StepContext& ctx_;
+  IslandWorkspace& workspace_;
   std::vector<int> island_body_;  // per group body: its island body, or -1 (left the island)
   std::vector<PreparedSystem> systems_;
   int fem_count_ = 0;
   // The island's bodies: FEM bodies first (in the group's order), then each dynamic rigid body
   // once, in the order the shares first name them; their first dofs.
-  std::vector<std::unique_ptr<sap::FemIslandBody>> fem_;
   std::vector<const sap::IslandBody*> bodies_;
   std::vector<Eigen::Index> offset_;
   std::vector<Vector6d> rigid_start_;  // per rigid island body
@@ -188,10 +194,9 @@ void Island::addSurfaceRows(SurfaceRows& s) {
 void Island::gatherRows() {
   for (std::size_t k = 0; k < group_.size(); ++k) {
     if (island_body_[k] < 0) continue;
-    fem_.push_back(std::make_unique<sap::FemIslandBody>(*systems_[k].op, *systems_[k].constraints,
-                                                        *systems_[k].b));
-    fem_.back()->useCoarseSpace(group_[k]->state().positions);
-    bodies_.push_back(fem_.back().get());
+    sap::FemIslandBody& body = group_[k]->islandBody();
+    body.useCoarseSpace(group_[k]->state().positions);
+    bodies_.push_back(&body);
   }
   // Each present body's share, its rigid bodies after all the FEM bodies.
   shares_.resize(group_.size());
@@ -326,47 +331,49 @@ sap::SapSolverSettings Island::solverSettings() const {
   return settings;
 }
 
+bool Island::makeProblem() {
+  const Status made = workspace_.problem.reset(bodies_, rows_, ctx_.dt);
+  // Cannot fail with rows built from the bodies' own data; reported, never skipped silently.
+  if (!made) reportFailure(made.error().message);
+  return static_cast<bool>(made);
+}
+
 IslandPairStats Island::solveAndFinish() {
   IslandPairStats stats;
-  const sap::SapSolverSettings settings = solverSettings();
-  Result<sap::SapProblem> created = sap::SapProblem::create(bodies_, rows_, ctx_.dt);
-  if (!created) {
-    // Cannot happen with rows built from the bodies' own data; reported, never skipped silently.
-    reportFailure(created.error().message);
+  sap::SapProblem& problem = workspace_.problem;
+  sap::SapSolver& solver = workspace_.solver;
+  solver.setSettings(solverSettings());
+  if (!makeProblem()) {
     stats.converged = false;
     return stats;
   }
-  sap::SapReport report =
-      sap::solveWithMatchedFrictionBounds(created.value(), row_group_, x_, settings);
+  sap::SapReport report = sap::solveWithMatchedFrictionBounds(solver, problem, row_group_, x_);
   int newton = report.newton_iterations, cg = report.cg_iterations;
   // The rows are linearised at the step's start: at 15 m/s a node ended 9.6 mm inside the other
   // cube without the gaps moved onto the end surface (bullet_collide_soft), and a closing loop of
   // the Greenhill rod meets pairs its predicted motion did not.
   for (int round = 0; round < kMaxSurfaceCorrections && report.converged; ++round) {
     bool added = false;
-    if (!correctSurfaces(created.value(), added)) break;
+    if (!correctSurfaces(problem, added)) break;
     if (added) {
       // New candidates: new rows, and the problem made again from the rows as they stand.
-      const sap::SapProblem& old = created.value();
       rows_.clear();
-      for (int r = 0; r < old.rowCount(); ++r)
-        rows_.push_back(old.row(r));
+      for (int r = 0; r < problem.rowCount(); ++r)
+        rows_.push_back(problem.row(r));
       for (SurfaceRows& s : surfaces_)
         addSurfaceRows(s);
-      created = sap::SapProblem::create(bodies_, rows_, ctx_.dt);
-      if (!created) {
-        reportFailure(created.error().message);
+      if (!makeProblem()) {
         stats.converged = false;
         return stats;
       }
     }
-    report = sap::solveWithMatchedFrictionBounds(created.value(), row_group_, x_, settings);
+    report = sap::solveWithMatchedFrictionBounds(solver, problem, row_group_, x_);
     newton += report.newton_iterations;
     cg += report.cg_iterations;
   }
   report.newton_iterations = newton;
   report.cg_iterations = cg;
-  takeAnswers(created.value(), report, stats);
+  takeAnswers(problem, report, stats);
   stats.iterations = report.newton_iterations;
   stats.converged = report.converged;
   LinearSolveReport solve;
@@ -389,8 +396,8 @@ IslandPairStats Island::solveAndFinish() {
 }  // namespace
 
 IslandPairStats stepIsland(const std::vector<FemBody*>& group, const std::vector<IslandPair>& pairs,
-                           const StepContext& ctx) {
-  Island island(group, pairs, ctx);
+                           const StepContext& ctx, IslandWorkspace& workspace) {
+  Island island(group, pairs, ctx, workspace);
   if (!island.prepare()) return {};
   if (pairs.empty() && island.solvesAlone()) return {};
   island.gatherRows();

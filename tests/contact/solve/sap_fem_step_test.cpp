@@ -46,7 +46,7 @@ class SapStepSolver final : public FemSoftBodySolver {
     time_ += ctx.dt;
     for (const auto& body : bodies()) {
       if (!sap_) {
-        stepIsland({body.get()}, {}, ctx);
+        stepIsland({body.get()}, {}, ctx, workspace_);
       } else {
         sapStep(*body, ctx);
       }
@@ -167,6 +167,7 @@ class SapStepSolver final : public FemSoftBodySolver {
   bool sap_;
   double time_ = 0;
   std::int64_t steps_ = 0;
+  IslandWorkspace workspace_;
   std::vector<LaggedImpulse> lagged_;
   std::vector<LaggedFaceImpulse> lagged_faces_;
 };

@@ -14,6 +14,7 @@
 #include "torsion/constraints/carried_nodes.h"
 #include "torsion/contact/rigid_contact.h"
 #include "torsion/contact/self_contact.h"
+#include "torsion/contact/solve/fem_island_body.h"
 #include "torsion/fem/fem_model.h"
 #include "torsion/mesh/input_numbering.h"
 #include "torsion/result.h"
@@ -147,6 +148,9 @@ class FemBody {
   bool prepare(const StepContext& ctx, bool touches_fem_bodies = false);
   /// The prepared step's system: operator, constraints (the groups' and anchors'), b, warm start.
   PreparedSystem preparedSystem() { return stepper_.prepared(); }
+  /// The prepared step as an island body (contact/solve/fem_island_body.h): this step's b and
+  /// the operator's blocks. One object from step to step, for its storage (its coarse space's).
+  sap::FemIslandBody& islandBody();
   /// Whether this step found rigid objects near the body (its contact rows, anchors included).
   bool touchesRigid() const { return rigid_contact_; }
   /// The prepared step's solve without contact (the stepper's CG, CHOLMOD or Newton): v' into
@@ -209,6 +213,7 @@ class FemBody {
   Eigen::VectorXd input_positions_, input_velocities_;  // inputPositions(), unless identity
   std::unique_ptr<RigidContactSolver> contacts_;
   std::unique_ptr<SelfContactSolver> self_contact_;
+  std::unique_ptr<sap::FemIslandBody> island_body_;  // islandBody()'s
   bool rigid_contact_ = false;  // this step found nodes near rigid bodies (prepare)
   StepReport last_report_;
 };

@@ -65,7 +65,8 @@ class FemContactIslands {
   std::vector<std::vector<FemBody*>> plan(const std::vector<FemBody*>& bodies,
                                           const StepContext& ctx);
   /// Steps one group from plan() as one island (stepIsland) with its pairs.
-  void advance(const std::vector<FemBody*>& group, const StepContext& ctx);
+  void advance(const std::vector<FemBody*>& group, const StepContext& ctx,
+               IslandWorkspace& workspace);
 
   const FemContactStats& stats() const { return stats_; }
   /// Every pair's multipliers now, in key order: what the next step takes over from the last.

@@ -206,6 +206,7 @@ class FemSoftBodySolver : public btSoftBodySolver {
 
   std::vector<std::unique_ptr<FemBody>> bodies_;
   std::unique_ptr<FemContactIslands> fem_contact_;  // nullptr: FEM-FEM contact off
+  IslandWorkspace island_workspace_;                // the island steps' storage
   std::unique_ptr<SoftBodyTouch> soft_touch_;       // whether Bullet's soft bodies touch ours
   std::vector<StepListener*> listeners_;
   bool rigid_step_announced_ = false;  // beforeRigidStep went out this substep

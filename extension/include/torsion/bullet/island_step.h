@@ -30,6 +30,8 @@
 #include "torsion/bullet/fem_body.h"
 #include "torsion/bullet/step_context.h"
 #include "torsion/contact/body_pair_contact.h"
+#include "torsion/contact/solve/sap_problem.h"
+#include "torsion/contact/solve/sap_solver.h"
 
 namespace torsion {
 
@@ -51,9 +53,19 @@ struct IslandPairStats {
   double gap_tolerance = 0;        ///< m, the largest tolerance of the island's pairs
 };
 
+/// What island steps keep from one to the next: storage, never results (a step gives the same
+/// bits with a fresh workspace). The SAP problem's blocks and the solver's workspace (its
+/// vectors, the preconditioner's matrices) are sized once instead of allocated and first touched
+/// at every step. One per FemSoftBodySolver; islands use it one after the other, and the problem
+/// is empty between them.
+struct IslandWorkspace {
+  sap::SapProblem problem;
+  sap::SapSolver solver;
+};
+
 /// Steps `group` (bodies in the solver's order) with the candidates of `pairs` between them.
 /// Reports an unconverged solve on the bodies (FemBody::noteContactNotConverged).
 IslandPairStats stepIsland(const std::vector<FemBody*>& group, const std::vector<IslandPair>& pairs,
-                           const StepContext& ctx);
+                           const StepContext& ctx, IslandWorkspace& workspace);
 
 }  // namespace torsion

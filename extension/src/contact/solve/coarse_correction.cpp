@@ -17,6 +17,18 @@ void CoarseCorrection::gather(const SapProblem& problem) {
   coarse_r_.resize(dofs);
   coarse_z_.resize(dofs);
   active_ = false;
+  analysed_ = false;
+  body_triplets_.clear();
+  for (int b = 0; b < problem.bodyCount(); ++b) {
+    const int first = body_first_[static_cast<std::size_t>(b)];
+    if (first < 0) continue;
+    const Eigen::MatrixXd& galerkin = problem.body(b).coarseSpace()->galerkin();
+    for (Eigen::Index c = 0; c < galerkin.cols(); ++c)
+      for (Eigen::Index r = 0; r < galerkin.rows(); ++r)
+        if (galerkin(r, c) != 0)
+          body_triplets_.emplace_back(first + static_cast<int>(r), first + static_cast<int>(c),
+                                      galerkin(r, c));
+  }
 }
 
 void CoarseCorrection::rowPieces(const SapProblem& problem, int row) {
@@ -43,24 +55,28 @@ void CoarseCorrection::prepare(const SapProblem& problem, const SapEvaluation& e
     if (e.rows[static_cast<std::size_t>(i)].state != ContactState::kSeparated)
       active_rows_.push_back(i);
   active_ = false;
-  matrix_.setZero(dofs, dofs);
-  for (int b = 0; b < problem.bodyCount(); ++b) {
-    const int first = body_first_[static_cast<std::size_t>(b)];
-    if (first < 0) continue;
-    const Eigen::MatrixXd& galerkin = problem.body(b).coarseSpace()->galerkin();
-    matrix_.block(first, first, galerkin.rows(), galerkin.cols()) = galerkin;
-  }
+  triplets_ = body_triplets_;
   for (int i : active_rows_) {
     const RowResponse& response = e.rows[static_cast<std::size_t>(i)];
     rowPieces(problem, i);
     for (const Piece& p : pieces_) {
       const Eigen::Matrix<double, 6, 3> left = p.block.transpose() * response.g;
-      for (const Piece& q : pieces_)
-        matrix_.block(p.column, q.column, p.columns, q.columns) +=
-            (left * q.block).topLeftCorner(p.columns, q.columns);
+      for (const Piece& q : pieces_) {
+        const Eigen::Matrix<double, 6, 6> m = left * q.block;
+        for (int c = 0; c < q.columns; ++c)
+          for (int r = 0; r < p.columns; ++r)
+            triplets_.emplace_back(p.column + r, q.column + c, m(r, c));
+      }
     }
   }
-  factor_.compute(matrix_);
+  const auto n = static_cast<Eigen::Index>(dofs);
+  matrix_.resize(n, n);
+  matrix_.setFromTriplets(triplets_.begin(), triplets_.end());
+  // The same active rows give the same pattern: only the values are factorised again.
+  if (!(analysed_ && active_rows_ == last_active_rows_)) factor_.analyzePattern(matrix_);
+  analysed_ = true;
+  last_active_rows_ = active_rows_;
+  factor_.factorize(matrix_);
   active_ = factor_.info() == Eigen::Success;
 }
 

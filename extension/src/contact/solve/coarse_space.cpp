@@ -79,12 +79,19 @@ std::vector<int> bisectIntoAggregates(const std::vector<Eigen::Vector3d>& points
 NodeCoarseSpace::NodeCoarseSpace(const SystemOperator& system, const NodeConstraints& constraints,
                                  const Eigen::VectorXd& positions,
                                  const std::vector<int>& aggregate_of, int aggregate_count) {
-  assert(positions.size() == 3 * system.model().nodeCount());
   assert(aggregate_of.size() == static_cast<std::size_t>(system.model().nodeCount()));
-  if (system.model().nodalPressure()) return;
   aggregate_of_ = aggregate_of;
+  aggregate_count_ = aggregate_count;
+  update(system, constraints, positions);
+}
+
+void NodeCoarseSpace::update(const SystemOperator& system, const NodeConstraints& constraints,
+                             const Eigen::VectorXd& positions) {
+  assert(positions.size() == 3 * system.model().nodeCount());
+  first_column_.assign(1, 0);
   constraints_ = &constraints;
-  buildBasis(constraints, positions, aggregate_count);
+  if (system.model().nodalPressure()) return;
+  buildBasis(constraints, positions, aggregate_count_);
   assembleGalerkin(system);
 }
 
@@ -146,7 +153,8 @@ void NodeCoarseSpace::assembleGalerkin(const SystemOperator& system) {
   const double mass_coefficient = system.massCoefficient();
   const double stiffness_coefficient = system.stiffnessCoefficient();
   const auto aggregates = static_cast<int>(reduction_.size());
-  std::vector<Matrix6d> sums(static_cast<std::size_t>(aggregates * aggregates), Matrix6d::Zero());
+  std::vector<Matrix6d>& sums = galerkin_sums_;
+  sums.assign(static_cast<std::size_t>(aggregates * aggregates), Matrix6d::Zero());
   const auto sum = [&](int a, int b) -> Matrix6d& {
     return sums[static_cast<std::size_t>(a * aggregates + b)];
   };

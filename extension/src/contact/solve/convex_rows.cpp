@@ -55,10 +55,8 @@ bool matchFrictionBounds(SapProblem& problem, const std::vector<int>& row_group,
 
 }  // namespace
 
-SapReport solveWithMatchedFrictionBounds(SapProblem& problem, const std::vector<int>& row_group,
-                                         Eigen::VectorXd& x, const SapSolverSettings& settings) {
-  // One solver for the rounds: its workspace is sized once.
-  SapSolver solver(settings);
+SapReport solveWithMatchedFrictionBounds(SapSolver& solver, SapProblem& problem,
+                                         const std::vector<int>& row_group, Eigen::VectorXd& x) {
   SapReport report = solver.solve(problem, x);
   // Every round's iterations count: the statistics say what the step cost.
   int newton = report.newton_iterations;

@@ -13,6 +13,14 @@ FemIslandBody::FemIslandBody(const SystemOperator& system, const NodeConstraints
   system_.diagonalBlocks(blocks_);
 }
 
+void FemIslandBody::beginStep(const Eigen::VectorXd& momentum) {
+  assert(momentum.size() == momentum_.size());
+  momentum_ = momentum;
+  system_.diagonalBlocks(blocks_);
+  factor_ = nullptr;
+  coarse_current_ = false;
+}
+
 void FemIslandBody::multiply(const Eigen::VectorXd& x, Eigen::VectorXd& out) const {
   out.resize(x.size());
   system_.multiply(x, out);
@@ -52,8 +60,10 @@ void FemIslandBody::useCoarseSpace(const Eigen::VectorXd& positions, int aggrega
   const FemModel& model = system_.model();
   const std::vector<Eigen::Vector3d>& rest = model.mesh().restPositions();
   const int count = aggregates > 0 ? aggregates : aggregateCountFor(rest);
-  if (count == 0) {
-    coarse_.reset();  // a chunky body: block-Jacobi alone
+  coarse_current_ = count > 0;  // a chunky body: block-Jacobi alone
+  if (count == 0) return;
+  if (coarse_ != nullptr && coarse_->aggregateCount() == count) {
+    coarse_->update(system_, constraints_, positions);  // the same aggregates (of the rest shape)
     return;
   }
   coarse_ = std::make_unique<NodeCoarseSpace>(system_, constraints_, positions,

@@ -131,25 +131,52 @@ void addSlipCurvature(const RowModel& m, const Eigen::Vector3d& vc, Eigen::Matri
 Result<SapProblem> SapProblem::create(std::vector<const IslandBody*> bodies,
                                       std::vector<ContactRow> rows, double dt,
                                       const SapParameters& parameters) {
-  if (!(dt > 0)) return Error{"SAP problem: time step " + std::to_string(dt) + " is not > 0"};
   SapProblem p;
-  p.bodies_ = std::move(bodies);
-  for (const IslandBody* body : p.bodies_) {
-    if (body == nullptr) return Error{"SAP problem: a body is null"};
-    p.body_offsets_.push_back(p.dofs_);
-    p.dofs_ += body->dofs();
-  }
-  p.collectBlocks();
-  p.rows_ = std::move(rows);
-  for (size_t i = 0; i < p.rows_.size(); ++i) {
-    const Status status = p.validate(p.rows_[i]);
-    if (!status)
-      return Error{"SAP problem: row " + std::to_string(i) + ": " + status.error().message};
-  }
-  p.dt_ = dt;
-  for (const ContactRow& row : p.rows_)
-    p.models_.push_back(p.makeModel(row, dt, parameters));
+  const Status made = p.reset(std::move(bodies), std::move(rows), dt, parameters);
+  if (!made) return made.error();
   return Result<SapProblem>(std::move(p));
+}
+
+void SapProblem::clear() {
+  bodies_.clear();
+  rows_.clear();
+  models_.clear();
+  body_offsets_.clear();
+  block_starts_.clear();
+  block_offsets_.clear();
+  blocks_.clear();
+  projectors_.clear();
+  free_inverses_.clear();
+  dofs_ = 0;
+  dt_ = 0;
+}
+
+Status SapProblem::reset(std::vector<const IslandBody*> bodies, std::vector<ContactRow> rows,
+                         double dt, const SapParameters& parameters) {
+  clear();
+  if (!(dt > 0)) return Error{"SAP problem: time step " + std::to_string(dt) + " is not > 0"};
+  for (const IslandBody* body : bodies)
+    if (body == nullptr) return Error{"SAP problem: a body is null"};
+  bodies_ = std::move(bodies);
+  for (const IslandBody* body : bodies_) {
+    body_offsets_.push_back(dofs_);
+    dofs_ += body->dofs();
+  }
+  collectBlocks();
+  rows_ = std::move(rows);
+  for (size_t i = 0; i < rows_.size(); ++i) {
+    const Status status = validate(rows_[i]);
+    if (!status) {
+      const std::string message =
+          "SAP problem: row " + std::to_string(i) + ": " + status.error().message;
+      clear();
+      return Error{message};
+    }
+  }
+  dt_ = dt;
+  for (const ContactRow& row : rows_)
+    models_.push_back(makeModel(row, dt, parameters));
+  return Ok{};
 }
 
 void SapProblem::collectBlocks() {

@@ -68,7 +68,12 @@ class NodeCoarseSpace {
   NodeCoarseSpace(const SystemOperator& system, const NodeConstraints& constraints,
                   const Eigen::VectorXd& positions, const std::vector<int>& aggregate_of,
                   int aggregate_count);
+  /// The space at another step: `positions` (3n) and the system's blocks then, the same
+  /// aggregates, the storage reused.
+  void update(const SystemOperator& system, const NodeConstraints& constraints,
+              const Eigen::VectorXd& positions);
 
+  int aggregateCount() const { return aggregate_count_; }
   /// The coarse dofs (columns of Z).
   int dofs() const { return first_column_.back(); }
   int aggregateOf(int node) const { return aggregate_of_[static_cast<std::size_t>(node)]; }
@@ -94,6 +99,7 @@ class NodeCoarseSpace {
   void assembleGalerkin(const SystemOperator& system);
 
   std::vector<int> aggregate_of_;
+  int aggregate_count_ = 0;
   std::vector<int> first_column_{0};  // per aggregate, then the total
   const NodeConstraints* constraints_ = nullptr;
   std::vector<NodeBasis> basis_;          // per node
@@ -102,6 +108,7 @@ class NodeCoarseSpace {
   // columns; the rest zero).
   std::vector<Eigen::Matrix<double, 6, 6>> reduction_;
   Eigen::MatrixXd galerkin_;
+  std::vector<Eigen::Matrix<double, 6, 6>> galerkin_sums_;  // assembleGalerkin's, per pair
   // restrictTo / prolongAdd scratch: per aggregate, a force and moment or a rigid motion.
   mutable std::vector<Eigen::Matrix<double, 6, 1>> moments_;
 };

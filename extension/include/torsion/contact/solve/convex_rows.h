@@ -55,8 +55,9 @@ struct SolvedBody {
 /// carried more than 1 % of it, each of its contact rows' bound becomes the impulse just found
 /// and the island is solved again (at most twice): a fixed point of mu gamma_n for the groups
 /// that need it.
-SapReport solveWithMatchedFrictionBounds(SapProblem& problem, const std::vector<int>& row_group,
-                                         Eigen::VectorXd& x, const SapSolverSettings& settings);
+/// `solver` solves every round with its settings (one solver: its workspace is sized once).
+SapReport solveWithMatchedFrictionBounds(SapSolver& solver, SapProblem& problem,
+                                         const std::vector<int>& row_group, Eigen::VectorXd& x);
 
 /// The twists of rigid island bodies first_body.. (6 dofs each) after the solve: each one's
 /// momentum plus the wrench of every row on it (J^T gamma), through its mass: its momentum

@@ -3,7 +3,8 @@
 // (dt^2 + dt beta) K with its coefficients already set, and the step's NodeConstraints, whose
 // prescribed components (fixed, carried, or along one direction) are the prescribed dofs.
 // b = M v0 + dt (f_elastic + f_external), as the implicit stepper builds it. The operator's
-// diagonal blocks are read once, at construction: the body is valid for one step.
+// diagonal blocks are read at construction and at beginStep(): the body is valid for the step it
+// last read (a FemBody keeps one from step to step, FemBody::islandBody, for its storage).
 //
 // Its preconditioner in the island's CG (island_body.h), by default none (the island's
 // block-Jacobi with the contact blocks). usePreconditioner() hands it the step's CHOLMOD factor
@@ -33,6 +34,9 @@ class FemIslandBody final : public IslandBody {
   /// Neither `system` nor `constraints` is owned; both outlive the body.
   FemIslandBody(const SystemOperator& system, const NodeConstraints& constraints,
                 Eigen::VectorXd momentum);
+  /// The same body at a new step: b (3n) and the operator's diagonal blocks read again. The coarse
+  /// space and the preconditioner are dropped until useCoarseSpace() or usePreconditioner().
+  void beginStep(const Eigen::VectorXd& momentum);
 
   int dofs() const override { return static_cast<int>(momentum_.size()); }
   int blockSize() const override { return 3; }
@@ -50,9 +54,12 @@ class FemIslandBody final : public IslandBody {
 
   /// Builds the body's coarse space at `positions` (3n, the step's current node positions) with
   /// `aggregates` aggregates of the mesh's rest shape (0: aggregateCountFor its rest shape, which
-  /// gives a body less slender than kMinSlenderness none).
+  /// gives a body less slender than kMinSlenderness none). The aggregates of the last call are
+  /// kept for the next with the same count.
   void useCoarseSpace(const Eigen::VectorXd& positions, int aggregates = 0);
-  const NodeCoarseSpace* coarseSpace() const override { return coarse_.get(); }
+  const NodeCoarseSpace* coarseSpace() const override {
+    return coarse_current_ ? coarse_.get() : nullptr;
+  }
 
  private:
   const SystemOperator& system_;
@@ -61,6 +68,7 @@ class FemIslandBody final : public IslandBody {
   std::vector<Eigen::Matrix3d> blocks_;
   const CholmodSolver* factor_ = nullptr;
   std::unique_ptr<NodeCoarseSpace> coarse_;
+  bool coarse_current_ = false;  // coarse_ is of this step
 };
 
 }  // namespace torsion::sap

@@ -94,6 +94,8 @@ class SapSolver {
  public:
   explicit SapSolver(SapSolverSettings settings = {}) : settings_(settings) {}
   const SapSolverSettings& settings() const { return settings_; }
+  /// For the next solves (a solver kept from step to step: its workspace is kept, nothing else).
+  void setSettings(const SapSolverSettings& settings) { settings_ = settings; }
 
   /// Minimises the problem's cost. v: in, the warm start (the previous step's velocities), or
   /// empty for zero; out, the velocities (prescribed dofs at their values).
