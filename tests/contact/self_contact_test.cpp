@@ -2,14 +2,17 @@
 // meshed as ONE body (two disjoint components) are the plainest case: every contact between them
 // is self-contact and the whole exchange of momentum happens inside one implicit solve, so linear
 // momentum must be kept to the solver's tolerance and angular momentum to the linearisation's.
+// The results are the same for any thread count and whatever storage the step kept.
 #include <gtest/gtest.h>
 
 #include <Eigen/Geometry>
 #include <cmath>
 #include <cstdio>
+#include <string>
 #include <vector>
 
 #include "torsion/analysis/surface_intersections.h"
+#include "torsion/bullet/checkpoint_io.h"
 #include "torsion/bullet/fem_body.h"
 #include "torsion/bullet/fem_world.h"
 #include "torsion/mesh/box_mesh.h"
@@ -162,6 +165,49 @@ TEST(SelfContact, TheImpactEndsTheSameToTheLastBitOnOneAndOnTwoThreads) {
   }
   EXPECT_GT(active, 0);  // the blocks met: the search found and held contacts
   EXPECT_EQ((result[0] - result[1]).cwiseAbs().maxCoeff(), 0.0);
+}
+
+TEST(SelfContact, AWorldRestoredFreshGoesOnAsTheOneThatKeptItsIslandStorage) {
+  // The island's storage (the SAP problem and solver, each body's island body and coarse space)
+  // is kept from step to step; it must hold storage only. A new world restored to the moment of
+  // contact (from the checkpoint's bytes) starts with none, and must go on to the last bit as the
+  // world that stepped into it.
+  int second = 0;
+  const TetMesh mesh = twoBlocks(0.02, 0.03, 3, second);
+  WorldSettings settings;
+  settings.gravity.setZero();
+  settings.solver.time_step = 5e-4;
+  auto make = [&](FemWorld& world) {
+    FemBody* body = world.addBody("blocks", mesh, Material{}).value();
+    EXPECT_TRUE(body->enableSelfContact(SelfContactSettings{}).ok());
+    return body;
+  };
+  FemWorld kept(settings);
+  FemBody* body = make(kept);
+  FemBodyCheckpoint start = body->checkpoint();
+  for (int i = second; i < mesh.nodeCount(); ++i)
+    start.state.velocities.segment<3>(3 * i) = Eigen::Vector3d(-15, 0, 0);
+  body->restore(start);
+  for (int k = 0; k < 6; ++k)
+    ASSERT_TRUE(kept.step().ok);
+  ASSERT_GT(body->selfContact()->stats().active, 0) << "the blocks must be in contact here";
+  const std::string moment = writeCheckpoint(kept, kept.checkpoint(), {}, {}, {});
+  int active = 0;
+  for (int k = 0; k < 20; ++k) {
+    ASSERT_TRUE(kept.step().ok);
+    active = std::max(active, body->selfContact()->stats().active);
+  }
+  ASSERT_GT(active, 0);
+
+  FemWorld fresh(settings);
+  FemBody* again = make(fresh);
+  Result<StoredCheckpoint> read = readCheckpoint(moment, fresh, {});
+  ASSERT_TRUE(read.ok()) << read.error().message;
+  ASSERT_TRUE(fresh.restore(read.value().world).ok());
+  for (int k = 0; k < 20; ++k)
+    ASSERT_TRUE(fresh.step().ok);
+  EXPECT_EQ((again->state().positions - body->state().positions).cwiseAbs().maxCoeff(), 0.0);
+  EXPECT_EQ((again->state().velocities - body->state().velocities).cwiseAbs().maxCoeff(), 0.0);
 }
 
 }  // namespace

@@ -178,5 +178,38 @@ TEST(CoarseSpace, IsTheFilteredRigidModesOfEachAggregateWithTheirGalerkinSystem)
   EXPECT_LT((space.galerkin() - expected).norm(), 1e-12 * expected.norm());
 }
 
+TEST(CoarseSpace, UpdatedAtAnotherShapeAndConstraintsItIsTheSpaceBuiltThere) {
+  // A FEM body keeps its coarse space from step to step and updates it (the same aggregates, of
+  // the rest shape): it must be, to the last bit, the space built afresh at the new step.
+  const std::shared_ptr<const FemModel> model = test::slenderBarModel(24);
+  const int n = model->nodeCount();
+  constexpr int kAggregates = 6;
+  Parallel parallel(1);
+  SystemOperator system(model, parallel);
+  system.setCoefficients(1.0, 4e-6);
+  const std::vector<Eigen::Vector3d>& rest = model->mesh().restPositions();
+  const std::vector<int> aggregate = bisectIntoAggregates(rest, kAggregates);
+  Eigen::VectorXd straight(3 * n), sheared(3 * n);
+  for (int i = 0; i < n; ++i) {
+    const Eigen::Vector3d& p = rest[static_cast<size_t>(i)];
+    straight.segment<3>(3 * i) = p;
+    sheared.segment<3>(3 * i) = p + Eigen::Vector3d(0, 0.1 * p.x() * p.x(), 0.05 * p.x());
+  }
+  const NodeConstraints free_nodes(n);
+  NodeConstraints held(n);
+  for (int i = 0; i < n; ++i)
+    if (aggregate[static_cast<size_t>(i)] == aggregate[0])
+      held.prescribeVelocity(i, Eigen::Vector3d::Zero());
+
+  NodeCoarseSpace kept(system, free_nodes, straight, aggregate, kAggregates);
+  const Eigen::MatrixXd before = denseBasis(kept, n);
+  kept.update(system, held, sheared);
+  const NodeCoarseSpace built(system, held, sheared, aggregate, kAggregates);
+  ASSERT_EQ(kept.dofs(), built.dofs());
+  EXPECT_LT(kept.dofs(), before.cols());  // the held aggregate lost its modes
+  EXPECT_EQ(kept.galerkin(), built.galerkin());
+  EXPECT_EQ(denseBasis(kept, n), denseBasis(built, n));
+}
+
 }  // namespace
 }  // namespace torsion::sap
