@@ -42,6 +42,23 @@ TetMesh twoBlocks(double gap, double offset, int cells, int& second_first) {
   return TetMesh(std::move(positions), std::move(tets));
 }
 
+// The impact scenes' world: no gravity, dt = 0.5 ms.
+WorldSettings impactSettings() {
+  WorldSettings settings;
+  settings.gravity.setZero();
+  settings.solver.time_step = 5e-4;
+  return settings;
+}
+
+// The second block (nodes from `second` on) thrown at the first, at rest, at 15 m/s along -x.
+void throwSecondBlock(FemBody& body, int second) {
+  FemBodyCheckpoint start = body.checkpoint();
+  start.state.velocities.setZero();
+  for (int i = second; i < body.model().nodeCount(); ++i)
+    start.state.velocities.segment<3>(3 * i) = Eigen::Vector3d(-15, 0, 0);
+  body.restore(start);
+}
+
 struct Momenta {
   Eigen::Vector3d linear, angular;
 };
@@ -59,23 +76,13 @@ Momenta momenta(const FemBody& body) {
 TEST(SelfContact, ABlockThrownAtAnotherAt15MetresPerSecondHandsItsMomentumOverExactly) {
   int second = 0;
   const TetMesh mesh = twoBlocks(0.02, 0.03, 3, second);
-  WorldSettings settings;
-  settings.gravity.setZero();
-  settings.solver.time_step = 5e-4;
-  FemWorld world(settings);
+  FemWorld world(impactSettings());
   Material material;
   material.youngs_modulus = 1e6;
   material.stiffness_damping = 1e-3;
   FemBody* body = world.addBody("blocks", mesh, material).value();
   ASSERT_TRUE(body->enableSelfContact(SelfContactSettings{}).ok());
-  Eigen::VectorXd v = Eigen::VectorXd::Zero(3 * mesh.nodeCount());
-  for (int i = second; i < mesh.nodeCount(); ++i)
-    v.segment<3>(3 * i) = Eigen::Vector3d(-15, 0, 0);
-  // setVelocity sets every node alike; the thrown block alone moves.
-  EXPECT_TRUE(body->setVelocity(Eigen::Vector3d::Zero()).ok());
-  FemBodyCheckpoint start = body->checkpoint();
-  start.state.velocities = v;
-  body->restore(start);
+  throwSecondBlock(*body, second);
 
   const Momenta before = momenta(*body);
   int crossing_steps = 0, unconverged = 0, max_active = 0;
@@ -146,17 +153,12 @@ TEST(SelfContact, TheImpactEndsTheSameToTheLastBitOnOneAndOnTwoThreads) {
   Eigen::VectorXd result[2];
   int active = 0;
   for (int run = 0; run < 2; ++run) {
-    WorldSettings settings;
-    settings.gravity.setZero();
-    settings.solver.time_step = 5e-4;
+    WorldSettings settings = impactSettings();
     settings.solver.threads = run + 1;
     FemWorld world(settings);
     FemBody* body = world.addBody("blocks", mesh, Material{}).value();
     ASSERT_TRUE(body->enableSelfContact(SelfContactSettings{}).ok());
-    FemBodyCheckpoint start = body->checkpoint();
-    for (int i = second; i < mesh.nodeCount(); ++i)
-      start.state.velocities.segment<3>(3 * i) = Eigen::Vector3d(-15, 0, 0);
-    body->restore(start);
+    throwSecondBlock(*body, second);
     for (int k = 0; k < 60; ++k) {
       ASSERT_TRUE(world.step().ok);
       active = std::max(active, body->selfContact()->stats().active);
@@ -174,9 +176,7 @@ TEST(SelfContact, AWorldRestoredFreshGoesOnAsTheOneThatKeptItsIslandStorage) {
   // world that stepped into it.
   int second = 0;
   const TetMesh mesh = twoBlocks(0.02, 0.03, 3, second);
-  WorldSettings settings;
-  settings.gravity.setZero();
-  settings.solver.time_step = 5e-4;
+  const WorldSettings settings = impactSettings();
   auto make = [&](FemWorld& world) {
     FemBody* body = world.addBody("blocks", mesh, Material{}).value();
     EXPECT_TRUE(body->enableSelfContact(SelfContactSettings{}).ok());
@@ -184,10 +184,7 @@ TEST(SelfContact, AWorldRestoredFreshGoesOnAsTheOneThatKeptItsIslandStorage) {
   };
   FemWorld kept(settings);
   FemBody* body = make(kept);
-  FemBodyCheckpoint start = body->checkpoint();
-  for (int i = second; i < mesh.nodeCount(); ++i)
-    start.state.velocities.segment<3>(3 * i) = Eigen::Vector3d(-15, 0, 0);
-  body->restore(start);
+  throwSecondBlock(*body, second);
   for (int k = 0; k < 6; ++k)
     ASSERT_TRUE(kept.step().ok);
   ASSERT_GT(body->selfContact()->stats().active, 0) << "the blocks must be in contact here";

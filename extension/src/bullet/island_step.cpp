@@ -81,7 +81,8 @@ class Island {
                    IslandPairStats& stats);
   void reportFailure(const std::string& message);
   sap::SapSolverSettings solverSettings() const;
-  // The problem made again from rows_ in the workspace's storage; false (reported) on failure.
+  // The problem made from rows_ (moved into it) in the workspace's storage; false (reported) on
+  // failure.
   bool makeProblem();
   Eigen::VectorBlock<Eigen::VectorXd> velocitiesOf(int body) {
     const auto b = static_cast<std::size_t>(body);
@@ -332,7 +333,9 @@ sap::SapSolverSettings Island::solverSettings() const {
 }
 
 bool Island::makeProblem() {
-  const Status made = workspace_.problem.reset(bodies_, rows_, ctx_.dt);
+  // The rows move into the problem (problem.row() from then on); rows_ is empty after.
+  const Status made = workspace_.problem.reset(bodies_, std::move(rows_), ctx_.dt);
+  rows_.clear();
   // Cannot fail with rows built from the bodies' own data; reported, never skipped silently.
   if (!made) reportFailure(made.error().message);
   return static_cast<bool>(made);
@@ -357,7 +360,6 @@ IslandPairStats Island::solveAndFinish() {
     if (!correctSurfaces(problem, added)) break;
     if (added) {
       // New candidates: new rows, and the problem made again from the rows as they stand.
-      rows_.clear();
       for (int r = 0; r < problem.rowCount(); ++r)
         rows_.push_back(problem.row(r));
       for (SurfaceRows& s : surfaces_)
