@@ -1,6 +1,11 @@
 #!/usr/bin/env bash
 # Installs the Debian packages Torsion needs, only those that are missing.
 #
+#   scripts/setup.sh           everything: building, testing, the examples
+#   scripts/setup.sh --build   only what the builds need (compilers, libraries, headers): a test
+#                              run (scripts/test.sh) installs the rest in the background while it
+#                              compiles
+#
 # As root it runs apt-get itself. As another user it uses `sudo -n` when that works without a
 # password; otherwise it prints the exact apt-get command to run and exits with status 1, changing
 # nothing. Nothing is downloaded from anywhere but Debian's archive.
@@ -10,7 +15,9 @@
 # failure the log's last lines, so every error stays visible.
 set -euo pipefail
 
-packages=(
+# What the Release build needs (it compiles the library, the tool, the Python module, the tests
+# and the benchmarks).
+build_packages=(
   # build; ccache: a tree built before on this machine recompiles only what changed
   cmake ninja-build g++ pkg-config ccache
   # libraries
@@ -24,26 +31,44 @@ packages=(
   libspnav-dev
   # the network device's packet authentication (HMAC-SHA256, random session ids)
   libsodium-dev
+  # tests and benchmarks
+  libgtest-dev libbenchmark-dev
+  # the Python package (`import torsion`)
+  python3-dev pybind11-dev python3-numpy
+  # the ParaView series: zlib compresses it
+  zlib1g-dev
+)
+# What the tests, the sanitizer builds and the examples need besides.
+other_packages=(
   # the viewer's test: a virtual X server and Mesa's software GLX
   xvfb xauth libgl1-mesa-dri libglx-mesa0
-  # tests and benchmarks; clang + its runtime for the libFuzzer targets
-  libgtest-dev libbenchmark-dev clang libclang-rt-14-dev
+  # the sanitizer builds: clang + its runtime (also for the libFuzzer targets)
+  clang libclang-rt-14-dev
   # mesh generation (`torsion mesh cylinder` runs the tetgen command)
   tetgen
-  # the Python package (`import torsion`), its tests and examples
-  python3-dev pybind11-dev python3-numpy python3-pytest python3-matplotlib
+  # the Python package's tests and examples
+  python3-pytest python3-matplotlib
   # examples/python/dask_sweep.py: a sweep fanned out over Dask's distributed scheduler
   python3-distributed
   # `pip install --no-build-isolation .` into a virtual environment (scikit-build runs CMake), and
   # `python3 -m build --wheel --no-isolation`; tests/python/pip_install_check.py does both
   python3-venv python3-skbuild python3-build
-  # the ParaView series: zlib compresses it; the series tests read it back with meshio and VTK
-  zlib1g-dev python3-meshio python3-vtk9
+  # the ParaView series tests read it back with meshio and VTK
+  python3-meshio python3-vtk9
   # instruction counts per step (tests/bench/bench_python_step.py --instructions: callgrind)
   valgrind
   # static analysis in CI (scripts/clang_tidy.sh, the committed .clang-tidy)
   clang-tidy-14
 )
+
+case "${1:-}" in
+  --build) packages=("${build_packages[@]}") ;;
+  "") packages=("${build_packages[@]}" "${other_packages[@]}") ;;
+  *)
+    echo "usage: scripts/setup.sh [--build]" >&2
+    exit 2
+    ;;
+esac
 
 missing=()
 for p in "${packages[@]}"; do

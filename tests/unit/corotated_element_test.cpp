@@ -100,7 +100,7 @@ TEST(CorotatedElement, StiffnessSymmetricPsdWithSixZeroModes) {
        {Eigen::Matrix3d(Eigen::Matrix3d::Identity()), randomRotation(rng)}) {
     const Eigen::Matrix<double, 12, 12> K = tet.stiffness(R);
     EXPECT_LT((K - K.transpose()).norm(), 1e-9 * K.norm());
-    Eigen::SelfAdjointEigenSolver<Eigen::Matrix<double, 12, 12>> eig(0.5 * (K + K.transpose()));
+    Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(0.5 * (K + K.transpose()));
     const auto values = eig.eigenvalues();  // ascending
     const double largest = values(11);
     for (int i = 0; i < 6; ++i)

@@ -246,13 +246,13 @@ TEST(HyperelasticShear, ShearStressAndNormalStressDifferences) {
 }
 
 double smallestEigenvalue(const PiolaTangent& A) {
-  return Eigen::SelfAdjointEigenSolver<PiolaTangent>(A).eigenvalues()(0);
+  return Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(A).eigenvalues()(0);
 }
 
 // The reference filters: a numerical 9x9 eigen-decomposition, its eigenvalues clamped at zero or
 // replaced by their magnitudes.
 PiolaTangent numericalFilter(const PiolaTangent& A, EigenvalueFilter filter) {
-  const Eigen::SelfAdjointEigenSolver<PiolaTangent> eigen(0.5 * (A + A.transpose()));
+  const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eigen(0.5 * (A + A.transpose()));
   const Eigen::Matrix<double, 9, 1> values = filter == EigenvalueFilter::kMirror
                                                  ? eigen.eigenvalues().cwiseAbs().eval()
                                                  : eigen.eigenvalues().cwiseMax(0.0).eval();
@@ -366,11 +366,11 @@ void checkTet(const L& law, const Nodes& x, const TetRestData& rest) {
   const TetStiffness& K = r.projected_stiffness;
   EXPECT_EQ(K, K.transpose());
   EXPECT_EQ(r.exact_stiffness, r.exact_stiffness.transpose());
-  const double smallest = Eigen::SelfAdjointEigenSolver<TetStiffness>(K).eigenvalues()(0);
+  const double smallest = Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(K).eigenvalues()(0);
   EXPECT_GE(smallest, -1e-12 * K.norm());
   // The projection only removes: K_exact - K_projected is negative semi-definite.
   const double largest_removed =
-      Eigen::SelfAdjointEigenSolver<TetStiffness>(r.exact_stiffness - K).eigenvalues()(11);
+      Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(r.exact_stiffness - K).eigenvalues()(11);
   EXPECT_LE(largest_removed, 1e-12 * K.norm());
 }
 
@@ -458,11 +458,11 @@ void checkTet10(const L& law, const Nodes10& x, const QuadraticRestData& rest) {
   const Tet10Stiffness& K = r.projected_stiffness;
   EXPECT_EQ(K, K.transpose());
   EXPECT_EQ(r.exact_stiffness, r.exact_stiffness.transpose());
-  const double smallest = Eigen::SelfAdjointEigenSolver<Tet10Stiffness>(K).eigenvalues()(0);
+  const double smallest = Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(K).eigenvalues()(0);
   EXPECT_GE(smallest, -1e-12 * K.norm());
   // The projection only removes: K_exact - K_projected is negative semi-definite.
   const double largest_removed =
-      Eigen::SelfAdjointEigenSolver<Tet10Stiffness>(r.exact_stiffness - K).eigenvalues()(29);
+      Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(r.exact_stiffness - K).eigenvalues()(29);
   EXPECT_LE(largest_removed, 1e-12 * K.norm());
 }
 

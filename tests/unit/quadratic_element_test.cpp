@@ -165,7 +165,7 @@ TEST(QuadraticElement, StiffnessSymmetricPsdWithSixZeroModes) {
        {Eigen::Matrix3d(Eigen::Matrix3d::Identity()), randomRotation(rng)}) {
     const Matrix30 K = tet.stiffness(R);
     EXPECT_LT((K - K.transpose()).norm(), 1e-9 * K.norm());
-    Eigen::SelfAdjointEigenSolver<Matrix30> eig(0.5 * (K + K.transpose()));
+    Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(0.5 * (K + K.transpose()));
     const auto values = eig.eigenvalues();  // ascending
     const double largest = values(29);
     for (int i = 0; i < 6; ++i)

@@ -1,9 +1,13 @@
 #include "torsion/solve/parallel.h"
 
+#include <tbb/blocked_range.h>
 #include <tbb/info.h>
+#include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
 
 #include <algorithm>
 #include <cerrno>
+#include <cstddef>
 #include <cstdlib>
 
 namespace torsion {
@@ -26,7 +30,22 @@ int Parallel::usableThreads(int requested) {
   return std::min(requested, cores);
 }
 
+struct Parallel::Arena {
+  explicit Arena(int threads) : arena(threads) {}
+  tbb::task_arena arena;
+};
+
 Parallel::Parallel(int threads)
-    : threads_(usableThreads(threads)), arena_(std::make_unique<tbb::task_arena>(threads_)) {}
+    : threads_(usableThreads(threads)), arena_(std::make_unique<Arena>(threads_)) {}
+
+Parallel::~Parallel() = default;
+
+void Parallel::splitRange(int n, int grain, ChunkCall call, void* fn) const {
+  split_calls_.fetch_add(1, std::memory_order_relaxed);
+  arena_->arena.execute([&] {
+    tbb::parallel_for(tbb::blocked_range<int>(0, n, static_cast<std::size_t>(grain)),
+                      [&](const tbb::blocked_range<int>& r) { call(fn, r.begin(), r.end()); });
+  });
+}
 
 }  // namespace torsion

@@ -2,17 +2,16 @@
 // Threading for the solver kernels, on TBB. Kernels take index ranges [begin, end) so they can be
 // split without new signatures. Results are identical for any thread count: loops write disjoint
 // outputs, and sums are left to the callers, which add per-chunk results in a fixed order.
-
-#include <tbb/blocked_range.h>
-#include <tbb/parallel_for.h>
-#include <tbb/parallel_reduce.h>
-#include <tbb/task_arena.h>
+//
+// TBB stays in parallel.cpp: its headers are some 100k preprocessed lines, a second of compile
+// time in every translation unit that includes this one (most of the library's and the tests').
+// A split range reaches the caller's function through one indirect call per chunk.
 
 #include <atomic>
-#include <cstddef>
 #include <cstdint>
 #include <memory>
 #include <optional>
+#include <type_traits>
 
 namespace torsion {
 
@@ -32,6 +31,9 @@ class Parallel {
   /// threads <= 0: TORSION_THREADS when set, else as many as the machine has; more than it has:
   /// as many as it has.
   explicit Parallel(int threads = 0);
+  ~Parallel();
+  Parallel(const Parallel&) = delete;
+  Parallel& operator=(const Parallel&) = delete;
   /// The threads a request gets: min(requested, cores); for requested <= 0, TORSION_THREADS
   /// (capped the same way) or all cores.
   static int usableThreads(int requested);
@@ -45,11 +47,9 @@ class Parallel {
       if (n > 0) fn(0, n);
       return;
     }
-    split_calls_.fetch_add(1, std::memory_order_relaxed);
-    arena_->execute([&] {
-      tbb::parallel_for(tbb::blocked_range<int>(0, n, static_cast<std::size_t>(grain)),
-                        [&](const tbb::blocked_range<int>& r) { fn(r.begin(), r.end()); });
-    });
+    using Function = std::remove_reference_t<Fn>;
+    splitRange(n, grain, &callChunk<Function>,
+               const_cast<void*>(static_cast<const void*>(std::addressof(fn))));
   }
 
   /// How many forRange calls were split across threads so far (tests check that a parallel
@@ -57,8 +57,17 @@ class Parallel {
   std::int64_t splitCalls() const { return split_calls_.load(std::memory_order_relaxed); }
 
  private:
+  using ChunkCall = void (*)(void* fn, int begin, int end);
+  template <class Function>
+  static void callChunk(void* fn, int begin, int end) {
+    (*static_cast<Function*>(fn))(begin, end);
+  }
+  /// tbb::parallel_for over [0, n) in this object's arena, calling call(fn, begin, end).
+  void splitRange(int n, int grain, ChunkCall call, void* fn) const;
+
+  struct Arena;
   int threads_;
-  std::unique_ptr<tbb::task_arena> arena_;
+  std::unique_ptr<Arena> arena_;
   mutable std::atomic<std::int64_t> split_calls_{0};
 };
 
