@@ -381,8 +381,10 @@ long wallNanoseconds() {
 
 // A flood of valid signed poses of the bound session (a runaway driver, or a replayer that
 // holds the key): each read() takes at most kMaxDatagramsPerRead datagrams (deterministic), and
-// costs the loop's thread a bounded CPU time. The bound, 5 ms, is 5 ticks: 64 receives and HMACs
-// take about 0.25 ms; the rest is slack for a loaded 2-core machine. It is thread CPU time: the
+// costs the loop's thread a bounded CPU time. 64 receives and HMACs take about 0.25 ms, and a
+// read that took the whole flood would take some 400 ms (100000 at about 4 us); the bound, 40 ms,
+// lies between with room on both sides: a loaded 2-core VM once charged a capped read 7.2 ms of
+// thread CPU (the hypervisor's stolen time counts as the thread's). It is thread CPU time: the
 // two senders preempt the reader (wall-clock reads of 5-15 ms, with or without the cap), which
 // is scheduling, not the read's cost. Without the cap a read took all the socket held (its whole
 // buffer: 256 datagrams, about 1 ms, with the default 208 KiB) or, while the flood outpaced it,
@@ -432,7 +434,7 @@ TEST(PacketAuthentication, AFloodOfValidPacketsCostsEachReadABoundedTime) {
       kFlood, reads, static_cast<unsigned long long>(s.device->stats().accepted.load()),
       1e-6 * static_cast<double>(max_cpu), 1e-6 * static_cast<double>(max_wall), max_datagrams);
   EXPECT_LE(max_datagrams, kMaxDatagramsPerRead);
-  EXPECT_LT(max_cpu, 5000000L);
+  EXPECT_LT(max_cpu, 40000000L);
   EXPECT_GT(s.device->stats().accepted, 1u);
   EXPECT_EQ(s.device->stats().replayed, 0u);
   EXPECT_DOUBLE_EQ(s.device->read(time).pose.position.x, 0.02);
