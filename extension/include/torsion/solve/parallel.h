@@ -3,8 +3,9 @@
 // split without new signatures. Results are identical for any thread count: loops write disjoint
 // outputs, and sums are left to the callers, which add per-chunk results in a fixed order.
 //
-// TBB stays in parallel.cpp: its headers are some 100k preprocessed lines, a second of compile
-// time in every translation unit that includes this one (most of the library's and the tests').
+// TBB stays in parallel.cpp: its headers are some 100k preprocessed lines, 0.3 s (clang) to 1.1 s
+// (gcc -O2) of compile time in every translation unit that includes this one (most of the
+// library's and the tests').
 // A split range reaches the caller's function through one indirect call per chunk.
 
 #include <atomic>
