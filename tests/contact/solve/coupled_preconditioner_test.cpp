@@ -100,9 +100,9 @@ Operators operatorsAt(const SapProblem& problem, const Eigen::VectorXd& v) {
   EXPECT_GT(coupled.coupledDofs(), 0);
   Operators out;
   out.h = denseOf(problem.dofs(), [&](const Eigen::VectorXd& x, Eigen::VectorXd& y) {
-    Eigen::VectorXd fx = x;
+    Eigen::VectorXd fx = x, ax;
     problem.filter(fx);
-    problem.multiplyHessian(e, fx, y);
+    problem.multiplyHessian(e, fx, ax, y);
   });
   out.p = denseOf(problem.dofs(), [&](const Eigen::VectorXd& x, Eigen::VectorXd& y) {
     Eigen::VectorXd fx = x;

@@ -370,8 +370,14 @@ void SapProblem::impose(Eigen::VectorXd& v) const {
 }
 
 void SapProblem::evaluate(const Eigen::VectorXd& v, SapEvaluation& e) const {
+  Eigen::VectorXd av;
+  multiplyA(v, av);
+  evaluate(v, std::move(av), e);
+}
+
+void SapProblem::evaluate(const Eigen::VectorXd& v, Eigen::VectorXd&& av, SapEvaluation& e) const {
   e.v = v;
-  multiplyA(v, e.av);
+  e.av = std::move(av);
   e.contact_impulse.setZero(dofs_);
   e.contact_velocity.resize(rows_.size());
   e.rows.resize(rows_.size());
@@ -390,8 +396,9 @@ void SapProblem::evaluate(const Eigen::VectorXd& v, SapEvaluation& e) const {
 }
 
 void SapProblem::multiplyHessian(const SapEvaluation& e, const Eigen::VectorXd& x,
-                                 Eigen::VectorXd& out) const {
-  multiplyA(x, out);
+                                 Eigen::VectorXd& ax, Eigen::VectorXd& out) const {
+  multiplyA(x, ax);
+  out = ax;
   for (int i = 0; i < rowCount(); ++i) {
     const RowResponse& r = e.rows[static_cast<size_t>(i)];
     if (r.state == ContactState::kSeparated) continue;

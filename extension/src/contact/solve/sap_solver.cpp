@@ -39,8 +39,13 @@ SapReport SapSolver::solve(const SapProblem& problem, Eigen::VectorXd& v) {
   Eigen::VectorXd dv;
   double first_residual = 0;
   double alpha = 1;
+  bool av_known = false;  // next_av_ = A v, carried from the last step (A dv summed by the CG)
   for (;;) {
-    problem.evaluate(v, evaluation_);
+    if (av_known) {
+      problem.evaluate(v, std::move(next_av_), evaluation_);
+    } else {
+      problem.evaluate(v, evaluation_);
+    }
     // The scales p = A v and j = J^T gamma, on the free dofs (the unknowns) only.
     z_ = evaluation_.av;
     problem.filter(z_);
@@ -76,6 +81,10 @@ SapReport SapSolver::solve(const SapProblem& problem, Eigen::VectorXd& v) {
       break;
     }
     v += alpha * dv;
+    // A (v + alpha dv) = A v + alpha A dv: a product saved per iteration (A v's rounding drifts
+    // by a few ulps over a solve, far below its tolerance).
+    next_av_ = evaluation_.av + alpha * a_dv_;
+    av_known = true;
     ++report.newton_iterations;
   }
   fillReport(problem, report);
@@ -143,6 +152,7 @@ int SapSolver::newtonDirection(const SapProblem& problem, double eta, Eigen::Vec
   const Eigen::VectorXd& g = evaluation_.gradient;
   preparePreconditioner(problem);
   dv.setZero(problem.dofs());
+  a_dv_.setZero(problem.dofs());
   residual_ = -g;
   precondition(problem, residual_, z_);
   p_ = z_;
@@ -150,11 +160,12 @@ int SapSolver::newtonDirection(const SapProblem& problem, double eta, Eigen::Vec
   const double target = eta * scaledNorm(problem, residual_);
   int iterations = 0;
   while (iterations < settings_.max_cg_iterations && scaledNorm(problem, residual_) > target) {
-    problem.multiplyHessian(evaluation_, p_, q_);
+    problem.multiplyHessian(evaluation_, p_, ap_, q_);
     const double curvature = p_.dot(q_);
     if (!(curvature > 0)) break;  // rounding: nothing left to gain along p
     const double a = rz / curvature;
     dv += a * p_;
+    a_dv_ += a * ap_;
     residual_ -= a * q_;
     precondition(problem, residual_, z_);
     const double rz_next = residual_.dot(z_);
@@ -166,14 +177,14 @@ int SapSolver::newtonDirection(const SapProblem& problem, double eta, Eigen::Vec
   if (!(g.dot(dv) < 0)) {
     precondition(problem, g, dv);
     dv = -dv;
+    problem.multiplyA(dv, a_dv_);
   }
   return iterations;
 }
 
 double SapSolver::lineSearch(const SapProblem& problem, const Eigen::VectorXd& dv,
                              int& iterations) {
-  const SapEvaluation& e = evaluation_;
-  problem.multiplyA(dv, a_dv_);
+  const SapEvaluation& e = evaluation_;  // a_dv_ = A dv, from newtonDirection
   line_linear_ = dv.dot(e.av) - dv.dot(problem.momentum());
   line_quadratic_ = dv.dot(a_dv_);
   line_vc_ = e.contact_velocity;

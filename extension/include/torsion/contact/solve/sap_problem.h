@@ -203,8 +203,11 @@ class SapProblem {
 
   /// Fills `e` at v (v already holds the prescribed values).
   void evaluate(const Eigen::VectorXd& v, SapEvaluation& e) const;
-  /// out = S H x at the evaluation's G blocks, x = S x.
-  void multiplyHessian(const SapEvaluation& e, const Eigen::VectorXd& x,
+  /// The same with A v known (`av`, moved into e.av): the solver carries it along its steps.
+  void evaluate(const Eigen::VectorXd& v, Eigen::VectorXd&& av, SapEvaluation& e) const;
+  /// out = S H x at the evaluation's G blocks, x = S x; ax = A x (unfiltered), the part of the
+  /// product the solver sums into A dv.
+  void multiplyHessian(const SapEvaluation& e, const Eigen::VectorXd& x, Eigen::VectorXd& ax,
                        Eigen::VectorXd& out) const;
   /// P0, the capacitance correction's base (sap_solver.h): a body with its own preconditioner
   /// (IslandBody::hasPreconditioner) applies it, P_b ~ A_b^-1; every other body's block k is

@@ -113,7 +113,7 @@ class SapSolver {
   void preparePreconditioner(const SapProblem& problem);
   // z = P r.
   void precondition(const SapProblem& problem, const Eigen::VectorXd& r, Eigen::VectorXd& z);
-  // The step length minimising the cost along dv from evaluation_.v.
+  // The step length minimising the cost along dv from evaluation_.v (a_dv_ = A dv).
   double lineSearch(const SapProblem& problem, const Eigen::VectorXd& dv, int& iterations);
   // ell'(alpha) and ell''(alpha) along the line set up by lineSearch; noise: the size of the
   // terms summed into ell', for the rounding floor.
@@ -132,8 +132,9 @@ class SapSolver {
   Eigen::PartialPivLU<Eigen::MatrixXd> capacitance_;
   Eigen::VectorXd row_values_;
   bool correction_ = false;  // this solve uses the capacitance correction
-  Eigen::VectorXd residual_, z_, p_, q_;
-  // The line: dv . (A v - b), dv . A dv, v_c and J dv per row.
+  Eigen::VectorXd residual_, z_, p_, q_, ap_;
+  Eigen::VectorXd next_av_;  // A v at the next iterate
+  // The line: dv . (A v - b), dv . A dv, v_c and J dv per row; A dv (the CG's sum of its A p).
   double line_linear_ = 0, line_quadratic_ = 0;
   Eigen::VectorXd a_dv_;
   std::vector<Eigen::Vector3d> line_vc_, line_dvc_;
