@@ -370,14 +370,17 @@ void SapProblem::impose(Eigen::VectorXd& v) const {
 }
 
 void SapProblem::evaluate(const Eigen::VectorXd& v, SapEvaluation& e) const {
-  Eigen::VectorXd av;
-  multiplyA(v, av);
-  evaluate(v, std::move(av), e);
+  multiplyA(v, e.av);
+  evaluateWithAv(v, e);
 }
 
 void SapProblem::evaluate(const Eigen::VectorXd& v, Eigen::VectorXd&& av, SapEvaluation& e) const {
+  e.av = std::move(av);  // swaps the storage: no allocation from one iterate to the next
+  evaluateWithAv(v, e);
+}
+
+void SapProblem::evaluateWithAv(const Eigen::VectorXd& v, SapEvaluation& e) const {
   e.v = v;
-  e.av = std::move(av);
   e.contact_impulse.setZero(dofs_);
   e.contact_velocity.resize(rows_.size());
   e.rows.resize(rows_.size());

@@ -39,7 +39,7 @@ SapReport SapSolver::solve(const SapProblem& problem, Eigen::VectorXd& v) {
   Eigen::VectorXd dv;
   double first_residual = 0;
   double alpha = 1;
-  bool av_known = false;  // next_av_ = A v, carried from the last step (A dv summed by the CG)
+  bool av_known = false;  // next_av_ = A v, carried from the last iterate (A dv from the CG)
   for (;;) {
     if (av_known) {
       problem.evaluate(v, std::move(next_av_), evaluation_);

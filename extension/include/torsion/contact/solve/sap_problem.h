@@ -230,6 +230,8 @@ class SapProblem {
   bool hasBodyPreconditioner() const;
 
  private:
+  // The rest of evaluate, with e.av already A v.
+  void evaluateWithAv(const Eigen::VectorXd& v, SapEvaluation& e) const;
   Status validate(const ContactRow& row) const;
   Status validateTerms(const ContactRow& row) const;
   void collectBlocks();
